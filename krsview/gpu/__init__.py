@@ -1,0 +1,1 @@
+"""GPU side: EGL context, shader builder and variant cache, uniform packing, renderer."""

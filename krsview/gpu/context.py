@@ -1,0 +1,21 @@
+"""OpenGL contexts: headless through EGL (tests, CI, `krsview render`)."""
+from __future__ import annotations
+
+import moderngl
+
+GL_VERSION = 430  # compute + std140 + explicit locations; llvmpipe offers 4.5 core
+
+
+class ContextError(RuntimeError):
+    """No usable OpenGL context; the message says what to install."""
+
+
+def headless_context() -> moderngl.Context:
+    try:
+        ctx = moderngl.create_standalone_context(backend="egl", require=GL_VERSION)
+    except Exception as e:  # moderngl raises plain Exception subclasses from glcontext
+        raise ContextError(
+            f"cannot create a headless OpenGL {GL_VERSION // 100}.{GL_VERSION % 100 // 10} "
+            f"context through EGL ({e}). On Debian install libegl1 libegl-mesa0 libgl1 "
+            "libgl1-mesa-dri (`make deps` does it).") from None
+    return ctx

@@ -1,0 +1,109 @@
+"""Shader program builder: ``#include`` resolution with ``#line`` mapping, one ``#define``
+per enabled feature, a variant cache keyed by the define set, and compile errors mapped back
+to ``file.glsl:line`` (the moderngl-window habit, DESIGN.md)."""
+from __future__ import annotations
+
+import re
+from importlib import resources
+from pathlib import Path
+
+import moderngl
+
+from .context import GL_VERSION
+
+SHADER_DIR = Path(str(resources.files("krsview") / "shaders"))
+_INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
+_MESA_LOCATION = re.compile(r"(\d+):(\d+)\((\d+)\)")
+
+
+class ShaderError(RuntimeError):
+    """A shader failed to build; ``str()`` names the .glsl file, line and the offending text."""
+
+
+class Source:
+    """A stage assembled from .glsl files; ``files[k]`` is the file of ``#line`` source k."""
+
+    def __init__(self, entry: str, defines: dict[str, str | int | float | None],
+                 shader_dir: Path = SHADER_DIR):
+        self.shader_dir = shader_dir
+        self.files: list[str] = ["<defines>"]
+        lines = [f"#version {GL_VERSION} core"]
+        lines += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
+                  sorted(defines.items())]
+        lines += self._expand(entry, [])
+        self.text = "\n".join(lines) + "\n"
+
+    def _expand(self, name: str, stack: list[str]) -> list[str]:
+        if name in stack:
+            raise ShaderError("#include cycle: " + " → ".join(stack + [name]))
+        path = self.shader_dir / name
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError:
+            where = f" (included from {stack[-1]})" if stack else ""
+            raise ShaderError(f"shader file not found: {name}{where}") from None
+        if name in self.files:  # each file once, like a header guard
+            return []
+        fid = len(self.files)
+        self.files.append(name)
+        out = [f"#line 1 {fid}"]
+        for k, line in enumerate(text.splitlines(), 1):
+            m = _INCLUDE.match(line)
+            if m:
+                out += self._expand(m.group(1), stack + [name])
+                out.append(f"#line {k + 1} {fid}")
+            else:
+                out.append(line)
+        return out
+
+    def line_of(self, fid: int, line: int) -> str:
+        if 0 < fid < len(self.files):
+            lines = (self.shader_dir / self.files[fid]).read_text().splitlines()
+            return lines[line - 1].strip() if 0 < line <= len(lines) else ""
+        return ""
+
+    def map_log(self, log: str) -> str:
+        """Rewrite Mesa's ``source:line(col)`` locations as ``file.glsl:line:col``, each error
+        followed by its source line."""
+        out = []
+        for raw in log.splitlines():
+            m = _MESA_LOCATION.search(raw)
+            if m and int(m.group(1)) < len(self.files):
+                fid, line, col = (int(g) for g in m.groups())
+                raw = raw[:m.start()] + f"{self.files[fid]}:{line}:{col}" + raw[m.end():]
+                text = self.line_of(fid, line)
+                out.append(raw + (f"\n    | {text}" if text else ""))
+            elif raw.strip():
+                out.append(raw)
+        return "\n".join(out)
+
+
+def build_program(ctx: moderngl.Context, vertex: str, fragment: str,
+                  defines: dict[str, str | int | float | None],
+                  shader_dir: Path = SHADER_DIR) -> moderngl.Program:
+    vs, fs = Source(vertex, defines, shader_dir), Source(fragment, defines, shader_dir)
+    try:
+        return ctx.program(vertex_shader=vs.text, fragment_shader=fs.text)
+    except moderngl.Error as e:
+        msg = str(e)
+        stage = vs if "vertex_shader" in msg and "fragment_shader" not in msg else fs
+        raise ShaderError(f"{vertex} + {fragment} failed to compile:\n"
+                          + stage.map_log(msg)) from None
+
+
+class ProgramCache:
+    """Compiled variants keyed by their define set: a variant compiles once per context."""
+
+    def __init__(self, ctx: moderngl.Context, shader_dir: Path = SHADER_DIR):
+        self.ctx, self.shader_dir = ctx, shader_dir
+        self._programs: dict[tuple, moderngl.Program] = {}
+        self.compiles = 0
+
+    def get(self, vertex: str, fragment: str,
+            defines: dict[str, str | int | float | None]) -> moderngl.Program:
+        key = (vertex, fragment, tuple(sorted(defines.items())))
+        if key not in self._programs:
+            self._programs[key] = build_program(self.ctx, vertex, fragment, defines,
+                                                self.shader_dir)
+            self.compiles += 1
+        return self._programs[key]

@@ -1,0 +1,84 @@
+"""Fragment-shader path: one full-screen pass writes colour, normal+depth and iterations to
+float32 render targets, read back as :class:`Buffers` in image order (rows top → bottom)."""
+from __future__ import annotations
+
+import time
+
+import moderngl
+import numpy as np
+
+from ..buffers import Buffers
+from ..reference.camera import view_of
+from ..reference.compiled import compile_krs
+from ..scene import KRS, Scene
+from .context import headless_context
+from .program import ProgramCache
+from .uniforms import krs_block, variant_defines, view_uniforms
+
+
+class Renderer:
+    def __init__(self, ctx: moderngl.Context | None = None):
+        self.ctx = ctx or headless_context()
+        self.programs = ProgramCache(self.ctx)
+        self._ubo: moderngl.Buffer | None = None
+        self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
+
+    def _framebuffer(self, width: int, height: int) -> moderngl.Framebuffer:
+        if (width, height) not in self._targets:
+            tex = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(3)]
+            self._targets[(width, height)] = self.ctx.framebuffer(color_attachments=tex)
+        return self._targets[(width, height)]
+
+    def prepare(self, scene: Scene, width: int, height: int, krs: KRS | None = None
+                ) -> moderngl.Program:
+        """Compile (or fetch) the scene's variant and upload its uniforms."""
+        view = view_of(scene.camera, width, height)
+        c = compile_krs(krs or scene.geometry(), scene.material.albedo, origin=view.origin)
+        prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c))
+        block = krs_block(c)
+        if self._ubo is None or self._ubo.size != len(block):
+            self._ubo = self.ctx.buffer(block)
+        else:
+            self._ubo.write(block)
+        if "KRSBlock" in prog:
+            prog["KRSBlock"].binding = 0
+        self._ubo.bind_to_uniform_block(0)
+        for name, value in view_uniforms(scene, view, c.n).items():
+            if name in prog:
+                prog[name].value = value
+        return prog
+
+    def draw(self, prog: moderngl.Program, width: int, height: int) -> moderngl.Framebuffer:
+        fbo = self._framebuffer(width, height)
+        fbo.use()
+        self.ctx.viewport = (0, 0, width, height)
+        self.ctx.vertex_array(prog, []).render(moderngl.TRIANGLES, vertices=3)
+        return fbo
+
+    def render(self, scene: Scene, width: int, height: int, krs: KRS | None = None) -> Buffers:
+        prog = self.prepare(scene, width, height, krs)
+        return read_buffers(self.draw(prog, width, height), width, height)
+
+    def time_frame(self, scene: Scene, width: int, height: int, krs: KRS | None = None,
+                   repeats: int = 1) -> list[float]:
+        """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up."""
+        prog = self.prepare(scene, width, height, krs)
+        self.draw(prog, width, height)
+        self.ctx.finish()
+        times = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            self.draw(prog, width, height)
+            self.ctx.finish()
+            times.append(time.perf_counter() - t0)
+        return times
+
+
+def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Buffers:
+    def plane(k: int) -> np.ndarray:
+        raw = fbo.read(attachment=k, components=4, dtype="f4")
+        return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)[::-1]
+    c, nd, it = plane(0), plane(1), plane(2)
+    hit = c[..., 3] > 0.5
+    return Buffers(c[..., :3].astype(np.float64), nd[..., 3].astype(np.float64),
+                   nd[..., :3].astype(np.float64), it[..., 0].astype(np.int64), hit)

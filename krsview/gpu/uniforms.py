@@ -1,0 +1,47 @@
+"""Scene → GPU: the variant's defines and the uniform values, camera-relative in float32."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..reference.camera import View
+from ..reference.compiled import RECORD_VEC4, CompiledKRS
+from ..scene import MAX_LEVELS, Scene
+
+
+def variant_defines(scene: Scene, c: CompiledKRS) -> dict[str, str | int | None]:
+    """One define per kernel type present and per enabled effect: nothing else is compiled."""
+    defines: dict[str, str | int | None] = {"KRS_MAX_LEVELS": MAX_LEVELS,
+                                            "KRS_RECORD": RECORD_VEC4}
+    for kind in set(c.types) - {"empty"}:
+        defines[f"KRS_KERNEL_{kind.upper()}"] = None
+    for effect in scene.effects:
+        defines[f"KRS_{effect.upper()}"] = None
+    return defines
+
+
+def krs_block(c: CompiledKRS) -> bytes:
+    """The std140 KRSBlock: mirrors[MAX_LEVELS] then kernel records, as float32."""
+    mirrors = np.zeros((MAX_LEVELS, 4), dtype=np.float32)
+    mirrors[:c.n] = c.mirrors
+    kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
+    kernels[:c.n + 1] = c.records
+    return mirrors.tobytes() + kernels.tobytes()
+
+
+def view_uniforms(scene: Scene, view: View, n: int) -> dict[str, object]:
+    lights = scene.lights
+    return {
+        "u_n": n,
+        "u_forward": tuple(view.forward), "u_right": tuple(view.right), "u_up": tuple(view.up),
+        "u_resolution": (float(view.width), float(view.height)),
+        "u_tan_half": view.tan_half,
+        "u_eps_per_t": view.footprint * scene.render.epsilon_scale,
+        "u_max_iterations": scene.render.max_iterations,
+        "u_max_distance": scene.render.max_distance,
+        "u_light_count": len(lights),
+        "u_light_dir": [lt.direction for lt in lights] + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
+        "u_light_color": [tuple(c * lt.intensity for c in lt.color) for lt in lights]
+                         + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
+        "u_ambient": scene.material.ambient,
+        "u_background": scene.material.background,
+    }

@@ -1,0 +1,247 @@
+"""Scene dataclasses: kernels, mirrors, levels, KRS, camera, lights, material, render settings.
+
+Names follow [KRS17 §3]: a KRS is (K_0..K_n; R_0..R_{n-1}); level i ≥ 1 holds mirror R_{i-1}
+(unit normal u, offset w: the plane u·x = w) and kernel K_i; level 0 holds K_0 only.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar
+
+from .schema import SceneError, Vec3, from_dict, param, to_dict
+
+MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
+EFFECTS: dict[str, str] = {}  # effect name -> help; the effects issue fills this registry
+
+_COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
+
+
+def _sub(a: Vec3, b: Vec3) -> Vec3:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _norm(a: Vec3) -> float:
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+# ----------------------------------------------------------------------------------- kernels
+class Kernel:
+    """Base of all kernel shapes; ``type`` in the file picks the subclass."""
+
+    kind: ClassVar[str]
+    registry: ClassVar[dict[str, type["Kernel"]]] = {}
+
+    def __init_subclass__(cls, **kw: Any):
+        super().__init_subclass__(**kw)
+        Kernel.registry[cls.kind] = cls
+
+    @classmethod
+    def from_toml(cls, data: Any, path: str) -> "Kernel":
+        if not isinstance(data, dict) or "type" not in data:
+            raise SceneError(path, data, "expected a kernel table with a 'type'; allowed types: "
+                             + ", ".join(Kernel.registry))
+        kind = data["type"]
+        if kind not in Kernel.registry:
+            raise SceneError(f"{path}.type", kind, "unknown kernel type; allowed: "
+                             + ", ".join(Kernel.registry))
+        rest = {k: v for k, v in data.items() if k != "type"}
+        return from_dict(Kernel.registry[kind], rest, path)
+
+    def to_toml(self) -> dict:
+        out: dict[str, Any] = {"type": self.kind}
+        for f in fields(self):  # type: ignore[arg-type]
+            v = getattr(self, f.name)
+            if v is not None:
+                out[f.name] = to_dict(v)
+        return out
+
+
+@dataclass(frozen=True)
+class Empty(Kernel):
+    """No geometry: a level that only reflects (e.g. the forest construction [KRS17 §9.2])."""
+    kind: ClassVar[str] = "empty"
+
+
+@dataclass(frozen=True)
+class Sphere(Kernel):
+    """Ball of ``radius`` around ``center``."""
+    kind: ClassVar[str] = "sphere"
+    center: Vec3 = param((0.0, 0.0, 0.0), help="centre")
+    radius: float = param(1.0, lo=0.0, lo_open=True, help="radius")
+    color: Vec3 | None = param(None, **_COLOR)
+
+
+@dataclass(frozen=True)
+class Capsule(Kernel):
+    """Segment a–b swept by a ball of ``radius``."""
+    kind: ClassVar[str] = "capsule"
+    a: Vec3 = param((0.0, 0.0, 0.0), help="first end")
+    b: Vec3 = param((0.0, 1.0, 0.0), help="second end")
+    radius: float = param(0.1, lo=0.0, lo_open=True, help="section radius")
+    color: Vec3 | None = param(None, **_COLOR)
+
+
+@dataclass(frozen=True)
+class ToroidalCapsule(Kernel):
+    """Circular arc start → control → end swept by a ball: a torus segment with two capping
+    spheres [KRS17 §9.2]. Nearly collinear points give a straight capsule."""
+    kind: ClassVar[str] = "toroidal_capsule"
+    start: Vec3 = param((0.0, 0.0, 0.0), help="fork point where the branch starts")
+    control: Vec3 = param((0.1, 0.5, 0.0), help="point the arc passes through (sets curvature)")
+    end: Vec3 = param((0.0, 1.0, 0.0), help="fork point where the branch ends")
+    radius: float = param(0.1, lo=0.0, lo_open=True, help="section radius")
+    color: Vec3 | None = param(None, **_COLOR)
+
+    def validate(self, path: str) -> None:
+        if _norm(_sub(self.end, self.start)) < 1e-9:
+            raise SceneError(f"{path}.end", list(self.end), "must differ from start")
+
+
+@dataclass(frozen=True)
+class Plane(Kernel):
+    """Half-space u·x ≤ offset (solid below the plane)."""
+    kind: ClassVar[str] = "plane"
+    normal: Vec3 = param((0.0, 1.0, 0.0), unit_vector="require", help="outward unit normal")
+    offset: float = param(0.0, help="plane offset w in u·x = w")
+    color: Vec3 | None = param(None, **_COLOR)
+
+
+# ---------------------------------------------------------------------------------- KRS
+@dataclass(frozen=True)
+class Mirror:
+    """Reflection plane u·x = w; points with u·x − w > 0 are folded [KRS17 Alg. 1]."""
+    normal: Vec3 = param((1.0, 0.0, 0.0), unit_vector="require", help="unit normal u")
+    offset: float = param(0.0, lo=-1e9, hi=1e9, help="offset w")
+
+
+@dataclass(frozen=True)
+class Level:
+    """Expansion level i: L_i = K_i ∪ L_{i-1} ∪ R_{i-1} L_{i-1}; level 0 has no mirror."""
+    kernel: Kernel = param(Empty(), help="kernel K_i added at this level")
+    mirror: Mirror | None = param(None, help="mirror R_{i-1} that doubles the level below")
+
+
+@dataclass(frozen=True)
+class KRS:
+    """A kernel–reflection sequence (K_0..K_n; R_0..R_{n-1}) [KRS17 §3]."""
+    levels: list[Level] = param([], help="level 0 first (finest), level n last (coarsest)")
+
+    def validate(self, path: str) -> None:
+        p = f"{path}.levels"
+        if not self.levels:
+            raise SceneError(p, [], "a KRS needs at least one level (level 0: a kernel)")
+        if len(self.levels) > MAX_LEVELS:
+            raise SceneError(p, f"<{len(self.levels)} levels>",
+                             f"too many levels; allowed: at most {MAX_LEVELS}")
+        if self.levels[0].mirror is not None:
+            raise SceneError(f"{p}[0].mirror", to_dict(self.levels[0].mirror),
+                             "level 0 has no mirror (it holds only kernel K_0)")
+        for i, lv in enumerate(self.levels[1:], 1):
+            if lv.mirror is None:
+                raise SceneError(f"{p}[{i}].mirror", "<missing>",
+                                 "every level above 0 needs a mirror {normal, offset}")
+
+    @property
+    def n(self) -> int:
+        """Number of reflections; the expansion has up to 2^n instances of K_0."""
+        return len(self.levels) - 1
+
+    @property
+    def kernels(self) -> list[Kernel]:
+        return [lv.kernel for lv in self.levels]
+
+    @property
+    def mirrors(self) -> list[Mirror]:
+        return [lv.mirror for lv in self.levels[1:]]  # type: ignore[misc]
+
+    def instance_count(self) -> int:
+        """Kernel instances in the expansion: K_i appears 2^i times (empty kernels excluded)."""
+        return sum(2 ** i for i, k in enumerate(self.kernels) if not isinstance(k, Empty))
+
+    def truncated(self, levels: int) -> "KRS":
+        """Keep the coarsest ``levels`` levels (K_{n-levels+1}..K_n): fewer, finer ones dropped."""
+        keep = self.levels[len(self.levels) - levels:]
+        return KRS([Level(keep[0].kernel, None)] + list(keep[1:]))
+
+
+# ------------------------------------------------------------------------ view and render
+@dataclass(frozen=True)
+class Camera:
+    """Pinhole camera; the renderer keeps it in float64 and gives the GPU camera-relative data."""
+    position: Vec3 = param((0.0, 1.0, -5.0), help="eye position")
+    target: Vec3 = param((0.0, 1.0, 0.0), help="point looked at")
+    up: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="up direction")
+    fov_y: float = param(45.0, lo=1.0, hi=170.0, unit="degrees", help="vertical field of view")
+
+    def validate(self, path: str) -> None:
+        fwd = _sub(self.target, self.position)
+        if _norm(fwd) < 1e-9:
+            raise SceneError(f"{path}.target", list(self.target), "must differ from position")
+        f = tuple(c / _norm(fwd) for c in fwd)
+        cos = abs(sum(a * b for a, b in zip(f, self.up)))
+        if cos > 1 - 1e-9:
+            raise SceneError(f"{path}.up", list(self.up), "must not be parallel to the view")
+
+
+@dataclass(frozen=True)
+class Light:
+    """Directional light arriving from ``direction`` (pointing towards the light)."""
+    direction: Vec3 = param((0.35777087639996635, 0.8944271909999159, -0.2683281572999748), unit_vector="normalise", help="towards the light")
+    color: Vec3 = param((1.0, 1.0, 1.0), lo=0.0, hi=100.0, help="linear RGB radiance")
+    intensity: float = param(1.0, lo=0.0, hi=100.0, help="scale of color")
+
+
+@dataclass(frozen=True)
+class Material:
+    """Lambert + ambient shading [KRS14 Alg. 2 without smoothing]."""
+    albedo: Vec3 = param((0.7, 0.7, 0.7), **_COLOR)
+    ambient: Vec3 = param((0.15, 0.17, 0.2), lo=0.0, hi=10.0, help="ambient light, linear RGB")
+    background: Vec3 = param((0.55, 0.7, 0.9), **_COLOR)
+
+
+@dataclass(frozen=True)
+class Render:
+    """Accuracy knobs; each is swept by the benchmark against time."""
+    tracer: str = param("sphere", choices=("sphere",), help="sphere tracing [Har96]")
+    epsilon_scale: float = param(1.0, lo=1e-4, hi=100.0, unit="pixels",
+                                 help="stop when distance < footprint × depth × scale")
+    max_iterations: int = param(256, lo=1, hi=10000, help="iteration cap per ray")
+    max_distance: float = param(100.0, lo=0.0, lo_open=True, hi=1e9, help="far limit of rays")
+
+
+# ------------------------------------------------------------------------------ arc geometry
+STRAIGHT_RATIO = 200.0  # arcs with radius > 200 × chord are drawn as capsules (sagitta < chord/1600)
+
+
+@dataclass(frozen=True)
+class Arc:
+    """Circular arc of a toroidal capsule: centre O, in-plane unit axes e1 (towards start) and e2,
+    radius R, arc angle phi from start to end (counter-clockwise around e1 × e2)."""
+    center: Vec3
+    e1: Vec3
+    e2: Vec3
+    R: float
+    phi: float
+
+
+def arc_of(k: ToroidalCapsule) -> Arc | None:
+    """The arc through start, control, end; None when nearly straight (draw as a capsule)."""
+    import numpy as np
+    A, C, B = (np.array(p, dtype=float) for p in (k.start, k.control, k.end))
+    a, b = A - C, B - C
+    axb = np.cross(a, b)
+    chord = float(np.linalg.norm(B - A))
+    denom = 2.0 * float(axb @ axb)
+    if denom <= 0.0:
+        return None
+    O = C + np.cross(a @ a * b - b @ b * a, axb) / denom
+    R = float(np.linalg.norm(A - O))
+    if not np.isfinite(R) or R > STRAIGHT_RATIO * chord:
+        return None
+    N = np.cross(C - A, B - C)
+    N /= np.linalg.norm(N)
+    e1 = (A - O) / R
+    e2 = np.cross(N, e1)
+    phi = math.atan2(float((B - O) @ e2), float((B - O) @ e1)) % (2 * math.pi)
+    return Arc(tuple(O), tuple(e1), tuple(e2), R, phi)  # type: ignore[arg-type]

@@ -1,0 +1,87 @@
+"""The scene: geometry (an explicit KRS or a tree), camera, lights, material, render settings
+and the effect set; loaded from and saved to TOML."""
+from __future__ import annotations
+
+import os
+import tempfile
+import tomllib
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import tomli_w
+
+from .model import EFFECTS, KRS, Camera, Light, Material, Render
+from .schema import SceneError, from_dict, param, to_dict
+from .tree import Tree
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str = param("untitled", help="shown in the viewer and reports")
+    description: str = param("", help="one line about the scene")
+    camera: Camera = param(Camera())
+    lights: list[Light] = param([Light()], help="directional lights (at most 4)")
+    material: Material = param(Material())
+    render: Render = param(Render())
+    effects: list[str] = param([], help="effects compiled into this scene's shader")
+    krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
+    tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
+
+    def validate(self, path: str) -> None:
+        if (self.krs is None) == (self.tree is None):
+            raise SceneError("krs / tree", "<both>" if self.krs else "<neither>",
+                             "a scene has exactly one geometry: a [krs] or a [tree] table")
+        if len(self.lights) > 4:
+            raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
+        for i, e in enumerate(self.effects):
+            if e not in EFFECTS:
+                raise SceneError(f"effects[{i}]", e, "unknown effect; allowed: "
+                                 + (", ".join(EFFECTS) or "none yet"))
+
+    def geometry(self) -> KRS:
+        """The KRS that is drawn: the explicit one, or the tree expanded [KRS17 §9.2]."""
+        return self.krs if self.krs is not None else self.tree.krs()  # type: ignore[union-attr]
+
+    def with_geometry(self, krs: KRS) -> "Scene":
+        return replace(self, krs=krs, tree=None)
+
+
+def scene_from_toml(text: str, file: str = "<string>") -> Scene:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError("<syntax>", str(e), "the file is not valid TOML", file) from None
+    try:
+        return from_dict(Scene, data)
+    except SceneError as e:
+        raise e.in_file(file) from None
+
+
+def load_scene(path: str | os.PathLike) -> Scene:
+    """Read and validate a scene file; every mistake raises SceneError naming file and field."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as e:
+        raise SceneError("<file>", str(p), f"cannot read: {e.strerror}", str(p)) from None
+    return scene_from_toml(text, str(p))
+
+
+def scene_to_toml(scene: Scene) -> str:
+    return tomli_w.dumps(to_dict(scene))
+
+
+def save_scene(scene: Scene, path: str | os.PathLike) -> None:
+    """Atomic save: write a temporary file beside the target, then rename over it."""
+    p = Path(path)
+    text = scene_to_toml(scene)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent or ".")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, p)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

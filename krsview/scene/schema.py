@@ -1,0 +1,178 @@
+"""One parameter schema for every consumer: dataclass fields carry range, unit and help.
+
+A field is declared with :func:`param`; :func:`from_dict` builds and validates a dataclass
+tree from TOML data and :func:`to_dict` writes it back, so validation, files and (later) GUI
+panels read the same metadata (the Fragmentarium habit, see DESIGN.md).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from dataclasses import MISSING, field, fields, is_dataclass
+from typing import Any
+
+Vec3 = tuple[float, float, float]
+UNIT_TOLERANCE = 1e-6  # how far a plane normal's length may be from 1 before it is an error
+
+
+class SceneError(ValueError):
+    """A user mistake in a scene: names the file, the field path, the value and what is allowed."""
+
+    def __init__(self, path: str, value: Any, allowed: str, file: str | None = None):
+        self.file, self.path, self.value, self.allowed = file, path, value, allowed
+        super().__init__(self._text())
+
+    def _text(self) -> str:
+        where = f"{self.file}: " if self.file else ""
+        return f"{where}{self.path} = {self.value!r}: {self.allowed}"
+
+    def in_file(self, file: str) -> "SceneError":
+        return SceneError(self.path, self.value, self.allowed, file)
+
+
+def param(default: Any = MISSING, *, lo: float | None = None, hi: float | None = None,
+          lo_open: bool = False, unit: str = "", help: str = "", choices: tuple | None = None,
+          unit_vector: str | None = None, step: float | None = None) -> Any:
+    """A scene field with its allowed range (closed unless ``lo_open``), unit and help text.
+
+    ``unit_vector``: "normalise" scales a direction to length 1; "require" rejects a normal
+    whose length is not 1 (a plane's offset is measured in units of its normal)."""
+    meta = dict(lo=lo, hi=hi, lo_open=lo_open, unit=unit, help=help, choices=choices,
+                unit_vector=unit_vector, step=step)
+    if isinstance(default, (list, dict)):
+        return field(default_factory=lambda d=default: type(d)(d), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+def _describe_range(meta: dict) -> str:
+    lo, hi = meta.get("lo"), meta.get("hi")
+    unit = f" {meta['unit']}" if meta.get("unit") else ""
+    if lo is not None and hi is not None:
+        return f"allowed: {lo} {'<' if meta.get('lo_open') else '≤'} value ≤ {hi}{unit}"
+    if lo is not None:
+        return f"allowed: value {'>' if meta.get('lo_open') else '≥'} {lo}{unit}"
+    if hi is not None:
+        return f"allowed: value ≤ {hi}{unit}"
+    return "allowed: a finite number"
+
+
+def _check_number(x: Any, path: str, meta: dict, kind: type) -> float | int:
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        raise SceneError(path, x, f"expected a number ({kind.__name__})")
+    if kind is int and not isinstance(x, int):
+        raise SceneError(path, x, "expected a whole number")
+    if not math.isfinite(x):
+        raise SceneError(path, x, "NaN and infinity are not allowed; " + _describe_range(meta))
+    lo, hi = meta.get("lo"), meta.get("hi")
+    below = lo is not None and (x <= lo if meta.get("lo_open") else x < lo)
+    if below or (hi is not None and x > hi):
+        raise SceneError(path, x, _describe_range(meta))
+    return kind(x)
+
+
+def _check_vec3(x: Any, path: str, meta: dict) -> Vec3:
+    if not isinstance(x, (list, tuple)) or len(x) != 3:
+        raise SceneError(path, x, "expected a list of 3 numbers [x, y, z]")
+    v = tuple(_check_number(c, f"{path}[{i}]", meta, float) for i, c in enumerate(x))
+    mode = meta.get("unit_vector")
+    if mode:
+        n = math.sqrt(sum(c * c for c in v))
+        if n < 1e-9:
+            raise SceneError(path, list(x), "a direction must not be the zero vector")
+        if mode == "require" and abs(n - 1.0) > UNIT_TOLERANCE:
+            hint = ", ".join(f"{c / n:.9g}" for c in v)
+            raise SceneError(path, list(x), f"must be a unit vector (length {n:.6g}, allowed "
+                             f"1 ± {UNIT_TOLERANCE:g}, because the offset is measured in its "
+                             f"units); normalised it is [{hint}]")
+        if abs(n - 1.0) > 1e-12:
+            v = tuple(c / n for c in v)  # normalise once; already-unit input is kept bit-exact
+    return v  # type: ignore[return-value]
+
+
+def _hint_args(hint: Any) -> tuple[Any, tuple]:
+    origin = typing.get_origin(hint)
+    return origin, typing.get_args(hint)
+
+
+def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
+    """Validate one value against a field type hint; returns the normalised value."""
+    origin, args = _hint_args(hint)
+    if origin in (typing.Union, types.UnionType):
+        if x is None and type(None) in args:
+            return None
+        (inner,) = [a for a in args if a is not type(None)]
+        return check_value(inner, x, path, meta)
+    if hint is float or hint is int:
+        return _check_number(x, path, meta, hint)
+    if hint is bool:
+        if not isinstance(x, bool):
+            raise SceneError(path, x, "expected true or false")
+        return x
+    if hint is str:
+        if not isinstance(x, str):
+            raise SceneError(path, x, "expected a string")
+        if meta.get("choices") and x not in meta["choices"]:
+            raise SceneError(path, x, "allowed: " + ", ".join(map(repr, meta["choices"])))
+        return x
+    if origin is tuple:  # Vec3
+        return _check_vec3(x, path, meta)
+    if origin is list:
+        if not isinstance(x, list):
+            raise SceneError(path, x, "expected a list")
+        (inner,) = args
+        return [check_value(inner, v, f"{path}[{i}]", meta) for i, v in enumerate(x)]
+    if is_dataclass(hint):
+        return from_dict(hint, x, path)
+    if callable(getattr(hint, "from_toml", None)):
+        return hint.from_toml(x, path)
+    raise TypeError(f"unsupported field type {hint!r} at {path}")  # a programming error
+
+
+def from_dict(cls: type, data: Any, path: str = "") -> Any:
+    """Build dataclass ``cls`` from TOML data, rejecting unknown keys and bad values."""
+    if not isinstance(data, dict):
+        raise SceneError(path or "<root>", data, f"expected a table of {cls.__name__} fields")
+    hints = typing.get_type_hints(cls)
+    known = {f.name for f in fields(cls) if f.init}
+    for key in data:
+        if key not in known:
+            raise SceneError(_join(path, key), data[key],
+                             f"unknown field; allowed fields: {', '.join(sorted(known))}")
+    kwargs = {}
+    for f in fields(cls):
+        if not f.init:
+            continue
+        if f.name in data:
+            kwargs[f.name] = check_value(hints[f.name], data[f.name], _join(path, f.name),
+                                         dict(f.metadata))
+        elif f.default is MISSING and f.default_factory is MISSING:
+            raise SceneError(_join(path, f.name), "<missing>", "this field is required")
+    obj = cls(**kwargs)
+    check = getattr(obj, "validate", None)
+    if check is not None:
+        check(path)
+    return obj
+
+
+def to_dict(obj: Any) -> Any:
+    """The TOML-ready form of a dataclass tree (None fields are omitted)."""
+    if hasattr(obj, "to_toml"):
+        return obj.to_toml()
+    if is_dataclass(obj):
+        out = {}
+        for f in fields(obj):
+            if not f.init:
+                continue
+            v = getattr(obj, f.name)
+            if v is not None:
+                out[f.name] = to_dict(v)
+        return out
+    if isinstance(obj, (list, tuple)):
+        return [to_dict(v) for v in obj]
+    return obj
+
+
+def _join(path: str, key: str) -> str:
+    return f"{path}.{key}" if path else key

@@ -1,0 +1,29 @@
+// Primary rays through pixel centres, traced and shaded; writes the reference's buffers.
+#include "scene_block.glsl"
+#include "trace.glsl"
+#include "shade.glsl"
+
+layout(location = 0) out vec4 out_color;      // rgb, hit
+layout(location = 1) out vec4 out_normal;     // xyz, depth t
+layout(location = 2) out vec4 out_iterations; // x
+
+void main() {
+    vec2 ndc = 2.0 * gl_FragCoord.xy / u_resolution - 1.0;
+    float aspect = u_resolution.x / u_resolution.y;
+    vec3 dir = normalize(u_forward + ndc.x * u_tan_half * aspect * u_right
+                         + ndc.y * u_tan_half * u_up);
+    float t;
+    int iterations;
+    bool hit = sphere_trace(vec3(0.0), dir, t, iterations);
+    out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
+    if (!hit) {
+        out_color = vec4(encode(u_background), 0.0);
+        out_normal = vec4(0.0);
+        return;
+    }
+    int level;
+    vec3 n;
+    krs_nearest(t * dir, level, n);
+    out_color = vec4(encode(lambert(kernel_rec(level, 0).rgb, n)), 1.0);
+    out_normal = vec4(n, t);
+}

@@ -1,0 +1,29 @@
+// Scene data: the compiled KRS (reference/compiled.py holds the same layout) and view.
+// Positions are camera-relative: the eye sits at the origin.
+#define KERNEL_EMPTY 0
+#define KERNEL_SPHERE 1
+#define KERNEL_CAPSULE 2
+#define KERNEL_TOROIDAL_CAPSULE 3
+#define KERNEL_PLANE 4
+#define FAR_AWAY 1e30
+
+layout(std140) uniform KRSBlock {
+    vec4 u_mirrors[KRS_MAX_LEVELS];                // u.xyz, w: the plane u·x = w
+    vec4 u_kernels[KRS_MAX_LEVELS * KRS_RECORD];   // per level: KRS_RECORD vec4s
+};
+uniform int u_n;            // number of mirrors; kernels K_0..K_n
+
+uniform vec3 u_forward;
+uniform vec3 u_right;
+uniform vec3 u_up;
+uniform vec2 u_resolution;
+uniform float u_tan_half;
+uniform float u_eps_per_t;  // pixel footprint × ε-scale
+uniform int u_max_iterations;
+uniform float u_max_distance;
+
+uniform int u_light_count;
+uniform vec3 u_light_dir[4];
+uniform vec3 u_light_color[4];  // colour × intensity
+uniform vec3 u_ambient;
+uniform vec3 u_background;
