@@ -19,8 +19,8 @@ RECORD_VEC4 = 6
 # record[1] = sphere (centre, r) | capsule/arc (start A, r) | plane (normal u, offset w)
 # record[2] = capsule/arc (end B, 0)
 # record[3] = arc (centre O, major radius R)
-# record[4] = arc (e1: unit O→A, arc angle phi)
-# record[5] = arc (e2: unit, in-plane ⟂ e1, 0)
+# record[4] = arc (e1: unit O→A, cos phi)     phi: arc angle from A to B, in (0, 2π)
+# record[5] = arc (e2: unit, in-plane ⟂ e1, sin phi)
 
 
 @dataclass(frozen=True)
@@ -59,8 +59,8 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float],
                 kind = "capsule"
             else:
                 r[3] = [*(np.array(arc.center) - o), arc.R]
-                r[4] = [*arc.e1, arc.phi]
-                r[5, :3] = arc.e2
+                r[4] = [*arc.e1, np.cos(arc.phi)]
+                r[5] = [*arc.e2, np.sin(arc.phi)]
         elif isinstance(k, Plane):
             r[1] = [*k.normal, k.offset - np.dot(k.normal, o)]
         else:

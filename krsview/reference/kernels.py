@@ -8,11 +8,25 @@ from __future__ import annotations
 
 import numpy as np
 
-TWO_PI = 2.0 * np.pi
-
-
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
+
+
+def in_wedge(rec: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Whether the angle a of (x, y) from e1 towards e2 lies in [0, phi], without trigonometry:
+    y = ρ sin a and s = x sin phi − y cos phi = ρ sin(phi − a) are both ≥ 0 inside an arc of at
+    most π; a longer arc excludes only the points where both are negative."""
+    cos_phi, sin_phi = rec[4, 3], rec[5, 3]
+    s = x * sin_phi - y * cos_phi
+    if sin_phi >= 0.0:
+        return (y >= 0.0) & (s >= 0.0)
+    return (y >= 0.0) | (s >= 0.0)
+
+
+def _arc_frame(rec: np.ndarray, p: np.ndarray):
+    O, e1, e2 = rec[3, :3], rec[4, :3], rec[5, :3]
+    q = p - O
+    return q, _dot(q, e1), _dot(q, e2)
 
 
 def core_point(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -24,18 +38,13 @@ def core_point(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
         ab = B - A
         h = np.clip(_dot(p - A, ab) / max(float(ab @ ab), 1e-300), 0.0, 1.0)
         return A + h[:, None] * ab
-    # toroidal capsule: nearest of (arc point at p's angle if inside the wedge, A, B)
-    O, R = rec[3, :3], rec[3, 3]
-    e1, phi, e2 = rec[4, :3], rec[4, 3], rec[5, :3]
-    q = p - O
-    x, y = _dot(q, e1), _dot(q, e2)
-    a = np.arctan2(y, x)
-    a = np.where(a < 0.0, a + TWO_PI, a)
-    on_arc = O + R * (np.cos(a)[:, None] * e1 + np.sin(a)[:, None] * e2)
-    dA, dB = np.linalg.norm(p - A, axis=1), np.linalg.norm(p - B, axis=1)
-    d_arc = np.where(a <= phi, np.linalg.norm(p - on_arc, axis=1), np.inf)
-    best = np.where((dA <= dB)[:, None], A, B)
-    return np.where((d_arc < np.minimum(dA, dB))[:, None], on_arc, best)
+    # toroidal capsule: inside the wedge the arc point at p's angle, else the nearer end
+    q, x, y = _arc_frame(rec, p)
+    rho = np.hypot(x, y)
+    radial = (x[:, None] * rec[4, :3] + y[:, None] * rec[5, :3]) / np.where(rho > 0, rho, 1)[:, None]
+    on_arc = rec[3, :3] + rec[3, 3] * np.where((rho > 0)[:, None], radial, rec[4, :3])
+    end = np.where((_dot(p - A, p - A) <= _dot(p - B, p - B))[:, None], A, B)
+    return np.where(in_wedge(rec, x, y)[:, None], on_arc, end)
 
 
 def kernel_distance(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -44,21 +53,14 @@ def kernel_distance(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
         return np.full(len(p), np.inf)
     if kind == "plane":
         return p @ rec[1, :3] - rec[1, 3]
-    if kind == "toroidal_capsule":  # the torus formula directly, as the shader does
-        O, R = rec[3, :3], rec[3, 3]
-        e1, phi, e2 = rec[4, :3], rec[4, 3], rec[5, :3]
-        q = p - O
-        x, y = _dot(q, e1), _dot(q, e2)
+    if kind == "toroidal_capsule":  # torus formula inside the wedge, else the nearer cap
+        q, x, y = _arc_frame(rec, p)
         z2 = np.maximum(_dot(q, q) - x * x - y * y, 0.0)
-        a = np.arctan2(y, x)
-        a = np.where(a < 0.0, a + TWO_PI, a)
-        d_arc = np.where(a <= phi, np.sqrt((np.hypot(x, y) - R) ** 2 + z2), np.inf)
-        dA = np.linalg.norm(p - rec[1, :3], axis=1)
-        dB = np.linalg.norm(p - rec[2, :3], axis=1)
-        return np.minimum(d_arc, np.minimum(dA, dB)) - rec[1, 3]
+        ring = np.sqrt((np.hypot(x, y) - rec[3, 3]) ** 2 + z2)
+        cap = np.minimum(np.linalg.norm(p - rec[1, :3], axis=1),
+                         np.linalg.norm(p - rec[2, :3], axis=1))
+        return np.where(in_wedge(rec, x, y), ring, cap) - rec[1, 3]
     return np.linalg.norm(p - core_point(kind, rec, p), axis=1) - rec[1, 3]
-
-
 def kernel_gradient(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Unit gradient of k_i at p (the outward surface normal)."""
     if kind == "plane":

@@ -1,8 +1,6 @@
 // Kernel distances k_i and gradients [KRS17 §3, §9.2]; twin of reference/kernels.py.
 // Sphere, capsule, toroidal capsule = point, segment, arc swept by a ball of radius r:
 // k(p) = |p - core(p)| - r never overshoots. Only the types a scene uses are compiled in.
-#define TWO_PI 6.283185307179586
-
 vec4 kernel_rec(int i, int k) { return u_kernels[i * KRS_RECORD + k]; }
 
 #ifdef KRS_KERNEL_CAPSULE
@@ -14,37 +12,37 @@ vec3 capsule_core(int i, vec3 p) {
 #endif
 
 #ifdef KRS_KERNEL_TOROIDAL_CAPSULE
-// Angle of p around the arc centre in [0, 2π), measured from e1 towards e2.
-float arc_angle(vec3 q, vec3 e1, vec3 e2) {
-    float a = atan(dot(q, e2), dot(q, e1));
-    return a < 0.0 ? a + TWO_PI : a;
+// Is the angle of (x, y) from e1 towards e2 within [0, phi]? y = ρ sin a and
+// s = x sin phi − y cos phi = ρ sin(phi − a); no trigonometry (twin of in_wedge).
+bool in_wedge(int i, float x, float y) {
+    float cos_phi = kernel_rec(i, 4).w, sin_phi = kernel_rec(i, 5).w;
+    float s = x * sin_phi - y * cos_phi;
+    return sin_phi >= 0.0 ? (y >= 0.0 && s >= 0.0) : (y >= 0.0 || s >= 0.0);
 }
 
+// Torus formula inside the wedge (the arc is nearer than its ends there), else the nearer cap.
 float toroidal_capsule_distance(int i, vec3 p) {
-    vec4 c = kernel_rec(i, 3), e1 = kernel_rec(i, 4);
-    vec3 e2 = kernel_rec(i, 5).xyz, q = p - c.xyz;
-    float x = dot(q, e1.xyz), y = dot(q, e2);
-    float z2 = max(dot(q, q) - x * x - y * y, 0.0);
-    float d = min(length(p - kernel_rec(i, 1).xyz), length(p - kernel_rec(i, 2).xyz));
-    if (arc_angle(q, e1.xyz, e2) <= e1.w) {
+    vec4 c = kernel_rec(i, 3);
+    vec3 q = p - c.xyz;
+    float x = dot(q, kernel_rec(i, 4).xyz), y = dot(q, kernel_rec(i, 5).xyz);
+    float d;
+    if (in_wedge(i, x, y)) {
         float ring = length(vec2(x, y)) - c.w;
-        d = min(d, sqrt(ring * ring + z2));
+        d = sqrt(ring * ring + max(dot(q, q) - x * x - y * y, 0.0));
+    } else {
+        d = min(length(p - kernel_rec(i, 1).xyz), length(p - kernel_rec(i, 2).xyz));
     }
     return d - kernel_rec(i, 1).w;
 }
 
 vec3 toroidal_capsule_core(int i, vec3 p) {
-    vec4 c = kernel_rec(i, 3), e1 = kernel_rec(i, 4);
-    vec3 e2 = kernel_rec(i, 5).xyz, q = p - c.xyz;
+    vec4 c = kernel_rec(i, 3);
+    vec3 e1 = kernel_rec(i, 4).xyz, e2 = kernel_rec(i, 5).xyz, q = p - c.xyz;
+    float x = dot(q, e1), y = dot(q, e2), rho = length(vec2(x, y));
+    if (in_wedge(i, x, y))
+        return c.xyz + c.w * (rho > 0.0 ? (x * e1 + y * e2) / rho : e1);
     vec3 A = kernel_rec(i, 1).xyz, B = kernel_rec(i, 2).xyz;
-    float a = arc_angle(q, e1.xyz, e2);
-    float dA = length(p - A), dB = length(p - B);
-    vec3 best = dA <= dB ? A : B;
-    if (a <= e1.w) {
-        vec3 on_arc = c.xyz + c.w * (cos(a) * e1.xyz + sin(a) * e2);
-        if (length(p - on_arc) < min(dA, dB)) best = on_arc;
-    }
-    return best;
+    return dot(p - A, p - A) <= dot(p - B, p - B) ? A : B;
 }
 #endif
 

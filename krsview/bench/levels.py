@@ -1,0 +1,74 @@
+"""`krsview bench levels`: frame time against the number of levels [KRS17 §11, Fig. 12].
+
+The paper's claim: the expansion grows as 2^n while the time per ray grows linearly in n.
+Level counts are interleaved round by round and medians compared, so machine noise hits
+every variant alike.
+"""
+from __future__ import annotations
+
+import statistics
+from pathlib import Path
+
+import numpy as np
+
+from ..gpu.renderer import Renderer
+from ..scene import Scene
+from .progress import Progress
+
+
+def level_counts(total: int, step: int) -> list[int]:
+    counts = list(range(step, total + 1, step))
+    if not counts or counts[-1] != total:
+        counts.append(total)
+    return counts
+
+
+def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int = 5,
+                 csv: str | None = None) -> list[dict]:
+    w, h = size
+    krs = scene.geometry()
+    counts = level_counts(len(krs.levels), step)
+    variants = {m: krs.truncated(m) for m in counts}
+    r = Renderer()
+    iters = {}
+    for m, k in variants.items():  # warm-up: compile once, measure iterations per pixel
+        iters[m] = float(r.render(scene, w, h, k).iterations.mean())
+    times: dict[int, list[float]] = {m: [] for m in counts}
+    bar = Progress(rounds * len(counts), f"bench levels {scene.name} {w}×{h}")
+    for _ in range(rounds):
+        for m in counts:
+            times[m] += r.time_frame(scene, w, h, variants[m], repeats=1)
+            bar.step(f"{m} levels")
+    base = counts[0]
+    t_base = statistics.median(times[base])
+    rows = []
+    for m in counts:
+        t = statistics.median(times[m])
+        rows.append(dict(levels=m, instances=variants[m].instance_count(), ms=t * 1e3,
+                         time_ratio=t / t_base, iterations=iters[m],
+                         ratio_per_iteration=(t / iters[m]) / (t_base / iters[base])))
+    print(f"\nFrame time against levels — {scene.name}, {w}×{h}, median of {rounds} "
+          f"interleaved rounds (ratios to {base} levels)\n")
+    print("| levels | kernel instances | ms/frame | time ratio | iterations/px | "
+          "time/iteration ratio |")
+    print("|---:|---:|---:|---:|---:|---:|")
+    for row in rows:
+        print(f"| {row['levels']} | {row['instances']:,} | {row['ms']:.2f} | "
+              f"{row['time_ratio']:.2f} | {row['iterations']:.1f} | "
+              f"{row['ratio_per_iteration']:.2f} |")
+    if len(rows) >= 3:
+        n = np.array([row["levels"] for row in rows], float)
+        t = np.array([row["ms"] for row in rows])
+        slope, icpt = np.polyfit(n, t, 1)
+        resid = t - (slope * n + icpt)
+        r2 = 1 - (resid @ resid) / max(((t - t.mean()) ** 2).sum(), 1e-30)
+        grow = rows[-1]["instances"] / rows[0]["instances"]
+        print(f"\nlinear fit: {icpt:.2f} ms + {slope:.3f} ms/level (R² = {r2:.3f}); geometry grew "
+              f"{grow:,.0f}× while time grew {rows[-1]['time_ratio']:.2f}×")
+    if csv:
+        Path(csv).parent.mkdir(parents=True, exist_ok=True)
+        keys = list(rows[0])
+        Path(csv).write_text(",".join(keys) + "\n" + "\n".join(
+            ",".join(f"{row[k]}" for k in keys) for row in rows) + "\n")
+        print(f"wrote {csv}")
+    return rows

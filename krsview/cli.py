@@ -1,0 +1,207 @@
+"""`krsview render|check|bench`: argument parsing only; the work lives in the packages."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from .presets import DEFAULT_PRESET, preset_names, resolve
+from .scene import MAX_LEVELS, Scene, SceneError, load_scene
+
+EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--size {text!r}: expected WIDTHxHEIGHT, e.g. 640x360") from None
+    if not (1 <= w <= 8192 and 1 <= h <= 8192):
+        raise argparse.ArgumentTypeError(f"--size {text!r}: each side must be 1..8192 pixels")
+    return w, h
+
+
+def _positive_float(name: str, lo: float, hi: float):
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            v = float("nan")
+        if not (lo <= v <= hi):
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: allowed {lo} ≤ value ≤ {hi}")
+        return v
+    return parse
+
+
+def _int_in(name: str, lo: int, hi: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: expected a whole number") from None
+        if not (lo <= v <= hi):
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: allowed {lo} ≤ value ≤ {hi}")
+        return v
+    return parse
+
+
+def _load(args: argparse.Namespace) -> Scene:
+    scene = load_scene(resolve(args.preset))
+    render = scene.render
+    if getattr(args, "epsilon_scale", None) is not None:
+        render = replace(render, epsilon_scale=args.epsilon_scale)
+    if getattr(args, "max_iterations", None) is not None:
+        render = replace(render, max_iterations=args.max_iterations)
+    scene = replace(scene, render=render)
+    levels = getattr(args, "levels", None)
+    if levels is not None:
+        krs = scene.geometry()
+        if levels > len(krs.levels):
+            raise SceneError("--levels", levels,
+                             f"this scene has {len(krs.levels)} levels; allowed 1..{len(krs.levels)}")
+        scene = scene.with_geometry(krs.truncated(levels))
+    return scene
+
+
+def cmd_render(args: argparse.Namespace) -> int:
+    scene = _load(args)
+    w, h = args.size
+    krs = scene.geometry()
+    print(f"krsview: {scene.name}: {len(krs.levels)} levels, {krs.instance_count():,} kernel "
+          f"instances, {w}×{h}, {'NumPy reference' if args.reference else 'GPU'}", flush=True)
+    t0 = time.perf_counter()
+    if args.reference:
+        from .reference import render_reference
+        buffers = render_reference(scene, w, h)
+        frame = time.perf_counter() - t0
+        print(f"  traced in {frame * 1e3:.0f} ms (float64 reference)")
+    else:
+        from .gpu.renderer import Renderer
+        r = Renderer()
+        print("  compiling shader variant …", end="", flush=True)
+        prog = r.prepare(scene, w, h)
+        r.draw(prog, w, h)
+        r.ctx.finish()
+        print(f" {(time.perf_counter() - t0) * 1e3:.0f} ms (first frame)", flush=True)
+        times = r.time_frame(scene, w, h, repeats=args.repeats)
+        frame = sorted(times)[len(times) // 2]
+        buffers = r.render(scene, w, h)
+        print(f"  frame time {frame * 1e3:.1f} ms (median of {args.repeats}), "
+              f"{buffers.iterations.mean():.1f} iterations/pixel, "
+              f"{buffers.hit.mean() * 100:.0f}% of pixels hit")
+    out = Path(args.output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    buffers.save_png(out)
+    print(f"  wrote {out}")
+    if args.buffers:
+        buffers.save_npz(args.buffers)
+        print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    path = resolve(args.preset)
+    scene = load_scene(path)
+    krs = scene.geometry()
+    kinds: dict[str, int] = {}
+    for k in krs.kernels:
+        kinds[k.kind] = kinds.get(k.kind, 0) + 1
+    print(f"{path}: ok — {scene.name}")
+    if scene.description:
+        print(f"  {scene.description}")
+    print(f"  geometry        {'tree (grown)' if scene.tree else 'explicit KRS'}")
+    print(f"  levels          {len(krs.levels)} (kernels K_0..K_{krs.n}, {krs.n} mirrors)")
+    print(f"  kernel instances {krs.instance_count():,} (up to 2^{krs.n} = {2 ** krs.n:,} of K_0)")
+    print("  kernels         " + ", ".join(f"{v}× {k}" for k, v in sorted(kinds.items())))
+    print(f"  effects         {', '.join(scene.effects) or 'none'}")
+    r = scene.render
+    print(f"  render          {r.tracer} tracer, ε-scale {r.epsilon_scale}, "
+          f"≤ {r.max_iterations} iterations, far {r.max_distance}")
+    return 0
+
+
+def cmd_bench_levels(args: argparse.Namespace) -> int:
+    from .bench.levels import bench_levels
+    scene = _load(args)
+    bench_levels(scene, args.size, step=args.step, rounds=args.rounds, csv=args.csv)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    presets = ", ".join(preset_names()) or "none found"
+    p = argparse.ArgumentParser(
+        prog="krsview",
+        description="Render, check and benchmark Kernel–Reflection Sequence scenes [KRS17]. "
+                    "A PRESET is a scene file (.toml) or the name of a shipped preset: "
+                    f"{presets}.",
+        epilog="examples:\n  krsview render tree -o tree.png --size 640x360\n"
+               "  krsview check presets/grass.toml\n  krsview bench levels tree",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    def accuracy(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--epsilon-scale", type=_positive_float("--epsilon-scale", 1e-4, 100.0),
+                        help="LOD threshold in pixels: stop when distance < footprint × depth × "
+                             "scale (overrides the scene; smaller = sharper and slower)")
+        sp.add_argument("--max-iterations", type=_int_in("--max-iterations", 1, 10000),
+                        help="iteration cap per ray (overrides the scene)")
+        sp.add_argument("--levels", type=_int_in("--levels", 1, MAX_LEVELS),
+                        help="keep only the coarsest N levels (drops the finest detail)")
+
+    r = sub.add_parser("render", help="render a scene headless to PNG (and raw buffers)",
+                       description="Render PRESET headless through EGL and write a PNG; prints "
+                                   "the measured frame time.")
+    r.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    r.add_argument("-o", "--output", default="out/render.png", help="PNG path (default %(default)s)")
+    r.add_argument("--size", type=_size, default=(640, 360), help="WIDTHxHEIGHT (default 640x360)")
+    r.add_argument("--buffers", metavar="NPZ",
+                   help="also write color, depth, normal, iterations and hit arrays (.npz)")
+    r.add_argument("--reference", action="store_true",
+                   help="render with the float64 NumPy reference instead of the GPU (slow)")
+    r.add_argument("--repeats", type=_int_in("--repeats", 1, 1000), default=5,
+                   help="frames timed; the median is printed (default 5)")
+    accuracy(r)
+    r.set_defaults(func=cmd_render)
+
+    c = sub.add_parser("check", help="validate a scene file and print its statistics",
+                       description="Validate PRESET; print levels, kernel instances, effects.")
+    c.add_argument("preset", metavar="PRESET")
+    c.set_defaults(func=cmd_check)
+
+    b = sub.add_parser("bench", help="benchmarks (levels)",
+                       description="Benchmarks that report ratios measured side by side.")
+    bsub = b.add_subparsers(dest="bench", required=True, metavar="BENCH")
+    bl = bsub.add_parser("levels", help="frame time against level count (O(n) vs 2^n)",
+                         description="Render the same view with the coarsest 4, 8, … levels, "
+                                     "interleaved, median of several frames; print time relative "
+                                     "to the smallest level count beside the kernel instances.")
+    bl.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    bl.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
+    bl.add_argument("--step", type=_int_in("--step", 1, MAX_LEVELS), default=4,
+                    help="level increment (default 4)")
+    bl.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=5,
+                    help="interleaved rounds; medians are reported (default 5)")
+    bl.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
+    bl.add_argument("--epsilon-scale", type=_positive_float("--epsilon-scale", 1e-4, 100.0))
+    bl.add_argument("--max-iterations", type=_int_in("--max-iterations", 1, 10000))
+    bl.set_defaults(func=cmd_bench_levels)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except SceneError as e:
+        print(f"krsview: error: {e}", file=sys.stderr)
+        return EXIT_SCENE
+    except RuntimeError as e:  # ContextError, ShaderError: environment or build problems
+        print(f"krsview: error: {e}", file=sys.stderr)
+        return EXIT_GL
+
+
+if __name__ == "__main__":
+    sys.exit(main())
