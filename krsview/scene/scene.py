@@ -8,10 +8,9 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import tomli_w
-
 from .model import EFFECTS, KRS, Camera, Light, Material, Render
 from .schema import SceneError, from_dict, param, to_dict
+from .toml_writer import dumps
 from .tree import Tree
 
 
@@ -68,7 +67,7 @@ def load_scene(path: str | os.PathLike) -> Scene:
 
 
 def scene_to_toml(scene: Scene) -> str:
-    return tomli_w.dumps(to_dict(scene))
+    return dumps(to_dict(scene))
 
 
 def save_scene(scene: Scene, path: str | os.PathLike) -> None:
