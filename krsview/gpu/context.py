@@ -12,7 +12,9 @@ class ContextError(RuntimeError):
 
 def headless_context() -> moderngl.Context:
     try:
-        ctx = moderngl.create_standalone_context(backend="egl", require=GL_VERSION)
+        # Versioned names: the runtime packages (libgl1, libegl1) ship only these.
+        ctx = moderngl.create_standalone_context(backend="egl", require=GL_VERSION,
+                                                 libgl="libGL.so.1", libegl="libEGL.so.1")
     except Exception as e:  # moderngl raises plain Exception subclasses from glcontext
         raise ContextError(
             f"cannot create a headless OpenGL {GL_VERSION // 100}.{GL_VERSION % 100 // 10} "

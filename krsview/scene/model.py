@@ -156,8 +156,10 @@ class KRS:
         return [lv.mirror for lv in self.levels[1:]]  # type: ignore[misc]
 
     def instance_count(self) -> int:
-        """Kernel instances in the expansion: K_i appears 2^i times (empty kernels excluded)."""
-        return sum(2 ** i for i, k in enumerate(self.kernels) if not isinstance(k, Empty))
+        """Kernel instances in the expansion: K_i is doubled by R_i..R_{n-1}, so it appears
+        2^(n−i) times (empty kernels excluded)."""
+        return sum(2 ** (self.n - i) for i, k in enumerate(self.kernels)
+                   if not isinstance(k, Empty))
 
     def truncated(self, levels: int) -> "KRS":
         """Keep the coarsest ``levels`` levels (K_{n-levels+1}..K_n): fewer, finer ones dropped."""

@@ -1,0 +1,95 @@
+"""Shared fixtures: one headless GL context per session, and the GPU-vs-reference comparison
+with the tolerances every pixel test uses."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from krsview.buffers import Buffers
+from krsview.presets import PRESET_DIR
+
+TEST_OUTPUT = Path(__file__).resolve().parent.parent / "test-output"
+
+# Tolerances of GPU (float32) against the reference (float64), and why:
+HIT_AGREEMENT = 0.995    # a ray whose last distance lands within float32 rounding of ε flips
+DEPTH_REL = 1e-3         # same stopping step ⇒ depths agree to float32 accumulation over ~100 steps
+NORMAL_DEG = 2.0         # same winning kernel ⇒ same analytic gradient up to float32 rounding
+CLOSE_FRACTION = 0.995   # …except where one side stopped a step later (|Δt| ≈ ε(t)), slipped past
+                         # a silhouette onto a surface behind, or a kernel tie at a crease flipped
+COLOR_TOL = 2.0 / 255.0  # one rounding of each channel plus float32 shading error
+COLOR_FRACTION = 0.99
+
+
+@pytest.fixture(scope="session")
+def renderer():
+    from krsview.gpu.renderer import Renderer
+    return Renderer()
+
+
+def preset_paths() -> list[Path]:
+    return sorted(PRESET_DIR.glob("*.toml"))
+
+
+@dataclass
+class Agreement:
+    hit: float          # fraction of pixels with equal hit mask
+    depth_close: float  # fraction of common hits with relative depth error ≤ DEPTH_REL
+    normal_close: float  # fraction of common hits with normal angle ≤ NORMAL_DEG
+    color: float        # fraction of pixels with every channel within COLOR_TOL
+
+    def failures(self) -> list[str]:
+        out = []
+        if self.hit < HIT_AGREEMENT:
+            out.append(f"hit masks agree on {self.hit:.4%} < {HIT_AGREEMENT:.1%}")
+        if self.depth_close < CLOSE_FRACTION:
+            out.append(f"depth within {DEPTH_REL} on {self.depth_close:.4%} < {CLOSE_FRACTION:.1%}")
+        if self.normal_close < CLOSE_FRACTION:
+            out.append(f"normals within {NORMAL_DEG}° on {self.normal_close:.4%}")
+        if self.color < COLOR_FRACTION:
+            out.append(f"colour within 2/255 on {self.color:.4%} < {COLOR_FRACTION:.0%}")
+        return out
+
+
+def agreement(gpu: Buffers, ref: Buffers) -> Agreement:
+    both = gpu.hit & ref.hit
+    t = ref.depth[both]
+    dt = np.abs(gpu.depth[both] - t)
+    cos = np.clip((gpu.normal * ref.normal).sum(-1)[both], -1.0, 1.0)
+    angle = np.degrees(np.arccos(cos))
+    n = max(int(both.sum()), 1)
+    return Agreement(
+        hit=float((gpu.hit == ref.hit).mean()),
+        depth_close=float((dt <= DEPTH_REL * np.maximum(t, 1e-12)).sum() / n) if both.any() else 1.0,
+        normal_close=float((angle <= NORMAL_DEG).sum() / n) if both.any() else 1.0,
+        color=float((np.abs(gpu.color - ref.color).max(-1) <= COLOR_TOL).mean()))
+
+
+def assert_finite(b: Buffers, max_iterations: int) -> None:
+    for name in ("color", "depth", "normal"):
+        assert np.isfinite(getattr(b, name)).all(), f"non-finite {name} pixels"
+    assert b.iterations.max() <= max_iterations, "a ray exceeded the iteration cap"
+    assert b.iterations.min() >= 1
+
+
+def save_diff(name: str, gpu: Buffers, ref: Buffers) -> Path:
+    """GPU | reference | amplified difference, side by side, for a failing pixel test."""
+    from PIL import Image
+    TEST_OUTPUT.mkdir(exist_ok=True)
+    diff = np.clip(np.abs(gpu.color - ref.color) * 10.0, 0, 1)
+    diff[gpu.hit != ref.hit] = (1.0, 0.0, 1.0)
+    strip = np.concatenate([gpu.rgb8(), ref.rgb8(), np.round(diff * 255).astype(np.uint8)], 1)
+    path = TEST_OUTPUT / f"{name}.png"
+    Image.fromarray(strip).save(path)
+    return path
+
+
+def check_against_reference(name: str, gpu: Buffers, ref: Buffers) -> Agreement:
+    a = agreement(gpu, ref)
+    problems = a.failures()
+    if problems:
+        path = save_diff(name, gpu, ref)
+        pytest.fail(f"{name}: " + "; ".join(problems) + f" (images: {path})")
+    return a

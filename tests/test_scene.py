@@ -1,0 +1,140 @@
+"""Scene files: every user mistake gets a clear error naming file, field, value and what is
+allowed; save → load round-trips exactly; saves are atomic."""
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from krsview.scene import (KRS, Level, Mirror, Scene, SceneError, Sphere, ToroidalCapsule, Tree,
+                           load_scene, save_scene, scene_from_toml, scene_to_toml)
+from krsview.scene.model import MAX_LEVELS
+
+from .conftest import preset_paths
+
+GOOD = """
+[camera]
+position = [0.0, 1.0, -5.0]
+target = [0.0, 1.0, 0.0]
+[[krs.levels]]
+kernel = { type = "sphere", center = [0.0, 0.0, 0.0], radius = 0.5 }
+[[krs.levels]]
+kernel = { type = "empty" }
+mirror = { normal = [1.0, 0.0, 0.0], offset = 1.0 }
+"""
+
+
+def error_of(text: str) -> SceneError:
+    with pytest.raises(SceneError) as e:
+        scene_from_toml(text, "scene.toml")
+    return e.value
+
+
+def test_good_scene_loads():
+    s = scene_from_toml(GOOD)
+    assert s.geometry().n == 1 and s.geometry().instance_count() == 2
+
+
+@pytest.mark.parametrize("old, new, path, value, allowed", [
+    ("normal = [1.0, 0.0, 0.0]", "normal = [0.0, 0.0, 0.0]", "krs.levels[1].mirror.normal",
+     "[0.0, 0.0, 0.0]", "zero vector"),
+    ("normal = [1.0, 0.0, 0.0]", "normal = [2.0, 0.0, 0.0]", "krs.levels[1].mirror.normal",
+     "[2.0, 0.0, 0.0]", "unit vector"),
+    ("radius = 0.5", "radius = -0.5", "krs.levels[0].kernel.radius", "-0.5", "value > 0"),
+    ("radius = 0.5", "radius = nan", "krs.levels[0].kernel.radius", "nan", "NaN"),
+    ("offset = 1.0", "offset = inf", "krs.levels[1].mirror.offset", "inf", "NaN and infinity"),
+    ('type = "sphere"', 'type = "cube"', "krs.levels[0].kernel.type", "'cube'",
+     "allowed: empty, sphere"),
+    ("radius = 0.5 }", "radius = 0.5, colour = [1, 0, 0] }", "krs.levels[0].kernel.colour",
+     "[1, 0, 0]", "unknown field; allowed fields: center, color, radius"),
+    ("target = [0.0, 1.0, 0.0]", "target = [0.0, 1.0, -5.0]", "camera.target",
+     "[0.0, 1.0, -5.0]", "must differ from position"),
+    ("radius = 0.5", 'radius = "big"', "krs.levels[0].kernel.radius", "'big'",
+     "expected a number"),
+])
+def test_bad_value_names_file_field_value_and_allowed(old, new, path, value, allowed):
+    assert old in GOOD
+    e = error_of(GOOD.replace(old, new))
+    assert str(e) == f"scene.toml: {path} = {value}: " + str(e).split(": ", 2)[2]
+    assert e.path == path and allowed in str(e), str(e)
+
+
+def test_unit_normal_error_suggests_the_normalised_vector():
+    e = error_of(GOOD.replace("normal = [1.0, 0.0, 0.0]", "normal = [3.0, 4.0, 0.0]"))
+    assert "length 5" in str(e) and "[0.6, 0.8, 0]" in str(e)
+
+
+def test_too_many_levels():
+    levels = [Level(Sphere(), None)] + [Level(Sphere(), Mirror())] * MAX_LEVELS
+    text = scene_to_toml(Scene(krs=KRS(levels)))
+    e = error_of(text)
+    assert e.path == "krs.levels" and f"at most {MAX_LEVELS}" in str(e)
+    e = error_of("[tree]\nlevels = 99")
+    assert e.path == "tree.levels" and "≤ 63" in str(e)
+
+
+def test_structural_mistakes():
+    assert "exactly one geometry" in str(error_of("name = 'x'"))
+    no_mirror = GOOD.replace("mirror = { normal = [1.0, 0.0, 0.0], offset = 1.0 }", "")
+    assert error_of(no_mirror).path == "krs.levels[1].mirror"
+    assert error_of("effects = ['shadows']\n" + GOOD).path == "effects[0]"
+    assert error_of("name = [").path == "<syntax>"
+    assert error_of("[tree]\nbranch_angle = 95.0").path == "tree.branch_angle"
+
+
+def test_missing_file_is_a_scene_error(tmp_path):
+    with pytest.raises(SceneError) as e:
+        load_scene(tmp_path / "nope.toml")
+    assert "cannot read" in str(e.value) and "nope.toml" in str(e.value)
+
+
+@pytest.mark.parametrize("path", preset_paths(), ids=lambda p: p.stem)
+def test_presets_round_trip_exactly(path, tmp_path):
+    scene = load_scene(path)
+    save_scene(scene, tmp_path / "copy.toml")
+    assert load_scene(tmp_path / "copy.toml") == scene
+    explicit = scene.with_geometry(scene.geometry())  # the expanded KRS round-trips too
+    save_scene(explicit, tmp_path / "explicit.toml")
+    assert load_scene(tmp_path / "explicit.toml") == explicit
+
+
+finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
+vec = st.tuples(finite, finite, finite)
+
+
+@settings(max_examples=60, deadline=None)
+@given(center=vec, radius=st.floats(1e-6, 1e6), normal=vec.filter(
+    lambda v: math.hypot(*v) > 1e-3), offset=finite, name=st.text(max_size=20))
+def test_round_trip_property(center, radius, normal, offset, name):
+    n = math.sqrt(sum(c * c for c in normal))
+    mirror = Mirror(tuple(c / n for c in normal), offset)
+    s = scene_from_toml(scene_to_toml(Scene(name=name, krs=KRS(
+        [Level(Sphere(center, radius), None), Level(Sphere(), mirror)]))))
+    assert scene_from_toml(scene_to_toml(s)) == s
+    assert s.krs.levels[0].kernel == Sphere(center, radius)
+
+
+def test_atomic_save_keeps_old_file_when_writing_fails(tmp_path, monkeypatch):
+    path = tmp_path / "scene.toml"
+    path.write_text(GOOD)
+    import krsview.scene.scene as mod
+
+    def broken(_scene):
+        raise RuntimeError("disk full")
+    monkeypatch.setattr(mod, "scene_to_toml", broken)
+    with pytest.raises(RuntimeError):
+        save_scene(scene_from_toml(GOOD), path)
+    assert path.read_text() == GOOD
+    assert list(tmp_path.iterdir()) == [path], "temporary file left behind"
+
+
+def test_tree_expands_to_toroidal_capsules_with_fork_mirrors():
+    krs = Tree(levels=6).krs()
+    assert krs.n == 6 and all(isinstance(k, ToroidalCapsule) for k in krs.kernels)
+    for i, m in enumerate(krs.mirrors):
+        fork = krs.kernels[i].start          # R_i passes through the fork where L_i starts
+        assert abs(sum(a * b for a, b in zip(m.normal, fork)) - m.offset) < 1e-9
+        parent = krs.kernels[i + 1]          # …and that fork is where K_{i+1} ends
+        assert max(abs(a - b) for a, b in zip(parent.end, fork)) < 1e-12
