@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from krsview.scene import (KRS, Level, Mirror, Scene, SceneError, Sphere, ToroidalCapsule, Tree,
+from krsview.scene import (KRS, Empty, Level, Mirror, Scene, SceneError, Sphere, ToroidalCapsule, Tree,
                            load_scene, save_scene, scene_from_toml, scene_to_toml)
 from krsview.scene.model import MAX_LEVELS
 
@@ -138,3 +138,13 @@ def test_tree_expands_to_toroidal_capsules_with_fork_mirrors():
         assert abs(sum(a * b for a, b in zip(m.normal, fork)) - m.offset) < 1e-9
         parent = krs.kernels[i + 1]          # …and that fork is where K_{i+1} ends
         assert max(abs(a - b) for a, b in zip(parent.end, fork)) < 1e-12
+
+
+def test_truncation_keeps_the_coarsest_levels_and_something_to_draw():
+    tree = Tree(levels=8).krs()
+    t = tree.truncated(3)
+    assert t.kernels[1:] == tree.kernels[-2:] and t.kernels[0] == tree.kernels[-3]
+    ifs = KRS([Level(Sphere(), None)] + [Level(Empty(), Mirror((1.0, 0.0, 0.0), float(i)))
+                                         for i in range(1, 6)])
+    cut = ifs.truncated(2)
+    assert cut.kernels[0] == Sphere() and cut.n == 1 and cut.mirrors == ifs.mirrors[-1:]

@@ -62,7 +62,7 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
         slope, icpt = np.polyfit(n, t, 1)
         resid = t - (slope * n + icpt)
         r2 = 1 - (resid @ resid) / max(((t - t.mean()) ** 2).sum(), 1e-30)
-        grow = rows[-1]["instances"] / rows[0]["instances"]
+        grow = rows[-1]["instances"] / max(rows[0]["instances"], 1)
         print(f"\nlinear fit: {icpt:.2f} ms + {slope:.3f} ms/level (R² = {r2:.3f}); geometry grew "
               f"{grow:,.0f}× while time grew {rows[-1]['time_ratio']:.2f}×")
     if csv:

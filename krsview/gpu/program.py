@@ -13,7 +13,8 @@ from .context import GL_VERSION
 
 SHADER_DIR = Path(str(resources.files("krsview") / "shaders"))
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
-_MESA_LOCATION = re.compile(r"(\d+):(\d+)\((\d+)\)")
+# Mesa: "0:12(5): error"; NVIDIA: "0(12) : error". The line is in the assembled source.
+_LOCATION = re.compile(r"\b\d+(?::(\d+)\((\d+)\)|\((\d+)\))")
 
 
 class ShaderError(RuntimeError):
@@ -21,16 +22,18 @@ class ShaderError(RuntimeError):
 
 
 class Source:
-    """A stage assembled from .glsl files; ``files[k]`` is the file of ``#line`` source k."""
+    """A stage assembled from .glsl files. ``origin[k]`` is the (file, line) of assembled line
+    k + 1, so compiler messages map back without trusting the driver's ``#line`` handling."""
 
     def __init__(self, entry: str, defines: dict[str, str | int | float | None],
                  shader_dir: Path = SHADER_DIR):
         self.shader_dir = shader_dir
-        self.files: list[str] = ["<defines>"]
-        lines = [f"#version {GL_VERSION} core"]
-        lines += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
-                  sorted(defines.items())]
-        lines += self._expand(entry, [])
+        self.included: set[str] = set()
+        head = [f"#version {GL_VERSION} core"]
+        head += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
+                 sorted(defines.items())]
+        self.origin: list[tuple[str, int]] = [("<defines>", k) for k in range(1, len(head) + 1)]
+        lines = head + self._expand(entry, [])
         self.text = "\n".join(lines) + "\n"
 
     def _expand(self, name: str, stack: list[str]) -> list[str]:
@@ -42,38 +45,34 @@ class Source:
         except OSError:
             where = f" (included from {stack[-1]})" if stack else ""
             raise ShaderError(f"shader file not found: {name}{where}") from None
-        if name in self.files:  # each file once, like a header guard
+        if name in self.included:  # each file once, like a header guard
             return []
-        fid = len(self.files)
-        self.files.append(name)
-        out = [f"#line 1 {fid}"]
+        self.included.add(name)
+        out: list[str] = []
         for k, line in enumerate(text.splitlines(), 1):
             m = _INCLUDE.match(line)
             if m:
                 out += self._expand(m.group(1), stack + [name])
-                out.append(f"#line {k + 1} {fid}")
             else:
                 out.append(line)
+                self.origin.append((name, k))
         return out
 
-    def line_of(self, fid: int, line: int) -> str:
-        if 0 < fid < len(self.files):
-            lines = (self.shader_dir / self.files[fid]).read_text().splitlines()
-            return lines[line - 1].strip() if 0 < line <= len(lines) else ""
-        return ""
-
     def map_log(self, log: str) -> str:
-        """Rewrite Mesa's ``source:line(col)`` locations as ``file.glsl:line:col``, each error
-        followed by its source line."""
+        """Rewrite each compiler location as ``file.glsl:line[:col]``, followed by that line."""
         out = []
+        lines = self.text.splitlines()
         for raw in log.splitlines():
-            m = _MESA_LOCATION.search(raw)
-            if m and int(m.group(1)) < len(self.files):
-                fid, line, col = (int(g) for g in m.groups())
-                raw = raw[:m.start()] + f"{self.files[fid]}:{line}:{col}" + raw[m.end():]
-                text = self.line_of(fid, line)
-                out.append(raw + (f"\n    | {text}" if text else ""))
-            elif raw.strip():
+            m = _LOCATION.search(raw)
+            if m:
+                n = int(m.group(1) or m.group(3))
+                if 0 < n <= len(self.origin):
+                    file, line = self.origin[n - 1]
+                    col = f":{m.group(2)}" if m.group(2) else ""
+                    out.append(raw[:m.start()] + f"{file}:{line}{col}" + raw[m.end():]
+                               + f"\n    | {lines[n - 1].strip()}")
+                    continue
+            if raw.strip():
                 out.append(raw)
         return "\n".join(out)
 

@@ -162,9 +162,14 @@ class KRS:
                    if not isinstance(k, Empty))
 
     def truncated(self, levels: int) -> "KRS":
-        """Keep the coarsest ``levels`` levels (K_{n-levels+1}..K_n): fewer, finer ones dropped."""
-        keep = self.levels[len(self.levels) - levels:]
-        return KRS([Level(keep[0].kernel, None)] + list(keep[1:]))
+        """Keep the coarsest ``levels`` levels (K_{n-levels+1}..K_n), dropping the finest.
+        If the kernel at the cut is empty (an IFS-like KRS whose only shape is K_0), the
+        nearest non-empty kernel below the cut becomes the new K_0, so something is drawn."""
+        cut = len(self.levels) - levels
+        keep = self.levels[cut:]
+        k0 = next((lv.kernel for lv in reversed(self.levels[:cut + 1])
+                   if not isinstance(lv.kernel, Empty)), keep[0].kernel)
+        return KRS([Level(k0, None)] + list(keep[1:]))
 
 
 # ------------------------------------------------------------------------ view and render

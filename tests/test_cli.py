@@ -1,0 +1,75 @@
+"""The command line: renders valid PNGs, validates files, and rejects bad input clearly."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from krsview.cli import main
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "krsview", *args], capture_output=True,
+                          text=True, timeout=300)
+
+
+def test_render_writes_png_of_requested_size_and_buffers(tmp_path):
+    out, npz = tmp_path / "a.png", tmp_path / "a.npz"
+    r = run("render", "sierpinski", "-o", str(out), "--size", "96x64", "--buffers", str(npz),
+            "--repeats", "1")
+    assert r.returncode == 0, r.stderr
+    assert "frame time" in r.stdout and str(out) in r.stdout
+    im = Image.open(out)
+    assert im.size == (96, 64) and im.mode == "RGB"
+    b = np.load(npz)
+    assert b["depth"].shape == (64, 96) and b["hit"].any() and np.isfinite(b["normal"]).all()
+
+
+def test_reference_render_matches_size(tmp_path):
+    out = tmp_path / "r.png"
+    assert main(["render", "sierpinski", "-o", str(out), "--size", "40x30", "--reference"]) == 0
+    assert Image.open(out).size == (40, 30)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["render", "tree", "--size", "640"], "expected WIDTHxHEIGHT"),
+    (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
+    (["render", "tree", "--epsilon-scale", "nan"], "--epsilon-scale 'nan': allowed"),
+    (["render", "tree", "--max-iterations", "-3"], "--max-iterations '-3': allowed 1"),
+    (["render", "no-such-preset"], "not a file and not a preset; presets: grass, sierpinski"),
+    (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
+    (["check", "missing.toml"], "no such scene file"),
+    (["frobnicate"], "invalid choice"),
+])
+def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):
+    r = run(*args)
+    assert r.returncode != 0
+    assert message in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_bad_scene_file_gets_file_field_value(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[tree]\nlevels = 12\nbranch_angle = -5.0\n")
+    r = run("check", str(bad))
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert f"{bad}: tree.branch_angle = -5.0: allowed: 0.0 ≤ value ≤ 89.0 degrees" in r.stderr
+
+
+def test_check_prints_statistics(capsys):
+    assert main(["check", "tree"]) == 0
+    out = capsys.readouterr().out
+    assert "levels          23" in out and "8,388,607" in out and "effects         none" in out
+
+
+def test_bench_levels_prints_the_ratio_table(capsys):
+    assert main(["bench", "levels", "sierpinski", "--size", "48x32", "--rounds", "1",
+                 "--step", "8"]) == 0
+    out = capsys.readouterr().out
+    assert "| levels | kernel instances |" in out
+    rows = [line for line in out.splitlines() if line.startswith("| ") and line[2].isdigit()]
+    assert [int(r.split("|")[1]) for r in rows] == [8, 16, 22]
+    assert rows[0].split("|")[4].strip() == "1.00"  # the smallest level count is the unit

@@ -1,0 +1,92 @@
+"""Hard cases are inputs, not accidents (DESIGN.md): finite pixels, bounded iterations, and
+GPU/reference agreement with the same tolerances as the presets."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from krsview.reference import render_reference
+from krsview.scene import (KRS, Camera, Empty, Level, Mirror, Plane, Render, Scene, Sphere, Tree,
+                           load_scene)
+from krsview.presets import resolve
+
+from .conftest import assert_finite, check_against_reference
+
+W, H = 120, 90
+
+
+def tree_scene() -> Scene:
+    return load_scene(resolve("tree"))
+
+
+def camera_on_top_mirror() -> Scene:
+    """The eye exactly on mirror R_{n-1} (the first fork's plane), looking along it."""
+    s = tree_scene()
+    m = s.geometry().mirrors[-1]
+    u, w = np.array(m.normal), m.offset
+    project = lambda p: np.array(p) - (np.array(p) @ u - w) * u  # noqa: E731
+    eye, target = project(s.camera.position), project(s.camera.target)
+    assert abs(eye @ u - w) < 1e-12
+    return replace(s, camera=replace(s.camera, position=tuple(eye), target=tuple(target)))
+
+
+def grazing_plane() -> Scene:
+    """Rays skimming a ground plane and sphere silhouettes; a low iteration cap is hit."""
+    levels = [Level(Sphere((0.0, 0.3, 0.0), 0.3), None),
+              Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.8)),
+              Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), Mirror((0.0, 0.0, 1.0), 1.5))]
+    return Scene(name="grazing", camera=Camera((0.0, 0.02, -4.0), (0.0, 0.0, 10.0)),
+                 render=Render(max_iterations=48, max_distance=60.0), krs=KRS(levels))
+
+
+def camera_inside_trunk() -> Scene:
+    s = tree_scene()
+    return replace(s, camera=replace(s.camera, position=(0.02, 0.5, 0.01), target=(0.0, 3.0, 1.0)))
+
+
+def thirty_levels() -> Scene:
+    s = tree_scene()
+    return replace(s, tree=replace(s.tree, levels=30))
+
+
+CASES = {"camera_on_mirror": camera_on_top_mirror, "grazing": grazing_plane,
+         "inside_kernel": camera_inside_trunk, "levels_30": thirty_levels}
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_hard_case_is_finite_bounded_and_matches_reference(renderer, name):
+    scene = CASES[name]()
+    gpu = renderer.render(scene, W, H)
+    ref = render_reference(scene, W, H)
+    assert_finite(gpu, scene.render.max_iterations)
+    assert_finite(ref, scene.render.max_iterations)
+    check_against_reference(f"hard_{name}", gpu, ref)
+
+
+def test_grazing_rays_reach_the_cap_and_stop_there(renderer):
+    scene = grazing_plane()
+    gpu = renderer.render(scene, W, H)
+    assert gpu.iterations.max() == scene.render.max_iterations  # the case really is hard
+
+
+def test_inside_a_kernel_every_ray_hits_at_the_eye(renderer):
+    gpu = renderer.render(camera_inside_trunk(), W, H)
+    assert gpu.hit.all() and np.all(gpu.depth == 0.0) and np.all(gpu.iterations == 1)
+
+
+def test_thirty_levels_has_a_billion_instances():
+    assert thirty_levels().geometry().instance_count() >= 2**30
+
+
+def test_image_changes_little_when_the_camera_moves_little(renderer):
+    """Continuity: a 1e-6 nudge of the eye across the mirror plane changes few pixels."""
+    s = camera_on_top_mirror()
+    u = np.array(s.geometry().mirrors[-1].normal)
+    a = renderer.render(replace(s, camera=replace(
+        s.camera, position=tuple(np.array(s.camera.position) - 1e-6 * u))), W, H)
+    b = renderer.render(replace(s, camera=replace(
+        s.camera, position=tuple(np.array(s.camera.position) + 1e-6 * u))), W, H)
+    assert (a.hit != b.hit).mean() < 0.002
+    assert (np.abs(a.color - b.color).max(-1) > 4 / 255).mean() < 0.005

@@ -1,0 +1,71 @@
+"""The program builder: #include resolution, errors mapped to .glsl file:line, variants
+specialised by #define and cached."""
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from krsview.gpu.program import SHADER_DIR, ShaderError, Source, build_program
+from krsview.gpu.uniforms import variant_defines
+from krsview.presets import resolve
+from krsview.reference import compile_krs
+from krsview.scene import load_scene
+
+DEFINES = {"KRS_MAX_LEVELS": 64, "KRS_RECORD": 6, "KRS_KERNEL_TOROIDAL_CAPSULE": None}
+
+
+@pytest.fixture
+def shader_copy(tmp_path):
+    d = tmp_path / "shaders"
+    shutil.copytree(SHADER_DIR, d)
+    return d
+
+
+def test_compile_error_is_mapped_to_file_and_line(renderer, shader_copy):
+    path = shader_copy / "kernels.glsl"
+    lines = path.read_text().splitlines()
+    k = next(i for i, line in enumerate(lines) if "return d - kernel_rec(i, 1).w;" in line)
+    lines[k] = lines[k].replace(";", " + undefined_thing;")
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ShaderError) as e:
+        build_program(renderer.ctx, "fullscreen.vert", "render.frag", DEFINES, shader_copy)
+    text = str(e.value)
+    assert f"kernels.glsl:{k + 1}:" in text, text
+    assert "undefined_thing" in text and "| return d - kernel_rec(i, 1).w + undefined_thing;" in text
+    assert "0:" not in text.split("===", 1)[-1].replace("===", ""), text  # no raw offsets left
+
+
+def test_include_cycle_and_missing_file_are_named(shader_copy):
+    (shader_copy / "a.glsl").write_text('#include "b.glsl"\n')
+    (shader_copy / "b.glsl").write_text('#include "a.glsl"\n')
+    with pytest.raises(ShaderError, match="a.glsl → b.glsl → a.glsl"):
+        Source("a.glsl", {}, shader_copy)
+    (shader_copy / "c.glsl").write_text('#include "nope.glsl"\n')
+    with pytest.raises(ShaderError, match=r"nope.glsl \(included from c.glsl\)"):
+        Source("c.glsl", {}, shader_copy)
+
+
+def test_source_map_points_every_line_back():
+    src = Source("render.frag", DEFINES)
+    lines = src.text.splitlines()
+    for n, (file, line) in enumerate(src.origin, 1):
+        if file != "<defines>":
+            assert (SHADER_DIR / file).read_text().splitlines()[line - 1] == lines[n - 1]
+
+
+def test_variant_contains_only_the_kernels_the_scene_uses(renderer):
+    sier = load_scene(resolve("sierpinski"))      # spheres only
+    tree = load_scene(resolve("tree"))            # toroidal capsules only
+    d_sier = variant_defines(sier, compile_krs(sier.geometry(), (1, 1, 1)))
+    d_tree = variant_defines(tree, compile_krs(tree.geometry(), (1, 1, 1)))
+    assert "KRS_KERNEL_SPHERE" in d_sier and "KRS_KERNEL_TOROIDAL_CAPSULE" not in d_sier
+    assert "KRS_KERNEL_TOROIDAL_CAPSULE" in d_tree and "KRS_KERNEL_SPHERE" not in d_tree
+    # The preprocessor removes what is not defined: no torus code in the sphere variant.
+    from krsview.gpu.program import Source as S
+    text = S("render.frag", d_sier).text
+    assert "#ifdef KRS_KERNEL_TOROIDAL_CAPSULE" in text  # present in source, compiled out
+    before = renderer.programs.compiles
+    renderer.render(sier, 8, 6)
+    renderer.render(sier, 8, 6)                    # same define set: cached
+    assert renderer.programs.compiles - before <= 1
