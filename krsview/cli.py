@@ -95,7 +95,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     buffers.save_png(out)
-    print(f"  wrote {out}")
+    print(f"  wrote {out.resolve()}")
     if args.buffers:
         buffers.save_npz(args.buffers)
         print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")

@@ -43,18 +43,42 @@ def random_kernel(rng: np.random.Generator, center: np.ndarray, size: float):
     return Empty()
 
 
+def core_samples(k) -> np.ndarray:
+    """Dense points on a kernel's core: its centre, segment or arc (as compiled)."""
+    c = compile_krs(KRS([Level(k)]), ALBEDO)
+    s = np.linspace(0.0, 1.0, 20001)[:, None]
+    if isinstance(k, Sphere):
+        return np.array([k.center])
+    if c.types[0] == "capsule":
+        a = np.array(k.a if isinstance(k, Capsule) else k.start)
+        b = np.array(k.b if isinstance(k, Capsule) else k.end)
+        return a + s * (b - a)
+    rec = c.records[0]
+    angle = s * (np.arctan2(rec[5, 3], rec[4, 3]) % (2 * np.pi))
+    return rec[3, :3] + rec[3, 3] * (np.cos(angle) * rec[4, :3] + np.sin(angle) * rec[5, :3])
+
+
+def extent(k, center: np.ndarray) -> float:
+    """Radius of the ball around ``center`` that holds kernel k (0 for an empty kernel)."""
+    if isinstance(k, Empty):
+        return 0.0
+    return float(np.max(np.linalg.norm(core_samples(k) - center, axis=1))) + k.radius
+
+
 def separated_krs(rng: np.random.Generator, n: int) -> KRS:
-    """Each mirror lies beyond the bounding ball of the level below it (kernel separation)."""
-    c, rho = np.zeros(3), 1.0
-    levels = [Level(random_kernel(rng, c, rho) if rng.random() < 0.8 else Sphere((0, 0, 0), 0.3))]
+    """Each mirror lies beyond the bounding ball of the level below it (kernel separation).
+    Ball radii come from the kernels' measured extents: an arc may bulge far out."""
+    c = np.zeros(3)
+    k0 = random_kernel(rng, c, 1.0) if rng.random() < 0.8 else Sphere((0, 0, 0), 0.3)
+    levels, rho = [Level(k0)], max(extent(k0, c), 1e-3)
     for _ in range(n):
         u = unit(rng)
-        gap = rho * rng.uniform(0.05, 0.5)
-        w = float(u @ c + rho + gap)
-        c2 = c + (w - u @ c) * u          # centre of L ∪ RL
-        rho2 = rho + (w - u @ c)
-        levels.append(Level(random_kernel(rng, c2, 0.5 * rho2), Mirror(tuple(u), w)))
-        c, rho = c2, rho2
+        gap = rho * rng.uniform(1.05, 1.5)  # plane distance from L's centre, beyond its ball
+        w = float(u @ c + gap)
+        c, rho = c + gap * u, gap + rho     # the ball of L ∪ RL, centred on the plane
+        k = random_kernel(rng, c, 0.5 * rho)
+        rho = max(rho, extent(k, c) * 1.001)
+        levels.append(Level(k, Mirror(tuple(u), w)))
     return KRS(levels)
 
 
@@ -166,20 +190,10 @@ def test_kernel_distance_matches_dense_core_samples(seed):
     if isinstance(k, Empty):
         return
     c = compile_krs(KRS([Level(k)]), ALBEDO)
-    s = np.linspace(0.0, 1.0, 20001)[:, None]
-    if isinstance(k, Sphere):
-        core = np.array([k.center])
-    elif c.types[0] == "capsule":
-        a = np.array(k.a if isinstance(k, Capsule) else k.start)
-        b = np.array(k.b if isinstance(k, Capsule) else k.end)
-        core = a + s * (b - a)
-    else:  # arc through start, control, end: sample it by angle from the compiled frame
-        rec = c.records[0]
-        phi = np.arctan2(rec[5, 3], rec[4, 3]) % (2 * np.pi)
-        a = s * phi
-        core = rec[3, :3] + rec[3, 3] * (np.cos(a) * rec[4, :3] + np.sin(a) * rec[5, :3])
-        for pt in (k.start, k.control, k.end):  # the arc really passes through all three
-            assert np.min(np.linalg.norm(core - np.array(pt), axis=1)) < 1e-3 * rec[3, 3] + 1e-9
+    core = core_samples(k)
+    if c.types[0] == "toroidal_capsule":  # the arc really passes through all three points
+        for pt in (k.start, k.control, k.end):
+            assert np.min(np.linalg.norm(core - np.array(pt), axis=1)) < 1e-3 * c.records[0, 3, 3]
     x = rng.normal(size=(200, 3)) * 2.0
     brute = np.min(np.linalg.norm(x[:, None] - core[None], axis=2), axis=1) - k.radius
     got = kernel_distance(c.types[0], c.records[0], x)
