@@ -34,13 +34,13 @@ class SceneError(ValueError):
 
 def param(default: Any = MISSING, *, lo: float | None = None, hi: float | None = None,
           lo_open: bool = False, unit: str = "", help: str = "", choices: tuple | None = None,
-          unit_vector: str | None = None, step: float | None = None) -> Any:
+          unit_vector: str | None = None) -> Any:
     """A scene field with its allowed range (closed unless ``lo_open``), unit and help text.
 
     ``unit_vector``: "normalise" scales a direction to length 1; "require" rejects a normal
     whose length is not 1 (a plane's offset is measured in units of its normal)."""
     meta = dict(lo=lo, hi=hi, lo_open=lo_open, unit=unit, help=help, choices=choices,
-                unit_vector=unit_vector, step=step)
+                unit_vector=unit_vector)
     if isinstance(default, (list, dict)):
         return field(default_factory=lambda d=default: type(d)(d), metadata=meta)
     return field(default=default, metadata=meta)
