@@ -4,14 +4,17 @@
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
-# Headless OpenGL through EGL on Mesa (llvmpipe when there is no GPU).
-APT_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri
+# Headless OpenGL through EGL on Mesa (llvmpipe when there is no GPU); Xvfb for the tests
+# that open the real viewer window.
+APT_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglx-mesa0 xvfb xauth
 STAMP  := $(VENV)/.installed
 
 .PHONY: demo test deps venv clean
 
+# The viewer where there is a display, else a headless render to a PNG.
 demo: $(STAMP)
-	$(BIN)/krsview render tree -o out/demo.png --size 640x360
+	@if [ -n "$$DISPLAY$$WAYLAND_DISPLAY" ]; then $(BIN)/krsview view tree; \
+	else $(BIN)/krsview render tree -o out/demo.png --size 640x360; fi
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

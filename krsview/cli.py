@@ -82,13 +82,10 @@ def cmd_render(args: argparse.Namespace) -> int:
         from .gpu.renderer import Renderer
         r = Renderer()
         print("  compiling shader variant …", end="", flush=True)
-        prog = r.prepare(scene, w, h)
-        r.draw(prog, w, h)
-        r.ctx.finish()
+        buffers = r.render(scene, w, h)
         print(f" {(time.perf_counter() - t0) * 1e3:.0f} ms (first frame)", flush=True)
         times = r.time_frame(scene, w, h, repeats=args.repeats)
         frame = sorted(times)[len(times) // 2]
-        buffers = r.render(scene, w, h)
         print(f"  frame time {frame * 1e3:.1f} ms (median of {args.repeats}), "
               f"{buffers.iterations.mean():.1f} iterations/pixel, "
               f"{buffers.hit.mean() * 100:.0f}% of pixels hit")
@@ -99,6 +96,16 @@ def cmd_render(args: argparse.Namespace) -> int:
     if args.buffers:
         buffers.save_npz(args.buffers)
         print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")
+    return 0
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    from .app.window import Viewer
+    viewer = Viewer(resolve(args.preset), size=args.size, hud=not args.no_hud,
+                    target_fps=args.fps)
+    print(f"krsview: viewing {viewer.path} — WASD/QE fly, right-drag look, scroll speed, "
+          "O orbit, R reset, B bookmark, F5/F6 record/replay, F12 screenshot, F1 HUD")
+    viewer.run()
     return 0
 
 
@@ -165,6 +172,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="frames timed; the median is printed (default 5)")
     accuracy(r)
     r.set_defaults(func=cmd_render)
+
+    v = sub.add_parser("view", help="fly through a scene in a window",
+                       description="Open PRESET in a window. WASD/QE fly (speed follows the "
+                                   "distance to the nearest surface; scroll scales it), right-drag "
+                                   "looks, O orbits the point at the centre, R resets, B saves a "
+                                   "bookmark in the preset, N cycles bookmarks, F5 records and F6 "
+                                   "replays a camera path, F12 saves a screenshot, F1 hides the "
+                                   "HUD. Editing the preset or a shader reloads it.")
+    v.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    v.add_argument("--size", type=_size, default=(960, 540), help="window size (default 960x540)")
+    v.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
+                   help="frame rate held while moving by lowering the internal resolution "
+                        "(default 30)")
+    v.add_argument("--no-hud", action="store_true", help="start with the HUD hidden")
+    v.set_defaults(func=cmd_view)
 
     c = sub.add_parser("check", help="validate a scene file and print its statistics",
                        description="Validate PRESET; print levels, kernel instances, effects.")

@@ -28,7 +28,7 @@ def test_compile_error_is_mapped_to_file_and_line(renderer, shader_copy):
     k = next(i for i, line in enumerate(lines) if "return d - kernel_rec(i, 1).w;" in line)
     lines[k] = lines[k].replace(";", " + undefined_thing;")
     path.write_text("\n".join(lines) + "\n")
-    with pytest.raises(ShaderError) as e:
+    with renderer.current(), pytest.raises(ShaderError) as e:
         build_program(renderer.ctx, "fullscreen.vert", "render.frag", DEFINES, shader_copy)
     text = str(e.value)
     assert f"kernels.glsl:{k + 1}:" in text, text

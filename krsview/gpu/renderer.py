@@ -3,6 +3,8 @@ float32 render targets, read back as :class:`Buffers` in image order (rows top â
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import moderngl
 import numpy as np
@@ -22,6 +24,22 @@ class Renderer:
         self.programs = ProgramCache(self.ctx)
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
+        self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
+        self._depth = 0
+
+    @contextmanager
+    def current(self) -> Iterator[None]:
+        """Make the context current for the outermost entry point only: glcontext's
+        enter/exit is not re-entrant, so a nested exit would leave no context current."""
+        if self._depth == 0:
+            self.ctx.__enter__()
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+            if self._depth == 0:
+                self.ctx.__exit__(None, None, None)
 
     def _framebuffer(self, width: int, height: int) -> moderngl.Framebuffer:
         if (width, height) not in self._targets:
@@ -32,6 +50,11 @@ class Renderer:
     def prepare(self, scene: Scene, width: int, height: int, krs: KRS | None = None
                 ) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms."""
+        with self.current():
+            return self._prepare(scene, width, height, krs)
+
+    def _prepare(self, scene: Scene, width: int, height: int, krs: KRS | None
+                 ) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
         c = compile_krs(krs or scene.geometry(), scene.material.albedo, origin=view.origin)
         prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c))
@@ -48,30 +71,43 @@ class Renderer:
                 prog[name].value = value
         return prog
 
-    def draw(self, prog: moderngl.Program, width: int, height: int) -> moderngl.Framebuffer:
-        fbo = self._framebuffer(width, height)
-        fbo.use()
-        self.ctx.viewport = (0, 0, width, height)
-        self.ctx.vertex_array(prog, []).render(moderngl.TRIANGLES, vertices=3)
-        return fbo
+    def draw(self, prog: moderngl.Program, width: int, height: int,
+             tile: tuple[int, int, int, int] | None = None) -> moderngl.Framebuffer:
+        """Trace the whole image, or only ``tile`` = (x, y, w, h) in GL pixel coordinates, so a
+        slow full-resolution frame can be spread over several event-loop turns."""
+        with self.current():
+            fbo = self._framebuffer(width, height)
+            fbo.use()
+            self.ctx.viewport = (0, 0, width, height)
+            self.ctx.scissor = tile
+            self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
+            self.ctx.scissor = None
+            return fbo
+
+    def _vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
+        if prog not in self._vaos:
+            self._vaos[prog] = self.ctx.vertex_array(prog, [])
+        return self._vaos[prog]
 
     def render(self, scene: Scene, width: int, height: int, krs: KRS | None = None) -> Buffers:
-        prog = self.prepare(scene, width, height, krs)
-        return read_buffers(self.draw(prog, width, height), width, height)
+        with self.current():
+            prog = self.prepare(scene, width, height, krs)
+            return read_buffers(self.draw(prog, width, height), width, height)
 
     def time_frame(self, scene: Scene, width: int, height: int, krs: KRS | None = None,
                    repeats: int = 1) -> list[float]:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up."""
-        prog = self.prepare(scene, width, height, krs)
-        self.draw(prog, width, height)
-        self.ctx.finish()
-        times = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
+        with self.current():
+            prog = self.prepare(scene, width, height, krs)
             self.draw(prog, width, height)
             self.ctx.finish()
-            times.append(time.perf_counter() - t0)
-        return times
+            times = []
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                self.draw(prog, width, height)
+                self.ctx.finish()
+                times.append(time.perf_counter() - t0)
+            return times
 
 
 def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Buffers:

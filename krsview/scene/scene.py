@@ -15,6 +15,13 @@ from .tree import Tree
 
 
 @dataclass(frozen=True)
+class Bookmark:
+    """A named camera saved in the scene file by the viewer."""
+    name: str = param("view", help="shown in the viewer's bookmark list")
+    camera: Camera = param(Camera())
+
+
+@dataclass(frozen=True)
 class Scene:
     name: str = param("untitled", help="shown in the viewer and reports")
     description: str = param("", help="one line about the scene")
@@ -25,6 +32,7 @@ class Scene:
     effects: list[str] = param([], help="effects compiled into this scene's shader")
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
+    bookmarks: list[Bookmark] = param([], help="saved cameras")
 
     def validate(self, path: str) -> None:
         if (self.krs is None) == (self.tree is None):

@@ -19,7 +19,7 @@ def _value(v: Any) -> str:
             return "nan"
         if math.isinf(v):
             return "inf" if v > 0 else "-inf"
-        return repr(v)
+        return repr(float(v))  # float(): numpy scalars repr as np.float64(…)
     if isinstance(v, str):
         # JSON escapes are TOML escapes; TOML also forbids a raw DEL character.
         return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")

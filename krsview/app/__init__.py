@@ -1,0 +1,1 @@
+"""The fly-through viewer: camera, input, adaptive resolution, window loop and HUD."""

@@ -1,0 +1,420 @@
+"""`krsview view`: a GLFW window to fly through a scene, with adaptive resolution, an ImGui HUD
+and hot reload of the preset and the shaders."""
+from __future__ import annotations
+
+import ctypes
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import moderngl
+import numpy as np
+from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
+import glfw  # noqa: E402  (order matters)
+
+from ..gpu.display import Display
+from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
+from ..gpu.renderer import Renderer
+from ..gpu.context import GL_VERSION
+from ..reference import compile_krs, distance
+from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
+from .adaptive import AdaptiveResolution, Refinement
+from .camera import FlyCamera
+from .controls import CONTROLS, LOOK_BUTTON, ORBIT_BUTTON, Input
+
+LOOK_RADIANS_PER_PIXEL = 0.004
+RELOAD_INTERVAL = 0.5   # seconds between checks of the preset and shader files
+GLFW_KEYS = {getattr(glfw, f"KEY_{k}"): k for k in set(CONTROLS.values())}
+GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
+
+
+class WindowError(RuntimeError):
+    """No window could be opened (no display, or no OpenGL 4.3+ there)."""
+
+
+class Viewer:
+    def __init__(self, path: Path, size: tuple[int, int] = (960, 540), hud: bool = True,
+                 target_fps: float = 30.0, visible: bool = True):
+        self.path = Path(path)
+        scene = load_scene(self.path)          # a bad file is a SceneError before any window
+        self.window = _open_window(size, f"krsview — {scene.name}", visible)
+        self.ctx = moderngl.create_context(require=GL_VERSION)
+        self.renderer = Renderer(self.ctx)
+        self.display = Display(self.ctx, self.renderer.programs)
+        self.input = Input()
+        self.hud = hud
+        self.view = "shaded"
+        self.levels = 0                         # 0: all of the scene's levels
+        self.speed_factor = 1.0                 # × distance to the nearest surface, per second
+        self.orbit_pivot: np.ndarray | None = None
+        self.message, self.error = "", ""
+        self.recording: list[tuple[float, np.ndarray, float, float]] | None = None
+        self.path_samples: list[tuple[float, np.ndarray, float, float]] = []
+        self.replay_start: float | None = None
+        self.bookmark_index = -1
+        self.clock = 0.0
+        fb = glfw.get_framebuffer_size(self.window)
+        self.adaptive = AdaptiveResolution(fb, target_fps)
+        self.image: tuple[moderngl.Framebuffer, tuple[int, int]] | None = None
+        self.refinement: Refinement | None = None
+        self.frame_seconds: list[float] = []
+        self._stamps = self._file_stamps()
+        self._last_check = time.perf_counter()
+        self._set_scene(scene, reset_camera=True)
+        self._init_imgui()
+        self._install_callbacks()
+
+    # ------------------------------------------------------------------------- scene state
+    def _set_scene(self, scene: Scene, reset_camera: bool = False) -> None:
+        self.scene = scene
+        self.geometry = scene.geometry()
+        self.levels = min(self.levels, len(self.geometry.levels))
+        self._apply_levels()
+        if reset_camera:
+            self.camera = FlyCamera.from_camera(scene.camera)
+        self.dirty = True
+
+    def _apply_levels(self) -> None:
+        self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
+        self.world = compile_krs(self.krs, self.scene.material.albedo)  # for speed & picking
+        self.dirty = True
+
+    def view_scene(self) -> Scene:
+        """The scene as drawn now: the viewer's camera and settings."""
+        return replace(self.scene, camera=self.camera.to_camera())
+
+    def nearest_distance(self) -> float:
+        return abs(float(distance(self.world, self.camera.position[None])[0]))
+
+    # --------------------------------------------------------------------------- the loop
+    def run(self) -> None:
+        last = time.perf_counter()
+        try:
+            while not glfw.window_should_close(self.window):
+                if self.is_idle():
+                    glfw.wait_events_timeout(0.05)
+                else:
+                    glfw.poll_events()
+                now = time.perf_counter()
+                self.step(now - last)
+                last = now
+        finally:
+            self.close()
+
+    def is_idle(self) -> bool:
+        return (not self.dirty and (self.refinement is None or self.refinement.done)
+                and not self.input.held and not self.input.buttons
+                and self.replay_start is None)
+
+    def step(self, dt: float) -> None:
+        """One event-loop turn: input, reload, a bounded amount of tracing, present, HUD."""
+        self.clock += dt
+        glfw.make_context_current(self.window)
+        self._handle_input(dt)
+        self._replay()
+        self._hot_reload()
+        self._trace()
+        self._present()
+        glfw.swap_buffers(self.window)
+
+    def close(self) -> None:
+        if self.window is not None:
+            imgui.backends.opengl3_shutdown()
+            imgui.backends.glfw_shutdown()
+            implot.destroy_context()
+            imgui.destroy_context()
+            glfw.destroy_window(self.window)
+            self.window = None
+
+    # -------------------------------------------------------------------------- tracing
+    def _trace(self) -> None:
+        scene = self.view_scene()
+        if self.dirty:
+            size = self.adaptive.moving_size()
+            t0 = time.perf_counter()
+            try:
+                prog = self.renderer.prepare(scene, *size, self.krs)
+            except ShaderError as e:
+                self.error, self.dirty = str(e), False
+                return
+            fbo = self.renderer.draw(prog, *size)
+            self.ctx.finish()
+            seconds = time.perf_counter() - t0
+            self.adaptive.frame_done(seconds)
+            self.frame_seconds = (self.frame_seconds + [seconds])[-240:]
+            self.image = (fbo, size)
+            still = self.adaptive.still_size()
+            self.refinement = Refinement(still) if still != size else None
+            self.dirty = False
+        elif self.refinement is not None and not self.refinement.done:
+            r = self.refinement
+            prog = self.renderer.prepare(scene, *r.size, self.krs)
+            spent, budget = 0.0, 0.8 * self.adaptive.budget
+            while not r.done and spent < budget:
+                tile = r.next_tile(budget - spent)
+                t0 = time.perf_counter()
+                fbo = self.renderer.draw(prog, *r.size, tile)
+                self.ctx.finish()
+                seconds = time.perf_counter() - t0
+                r.tile_done(tile, seconds)
+                spent += seconds
+            if r.done:
+                self.image = (fbo, r.size)
+
+    @property
+    def refined(self) -> bool:
+        """The window shows the full-resolution image of the current view."""
+        return not self.dirty and (self.refinement is None or self.refinement.done)
+
+    def _present(self) -> None:
+        fb = glfw.get_framebuffer_size(self.window)
+        if fb != self.adaptive.full and fb[0] > 0 and fb[1] > 0:
+            self.adaptive.full = fb
+            self.dirty = True
+        self.ctx.screen.use()
+        self.ctx.clear(*self.scene.material.background)
+        if self.image is not None:
+            self.display.show(self.image[0], self.ctx.screen, fb, self.view,
+                              self.scene.render.max_iterations, self._depth_scale())
+        if self.hud:
+            from .hud import draw_hud
+            imgui.backends.opengl3_new_frame()
+            imgui.backends.glfw_new_frame()
+            imgui.new_frame()
+            draw_hud(self)
+            imgui.render()
+            imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+    def _depth_scale(self) -> float:
+        return max(float(np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))),
+                   1e-9)
+
+    # ---------------------------------------------------------------------------- input
+    def _handle_input(self, dt: float) -> None:
+        for action in self.input.actions():
+            self.act(action)
+        scroll = self.input.take_scroll()
+        if scroll:
+            self.speed_factor *= 1.25 ** scroll
+        dx, dy = self.input.take_drag()
+        move = np.array(self.input.movement(), dtype=float)
+        if self.orbit_pivot is not None:
+            if ORBIT_BUTTON in self.input.buttons and (dx or dy):
+                self.camera.orbit(self.orbit_pivot, -dx * LOOK_RADIANS_PER_PIXEL,
+                                  dy * LOOK_RADIANS_PER_PIXEL)
+                self.dirty = True
+            if move[2]:
+                self.camera.dolly(self.orbit_pivot, 0.5 ** (move[2] * dt * self.speed_factor))
+                self.dirty = True
+            return
+        if LOOK_BUTTON in self.input.buttons and (dx or dy):
+            self.camera.look(-dx * LOOK_RADIANS_PER_PIXEL, -dy * LOOK_RADIANS_PER_PIXEL)
+            self.dirty = True
+        if move.any():
+            # Speed ∝ distance to the nearest surface: fly from a forest into a twig many
+            # levels deep without overshooting.
+            speed = self.speed_factor * max(self.nearest_distance(), 1e-12)
+            self.camera.fly(move, speed * dt)
+            self.dirty = True
+
+    def act(self, action: str) -> None:
+        if action == "reset":
+            self.camera = FlyCamera.from_camera(self.scene.camera)
+            self.orbit_pivot, self.dirty = None, True
+        elif action == "orbit":
+            self.orbit_pivot = None if self.orbit_pivot is not None else self.pick_center()
+            self.message = "orbit mode: left-drag turns, W/S dolly" if self.orbit_pivot is not None \
+                else "fly mode"
+        elif action == "screenshot":
+            self.screenshot()
+        elif action == "hud":
+            self.hud = not self.hud
+        elif action == "bookmark":
+            self.add_bookmark()
+        elif action == "next_bookmark" and self.scene.bookmarks:
+            self.bookmark_index = (self.bookmark_index + 1) % len(self.scene.bookmarks)
+            b = self.scene.bookmarks[self.bookmark_index]
+            self.camera, self.dirty = FlyCamera.from_camera(b.camera), True
+            self.message = f"bookmark {b.name!r}"
+        elif action == "record":
+            if self.recording is None:
+                self.recording, self.message = [], "recording the camera path (F5 stops)"
+            else:
+                self.path_samples, self.recording = self.recording, None
+                self.message = f"recorded {len(self.path_samples)} poses (F6 replays)"
+        elif action == "replay" and self.path_samples:
+            self.replay_start = self.clock
+
+    def pick_center(self) -> np.ndarray:
+        """The surface point under the window centre, from the last traced depth; else a point
+        ahead at the distance of the nearest surface."""
+        if self.image is not None:
+            fbo, (w, h) = self.image
+            x, y = w // 2, h // 2
+            raw = fbo.read(viewport=(x, y, 1, 1), attachment=1, components=4, dtype="f4")
+            depth = float(np.frombuffer(raw, np.float32)[3])
+            if depth > 0:
+                return self.camera.position + depth * self.camera.forward()
+        return self.camera.position + max(self.nearest_distance(), 1e-9) * self.camera.forward()
+
+    def _replay(self) -> None:
+        if self.recording is not None:
+            self.recording.append((self.clock, self.camera.position.copy(), self.camera.yaw,
+                                   self.camera.pitch))
+        if self.replay_start is None:
+            return
+        t = self.clock - self.replay_start + self.path_samples[0][0]
+        times = [s[0] for s in self.path_samples]
+        k = int(np.searchsorted(times, t))
+        if k >= len(times):
+            self.replay_start, self.message = None, "replay finished"
+            k = len(times) - 1
+        _, pos, yaw, pitch = self.path_samples[k]
+        self.camera.position, self.camera.yaw, self.camera.pitch = pos.copy(), yaw, pitch
+        self.dirty = True
+
+    # ------------------------------------------------------------------ files and output
+    def _file_stamps(self) -> tuple:
+        def mtime(p: Path) -> float:
+            try:
+                return p.stat().st_mtime
+            except OSError:
+                return 0.0
+        shaders = sorted(SHADER_DIR.iterdir())
+        return (mtime(self.path), tuple(mtime(p) for p in shaders))
+
+    def _hot_reload(self) -> None:
+        now = time.perf_counter()
+        if now - self._last_check < RELOAD_INTERVAL:
+            return
+        self._last_check = now
+        stamps = self._file_stamps()
+        if stamps == self._stamps:
+            return
+        preset_changed = stamps[0] != self._stamps[0]
+        self._stamps = stamps
+        if preset_changed:
+            try:
+                self._set_scene(load_scene(self.path))
+                self.error, self.message = "", f"reloaded {self.path.name}"
+            except SceneError as e:
+                self.error = str(e)             # keep the last good scene and image
+        else:
+            self.reload_shaders()
+
+    def reload_shaders(self) -> None:
+        """Compile the current variant from the edited files; on failure keep the old ones."""
+        programs = ProgramCache(self.ctx)
+        old = self.renderer.programs
+        try:
+            self.renderer.programs = programs
+            self.renderer.prepare(self.view_scene(), 1, 1, self.krs)
+            display = Display(self.ctx, programs)
+        except ShaderError as e:
+            self.renderer.programs, self.error = old, str(e)
+            return
+        self.display, self.error, self.message = display, "", "shaders reloaded"
+        self.dirty = True
+
+    def screenshot(self, path: Path | None = None) -> Path:
+        """A full-resolution PNG of the current view and view mode."""
+        size = self.adaptive.still_size()
+        out = path or Path("screenshots") / f"{self.path.stem}-{time.strftime('%Y%m%d-%H%M%S')}.png"
+        out.parent.mkdir(parents=True, exist_ok=True)
+        prog = self.renderer.prepare(self.view_scene(), *size, self.krs)
+        fbo = self.renderer.draw(prog, *size)
+        target = self.ctx.simple_framebuffer(size, components=4)
+        self.display.show(fbo, target, size, self.view, self.scene.render.max_iterations,
+                          self._depth_scale())
+        rgb = np.frombuffer(target.read(components=3), np.uint8).reshape(size[1], size[0], 3)
+        from PIL import Image
+        Image.fromarray(rgb[::-1]).save(out)
+        target.release()
+        self.message = f"screenshot: {out.resolve()}"
+        return out
+
+    def add_bookmark(self) -> None:
+        """Append the current camera to the preset file's bookmarks (atomic save)."""
+        try:
+            on_disk = load_scene(self.path)
+        except SceneError as e:
+            self.error = f"bookmark not saved: {e}"
+            return
+        b = Bookmark(f"view {len(on_disk.bookmarks) + 1}", self.camera.to_camera())
+        save_scene(replace(on_disk, bookmarks=on_disk.bookmarks + [b]), self.path)
+        self._stamps = self._file_stamps()      # our own save is not an outside edit
+        self.scene = replace(self.scene, bookmarks=on_disk.bookmarks + [b])
+        self.message = f"saved bookmark {b.name!r} in {self.path.name}"
+
+    def read_window(self) -> np.ndarray:
+        """The window's pixels (H, W, 3), rows top → bottom (for tests and screenshots)."""
+        w, h = glfw.get_framebuffer_size(self.window)
+        raw = self.ctx.screen.read(viewport=(0, 0, w, h), components=3)
+        _ = self.ctx.error  # screen reads can leave a GL error pending (DESIGN.md)
+        return np.frombuffer(raw, np.uint8).reshape(h, w, 3)[::-1].copy()
+
+    # ------------------------------------------------------------------ window plumbing
+    def _init_imgui(self) -> None:
+        imgui.create_context()
+        implot.create_context()
+        imgui.get_io().set_ini_filename("")
+        addr = ctypes.cast(self.window, ctypes.c_void_p).value
+        self._addr = addr
+        imgui.backends.glfw_init_for_opengl(addr, False)
+        imgui.backends.opengl3_init("#version 430")
+
+    def _install_callbacks(self) -> None:
+        b, a = imgui.backends, self._addr
+
+        def on_key(_w, key, scancode, action, mods):
+            b.glfw_key_callback(a, key, scancode, action, mods)
+            if action != glfw.REPEAT and key in GLFW_KEYS and not imgui.get_io().want_capture_keyboard:
+                self.input.key(GLFW_KEYS[key], action == glfw.PRESS)
+
+        def on_button(_w, button, action, mods):
+            b.glfw_mouse_button_callback(a, button, action, mods)
+            if button in GLFW_BUTTONS and (action == glfw.RELEASE or
+                                           not imgui.get_io().want_capture_mouse):
+                self.input.button(GLFW_BUTTONS[button], action == glfw.PRESS)
+                look = GLFW_BUTTONS[button] == LOOK_BUTTON
+                if look and self.orbit_pivot is None:
+                    mode = glfw.CURSOR_DISABLED if action == glfw.PRESS else glfw.CURSOR_NORMAL
+                    glfw.set_input_mode(self.window, glfw.CURSOR, mode)
+
+        def on_cursor(_w, x, y):
+            b.glfw_cursor_pos_callback(a, x, y)
+            self.input.move_cursor(x, y)
+
+        def on_scroll(_w, dx, dy):
+            b.glfw_scroll_callback(a, dx, dy)
+            if not imgui.get_io().want_capture_mouse:
+                self.input.wheel(dy)
+
+        def on_char(_w, c):
+            b.glfw_char_callback(a, c)
+
+        self._callbacks = (on_key, on_button, on_cursor, on_scroll, on_char)  # keep alive
+        glfw.set_key_callback(self.window, on_key)
+        glfw.set_mouse_button_callback(self.window, on_button)
+        glfw.set_cursor_pos_callback(self.window, on_cursor)
+        glfw.set_scroll_callback(self.window, on_scroll)
+        glfw.set_char_callback(self.window, on_char)
+
+
+def _open_window(size: tuple[int, int], title: str, visible: bool):
+    if not glfw.init():
+        raise WindowError("cannot open a window: GLFW found no display (is DISPLAY set? "
+                          "use `krsview render` to render headless)")
+    for minor in (5, 3):  # 4.6 fails on llvmpipe (DESIGN.md)
+        glfw.default_window_hints()
+        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
+        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, minor)
+        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
+        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
+        glfw.window_hint(glfw.VISIBLE, visible)
+        window = glfw.create_window(size[0], size[1], title, None, None)
+        if window:
+            glfw.make_context_current(window)
+            glfw.swap_interval(0)
+            return window
+    raise WindowError("cannot open an OpenGL 4.3+ core window on this display")

@@ -1,0 +1,194 @@
+"""The real viewer window under Xvfb, driven through its input layer."""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from krsview.app.adaptive import AdaptiveResolution, Refinement
+from krsview.presets import resolve
+from krsview.scene import load_scene, save_scene
+
+SIZE = (160, 120)
+
+
+@pytest.fixture(scope="module")
+def display():
+    """An X display: the session's own, or an Xvfb started for these tests."""
+    if os.environ.get("DISPLAY"):
+        yield os.environ["DISPLAY"]
+        return
+    xvfb = shutil.which("Xvfb")
+    assert xvfb, "Xvfb is needed for the window tests (`make deps` installs it)"
+    for n in range(90, 110):
+        if not Path(f"/tmp/.X{n}-lock").exists():
+            break
+    proc = subprocess.Popen([xvfb, f":{n}", "-screen", "0", "640x480x24", "-nolisten", "tcp"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(100):
+        if Path(f"/tmp/.X11-unix/X{n}").exists():
+            break
+        time.sleep(0.05)
+    os.environ["DISPLAY"] = f":{n}"
+    yield f":{n}"
+    del os.environ["DISPLAY"]
+    proc.terminate()
+    proc.wait(5)
+
+
+@pytest.fixture
+def viewer(display, tmp_path):
+    from krsview.app.window import Viewer
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=SIZE, hud=False)
+    yield v
+    v.close()
+
+
+def settle(v, limit: int = 400) -> None:
+    for _ in range(limit):
+        v.step(0.02)
+        if v.refined:
+            return
+    raise AssertionError("the view never refined to full resolution")
+
+
+def headless_render(scene, path: Path) -> np.ndarray:
+    """`krsview render` in its own process (EGL, no window) of the same scene and camera."""
+    save_scene(scene, path.with_suffix(".toml"))
+    out = path.with_suffix(".png")
+    r = subprocess.run([sys.executable, "-m", "krsview", "render", str(path.with_suffix(".toml")),
+                        "-o", str(out), "--size", f"{SIZE[0]}x{SIZE[1]}", "--repeats", "1"],
+                       capture_output=True, text=True, timeout=120, env={**os.environ, "DISPLAY": ""})
+    assert r.returncode == 0, r.stderr
+    return np.asarray(Image.open(out).convert("RGB"))
+
+
+def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_path):
+    v = viewer
+    settle(v)
+    start = v.read_window()
+    p0 = v.camera.position.copy()
+    v.input.key("W", True)
+    for _ in range(5):
+        v.step(0.1)
+    v.input.key("W", False)
+    v.input.button("right", True)
+    v.input.move_cursor(0, 0)
+    v.input.move_cursor(25, -10)
+    v.step(0.05)
+    v.input.button("right", False)
+    settle(v)
+    assert np.linalg.norm(v.camera.position - p0) > 0.1, "W did not move the camera"
+    shot = v.read_window()
+    assert np.abs(shot.astype(int) - start).max() > 50, "the view did not change"
+    ref = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "headless")
+    close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
+    assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
+
+
+def test_adaptive_resolution_drops_when_slow_and_restores_when_still(viewer):
+    v = viewer
+    v.adaptive.target_fps = 2000.0           # a budget no llvmpipe frame meets
+    scales = []
+    for _ in range(8):
+        v.input.key("D", True)
+        v.step(0.05)
+        scales.append(v.adaptive.scale)
+    v.input.key("D", False)
+    assert scales[-1] < scales[0] and v.adaptive.moving_size()[0] < SIZE[0] / 3
+    settle(v)
+    assert v.image[1] == SIZE, "the still image is not back at full resolution"
+
+
+def test_orbit_keeps_distance_to_the_picked_point(viewer):
+    v = viewer
+    settle(v)
+    v.act("orbit")
+    pivot = v.orbit_pivot
+    r0 = np.linalg.norm(v.camera.position - pivot)
+    v.input.button("left", True)
+    v.input.move_cursor(0, 0)
+    v.input.move_cursor(80, 0)
+    v.step(0.05)
+    v.input.button("left", False)
+    assert np.isclose(np.linalg.norm(v.camera.position - pivot), r0, rtol=1e-9)
+    assert np.allclose(v.camera.forward(), (pivot - v.camera.position) / r0, atol=1e-9)
+
+
+def test_bookmark_is_saved_in_the_preset_and_reset_restores(viewer):
+    v = viewer
+    v.input.key("A", True)
+    v.step(0.2)
+    v.input.key("A", False)
+    moved = v.camera.to_camera()
+    v.input.key("B", True)
+    v.step(0.01)
+    v.input.key("B", False)
+    saved = load_scene(v.path)
+    assert saved.bookmarks and saved.bookmarks[-1].camera == moved
+    v.act("reset")
+    assert v.camera.to_camera().position == saved.camera.position
+    v.act("next_bookmark")
+    assert np.allclose(v.camera.position, moved.position)
+
+
+def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
+    v = viewer
+    settle(v)
+    scene = load_scene(v.path)
+    save_scene(replace(scene, material=replace(scene.material, background=(1.0, 0.0, 0.0))),
+               v.path)
+    time.sleep(0.6)
+    for _ in range(3):
+        v.step(0.3)
+    assert v.scene.material.background == (1.0, 0.0, 0.0) and not v.error
+    v.path.write_text(v.path.read_text().replace("levels = 22", "levels = -4"))
+    time.sleep(0.6)
+    for _ in range(3):
+        v.step(0.3)
+    assert "tree.levels = -4" in v.error
+    assert v.scene.material.background == (1.0, 0.0, 0.0)  # last good scene kept
+    assert v.image is not None
+
+
+def test_record_and_replay_a_camera_path(viewer):
+    v = viewer
+    v.act("record")
+    for _ in range(5):
+        v.input.key("E", True)
+        v.step(0.05)
+    v.input.key("E", False)
+    v.act("record")
+    end = v.camera.position.copy()
+    v.act("reset")
+    v.act("replay")
+    for _ in range(20):
+        v.step(0.05)
+    assert v.replay_start is None and np.allclose(v.camera.position, end)
+
+
+def test_adaptive_controller_unit():
+    a = AdaptiveResolution((640, 360), target_fps=30)
+    for _ in range(20):
+        a.frame_done(0.2)                  # far over budget: shrink to the floor
+    assert a.scale == a.min_scale
+    for _ in range(40):
+        a.frame_done(0.001)                # far under budget: grow back to full
+    assert a.scale == 1.0
+    r = Refinement((100, 50))
+    tiles = []
+    while not r.done:
+        tile = r.next_tile(0.01)
+        r.tile_done(tile, 0.004)
+        tiles.append(tile)
+    assert sum(t[3] for t in tiles) == 50 and tiles[0][1] == 0
