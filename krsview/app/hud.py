@@ -22,11 +22,14 @@ TRACERS = Render.__dataclass_fields__["tracer"].metadata["choices"]
 
 def draw_hud(v: "Viewer") -> None:
     imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
-    imgui.set_next_window_bg_alpha(0.8)
-    imgui.begin("krsview")
+    imgui.set_next_window_size(imgui.ImVec2(330, 0), imgui.Cond_.first_use_ever)
+    imgui.set_next_window_bg_alpha(0.75)
+    imgui.begin("krsview (F1 hides)")
     _performance(v)
-    _accuracy(v)
-    _scene(v)
+    if imgui.collapsing_header("accuracy and view"):
+        _accuracy(v)
+    if imgui.collapsing_header("scene, camera, output"):
+        _scene(v)
     if v.message:
         imgui.text_wrapped(v.message)
     if v.error:
@@ -40,9 +43,9 @@ def _performance(v: "Viewer") -> None:
     w, h = v.adaptive.moving_size()
     state = "refined" if v.refined else f"refining {v.refinement.next_row}/{v.refinement.size[1]}" \
         if v.refinement else "moving"
-    imgui.text(f"{fps:5.1f} FPS  {np.median(times):6.1f} ms   internal {w}×{h} "
-               f"({v.adaptive.scale:.0%}), {state}")
-    if implot.begin_plot("##frametime", imgui.ImVec2(-1, 90)):
+    imgui.text(f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.adaptive.scale:.0%})")
+    imgui.text(f"{state}; {v.view} view")
+    if implot.begin_plot("##frametime", imgui.ImVec2(-1, 70), implot.Flags_.no_legend):
         implot.setup_axes_limits(0, 120, 0, max(60.0, float(times.max()) * 1.1),
                                  implot.Cond_.always)
         implot.plot_line("frame ms", times)
