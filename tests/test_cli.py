@@ -73,3 +73,13 @@ def test_bench_levels_prints_the_ratio_table(capsys):
     rows = [line for line in out.splitlines() if line.startswith("| ") and line[2].isdigit()]
     assert [int(r.split("|")[1]) for r in rows] == [8, 16, 22]
     assert rows[0].split("|")[4].strip() == "1.00"  # the smallest level count is the unit
+
+
+def test_view_without_a_display_says_what_to_do():
+    import os
+    r = subprocess.run([sys.executable, "-m", "krsview", "view", "tree"], capture_output=True,
+                       text=True, timeout=60, env={k: v for k, v in os.environ.items()
+                                                   if k not in ("DISPLAY", "WAYLAND_DISPLAY")})
+    assert r.returncode == 3 and "Traceback" not in r.stderr
+    assert r.stderr.strip() == ("krsview: error: cannot open a window: GLFW found no display "
+                                "(is DISPLAY set? use `krsview render` to render headless)")

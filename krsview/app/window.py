@@ -402,6 +402,7 @@ class Viewer:
 
 
 def _open_window(size: tuple[int, int], title: str, visible: bool):
+    glfw.ERROR_REPORTING = "ignore"  # failures are reported below, as a WindowError
     if not glfw.init():
         raise WindowError("cannot open a window: GLFW found no display (is DISPLAY set? "
                           "use `krsview render` to render headless)")
