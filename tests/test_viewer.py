@@ -161,6 +161,35 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
     assert v.image is not None
 
 
+def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(display, tmp_path):
+    from krsview.app.window import Viewer
+    from krsview.gpu.program import SHADER_DIR
+    shaders = tmp_path / "shaders"
+    shutil.copytree(SHADER_DIR, shaders)
+    v = Viewer(resolve("sierpinski"), size=SIZE, hud=False, shader_dir=shaders)
+    try:
+        settle(v)
+        shade = shaders / "shade.glsl"
+        shade.write_text(shade.read_text().replace("return albedo * light;",
+                                                   "return vec3(1.0, 0.0, 1.0);"))
+        time.sleep(0.6)
+        v.step(0.01)
+        settle(v)
+        magenta = v.read_window()
+        assert not v.error and (np.abs(magenta.astype(int) - (255, 0, 255)).max(-1) < 3).mean() > 0.1
+        lines = shade.read_text().splitlines()
+        k = next(i for i, line in enumerate(lines) if "vec3(1.0, 0.0, 1.0)" in line)
+        lines[k] = lines[k].replace(";", " +;")
+        shade.write_text("\n".join(lines) + "\n")
+        time.sleep(0.6)
+        v.step(0.01)
+        settle(v)
+        assert f"shade.glsl:{k + 1}" in v.error, v.error
+        assert np.array_equal(v.read_window(), magenta), "the last good image was lost"
+    finally:
+        v.close()
+
+
 def test_record_and_replay_a_camera_path(viewer):
     v = viewer
     v.act("record")

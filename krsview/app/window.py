@@ -34,12 +34,13 @@ class WindowError(RuntimeError):
 
 class Viewer:
     def __init__(self, path: Path, size: tuple[int, int] = (960, 540), hud: bool = True,
-                 target_fps: float = 30.0, visible: bool = True):
+                 target_fps: float = 30.0, visible: bool = True, shader_dir: Path = SHADER_DIR):
         self.path = Path(path)
+        self.shader_dir = Path(shader_dir)
         scene = load_scene(self.path)          # a bad file is a SceneError before any window
         self.window = _open_window(size, f"krsview — {scene.name}", visible)
         self.ctx = moderngl.create_context(require=GL_VERSION)
-        self.renderer = Renderer(self.ctx)
+        self.renderer = Renderer(self.ctx, self.shader_dir)
         self.display = Display(self.ctx, self.renderer.programs)
         self.input = Input()
         self.hud = hud
@@ -280,7 +281,7 @@ class Viewer:
                 return p.stat().st_mtime
             except OSError:
                 return 0.0
-        shaders = sorted(SHADER_DIR.iterdir())
+        shaders = sorted(self.shader_dir.iterdir())
         return (mtime(self.path), tuple(mtime(p) for p in shaders))
 
     def _hot_reload(self) -> None:
@@ -304,7 +305,7 @@ class Viewer:
 
     def reload_shaders(self) -> None:
         """Compile the current variant from the edited files; on failure keep the old ones."""
-        programs = ProgramCache(self.ctx)
+        programs = ProgramCache(self.ctx, self.shader_dir)
         old = self.renderer.programs
         try:
             self.renderer.programs = programs

@@ -3,6 +3,7 @@ float32 render targets, read back as :class:`Buffers` in image order (rows top â
 from __future__ import annotations
 
 import time
+from pathlib import Path
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -14,14 +15,14 @@ from ..reference.camera import view_of
 from ..reference.compiled import compile_krs
 from ..scene import KRS, Scene
 from .context import headless_context
-from .program import ProgramCache
+from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
 
 
 class Renderer:
-    def __init__(self, ctx: moderngl.Context | None = None):
+    def __init__(self, ctx: moderngl.Context | None = None, shader_dir: Path = SHADER_DIR):
         self.ctx = ctx or headless_context()
-        self.programs = ProgramCache(self.ctx)
+        self.programs = ProgramCache(self.ctx, shader_dir)
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
