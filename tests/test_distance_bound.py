@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from krsview.reference import compile_krs, distance
 from krsview.reference.kernels import kernel_distance
-from krsview.scene import KRS, Capsule, Empty, Level, Mirror, Sphere, ToroidalCapsule
+from krsview.scene import KRS, Capsule, Empty, Level, Mirror, Plane, Sphere, ToroidalCapsule
 
 ALBEDO = (0.5, 0.5, 0.5)
 seeds = st.integers(0, 2**32 - 1)
@@ -199,3 +199,20 @@ def test_kernel_distance_matches_dense_core_samples(seed):
     got = kernel_distance(c.types[0], c.records[0], x)
     spacing = np.max(np.linalg.norm(np.diff(core, axis=0), axis=1)) if len(core) > 1 else 0.0
     assert np.all(got <= brute + 1e-9) and np.all(brute - got <= spacing + 1e-9)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=seeds, n=st.integers(0, 6))
+def test_camera_relative_compile_is_a_pure_translation(seed, n):
+    """relative_to(o) (the per-frame step for the GPU) moves every kernel type and mirror by
+    −o: distances at x − o equal world distances at x."""
+    rng = np.random.default_rng(seed)
+    krs = arbitrary_krs(rng, n)
+    u = unit(rng)
+    krs = KRS(krs.levels + [Level(Plane(tuple(u), float(rng.normal())),
+                                  Mirror(tuple(unit(rng)), float(rng.normal())))])
+    world = compile_krs(krs, ALBEDO)
+    o = rng.normal(size=3) * 10.0
+    x = rng.normal(size=(200, 3)) * 3.0
+    assert np.allclose(distance(world.relative_to(o), x - o), distance(world, x),
+                       rtol=1e-9, atol=1e-9)

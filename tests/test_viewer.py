@@ -221,3 +221,21 @@ def test_adaptive_controller_unit():
         r.tile_done(tile, 0.004)
         tiles.append(tile)
     assert sum(t[3] for t in tiles) == 50 and tiles[0][1] == 0
+
+
+def test_preset_picker_and_levels_slider(viewer):
+    v = viewer
+    settle(v)
+    full = v.read_window()
+    v.set_levels(6)
+    assert len(v.krs.levels) == 6 and v.krs.kernels[-1] == v.geometry.kernels[-1]
+    settle(v)
+    assert (np.abs(v.read_window().astype(int) - full).max(-1) > 30).mean() > 0.01  # fewer twigs
+    v.set_levels(len(v.geometry.levels))
+    assert v.krs is v.geometry
+    v.open_preset(resolve("sierpinski"))
+    assert v.scene.name == "sierpinski" and v.path == resolve("sierpinski") and not v.error
+    assert v.camera.to_camera().position == v.scene.camera.position
+    settle(v)
+    v.open_preset(v.path.with_name("missing.toml"))
+    assert "cannot read" in v.error and v.scene.name == "sierpinski"  # kept the last good one

@@ -10,7 +10,7 @@ from imgui_bundle import imgui, implot
 
 from ..gpu.display import VIEW_MODES
 from ..presets import preset_names, resolve
-from ..scene import EFFECTS, SceneError, load_scene
+from ..scene import EFFECTS
 from ..scene.model import Render
 
 if TYPE_CHECKING:
@@ -79,8 +79,7 @@ def _accuracy(v: "Viewer") -> None:
     total = len(v.geometry.levels)
     changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
     if changed:
-        v.levels = 0 if levels == total else levels
-        v._apply_levels()
+        v.set_levels(levels)
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))
     if changed:
         v.view = VIEW_MODES[k]
@@ -100,13 +99,7 @@ def _scene(v: "Viewer") -> None:
     current = names.index(v.path.stem) if v.path.stem in names else -1
     changed, k = imgui.combo("preset", current, names)
     if changed:
-        try:
-            path = resolve(names[k])
-            v.path = path
-            v._set_scene(load_scene(path), reset_camera=True)
-            v._stamps, v.error = v._file_stamps(), ""
-        except SceneError as e:
-            v.error = str(e)
+        v.open_preset(resolve(names[k]))
     imgui.text(f"speed ×{v.speed_factor:.2f} of the nearest distance "
                f"({v.nearest_distance():.3g}); scroll to change")
     if imgui.button("screenshot (F12)"):

@@ -75,6 +75,22 @@ class Viewer:
             self.camera = FlyCamera.from_camera(scene.camera)
         self.dirty = True
 
+    def open_preset(self, path: Path) -> None:
+        """Show another scene file from its own camera; it becomes the one watched for edits."""
+        try:
+            scene = load_scene(path)
+        except SceneError as e:
+            self.error = str(e)
+            return
+        self.path = Path(path)
+        self._set_scene(scene, reset_camera=True)
+        self._stamps, self.error = self._file_stamps(), ""
+
+    def set_levels(self, levels: int) -> None:
+        """Draw only the coarsest ``levels`` levels (0 or all: the whole scene)."""
+        self.levels = 0 if levels >= len(self.geometry.levels) else levels
+        self._apply_levels()
+
     def _apply_levels(self) -> None:
         self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
         self.world = compile_krs(self.krs, self.scene.material.albedo)  # for speed & picking

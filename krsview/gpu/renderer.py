@@ -12,7 +12,7 @@ import numpy as np
 
 from ..buffers import Buffers
 from ..reference.camera import view_of
-from ..reference.compiled import compile_krs
+from ..reference.compiled import CompiledKRS, compile_krs
 from ..scene import KRS, Scene
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
@@ -27,6 +27,7 @@ class Renderer:
         self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
+        self._compiled: tuple[KRS, tuple, CompiledKRS] | None = None  # last KRS, per scene
 
     @contextmanager
     def current(self) -> Iterator[None]:
@@ -57,7 +58,7 @@ class Renderer:
     def _prepare(self, scene: Scene, width: int, height: int, krs: KRS | None
                  ) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
-        c = compile_krs(krs or scene.geometry(), scene.material.albedo, origin=view.origin)
+        c = self._world(krs or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c))
         block = krs_block(c)
         if self._ubo is None or self._ubo.size != len(block):
@@ -71,6 +72,13 @@ class Renderer:
             if name in prog:
                 prog[name].value = value
         return prog
+
+    def _world(self, krs: KRS, albedo: tuple) -> CompiledKRS:
+        """The KRS compiled in world coordinates, redone only when the KRS or albedo changes
+        (a moving camera only translates it: per-frame work stays per-frame)."""
+        if self._compiled is None or self._compiled[0] is not krs or self._compiled[1] != albedo:
+            self._compiled = (krs, albedo, compile_krs(krs, albedo))
+        return self._compiled[2]
 
     def draw(self, prog: moderngl.Program, width: int, height: int,
              tile: tuple[int, int, int, int] | None = None) -> moderngl.Framebuffer:

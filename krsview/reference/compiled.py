@@ -1,8 +1,9 @@
 """A KRS flattened to arrays, shared by the NumPy reference and the GPU uniform packer.
 
 Each kernel becomes a record of ``RECORD_VEC4`` vec4s (layout below, mirrored in
-``shaders/kernels.glsl``); positions are relative to ``origin`` so the GPU can work in
-camera-relative coordinates while the CPU keeps the camera in float64 (DESIGN.md, Precision).
+``shaders/kernels.glsl``). Compiled once per scene in world coordinates; ``relative_to`` moves
+the origin to the camera each frame, so the GPU works in camera-relative float32 while the CPU
+keeps the camera in float64 (DESIGN.md, Precision).
 """
 from __future__ import annotations
 
@@ -23,9 +24,13 @@ RECORD_VEC4 = 6
 # record[5] = arc (e2: unit, in-plane ⟂ e1, sin phi)
 
 
+# Record slots holding a position (xyz), per kernel type: what moves when the origin moves.
+POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1, 2, 3)}
+
+
 @dataclass(frozen=True)
 class CompiledKRS:
-    mirrors: np.ndarray   # (n, 4): u.xyz, w  (plane u·x = w, relative to origin)
+    mirrors: np.ndarray   # (n, 4): u.xyz, w  (the plane u·x = w)
     records: np.ndarray   # (n+1, RECORD_VEC4, 4) float64
     types: tuple[str, ...]  # kernel type per level (after arc → capsule degeneration)
 
@@ -33,12 +38,24 @@ class CompiledKRS:
     def n(self) -> int:
         return len(self.mirrors)
 
+    def relative_to(self, origin: np.ndarray | tuple) -> "CompiledKRS":
+        """The same KRS with every position taken relative to ``origin`` (float64): the
+        per-frame step of camera-relative rendering; the rest is compiled once per scene."""
+        o = np.asarray(origin, dtype=np.float64)
+        mirrors = self.mirrors.copy()
+        mirrors[:, 3] -= mirrors[:, :3] @ o
+        records = self.records.copy()
+        for i, kind in enumerate(self.types):
+            for slot in POSITION_SLOTS.get(kind, ()):
+                records[i, slot, :3] -= o
+            if kind == "plane":
+                records[i, 1, 3] -= records[i, 1, :3] @ o
+        return CompiledKRS(mirrors, records, self.types)
 
-def compile_krs(krs: KRS, albedo: tuple[float, float, float],
-                origin: np.ndarray | tuple = (0.0, 0.0, 0.0)) -> CompiledKRS:
-    """Flatten ``krs`` with all positions taken relative to ``origin`` (float64)."""
-    o = np.asarray(origin, dtype=np.float64)
-    mirrors = np.array([[*m.normal, m.offset - np.dot(m.normal, o)] for m in krs.mirrors],
+
+def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
+    """Flatten ``krs`` in world coordinates (float64); see :meth:`CompiledKRS.relative_to`."""
+    mirrors = np.array([[*m.normal, m.offset] for m in krs.mirrors],
                        dtype=np.float64).reshape(-1, 4)
     records = np.zeros((len(krs.levels), RECORD_VEC4, 4))
     types = []
@@ -47,22 +64,22 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float],
         r = records[i]
         color = getattr(k, "color", None) or albedo
         if isinstance(k, Sphere):
-            r[1] = [*(np.array(k.center) - o), k.radius]
+            r[1] = [*k.center, k.radius]
         elif isinstance(k, Capsule):
-            r[1] = [*(np.array(k.a) - o), k.radius]
-            r[2, :3] = np.array(k.b) - o
+            r[1] = [*k.a, k.radius]
+            r[2, :3] = k.b
         elif isinstance(k, ToroidalCapsule):
-            r[1] = [*(np.array(k.start) - o), k.radius]
-            r[2, :3] = np.array(k.end) - o
+            r[1] = [*k.start, k.radius]
+            r[2, :3] = k.end
             arc = arc_of(k)
             if arc is None:
                 kind = "capsule"
             else:
-                r[3] = [*(np.array(arc.center) - o), arc.R]
+                r[3] = [*arc.center, arc.R]
                 r[4] = [*arc.e1, np.cos(arc.phi)]
                 r[5] = [*arc.e2, np.sin(arc.phi)]
         elif isinstance(k, Plane):
-            r[1] = [*k.normal, k.offset - np.dot(k.normal, o)]
+            r[1] = [*k.normal, k.offset]
         else:
             assert isinstance(k, Empty), k
         r[0] = [*color, KERNEL_CODES[kind]]
