@@ -45,10 +45,12 @@ class Source:
         except OSError:
             where = f" (included from {stack[-1]})" if stack else ""
             raise ShaderError(f"shader file not found: {name}{where}") from None
-        if name in self.included:  # each file once, like a header guard
-            return []
         self.included.add(name)
-        out: list[str] = []
+        # A real header guard, not a textual skip: an #include inside an inactive #ifdef
+        # branch must not hide the file from an active branch later.
+        guard = "KRS_FILE_" + re.sub(r"\W", "_", name).upper()
+        out: list[str] = [f"#ifndef {guard}", f"#define {guard}"]
+        self.origin += [(name, 0), (name, 0)]
         for k, line in enumerate(text.splitlines(), 1):
             m = _INCLUDE.match(line)
             if m:
@@ -56,6 +58,8 @@ class Source:
             else:
                 out.append(line)
                 self.origin.append((name, k))
+        out.append(f"#endif  // {guard}")
+        self.origin.append((name, len(text.splitlines()) + 1))
         return out
 
     def map_log(self, log: str) -> str:

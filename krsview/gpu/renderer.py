@@ -12,8 +12,8 @@ import numpy as np
 
 from ..buffers import Buffers
 from ..reference.camera import view_of
-from ..reference.compiled import CompiledKRS, compile_krs
-from ..scene import KRS, Scene
+from ..reference.geometry import Compiled, compile_geometry
+from ..scene import KRS, MoKRS, Scene
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
@@ -27,7 +27,7 @@ class Renderer:
         self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
-        self._compiled: tuple[KRS, tuple, CompiledKRS] | None = None  # last KRS, per scene
+        self._compiled: tuple[KRS | MoKRS, tuple, Compiled] | None = None  # last geometry
 
     @contextmanager
     def current(self) -> Iterator[None]:
@@ -49,16 +49,16 @@ class Renderer:
             self._targets[(width, height)] = self.ctx.framebuffer(color_attachments=tex)
         return self._targets[(width, height)]
 
-    def prepare(self, scene: Scene, width: int, height: int, krs: KRS | None = None
+    def prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None
                 ) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms."""
         with self.current():
-            return self._prepare(scene, width, height, krs)
+            return self._prepare(scene, width, height, geometry)
 
-    def _prepare(self, scene: Scene, width: int, height: int, krs: KRS | None
+    def _prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None
                  ) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
-        c = self._world(krs or scene.geometry(), scene.material.albedo).relative_to(view.origin)
+        c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c))
         block = krs_block(c)
         if self._ubo is None or self._ubo.size != len(block):
@@ -73,11 +73,12 @@ class Renderer:
                 prog[name].value = value
         return prog
 
-    def _world(self, krs: KRS, albedo: tuple) -> CompiledKRS:
-        """The KRS compiled in world coordinates, redone only when the KRS or albedo changes
-        (a moving camera only translates it: per-frame work stays per-frame)."""
-        if self._compiled is None or self._compiled[0] is not krs or self._compiled[1] != albedo:
-            self._compiled = (krs, albedo, compile_krs(krs, albedo))
+    def _world(self, geometry: KRS | MoKRS, albedo: tuple) -> Compiled:
+        """The geometry compiled in world coordinates, redone only when it or the albedo
+        changes (a moving camera only translates it: per-frame work stays per-frame)."""
+        if (self._compiled is None or self._compiled[0] is not geometry
+                or self._compiled[1] != albedo):
+            self._compiled = (geometry, albedo, compile_geometry(geometry, albedo))
         return self._compiled[2]
 
     def draw(self, prog: moderngl.Program, width: int, height: int,
@@ -98,16 +99,16 @@ class Renderer:
             self._vaos[prog] = self.ctx.vertex_array(prog, [])
         return self._vaos[prog]
 
-    def render(self, scene: Scene, width: int, height: int, krs: KRS | None = None) -> Buffers:
+    def render(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None) -> Buffers:
         with self.current():
-            prog = self.prepare(scene, width, height, krs)
+            prog = self.prepare(scene, width, height, geometry)
             return read_buffers(self.draw(prog, width, height), width, height)
 
-    def time_frame(self, scene: Scene, width: int, height: int, krs: KRS | None = None,
+    def time_frame(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None,
                    repeats: int = 1) -> list[float]:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up."""
         with self.current():
-            prog = self.prepare(scene, width, height, krs)
+            prog = self.prepare(scene, width, height, geometry)
             self.draw(prog, width, height)
             self.ctx.finish()
             times = []

@@ -3,29 +3,51 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..reference import mobius
 from ..reference.camera import View
-from ..reference.compiled import RECORD_VEC4, CompiledKRS
+from ..reference.compiled import RECORD_VEC4
+from ..reference.geometry import Compiled
+from ..reference.mokrs import CompiledMoKRS
 from ..scene import MAX_LEVELS, Scene
 
+MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, (pole.xyz, flags); mobius.glsl
 
-def variant_defines(scene: Scene, c: CompiledKRS) -> dict[str, str | int | None]:
-    """One define per kernel type present and per enabled effect: nothing else is compiled."""
+
+def variant_defines(scene: Scene, c: Compiled) -> dict[str, str | int | None]:
+    """One define per kernel type present, per enabled effect, for the tracer and for the
+    Möbius geometry family: nothing else is compiled."""
     defines: dict[str, str | int | None] = {"KRS_MAX_LEVELS": MAX_LEVELS,
                                             "KRS_RECORD": RECORD_VEC4}
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
     for effect in scene.effects:
         defines[f"KRS_{effect.upper()}"] = None
+    if scene.render.tracer == "binary":
+        defines["KRS_TRACER_BINARY"] = None
+    if isinstance(c, CompiledMoKRS):
+        defines["KRS_MOBIUS"] = None
+        defines["MOBIUS_RECORD"] = MOBIUS_RECORD
     return defines
 
 
-def krs_block(c: CompiledKRS) -> bytes:
-    """The std140 KRSBlock: mirrors[MAX_LEVELS] then kernel records, as float32."""
-    mirrors = np.zeros((MAX_LEVELS, 4), dtype=np.float32)
-    mirrors[:c.n] = c.mirrors
-    kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
-    kernels[:c.n + 1] = c.records
-    return mirrors.tobytes() + kernels.tobytes()
+def krs_block(c: Compiled) -> bytes:
+    """The std140 KRSBlock: mirrors (or Möbius records) then kernel records, as float32."""
+    if isinstance(c, CompiledMoKRS):
+        levels = np.zeros((MAX_LEVELS, MOBIUS_RECORD, 4))
+        levels[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
+        for i, H in enumerate(c.inverse):
+            p = mobius.pole(H)
+            levels[i, 4] = [*(p if p is not None else (0.0, 0.0, 0.0)),
+                            (p is not None) + 2 * bool(c.reflect[i])]
+        head = levels.astype(np.float32)
+        kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
+        kernels[:c.n] = c.records
+    else:
+        head = np.zeros((MAX_LEVELS, 4), dtype=np.float32)
+        head[:c.n] = c.mirrors
+        kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
+        kernels[:c.n + 1] = c.records
+    return head.tobytes() + kernels.tobytes()
 
 
 def view_uniforms(scene: Scene, view: View, n: int) -> dict[str, object]:
@@ -38,6 +60,8 @@ def view_uniforms(scene: Scene, view: View, n: int) -> dict[str, object]:
         "u_eps_per_t": view.footprint * scene.render.epsilon_scale,
         "u_max_iterations": scene.render.max_iterations,
         "u_max_distance": scene.render.max_distance,
+        "u_xi_bonus": scene.render.xi_bonus,
+        "u_xi_penalty": scene.render.xi_penalty,
         "u_light_count": len(lights),
         "u_light_dir": [lt.direction for lt in lights] + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
         "u_light_color": [tuple(c * lt.intensity for c in lt.color) for lt in lights]

@@ -57,9 +57,16 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
     """Flatten ``krs`` in world coordinates (float64); see :meth:`CompiledKRS.relative_to`."""
     mirrors = np.array([[*m.normal, m.offset] for m in krs.mirrors],
                        dtype=np.float64).reshape(-1, 4)
-    records = np.zeros((len(krs.levels), RECORD_VEC4, 4))
+    records, types = kernel_records(krs.kernels, albedo)
+    return CompiledKRS(mirrors, records, types)
+
+
+def kernel_records(kernels: list, albedo: tuple[float, float, float]
+                   ) -> tuple[np.ndarray, tuple[str, ...]]:
+    """One record per kernel (layout above) and each kernel's drawn type."""
+    records = np.zeros((len(kernels), RECORD_VEC4, 4))
     types = []
-    for i, k in enumerate(krs.kernels):
+    for i, k in enumerate(kernels):
         kind = k.kind
         r = records[i]
         color = getattr(k, "color", None) or albedo
@@ -84,4 +91,4 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
             assert isinstance(k, Empty), k
         r[0] = [*color, KERNEL_CODES[kind]]
         types.append(kind)
-    return CompiledKRS(mirrors, records, tuple(types))
+    return records, tuple(types)

@@ -4,27 +4,31 @@ from __future__ import annotations
 import numpy as np
 
 from ..buffers import Buffers
-from ..scene import KRS, Scene
+from ..scene import KRS, MoKRS, Scene
 from .camera import primary_rays, view_of
-from .compiled import compile_krs
-from .krs import nearest
+from .geometry import compile_geometry, is_unbounding, nearest
 from .shade import encode, lambert
-from .trace import sphere_trace
+from .trace import binary_trace, sphere_trace
 
 
-def render_reference(scene: Scene, width: int, height: int, krs: KRS | None = None) -> Buffers:
+def render_reference(scene: Scene, width: int, height: int,
+                     geometry: KRS | MoKRS | None = None) -> Buffers:
     view = view_of(scene.camera, width, height)
-    c = compile_krs(krs or scene.geometry(), scene.material.albedo)
+    c = compile_geometry(geometry or scene.geometry(), scene.material.albedo)
     dirs = primary_rays(view)
     r = scene.render
-    tr = sphere_trace(c, view.origin, dirs, view.footprint * r.epsilon_scale,
-                      r.max_iterations, r.max_distance)
+    eps = view.footprint * r.epsilon_scale
+    if r.tracer == "binary":
+        tr = binary_trace(lambda x, s: is_unbounding(c, x, s), view.origin, dirs, eps,
+                          r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty)
+    else:
+        tr = sphere_trace(c, view.origin, dirs, eps, r.max_iterations, r.max_distance)
     N = len(dirs)
     normal = np.zeros((N, 3))
     color = np.broadcast_to(encode(np.array(scene.material.background)), (N, 3)).copy()
     h = np.flatnonzero(tr.hit)
     if h.size:
-        _, level, g = nearest(c, view.origin + tr.t[h, None] * dirs[h])
+        level, g = nearest(c, view.origin + tr.t[h, None] * dirs[h])
         normal[h] = g
         albedo = c.records[level, 0, :3]
         color[h] = encode(lambert(scene, albedo, g))

@@ -6,12 +6,13 @@ Names follow [KRS17 §3]: a KRS is (K_0..K_n; R_0..R_{n-1}); level i ≥ 1 holds
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
-from typing import Any, ClassVar
+from dataclasses import dataclass
+from typing import ClassVar
 
-from .schema import SceneError, Vec3, from_dict, param, to_dict
+from .schema import SceneError, Tagged, Vec3, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
+TRACERS = ("sphere", "binary")
 EFFECTS: dict[str, str] = {}  # effect name -> help; the effects issue fills this registry
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
@@ -26,35 +27,11 @@ def _norm(a: Vec3) -> float:
 
 
 # ----------------------------------------------------------------------------------- kernels
-class Kernel:
+class Kernel(Tagged):
     """Base of all kernel shapes; ``type`` in the file picks the subclass."""
 
-    kind: ClassVar[str]
     registry: ClassVar[dict[str, type["Kernel"]]] = {}
-
-    def __init_subclass__(cls, **kw: Any):
-        super().__init_subclass__(**kw)
-        Kernel.registry[cls.kind] = cls
-
-    @classmethod
-    def from_toml(cls, data: Any, path: str) -> "Kernel":
-        if not isinstance(data, dict) or "type" not in data:
-            raise SceneError(path, data, "expected a kernel table with a 'type'; allowed types: "
-                             + ", ".join(Kernel.registry))
-        kind = data["type"]
-        if kind not in Kernel.registry:
-            raise SceneError(f"{path}.type", kind, "unknown kernel type; allowed: "
-                             + ", ".join(Kernel.registry))
-        rest = {k: v for k, v in data.items() if k != "type"}
-        return from_dict(Kernel.registry[kind], rest, path)
-
-    def to_toml(self) -> dict:
-        out: dict[str, Any] = {"type": self.kind}
-        for f in fields(self):  # type: ignore[arg-type]
-            v = getattr(self, f.name)
-            if v is not None:
-                out[f.name] = to_dict(v)
-        return out
+    noun: ClassVar[str] = "kernel"
 
 
 @dataclass(frozen=True)
@@ -210,11 +187,17 @@ class Material:
 @dataclass(frozen=True)
 class Render:
     """Accuracy knobs; each is swept by the benchmark against time."""
-    tracer: str = param("sphere", choices=("sphere",), help="sphere tracing [Har96]")
+    tracer: str = param("sphere", choices=TRACERS,
+                        help="sphere: sphere tracing [Har96]; binary: binary sphere tracing "
+                             "with unbounding probes [KRS17 Alg. 2] (required by a MöKRS)")
     epsilon_scale: float = param(1.0, lo=1e-4, hi=100.0, unit="pixels",
                                  help="stop when distance < footprint × depth × scale")
     max_iterations: int = param(256, lo=1, hi=10000, help="iteration cap per ray")
     max_distance: float = param(100.0, lo=0.0, lo_open=True, hi=1e9, help="far limit of rays")
+    xi_bonus: float = param(2.0, lo=1.0, lo_open=True, hi=16.0,
+                            help="binary tracing: probe growth after a free probe [KRS17 §6.1]")
+    xi_penalty: float = param(0.3, lo=0.01, hi=0.95,
+                              help="binary tracing: probe shrink after a blocked probe")
 
 
 # ------------------------------------------------------------------------------ arc geometry

@@ -9,6 +9,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .model import EFFECTS, KRS, Camera, Light, Material, Render
+from .mokrs import MoKRS, check_view
 from .schema import SceneError, from_dict, param, to_dict
 from .toml_writer import dumps
 from .tree import Tree
@@ -32,25 +33,38 @@ class Scene:
     effects: list[str] = param([], help="effects compiled into this scene's shader")
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
+    mokrs: MoKRS | None = param(None, help="Möbius kernel–reflection sequence (instead of krs)")
     bookmarks: list[Bookmark] = param([], help="saved cameras")
 
     def validate(self, path: str) -> None:
-        if (self.krs is None) == (self.tree is None):
-            raise SceneError("krs / tree", "<both>" if self.krs else "<neither>",
-                             "a scene has exactly one geometry: a [krs] or a [tree] table")
+        given = [k for k in ("krs", "tree", "mokrs") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise SceneError("krs / tree / mokrs", "<" + (" and ".join(given) or "none") + ">",
+                             "a scene has exactly one geometry: a [krs], [tree] or [mokrs] table")
         if len(self.lights) > 4:
             raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
         for i, e in enumerate(self.effects):
             if e not in EFFECTS:
                 raise SceneError(f"effects[{i}]", e, "unknown effect; allowed: "
                                  + (", ".join(EFFECTS) or "none yet"))
+        if self.mokrs is not None:
+            if self.render.tracer != "binary":
+                raise SceneError("render.tracer", self.render.tracer, "a MöKRS has no distance "
+                                 "function, only unbounding tests; allowed: 'binary'")
+            check_view(self.mokrs, self.camera.position, "camera.position")
+            for i, b in enumerate(self.bookmarks):
+                check_view(self.mokrs, b.camera.position, f"bookmarks[{i}].camera.position")
 
-    def geometry(self) -> KRS:
-        """The KRS that is drawn: the explicit one, or the tree expanded [KRS17 §9.2]."""
-        return self.krs if self.krs is not None else self.tree.krs()  # type: ignore[union-attr]
+    def geometry(self) -> KRS | MoKRS:
+        """What is drawn: the explicit KRS or MöKRS, or the tree expanded [KRS17 §9.2]."""
+        if self.tree is not None:
+            return self.tree.krs()
+        return self.krs if self.krs is not None else self.mokrs  # type: ignore[return-value]
 
-    def with_geometry(self, krs: KRS) -> "Scene":
-        return replace(self, krs=krs, tree=None)
+    def with_geometry(self, geometry: KRS | MoKRS) -> "Scene":
+        if isinstance(geometry, MoKRS):
+            return replace(self, krs=None, tree=None, mokrs=geometry)
+        return replace(self, krs=geometry, tree=None, mokrs=None)
 
 
 def scene_from_toml(text: str, file: str = "<string>") -> Scene:

@@ -11,7 +11,7 @@ import math
 import types
 import typing
 from dataclasses import MISSING, field, fields, is_dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 Vec3 = tuple[float, float, float]
 UNIT_TOLERANCE = 1e-6  # how far a plane normal's length may be from 1 before it is an error
@@ -172,6 +172,39 @@ def to_dict(obj: Any) -> Any:
     if isinstance(obj, (list, tuple)):
         return [to_dict(v) for v in obj]
     return obj
+
+
+class Tagged:
+    """Base of a family of dataclasses told apart by a ``type`` key in the file (kernels,
+    Möbius steps). Each family base declares ``registry`` and ``noun``; each member ``kind``."""
+
+    kind: ClassVar[str]
+    registry: ClassVar[dict[str, type]]
+    noun: ClassVar[str]
+
+    def __init_subclass__(cls, **kw: Any):
+        super().__init_subclass__(**kw)
+        if "kind" in cls.__dict__:
+            cls.registry[cls.kind] = cls
+
+    @classmethod
+    def from_toml(cls, data: Any, path: str) -> Any:
+        allowed = ", ".join(cls.registry)
+        if not isinstance(data, dict) or "type" not in data:
+            raise SceneError(path, data, f"expected a {cls.noun} table with a 'type'; "
+                             f"allowed types: {allowed}")
+        kind = data["type"]
+        if kind not in cls.registry:
+            raise SceneError(f"{path}.type", kind, f"unknown {cls.noun} type; allowed: {allowed}")
+        return from_dict(cls.registry[kind], {k: v for k, v in data.items() if k != "type"}, path)
+
+    def to_toml(self) -> dict:
+        out: dict[str, Any] = {"type": self.kind}
+        for f in fields(self):  # type: ignore[arg-type]
+            v = getattr(self, f.name)
+            if v is not None:
+                out[f.name] = to_dict(v)
+        return out
 
 
 def _join(path: str, key: str) -> str:

@@ -42,3 +42,8 @@ float krs_nearest(vec3 xw, out int level, out vec3 normal) {
     normal = g;
     return d;
 }
+
+#ifdef KRS_TRACER_BINARY
+// A ball is free of the KRS when the distance bound at its centre covers it.
+bool is_unbounding(vec3 center, float radius) { return krs_distance(center) >= radius; }
+#endif

@@ -14,7 +14,7 @@ void main() {
                          + ndc.y * u_tan_half * u_up);
     float t;
     int iterations;
-    bool hit = sphere_trace(vec3(0.0), dir, t, iterations);
+    bool hit = trace_ray(vec3(0.0), dir, t, iterations);
     out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
     if (!hit) {
         out_color = vec4(encode(u_background), 0.0);
@@ -23,7 +23,7 @@ void main() {
     }
     int level;
     vec3 n;
-    krs_nearest(t * dir, level, n);
+    nearest_kernel(t * dir, level, n);
     out_color = vec4(encode(lambert(kernel_rec(level, 0).rgb, n)), 1.0);
     out_normal = vec4(n, t);
 }

@@ -8,10 +8,14 @@
 #define FAR_AWAY 1e30
 
 layout(std140) uniform KRSBlock {
+#ifdef KRS_MOBIUS
+    vec4 u_mobius[KRS_MAX_LEVELS * MOBIUS_RECORD]; // per level: H_i = G_i⁻¹ (mobius.glsl)
+#else
     vec4 u_mirrors[KRS_MAX_LEVELS];                // u.xyz, w: the plane u·x = w
+#endif
     vec4 u_kernels[KRS_MAX_LEVELS * KRS_RECORD];   // per level: KRS_RECORD vec4s
 };
-uniform int u_n;            // number of mirrors; kernels K_0..K_n
+uniform int u_n;            // KRS: number of mirrors, kernels K_0..K_n; MöKRS: levels
 
 uniform vec3 u_forward;
 uniform vec3 u_right;
@@ -20,6 +24,8 @@ uniform vec2 u_resolution;
 uniform float u_tan_half;
 uniform float u_eps_per_t;  // pixel footprint × ε-scale
 uniform int u_max_iterations;
+uniform float u_xi_bonus;   // binary tracing [KRS17 Alg. 2]
+uniform float u_xi_penalty;
 uniform float u_max_distance;
 
 uniform int u_light_count;

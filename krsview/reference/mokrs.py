@@ -1,0 +1,98 @@
+"""MöKRS: compiled form, ISUNBOUNDING [KRS17 Alg. 3] and the nearest kernel with its world
+normal [KRS17 §8.1, App. C]. Twin of ``shaders/mokrs.glsl``.
+
+The tracer walks levels from the world inwards: the probe ball is mapped by H_i = G_i⁻¹,
+folded across x = 0 on its centre, and tested against K_i.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..scene import MoKRS
+from . import mobius
+from .compiled import kernel_records
+from .kernels import kernel_distance, kernel_gradient
+
+
+@dataclass(frozen=True)
+class CompiledMoKRS:
+    inverse: np.ndarray      # (n, 2, 2, 4): H_i = G_i⁻¹, level i+1's space → level i's
+    reflect: np.ndarray      # (n,) bool
+    records: np.ndarray      # (n, RECORD_VEC4, 4), in each level's own space
+    types: tuple[str, ...]
+
+    @property
+    def n(self) -> int:
+        return len(self.reflect)
+
+    def relative_to(self, origin) -> "CompiledMoKRS":
+        """World positions taken relative to ``origin``: only the outermost H changes,
+        H_{n−1} ← H_{n−1} · T(origin) (the world point is origin + the relative point)."""
+        inverse = self.inverse.copy()
+        inverse[-1] = mobius.tidy(mobius.compose(inverse[-1], mobius.translation(origin)))
+        return CompiledMoKRS(inverse, self.reflect, self.records, self.types)
+
+
+def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS:
+    inverse = np.array([mobius.tidy(mobius.inverse(lv.matrix())) for lv in m.levels])
+    records, types = kernel_records(m.kernels, albedo)
+    return CompiledMoKRS(inverse, np.array([lv.reflect for lv in m.levels]), records, types)
+
+
+def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """ISUNBOUNDING(κ_w, ρ_w) [KRS17 Alg. 3] for balls (N, 3), (N,): whether each ball is free
+    of the MöKRS. A ball that holds a level's pole maps to a ball's exterior ("inside-out")
+    and is rejected. The mirror decision is taken on the ball's centre, as in the paper."""
+    free = np.ones(len(center), dtype=bool)
+    kappa, rho = center, radius
+    with np.errstate(all="ignore"):
+        for i in range(c.n - 1, -1, -1):
+            kappa, rho, ok = mobius.map_ball(c.inverse[i], kappa, rho)
+            free &= ok
+            kappa = np.where(ok[:, None], kappa, 0.0)
+            if c.reflect[i]:
+                kappa = kappa * np.where(kappa[:, :1] > 0.0, [-1.0, 1.0, 1.0], 1.0)
+            if c.types[i] != "empty":
+                free &= kernel_distance(c.types[i], c.records[i], kappa) >= rho
+    return free
+
+
+def nearest(c: CompiledMoKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The level j whose kernel is nearest to world points xw (N, 3) and the world normal there.
+
+    The point is followed inwards while J, the Jacobian of world → level space, accumulates
+    (columns from App. C). A conformal J scales lengths by |J e_x|, so k_i(x_i)/|J e_x| is the
+    world distance to first order, comparable across levels (ties go to the coarser level).
+    The world gradient of k_j ∘ (world → level j) is Jᵀ ∇k_j [KRS17 §8.1]."""
+    N = len(xw)
+    x = xw
+    J = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
+    best = np.full(N, np.inf)
+    level = np.zeros(N, dtype=np.int64)
+    xk, Jk = x.copy(), J.copy()
+    flip = np.array([-1.0, 1.0, 1.0])
+    with np.errstate(all="ignore"):
+        for i in range(c.n - 1, -1, -1):
+            J = mobius.jacobian(c.inverse[i], x) @ J
+            x = mobius.apply(c.inverse[i], x)
+            if c.reflect[i]:
+                behind = x[:, 0] > 0.0
+                x = np.where(behind[:, None], x * flip, x)
+                J = np.where(behind[:, None, None], J * flip[:, None], J)
+            if c.types[i] == "empty":
+                continue
+            d = kernel_distance(c.types[i], c.records[i], x) / np.linalg.norm(J[:, :, 0], axis=1)
+            better = d < best
+            best = np.where(better, d, best)
+            level = np.where(better, i, level)
+            xk = np.where(better[:, None], x, xk)
+            Jk = np.where(better[:, None, None], J, Jk)
+    g = np.zeros((N, 3))
+    for j in np.unique(level):
+        sel = level == j
+        g[sel] = kernel_gradient(c.types[j], c.records[j], xk[sel])
+    gw = np.einsum("nji,nj->ni", Jk, g)
+    n = np.linalg.norm(gw, axis=1, keepdims=True)
+    return level, np.where(n > 0, gw / np.where(n > 0, n, 1.0), [0.0, 0.0, 1.0])

@@ -1,0 +1,50 @@
+"""Quaternions as float64 arrays (..., 4) = (real, i, j, k), vectorised [KRS17 §6.2].
+
+R³ is embedded as the pure quaternions H_0 (real part 0). Mirrors ``shaders/quaternion.glsl``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def pure(v: np.ndarray) -> np.ndarray:
+    """Embed points (..., 3) of R³ into H_0."""
+    v = np.asarray(v, dtype=np.float64)
+    return np.concatenate([np.zeros(v.shape[:-1] + (1,)), v], axis=-1)
+
+
+def mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Hamilton product pq."""
+    pw, pv = p[..., :1], p[..., 1:]
+    qw, qv = q[..., :1], q[..., 1:]
+    w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
+    v = pw * qv + qw * pv + np.cross(pv, qv)
+    return np.concatenate([w, v], axis=-1)
+
+
+def conj(q: np.ndarray) -> np.ndarray:
+    """q̄: the real part kept, the imaginary part negated."""
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def norm2(q: np.ndarray) -> np.ndarray:
+    """q q̄ = |q|² (a real number, returned with shape (...))."""
+    return np.sum(q * q, axis=-1)
+
+
+def inv(q: np.ndarray) -> np.ndarray:
+    """q⁻¹ = q̄ / (q q̄)."""
+    return conj(q) / norm2(q)[..., None]
+
+
+def left_matrix(q: np.ndarray) -> np.ndarray:
+    """The real 4×4 matrix of x ↦ q x (for one quaternion q)."""
+    w, x, y, z = q
+    return np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]])
+
+
+def from_axis_angle(axis, radians: float) -> np.ndarray:
+    """Unit quaternion r with r q r⁻¹ the rotation by ``radians`` about ``axis``."""
+    a = np.asarray(axis, dtype=np.float64)
+    a = a / np.linalg.norm(a)
+    return np.concatenate([[np.cos(radians / 2.0)], np.sin(radians / 2.0) * a])

@@ -1,0 +1,202 @@
+"""Möbius kernel–reflection sequences [KRS17 §7]: each level is conformally transformed.
+
+Level i holds a kernel K_i, a Möbius transformation G_i (a list of elementary steps from
+[KRS17 Table 1]) and whether it reflects: L_i = G_i(K_i ∪ L_{i−1} ∪ R(L_{i−1})), R the
+reflection across x = 0 of the level's own space. Kernels are written in their level's space;
+G_i maps that space into level i+1's (the last level's G maps into the world).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+from .model import MAX_LEVELS, Empty, Kernel
+from .schema import SceneError, Tagged, Vec3, param
+
+SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
+
+
+class MobiusStep(Tagged):
+    """One elementary transformation; ``type`` picks it. Steps apply in the order listed."""
+
+    registry: ClassVar[dict[str, type["MobiusStep"]]] = {}
+    noun: ClassVar[str] = "Möbius step"
+
+    def matrix(self):
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Translate(MobiusStep):
+    """q ↦ q + by."""
+    kind: ClassVar[str] = "translate"
+    by: Vec3 = param((0.0, 0.0, 0.0), help="translation vector")
+
+    def matrix(self):
+        from ..reference import mobius
+        return mobius.translation(self.by)
+
+
+@dataclass(frozen=True)
+class Scale(MobiusStep):
+    """Dilation q ↦ s q about the origin."""
+    kind: ClassVar[str] = "scale"
+    factor: float = param(1.0, lo=1e-6, hi=1e6, help="dilation factor s")
+
+    def matrix(self):
+        from ..reference import mobius
+        return mobius.dilation(self.factor)
+
+
+@dataclass(frozen=True)
+class Rotate(MobiusStep):
+    """Rotation q ↦ r q r⁻¹ about an axis through the origin."""
+    kind: ClassVar[str] = "rotate"
+    axis: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="rotation axis")
+    degrees: float = param(0.0, lo=-360.0, hi=360.0, unit="degrees", help="angle (right hand)")
+
+    def matrix(self):
+        from ..reference import mobius
+        return mobius.rotation(self.axis, math.radians(self.degrees))
+
+
+@dataclass(frozen=True)
+class Invert(MobiusStep):
+    """q ↦ c + r²(q − c)⁻¹: inversion in the sphere (c, r) composed with the point reflection
+    through c (Table 1's q ↦ q⁻¹, moved and scaled). c itself goes to infinity."""
+    kind: ClassVar[str] = "invert"
+    center: Vec3 = param((0.0, 0.0, 0.0), help="centre c (mapped to infinity)")
+    radius: float = param(1.0, lo=1e-6, hi=1e6, help="radius r of the fixed sphere")
+
+    def matrix(self):
+        from ..reference import mobius as M
+        neg = tuple(-v for v in self.center)
+        return M.compose(M.translation(self.center), M.dilation(self.radius),
+                         M.inversion(), M.dilation(1.0 / self.radius), M.translation(neg))
+
+
+@dataclass(frozen=True)
+class MobiusLevel:
+    """Level i: kernel K_i in this level's space, transform G_i out of it, reflection R."""
+    kernel: Kernel = param(Empty(), help="kernel K_i, in this level's space")
+    transform: list[MobiusStep] = param([], help="G_i: steps applied in order, into the "
+                                                 "next level's space (world for the last)")
+    reflect: bool = param(True, help="double the level below by the reflection across x = 0")
+
+    def matrix(self):
+        """G_i as a quaternion matrix: the last step applied last (leftmost)."""
+        from ..reference import mobius
+        return mobius.compose(mobius.identity(), *[s.matrix() for s in reversed(self.transform)])
+
+
+@dataclass(frozen=True)
+class MoKRS:
+    """A Möbius kernel–reflection sequence [KRS17 §7]; traced by binary sphere tracing."""
+    levels: list[MobiusLevel] = param([], help="level 0 first (finest), last level coarsest")
+
+    def validate(self, path: str) -> None:
+        from ..reference import mobius
+        p = f"{path}.levels"
+        if not self.levels:
+            raise SceneError(p, [], "a MöKRS needs at least one level")
+        if len(self.levels) > MAX_LEVELS:
+            raise SceneError(p, f"<{len(self.levels)} levels>",
+                             f"too many levels; allowed: at most {MAX_LEVELS}")
+        for i, lv in enumerate(self.levels):
+            cond = mobius.condition(lv.matrix())
+            if not cond <= SINGULAR_CONDITION:
+                raise SceneError(f"{p}[{i}].transform", f"<condition number {cond:.3g}>",
+                                 f"numerically singular; allowed: condition ≤ "
+                                 f"{SINGULAR_CONDITION:g} (avoid extreme scale factors)")
+
+    @property
+    def n(self) -> int:
+        """Number of levels the tracer walks (each may reflect)."""
+        return len(self.levels)
+
+    @property
+    def kernels(self) -> list[Kernel]:
+        return [lv.kernel for lv in self.levels]
+
+    def instance_count(self) -> int:
+        """K_i is doubled by every reflecting level from i up."""
+        total, copies = 0, 1
+        for lv in reversed(self.levels):
+            copies *= 2 if lv.reflect else 1
+            if not isinstance(lv.kernel, Empty):
+                total += copies
+        return total
+
+    def truncated(self, levels: int) -> "MoKRS":
+        """Keep the coarsest ``levels`` levels, dropping the finest."""
+        return MoKRS(list(self.levels[len(self.levels) - levels:]))
+
+
+POLE_DISTANCE = 1e-6  # a viewpoint closer than this (× the level's scale) to a pole is rejected
+
+
+def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
+    """Follow a viewpoint into every level (mirror tests on the point, as the tracer does) and
+    reject it where a level's inverse transformation sends it to infinity."""
+    import numpy as np
+    from ..reference import mobius
+    x = np.array([position], dtype=np.float64)
+    for i in range(mokrs.n - 1, -1, -1):
+        H = mobius.tidy(mobius.inverse(mokrs.levels[i].matrix()))
+        p = mobius.pole(H)
+        if p is not None:
+            scale = max(1.0, float(np.linalg.norm(x)))
+            if np.linalg.norm(x[0] - p) <= POLE_DISTANCE * scale:
+                raise SceneError(path, list(position),
+                                 f"level {i}'s transform sends this point to infinity (its "
+                                 f"pole); move the viewpoint or the transform's centre")
+        x = mobius.apply(H, x)
+        if mokrs.levels[i].reflect and x[0, 0] > 0.0:
+            x[0, 0] = -x[0, 0]
+
+
+def mokrs_of(krs) -> MoKRS:
+    """The same geometry as a plain KRS, written as a MöKRS with rigid transforms: level i's
+    space puts mirror R_i on x = 0 (normal along +x), so folding there is Alg. 1's fold
+    (used by the tracer cross-check). The top kernel K_n stays in the world, unreflected."""
+    import numpy as np
+    from dataclasses import fields, replace
+    from .model import Plane
+
+    def to_x(u):
+        """Axis and degrees of the rotation taking unit u to +x."""
+        u = np.asarray(u, dtype=np.float64)
+        axis = np.cross(u, [1.0, 0.0, 0.0])
+        s, c = float(np.linalg.norm(axis)), float(u[0])
+        if s < 1e-12:
+            return (0.0, 1.0, 0.0), (0.0 if c > 0 else 180.0)
+        return tuple(axis / s), math.degrees(math.atan2(s, c))
+
+    def rotation(axis, degrees):
+        a, th = np.asarray(axis), math.radians(degrees)
+        K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+        return np.eye(3) + math.sin(th) * K + (1 - math.cos(th)) * K @ K
+
+    def moved(k: Kernel, R, o) -> Kernel:
+        """Kernel k in the frame y = R (x − o)."""
+        if isinstance(k, Plane):
+            return replace(k, normal=tuple(R @ k.normal), offset=k.offset - float(np.dot(k.normal, o)))
+        change = {f.name: tuple(R @ (np.asarray(getattr(k, f.name)) - o)) for f in fields(k)
+                  if f.name in ("center", "a", "b", "start", "control", "end")}
+        return replace(k, **change)
+
+    frames = []  # (axis, degrees, origin w·u) of each mirror's frame
+    for m in krs.mirrors:
+        axis, deg = to_x(m.normal)
+        frames.append((axis, deg, m.offset * np.asarray(m.normal)))
+    levels = []
+    for i, (axis, deg, o) in enumerate(frames):
+        steps: list[MobiusStep] = [Rotate(axis, -deg)]
+        shift = o - (frames[i + 1][2] if i + 1 < len(frames) else 0.0)
+        steps.append(Translate(tuple(float(v) for v in shift)))
+        if i + 1 < len(frames):
+            steps.append(Rotate(frames[i + 1][0], frames[i + 1][1]))
+        levels.append(MobiusLevel(moved(krs.kernels[i], rotation(axis, deg), o), steps, True))
+    levels.append(MobiusLevel(krs.kernels[-1], [], False))
+    return MoKRS(levels)

@@ -1,0 +1,34 @@
+// MöKRS: ISUNBOUNDING [KRS17 Alg. 3] and the nearest kernel with its world normal
+// [KRS17 §8.1, App. C]; twin of reference/mokrs.py.
+#include "kernels.glsl"
+#include "mobius.glsl"
+
+bool reflects(int i) { return (int(mobius_rec(i, 4).w) & 2) != 0; }
+
+bool is_unbounding(vec3 center, float radius) {
+    for (int i = u_n - 1; i >= 0; --i) {
+        if (!map_ball(i, center, radius)) return false;   // inside-out
+        if (reflects(i)) center.x = -abs(center.x);      // mirror decision on the centre
+        if (kernel_distance(i, center) < radius) return false;
+    }
+    return true;
+}
+
+// Follow the point inwards accumulating J = d(world → level); k_i / |J e_x| is the world
+// distance to first order; the winner's world normal is Jᵀ ∇k_j.
+void mokrs_nearest(vec3 xw, out int level, out vec3 normal) {
+    vec3 x = xw, xk = xw;
+    mat3 J = mat3(1.0), Jk = mat3(1.0);
+    const mat3 FLIP = mat3(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    float best = FAR_AWAY;
+    level = 0;
+    for (int i = u_n - 1; i >= 0; --i) {
+        vec3 image = mobius_apply(i, x);
+        J = mobius_jacobian(i, x, image) * J;
+        x = image;
+        if (reflects(i) && x.x > 0.0) { x.x = -x.x; J = FLIP * J; }
+        float d = kernel_distance(i, x) / length(J[0]);
+        if (d < best) { best = d; level = i; xk = x; Jk = J; }
+    }
+    normal = normalize(transpose(Jk) * kernel_gradient(level, xk));
+}
