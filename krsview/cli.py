@@ -119,13 +119,18 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"{path}: ok — {scene.name}")
     if scene.description:
         print(f"  {scene.description}")
-    print(f"  geometry        {'tree (grown)' if scene.tree else 'explicit KRS'}")
-    print(f"  levels          {len(krs.levels)} (kernels K_0..K_{krs.n}, {krs.n} mirrors)")
-    print(f"  kernel instances {krs.instance_count():,} (up to 2^{krs.n} = {2 ** krs.n:,} of K_0)")
+    if scene.mokrs is not None:
+        print(f"  geometry        MöKRS: {krs.n} levels, "
+              f"{sum(lv.reflect for lv in scene.mokrs.levels)} reflecting")
+    else:
+        print(f"  geometry        {'tree (grown)' if scene.tree else 'explicit KRS'}")
+        print(f"  levels          {len(krs.levels)} (kernels K_0..K_{krs.n}, {krs.n} mirrors)")
+    print(f"  kernel instances {krs.instance_count():,}")
     print("  kernels         " + ", ".join(f"{v}× {k}" for k, v in sorted(kinds.items())))
     print(f"  effects         {', '.join(scene.effects) or 'none'}")
     r = scene.render
-    print(f"  render          {r.tracer} tracer, ε-scale {r.epsilon_scale}, "
+    binary = f" (ξ_bonus {r.xi_bonus}, ξ_penalty {r.xi_penalty})" if r.tracer == "binary" else ""
+    print(f"  render          {r.tracer} tracer{binary}, ε-scale {r.epsilon_scale}, "
           f"≤ {r.max_iterations} iterations, far {r.max_distance}")
     return 0
 

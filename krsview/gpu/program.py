@@ -50,7 +50,7 @@ class Source:
         # branch must not hide the file from an active branch later.
         guard = "KRS_FILE_" + re.sub(r"\W", "_", name).upper()
         out: list[str] = [f"#ifndef {guard}", f"#define {guard}"]
-        self.origin += [(name, 0), (name, 0)]
+        self.origin += [("<defines>", 0), ("<defines>", 0)]  # generated, like the defines
         for k, line in enumerate(text.splitlines(), 1):
             m = _INCLUDE.match(line)
             if m:
@@ -59,7 +59,7 @@ class Source:
                 out.append(line)
                 self.origin.append((name, k))
         out.append(f"#endif  // {guard}")
-        self.origin.append((name, len(text.splitlines()) + 1))
+        self.origin.append(("<defines>", 0))
         return out
 
     def map_log(self, log: str) -> str:

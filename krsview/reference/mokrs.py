@@ -46,16 +46,17 @@ def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray) -> n
     of the MöKRS. A ball that holds a level's pole maps to a ball's exterior ("inside-out")
     and is rejected. The mirror decision is taken on the ball's centre, as in the paper."""
     free = np.ones(len(center), dtype=bool)
+    live = np.arange(len(center))          # balls not yet rejected (the shader returns early)
     kappa, rho = center, radius
     with np.errstate(all="ignore"):
         for i in range(c.n - 1, -1, -1):
             kappa, rho, ok = mobius.map_ball(c.inverse[i], kappa, rho)
-            free &= ok
-            kappa = np.where(ok[:, None], kappa, 0.0)
             if c.reflect[i]:
                 kappa = kappa * np.where(kappa[:, :1] > 0.0, [-1.0, 1.0, 1.0], 1.0)
             if c.types[i] != "empty":
-                free &= kernel_distance(c.types[i], c.records[i], kappa) >= rho
+                ok &= kernel_distance(c.types[i], c.records[i], kappa) >= rho
+            free[live[~ok]] = False
+            live, kappa, rho = live[ok], kappa[ok], rho[ok]
     return free
 
 

@@ -14,12 +14,13 @@ def pure(v: np.ndarray) -> np.ndarray:
 
 
 def mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Hamilton product pq."""
-    pw, pv = p[..., :1], p[..., 1:]
-    qw, qv = q[..., :1], q[..., 1:]
-    w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
-    v = pw * qv + qw * pv + np.cross(pv, qv)
-    return np.concatenate([w, v], axis=-1)
+    """Hamilton product pq (written out by component: the reference's hot loop)."""
+    pw, px, py, pz = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
+    qw, qx, qy, qz = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack([pw * qw - px * qx - py * qy - pz * qz,
+                     pw * qx + px * qw + py * qz - pz * qy,
+                     pw * qy - px * qz + py * qw + pz * qx,
+                     pw * qz + px * qy - py * qx + pz * qw], axis=-1)
 
 
 def conj(q: np.ndarray) -> np.ndarray:
