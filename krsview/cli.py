@@ -8,7 +8,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from .presets import DEFAULT_PRESET, preset_names, resolve
-from .scene import MAX_LEVELS, Scene, SceneError, load_scene
+import numpy as np
+
+from .scene import MAX_LEVELS, TRACERS, Scene, SceneError, load_scene
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
 
@@ -55,6 +57,11 @@ def _load(args: argparse.Namespace) -> Scene:
         render = replace(render, epsilon_scale=args.epsilon_scale)
     if getattr(args, "max_iterations", None) is not None:
         render = replace(render, max_iterations=args.max_iterations)
+    if getattr(args, "tracer", None) is not None:
+        if scene.mokrs is not None and args.tracer != "binary":
+            raise SceneError("--tracer", args.tracer, "this scene is a MöKRS, which has no "
+                             "distance function; allowed: binary")
+        render = replace(render, tracer=args.tracer)
     scene = replace(scene, render=render)
     levels = getattr(args, "levels", None)
     if levels is not None:
@@ -91,7 +98,15 @@ def cmd_render(args: argparse.Namespace) -> int:
               f"{buffers.hit.mean() * 100:.0f}% of pixels hit")
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
-    buffers.save_png(out)
+    if args.view == "iterations":
+        from .heatmap import save_heatmap
+        it = buffers.iterations
+        vmax = save_heatmap(it, out, args.legend_max,
+                            f"{scene.render.tracer} tracing: iterations per pixel")
+        print(f"  iterations per pixel: median {np.median(it):.0f}, mean {it.mean():.1f}, "
+              f"max {it.max()} (colour scale 0..{vmax})")
+    else:
+        buffers.save_png(out)
     print(f"  wrote {out.resolve()}")
     if args.buffers:
         buffers.save_npz(args.buffers)
@@ -142,6 +157,13 @@ def cmd_bench_levels(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bench_tracers(args: argparse.Namespace) -> int:
+    from .bench.tracers import bench_tracers
+    bench_tracers(_load(args), args.size, rounds=args.rounds, sweep=not args.no_sweep,
+                  csv=args.csv)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     presets = ", ".join(preset_names()) or "none found"
     p = argparse.ArgumentParser(
@@ -150,7 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "A PRESET is a scene file (.toml) or the name of a shipped preset: "
                     f"{presets}.",
         epilog="examples:\n  krsview render tree -o tree.png --size 640x360\n"
-               "  krsview check presets/grass.toml\n  krsview bench levels tree",
+               "  krsview check presets/grass.toml\n  krsview bench levels tree\n"
+               "  krsview render palm --view iterations -o palm-iterations.png\n"
+               "  krsview bench tracers tree",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -175,6 +199,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="render with the float64 NumPy reference instead of the GPU (slow)")
     r.add_argument("--repeats", type=_int_in("--repeats", 1, 1000), default=5,
                    help="frames timed; the median is printed (default 5)")
+    r.add_argument("--view", choices=("shaded", "iterations"), default="shaded",
+                   help="shaded image, or the per-pixel iteration count as a heat map with a "
+                        "legend (black = 0, white = the maximum) [KRS17 Fig. 13]")
+    r.add_argument("--legend-max", type=_int_in("--legend-max", 1, 100000), metavar="N",
+                   help="iterations shown as white in --view iterations (default: the image's "
+                        "maximum); fix it to compare tracers on one scale")
+    r.add_argument("--tracer", choices=TRACERS,
+                   help="sphere or binary sphere tracing (overrides the scene; a MöKRS needs "
+                        "binary)")
     accuracy(r)
     r.set_defaults(func=cmd_render)
 
@@ -198,7 +231,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("preset", metavar="PRESET")
     c.set_defaults(func=cmd_check)
 
-    b = sub.add_parser("bench", help="benchmarks (levels)",
+    b = sub.add_parser("bench", help="benchmarks (levels, tracers)",
                        description="Benchmarks that report ratios measured side by side.")
     bsub = b.add_subparsers(dest="bench", required=True, metavar="BENCH")
     bl = bsub.add_parser("levels", help="frame time against level count (O(n) vs 2^n)",
@@ -215,6 +248,20 @@ def build_parser() -> argparse.ArgumentParser:
     bl.add_argument("--epsilon-scale", type=_positive_float("--epsilon-scale", 1e-4, 100.0))
     bl.add_argument("--max-iterations", type=_int_in("--max-iterations", 1, 10000))
     bl.set_defaults(func=cmd_bench_levels)
+    bt = bsub.add_parser("tracers", help="sphere vs binary sphere tracing, and a ξ sweep",
+                         description="On one scene and view: sphere tracing, binary tracing at "
+                                     "the paper's ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over "
+                                     "ξ_bonus ∈ {1.5, 2, 3} × ξ_penalty ∈ {0.2, 0.3, 0.5}; "
+                                     "iterations per pixel, frame time and hit agreement, as "
+                                     "ratios to sphere tracing (to binary 2.0/0.3 for a MöKRS).")
+    bt.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    bt.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
+    bt.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=5,
+                    help="interleaved rounds; medians are reported (default 5)")
+    bt.add_argument("--no-sweep", action="store_true", help="only sphere vs binary 2.0/0.3")
+    bt.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
+    accuracy(bt)
+    bt.set_defaults(func=cmd_bench_tracers)
     return p
 
 

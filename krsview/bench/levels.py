@@ -7,13 +7,12 @@ every variant alike.
 from __future__ import annotations
 
 import statistics
-from pathlib import Path
-
 import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from .progress import Progress
+from .report import write_csv
 
 
 def level_counts(total: int, step: int) -> list[int]:
@@ -66,9 +65,5 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
         print(f"\nlinear fit: {icpt:.2f} ms + {slope:.3f} ms/level (R² = {r2:.3f}); geometry grew "
               f"{grow:,.0f}× while time grew {rows[-1]['time_ratio']:.2f}×")
     if csv:
-        Path(csv).parent.mkdir(parents=True, exist_ok=True)
-        keys = list(rows[0])
-        Path(csv).write_text(",".join(keys) + "\n" + "\n".join(
-            ",".join(f"{row[k]}" for k in keys) for row in rows) + "\n")
-        print(f"wrote {csv}")
+        write_csv(rows, csv)
     return rows

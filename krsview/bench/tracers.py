@@ -1,0 +1,86 @@
+"""`krsview bench tracers`: sphere tracing against binary sphere tracing [KRS17 §6.1, §11].
+
+The paper reports about twice the iterations for binary tracing and leaves ξ_bonus/ξ_penalty
+unexplored (§12). On one KRS scene and view, in one run: sphere tracing, binary tracing at
+the paper's (2.0, 0.3), and a small ξ sweep; frames interleaved round by round, medians and
+ratios to sphere tracing. "Hit agreement" compares each hit mask with sphere tracing's.
+"""
+from __future__ import annotations
+
+import itertools
+import statistics
+from dataclasses import replace
+
+import numpy as np
+
+from ..gpu.renderer import Renderer
+from ..scene import Scene, SceneError
+from .progress import Progress
+from .report import write_csv
+
+BONUS = (1.5, 2.0, 3.0)
+PENALTY = (0.2, 0.3, 0.5)
+
+
+def variants(scene: Scene, sweep: bool) -> dict[str, Scene]:
+    """name → scene: sphere (KRS only), binary at the paper's ξ, then the ξ sweep."""
+    out = {}
+    if scene.mokrs is None:
+        out["sphere"] = replace(scene, render=replace(scene.render, tracer="sphere"))
+    pairs = [(2.0, 0.3)] + ([p for p in itertools.product(BONUS, PENALTY) if p != (2.0, 0.3)]
+                            if sweep else [])
+    for b, p in pairs:
+        out[f"binary {b:g}/{p:g}"] = replace(scene, render=replace(
+            scene.render, tracer="binary", xi_bonus=b, xi_penalty=p))
+    return out
+
+
+def bench_tracers(scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: bool = True,
+                  csv: str | None = None) -> list[dict]:
+    if scene.mokrs is not None and not sweep:
+        raise SceneError("--no-sweep", True, "a MöKRS has only the binary tracer; keep the ξ "
+                         "sweep to have something to compare")
+    w, h = size
+    runs = variants(scene, sweep)
+    r = Renderer()
+    buffers = {name: r.render(s, w, h) for name, s in runs.items()}  # warm-up + iterations
+    times: dict[str, list[float]] = {name: [] for name in runs}
+    bar = Progress(rounds * len(runs), f"bench tracers {scene.name} {w}×{h}")
+    for _ in range(rounds):
+        for name, s in runs.items():
+            times[name] += r.time_frame(s, w, h, repeats=1)
+            bar.step(name)
+    base = next(iter(runs))
+    t0 = statistics.median(times[base])
+    it0 = float(np.mean(buffers[base].iterations))
+    rows = []
+    for name, s in runs.items():
+        b, t = buffers[name], statistics.median(times[name])
+        rows.append(dict(tracer=s.render.tracer, xi_bonus=s.render.xi_bonus if "binary" in name
+                         else "", xi_penalty=s.render.xi_penalty if "binary" in name else "",
+                         median_iterations=float(np.median(b.iterations)),
+                         mean_iterations=float(np.mean(b.iterations)),
+                         iteration_ratio=float(np.mean(b.iterations)) / it0, ms=t * 1e3,
+                         time_ratio=t / t0, hit_fraction=float(b.hit.mean()),
+                         hit_agreement=float((b.hit == buffers[base].hit).mean())))
+    print(f"\nSphere vs binary tracing — {scene.name}, {w}×{h}, ε-scale "
+          f"{scene.render.epsilon_scale}, median of {rounds} interleaved rounds "
+          f"(ratios to {base})\n")
+    print("| tracer | ξ_bonus | ξ_penalty | median it/px | mean it/px | iteration ratio | "
+          "ms/frame | time ratio | hit agreement |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for row in rows:
+        print(f"| {row['tracer']} | {row['xi_bonus']} | {row['xi_penalty']} | "
+              f"{row['median_iterations']:.0f} | {row['mean_iterations']:.1f} | "
+              f"{row['iteration_ratio']:.2f} | {row['ms']:.1f} | {row['time_ratio']:.2f} | "
+              f"{row['hit_agreement']:.2%} |")
+    binary = [row for row in rows if row["tracer"] == "binary"]
+    if len(binary) > 1:
+        fast = min(binary, key=lambda row: row["ms"])
+        few = min(binary, key=lambda row: row["mean_iterations"])
+        print(f"\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
+              f"({fast['time_ratio']:.2f}× {base}); fewest iterations: "
+              f"{few['xi_bonus']}/{few['xi_penalty']} ({few['mean_iterations']:.1f} it/px)")
+    if csv:
+        write_csv(rows, csv)
+    return rows
