@@ -206,6 +206,71 @@ def test_record_and_replay_a_camera_path(viewer):
     assert v.replay_start is None and np.allclose(v.camera.position, end)
 
 
+def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
+    v = viewer
+    v.act("record")
+    for _ in range(4):
+        v.input.key("W", True)
+        v.step(0.05)
+    v.input.key("W", False)
+    v.act("record")
+    end, recorded = v.camera.position.copy(), len(v.path_samples)
+    assert v.path_file().exists() and v.path_file().name == "tree.path.json"
+    v.path_samples = []
+    v.open_preset(v.path)  # as a new session would: the path comes from the file
+    assert len(v.path_samples) == recorded > 0
+    v.act("replay")
+    for _ in range(20):
+        v.step(0.05)
+    assert np.allclose(v.camera.position, end)
+    v.path_file().write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
+    v.open_preset(v.path)
+    assert v.path_samples == [] and "tree.path.json: not a camera path" in v.error
+
+
+def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
+    """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once;
+    switching back, and moving accuracy knobs, compile nothing."""
+    v = viewer
+    settle(v)
+    programs = v.renderer.programs
+    before = programs.compiles
+    sphere_image = v.read_window()
+    v.set_render(tracer="binary")
+    settle(v)
+    assert programs.compiles == before + 1
+    assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
+    binary_image = v.read_window()
+    assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
+    v.set_render(tracer="sphere")
+    settle(v)
+    v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
+    settle(v)
+    assert programs.compiles == before + 1
+
+
+def test_mokrs_presets_fly_in_the_viewer(viewer):
+    v = viewer
+    for name in ("palm", "shell", "inversion"):
+        v.open_preset(resolve(name))
+        assert v.error == "" and v.scene.mokrs is not None
+        settle(v)
+        img = v.read_window()
+        background = np.round(np.array(v.scene.material.background) ** (1 / 2.2) * 255)
+        assert (np.abs(img - background).max(-1) > 8).mean() > 0.02, f"{name}: nothing drawn"
+        d = v.nearest_distance()
+        assert 0 < d < 1e6, f"{name}: free radius {d}"
+        v.set_render(tracer="sphere")
+        assert v.scene.render.tracer == "binary" and "binary tracing" in v.error
+        v.error = ""
+        for _ in range(3):
+            v.input.key("W", True)
+            v.step(0.05)
+        v.input.key("W", False)
+        settle(v)
+        assert np.isfinite(v.camera.position).all()
+
+
 def test_adaptive_controller_unit():
     a = AdaptiveResolution((640, 360), target_fps=30)
     for _ in range(20):

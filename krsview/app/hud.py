@@ -2,7 +2,6 @@
 bookmarks, screenshot, and any error from a hot reload."""
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -10,14 +9,12 @@ from imgui_bundle import imgui, implot
 
 from ..gpu.display import VIEW_MODES
 from ..presets import preset_names, resolve
-from ..scene import EFFECTS
-from ..scene.model import Render
+from ..scene import EFFECTS, TRACERS
 
 if TYPE_CHECKING:
     from .window import Viewer
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
-TRACERS = Render.__dataclass_fields__["tracer"].metadata["choices"]
 
 
 def draw_hud(v: "Viewer") -> None:
@@ -62,10 +59,14 @@ def _performance(v: "Viewer") -> None:
 
 def _accuracy(v: "Viewer") -> None:
     r = v.scene.render
-    edits = {}
-    changed, k = imgui.combo("tracer", TRACERS.index(r.tracer), list(TRACERS))
+    edits: dict = {}
+    tracers = ["binary"] if v.scene.mokrs is not None else list(TRACERS)
+    changed, k = imgui.combo("tracer", tracers.index(r.tracer), tracers)
     if changed:
-        edits["tracer"] = TRACERS[k]
+        edits["tracer"] = tracers[k]
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("sphere tracing or binary sphere tracing [KRS17 Alg. 2]; switching "
+                          "compiles the other variant once")
     changed, eps = imgui.slider_float("eps scale (px)", r.epsilon_scale, 0.01, 20.0, "%.3f",
                                       imgui.SliderFlags_.logarithmic)
     if changed:
@@ -74,8 +75,15 @@ def _accuracy(v: "Viewer") -> None:
                                     imgui.SliderFlags_.logarithmic)
     if changed:
         edits["max_iterations"] = cap
-    if edits:  # uniforms only: no recompile
-        v.scene, v.dirty = replace(v.scene, render=replace(r, **edits)), True
+    if r.tracer == "binary":
+        changed, bonus = imgui.slider_float("xi bonus", r.xi_bonus, 1.05, 8.0, "%.2f")
+        if changed:
+            edits["xi_bonus"] = bonus
+        changed, penalty = imgui.slider_float("xi penalty", r.xi_penalty, 0.05, 0.95, "%.2f")
+        if changed:
+            edits["xi_penalty"] = penalty
+    if edits:
+        v.set_render(**edits)
     total = len(v.geometry.levels)
     changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
     if changed:
@@ -88,8 +96,7 @@ def _accuracy(v: "Viewer") -> None:
     for name, help_text in EFFECTS.items():
         changed, on = imgui.checkbox(name, name in v.scene.effects)
         if changed:
-            effects = [e for e in v.scene.effects if e != name] + ([name] if on else [])
-            v.scene, v.dirty = replace(v.scene, effects=effects), True
+            v.set_effect(name, on)
         if imgui.is_item_hovered():
             imgui.set_tooltip(help_text)
 

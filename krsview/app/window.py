@@ -3,6 +3,7 @@ and hot reload of the preset and the shaders."""
 from __future__ import annotations
 
 import ctypes
+import json
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -16,8 +17,9 @@ from ..gpu.display import Display
 from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..gpu.context import GL_VERSION
-from ..reference import compile_krs, distance
+from ..reference.geometry import compile_geometry, free_radius
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
+from ..scene.scene import write_atomic
 from .adaptive import AdaptiveResolution, Refinement
 from .camera import FlyCamera
 from .controls import CONTROLS, LOOK_BUTTON, ORBIT_BUTTON, Input
@@ -62,6 +64,7 @@ class Viewer:
         self._stamps = self._file_stamps()
         self._last_check = time.perf_counter()
         self._set_scene(scene, reset_camera=True)
+        self.load_path()
         self._init_imgui()
         self._install_callbacks()
 
@@ -85,6 +88,7 @@ class Viewer:
         self.path = Path(path)
         self._set_scene(scene, reset_camera=True)
         self._stamps, self.error = self._file_stamps(), ""
+        self.load_path()
 
     def set_levels(self, levels: int) -> None:
         """Draw only the coarsest ``levels`` levels (0 or all: the whole scene)."""
@@ -93,15 +97,29 @@ class Viewer:
 
     def _apply_levels(self) -> None:
         self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
-        self.world = compile_krs(self.krs, self.scene.material.albedo)  # for speed & picking
+        self.world = compile_geometry(self.krs, self.scene.material.albedo)  # speed, picking
         self.dirty = True
+
+    def set_render(self, **edits) -> None:
+        """Change render settings (the HUD's knobs). Accuracy knobs are uniforms; a new tracer
+        is a new shader variant, compiled once and then fetched from the cache. A MöKRS
+        keeps the binary tracer (the choice is rejected with a message)."""
+        if edits.get("tracer") == "sphere" and self.scene.mokrs is not None:
+            self.error = "a MöKRS has no distance function: only binary tracing draws it"
+            return
+        self.scene, self.dirty = replace(self.scene, render=replace(self.scene.render, **edits)), True
+
+    def set_effect(self, name: str, on: bool) -> None:
+        """Switch an effect: a different define set, so a different (cached) variant."""
+        effects = [e for e in self.scene.effects if e != name] + ([name] if on else [])
+        self.scene, self.dirty = replace(self.scene, effects=effects), True
 
     def view_scene(self) -> Scene:
         """The scene as drawn now: the viewer's camera and settings."""
         return replace(self.scene, camera=self.camera.to_camera())
 
     def nearest_distance(self) -> float:
-        return abs(float(distance(self.world, self.camera.position[None])[0]))
+        return free_radius(self.world, self.camera.position)
 
     # --------------------------------------------------------------------------- the loop
     def run(self) -> None:
@@ -258,9 +276,40 @@ class Viewer:
                 self.recording, self.message = [], "recording the camera path (F5 stops)"
             else:
                 self.path_samples, self.recording = self.recording, None
-                self.message = f"recorded {len(self.path_samples)} poses (F6 replays)"
+                self.save_path()
         elif action == "replay" and self.path_samples:
             self.replay_start = self.clock
+
+    def path_file(self) -> Path:
+        """Where the camera path of this preset is kept: beside it, ``NAME.path.json``."""
+        return self.path.with_name(self.path.stem + ".path.json")
+
+    def save_path(self) -> None:
+        samples = [dict(t=t, position=[float(c) for c in pos], yaw=yaw, pitch=pitch)
+                   for t, pos, yaw, pitch in self.path_samples]
+        try:
+            write_atomic(self.path_file(), json.dumps({"poses": samples}, indent=1))
+            self.message = (f"recorded {len(samples)} poses to {self.path_file().name} "
+                            "(F6 replays)")
+        except OSError as e:
+            self.error = f"{self.path_file()}: cannot save the camera path: {e.strerror}"
+
+    def load_path(self) -> None:
+        """The preset's saved camera path, if any; a damaged file is reported, not fatal."""
+        f = self.path_file()
+        self.path_samples = []
+        if not f.exists():
+            return
+        try:
+            poses = json.loads(f.read_text())["poses"]
+            self.path_samples = [(float(p["t"]), np.array(p["position"], dtype=np.float64),
+                                  float(p["yaw"]), float(p["pitch"])) for p in poses]
+            if not all(np.isfinite(s[1]).all() and s[1].shape == (3,) for s in self.path_samples):
+                raise ValueError("non-finite or malformed position")
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            self.path_samples = []
+            self.error = (f"{f}: not a camera path ({e}); expected {{\"poses\": [{{\"t\", "
+                          "\"position\": [x, y, z], \"yaw\", \"pitch\"}, …]}}")
 
     def pick_center(self) -> np.ndarray:
         """The surface point under the window centre, from the last traced depth; else a point

@@ -31,3 +31,16 @@ def nearest(c: Compiled, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return mokrs.nearest(c, x)
     _, level, g = krs.nearest(c, x)
     return level, g
+
+
+FREE_RADII = np.geomspace(1e-9, 1e6, 96)  # radii tried by free_radius, ratio ≈ 1.44 apart
+
+
+def free_radius(c: Compiled, x: np.ndarray) -> float:
+    """The radius of an empty ball around the point x (3,): |DISTANCE| for a KRS; for a MöKRS
+    (no distance function) the largest of FREE_RADII that is unbounding, found in one batch.
+    Used by the viewer to scale flying speed."""
+    if isinstance(c, CompiledKRS):
+        return abs(float(krs.distance(c, x[None])[0]))
+    free = is_unbounding(c, np.broadcast_to(x, (len(FREE_RADII), 3)), FREE_RADII)
+    return float(FREE_RADII[free].max()) if free.any() else 0.0

@@ -93,9 +93,13 @@ def scene_to_toml(scene: Scene) -> str:
 
 
 def save_scene(scene: Scene, path: str | os.PathLike) -> None:
-    """Atomic save: write a temporary file beside the target, then rename over it."""
+    """Atomic save, so an edit is never lost half-written."""
+    write_atomic(path, scene_to_toml(scene))
+
+
+def write_atomic(path: str | os.PathLike, text: str) -> None:
+    """Write a temporary file beside the target, then rename it over the target."""
     p = Path(path)
-    text = scene_to_toml(scene)
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent or ".")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
