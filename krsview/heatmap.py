@@ -15,7 +15,7 @@ LEGEND_BACKGROUND = (32, 32, 36)  # dark, so the white end of the bar shows
 def heat(x: np.ndarray) -> np.ndarray:
     """Black → purple → orange → white for x in [0, 1]; returns (..., 3) in [0, 1]."""
     x = np.clip(x, 0.0, 1.0)
-    rgb = np.stack([1.6 * x, 1.8 * x * x - 0.15, 0.9 * np.sin(np.pi * x) + x ** 3], axis=-1)
+    rgb = np.stack([1.6 * x, 1.15 * x * x - 0.15, 0.9 * np.sin(np.pi * x) + x ** 3], axis=-1)
     return np.clip(rgb, 0.0, 1.0)
 
 

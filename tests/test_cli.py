@@ -83,3 +83,42 @@ def test_view_without_a_display_says_what_to_do():
     assert r.returncode == 3 and "Traceback" not in r.stderr
     assert r.stderr.strip() == ("krsview: error: cannot open a window: GLFW found no display "
                                 "(is DISPLAY set? use `krsview render` to render headless)")
+
+
+@pytest.mark.parametrize("tracer", ["sphere", "binary"])
+def test_iterations_view_writes_a_heat_map_with_legend(tmp_path, tracer):
+    from krsview.heatmap import LEGEND_HEIGHT, heat
+    out, npz = tmp_path / "it.png", tmp_path / "b.npz"
+    r = run("render", "tree", "--view", "iterations", "--tracer", tracer, "--legend-max", "60",
+            "-o", str(out), "--size", "96x64", "--buffers", str(npz), "--repeats", "1")
+    assert r.returncode == 0, r.stderr
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    assert img.shape == (64 + LEGEND_HEIGHT, 96, 3)
+    it = np.load(npz)["iterations"]
+    want = np.round(heat(it / 60) * 255)
+    assert np.abs(img[:64] - want).max() <= 1                 # the image is the iteration count
+    assert img[64:].max() >= 250 and img[64:].min() <= 40     # the legend's bar runs dark → white
+    assert "iterations per pixel: median" in r.stdout
+
+
+def test_heat_ramp_runs_from_black_to_white_and_brightens():
+    """Every count must map to a distinct brightness: no flat white top of the scale."""
+    from krsview.heatmap import heat
+    x = np.linspace(0, 1, 101)
+    lum = heat(x) @ [0.2126, 0.7152, 0.0722]
+    assert np.allclose(heat(np.array([0.0, 1.0])), [[0, 0, 0], [1, 1, 1]])
+    assert (np.diff(lum) > 0).all()
+
+
+def test_sphere_tracer_on_a_mokrs_is_refused():
+    r = run("render", "palm", "--tracer", "sphere", "-o", "/tmp/never.png")
+    assert r.returncode == 2
+    assert "--tracer = 'sphere': this scene is a MöKRS" in r.stderr
+
+
+def test_bench_tracers_prints_ratios_and_best_pair(capsys):
+    from krsview.cli import main
+    assert main(["bench", "tracers", "tree", "--size", "32x24", "--rounds", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "| sphere |" in out and "| binary | 2.0 | 0.3 |" in out
+    assert out.count("| binary |") == 9 and "fastest ξ pair:" in out

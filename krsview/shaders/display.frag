@@ -19,7 +19,7 @@ out vec4 frag_color;
 // Black → purple → orange → white heat ramp for iteration counts [KRS17 Fig. 13].
 vec3 heat(float x) {
     x = clamp(x, 0.0, 1.0);
-    return clamp(vec3(1.6 * x, 1.8 * x * x - 0.15, 0.9 * sin(3.14159265 * x) + x * x * x),
+    return clamp(vec3(1.6 * x, 1.15 * x * x - 0.15, 0.9 * sin(3.14159265 * x) + x * x * x),
                  0.0, 1.0);
 }
 
