@@ -10,7 +10,7 @@ from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import MAX_LEVELS, Scene
 
-MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, (pole.xyz, flags); mobius.glsl
+MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, (pole.xyz | scale, flags)
 
 
 def variant_defines(scene: Scene, c: Compiled) -> dict[str, str | int | None]:
@@ -37,8 +37,8 @@ def krs_block(c: Compiled) -> bytes:
         levels[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
         for i, H in enumerate(c.inverse):
             p = mobius.pole(H)
-            levels[i, 4] = [*(p if p is not None else (0.0, 0.0, 0.0)),
-                            (p is not None) + 2 * bool(c.reflect[i])]
+            slot = p if p is not None else (mobius.affine_scale(H), 0.0, 0.0)
+            levels[i, 4] = [*slot, (p is not None) + 2 * bool(c.reflect[i])]
         head = levels.astype(np.float32)
         kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
         kernels[:c.n] = c.records

@@ -162,19 +162,23 @@ def map_ball(M: np.ndarray, center: np.ndarray, radius: np.ndarray):
     Same sphere as App. A applied with M⁻¹, computed from two points instead: the diameter
     on the line through the pole maps to a diameter of the image (both are symmetric about
     that line), so the radius comes from a difference of nearby points. App. A instead
-    recovers ρ² = |κ|² − γ, which cancels catastrophically in float32 when ρ ≪ |κ|."""
+    recovers ρ² = |κ|² − γ, which cancels catastrophically in float32 when ρ ≪ |κ|.
+    Without a pole L_M is a similarity and one point suffices."""
     p = pole(M)
-    if p is None:
-        u = np.broadcast_to([1.0, 0.0, 0.0], center.shape)
-        ok = np.ones(len(center), dtype=bool)
-    else:
-        off = center - p
-        dist = np.linalg.norm(off, axis=-1)
-        ok = dist > radius
-        u = off / np.where(dist > 0, dist, 1.0)[:, None]
+    if p is None:  # a similarity: the centre maps to the centre, radii scale by |a|/|d|
+        return apply(M, center), radius * affine_scale(M), np.ones(len(center), dtype=bool)
+    off = center - p
+    dist = np.linalg.norm(off, axis=-1)
+    ok = dist > radius
+    u = off / np.where(dist > 0, dist, 1.0)[:, None]
     r = np.where(ok, radius, 0.0)[:, None]
     x1, x2 = apply(M, center + r * u), apply(M, center - r * u)
     return 0.5 * (x1 + x2), 0.5 * np.linalg.norm(x1 - x2, axis=-1), ok
+
+
+def affine_scale(M: np.ndarray) -> float:
+    """The length scale |a|/|d| of an affine L_M(q) = (aq + b)d⁻¹ (c = 0)."""
+    return float(np.sqrt(Q.norm2(M[0, 0]) / Q.norm2(M[1, 1])))
 
 
 def ray_sphere(alpha, beta, gamma, tau: np.ndarray, omega: np.ndarray) -> np.ndarray:

@@ -1,6 +1,7 @@
 // Möbius transformations H_i = G_i⁻¹ of the MöKRS levels [KRS17 §6.2, App. C]; twin of
-// reference/mobius.py (apply, map_ball, gradient). Record per level: a, b, c, d,
-// (pole.xyz, flags) with flags = has_pole + 2 · reflects.
+// reference/mobius.py (apply, map_ball, gradient). Record per level: a, b, c, d, then
+// (pole.xyz, flags) with a pole, or (|a|/|d|, 0, 0, flags) for a similarity (c = 0);
+// flags = has_pole + 2 · reflects.
 #include "quaternion.glsl"
 
 vec4 mobius_rec(int i, int k) { return u_mobius[i * MOBIUS_RECORD + k]; }
@@ -15,16 +16,18 @@ vec3 mobius_apply(int i, vec3 p) {
 
 // The image of a ball under L_H, from the diameter on the line through the pole (it maps
 // to a diameter of the image); false if the ball holds the pole (image: an exterior).
-// Float32-safe, unlike App. A's ρ² = |κ|² − γ.
+// Float32-safe, unlike App. A's ρ² = |κ|² − γ. A similarity needs only the centre.
 bool map_ball(int i, inout vec3 center, inout float radius) {
     vec4 pf = mobius_rec(i, 4);
-    vec3 u = vec3(1.0, 0.0, 0.0);
-    if ((int(pf.w) & 1) != 0) {
-        vec3 off = center - pf.xyz;
-        float dist = length(off);
-        if (dist <= radius) return false;
-        u = off / dist;
+    if ((int(pf.w) & 1) == 0) {  // a similarity: one point and a scale
+        center = mobius_apply(i, center);
+        radius *= pf.x;
+        return true;
     }
+    vec3 off = center - pf.xyz;
+    float dist = length(off);
+    if (dist <= radius) return false;
+    vec3 u = off / dist;
     vec3 x1 = mobius_apply(i, center + radius * u), x2 = mobius_apply(i, center - radius * u);
     center = 0.5 * (x1 + x2);
     radius = 0.5 * length(x1 - x2);
