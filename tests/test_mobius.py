@@ -95,7 +95,11 @@ def test_app_a_preimage_maps_onto_the_sphere(seed):
     on = c2 + r2[:, None] * u
     image = M.apply(H, on)
     err = np.abs(np.linalg.norm(image - c[proper], axis=1) - r[proper])
-    assert (err <= 1e-7 * (1 + np.abs(c[proper]).max(1) + r[proper])).all()
+    # App. A recovers ρ'² = |κ'|² − γ'/α', which cancels: its relative error is about
+    # 1e-16 (1 + |κ'|²)/ρ'² — the reason the tracer maps balls by two points instead
+    cancel = 1e-15 * (1 + np.sum(c2 * c2, axis=1)) / r2 ** 2
+    assert (err <= 1e-7 * (1 + np.abs(c[proper]).max(1) + r[proper])
+            + cancel * r[proper]).all()
 
 
 @settings(max_examples=60, deadline=None)
@@ -110,8 +114,9 @@ def test_map_ball_equals_app_a(seed):
     good = ok & (a2 > 1e-6)
     c2, r2 = M.sphere_of(a2[good], b2[good], g2[good])
     scale = 1 + np.abs(c2).max(1) + r2
+    cancel = 1e-15 * (1 + np.sum(c2 * c2, axis=1)) / r2 ** 2  # App. A's own error, as above
     assert (np.abs(c3[good] - c2).max(1) <= 1e-7 * scale).all()
-    assert (np.abs(r3[good] - r2) <= 1e-7 * scale).all()
+    assert (np.abs(r3[good] - r2) <= 1e-7 * scale + cancel * r2).all()
 
 
 def test_map_ball_keeps_a_tiny_probe_in_float32_where_app_a_loses_it():
