@@ -58,9 +58,7 @@ def _load(args: argparse.Namespace) -> Scene:
     if getattr(args, "max_iterations", None) is not None:
         render = replace(render, max_iterations=args.max_iterations)
     if getattr(args, "tracer", None) is not None:
-        if scene.mokrs is not None and args.tracer != "binary":
-            raise SceneError("--tracer", args.tracer, "this scene is a MöKRS, which has no "
-                             "distance function; allowed: binary")
+        scene.check_tracer(args.tracer, "--tracer")
         render = replace(render, tracer=args.tracer)
     scene = replace(scene, render=render)
     levels = getattr(args, "levels", None)
@@ -187,6 +185,13 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--levels", type=_int_in("--levels", 1, MAX_LEVELS),
                         help="keep only the coarsest N levels (drops the finest detail)")
 
+    def bench_arguments(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+        sp.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
+        sp.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=5,
+                        help="interleaved rounds; medians are reported (default 5)")
+        sp.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
+
     r = sub.add_parser("render", help="render a scene headless to PNG (and raw buffers)",
                        description="Render PRESET headless through EGL and write a PNG; prints "
                                    "the measured frame time.")
@@ -238,13 +243,9 @@ def build_parser() -> argparse.ArgumentParser:
                          description="Render the same view with the coarsest 4, 8, … levels, "
                                      "interleaved, median of several frames; print time relative "
                                      "to the smallest level count beside the kernel instances.")
-    bl.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    bl.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
+    bench_arguments(bl)
     bl.add_argument("--step", type=_int_in("--step", 1, MAX_LEVELS), default=4,
                     help="level increment (default 4)")
-    bl.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=5,
-                    help="interleaved rounds; medians are reported (default 5)")
-    bl.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
     bl.add_argument("--epsilon-scale", type=_positive_float("--epsilon-scale", 1e-4, 100.0))
     bl.add_argument("--max-iterations", type=_int_in("--max-iterations", 1, 10000))
     bl.set_defaults(func=cmd_bench_levels)
@@ -254,12 +255,8 @@ def build_parser() -> argparse.ArgumentParser:
                                      "ξ_bonus ∈ {1.5, 2, 3} × ξ_penalty ∈ {0.2, 0.3, 0.5}; "
                                      "iterations per pixel, frame time and hit agreement, as "
                                      "ratios to sphere tracing (to binary 2.0/0.3 for a MöKRS).")
-    bt.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    bt.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
-    bt.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=5,
-                    help="interleaved rounds; medians are reported (default 5)")
+    bench_arguments(bt)
     bt.add_argument("--no-sweep", action="store_true", help="only sphere vs binary 2.0/0.3")
-    bt.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
     accuracy(bt)
     bt.set_defaults(func=cmd_bench_tracers)
     return p

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from krsview.reference import render_reference
-from krsview.scene import (KRS, Camera, Empty, Level, Mirror, Plane, Render, Scene, Sphere, Tree,
+from krsview.scene import (KRS, Camera, Empty, Level, Mirror, Plane, Render, Scene, Sphere,
                            load_scene)
 from krsview.presets import resolve
 

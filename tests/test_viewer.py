@@ -62,6 +62,14 @@ def settle(v, limit: int = 400) -> None:
     raise AssertionError("the view never refined to full resolution")
 
 
+def hold(v, key: str, steps: int, dt: float = 0.05) -> None:
+    """Hold ``key`` for ``steps`` event-loop turns, then release it."""
+    v.input.key(key, True)
+    for _ in range(steps):
+        v.step(dt)
+    v.input.key(key, False)
+
+
 def headless_render(scene, path: Path) -> np.ndarray:
     """`krsview render` in its own process (EGL, no window) of the same scene and camera."""
     save_scene(scene, path.with_suffix(".toml"))
@@ -78,10 +86,7 @@ def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_
     settle(v)
     start = v.read_window()
     p0 = v.camera.position.copy()
-    v.input.key("W", True)
-    for _ in range(5):
-        v.step(0.1)
-    v.input.key("W", False)
+    hold(v, "W", 5, 0.1)
     v.input.button("right", True)
     v.input.move_cursor(0, 0)
     v.input.move_cursor(25, -10)
@@ -127,13 +132,9 @@ def test_orbit_keeps_distance_to_the_picked_point(viewer):
 
 def test_bookmark_is_saved_in_the_preset_and_reset_restores(viewer):
     v = viewer
-    v.input.key("A", True)
-    v.step(0.2)
-    v.input.key("A", False)
+    hold(v, "A", 1, 0.2)
     moved = v.camera.to_camera()
-    v.input.key("B", True)
-    v.step(0.01)
-    v.input.key("B", False)
+    hold(v, "B", 1, 0.01)
     saved = load_scene(v.path)
     assert saved.bookmarks and saved.bookmarks[-1].camera == moved
     v.act("reset")
@@ -193,10 +194,7 @@ def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(displ
 def test_record_and_replay_a_camera_path(viewer):
     v = viewer
     v.act("record")
-    for _ in range(5):
-        v.input.key("E", True)
-        v.step(0.05)
-    v.input.key("E", False)
+    hold(v, "E", 5)
     v.act("record")
     end = v.camera.position.copy()
     v.act("reset")
@@ -209,10 +207,7 @@ def test_record_and_replay_a_camera_path(viewer):
 def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
     v = viewer
     v.act("record")
-    for _ in range(4):
-        v.input.key("W", True)
-        v.step(0.05)
-    v.input.key("W", False)
+    hold(v, "W", 4)
     v.act("record")
     end, recorded = v.camera.position.copy(), len(v.path_samples)
     assert v.path_file().exists() and v.path_file().name == "tree.path.json"
@@ -263,10 +258,7 @@ def test_mokrs_presets_fly_in_the_viewer(viewer):
         v.set_render(tracer="sphere")
         assert v.scene.render.tracer == "binary" and "binary tracing" in v.error
         v.error = ""
-        for _ in range(3):
-            v.input.key("W", True)
-            v.step(0.05)
-        v.input.key("W", False)
+        hold(v, "W", 3)
         settle(v)
         assert np.isfinite(v.camera.position).all()
 

@@ -104,9 +104,11 @@ class Viewer:
     def set_render(self, **edits) -> None:
         """Change render settings (the HUD's knobs). Accuracy knobs are uniforms; a new tracer
         is a new shader variant, compiled once and then fetched from the cache. A MöKRS
-        keeps the binary tracer (the choice is rejected with a message)."""
-        if edits.get("tracer") == "sphere" and self.scene.mokrs is not None:
-            self.error = "a MöKRS has no distance function: only binary tracing draws it"
+        keeps the binary tracer (the HUD shows why another choice is refused)."""
+        try:
+            self.scene.check_tracer(edits.get("tracer", self.scene.render.tracer), "tracer")
+        except SceneError as e:
+            self.error = str(e)
             return
         self.scene, self.dirty = replace(self.scene, render=replace(self.scene.render, **edits)), True
 
@@ -320,8 +322,8 @@ class Viewer:
                 raise ValueError("non-finite or malformed position")
         except (OSError, ValueError, KeyError, TypeError) as e:
             self.path_samples = []
-            self.error = (f"{f}: not a camera path ({e}); expected {{\"poses\": [{{\"t\", "
-                          "\"position\": [x, y, z], \"yaw\", \"pitch\"}, …]}}")
+            self.error = (f"{f}: not a camera path ({e}); expected "
+                          '{"poses": [{"t", "position": [x, y, z], "yaw", "pitch"}, …]}')
 
     def pick_center(self) -> np.ndarray:
         """The surface point under the window centre, from the last traced depth; else a point

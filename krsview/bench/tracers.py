@@ -56,8 +56,9 @@ def bench_tracers(scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: b
     rows = []
     for name, s in runs.items():
         b, t = buffers[name], statistics.median(times[name])
-        rows.append(dict(tracer=s.render.tracer, xi_bonus=s.render.xi_bonus if "binary" in name
-                         else "", xi_penalty=s.render.xi_penalty if "binary" in name else "",
+        binary = s.render.tracer == "binary"
+        rows.append(dict(tracer=s.render.tracer, xi_bonus=s.render.xi_bonus if binary else "",
+                         xi_penalty=s.render.xi_penalty if binary else "",
                          median_iterations=float(np.median(b.iterations)),
                          mean_iterations=float(np.mean(b.iterations)),
                          iteration_ratio=float(np.mean(b.iterations)) / it0, ms=t * 1e3,
@@ -74,10 +75,10 @@ def bench_tracers(scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: b
               f"{row['median_iterations']:.0f} | {row['mean_iterations']:.1f} | "
               f"{row['iteration_ratio']:.2f} | {row['ms']:.1f} | {row['time_ratio']:.2f} | "
               f"{row['hit_agreement']:.2%} |")
-    binary = [row for row in rows if row["tracer"] == "binary"]
-    if len(binary) > 1:
-        fast = min(binary, key=lambda row: row["ms"])
-        few = min(binary, key=lambda row: row["mean_iterations"])
+    binaries = [row for row in rows if row["tracer"] == "binary"]
+    if len(binaries) > 1:
+        fast = min(binaries, key=lambda row: row["ms"])
+        few = min(binaries, key=lambda row: row["mean_iterations"])
         print(f"\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
               f"({fast['time_ratio']:.2f}× {base}); fewest iterations: "
               f"{few['xi_bonus']}/{few['xi_penalty']} ({few['mean_iterations']:.1f} it/px)")

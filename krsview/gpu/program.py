@@ -28,7 +28,6 @@ class Source:
     def __init__(self, entry: str, defines: dict[str, str | int | float | None],
                  shader_dir: Path = SHADER_DIR):
         self.shader_dir = shader_dir
-        self.included: set[str] = set()
         head = [f"#version {GL_VERSION} core"]
         head += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
                  sorted(defines.items())]
@@ -45,7 +44,6 @@ class Source:
         except OSError:
             where = f" (included from {stack[-1]})" if stack else ""
             raise ShaderError(f"shader file not found: {name}{where}") from None
-        self.included.add(name)
         # A real header guard, not a textual skip: an #include inside an inactive #ifdef
         # branch must not hide the file from an active branch later.
         guard = "KRS_FILE_" + re.sub(r"\W", "_", name).upper()

@@ -3,14 +3,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..reference import mobius
 from ..reference.camera import View
 from ..reference.compiled import RECORD_VEC4
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import MAX_LEVELS, Scene
 
-MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, (pole.xyz | scale, flags)
+MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, then its pole record
 
 
 def variant_defines(scene: Scene, c: Compiled) -> dict[str, str | int | None]:
@@ -33,20 +32,14 @@ def variant_defines(scene: Scene, c: Compiled) -> dict[str, str | int | None]:
 def krs_block(c: Compiled) -> bytes:
     """The std140 KRSBlock: mirrors (or Möbius records) then kernel records, as float32."""
     if isinstance(c, CompiledMoKRS):
-        levels = np.zeros((MAX_LEVELS, MOBIUS_RECORD, 4))
-        levels[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
-        for i, H in enumerate(c.inverse):
-            p = mobius.pole(H)
-            slot = p if p is not None else (mobius.affine_scale(H), 0.0, 0.0)
-            levels[i, 4] = [*slot, (p is not None) + 2 * bool(c.reflect[i])]
-        head = levels.astype(np.float32)
-        kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
-        kernels[:c.n] = c.records
+        head = np.zeros((MAX_LEVELS, MOBIUS_RECORD, 4), dtype=np.float32)
+        head[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
+        head[:c.n, 4] = c.poles
     else:
         head = np.zeros((MAX_LEVELS, 4), dtype=np.float32)
         head[:c.n] = c.mirrors
-        kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
-        kernels[:c.n + 1] = c.records
+    kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
+    kernels[:len(c.records)] = c.records
     return head.tobytes() + kernels.tobytes()
 
 

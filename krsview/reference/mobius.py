@@ -146,7 +146,7 @@ def transform_sphere(H: np.ndarray, alpha, beta, gamma):
     γ' = α b b̄ + 2 Re(d̄ β b) + γ d d̄. The sign of the implicit function is kept, so the
     inside stays the inside: α' < 0 means the preimage of the ball is a ball's exterior."""
     a, b, c, d = H[0, 0], H[0, 1], H[1, 0], H[1, 1]
-    ab, bb, cb, db = Q.conj(a), Q.conj(b), Q.conj(c), Q.conj(d)
+    bb, cb, db = Q.conj(b), Q.conj(c), Q.conj(d)
     al, ga = np.asarray(alpha)[..., None], np.asarray(gamma)[..., None]
     M = Q.mul
     a2 = al * Q.norm2(a) + 2.0 * M(M(cb, beta), a)[..., :1] + ga * Q.norm2(c)

@@ -22,6 +22,7 @@ class CompiledMoKRS:
     reflect: np.ndarray      # (n,) bool
     records: np.ndarray      # (n, RECORD_VEC4, 4), in each level's own space
     types: tuple[str, ...]
+    poles: np.ndarray        # (n, 4): (pole.xyz | (|a|/|d|, 0, 0), has_pole + 2·reflects)
 
     @property
     def n(self) -> int:
@@ -30,15 +31,26 @@ class CompiledMoKRS:
     def relative_to(self, origin) -> "CompiledMoKRS":
         """World positions taken relative to ``origin``: only the outermost H changes,
         H_{n−1} ← H_{n−1} · T(origin) (the world point is origin + the relative point)."""
-        inverse = self.inverse.copy()
+        inverse, poles = self.inverse.copy(), self.poles.copy()
         inverse[-1] = mobius.tidy(mobius.compose(inverse[-1], mobius.translation(origin)))
-        return CompiledMoKRS(inverse, self.reflect, self.records, self.types)
+        poles[-1] = pole_record(inverse[-1], self.reflect[-1])
+        return CompiledMoKRS(inverse, self.reflect, self.records, self.types, poles)
+
+
+def pole_record(H: np.ndarray, reflect: bool) -> np.ndarray:
+    """What ``map_ball`` in mobius.glsl needs besides H: the pole, or for a similarity its
+    scale, and the flags; computed per scene (the top level's per frame), not per pixel."""
+    p = mobius.pole(H)
+    slot = p if p is not None else (mobius.affine_scale(H), 0.0, 0.0)
+    return np.array([*slot, (p is not None) + 2 * bool(reflect)], dtype=np.float64)
 
 
 def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS:
-    inverse = np.array([mobius.tidy(mobius.inverse(lv.matrix())) for lv in m.levels])
+    inverse = np.array([lv.inverse() for lv in m.levels])
+    reflect = np.array([lv.reflect for lv in m.levels])
     records, types = kernel_records(m.kernels, albedo)
-    return CompiledMoKRS(inverse, np.array([lv.reflect for lv in m.levels]), records, types)
+    poles = np.array([pole_record(H, r) for H, r in zip(inverse, reflect)])
+    return CompiledMoKRS(inverse, reflect, records, types, poles)
 
 
 def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray) -> np.ndarray:

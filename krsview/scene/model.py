@@ -99,6 +99,15 @@ class Level:
     mirror: Mirror | None = param(None, help="mirror R_{i-1} that doubles the level below")
 
 
+def check_level_count(levels: list, path: str, empty: str) -> None:
+    """1..MAX_LEVELS levels (the shader's uniform block is sized for MAX_LEVELS)."""
+    if not levels:
+        raise SceneError(path, [], empty)
+    if len(levels) > MAX_LEVELS:
+        raise SceneError(path, f"<{len(levels)} levels>",
+                         f"too many levels; allowed: at most {MAX_LEVELS}")
+
+
 @dataclass(frozen=True)
 class KRS:
     """A kernel–reflection sequence (K_0..K_n; R_0..R_{n-1}) [KRS17 §3]."""
@@ -106,11 +115,7 @@ class KRS:
 
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
-        if not self.levels:
-            raise SceneError(p, [], "a KRS needs at least one level (level 0: a kernel)")
-        if len(self.levels) > MAX_LEVELS:
-            raise SceneError(p, f"<{len(self.levels)} levels>",
-                             f"too many levels; allowed: at most {MAX_LEVELS}")
+        check_level_count(self.levels, p, "a KRS needs at least one level (level 0: a kernel)")
         if self.levels[0].mirror is not None:
             raise SceneError(f"{p}[0].mirror", to_dict(self.levels[0].mirror),
                              "level 0 has no mirror (it holds only kernel K_0)")

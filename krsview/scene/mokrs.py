@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-from .model import MAX_LEVELS, Empty, Kernel
+from .model import Empty, Kernel, check_level_count
 from .schema import SceneError, Tagged, Vec3, param
 
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
@@ -89,6 +89,11 @@ class MobiusLevel:
         from ..reference import mobius
         return mobius.compose(mobius.identity(), *[s.matrix() for s in reversed(self.transform)])
 
+    def inverse(self):
+        """G_i⁻¹, which the tracer applies going inwards, with a rounding-level c zeroed."""
+        from ..reference import mobius
+        return mobius.tidy(mobius.inverse(self.matrix()))
+
 
 @dataclass(frozen=True)
 class MoKRS:
@@ -98,11 +103,7 @@ class MoKRS:
     def validate(self, path: str) -> None:
         from ..reference import mobius
         p = f"{path}.levels"
-        if not self.levels:
-            raise SceneError(p, [], "a MöKRS needs at least one level")
-        if len(self.levels) > MAX_LEVELS:
-            raise SceneError(p, f"<{len(self.levels)} levels>",
-                             f"too many levels; allowed: at most {MAX_LEVELS}")
+        check_level_count(self.levels, p, "a MöKRS needs at least one level")
         for i, lv in enumerate(self.levels):
             cond = mobius.condition(lv.matrix())
             if not cond <= SINGULAR_CONDITION:
@@ -143,7 +144,7 @@ def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
     from ..reference import mobius
     x = np.array([position], dtype=np.float64)
     for i in range(mokrs.n - 1, -1, -1):
-        H = mobius.tidy(mobius.inverse(mokrs.levels[i].matrix()))
+        H = mokrs.levels[i].inverse()
         p = mobius.pole(H)
         if p is not None:
             scale = max(1.0, float(np.linalg.norm(x)))
@@ -162,6 +163,7 @@ def mokrs_of(krs) -> MoKRS:
     (used by the tracer cross-check). The top kernel K_n stays in the world, unreflected."""
     import numpy as np
     from dataclasses import fields, replace
+    from ..reference import mobius
     from .model import Plane
 
     def to_x(u):
@@ -173,16 +175,13 @@ def mokrs_of(krs) -> MoKRS:
             return (0.0, 1.0, 0.0), (0.0 if c > 0 else 180.0)
         return tuple(axis / s), math.degrees(math.atan2(s, c))
 
-    def rotation(axis, degrees):
-        a, th = np.asarray(axis), math.radians(degrees)
-        K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-        return np.eye(3) + math.sin(th) * K + (1 - math.cos(th)) * K @ K
-
-    def moved(k: Kernel, R, o) -> Kernel:
-        """Kernel k in the frame y = R (x − o)."""
+    def moved(k: Kernel, rotate: Rotate, o) -> Kernel:
+        """Kernel k in the frame y = R (x − o), R the rotation ``rotate``."""
+        R = rotate.matrix()
+        turn = lambda v: tuple(float(c) for c in mobius.apply(R, np.array([v]))[0])  # noqa: E731
         if isinstance(k, Plane):
-            return replace(k, normal=tuple(R @ k.normal), offset=k.offset - float(np.dot(k.normal, o)))
-        change = {f.name: tuple(R @ (np.asarray(getattr(k, f.name)) - o)) for f in fields(k)
+            return replace(k, normal=turn(k.normal), offset=k.offset - float(np.dot(k.normal, o)))
+        change = {f.name: turn(np.asarray(getattr(k, f.name)) - o) for f in fields(k)
                   if f.name in ("center", "a", "b", "start", "control", "end")}
         return replace(k, **change)
 
@@ -197,6 +196,6 @@ def mokrs_of(krs) -> MoKRS:
         steps.append(Translate(tuple(float(v) for v in shift)))
         if i + 1 < len(frames):
             steps.append(Rotate(frames[i + 1][0], frames[i + 1][1]))
-        levels.append(MobiusLevel(moved(krs.kernels[i], rotation(axis, deg), o), steps, True))
+        levels.append(MobiusLevel(moved(krs.kernels[i], Rotate(axis, deg), o), steps, True))
     levels.append(MobiusLevel(krs.kernels[-1], [], False))
     return MoKRS(levels)

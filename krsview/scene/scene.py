@@ -48,12 +48,18 @@ class Scene:
                 raise SceneError(f"effects[{i}]", e, "unknown effect; allowed: "
                                  + (", ".join(EFFECTS) or "none yet"))
         if self.mokrs is not None:
-            if self.render.tracer != "binary":
-                raise SceneError("render.tracer", self.render.tracer, "a MöKRS has no distance "
-                                 "function, only unbounding tests; allowed: 'binary'")
+            self.check_tracer(self.render.tracer)
             check_view(self.mokrs, self.camera.position, "camera.position")
             for i, b in enumerate(self.bookmarks):
                 check_view(self.mokrs, b.camera.position, f"bookmarks[{i}].camera.position")
+
+    def check_tracer(self, tracer: str, path: str = "render.tracer") -> None:
+        """The one rule for a tracer choice, from a file, the CLI or the HUD: a MöKRS needs
+        binary tracing."""
+        if self.mokrs is not None and tracer != "binary":
+            raise SceneError(path, tracer, "this scene is a MöKRS, which has no distance "
+                             "function, only unbounding tests: it needs binary tracing; "
+                             "allowed: 'binary'")
 
     def geometry(self) -> KRS | MoKRS:
         """What is drawn: the explicit KRS or MöKRS, or the tree expanded [KRS17 §9.2]."""

@@ -6,7 +6,6 @@ panels read the same metadata (the Fragmentarium habit, see DESIGN.md).
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import types
 import typing
