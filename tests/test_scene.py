@@ -79,7 +79,14 @@ def test_structural_mistakes():
     assert "exactly one geometry" in str(error_of("name = 'x'"))
     no_mirror = GOOD.replace("mirror = { normal = [1.0, 0.0, 0.0], offset = 1.0 }", "")
     assert error_of(no_mirror).path == "krs.levels[1].mirror"
-    assert error_of("effects = ['shadows']\n" + GOOD).path == "effects[0]"
+    assert error_of("effects = ['shadow']\n" + GOOD).path == "effects[0]"
+    assert "soft_shadows" in str(error_of("effects = ['shadow']\n" + GOOD))  # lists the allowed
+    both = error_of("effects = ['shadows', 'soft_shadows']\n" + GOOD)
+    assert both.path == "effects" and "exclude each other" in str(both)
+    assert "at most once" in str(error_of("effects = ['fog', 'fog']\n" + GOOD))
+    zones = "\n[effect_settings]\nempty_zones = [" + "{radius = 1.0}, " * 9 + "]\n"
+    assert error_of(GOOD + zones).path == "effect_settings.empty_zones"
+    assert error_of(GOOD + "\n[effect_settings]\nao_step = 0.0\n").path == "effect_settings.ao_step"
     assert error_of("name = [").path == "<syntax>"
     assert error_of("[tree]\nbranch_angle = 95.0").path == "tree.branch_angle"
 

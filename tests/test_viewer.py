@@ -171,8 +171,8 @@ def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(displ
     try:
         settle(v)
         shade = shaders / "shade.glsl"
-        shade.write_text(shade.read_text().replace("return albedo * light;",
-                                                   "return vec3(1.0, 0.0, 1.0);"))
+        shade.write_text(shade.read_text().replace("vec3 color = albedo * light;",
+                                                   "vec3 color = vec3(1.0, 0.0, 1.0);"))
         time.sleep(0.6)
         v.step(0.01)
         settle(v)

@@ -21,9 +21,17 @@ class ShaderError(RuntimeError):
     """A shader failed to build; ``str()`` names the .glsl file, line and the offending text."""
 
 
+_DIRECTIVE = re.compile(r"^\s*#\s*(ifdef|ifndef|if|else|endif|define|undef)\b\s*(.*?)\s*(//.*)?$")
+_DEFINED = re.compile(r"defined\s*\(?\s*(\w+)\s*\)?")
+
+
 class Source:
     """A stage assembled from .glsl files. ``origin[k]`` is the (file, line) of assembled line
-    k + 1, so compiler messages map back without trusting the driver's ``#line`` handling."""
+    k + 1, so compiler messages map back without trusting the driver's ``#line`` handling.
+
+    Conditionals are resolved here, against the variant's defines: an inactive ``#ifdef``
+    block, and any file it includes, never reaches the driver, so a scene without an effect
+    compiles none of that effect's code (DESIGN.md, Specialise, don't branch)."""
 
     def __init__(self, entry: str, defines: dict[str, str | int | float | None],
                  shader_dir: Path = SHADER_DIR):
@@ -32,33 +40,68 @@ class Source:
         head += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
                  sorted(defines.items())]
         self.origin: list[tuple[str, int]] = [("<defines>", k) for k in range(1, len(head) + 1)]
+        self.defined = set(defines)
+        self.included: set[str] = set()
         lines = head + self._expand(entry, [])
         self.text = "\n".join(lines) + "\n"
 
     def _expand(self, name: str, stack: list[str]) -> list[str]:
         if name in stack:
             raise ShaderError("#include cycle: " + " → ".join(stack + [name]))
+        if name in self.included:
+            return []  # once per stage: inactive branches are gone, so a plain skip is safe
+        self.included.add(name)
         path = self.shader_dir / name
         try:
             text = path.read_text(encoding="utf-8")
         except OSError:
             where = f" (included from {stack[-1]})" if stack else ""
             raise ShaderError(f"shader file not found: {name}{where}") from None
-        # A real header guard, not a textual skip: an #include inside an inactive #ifdef
-        # branch must not hide the file from an active branch later.
-        guard = "KRS_FILE_" + re.sub(r"\W", "_", name).upper()
-        out: list[str] = [f"#ifndef {guard}", f"#define {guard}"]
-        self.origin += [("<defines>", 0), ("<defines>", 0)]  # generated, like the defines
+        out: list[str] = []
+        active = [True]  # one entry per open conditional: is this branch emitted?
         for k, line in enumerate(text.splitlines(), 1):
+            d = _DIRECTIVE.match(line)
+            if d and d.group(1) in ("ifdef", "ifndef", "if", "else", "endif"):
+                self._conditional(d.group(1), d.group(2), active, name, k)
+                continue
+            if not all(active):
+                continue
+            if d and d.group(1) == "define":
+                self.defined.add(d.group(2).split("(")[0].split()[0])
+            elif d and d.group(1) == "undef":
+                self.defined.discard(d.group(2))
             m = _INCLUDE.match(line)
             if m:
                 out += self._expand(m.group(1), stack + [name])
             else:
                 out.append(line)
                 self.origin.append((name, k))
-        out.append(f"#endif  // {guard}")
-        self.origin.append(("<defines>", 0))
+        if len(active) != 1:
+            raise ShaderError(f"{name}: #if without #endif")
         return out
+
+    def _conditional(self, kind: str, arg: str, active: list[bool], name: str, k: int) -> None:
+        if kind == "ifdef":
+            active.append(arg in self.defined)
+        elif kind == "ifndef":
+            active.append(arg not in self.defined)
+        elif kind == "if":
+            active.append(self._evaluate(arg, name, k))
+        elif len(active) == 1:
+            raise ShaderError(f"{name}:{k}: #{kind} without #if")
+        elif kind == "else":
+            active[-1] = not active[-1]
+        else:
+            active.pop()
+
+    def _evaluate(self, expr: str, name: str, k: int) -> bool:
+        """``#if`` over ``defined(NAME)``, ``!``, ``&&``, ``||`` and parentheses only."""
+        py = _DEFINED.sub(lambda m: str(m.group(1) in self.defined), expr)
+        py = py.replace("&&", " and ").replace("||", " or ").replace("!", " not ")
+        if re.fullmatch(r"[\s()]*((True|False|and|or|not)[\s()]*)*", py) is None:
+            raise ShaderError(f"{name}:{k}: #if {expr}: only defined(), !, && and || are "
+                              "supported by the builder")
+        return bool(eval(py))  # noqa: S307 - the expression holds only booleans and operators
 
     def map_log(self, log: str) -> str:
         """Rewrite each compiler location as ``file.glsl:line[:col]``, followed by that line."""

@@ -49,17 +49,18 @@ class Renderer:
             self._targets[(width, height)] = self.ctx.framebuffer(color_attachments=tex)
         return self._targets[(width, height)]
 
-    def prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None
-                ) -> moderngl.Program:
-        """Compile (or fetch) the scene's variant and upload its uniforms."""
+    def prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None,
+                all_effects: bool = False) -> moderngl.Program:
+        """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
+        picks the variant with every effect compiled in and switched by uniforms."""
         with self.current():
-            return self._prepare(scene, width, height, geometry)
+            return self._prepare(scene, width, height, geometry, all_effects)
 
-    def _prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None
-                 ) -> moderngl.Program:
+    def _prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None,
+                 all_effects: bool) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
         c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
-        prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c))
+        prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c, all_effects))
         block = krs_block(c)
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)

@@ -7,20 +7,30 @@ from ..reference.camera import View
 from ..reference.compiled import RECORD_VEC4
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
-from ..scene import MAX_LEVELS, Scene
+from ..scene import EFFECTS, MAX_LEVELS, Scene
+from ..scene.effects import MAX_EMPTY_ZONES
 
 MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, then its pole record
 
 
-def variant_defines(scene: Scene, c: Compiled) -> dict[str, str | int | None]:
+def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
+                    ) -> dict[str, str | int | None]:
     """One define per kernel type present, per enabled effect, for the tracer and for the
-    Möbius geometry family: nothing else is compiled."""
+    Möbius geometry family: nothing else is compiled. ``all_effects`` compiles every effect
+    the geometry allows, each switched by its bit of ``u_effects`` (the benchmark's baseline)."""
     defines: dict[str, str | int | None] = {"KRS_MAX_LEVELS": MAX_LEVELS,
                                             "KRS_RECORD": RECORD_VEC4}
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
-    for effect in scene.effects:
-        defines[f"KRS_{effect.upper()}"] = None
+    if all_effects:
+        defines["KRS_ALL_EFFECTS"] = None
+        for e in EFFECTS.values():
+            if not (e.needs_distance and isinstance(c, CompiledMoKRS)):
+                defines[f"KRS_{e.name.upper()}"] = None
+                defines[f"KRS_{e.name.upper()}_BIT"] = e.bit
+    else:
+        for effect in scene.effects:
+            defines[f"KRS_{effect.upper()}"] = None
     if scene.render.tracer == "binary":
         defines["KRS_TRACER_BINARY"] = None
     if isinstance(c, CompiledMoKRS):
@@ -44,9 +54,15 @@ def krs_block(c: Compiled) -> bytes:
 
 
 def view_uniforms(scene: Scene, view: View, n: int) -> dict[str, object]:
+    """Per-frame values; positions are camera-relative (the eye is the origin)."""
     lights = scene.lights
+    fx = scene.effect_settings
+    zones = [tuple(float(v) for v in (*(np.array(z.center) - view.origin), z.radius))
+             for z in fx.empty_zones]
     return {
         "u_n": n,
+        "u_footprint": view.footprint,
+        "u_eye": tuple(view.origin),
         "u_forward": tuple(view.forward), "u_right": tuple(view.right), "u_up": tuple(view.up),
         "u_resolution": (float(view.width), float(view.height)),
         "u_tan_half": view.tan_half,
@@ -61,4 +77,18 @@ def view_uniforms(scene: Scene, view: View, n: int) -> dict[str, object]:
                          + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
         "u_ambient": scene.material.ambient,
         "u_background": scene.material.background,
+        "u_effects": sum(EFFECTS[e].bit for e in scene.effects),
+        "u_smooth_width": fx.smooth_width,
+        "u_shadow_softness": fx.shadow_softness,
+        "u_ao_step": fx.ao_step,
+        "u_ao_strength": fx.ao_strength,
+        "u_texture_scale": fx.texture_scale,
+        "u_texture_strength": fx.texture_strength,
+        "u_twist": float(np.radians(fx.twist)),
+        "u_twist_center": tuple(np.array(fx.twist_center) - view.origin),
+        "u_empty_zone_count": len(zones),
+        "u_empty_zones": zones + [(0.0, 0.0, 0.0, 0.0)] * (MAX_EMPTY_ZONES - len(zones)),
+        "u_sky_zenith": fx.sky_zenith,
+        "u_fog_density": fx.fog_density,
+        "u_exposure": fx.exposure,
     }

@@ -30,18 +30,33 @@ def distance(c: CompiledKRS, xw: np.ndarray) -> np.ndarray:
     return d
 
 
-def nearest(c: CompiledKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Alg. 1 that also keeps the winning level j and the world-space normal: the kernel
-    gradient at x_j reflected back through the mirrors that folded x [KRS14 §6.1].
-    Ties go to the coarser level (strict <), as in the shader."""
+def mirror_weight(e: np.ndarray, width: np.ndarray | None) -> np.ndarray:
+    """How much of mirror i's reflection the normal takes: 1 where it folded (e > 0), else 0;
+    with smooth shading a ramp over a band of ``width`` around the plane [KRS14 Alg. 2]."""
+    if width is None:
+        return (e > 0.0).astype(float)
+    return np.clip(e / width + 0.5, 0.0, 1.0)
+
+
+def nearest(c: CompiledKRS, xw: np.ndarray, width: np.ndarray | None = None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Alg. 1 that also keeps the winning level j, its kernel-space point x_j and the world
+    normal M ∇k_j(x_j), where M = A_{n−1} ⋯ A_j with A_i = I − 2 w_i u_i u_iᵀ accumulates while
+    walking down (w_i from :func:`mirror_weight`) [KRS14 §6.1]. Ties go to the coarser level
+    (strict <), as in the shader. Returns (d, level, normal, x_j)."""
     N = len(xw)
     x = xw
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
     level = np.full(N, c.n)
     xk = x.copy()
-    flips = np.zeros((max(c.n, 1), N), dtype=bool)
+    M = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
+    Mk = M.copy()
     for i in range(c.n - 1, -1, -1):
-        x, flips[i] = fold(c.mirrors[i], x)
+        u = c.mirrors[i, :3]
+        e = x @ u - c.mirrors[i, 3]
+        x, _ = fold(c.mirrors[i], x)
+        w = mirror_weight(e, width)
+        M = M - 2.0 * w[:, None, None] * np.einsum("ni,j->nij", M @ u, u)
         if c.types[i] == "empty":
             continue
         di = kernel_distance(c.types[i], c.records[i], x)
@@ -49,12 +64,11 @@ def nearest(c: CompiledKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.
         d = np.where(better, di, d)
         level = np.where(better, i, level)
         xk = np.where(better[:, None], x, xk)
+        Mk = np.where(better[:, None, None], M, Mk)
     g = np.zeros((N, 3))
     for j in np.unique(level):
         sel = level == j
         g[sel] = kernel_gradient(c.types[j], c.records[j], xk[sel])
-    for i in range(c.n):  # apply M_j first, M_{n-1} last
-        u = c.mirrors[i, :3]
-        back = flips[i] & (level <= i)
-        g = np.where(back[:, None], g - 2.0 * (g @ u)[:, None] * u, g)
-    return d, level, g
+    gw = np.einsum("nij,nj->ni", Mk, g)
+    n = np.linalg.norm(gw, axis=1, keepdims=True)
+    return d, level, np.where(n > 0.0, gw / np.where(n > 0.0, n, 1.0), g), xk

@@ -5,9 +5,11 @@ import numpy as np
 
 from ..buffers import Buffers
 from ..scene import KRS, MoKRS, Scene
+from .atmosphere import background
 from .camera import primary_rays, view_of
-from .geometry import compile_geometry, is_unbounding, nearest
-from .shade import encode, lambert
+from .distortion import Distortion
+from .geometry import compile_geometry, is_unbounding, nearest, scene_distance
+from .shade import Hits, encode, shade
 from .trace import binary_trace, sphere_trace
 
 
@@ -15,23 +17,28 @@ def render_reference(scene: Scene, width: int, height: int,
                      geometry: KRS | MoKRS | None = None) -> Buffers:
     view = view_of(scene.camera, width, height)
     c = compile_geometry(geometry or scene.geometry(), scene.material.albedo)
+    dist = Distortion.of(scene)
     dirs = primary_rays(view)
     r = scene.render
     eps = view.footprint * r.epsilon_scale
     if r.tracer == "binary":
-        tr = binary_trace(lambda x, s: is_unbounding(c, x, s), view.origin, dirs, eps,
+        tr = binary_trace(lambda x, s: is_unbounding(c, x, s, dist), view.origin, dirs, eps,
                           r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty)
     else:
-        tr = sphere_trace(c, view.origin, dirs, eps, r.max_iterations, r.max_distance)
+        tr = sphere_trace(lambda x: scene_distance(c, x, dist), view.origin, dirs, eps,
+                          r.max_iterations, r.max_distance)
     N = len(dirs)
     normal = np.zeros((N, 3))
-    color = np.broadcast_to(encode(np.array(scene.material.background)), (N, 3)).copy()
+    color = encode(scene, background(scene, dirs))
     h = np.flatnonzero(tr.hit)
     if h.size:
-        level, g = nearest(c, view.origin + tr.t[h, None] * dirs[h])
+        p = view.origin + tr.t[h, None] * dirs[h]
+        width_ = (np.maximum(scene.effect_settings.smooth_width, 2.0 * view.footprint * tr.t[h])
+                  if "smooth_shading" in scene.effects else None)
+        level, g, xk = nearest(c, p, width_, dist)
         normal[h] = g
-        albedo = c.records[level, 0, :3]
-        color[h] = encode(lambert(scene, albedo, g))
+        hits = Hits(p, dirs[h], tr.t[h], level, g, xk)
+        color[h] = encode(scene, shade(scene, c, dist, hits, view.footprint, eps))
     H, W = height, width
     return Buffers(color.reshape(H, W, 3), np.where(tr.hit, tr.t, 0.0).reshape(H, W),
                    normal.reshape(H, W, 3), tr.iterations.reshape(H, W), tr.hit.reshape(H, W))

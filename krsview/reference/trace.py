@@ -11,9 +11,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .compiled import CompiledKRS
-from .krs import distance
-
 INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 Alg. 2 line 2]
 
 
@@ -24,8 +21,10 @@ class Trace:
     iterations: np.ndarray  # distance evaluations (N,)
 
 
-def sphere_trace(c: CompiledKRS, origin: np.ndarray, dirs: np.ndarray, eps_per_t: float,
-                 max_iterations: int, max_distance: float) -> Trace:
+def sphere_trace(distance: Callable[[np.ndarray], np.ndarray], origin: np.ndarray,
+                 dirs: np.ndarray, eps_per_t: float, max_iterations: int, max_distance: float
+                 ) -> Trace:
+    """Sphere tracing of the distance bound ``distance`` (points (N, 3) → (N,))."""
     N = len(dirs)
     t = np.zeros(N)
     hit = np.zeros(N, dtype=bool)
@@ -35,7 +34,7 @@ def sphere_trace(c: CompiledKRS, origin: np.ndarray, dirs: np.ndarray, eps_per_t
         if active.size == 0:
             break
         ta = t[active]
-        d = distance(c, origin + ta[:, None] * dirs[active])
+        d = distance(origin + ta[:, None] * dirs[active])
         iters[active] += 1
         converged = d <= eps_per_t * ta
         hit[active[converged]] = True

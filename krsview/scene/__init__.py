@@ -1,12 +1,13 @@
 """Scene model: validated dataclasses, TOML load/save, tree → KRS. Imports nothing from GL."""
-from .model import (EFFECTS, KRS, MAX_LEVELS, TRACERS, Arc, Camera, Capsule, Empty, Kernel, Level, Light,
+from .effects import EFFECTS, EffectSettings, EmptyZone
+from .model import (KRS, MAX_LEVELS, TRACERS, Arc, Camera, Capsule, Empty, Kernel, Level, Light,
                     Material, Mirror, Plane, Render, Sphere, ToroidalCapsule, arc_of)
 from .mokrs import Invert, MobiusLevel, MobiusStep, MoKRS, Rotate, Scale, Translate
 from .scene import Bookmark, Scene, load_scene, save_scene, scene_from_toml, scene_to_toml
 from .schema import SceneError
 from .tree import Tree
 
-__all__ = ["Bookmark", "EFFECTS", "KRS", "MAX_LEVELS", "Arc", "Camera", "Capsule", "Empty", "Kernel",
+__all__ = ["Bookmark", "EFFECTS", "EffectSettings", "EmptyZone", "KRS", "MAX_LEVELS", "Arc", "Camera", "Capsule", "Empty", "Kernel",
            "Level", "Light", "Material", "Mirror", "MobiusLevel", "MobiusStep", "MoKRS", "Invert", "Rotate", "Scale",
            "Translate", "TRACERS", "Plane", "Render", "Scene", "SceneError",
            "Sphere", "ToroidalCapsule", "Tree", "arc_of", "load_scene", "save_scene",

@@ -13,7 +13,6 @@ from .schema import SceneError, Tagged, Vec3, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
 TRACERS = ("sphere", "binary")
-EFFECTS: dict[str, str] = {}  # effect name -> help; the effects issue fills this registry
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 

@@ -8,7 +8,8 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .model import EFFECTS, KRS, Camera, Light, Material, Render
+from .effects import EffectSettings, check_effects
+from .model import KRS, Camera, Light, Material, Render
 from .mokrs import MoKRS, check_view
 from .schema import SceneError, from_dict, param, to_dict
 from .toml_writer import dumps
@@ -30,7 +31,9 @@ class Scene:
     lights: list[Light] = param([Light()], help="directional lights (at most 4)")
     material: Material = param(Material())
     render: Render = param(Render())
-    effects: list[str] = param([], help="effects compiled into this scene's shader")
+    effects: list[str] = param([], help="effects compiled into this scene's shader "
+                               "(krsview check --effects lists them)")
+    effect_settings: EffectSettings = param(EffectSettings())
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
     mokrs: MoKRS | None = param(None, help="Möbius kernel–reflection sequence (instead of krs)")
@@ -43,10 +46,7 @@ class Scene:
                              "a scene has exactly one geometry: a [krs], [tree] or [mokrs] table")
         if len(self.lights) > 4:
             raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
-        for i, e in enumerate(self.effects):
-            if e not in EFFECTS:
-                raise SceneError(f"effects[{i}]", e, "unknown effect; allowed: "
-                                 + (", ".join(EFFECTS) or "none yet"))
+        check_effects(self.effects, self.mokrs is not None)
         if self.mokrs is not None:
             self.check_tracer(self.render.tracer)
             check_view(self.mokrs, self.camera.position, "camera.position")

@@ -40,7 +40,7 @@ class Tree:
         theta = math.radians(self.branch_angle)
         up = np.array(self.up)
         d = up.copy()                                   # branch direction d_i
-        s = _perpendicular(d)                           # in-plane side vector, ⟂ d
+        s = perpendicular(d)                           # in-plane side vector, ⟂ d
         P = np.array(self.base, dtype=float)            # fork P_{i+1}: where K_i starts
         length, radius = self.trunk_length, self.trunk_radius
         kernels: list[ToroidalCapsule] = []
@@ -72,7 +72,7 @@ def _t(v: np.ndarray | tuple) -> Vec3:
     return tuple(float(c) for c in v)  # type: ignore[return-value]
 
 
-def _perpendicular(d: np.ndarray) -> np.ndarray:
+def perpendicular(d: np.ndarray) -> np.ndarray:
     a = np.array([1.0, 0.0, 0.0]) if abs(d[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
     s = a - (a @ d) * d
     return s / np.linalg.norm(s)

@@ -20,30 +20,37 @@ float krs_distance(vec3 xw) {
     return d;
 }
 
-// Winning level j (ties to the coarser level) and the kernel gradient at x_j reflected back
-// through every mirror that folded x at levels ≥ j (M_j first).
-float krs_nearest(vec3 xw, out int level, out vec3 normal) {
-    vec3 x = xw, xk = xw;
+#ifdef KRS_SMOOTH_SHADING
+uniform float u_smooth_width;  // scene units
+
+// [KRS14 Alg. 2]: near mirror i the reflection is blended in over a band of the given width
+// (0 at −width/2, ½ on the plane, 1 at +width/2), so the two copies' normals meet smoothly.
+float mirror_weight(float e, float width) {
+    return EFFECT_ON(KRS_SMOOTH_SHADING_BIT) ? clamp(e / width + 0.5, 0.0, 1.0)
+                                             : (e > 0.0 ? 1.0 : 0.0);
+}
+#else
+float mirror_weight(float e, float width) { return e > 0.0 ? 1.0 : 0.0; }
+#endif
+
+// Winning level j (ties to the coarser level), the point x_j in its kernel's space, and the
+// world normal M ∇k_j(x_j) with M = A_{n−1} ⋯ A_j, A_i = I − 2 w_i u_i u_iᵀ accumulated while
+// walking down [KRS14 §6.1]: w_i = 1 where mirror i folded x, else 0 (smoothed near the plane).
+float krs_nearest(vec3 xw, float width, out int level, out vec3 normal, out vec3 xk) {
+    vec3 x = xw;
+    xk = xw;
     float d = kernel_distance(u_n, x);
     level = u_n;
-    uint flips[2] = uint[2](0u, 0u);
+    mat3 M = mat3(1.0), Mk = mat3(1.0);
     for (int i = u_n - 1; i >= 0; --i) {
-        if (fold(i, x)) flips[i >> 5] |= 1u << uint(i & 31);
+        vec3 u = u_mirrors[i].xyz;
+        float e = dot(x, u) - u_mirrors[i].w;
+        fold(i, x);
+        M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
         float di = kernel_distance(i, x);
-        if (di < d) { d = di; level = i; xk = x; }
+        if (di < d) { d = di; level = i; xk = x; Mk = M; }
     }
-    vec3 g = kernel_gradient(level, xk);
-    for (int i = level; i < u_n; ++i) {
-        if ((flips[i >> 5] & (1u << uint(i & 31))) != 0u) {
-            vec3 u = u_mirrors[i].xyz;
-            g -= 2.0 * dot(g, u) * u;
-        }
-    }
-    normal = g;
+    vec3 g = Mk * kernel_gradient(level, xk);
+    normal = length(g) > 0.0 ? normalize(g) : kernel_gradient(level, xk);
     return d;
 }
-
-#ifdef KRS_TRACER_BINARY
-// A ball is free of the KRS when the distance bound at its centre covers it.
-bool is_unbounding(vec3 center, float radius) { return krs_distance(center) >= radius; }
-#endif

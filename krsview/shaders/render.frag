@@ -1,4 +1,5 @@
 // Primary rays through pixel centres, traced and shaded; writes the reference's buffers.
+#include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
 #include "shade.glsl"
@@ -17,13 +18,13 @@ void main() {
     bool hit = trace_ray(vec3(0.0), dir, t, iterations);
     out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
     if (!hit) {
-        out_color = vec4(encode(u_background), 0.0);
+        out_color = vec4(encode(background(dir)), 0.0);
         out_normal = vec4(0.0);
         return;
     }
     int level;
-    vec3 n;
-    nearest_kernel(t * dir, level, n);
-    out_color = vec4(encode(lambert(kernel_rec(level, 0).rgb, n)), 1.0);
+    vec3 n, xk;
+    nearest_kernel(t * dir, t, level, n, xk);
+    out_color = vec4(encode(shade(t * dir, dir, t, level, n, xk)), 1.0);
     out_normal = vec4(n, t);
 }

@@ -22,6 +22,7 @@ uniform vec3 u_right;
 uniform vec3 u_up;
 uniform vec2 u_resolution;
 uniform float u_tan_half;
+uniform float u_footprint;  // pixel size at unit distance (the LOD measure [KRS17 §4])
 uniform float u_eps_per_t;  // pixel footprint × ε-scale
 uniform int u_max_iterations;
 uniform float u_xi_bonus;   // binary tracing [KRS17 Alg. 2]

@@ -1,11 +1,52 @@
-// Lambert + ambient shading, gamma-encoded [KRS17 §8.1]; twin of reference/shade.py.
+// Shading of a hit [KRS17 §8]: Lambert + ambient with the scene's effects (texture, shadows,
+// ambient occlusion, fog), then tone mapping and gamma; twin of reference/shade.py.
+#include "atmosphere.glsl"
+#if defined(KRS_TRIPLANAR_TEXTURE) || defined(KRS_KERNEL_TEXTURE)
+#include "texture.glsl"
+#endif
+#if defined(KRS_SHADOWS) || defined(KRS_SOFT_SHADOWS)
+#include "shadows.glsl"
+#endif
+#ifdef KRS_AMBIENT_OCCLUSION
+#include "occlusion.glsl"
+#endif
 #define GAMMA 2.2
 
-vec3 encode(vec3 linear) { return pow(clamp(linear, 0.0, 1.0), vec3(1.0 / GAMMA)); }
+vec3 encode(vec3 linear) {
+#ifdef KRS_TONE_MAPPING
+    if (EFFECT_ON(KRS_TONE_MAPPING_BIT)) linear = tone_map(linear);
+#endif
+    return pow(clamp(linear, 0.0, 1.0), vec3(1.0 / GAMMA));
+}
 
-vec3 lambert(vec3 albedo, vec3 n) {
+// Linear radiance of the hit at p (ray distance t along dir) on kernel `level` with world
+// normal n and kernel-space point xk.
+vec3 shade(vec3 p, vec3 dir, float t, int level, vec3 n, vec3 xk) {
+    vec3 albedo = kernel_rec(level, 0).rgb;
+    float footprint = u_footprint * t;
+#ifdef KRS_TRIPLANAR_TEXTURE
+    if (EFFECT_ON(KRS_TRIPLANAR_TEXTURE_BIT))
+        albedo *= texture_modulation(triplanar(p + u_eye, n, footprint));
+#endif
+#ifdef KRS_KERNEL_TEXTURE
+    if (EFFECT_ON(KRS_KERNEL_TEXTURE_BIT))
+        albedo *= texture_modulation(kernel_texture(level, xk, u_eye, footprint));
+#endif
     vec3 light = u_ambient;
-    for (int k = 0; k < u_light_count; ++k)
-        light += max(dot(n, u_light_dir[k]), 0.0) * u_light_color[k];
-    return albedo * light;
+#ifdef KRS_AMBIENT_OCCLUSION
+    if (EFFECT_ON(KRS_AMBIENT_OCCLUSION_BIT)) light *= ambient_occlusion(p, n);
+#endif
+    for (int k = 0; k < u_light_count; ++k) {
+        float cos_l = max(dot(n, u_light_dir[k]), 0.0);
+#if defined(KRS_SHADOWS) || defined(KRS_SOFT_SHADOWS)
+        if (cos_l > 0.0 && shadows_on())
+            cos_l *= shadow_visibility(p, n, u_light_dir[k], u_eps_per_t * t);
+#endif
+        light += cos_l * u_light_color[k];
+    }
+    vec3 color = albedo * light;
+#ifdef KRS_FOG
+    if (EFFECT_ON(KRS_FOG_BIT)) color = fog(color, dir, t);
+#endif
+    return color;
 }

@@ -4,7 +4,7 @@
 #ifdef KRS_MOBIUS
 #include "mokrs.glsl"
 #else
-#include "krs.glsl"
+#include "distance.glsl"
 #endif
 
 #ifdef KRS_TRACER_BINARY
@@ -33,7 +33,7 @@ bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
 bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
     t = 0.0;
     for (iterations = 0; iterations < u_max_iterations;) {
-        float d = krs_distance(origin + t * dir);
+        float d = scene_distance(origin + t * dir);
         ++iterations;
         if (d <= u_eps_per_t * t) return true;
         t += d;
@@ -43,11 +43,13 @@ bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
 }
 #endif
 
-// The kernel level nearest to a hit point and the world normal there.
-void nearest_kernel(vec3 p, out int level, out vec3 normal) {
+// The kernel level nearest to a hit point at ray distance t, the world normal there, and the
+// point in that kernel's own space (for kernel texture coordinates).
+void nearest_kernel(vec3 p, float t, out int level, out vec3 normal, out vec3 xk) {
 #ifdef KRS_MOBIUS
     mokrs_nearest(p, level, normal);
+    xk = p;
 #else
-    krs_nearest(p, level, normal);
+    scene_nearest(p, t, level, normal, xk);
 #endif
 }

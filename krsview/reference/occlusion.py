@@ -1,0 +1,72 @@
+"""Shadow rays and ambient occlusion [KRS17 §8.5]; twin of ``shaders/shadows.glsl`` and
+``shaders/occlusion.glsl``.
+
+Shadow rays start SHADOW_OFFSET·ε off the surface and stop at the primary ray's threshold ε.
+Soft shadows take the smallest free distance met along the ray as a fraction k·free/t of the
+distance travelled (Fig. 11): sphere-traced distances for a KRS, free probe radii for a MöKRS.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..scene import Render
+from .trace import INITIAL_PROBE
+
+SHADOW_OFFSET = 2.0
+AO_SAMPLES = 5
+
+
+def shadow_by_distance(distance: Callable[[np.ndarray], np.ndarray], o: np.ndarray,
+                       l: np.ndarray, eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
+    """Visibility of direction l from points o (sphere tracing); k None: hard shadows."""
+    N = len(o)
+    vis, t = np.ones(N), np.zeros(N)
+    live = np.arange(N)
+    for _ in range(r.max_iterations):
+        if live.size == 0:
+            break
+        tl = t[live]
+        d = distance(o[live] + tl[:, None] * l)
+        blocked = d <= eps[live]
+        vis[live[blocked]] = 0.0
+        if k is not None:
+            ratio = np.where(tl > 0.0, k * d / np.where(tl > 0.0, tl, 1.0), np.inf)
+            vis[live] = np.where(blocked, 0.0, np.minimum(vis[live], ratio))
+        t[live] = tl + d
+        live = live[~blocked & (tl + d <= r.max_distance)]
+    return vis
+
+
+def shadow_by_probes(is_free: Callable[[np.ndarray, np.ndarray], np.ndarray], o: np.ndarray,
+                     l: np.ndarray, eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
+    """Visibility of direction l from points o by binary probing [KRS17 Alg. 2]."""
+    N = len(o)
+    vis, t, s = np.ones(N), np.zeros(N), np.full(N, INITIAL_PROBE)
+    live = np.arange(N)
+    for _ in range(r.max_iterations):
+        if live.size == 0:
+            break
+        tl, sl = t[live], s[live]
+        free = is_free(o[live] + (tl + sl)[:, None] * l, sl)
+        if k is not None:
+            vis[live] = np.where(free, np.minimum(vis[live], k * sl / (tl + sl)), vis[live])
+        blocked = ~free & (sl <= eps[live])
+        vis[live[blocked]] = 0.0
+        t[live] = np.where(free, tl + 2.0 * sl, tl)
+        s[live] = np.where(free, sl * r.xi_bonus, sl * r.xi_penalty)
+        live = live[~blocked & (t[live] <= r.max_distance)]
+    return vis
+
+
+def ambient_occlusion(distance: Callable[[np.ndarray], np.ndarray], p: np.ndarray,
+                      n: np.ndarray, step: float, strength: float) -> np.ndarray:
+    """1 − strength·Σ 2^−k·clamp((h_k − d(p + h_k n))/h_k) over h_k = k·step, k = 1..5."""
+    occlusion = np.zeros(len(p))
+    weight = 0.5
+    for k in range(1, AO_SAMPLES + 1):
+        h = k * step
+        occlusion += weight * np.clip((h - distance(p + h * n)) / h, 0.0, 1.0)
+        weight *= 0.5
+    return np.clip(1.0 - strength * occlusion, 0.0, 1.0)

@@ -1,0 +1,31 @@
+// Twist around a vertical axis, a Lipschitz distance distortion [KRS17 §5.2, Har96];
+// twin of reference/distortion.py. The axis passes through u_twist_center (camera-relative);
+// a point at height h above it is turned by u_twist · h radians.
+uniform float u_twist;         // radians per unit height
+uniform vec3 u_twist_center;
+
+vec2 turn(vec2 v, float a) { return vec2(v.x * cos(a) - v.y * sin(a), v.x * sin(a) + v.y * cos(a)); }
+
+// g = f⁻¹: where the untwisted geometry is looked up for the world point p.
+vec3 untwist(vec3 p) {
+    vec3 r = p - u_twist_center;
+    return u_twist_center + vec3(turn(r.xz, -u_twist * r.y), r.y).xzy;
+}
+
+// A safe step from the untwisted distance D: ‖Dg‖ ≤ 1 + |k|ρ at axis distance ρ, so over the
+// ball of radius δ around p it is ≤ 1 + |k|(ρ + δ); δ(1 + |k|ρ + |k|δ) = D is solved in its
+// cancellation-free form, and δ = D when k = 0.
+float twist_step(vec3 p, float D) {
+    if (D <= 0.0) return D;
+    float k = abs(u_twist), a = 1.0 + k * length(p.xz - u_twist_center.xz);
+    return 2.0 * D / (a + sqrt(a * a + 4.0 * k * D));
+}
+
+// World normal from the gradient g at q = g(p): Dgᵀ g; only Dg's y column is not a rotation.
+vec3 twist_normal(vec3 p, vec3 q, vec3 g) {
+    vec3 r = p - u_twist_center, s = q - u_twist_center;
+    float a = -u_twist * r.y;
+    vec2 gxz = turn(g.xz, -a);   // Rᵀ g on the horizontal part
+    float gy = g.y - u_twist * dot(vec2(-s.z, s.x), g.xz);
+    return normalize(vec3(gxz.x, gy, gxz.y));
+}
