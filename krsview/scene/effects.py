@@ -78,8 +78,8 @@ class EffectSettings:
     sky_zenith: Vec3 = param((0.22, 0.42, 0.82), **_COLOR)
     fog_density: float = param(0.03, lo=0.0, hi=100.0, unit="per scene unit",
                                help="fog: fraction of light lost is 1 − exp(−density·t)")
-    exposure: float = param(1.0, lo=0.0, lo_open=True, hi=64.0,
-                            help="tone_mapping: scale of linear radiance before the curve")
+    exposure: float = param(0.6, lo=0.0, lo_open=True, hi=64.0,
+                            help="tone_mapping: scale of linear radiance before the curve (0.6 maps mid-grey near where plain gamma puts it)")
 
     def validate(self, path: str) -> None:
         if len(self.empty_zones) > MAX_EMPTY_ZONES:
