@@ -10,7 +10,8 @@ from pathlib import Path
 from .presets import DEFAULT_PRESET, preset_names, resolve
 import numpy as np
 
-from .scene import MAX_LEVELS, TRACERS, Scene, SceneError, load_scene
+from .scene import EFFECTS, MAX_LEVELS, TRACERS, Scene, SceneError, load_scene
+from .scene.effects import check_effects
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
 
@@ -61,6 +62,11 @@ def _load(args: argparse.Namespace) -> Scene:
         scene.check_tracer(args.tracer, "--tracer")
         render = replace(render, tracer=args.tracer)
     scene = replace(scene, render=render)
+    effects = getattr(args, "effects", None)
+    if effects is not None:
+        names = [] if effects.strip() == "none" else [e.strip() for e in effects.split(",")]
+        check_effects(names, scene.mokrs is not None, "--effects")
+        scene = replace(scene, effects=names)
     levels = getattr(args, "levels", None)
     if levels is not None:
         krs = scene.geometry()
@@ -162,6 +168,12 @@ def cmd_bench_tracers(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bench_effects(args: argparse.Namespace) -> int:
+    from .bench.effects import bench_effects
+    bench_effects(_load(args), args.size, rounds=args.rounds, csv=args.csv)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     presets = ", ".join(preset_names()) or "none found"
     p = argparse.ArgumentParser(
@@ -184,6 +196,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="iteration cap per ray (overrides the scene)")
         sp.add_argument("--levels", type=_int_in("--levels", 1, MAX_LEVELS),
                         help="keep only the coarsest N levels (drops the finest detail)")
+        sp.add_argument("--effects", metavar="LIST",
+                        help="comma-separated effects replacing the scene's, or 'none'; one of: "
+                             + ", ".join(EFFECTS))
 
     def bench_arguments(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
@@ -236,7 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("preset", metavar="PRESET")
     c.set_defaults(func=cmd_check)
 
-    b = sub.add_parser("bench", help="benchmarks (levels, tracers)",
+    b = sub.add_parser("bench", help="benchmarks (levels, tracers, effects)",
                        description="Benchmarks that report ratios measured side by side.")
     bsub = b.add_subparsers(dest="bench", required=True, metavar="BENCH")
     bl = bsub.add_parser("levels", help="frame time against level count (O(n) vs 2^n)",
@@ -259,6 +274,16 @@ def build_parser() -> argparse.ArgumentParser:
     bt.add_argument("--no-sweep", action="store_true", help="only sphere vs binary 2.0/0.3")
     accuracy(bt)
     bt.set_defaults(func=cmd_bench_tracers)
+    be = bsub.add_parser("effects", help="cost of each effect; specialised vs all compiled",
+                         description="On one scene and view: the plain render (no effect), "
+                                     "each effect alone, and the scene's effect set both "
+                                     "specialised (#define) and in the variant that compiles "
+                                     "every effect and switches them by uniforms; frame times "
+                                     "as ratios to the plain render. An idle twist (0°) or "
+                                     "an empty zone list gets a stand-in so its cost shows.")
+    bench_arguments(be)
+    accuracy(be)
+    be.set_defaults(func=cmd_bench_effects)
     return p
 
 

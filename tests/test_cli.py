@@ -39,7 +39,7 @@ def test_reference_render_matches_size(tmp_path):
     (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
     (["render", "tree", "--epsilon-scale", "nan"], "--epsilon-scale 'nan': allowed"),
     (["render", "tree", "--max-iterations", "-3"], "--max-iterations '-3': allowed 1"),
-    (["render", "no-such-preset"], "not a file and not a preset; presets: grass, inversion, palm"),
+    (["render", "no-such-preset"], "not a file and not a preset; presets: forest, grass, inversion"),
     (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
     (["check", "missing.toml"], "no such scene file"),
     (["frobnicate"], "invalid choice"),
@@ -62,7 +62,8 @@ def test_bad_scene_file_gets_file_field_value(tmp_path):
 def test_check_prints_statistics(capsys):
     assert main(["check", "tree"]) == 0
     out = capsys.readouterr().out
-    assert "levels          23" in out and "8,388,607" in out and "effects         none" in out
+    assert "levels          23" in out and "8,388,607" in out
+    assert "effects         kernel_texture, soft_shadows, sky, tone_mapping" in out
 
 
 def test_bench_levels_prints_the_ratio_table(capsys):

@@ -106,10 +106,10 @@ class Renderer:
             return read_buffers(self.draw(prog, width, height), width, height)
 
     def time_frame(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None,
-                   repeats: int = 1) -> list[float]:
+                   repeats: int = 1, all_effects: bool = False) -> list[float]:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up."""
         with self.current():
-            prog = self.prepare(scene, width, height, geometry)
+            prog = self.prepare(scene, width, height, geometry, all_effects)
             self.draw(prog, width, height)
             self.ctx.finish()
             times = []

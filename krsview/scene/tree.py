@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import KRS, Level, Mirror, ToroidalCapsule, _COLOR
-from .schema import Vec3, param
+from .model import KRS, Empty, Level, Mirror, Plane, ToroidalCapsule, _COLOR
+from .schema import SceneError, Vec3, param
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,19 @@ class Tree:
     bark: Vec3 = param((0.30, 0.20, 0.12), **_COLOR)
     leaf: Vec3 = param((0.20, 0.45, 0.10), **_COLOR)
     leaf_levels: int = param(5, lo=0, hi=63, help="finest levels coloured as leaves")
+    forest: list[Mirror] = param([], help="extra reflections above the trunk, with empty "
+                                 "kernels: 2^k trees from one [KRS17 §9.2]")
+    ground: Vec3 | None = param(None, lo=0.0, hi=1.0, help="colour of a ground plane through "
+                                "the base, ⟂ up (kernel of the last forest level)")
+
+    def validate(self, path: str) -> None:
+        if self.levels + 1 + len(self.forest) > 64:
+            raise SceneError(f"{path}.forest", f"<{len(self.forest)} mirrors>",
+                             f"levels + 1 + forest mirrors must be ≤ 64; allowed: at most "
+                             f"{63 - self.levels} forest mirrors with {self.levels} levels")
+        if self.ground is not None and not self.forest:
+            raise SceneError(f"{path}.ground", list(self.ground), "the ground is the kernel of "
+                             "the last forest level: add at least one forest mirror")
 
     def krs(self) -> KRS:
         """Grow the route and turn it into KRS levels (level 0 = twig tip, level n = trunk)."""
@@ -64,8 +77,13 @@ class Tree:
             radius *= self.radius_ratio
         kernels.reverse()
         mirrors.reverse()
-        return KRS([Level(kernels[0], None)] +
-                   [Level(k, m) for k, m in zip(kernels[1:], mirrors)])
+        levels = [Level(kernels[0], None)] + [Level(k, m) for k, m in zip(kernels[1:], mirrors)]
+        for i, m in enumerate(self.forest):
+            last = i == len(self.forest) - 1
+            k = (Plane(_t(up), float(up @ np.array(self.base)), self.ground)
+                 if last and self.ground is not None else Empty())
+            levels.append(Level(k, m))
+        return KRS(levels)
 
 
 def _t(v: np.ndarray | tuple) -> Vec3:
