@@ -296,3 +296,30 @@ def test_preset_picker_and_levels_slider(viewer):
     settle(v)
     v.open_preset(v.path.with_name("missing.toml"))
     assert "cannot read" in v.error and v.scene.name == "sierpinski"  # kept the last good one
+
+
+def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
+    """The HUD's effect checkboxes go through Viewer.set_effect: a new effect set compiles one
+    variant with its define; switching back and forth again compiles nothing."""
+    v = viewer
+    v.open_preset(resolve("sierpinski"))
+    settle(v)
+    programs = v.renderer.programs
+    before = programs.compiles
+    plain = v.read_window()
+    v.set_effect("shadows", True)
+    settle(v)
+    assert programs.compiles == before + 1
+    assert any(("KRS_SHADOWS", None) in key[2] for key in programs._programs)
+    assert np.abs(v.read_window().astype(int) - plain).max() > 0
+    v.set_effect("soft_shadows", True)  # replaces the hard shadows: they exclude each other
+    assert v.scene.effects == ["soft_shadows"]
+    settle(v)
+    v.set_effect("soft_shadows", False)
+    settle(v)
+    v.set_effect("shadows", True)
+    settle(v)
+    assert programs.compiles == before + 2
+    v.open_preset(resolve("palm"))
+    v.set_effect("twist", True)
+    assert "twist" not in v.scene.effects and "MöKRS" in v.error

@@ -91,14 +91,15 @@ def _accuracy(v: "Viewer") -> None:
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))
     if changed:
         v.view = VIEW_MODES[k]
-    if EFFECTS:
-        imgui.text("effects (each compiles its own shader variant)")
-    for name, help_text in EFFECTS.items():
+    imgui.text("effects (each compiles its own shader variant, cached)")
+    for name, effect in EFFECTS.items():
+        if effect.needs_distance and v.scene.mokrs is not None:
+            continue  # a MöKRS has no distance function or mirror planes
         changed, on = imgui.checkbox(name, name in v.scene.effects)
         if changed:
             v.set_effect(name, on)
         if imgui.is_item_hovered():
-            imgui.set_tooltip(help_text)
+            imgui.set_tooltip(effect.help)
 
 
 def _scene(v: "Viewer") -> None:

@@ -18,6 +18,7 @@ from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..gpu.context import GL_VERSION
 from ..reference.geometry import compile_geometry, free_radius
+from ..scene.effects import EXCLUSIVE, check_effects
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.scene import write_atomic
 from .adaptive import AdaptiveResolution, Refinement
@@ -113,8 +114,17 @@ class Viewer:
         self.scene, self.dirty = replace(self.scene, render=replace(self.scene.render, **edits)), True
 
     def set_effect(self, name: str, on: bool) -> None:
-        """Switch an effect: a different define set, so a different (cached) variant."""
-        effects = [e for e in self.scene.effects if e != name] + ([name] if on else [])
+        """Switch an effect: a different define set, so a different (cached) variant. Turning
+        on one of an exclusive pair (hard / soft shadows) turns the other off; an effect the
+        geometry cannot draw is refused with the scene's own message."""
+        partners = {b if a == name else a for a, b in EXCLUSIVE if name in (a, b)}
+        effects = [e for e in self.scene.effects if e != name and not (on and e in partners)]
+        effects += [name] if on else []
+        try:
+            check_effects(effects, self.scene.mokrs is not None, "effect")
+        except SceneError as e:
+            self.error = str(e)
+            return
         self.scene, self.dirty = replace(self.scene, effects=effects), True
 
     def view_scene(self) -> Scene:

@@ -31,8 +31,8 @@ class Scene:
     lights: list[Light] = param([Light()], help="directional lights (at most 4)")
     material: Material = param(Material())
     render: Render = param(Render())
-    effects: list[str] = param([], help="effects compiled into this scene's shader "
-                               "(krsview check --effects lists them)")
+    effects: list[str] = param([], help="effects compiled into this scene's shader; "
+                               "allowed: see krsview.scene.effects.EFFECTS (README, Effects)")
     effect_settings: EffectSettings = param(EffectSettings())
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
