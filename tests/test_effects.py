@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 
 from krsview.gpu.program import SHADER_DIR, Source
+from krsview.gpu.renderer import read_buffers
 from krsview.gpu.uniforms import variant_defines
 from krsview.presets import resolve
 from krsview.reference import compile_krs, distance, render_reference
 from krsview.reference.distortion import Distortion
 from krsview.reference.geometry import compile_geometry, scene_distance
-from krsview.scene import (EFFECTS, KRS, EffectSettings, EmptyZone, Level, Mirror, Plane,
+from krsview.scene import (EFFECTS, KRS, EffectSettings, EmptyZone, Level, Plane,
                            load_scene, scene_from_toml)
 
 from .conftest import assert_finite, check_against_reference
@@ -80,7 +81,6 @@ def test_all_effects_variant_switched_by_uniforms_equals_the_specialised(rendere
     for effects in (["shadows", "kernel_texture", "fog"], []):
         s = replace(scene, effects=effects)
         with renderer.current():
-            from krsview.gpu.renderer import read_buffers
             prog = renderer.prepare(s, W, H, all_effects=True)
             uber = read_buffers(renderer.draw(prog, W, H), W, H)
         special = renderer.render(s, W, H)

@@ -10,6 +10,7 @@ from imgui_bundle import imgui, implot
 from ..gpu.display import VIEW_MODES
 from ..presets import preset_names, resolve
 from ..scene import EFFECTS, TRACERS
+from ..scene.effects import allowed_effects
 
 if TYPE_CHECKING:
     from .window import Viewer
@@ -92,14 +93,12 @@ def _accuracy(v: "Viewer") -> None:
     if changed:
         v.view = VIEW_MODES[k]
     imgui.text("effects (each compiles its own shader variant, cached)")
-    for name, effect in EFFECTS.items():
-        if effect.needs_distance and v.scene.mokrs is not None:
-            continue  # a MöKRS has no distance function or mirror planes
+    for name in allowed_effects(v.scene.mokrs is not None):
         changed, on = imgui.checkbox(name, name in v.scene.effects)
         if changed:
             v.set_effect(name, on)
         if imgui.is_item_hovered():
-            imgui.set_tooltip(effect.help)
+            imgui.set_tooltip(EFFECTS[name].help)
 
 
 def _scene(v: "Viewer") -> None:

@@ -15,15 +15,12 @@ import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
-from ..scene import EFFECTS, EmptyZone, Scene
+from ..scene import EmptyZone, Scene
+from ..scene.effects import allowed_effects
 from .progress import Progress
 from .report import write_csv
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
-
-
-def applicable(scene: Scene) -> list[str]:
-    return [e for e, fx in EFFECTS.items() if not (fx.needs_distance and scene.mokrs is not None)]
 
 
 def with_settings_for(scene: Scene, effect: str) -> Scene:
@@ -40,7 +37,7 @@ def runs_of(scene: Scene) -> dict[str, tuple[Scene, bool]]:
     """name → (scene, all_effects variant?)."""
     plain = replace(scene, effects=[])
     runs = {"plain": (plain, False)}
-    for e in applicable(scene):
+    for e in allowed_effects(scene.mokrs is not None):
         runs[e] = (with_settings_for(scene, e), False)
     if scene.effects:
         runs["scene, specialised"] = (scene, False)

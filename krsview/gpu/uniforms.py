@@ -8,7 +8,7 @@ from ..reference.compiled import RECORD_VEC4
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_LEVELS, Scene
-from ..scene.effects import MAX_EMPTY_ZONES
+from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
 
 MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, then its pole record
 
@@ -24,10 +24,9 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
     if all_effects:
         defines["KRS_ALL_EFFECTS"] = None
-        for e in EFFECTS.values():
-            if not (e.needs_distance and isinstance(c, CompiledMoKRS)):
-                defines[f"KRS_{e.name.upper()}"] = None
-                defines[f"KRS_{e.name.upper()}_BIT"] = e.bit
+        for name in allowed_effects(isinstance(c, CompiledMoKRS)):
+            defines[f"KRS_{name.upper()}"] = None
+            defines[f"KRS_{name.upper()}_BIT"] = EFFECTS[name].bit
     else:
         for effect in scene.effects:
             defines[f"KRS_{effect.upper()}"] = None

@@ -70,3 +70,16 @@ def kernel_gradient(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     g = p - core_point(kind, rec, p)
     n = np.linalg.norm(g, axis=1, keepdims=True)
     return np.where(n > 0.0, g / np.where(n > 0.0, n, 1.0), np.array([0.0, 0.0, 1.0]))
+
+
+def world_normal(types: tuple[str, ...], records: np.ndarray, level: np.ndarray,
+                 xk: np.ndarray, to_world: np.ndarray) -> np.ndarray:
+    """Unit world normals to_world[n] · ∇k_j(x_j) of each point's winning kernel j = level[n]
+    at its kernel-space point xk[n]; the kernel gradient itself where the map degenerates."""
+    g = np.zeros((len(xk), 3))
+    for j in np.unique(level):
+        sel = level == j
+        g[sel] = kernel_gradient(types[j], records[j], xk[sel])
+    gw = np.einsum("nij,nj->ni", to_world, g)
+    n = np.linalg.norm(gw, axis=1, keepdims=True)
+    return np.where(n > 0.0, gw / np.where(n > 0.0, n, 1.0), g)

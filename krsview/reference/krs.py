@@ -9,14 +9,14 @@ from __future__ import annotations
 import numpy as np
 
 from .compiled import CompiledKRS
-from .kernels import kernel_distance, kernel_gradient
+from .kernels import kernel_distance, world_normal
 
 
 def fold(m: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Reflect the points behind mirror m = (u, w) (u·x − w > 0); returns (x', reflected)."""
-    s = x @ m[:3] - m[3]
-    flip = s > 0.0
-    return np.where(flip[:, None], x - 2.0 * s[:, None] * m[:3], x), flip
+    """Reflect the points behind mirror m = (u, w); returns (x', e) with e = u·x − w, the
+    signed distance before folding (e > 0: reflected)."""
+    e = x @ m[:3] - m[3]
+    return np.where((e > 0.0)[:, None], x - 2.0 * e[:, None] * m[:3], x), e
 
 
 def distance(c: CompiledKRS, xw: np.ndarray) -> np.ndarray:
@@ -53,8 +53,7 @@ def nearest(c: CompiledKRS, xw: np.ndarray, width: np.ndarray | None = None
     Mk = M.copy()
     for i in range(c.n - 1, -1, -1):
         u = c.mirrors[i, :3]
-        e = x @ u - c.mirrors[i, 3]
-        x, _ = fold(c.mirrors[i], x)
+        x, e = fold(c.mirrors[i], x)
         w = mirror_weight(e, width)
         M = M - 2.0 * w[:, None, None] * np.einsum("ni,j->nij", M @ u, u)
         if c.types[i] == "empty":
@@ -65,10 +64,4 @@ def nearest(c: CompiledKRS, xw: np.ndarray, width: np.ndarray | None = None
         level = np.where(better, i, level)
         xk = np.where(better[:, None], x, xk)
         Mk = np.where(better[:, None, None], M, Mk)
-    g = np.zeros((N, 3))
-    for j in np.unique(level):
-        sel = level == j
-        g[sel] = kernel_gradient(c.types[j], c.records[j], xk[sel])
-    gw = np.einsum("nij,nj->ni", Mk, g)
-    n = np.linalg.norm(gw, axis=1, keepdims=True)
-    return d, level, np.where(n > 0.0, gw / np.where(n > 0.0, n, 1.0), g), xk
+    return d, level, world_normal(c.types, c.records, level, xk, Mk), xk

@@ -13,7 +13,7 @@ import numpy as np
 from ..scene import MoKRS
 from . import mobius
 from .compiled import kernel_records
-from .kernels import kernel_distance, kernel_gradient
+from .kernels import kernel_distance, world_normal
 
 
 @dataclass(frozen=True)
@@ -102,10 +102,4 @@ def nearest(c: CompiledMoKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             level = np.where(better, i, level)
             xk = np.where(better[:, None], x, xk)
             Jk = np.where(better[:, None, None], J, Jk)
-    g = np.zeros((N, 3))
-    for j in np.unique(level):
-        sel = level == j
-        g[sel] = kernel_gradient(c.types[j], c.records[j], xk[sel])
-    gw = np.einsum("nji,nj->ni", Jk, g)
-    n = np.linalg.norm(gw, axis=1, keepdims=True)
-    return level, np.where(n > 0, gw / np.where(n > 0, n, 1.0), [0.0, 0.0, 1.0])
+    return level, world_normal(c.types, c.records, level, xk, np.swapaxes(Jk, 1, 2))

@@ -87,15 +87,20 @@ class EffectSettings:
                              f"allowed: at most {MAX_EMPTY_ZONES}")
 
 
+def allowed_effects(mokrs: bool) -> list[str]:
+    """The effects a geometry can draw: a MöKRS lacks Alg. 1's distance and mirror planes."""
+    return [n for n, e in EFFECTS.items() if not (mokrs and e.needs_distance)]
+
+
 def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> None:
     """Known names, no pair that excludes each other, nothing a MöKRS cannot draw."""
     for i, e in enumerate(effects):
         if e not in EFFECTS:
             raise SceneError(f"{path}[{i}]", e, "unknown effect; allowed: " + ", ".join(EFFECTS))
-        if mokrs and EFFECTS[e].needs_distance:
-            ok = ", ".join(n for n, x in EFFECTS.items() if not x.needs_distance)
+        if e not in allowed_effects(mokrs):
             raise SceneError(f"{path}[{i}]", e, "needs a KRS distance function and mirror "
-                             "planes, which a MöKRS does not have; allowed on a MöKRS: " + ok)
+                             "planes, which a MöKRS does not have; allowed on a MöKRS: "
+                             + ", ".join(allowed_effects(True)))
     if len(set(effects)) != len(effects):
         raise SceneError(path, effects, "each effect at most once")
     for a, b in EXCLUSIVE:

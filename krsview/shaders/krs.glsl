@@ -2,12 +2,12 @@
 // twin of reference/krs.py. Folding clips each level to its mirror's negative side.
 #include "kernels.glsl"
 
-// Reflect p if it lies behind mirror i (u·p − w > 0); returns whether it did.
-bool fold(int i, inout vec3 p) {
+// Reflect p if it lies behind mirror i (u·p − w > 0); returns that signed distance u·p − w.
+float fold(int i, inout vec3 p) {
     vec4 m = u_mirrors[i];
-    float s = dot(p, m.xyz) - m.w;
-    if (s > 0.0) { p -= 2.0 * s * m.xyz; return true; }
-    return false;
+    float e = dot(p, m.xyz) - m.w;
+    if (e > 0.0) p -= 2.0 * e * m.xyz;
+    return e;
 }
 
 float krs_distance(vec3 xw) {
@@ -44,8 +44,7 @@ float krs_nearest(vec3 xw, float width, out int level, out vec3 normal, out vec3
     mat3 M = mat3(1.0), Mk = mat3(1.0);
     for (int i = u_n - 1; i >= 0; --i) {
         vec3 u = u_mirrors[i].xyz;
-        float e = dot(x, u) - u_mirrors[i].w;
-        fold(i, x);
+        float e = fold(i, x);
         M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
         float di = kernel_distance(i, x);
         if (di < d) { d = di; level = i; xk = x; Mk = M; }

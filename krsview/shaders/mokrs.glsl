@@ -30,5 +30,6 @@ void mokrs_nearest(vec3 xw, out int level, out vec3 normal) {
         float d = kernel_distance(i, x) / length(J[0]);
         if (d < best) { best = d; level = i; xk = x; Jk = J; }
     }
-    normal = normalize(transpose(Jk) * kernel_gradient(level, xk));
+    vec3 g = kernel_gradient(level, xk), gw = transpose(Jk) * g;
+    normal = length(gw) > 0.0 ? normalize(gw) : g;  // as krs_nearest where J degenerates
 }
