@@ -70,9 +70,9 @@ def _load(args: argparse.Namespace) -> Scene:
     levels = getattr(args, "levels", None)
     if levels is not None:
         krs = scene.geometry()
-        if levels > len(krs.levels):
+        if levels > krs.depth:
             raise SceneError("--levels", levels,
-                             f"this scene has {len(krs.levels)} levels; allowed 1..{len(krs.levels)}")
+                             f"this scene has {krs.depth} levels; allowed 1..{krs.depth}")
         scene = scene.with_geometry(krs.truncated(levels))
     return scene
 
@@ -81,7 +81,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     scene = _load(args)
     w, h = args.size
     krs = scene.geometry()
-    print(f"krsview: {scene.name}: {len(krs.levels)} levels, {krs.instance_count():,} kernel "
+    print(f"krsview: {scene.name}: {krs.depth} levels, {krs.instance_count():,} kernel "
           f"instances, {w}×{h}, {'NumPy reference' if args.reference else 'GPU'}", flush=True)
     t0 = time.perf_counter()
     if args.reference:
@@ -141,9 +141,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     if scene.mokrs is not None:
         print(f"  geometry        MöKRS: {krs.n} levels, "
               f"{sum(lv.reflect for lv in scene.mokrs.levels)} reflecting")
+    elif scene.compound:
+        print(f"  geometry        compound of {len(scene.compound)}: " + ", ".join(
+            f"{'tree' if c.tree else 'KRS'} of {p.depth} levels"
+            for c, p in zip(scene.compound, krs.parts)))
     else:
         print(f"  geometry        {'tree (grown)' if scene.tree else 'explicit KRS'}")
-        print(f"  levels          {len(krs.levels)} (kernels K_0..K_{krs.n}, {krs.n} mirrors)")
+        print(f"  levels          {krs.depth} (kernels K_0..K_{krs.n}, {krs.n} mirrors)")
     print(f"  kernel instances {krs.instance_count():,}")
     print("  kernels         " + ", ".join(f"{v}× {k}" for k, v in sorted(kinds.items())))
     print(f"  effects         {', '.join(scene.effects) or 'none'}")

@@ -12,7 +12,7 @@ from krsview.presets import resolve
 from krsview.reference import compile_krs
 from krsview.scene import load_scene
 
-DEFINES = {"KRS_MAX_LEVELS": 64, "KRS_RECORD": 6, "KRS_KERNEL_TOROIDAL_CAPSULE": None}
+DEFINES = {"KRS_SLOTS": 64, "KRS_RECORD": 6, "KRS_KERNEL_TOROIDAL_CAPSULE": None}
 
 
 @pytest.fixture

@@ -85,7 +85,7 @@ def _accuracy(v: "Viewer") -> None:
             edits["xi_penalty"] = penalty
     if edits:
         v.set_render(**edits)
-    total = len(v.geometry.levels)
+    total = v.geometry.depth
     changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
     if changed:
         v.set_levels(levels)

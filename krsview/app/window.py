@@ -73,7 +73,7 @@ class Viewer:
     def _set_scene(self, scene: Scene, reset_camera: bool = False) -> None:
         self.scene = scene
         self.geometry = scene.geometry()
-        self.levels = min(self.levels, len(self.geometry.levels))
+        self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()
         if reset_camera:
             self.camera = FlyCamera.from_camera(scene.camera)
@@ -93,7 +93,7 @@ class Viewer:
 
     def set_levels(self, levels: int) -> None:
         """Draw only the coarsest ``levels`` levels (0 or all: the whole scene)."""
-        self.levels = 0 if levels >= len(self.geometry.levels) else levels
+        self.levels = 0 if levels >= self.geometry.depth else levels
         self._apply_levels()
 
     def _apply_levels(self) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 from ..buffers import Buffers
 from ..reference.camera import view_of
 from ..reference.geometry import Compiled, compile_geometry
-from ..scene import KRS, MoKRS, Scene
+from ..scene import Geometry, Scene, SceneError
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
@@ -27,7 +27,7 @@ class Renderer:
         self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
-        self._compiled: tuple[KRS | MoKRS, tuple, Compiled] | None = None  # last geometry
+        self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
 
     @contextmanager
     def current(self) -> Iterator[None]:
@@ -49,19 +49,25 @@ class Renderer:
             self._targets[(width, height)] = self.ctx.framebuffer(color_attachments=tex)
         return self._targets[(width, height)]
 
-    def prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None,
+    def prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
                 all_effects: bool = False) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms."""
         with self.current():
             return self._prepare(scene, width, height, geometry, all_effects)
 
-    def _prepare(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None,
+    def _prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None,
                  all_effects: bool) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
         c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c, all_effects))
         block = krs_block(c)
+        limit = self.ctx.info["GL_MAX_UNIFORM_BLOCK_SIZE"]
+        if len(block) > limit:
+            raise SceneError("compound", f"<a uniform block of {len(block)} bytes>",
+                             f"this GPU's uniform blocks hold at most {limit} bytes, too few "
+                             "for a compound's 8 × 64 level slots: render its components as "
+                             "separate scenes")
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
         else:
@@ -69,12 +75,12 @@ class Renderer:
         if "KRSBlock" in prog:
             prog["KRSBlock"].binding = 0
         self._ubo.bind_to_uniform_block(0)
-        for name, value in view_uniforms(scene, view, c.n).items():
+        for name, value in view_uniforms(scene, view, c).items():
             if name in prog:
                 prog[name].value = value
         return prog
 
-    def _world(self, geometry: KRS | MoKRS, albedo: tuple) -> Compiled:
+    def _world(self, geometry: Geometry, albedo: tuple) -> Compiled:
         """The geometry compiled in world coordinates, redone only when it or the albedo
         changes (a moving camera only translates it: per-frame work stays per-frame)."""
         if (self._compiled is None or self._compiled[0] is not geometry
@@ -100,12 +106,12 @@ class Renderer:
             self._vaos[prog] = self.ctx.vertex_array(prog, [])
         return self._vaos[prog]
 
-    def render(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None) -> Buffers:
+    def render(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None) -> Buffers:
         with self.current():
             prog = self.prepare(scene, width, height, geometry)
             return read_buffers(self.draw(prog, width, height), width, height)
 
-    def time_frame(self, scene: Scene, width: int, height: int, geometry: KRS | MoKRS | None = None,
+    def time_frame(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
                    repeats: int = 1, all_effects: bool = False) -> list[float]:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up."""
         with self.current():

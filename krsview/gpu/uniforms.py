@@ -4,10 +4,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..reference.camera import View
-from ..reference.compiled import RECORD_VEC4
+from ..reference.compiled import RECORD_VEC4, CompiledCompound
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
-from ..scene import EFFECTS, MAX_LEVELS, Scene
+from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
+from ..scene.compound import COMPOUND_SLOTS
 from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
 
 MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, then its pole record
@@ -15,11 +16,11 @@ MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, then its pole re
 
 def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
                     ) -> dict[str, str | int | None]:
-    """One define per kernel type present, per enabled effect, for the tracer and for the
-    Möbius geometry family: nothing else is compiled. ``all_effects`` compiles every effect
-    the geometry allows, each switched by its bit of ``u_effects`` (the benchmark's baseline)."""
-    defines: dict[str, str | int | None] = {"KRS_MAX_LEVELS": MAX_LEVELS,
-                                            "KRS_RECORD": RECORD_VEC4}
+    """One define per kernel type present, per enabled effect, for the tracer, for the
+    Möbius geometry family and for a compound: nothing else is compiled. ``all_effects``
+    compiles every effect the geometry allows, each switched by its bit of ``u_effects``
+    (the benchmark's baseline)."""
+    defines: dict[str, str | int | None] = {"KRS_SLOTS": slots(c), "KRS_RECORD": RECORD_VEC4}
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
     if all_effects:
@@ -35,31 +36,52 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
+    if isinstance(c, CompiledCompound):
+        defines["KRS_COMPOUND"] = None
+        defines["KRS_MAX_COMPONENTS"] = MAX_COMPONENTS
     return defines
+
+
+def slots(c: Compiled) -> int:
+    """Level slots in the uniform block: fixed per geometry family, so that edits (levels,
+    components' depths) never change the variant. A compound has room for 8 × 64 levels."""
+    return COMPOUND_SLOTS if isinstance(c, CompiledCompound) else MAX_LEVELS
 
 
 def krs_block(c: Compiled) -> bytes:
     """The std140 KRSBlock: mirrors (or Möbius records) then kernel records, as float32."""
+    n = slots(c)
     if isinstance(c, CompiledMoKRS):
-        head = np.zeros((MAX_LEVELS, MOBIUS_RECORD, 4), dtype=np.float32)
+        head = np.zeros((n, MOBIUS_RECORD, 4), dtype=np.float32)
         head[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
         head[:c.n, 4] = c.poles
     else:
-        head = np.zeros((MAX_LEVELS, 4), dtype=np.float32)
-        head[:c.n] = c.mirrors
-    kernels = np.zeros((MAX_LEVELS, RECORD_VEC4, 4), dtype=np.float32)
+        head = np.zeros((n, 4), dtype=np.float32)
+        for part, first in component_slots(c):
+            head[first:first + part.n] = part.mirrors
+    kernels = np.zeros((n, RECORD_VEC4, 4), dtype=np.float32)
     kernels[:len(c.records)] = c.records
     return head.tobytes() + kernels.tobytes()
 
 
-def view_uniforms(scene: Scene, view: View, n: int) -> dict[str, object]:
+def component_slots(c: Compiled) -> list[tuple]:
+    """(compiled KRS, first slot) per component."""
+    if isinstance(c, CompiledCompound):
+        return list(zip(c.parts, c.bases))
+    return [(c, 0)]
+
+
+def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     """Per-frame values; positions are camera-relative (the eye is the origin)."""
     lights = scene.lights
     fx = scene.effect_settings
     zones = [tuple(float(v) for v in (*(np.array(z.center) - view.origin), z.radius))
              for z in fx.empty_zones]
+    parts = [(int(first), part.n) for part, first in component_slots(c)]
     return {
-        "u_n": n,
+        "u_n": getattr(c, "n", 0),
+        "u_components": len(parts),
+        "u_component": parts + [(0, 0)] * (MAX_COMPONENTS - len(parts)),
         "u_footprint": view.footprint,
         "u_eye": tuple(view.origin),
         "u_forward": tuple(view.forward), "u_right": tuple(view.right), "u_up": tuple(view.up),

@@ -8,6 +8,7 @@ keeps the camera in float64 (DESIGN.md, Precision).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -92,3 +93,26 @@ def kernel_records(kernels: list, albedo: tuple[float, float, float]
         r[0] = [*color, KERNEL_CODES[kind]]
         types.append(kind)
     return records, tuple(types)
+
+
+@dataclass(frozen=True)
+class CompiledCompound:
+    """A compound's components [KRS17 §5.1], each a CompiledKRS. Their levels share one row of
+    slots, as in the GPU's uniform block: level i of component c is slot ``bases[c] + i``, so
+    a slot names a kernel record across the whole compound (shading looks colours up by it)."""
+    parts: tuple[CompiledKRS, ...]
+
+    @cached_property
+    def bases(self) -> tuple[int, ...]:
+        return tuple(int(b) for b in np.cumsum([0] + [p.n + 1 for p in self.parts[:-1]]))
+
+    @cached_property
+    def records(self) -> np.ndarray:
+        return np.concatenate([p.records for p in self.parts])
+
+    @cached_property
+    def types(self) -> tuple[str, ...]:
+        return tuple(t for p in self.parts for t in p.types)
+
+    def relative_to(self, origin: np.ndarray | tuple) -> "CompiledCompound":
+        return CompiledCompound(tuple(p.relative_to(origin) for p in self.parts))

@@ -1,29 +1,47 @@
-"""One interface over both geometry families, so tracers and renderers need not know which:
-compile, test a ball for being unbounding, find the nearest kernel and its world normal."""
+"""One interface over the geometry families, so tracers and renderers need not know which:
+compile, give each component's distance or unbounding test to the tracer, find the nearest
+kernel and its world normal. A single KRS or MöKRS is the compound of one [KRS17 §5.1]."""
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
-from ..scene import KRS, MoKRS
+from ..scene import Compound, Geometry, MoKRS
 from . import krs, mokrs
-from .compiled import CompiledKRS, compile_krs
+from .compiled import CompiledCompound, CompiledKRS, compile_krs
 from .distortion import Distortion
 
-Compiled = CompiledKRS | mokrs.CompiledMoKRS
+Compiled = CompiledKRS | CompiledCompound | mokrs.CompiledMoKRS
 
 
-def compile_geometry(g: KRS | MoKRS, albedo: tuple[float, float, float]) -> Compiled:
+def compile_geometry(g: Geometry, albedo: tuple[float, float, float]) -> Compiled:
     if isinstance(g, MoKRS):
         return mokrs.compile_mokrs(g, albedo)
+    if isinstance(g, Compound):
+        return CompiledCompound(tuple(compile_krs(p, albedo) for p in g.parts))
     return compile_krs(g, albedo)
 
 
-def scene_distance(c: CompiledKRS, x: np.ndarray, dist: Distortion | None = None
-                   ) -> np.ndarray:
-    """The distance bound of what a KRS draws: Alg. 1, through the scene's distortion."""
+def components(c: CompiledKRS | CompiledCompound) -> tuple[CompiledKRS, ...]:
+    return c.parts if isinstance(c, CompiledCompound) else (c,)
+
+
+def component_distance(part: CompiledKRS, x: np.ndarray, dist: Distortion | None = None
+                       ) -> np.ndarray:
+    """The distance bound of one KRS: Alg. 1, through the scene's distortion."""
     if dist is None:
-        return krs.distance(c, x)
-    return dist.distance(x, krs.distance(c, dist.undistort(x)))
+        return krs.distance(part, x)
+    return dist.distance(x, krs.distance(part, dist.undistort(x)))
+
+
+def scene_distance(c: CompiledKRS | CompiledCompound, x: np.ndarray,
+                   dist: Distortion | None = None) -> np.ndarray:
+    """The distance bound of everything drawn: the least over the components (a distortion
+    is monotone in the distance, so it may be applied once, after the minimum)."""
+    q = x if dist is None else dist.undistort(x)
+    D = np.min([krs.distance(p, q) for p in components(c)], axis=0)
+    return D if dist is None else dist.distance(x, D)
 
 
 def is_unbounding(c: Compiled, center: np.ndarray, radius: np.ndarray,
@@ -35,15 +53,43 @@ def is_unbounding(c: Compiled, center: np.ndarray, radius: np.ndarray,
     return scene_distance(c, center, dist) >= radius
 
 
+Distance = Callable[[np.ndarray], np.ndarray]
+Test = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+def component_distances(c: CompiledKRS | CompiledCompound, dist: Distortion | None
+                        ) -> list[Distance]:
+    """One distance bound per component, for the sphere tracer's free distances."""
+    return [lambda x, p=p: component_distance(p, x, dist) for p in components(c)]
+
+
+def component_tests(c: Compiled, dist: Distortion | None) -> list[Test]:
+    """One unbounding test per component, for the binary tracer's free distances."""
+    if isinstance(c, mokrs.CompiledMoKRS):
+        return [lambda x, s: mokrs.is_unbounding(c, x, s)]
+    return [lambda x, s, p=p: component_distance(p, x, dist) >= s for p in components(c)]
+
+
 def nearest(c: Compiled, x: np.ndarray, width: np.ndarray | None = None,
             dist: Distortion | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(level, unit world normal, kernel-space point) of the kernel nearest to each point;
-    ``width`` is the smooth-shading band per point (None: no smoothing)."""
+    """(level slot, unit world normal, kernel-space point) of the kernel nearest to each
+    point; ``width`` is the smooth-shading band per point (None: no smoothing). In a compound
+    the component nearest to the point is asked (ties: the first), and its level is offset
+    to the compound's slot."""
     if isinstance(c, mokrs.CompiledMoKRS):
         level, g = mokrs.nearest(c, x)
         return level, g, x
     q = x if dist is None else dist.undistort(x)
-    D, level, g, xk = krs.nearest(c, q, width)
+    if isinstance(c, CompiledKRS):
+        D, level, g, xk = krs.nearest(c, q, width)
+    else:
+        win = np.argmin([krs.distance(p, q) for p in c.parts], axis=0)
+        D, level, g, xk = np.empty(len(q)), np.empty(len(q), int), np.empty_like(q), np.empty_like(q)
+        for k, (part, base) in enumerate(zip(c.parts, c.bases)):
+            sel = win == k
+            D[sel], level[sel], g[sel], xk[sel] = krs.nearest(
+                part, q[sel], None if width is None else width[sel])
+            level[sel] += base
     if dist is not None:
         g = dist.normal(x, q, D, g)
     return level, g, xk
@@ -56,7 +102,7 @@ def free_radius(c: Compiled, x: np.ndarray) -> float:
     """The radius of an empty ball around the point x (3,): |DISTANCE| for a KRS; for a MöKRS
     (no distance function) the largest of FREE_RADII that is unbounding, found in one batch.
     Used by the viewer to scale flying speed."""
-    if isinstance(c, CompiledKRS):
-        return abs(float(krs.distance(c, x[None])[0]))
+    if not isinstance(c, mokrs.CompiledMoKRS):
+        return abs(float(scene_distance(c, x[None])[0]))
     free = is_unbounding(c, np.broadcast_to(x, (len(FREE_RADII), 3)), FREE_RADII)
     return float(FREE_RADII[free].max()) if free.any() else 0.0

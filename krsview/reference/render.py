@@ -4,17 +4,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..buffers import Buffers
-from ..scene import KRS, MoKRS, Scene
+from ..scene import Geometry, Scene
 from .atmosphere import background
 from .camera import primary_rays, view_of
 from .distortion import Distortion
-from .geometry import compile_geometry, is_unbounding, nearest, scene_distance
+from .geometry import component_distances, component_tests, compile_geometry, nearest
 from .shade import Hits, encode, shade
 from .trace import binary_trace, sphere_trace
 
 
 def render_reference(scene: Scene, width: int, height: int,
-                     geometry: KRS | MoKRS | None = None) -> Buffers:
+                     geometry: Geometry | None = None) -> Buffers:
     view = view_of(scene.camera, width, height)
     c = compile_geometry(geometry or scene.geometry(), scene.material.albedo)
     dist = Distortion.of(scene)
@@ -22,10 +22,10 @@ def render_reference(scene: Scene, width: int, height: int,
     r = scene.render
     eps = view.footprint * r.epsilon_scale
     if r.tracer == "binary":
-        tr = binary_trace(lambda x, s: is_unbounding(c, x, s, dist), view.origin, dirs, eps,
+        tr = binary_trace(component_tests(c, dist), view.origin, dirs, eps,
                           r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty)
     else:
-        tr = sphere_trace(lambda x: scene_distance(c, x, dist), view.origin, dirs, eps,
+        tr = sphere_trace(component_distances(c, dist), view.origin, dirs, eps,  # type: ignore[arg-type]
                           r.max_iterations, r.max_distance)
     N = len(dirs)
     normal = np.zeros((N, 3))

@@ -21,57 +21,81 @@ class Trace:
     iterations: np.ndarray  # distance evaluations (N,)
 
 
-def sphere_trace(distance: Callable[[np.ndarray], np.ndarray], origin: np.ndarray,
-                 dirs: np.ndarray, eps_per_t: float, max_iterations: int, max_distance: float
-                 ) -> Trace:
-    """Sphere tracing of the distance bound ``distance`` (points (N, 3) → (N,))."""
+Distance = Callable[[np.ndarray], np.ndarray]
+Test = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray,
+                 eps_per_t: float, max_iterations: int, max_distance: float) -> Trace:
+    """Sphere tracing of the components' distance bounds (points (N, 3) → (N,)), each with
+    its own free distance t_c along the ray [KRS17 §5.1]: the component with the least t_c
+    (ties: the first) takes the step, and the ray converges when that step does. So it
+    stops at the nearest of the hits each component would have alone, after at most the sum
+    of their iterations. One KRS is the compound of one: plain sphere tracing."""
     N = len(dirs)
+    tc = np.zeros((N, len(distances)))
     t = np.zeros(N)
     hit = np.zeros(N, dtype=bool)
     iters = np.zeros(N, dtype=np.int64)
     active = np.arange(N)
     for _ in range(max_iterations):
+        c = tc[active].argmin(axis=1)
+        t[active] = tc[active, c]
+        live = t[active] <= max_distance
+        active, c = active[live], c[live]
         if active.size == 0:
             break
         ta = t[active]
-        d = distance(origin + ta[:, None] * dirs[active])
+        d = np.empty(active.size)
+        for k, distance in enumerate(distances):
+            sel = np.flatnonzero(c == k)
+            if sel.size:
+                d[sel] = distance(origin + ta[sel, None] * dirs[active[sel]])
         iters[active] += 1
         converged = d <= eps_per_t * ta
         hit[active[converged]] = True
-        ta = ta + d
-        t[active[~converged]] = ta[~converged]
-        active = active[~converged & (ta <= max_distance)]
+        tc[active, c] = ta + d
+        active = active[~converged]
     return Trace(hit, t, iters)
 
 
-def binary_trace(is_free: Callable[[np.ndarray, np.ndarray], np.ndarray], origin: np.ndarray,
-                 dirs: np.ndarray, eps_per_t: float, max_iterations: int, max_distance: float,
-                 xi_bonus: float, xi_penalty: float) -> Trace:
+def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_per_t: float,
+                 max_iterations: int, max_distance: float, xi_bonus: float,
+                 xi_penalty: float) -> Trace:
     """BINARYTRACE [KRS17 Alg. 2]: probe the ball of radius s that touches the free point t;
     if it is unbounding, advance by its diameter 2s and grow s by ξ_bonus, else shrink s by
     ξ_penalty. Iterations count probes. Two departures from the paper's listing: we advance
     before growing s (growing first would step 2ξ_bonus·s, past the verified ball), and a ray
     converges when a *blocked* probe has s ≤ ε(t): a ray passing within δ of a surface then
     hits when δ ≲ ε(t), as in sphere tracing, so both tracers draw the same silhouettes at
-    equal ε (the paper tests the shrunk probe, which thickens them by 1/ξ_penalty ≈ 3.3×)."""
+    equal ε (the paper tests the shrunk probe, which thickens them by 1/ξ_penalty ≈ 3.3×).
+    Each component keeps its own (t_c, s_c) and ``tests`` its unbounding test, chosen as in
+    :func:`sphere_trace` [KRS17 §5.1]."""
     N = len(dirs)
+    tc = np.zeros((N, len(tests)))
+    sc = np.full((N, len(tests)), INITIAL_PROBE)
     t = np.zeros(N)
-    s = np.full(N, INITIAL_PROBE)
     hit = np.zeros(N, dtype=bool)
     iters = np.zeros(N, dtype=np.int64)
     active = np.arange(N)
-    while active.size:
-        active = active[iters[active] < max_iterations]
+    for _ in range(max_iterations):
+        c = tc[active].argmin(axis=1)
+        t[active] = tc[active, c]
+        live = t[active] <= max_distance
+        active, c = active[live], c[live]
         if active.size == 0:
             break
-        sa, ta = s[active], t[active]
-        free = is_free(origin + (ta + sa)[:, None] * dirs[active], sa)
+        ta, sa = t[active], sc[active, c]
+        free = np.empty(active.size, dtype=bool)
+        for k, test in enumerate(tests):
+            sel = np.flatnonzero(c == k)
+            if sel.size:
+                free[sel] = test(origin + (ta[sel] + sa[sel])[:, None] * dirs[active[sel]],
+                                 sa[sel])
         iters[active] += 1
         converged = ~free & (sa <= eps_per_t * ta)
         hit[active[converged]] = True
-        go, stay = active[free], active[~free & ~converged]
-        t[go] += 2.0 * s[go]
-        s[go] *= xi_bonus
-        s[stay] *= xi_penalty
-        active = np.concatenate([go[t[go] <= max_distance], stay])
+        tc[active, c] = np.where(free, ta + 2.0 * sa, ta)
+        sc[active, c] = np.where(free, sa * xi_bonus, sa * xi_penalty)
+        active = active[~converged]
     return Trace(hit, t, iters)

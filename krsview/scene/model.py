@@ -124,6 +124,11 @@ class KRS:
                                  "every level above 0 needs a mirror {normal, offset}")
 
     @property
+    def depth(self) -> int:
+        """Number of levels (the range of the viewer's levels slider and of --levels)."""
+        return len(self.levels)
+
+    @property
     def n(self) -> int:
         """Number of reflections; the expansion has up to 2^n instances of K_0."""
         return len(self.levels) - 1

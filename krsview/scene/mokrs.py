@@ -112,6 +112,11 @@ class MoKRS:
                                  f"{SINGULAR_CONDITION:g} (avoid extreme scale factors)")
 
     @property
+    def depth(self) -> int:
+        """Number of levels (the range of the viewer's levels slider and of --levels)."""
+        return len(self.levels)
+
+    @property
     def n(self) -> int:
         """Number of levels the tracer walks (each may reflect)."""
         return len(self.levels)

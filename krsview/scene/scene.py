@@ -8,12 +8,16 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from .compound import Component, Compound, check_compound
 from .effects import EffectSettings, check_effects
 from .model import KRS, Camera, Light, Material, Render
 from .mokrs import MoKRS, check_view
 from .schema import SceneError, from_dict, param, to_dict
 from .toml_writer import dumps
 from .tree import Tree
+
+
+Geometry = KRS | MoKRS | Compound
 
 
 @dataclass(frozen=True)
@@ -37,13 +41,19 @@ class Scene:
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
     mokrs: MoKRS | None = param(None, help="Möbius kernel–reflection sequence (instead of krs)")
+    compound: list[Component] = param([], help="up to 8 placed KRSs or trees, drawn as one "
+                                      "scene (instead of krs) [KRS17 §5.1]")
     bookmarks: list[Bookmark] = param([], help="saved cameras")
 
     def validate(self, path: str) -> None:
         given = [k for k in ("krs", "tree", "mokrs") if getattr(self, k) is not None]
+        given += ["compound"] if self.compound else []
         if len(given) != 1:
-            raise SceneError("krs / tree / mokrs", "<" + (" and ".join(given) or "none") + ">",
-                             "a scene has exactly one geometry: a [krs], [tree] or [mokrs] table")
+            raise SceneError("krs / tree / mokrs / compound",
+                             "<" + (" and ".join(given) or "none") + ">",
+                             "a scene has exactly one geometry: a [krs], [tree] or [mokrs] "
+                             "table, or a [[compound]] list")
+        check_compound(self.compound)
         if len(self.lights) > 4:
             raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
         check_effects(self.effects, self.mokrs is not None)
@@ -61,16 +71,22 @@ class Scene:
                              "function, only unbounding tests: it needs binary tracing; "
                              "allowed: 'binary'")
 
-    def geometry(self) -> KRS | MoKRS:
-        """What is drawn: the explicit KRS or MöKRS, or the tree expanded [KRS17 §9.2]."""
+    def geometry(self) -> Geometry:
+        """What is drawn: the explicit KRS or MöKRS, the tree expanded [KRS17 §9.2], or the
+        compound's components placed in the world [KRS17 §5.1]."""
         if self.tree is not None:
             return self.tree.krs()
+        if self.compound:
+            return Compound(tuple(c.placed() for c in self.compound))
         return self.krs if self.krs is not None else self.mokrs  # type: ignore[return-value]
 
-    def with_geometry(self, geometry: KRS | MoKRS) -> "Scene":
+    def with_geometry(self, geometry: Geometry) -> "Scene":
+        none = dict(krs=None, tree=None, mokrs=None, compound=[])
         if isinstance(geometry, MoKRS):
-            return replace(self, krs=None, tree=None, mokrs=geometry)
-        return replace(self, krs=geometry, tree=None, mokrs=None)
+            return replace(self, **{**none, "mokrs": geometry})
+        if isinstance(geometry, Compound):
+            return replace(self, **{**none, "compound": [Component(krs=p) for p in geometry.parts]})
+        return replace(self, **{**none, "krs": geometry})
 
 
 def scene_from_toml(text: str, file: str = "<string>") -> Scene:

@@ -64,12 +64,12 @@ class Tree:
             side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-6 else np.zeros(3)
             control = P + 0.5 * length * d + self.bend * length * side
             color = self.leaf if i < self.leaf_levels else self.bark
-            kernels.append(ToroidalCapsule(_t(P), _t(control), _t(end), radius, color))
+            kernels.append(ToroidalCapsule(as_vec3(P), as_vec3(control), as_vec3(end), radius, color))
             if i == 0:
                 break
             # Mirror R_{i-1} through the fork P_i = end, containing the parent direction.
             u = _rotate(s, d, math.radians(self.divergence))
-            mirrors.append(Mirror(_t(u), float(u @ end)))
+            mirrors.append(Mirror(as_vec3(u), float(u @ end)))
             d_child = math.cos(theta) * d - math.sin(theta) * u   # child on the negative side
             s = math.sin(theta) * d + math.cos(theta) * u
             d, P = d_child / np.linalg.norm(d_child), end
@@ -80,13 +80,14 @@ class Tree:
         levels = [Level(kernels[0], None)] + [Level(k, m) for k, m in zip(kernels[1:], mirrors)]
         for i, m in enumerate(self.forest):
             last = i == len(self.forest) - 1
-            k = (Plane(_t(up), float(up @ np.array(self.base)), self.ground)
+            k = (Plane(as_vec3(up), float(up @ np.array(self.base)), self.ground)
                  if last and self.ground is not None else Empty())
             levels.append(Level(k, m))
         return KRS(levels)
 
 
-def _t(v: np.ndarray | tuple) -> Vec3:
+def as_vec3(v: np.ndarray | tuple) -> Vec3:
+    """A plain tuple of Python floats (what the scene dataclasses hold)."""
     return tuple(float(c) for c in v)  # type: ignore[return-value]
 
 

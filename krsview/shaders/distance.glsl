@@ -1,6 +1,7 @@
 // What is drawn, for the KRS family: the distance bound with the scene's distortions and the
-// nearest kernel with its world normal; twin of reference/distortion.py. Without twist and
-// empty zones this is Alg. 1 itself [KRS17 Alg. 1].
+// nearest kernel with its world normal; twin of reference/geometry.py and distortion.py.
+// Without twist and empty zones this is Alg. 1 itself [KRS17 Alg. 1]; in a compound, each
+// component is a KRS of its own [KRS17 §5.1].
 #include "krs.glsl"
 #ifdef KRS_TWIST
 #include "twist.glsl"
@@ -29,20 +30,56 @@ float distort_distance(vec3 p, float D) {
     return D;
 }
 
-float scene_distance(vec3 p) { return distort_distance(p, krs_distance(undistort(p))); }
+// Component c's slots: (first, n).
+ivec2 component(int c) {
+#ifdef KRS_COMPOUND
+    return u_component[c];
+#else
+    return ivec2(0, u_n);
+#endif
+}
 
-// A ball is free of the geometry when the distance bound at its centre covers it.
-bool is_unbounding(vec3 center, float radius) { return scene_distance(center) >= radius; }
+float undistorted_distance(int c, vec3 q) {
+    ivec2 k = component(c);
+    return krs_distance(k.x, k.y, q);
+}
 
-// Nearest kernel level, its kernel-space point and the world normal at the hit point p, whose
-// ray distance t sets the smoothing band (at least 2 pixel footprints, against aliasing).
+// The distance bound of component c, which the tracer steps by.
+float component_distance(int c, vec3 p) {
+    return distort_distance(p, undistorted_distance(c, undistort(p)));
+}
+
+// The bound of everything drawn: the least over the components (a distortion is monotone in
+// the distance, so it is applied once, after the minimum).
+float scene_distance(vec3 p) {
+    vec3 q = undistort(p);
+    float D = undistorted_distance(0, q);
+    for (int c = 1; c < COMPONENTS; ++c) D = min(D, undistorted_distance(c, q));
+    return distort_distance(p, D);
+}
+
+// A ball is free of component c when its distance bound at the centre covers it.
+bool is_unbounding(int c, vec3 center, float radius) {
+    return component_distance(c, center) >= radius;
+}
+
+// Nearest kernel's level slot, its kernel-space point and the world normal at the hit point
+// p, whose ray distance t sets the smoothing band (at least 2 pixel footprints, against
+// aliasing). In a compound, the component nearest to p is asked (ties: the first).
 void scene_nearest(vec3 p, float t, out int level, out vec3 normal, out vec3 xk) {
     vec3 q = undistort(p);
     float width = 0.0;
 #ifdef KRS_SMOOTH_SHADING
     width = max(u_smooth_width, 2.0 * u_footprint * t);
 #endif
-    float D = krs_nearest(q, width, level, normal, xk);
+    int win = 0;
+    float best = undistorted_distance(0, q);
+    for (int c = 1; c < COMPONENTS; ++c) {
+        float d = undistorted_distance(c, q);
+        if (d < best) { best = d; win = c; }
+    }
+    ivec2 k = component(win);
+    float D = krs_nearest(k.x, k.y, q, width, level, normal, xk);
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) normal = twist_normal(p, q, normal);
 #endif

@@ -10,10 +10,11 @@ float fold(int i, inout vec3 p) {
     return e;
 }
 
-float krs_distance(vec3 xw) {
+// The KRS whose kernels K_0..K_n and mirrors R_0..R_{n−1} sit in slots first..first + n.
+float krs_distance(int first, int n, vec3 xw) {
     vec3 x = xw;
-    float d = kernel_distance(u_n, x);
-    for (int i = u_n - 1; i >= 0; --i) {
+    float d = kernel_distance(first + n, x);
+    for (int i = first + n - 1; i >= first; --i) {
         fold(i, x);
         d = min(d, kernel_distance(i, x));
     }
@@ -33,16 +34,17 @@ float mirror_weight(float e, float width) {
 float mirror_weight(float e, float width) { return e > 0.0 ? 1.0 : 0.0; }
 #endif
 
-// Winning level j (ties to the coarser level), the point x_j in its kernel's space, and the
+// Winning level slot j (ties to the coarser level), the point x_j in its kernel's space, and the
 // world normal M ∇k_j(x_j) with M = A_{n−1} ⋯ A_j, A_i = I − 2 w_i u_i u_iᵀ accumulated while
 // walking down [KRS14 §6.1]: w_i = 1 where mirror i folded x, else 0 (smoothed near the plane).
-float krs_nearest(vec3 xw, float width, out int level, out vec3 normal, out vec3 xk) {
+float krs_nearest(int first, int n, vec3 xw, float width, out int level, out vec3 normal,
+                  out vec3 xk) {
     vec3 x = xw;
     xk = xw;
-    float d = kernel_distance(u_n, x);
-    level = u_n;
+    float d = kernel_distance(first + n, x);
+    level = first + n;
     mat3 M = mat3(1.0), Mk = mat3(1.0);
-    for (int i = u_n - 1; i >= 0; --i) {
+    for (int i = first + n - 1; i >= first; --i) {
         vec3 u = u_mirrors[i].xyz;
         float e = fold(i, x);
         M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);

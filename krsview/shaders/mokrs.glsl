@@ -5,7 +5,8 @@
 
 bool reflects(int i) { return (int(mobius_rec(i, 4).w) & 2) != 0; }
 
-bool is_unbounding(vec3 center, float radius) {
+// c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
+bool is_unbounding(int c, vec3 center, float radius) {
     for (int i = u_n - 1; i >= 0; --i) {
         if (!map_ball(i, center, radius)) return false;   // inside-out
         if (reflects(i)) center.x = -abs(center.x);      // mirror decision on the centre

@@ -7,15 +7,29 @@
 #define KERNEL_PLANE 4
 #define FAR_AWAY 1e30
 
+// KRS_SLOTS level slots: one per level, or in a compound, component c's level i is slot
+// first_c + i (its mirror and its kernel record share the slot).
 layout(std140) uniform KRSBlock {
 #ifdef KRS_MOBIUS
-    vec4 u_mobius[KRS_MAX_LEVELS * MOBIUS_RECORD]; // per level: H_i = G_i⁻¹ (mobius.glsl)
+    vec4 u_mobius[KRS_SLOTS * MOBIUS_RECORD];   // per level: H_i = G_i⁻¹ (mobius.glsl)
 #else
-    vec4 u_mirrors[KRS_MAX_LEVELS];                // u.xyz, w: the plane u·x = w
+    vec4 u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
 #endif
-    vec4 u_kernels[KRS_MAX_LEVELS * KRS_RECORD];   // per level: KRS_RECORD vec4s
+    vec4 u_kernels[KRS_SLOTS * KRS_RECORD];     // per level: KRS_RECORD vec4s
 };
 uniform int u_n;            // KRS: number of mirrors, kernels K_0..K_n; MöKRS: levels
+
+// Compound [KRS17 §5.1]: the tracer keeps one free distance per component. A single KRS or
+// MöKRS is the compound of one, and then all of this folds to constants.
+#ifdef KRS_COMPOUND
+uniform int u_components;
+uniform ivec2 u_component[KRS_MAX_COMPONENTS];  // per component: first slot, mirror count n
+#define COMPONENTS u_components
+#define COMPONENT_SLOTS KRS_MAX_COMPONENTS
+#else
+#define COMPONENTS 1
+#define COMPONENT_SLOTS 1
+#endif
 
 uniform vec3 u_forward;
 uniform vec3 u_right;

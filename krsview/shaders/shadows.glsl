@@ -29,7 +29,7 @@ float shadow_visibility(vec3 p, vec3 n, vec3 l, float eps) {
 #ifdef KRS_MOBIUS
     float s = INITIAL_PROBE;
     for (int i = 0; i < u_max_iterations; ++i) {
-        if (is_unbounding(o + (t + s) * l, s)) {
+        if (is_unbounding(0, o + (t + s) * l, s)) {
             if (soft) vis = min(vis, u_shadow_softness * s / (t + s));
             t += 2.0 * s;
             s *= u_xi_bonus;

@@ -1,11 +1,20 @@
 // Sphere tracing [Har96] or binary sphere tracing [KRS17 Alg. 2], with the LOD threshold
 // ε = footprint × t × ε-scale [KRS17 §4]; twin of reference/trace.py. One tracer and one
-// geometry family are compiled in.
+// geometry family are compiled in. Each component c keeps its own free distance t_c along
+// the ray; the one with the least t_c takes the step, and the ray converges when that step
+// does: at the nearest of the components' own hits [KRS17 §5.1].
 #ifdef KRS_MOBIUS
 #include "mokrs.glsl"
 #else
 #include "distance.glsl"
 #endif
+
+// The component with the least free distance (ties: the first).
+int front(float tc[COMPONENT_SLOTS]) {
+    int f = 0;
+    for (int c = 1; c < COMPONENTS; ++c) if (tc[c] < tc[f]) f = c;
+    return f;
+}
 
 #ifdef KRS_TRACER_BINARY
 #define INITIAL_PROBE 1.0
@@ -13,31 +22,37 @@
 // Probe the ball of radius s touching the free point t: free → advance 2s, grow s;
 // blocked → converged if s ≤ ε(t), else shrink s (see reference/trace.py for why).
 bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
-    t = 0.0;
-    float s = INITIAL_PROBE;
+    float tc[COMPONENT_SLOTS], sc[COMPONENT_SLOTS];
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) { tc[c] = 0.0; sc[c] = INITIAL_PROBE; }
     for (iterations = 0; iterations < u_max_iterations;) {
-        bool free = is_unbounding(origin + (t + s) * dir, s);
+        int c = front(tc);
+        t = tc[c];
+        if (t > u_max_distance) return false;
+        float s = sc[c];
+        bool free = is_unbounding(c, origin + (t + s) * dir, s);
         ++iterations;
         if (free) {
-            t += 2.0 * s;
-            s *= u_xi_bonus;
-            if (t > u_max_distance) return false;
+            tc[c] = t + 2.0 * s;
+            sc[c] = s * u_xi_bonus;
         } else {
             if (s <= u_eps_per_t * t) return true;
-            s *= u_xi_penalty;
+            sc[c] = s * u_xi_penalty;
         }
     }
     return false;
 }
 #else
 bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
-    t = 0.0;
+    float tc[COMPONENT_SLOTS];
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) tc[c] = 0.0;
     for (iterations = 0; iterations < u_max_iterations;) {
-        float d = scene_distance(origin + t * dir);
+        int c = front(tc);
+        t = tc[c];
+        if (t > u_max_distance) return false;
+        float d = component_distance(c, origin + t * dir);
         ++iterations;
         if (d <= u_eps_per_t * t) return true;
-        t += d;
-        if (t > u_max_distance) return false;
+        tc[c] = t + d;
     }
     return false;
 }
