@@ -3,14 +3,13 @@ compile, give each component's distance or unbounding test to the tracer, find t
 kernel and its world normal. A single KRS or MöKRS is the compound of one [KRS17 §5.1]."""
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from ..scene import Compound, Geometry, MoKRS
 from . import krs, mokrs
 from .compiled import CompiledCompound, CompiledKRS, compile_krs
 from .distortion import Distortion
+from .trace import Distance, Test
 
 Compiled = CompiledKRS | CompiledCompound | mokrs.CompiledMoKRS
 
@@ -51,10 +50,6 @@ def is_unbounding(c: Compiled, center: np.ndarray, radius: np.ndarray,
     if isinstance(c, mokrs.CompiledMoKRS):
         return mokrs.is_unbounding(c, center, radius)
     return scene_distance(c, center, dist) >= radius
-
-
-Distance = Callable[[np.ndarray], np.ndarray]
-Test = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 def component_distances(c: CompiledKRS | CompiledCompound, dist: Distortion | None

@@ -4,42 +4,48 @@
 Shadow rays start SHADOW_OFFSET·ε off the surface and stop at the primary ray's threshold ε.
 Soft shadows take the smallest free distance met along the ray as a fraction k·free/t of the
 distance travelled (Fig. 11): sphere-traced distances for a KRS, free probe radii for a MöKRS.
+In a compound the shadow ray keeps one free distance per component, as the primary ray does
+[KRS17 §5.1], so a step costs one component's distance, not all of them.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 
 import numpy as np
 
 from ..scene import Render
-from .trace import INITIAL_PROBE
+from .trace import INITIAL_PROBE, Distance, Test, by_component
 
 SHADOW_OFFSET = 2.0
 AO_SAMPLES = 5
 
 
-def shadow_by_distance(distance: Callable[[np.ndarray], np.ndarray], o: np.ndarray,
-                       l: np.ndarray, eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
-    """Visibility of direction l from points o (sphere tracing); k None: hard shadows."""
+def shadow_by_distance(distances: list[Distance], o: np.ndarray, l: np.ndarray,
+                       eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
+    """Visibility of direction l from points o, sphere tracing each component's distance
+    (the least free distance steps, as in :func:`trace.sphere_trace`); k None: hard shadows.
+    The ray is blocked when any step converges; soft visibility is the least k·d/t met."""
     N = len(o)
-    vis, t = np.ones(N), np.zeros(N)
+    vis, tc = np.ones(N), np.zeros((N, len(distances)))
     live = np.arange(N)
     for _ in range(r.max_iterations):
+        c = tc[live].argmin(axis=1)
+        tl = tc[live, c]
+        keep = tl <= r.max_distance
+        live, c, tl = live[keep], c[keep], tl[keep]
         if live.size == 0:
             break
-        tl = t[live]
-        d = distance(o[live] + tl[:, None] * l)
+        d = by_component(distances, c, o[live] + tl[:, None] * l)
         blocked = d <= eps[live]
         vis[live[blocked]] = 0.0
         if k is not None:
             ratio = np.where(tl > 0.0, k * d / np.where(tl > 0.0, tl, 1.0), np.inf)
             vis[live] = np.where(blocked, 0.0, np.minimum(vis[live], ratio))
-        t[live] = tl + d
-        live = live[~blocked & (tl + d <= r.max_distance)]
+        tc[live, c] = tl + d
+        live = live[~blocked]
     return vis
 
 
-def shadow_by_probes(is_free: Callable[[np.ndarray, np.ndarray], np.ndarray], o: np.ndarray,
+def shadow_by_probes(is_free: Test, o: np.ndarray,
                      l: np.ndarray, eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
     """Visibility of direction l from points o by binary probing [KRS17 Alg. 2]."""
     N = len(o)
@@ -60,7 +66,7 @@ def shadow_by_probes(is_free: Callable[[np.ndarray, np.ndarray], np.ndarray], o:
     return vis
 
 
-def ambient_occlusion(distance: Callable[[np.ndarray], np.ndarray], p: np.ndarray,
+def ambient_occlusion(distance: Distance, p: np.ndarray,
                       n: np.ndarray, step: float, strength: float) -> np.ndarray:
     """1 − strength·Σ 2^−k·clamp((h_k − d(p + h_k n))/h_k) over h_k = k·step, k = 1..5."""
     occlusion = np.zeros(len(p))

@@ -9,7 +9,7 @@ import numpy as np
 from ..scene import Scene
 from . import atmosphere, occlusion, texture
 from .distortion import Distortion
-from .geometry import Compiled, is_unbounding, scene_distance
+from .geometry import Compiled, component_distances, is_unbounding, scene_distance
 from .mokrs import CompiledMoKRS
 
 GAMMA = 2.2
@@ -78,7 +78,8 @@ def shade(scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint
                 vis = occlusion.shadow_by_probes(lambda x, s: is_unbounding(c, x, s), o, l,
                                                  eps[lit], scene.render, k)
             else:
-                vis = occlusion.shadow_by_distance(distance, o, l, eps[lit], scene.render, k)
+                vis = occlusion.shadow_by_distance(component_distances(c, dist), o, l,  # type: ignore[arg-type]
+                                                   eps[lit], scene.render, k)
             cos[lit] *= vis
         light = light + lt.intensity * cos[:, None] * np.array(lt.color)
     color = albedo(scene, c, h, fp) * light

@@ -25,6 +25,21 @@ Distance = Callable[[np.ndarray], np.ndarray]
 Test = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
+def by_component(fns: list, c: np.ndarray, *args: np.ndarray) -> np.ndarray:
+    """Row i of the result is ``fns[c[i]]`` applied to row i of each argument: one batch per
+    component, for the compound's per-component free distances [KRS17 §5.1]."""
+    out: np.ndarray | None = None
+    for k, f in enumerate(fns):
+        sel = np.flatnonzero(c == k)
+        if sel.size:
+            v = f(*(a[sel] for a in args))
+            if out is None:
+                out = np.empty(len(c), dtype=v.dtype)
+            out[sel] = v
+    assert out is not None
+    return out
+
+
 def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray,
                  eps_per_t: float, max_iterations: int, max_distance: float) -> Trace:
     """Sphere tracing of the components' distance bounds (points (N, 3) → (N,)), each with
@@ -46,11 +61,7 @@ def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray
         if active.size == 0:
             break
         ta = t[active]
-        d = np.empty(active.size)
-        for k, distance in enumerate(distances):
-            sel = np.flatnonzero(c == k)
-            if sel.size:
-                d[sel] = distance(origin + ta[sel, None] * dirs[active[sel]])
+        d = by_component(distances, c, origin + ta[:, None] * dirs[active])
         iters[active] += 1
         converged = d <= eps_per_t * ta
         hit[active[converged]] = True
@@ -86,12 +97,7 @@ def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_pe
         if active.size == 0:
             break
         ta, sa = t[active], sc[active, c]
-        free = np.empty(active.size, dtype=bool)
-        for k, test in enumerate(tests):
-            sel = np.flatnonzero(c == k)
-            if sel.size:
-                free[sel] = test(origin + (ta[sel] + sa[sel])[:, None] * dirs[active[sel]],
-                                 sa[sel])
+        free = by_component(tests, c, origin + (ta + sa)[:, None] * dirs[active], sa)
         iters[active] += 1
         converged = ~free & (sa <= eps_per_t * ta)
         hit[active[converged]] = True

@@ -1,7 +1,8 @@
 // Shadow rays [KRS17 §8.5]: hard (blocked or not), or soft, where the smallest free distance
 // met along the ray, as a fraction k·free/t of the distance travelled, sets the penumbra
-// (Fig. 11); twin of reference/effects.py. A KRS is sphere traced along the shadow ray,
-// a MöKRS probed with unbounding balls (its free distances are the free probe radii).
+// (Fig. 11); twin of reference/occlusion.py. A KRS is sphere traced along the shadow ray
+// (a compound with one free distance per component), a MöKRS probed with unbounding balls
+// (its free distances are the free probe radii).
 uniform float u_shadow_softness;  // k
 #define SHADOW_OFFSET 2.0         // the ray starts this many ε off the surface, along the normal
 
@@ -40,12 +41,16 @@ float shadow_visibility(vec3 p, vec3 n, vec3 l, float eps) {
         }
     }
 #else
+    float tc[COMPONENT_SLOTS];  // one free distance per component, as in trace.glsl
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) tc[c] = 0.0;
     for (int i = 0; i < u_max_iterations; ++i) {
-        float d = scene_distance(o + t * l);
+        int c = front(tc);
+        t = tc[c];
+        if (t > u_max_distance) break;
+        float d = component_distance(c, o + t * l);
         if (d <= eps) return 0.0;
         if (soft && t > 0.0) vis = min(vis, u_shadow_softness * d / t);
-        t += d;
-        if (t > u_max_distance) break;
+        tc[c] = t + d;
     }
 #endif
     return vis;
