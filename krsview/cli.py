@@ -284,7 +284,9 @@ def build_parser() -> argparse.ArgumentParser:
                                      "specialised (#define) and in the variant that compiles "
                                      "every effect and switches them by uniforms; frame times "
                                      "as ratios to the plain render. An idle twist (0°) or "
-                                     "an empty zone list gets a stand-in so its cost shows.")
+                                     "an empty zone list gets a stand-in so its cost shows. "
+                                     "A KRS is also drawn as a compound of one; a compound "
+                                     "against its components drawn alone, and their sum.")
     bench_arguments(be)
     accuracy(be)
     be.set_defaults(func=cmd_bench_effects)

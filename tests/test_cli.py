@@ -39,7 +39,7 @@ def test_reference_render_matches_size(tmp_path):
     (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
     (["render", "tree", "--epsilon-scale", "nan"], "--epsilon-scale 'nan': allowed"),
     (["render", "tree", "--max-iterations", "-3"], "--max-iterations '-3': allowed 1"),
-    (["render", "no-such-preset"], "not a file and not a preset; presets: forest, grass, inversion"),
+    (["render", "no-such-preset"], "not a file and not a preset; presets: forest, grass, grove, inversion"),
     (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
     (["check", "missing.toml"], "no such scene file"),
     (["frobnicate"], "invalid choice"),

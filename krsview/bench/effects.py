@@ -5,9 +5,13 @@ On one scene and view, in one run, frames interleaved round by round (medians):
 - each effect alone, specialised (its #define only): its incremental cost;
 - the scene's own effect set, specialised, against the same set in the variant that compiles
   every effect and switches them by a bit of ``u_effects`` (the "uber-shader"), and that
-  variant with every bit off against ``plain``.
-The paper reports soft shadows at quarter resolution ≈ 25 % of the primary cost and ambient
-occlusion ≈ one extra level; we trace shadows at full resolution.
+  variant with every bit off against ``plain``;
+- the compound [KRS17 §5.1]: a KRS scene drawn as a compound of one (what the compound
+  variant's per-component bookkeeping costs); a compound scene against each of its components
+  drawn alone, and their sum (what drawing them separately and composing by depth would cost).
+The paper reports soft shadows at quarter resolution ≈ 25 % of the primary cost, ambient
+occlusion ≈ one extra level and a compound of eight ≈ a single KRS of similar kernel count;
+we trace shadows at full resolution.
 """
 from __future__ import annotations
 
@@ -15,7 +19,7 @@ import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
-from ..scene import EmptyZone, Scene
+from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
 from .progress import Progress
 from .report import write_csv
@@ -43,6 +47,12 @@ def runs_of(scene: Scene) -> dict[str, tuple[Scene, bool]]:
         runs["scene, specialised"] = (scene, False)
         runs["scene, all compiled"] = (scene, True)
     runs["none on, all compiled"] = (plain, True)
+    geometry = scene.geometry()
+    if isinstance(geometry, Compound):
+        for k, part in enumerate(geometry.parts, 1):
+            runs[f"component {k} alone"] = (plain.with_geometry(part), False)
+    elif scene.mokrs is None:
+        runs["compound of 1"] = (plain.with_geometry(Compound((geometry,))), False)
     return runs
 
 
@@ -65,6 +75,12 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5,
                  ratio_to_plain=med[name] / med["plain"],
                  incremental=med[name] / med["plain"] - 1.0)
             for name, (s, uber) in runs.items()]
+    alone = [med[name] for name in runs if name.startswith("component ")]
+    if alone:
+        rows.append(dict(variant="components alone, summed", effects="none",
+                         all_effects_compiled=False, ms=sum(alone) * 1e3,
+                         ratio_to_plain=sum(alone) / med["plain"],
+                         incremental=sum(alone) / med["plain"] - 1.0))
     print(f"\nEffect costs — {scene.name}, {w}×{h}, {scene.render.tracer} tracing, median of "
           f"{rounds} interleaved rounds (ratios to plain = no effect, specialised)\n")
     print("| variant | effects | ms/frame | × plain | incremental cost |")
