@@ -323,3 +323,21 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     v.open_preset(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error
+
+
+def test_compound_preset_flies_and_the_levels_slider_cuts_every_component(viewer):
+    v = viewer
+    v.open_preset(resolve("grove"))
+    assert v.error == "" and len(v.geometry.parts) == 8
+    settle(v)
+    full = v.read_window()
+    background = np.round(np.array(v.scene.material.background) ** (1 / 2.2) * 255)
+    assert (np.abs(full - background).max(-1) > 8).mean() > 0.02, "nothing drawn"
+    v.set_levels(4)
+    assert [p.depth for p in v.krs.parts] == [4] * 7 + [1]
+    settle(v)
+    assert (np.abs(v.read_window().astype(int) - full).max(-1) > 30).mean() > 0.01
+    assert 0 < v.nearest_distance() < 1e3
+    hold(v, "W", 3)
+    settle(v)
+    assert np.isfinite(v.camera.position).all()
