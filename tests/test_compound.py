@@ -15,7 +15,8 @@ from krsview.gpu.program import Source
 from krsview.gpu.uniforms import variant_defines
 from krsview.reference import compile_krs, distance, render_reference
 from krsview.reference.geometry import compile_geometry
-from krsview.scene import Compound, SceneError, Tree, scene_from_toml, scene_to_toml
+from krsview.scene import (Compound, EffectSettings, EmptyZone, SceneError, Tree,
+                           scene_from_toml, scene_to_toml)
 from krsview.scene.compound import Placement
 
 from .conftest import HIT_AGREEMENT, assert_finite, check_against_reference
@@ -88,12 +89,25 @@ def test_compound_is_the_nearest_of_its_components(tracer):
     assert same[hit].mean() > 0.99, f"colour of the nearest component on {same[hit].mean():.2%}"
 
 
-@pytest.mark.parametrize("tracer", ["sphere", "binary"])
-def test_gpu_compound_matches_reference(renderer, tracer):
-    s = compound_scene(tracer)
+DISTORTED = EffectSettings(twist=12.0, empty_zones=[EmptyZone((-1.2, 2.2, 0.0), 0.8)])
+
+
+@pytest.mark.parametrize("tracer, effects", [
+    ("sphere", []), ("binary", []),
+    ("sphere", ["twist", "empty_zones"]),
+    ("sphere", ["smooth_shading", "kernel_texture", "ambient_occlusion"]),
+], ids=lambda v: "+".join(v) if isinstance(v, list) else v)
+def test_gpu_compound_matches_reference(renderer, tracer, effects):
+    """Both tracers, and effects that act per component (distortions, nearest-kernel
+    shading) or on the whole compound (AO samples the least distance)."""
+    s = replace(compound_scene(tracer), effects=effects, effect_settings=DISTORTED)
     gpu = renderer.render(s, W, H)
     assert_finite(gpu, CAP)
-    check_against_reference(f"compound-{tracer}", gpu, render_reference(s, W, H))
+    ref = render_reference(s, W, H)
+    if effects:
+        assert np.mean(np.abs(ref.color - render_reference(compound_scene(), W, H).color)
+                       .max(-1) > 0.02) > 0.01, "the effects changed nothing"
+    check_against_reference(f"compound-{tracer}-{'+'.join(effects)}", gpu, ref)
 
 
 def test_gpu_compound_is_the_nearest_of_its_components(renderer):
