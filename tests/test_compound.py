@@ -162,7 +162,7 @@ def test_placement_moves_the_distance_as_a_similarity(tree, place, seed):
     x = np.random.default_rng(seed).normal(0.0, 2.0, (64, 3))
     krs = tree.krs()
     moved = place.krs(krs)
-    y = x @ place.matrix().T + np.array(place.position)
+    y = x @ place.linear.T + np.array(place.position)
     got = distance(compile_krs(moved, (1, 1, 1)), y)
     want = place.scale * distance(compile_krs(krs, (1, 1, 1)), x)
     np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * place.scale * (1 + abs(y).max()))

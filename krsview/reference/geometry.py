@@ -43,15 +43,6 @@ def scene_distance(c: CompiledKRS | CompiledCompound, x: np.ndarray,
     return D if dist is None else dist.distance(x, D)
 
 
-def is_unbounding(c: Compiled, center: np.ndarray, radius: np.ndarray,
-                  dist: Distortion | None = None) -> np.ndarray:
-    """Whether each ball is free of geometry: Alg. 3 for a MöKRS; for a KRS the distance
-    bound at the centre is at least the radius."""
-    if isinstance(c, mokrs.CompiledMoKRS):
-        return mokrs.is_unbounding(c, center, radius)
-    return scene_distance(c, center, dist) >= radius
-
-
 def component_distances(c: CompiledKRS | CompiledCompound, dist: Distortion | None
                         ) -> list[Distance]:
     """One distance bound per component, for the sphere tracer's free distances."""
@@ -99,5 +90,5 @@ def free_radius(c: Compiled, x: np.ndarray) -> float:
     Used by the viewer to scale flying speed."""
     if not isinstance(c, mokrs.CompiledMoKRS):
         return abs(float(scene_distance(c, x[None])[0]))
-    free = is_unbounding(c, np.broadcast_to(x, (len(FREE_RADII), 3)), FREE_RADII)
+    free = mokrs.is_unbounding(c, np.broadcast_to(x, (len(FREE_RADII), 3)), FREE_RADII)
     return float(FREE_RADII[free].max()) if free.any() else 0.0

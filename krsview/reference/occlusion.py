@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scene import Render
-from .trace import INITIAL_PROBE, Distance, Test, by_component
+from .trace import INITIAL_PROBE, Distance, Test, by_component, front
 
 SHADOW_OFFSET = 2.0
 AO_SAMPLES = 5
@@ -28,10 +28,7 @@ def shadow_by_distance(distances: list[Distance], o: np.ndarray, l: np.ndarray,
     vis, tc = np.ones(N), np.zeros((N, len(distances)))
     live = np.arange(N)
     for _ in range(r.max_iterations):
-        c = tc[live].argmin(axis=1)
-        tl = tc[live, c]
-        keep = tl <= r.max_distance
-        live, c, tl = live[keep], c[keep], tl[keep]
+        live, c, tl = front(tc, live, r.max_distance)
         if live.size == 0:
             break
         d = by_component(distances, c, o[live] + tl[:, None] * l)

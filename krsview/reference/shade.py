@@ -7,9 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import Scene
-from . import atmosphere, occlusion, texture
+from . import atmosphere, mokrs, occlusion, texture
 from .distortion import Distortion
-from .geometry import Compiled, component_distances, is_unbounding, scene_distance
+from .geometry import Compiled, component_distances, scene_distance
 from .mokrs import CompiledMoKRS
 
 GAMMA = 2.2
@@ -75,7 +75,7 @@ def shade(scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint
             o = h.p[lit] + occlusion.SHADOW_OFFSET * eps[lit, None] * h.normal[lit]
             k = fx.shadow_softness if soft else None
             if isinstance(c, CompiledMoKRS):
-                vis = occlusion.shadow_by_probes(lambda x, s: is_unbounding(c, x, s), o, l,
+                vis = occlusion.shadow_by_probes(lambda x, s: mokrs.is_unbounding(c, x, s), o, l,
                                                  eps[lit], scene.render, k)
             else:
                 vis = occlusion.shadow_by_distance(component_distances(c, dist), o, l,  # type: ignore[arg-type]

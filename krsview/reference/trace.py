@@ -17,7 +17,7 @@ INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 
 @dataclass
 class Trace:
     hit: np.ndarray         # bool (N,)
-    t: np.ndarray           # ray distance at termination (N,)
+    t: np.ndarray           # ray distance where the ray converged (N,); meaningless on a miss
     iterations: np.ndarray  # distance evaluations (N,)
 
 
@@ -40,6 +40,18 @@ def by_component(fns: list, c: np.ndarray, *args: np.ndarray) -> np.ndarray:
     return out
 
 
+def front(tc: np.ndarray, rays: np.ndarray, max_distance: float
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """On each of ``rays``, the component with the least free distance in ``tc`` (N, C)
+    (ties: the first, as front() in trace.glsl) and that distance; a ray whose least free
+    distance is past max_distance has left every component and is dropped.
+    Returns (rays still tracing, their component, their free distance)."""
+    c = tc[rays].argmin(axis=1)
+    t = tc[rays, c]
+    live = t <= max_distance
+    return rays[live], c[live], t[live]
+
+
 def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray,
                  eps_per_t: float, max_iterations: int, max_distance: float) -> Trace:
     """Sphere tracing of the components' distance bounds (points (N, 3) → (N,)), each with
@@ -54,13 +66,10 @@ def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray
     iters = np.zeros(N, dtype=np.int64)
     active = np.arange(N)
     for _ in range(max_iterations):
-        c = tc[active].argmin(axis=1)
-        t[active] = tc[active, c]
-        live = t[active] <= max_distance
-        active, c = active[live], c[live]
+        active, c, ta = front(tc, active, max_distance)
         if active.size == 0:
             break
-        ta = t[active]
+        t[active] = ta
         d = by_component(distances, c, origin + ta[:, None] * dirs[active])
         iters[active] += 1
         converged = d <= eps_per_t * ta
@@ -90,13 +99,10 @@ def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_pe
     iters = np.zeros(N, dtype=np.int64)
     active = np.arange(N)
     for _ in range(max_iterations):
-        c = tc[active].argmin(axis=1)
-        t[active] = tc[active, c]
-        live = t[active] <= max_distance
-        active, c = active[live], c[live]
+        active, c, ta = front(tc, active, max_distance)
         if active.size == 0:
             break
-        ta, sa = t[active], sc[active, c]
+        t[active], sa = ta, sc[active, c]
         free = by_component(tests, c, origin + (ta + sa)[:, None] * dirs[active], sa)
         iters[active] += 1
         converged = ~free & (sa <= eps_per_t * ta)

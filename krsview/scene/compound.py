@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -30,7 +31,8 @@ class Placement:
     angle: float  # degrees
     scale: float
 
-    def matrix(self) -> np.ndarray:
+    @cached_property
+    def linear(self) -> np.ndarray:
         """scale · R, by Rodrigues' formula."""
         k = np.array(self.axis, dtype=float)
         a = math.radians(self.angle)
@@ -38,11 +40,11 @@ class Placement:
         return self.scale * (np.eye(3) + math.sin(a) * K + (1 - math.cos(a)) * K @ K)
 
     def point(self, p: Vec3) -> Vec3:
-        return as_vec3(self.matrix() @ np.array(p) + np.array(self.position))
+        return as_vec3(self.linear @ np.array(p) + np.array(self.position))
 
     def plane(self, u: Vec3, w: float) -> tuple[Vec3, float]:
         """The plane u·x = w moved: normal R u (still unit), offset scale·w + R u · position."""
-        ru = self.matrix() @ np.array(u) / self.scale
+        ru = self.linear @ np.array(u) / self.scale
         return as_vec3(ru / np.linalg.norm(ru)), float(self.scale * w + ru @ np.array(self.position))
 
     def kernel(self, k: Kernel) -> Kernel:

@@ -67,6 +67,19 @@ bool is_unbounding(int c, vec3 center, float radius) {
     return component_distance(c, center) >= radius;
 }
 
+// The component nearest to the undistorted point q (ties: the first).
+int nearest_component(vec3 q) {
+    int win = 0;
+#ifdef KRS_COMPOUND
+    float best = undistorted_distance(0, q);
+    for (int c = 1; c < COMPONENTS; ++c) {
+        float d = undistorted_distance(c, q);
+        if (d < best) { best = d; win = c; }
+    }
+#endif
+    return win;
+}
+
 // Nearest kernel's level slot, its kernel-space point and the world normal at the hit point
 // p, whose ray distance t sets the smoothing band (at least 2 pixel footprints, against
 // aliasing). In a compound, the component nearest to p is asked (ties: the first).
@@ -76,13 +89,7 @@ void scene_nearest(vec3 p, float t, out int level, out vec3 normal, out vec3 xk)
 #ifdef KRS_SMOOTH_SHADING
     width = max(u_smooth_width, 2.0 * u_footprint * t);
 #endif
-    int win = 0;
-    float best = undistorted_distance(0, q);
-    for (int c = 1; c < COMPONENTS; ++c) {
-        float d = undistorted_distance(c, q);
-        if (d < best) { best = d; win = c; }
-    }
-    ivec2 k = component(win);
+    ivec2 k = component(nearest_component(q));
     float D = krs_nearest(k.x, k.y, q, width, level, normal, xk);
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) normal = twist_normal(p, q, normal);
