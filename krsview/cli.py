@@ -143,14 +143,17 @@ def cmd_check(args: argparse.Namespace) -> int:
               f"{sum(lv.reflect for lv in scene.mokrs.levels)} reflecting")
     elif scene.compound:
         print(f"  geometry        compound of {len(scene.compound)}: " + ", ".join(
-            f"{'tree' if c.tree else 'KRS'} of {p.depth} levels"
+            f"{'tree' if c.tree else 'route' if c.route else 'KRS'} of {p.depth} levels"
             for c, p in zip(scene.compound, krs.parts)))
     else:
-        print(f"  geometry        {'tree (grown)' if scene.tree else 'explicit KRS'}")
+        kind = "tree (grown)" if scene.tree else "tree (route)" if scene.route else "explicit KRS"
+        print(f"  geometry        {kind}")
         print(f"  levels          {krs.depth} (kernels K_0..K_{krs.n}, {krs.n} mirrors)")
     print(f"  kernel instances {krs.instance_count():,}")
     print("  kernels         " + ", ".join(f"{v}× {k}" for k, v in sorted(kinds.items())))
     print(f"  effects         {', '.join(scene.effects) or 'none'}")
+    for w in scene.route.warnings() if scene.route else []:
+        print(f"  warning         route.{w}")
     r = scene.render
     binary = f" (ξ_bonus {r.xi_bonus}, ξ_penalty {r.xi_penalty})" if r.tracer == "binary" else ""
     print(f"  render          {r.tracer} tracer{binary}, ε-scale {r.epsilon_scale}, "

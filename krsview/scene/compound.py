@@ -16,6 +16,7 @@ import numpy as np
 from .model import KRS, MAX_LEVELS, Capsule, Empty, Kernel, Level, Mirror, Plane, Sphere, \
     ToroidalCapsule
 from .schema import SceneError, Vec3, param
+from .route import Route
 from .tree import Tree, as_vec3
 
 MAX_COMPONENTS = 8  # [KRS17 §8.3]: "compound of eight KRSs"
@@ -75,6 +76,7 @@ class Component:
     ``axis``, scaled, then moved to ``position``."""
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
+    route: Route | None = param(None, help="a tree given by its route (instead of krs)")
     position: Vec3 = param((0.0, 0.0, 0.0), help="where the component's origin goes")
     axis: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="rotation axis")
     angle: float = param(0.0, lo=-360.0, hi=360.0, unit="degrees",
@@ -82,16 +84,17 @@ class Component:
     scale: float = param(1.0, lo=1e-3, hi=1e3, help="uniform scale, applied before the move")
 
     def validate(self, path: str) -> None:
-        given = [k for k in ("krs", "tree") if getattr(self, k) is not None]
+        given = [k for k in ("krs", "tree", "route") if getattr(self, k) is not None]
         if len(given) != 1:
-            raise SceneError(f"{path}.krs / {path}.tree",
+            raise SceneError(f"{path}.krs / {path}.tree / {path}.route",
                              "<" + (" and ".join(given) or "none") + ">",
-                             "a compound component has exactly one geometry: a krs or a tree "
-                             "table (a MöKRS cannot join a compound: it has no distance)")
+                             "a compound component has exactly one geometry: a krs, tree or "
+                             "route table (a MöKRS cannot join a compound: it has no distance)")
 
     def placed(self) -> KRS:
         """The component's KRS in world space."""
-        krs = self.tree.krs() if self.tree is not None else self.krs
+        source = self.tree or self.route
+        krs = source.krs() if source is not None else self.krs
         assert krs is not None
         return Placement(self.position, self.axis, self.angle, self.scale).krs(krs)
 

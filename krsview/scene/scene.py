@@ -14,10 +14,12 @@ from .model import KRS, Camera, Light, Material, Render
 from .mokrs import MoKRS, check_view
 from .schema import SceneError, from_dict, param, to_dict
 from .toml_writer import dumps
+from .route import Route
 from .tree import Tree
 
 
 Geometry = KRS | MoKRS | Compound
+GEOMETRY_KEYS = ("krs", "tree", "route", "mokrs", "compound")  # a scene has exactly one
 
 
 @dataclass(frozen=True)
@@ -40,19 +42,20 @@ class Scene:
     effect_settings: EffectSettings = param(EffectSettings())
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
+    route: Route | None = param(None, help="a tree given by its route: forks, control "
+                                "points, widths, fork mirrors (the editor's form of a tree)")
     mokrs: MoKRS | None = param(None, help="Möbius kernel–reflection sequence (instead of krs)")
     compound: list[Component] = param([], help="up to 8 placed KRSs or trees, drawn as one "
                                       "scene (instead of krs) [KRS17 §5.1]")
     bookmarks: list[Bookmark] = param([], help="saved cameras")
 
     def validate(self, path: str) -> None:
-        given = [k for k in ("krs", "tree", "mokrs") if getattr(self, k) is not None]
-        given += ["compound"] if self.compound else []
+        given = [k for k in GEOMETRY_KEYS if getattr(self, k)]
         if len(given) != 1:
-            raise SceneError("krs / tree / mokrs / compound",
+            raise SceneError(" / ".join(GEOMETRY_KEYS),
                              "<" + (" and ".join(given) or "none") + ">",
-                             "a scene has exactly one geometry: a [krs], [tree] or [mokrs] "
-                             "table, or a [[compound]] list")
+                             "a scene has exactly one geometry: a [krs], [tree], [route] or "
+                             "[mokrs] table, or a [[compound]] list")
         check_compound(self.compound)
         if len(self.lights) > 4:
             raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
@@ -76,12 +79,14 @@ class Scene:
         compound's components placed in the world [KRS17 §5.1]."""
         if self.tree is not None:
             return self.tree.krs()
+        if self.route is not None:
+            return self.route.krs()
         if self.compound:
             return Compound(tuple(c.placed() for c in self.compound))
         return self.krs if self.krs is not None else self.mokrs  # type: ignore[return-value]
 
     def with_geometry(self, geometry: Geometry) -> "Scene":
-        none = dict(krs=None, tree=None, mokrs=None, compound=[])
+        none = dict(krs=None, tree=None, route=None, mokrs=None, compound=[])
         if isinstance(geometry, MoKRS):
             return replace(self, **{**none, "mokrs": geometry})
         if isinstance(geometry, Compound):

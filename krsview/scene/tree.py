@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import KRS, Empty, Level, Mirror, Plane, ToroidalCapsule, _COLOR
+from .model import KRS, Mirror, Plane, _COLOR
+from .route import Route, RouteLevel
 from .schema import SceneError, Vec3, param
 
 
@@ -48,7 +49,12 @@ class Tree:
                              "the last forest level: add at least one forest mirror")
 
     def krs(self) -> KRS:
-        """Grow the route and turn it into KRS levels (level 0 = twig tip, level n = trunk)."""
+        """Grow the route and expand it into KRS levels (level 0 = twig tip, level n = trunk)."""
+        return self.route().krs()
+
+    def route(self) -> Route:
+        """Bake the growth parameters into a route: fork points, control points, radii,
+        colours and fork mirror normals, each then editable [KRS17 §9.2]."""
         n = self.levels
         theta = math.radians(self.branch_angle)
         up = np.array(self.up)
@@ -56,34 +62,27 @@ class Tree:
         s = perpendicular(d)                           # in-plane side vector, ⟂ d
         P = np.array(self.base, dtype=float)            # fork P_{i+1}: where K_i starts
         length, radius = self.trunk_length, self.trunk_radius
-        kernels: list[ToroidalCapsule] = []
-        mirrors: list[Mirror] = []
+        entries: list[RouteLevel] = []
         for i in range(n, -1, -1):
             end = P + length * d
             side = up - (up @ d) * d
             side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-6 else np.zeros(3)
             control = P + 0.5 * length * d + self.bend * length * side
             color = self.leaf if i < self.leaf_levels else self.bark
-            kernels.append(ToroidalCapsule(as_vec3(P), as_vec3(control), as_vec3(end), radius, color))
             if i == 0:
+                entries.append(RouteLevel(as_vec3(end), as_vec3(control), radius, color))
                 break
             # Mirror R_{i-1} through the fork P_i = end, containing the parent direction.
             u = _rotate(s, d, math.radians(self.divergence))
-            mirrors.append(Mirror(as_vec3(u), float(u @ end)))
+            entries.append(RouteLevel(as_vec3(end), as_vec3(control), radius, color, as_vec3(u)))
             d_child = math.cos(theta) * d - math.sin(theta) * u   # child on the negative side
             s = math.sin(theta) * d + math.cos(theta) * u
             d, P = d_child / np.linalg.norm(d_child), end
             length *= self.length_ratio
             radius *= self.radius_ratio
-        kernels.reverse()
-        mirrors.reverse()
-        levels = [Level(kernels[0], None)] + [Level(k, m) for k, m in zip(kernels[1:], mirrors)]
-        for i, m in enumerate(self.forest):
-            last = i == len(self.forest) - 1
-            k = (Plane(as_vec3(up), float(up @ np.array(self.base)), self.ground)
-                 if last and self.ground is not None else Empty())
-            levels.append(Level(k, m))
-        return KRS(levels)
+        ground = (Plane(as_vec3(up), float(up @ np.array(self.base)), self.ground)
+                  if self.ground is not None else None)
+        return Route(self.base, entries[::-1], list(self.forest), ground)
 
 
 def as_vec3(v: np.ndarray | tuple) -> Vec3:

@@ -1,0 +1,191 @@
+"""The document: the one seam through which every scene change passes (DESIGN.md).
+
+It owns the scene, its file, the undo history and the saved version. A drag, a panel field,
+an effect toggle, a render knob, a bookmark or a reload from disk is an edit applied here:
+validated by the scene schema first (a bad value leaves the last valid scene in place), then
+recorded for undo. Saves are atomic; while there are unsaved edits a recovery file beside the
+scene is rewritten every few seconds, and a file changed on disk is never overwritten
+silently.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Hashable
+
+from ..scene import Scene, SceneError, load_scene, scene_to_toml
+from ..scene.edits import Path as EditPath, apply_edit, path_text, validated
+from ..scene.scene import write_atomic
+from .history import History, Step
+
+AUTOSAVE_SECONDS = 3.0    # a crash loses at most this much work
+RECOVERY_SUFFIX = ".recovery"
+
+
+class ConflictError(RuntimeError):
+    """The file changed on disk since it was loaded or saved here; saving would overwrite it."""
+
+
+@dataclass(frozen=True)
+class Stamp:
+    """What a file looked like when we last read or wrote it."""
+    mtime_ns: int
+    size: int
+
+    @staticmethod
+    def of(path: Path) -> "Stamp | None":
+        try:
+            st = path.stat()
+        except OSError:
+            return None
+        return Stamp(st.st_mtime_ns, st.st_size)
+
+
+class Document:
+    def __init__(self, path: str | os.PathLike):
+        self.path = Path(path)
+        self._scene = load_scene(self.path)       # a bad file is a SceneError, nothing opened
+        self.saved = self._scene                   # the version on disk
+        self.saved_text = scene_to_toml(self._scene)
+        self.stamp = Stamp.of(self.path)
+        self.history = History()
+        self.version = 0                           # bumps on every change: views redraw
+        self._autosaved: Scene | None = None
+        self._autosave_clock: float | None = None
+
+    # ----------------------------------------------------------------------------- state
+    @property
+    def scene(self) -> Scene:
+        return self._scene
+
+    @property
+    def dirty(self) -> bool:
+        """Unsaved edits: the scene differs from the saved version (undoing back to it is clean)."""
+        return self._scene != self.saved
+
+    @property
+    def title(self) -> str:
+        return f"{'● ' if self.dirty else ''}{self.path.name} — {self._scene.name}"
+
+    def _set(self, scene: Scene) -> None:
+        self._scene = scene
+        self.version += 1
+
+    # ----------------------------------------------------------------------------- edits
+    def apply(self, path: EditPath, value: Any, interaction: Hashable | None = None,
+              label: str | None = None) -> None:
+        """Set the field at ``path``; one undo step (merged with the previous one when both
+        come from the same ``interaction``). A SceneError leaves everything unchanged."""
+        scene = apply_edit(self._scene, path, value)
+        self.commit(scene, label or f"set {path_text(path)}", interaction)
+
+    def commit(self, scene: Scene, label: str, interaction: Hashable | None = None) -> None:
+        """Make ``scene`` (already valid) the document's scene, as one undo step."""
+        if scene == self._scene:
+            return
+        self.history.push(Step(label, self._scene, scene, interaction))
+        self._set(scene)
+
+    def replace_scene(self, scene: Scene, label: str) -> None:
+        """A whole new scene (restoring a recovery, a bake): validated, one undo step."""
+        self.commit(validated(scene), label)
+
+    def undo(self) -> bool:
+        scene = self.history.undo()
+        if scene is not None:
+            self._set(scene)
+        return scene is not None
+
+    def redo(self) -> bool:
+        scene = self.history.redo()
+        if scene is not None:
+            self._set(scene)
+        return scene is not None
+
+    # ------------------------------------------------------------------------------ disk
+    def changed_on_disk(self) -> bool:
+        """The file is not what we last read or wrote (another program edited it)."""
+        stamp = Stamp.of(self.path)
+        if stamp == self.stamp:
+            return False
+        try:
+            return self.path.read_text(encoding="utf-8") != self.saved_text
+        except (OSError, UnicodeDecodeError):
+            return True
+
+    def reload(self) -> None:
+        """Take the file's new contents as the saved version (an undoable step). Raises
+        SceneError for a bad file, keeping the current scene."""
+        scene = load_scene(self.path)
+        self.commit(scene, f"reload {self.path.name}")
+        self._mark_saved(scene)
+
+    def save(self, path: str | os.PathLike | None = None, overwrite: bool = False) -> Path:
+        """Write the scene atomically (to ``path``: save as). Refuses, with ConflictError, to
+        overwrite a file changed on disk since we read it, unless ``overwrite``."""
+        target = Path(path) if path is not None else self.path
+        if target == self.path and not overwrite and self.changed_on_disk():
+            raise ConflictError(f"{self.path} changed on disk since it was opened here; "
+                                "reload it (your edits stay undoable) or overwrite it")
+        try:
+            write_atomic(target, scene_to_toml(self._scene))
+        except OSError as e:
+            raise SceneError("<file>", str(target), f"cannot save: {e.strerror}") from None
+        old_recovery = self.recovery_path
+        self.path = target
+        self._mark_saved(self._scene)
+        old_recovery.unlink(missing_ok=True)
+        self.recovery_path.unlink(missing_ok=True)
+        self.version += 1
+        return target
+
+    def _mark_saved(self, scene: Scene) -> None:
+        self.saved, self.saved_text = scene, scene_to_toml(scene)
+        self.stamp = Stamp.of(self.path)
+
+    # -------------------------------------------------------------------------- recovery
+    @property
+    def recovery_path(self) -> Path:
+        """Beside the scene: ``NAME.toml.recovery`` (not a ``.toml``, so never a preset)."""
+        return self.path.with_name(self.path.name + RECOVERY_SUFFIX)
+
+    def autosave(self, now: float) -> bool:
+        """Call every event-loop turn: while dirty, rewrite the recovery file at most every
+        AUTOSAVE_SECONDS (atomic); when clean, there is none. Returns True when it wrote."""
+        if not self.dirty:
+            if self._autosaved is not None:
+                self.recovery_path.unlink(missing_ok=True)
+                self._autosaved = None
+            self._autosave_clock = None
+            return False
+        if self._autosave_clock is None:
+            self._autosave_clock = now           # first unsaved edit: start the interval
+        if self._scene == self._autosaved or now - self._autosave_clock < AUTOSAVE_SECONDS:
+            return False
+        try:
+            write_atomic(self.recovery_path, scene_to_toml(self._scene))
+        except OSError:
+            return False                          # a read-only folder: editing goes on
+        self._autosaved, self._autosave_clock = self._scene, now
+        return True
+
+    def recovery(self) -> Scene | None:
+        """The autosaved scene, if a recovery file newer than the scene file holds one that
+        differs from it (a crash left unsaved edits); None otherwise."""
+        rec = Stamp.of(self.recovery_path)
+        if rec is None or (self.stamp is not None and rec.mtime_ns < self.stamp.mtime_ns):
+            return None
+        try:
+            scene = load_scene(self.recovery_path)
+        except SceneError:
+            return None
+        return None if scene == self._scene else scene
+
+    def restore_recovery(self) -> None:
+        scene = self.recovery()
+        if scene is not None:
+            self.replace_scene(scene, "restore unsaved edits")
+
+    def discard_recovery(self) -> None:
+        self.recovery_path.unlink(missing_ok=True)

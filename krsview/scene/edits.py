@@ -1,0 +1,70 @@
+"""Edits as data: a path into the scene's dataclass tree and a new value, applied as a pure
+"replace at path" and validated by the same schema that reads files, so an edit from the
+editor is held to exactly the rules of a scene file (DESIGN.md, One seam for edits).
+
+A path is a tuple of field names and list indices, e.g. ``("route", "levels", 3, "fork")``;
+it prints as ``route.levels[3].fork``, the form scene-file errors use.
+"""
+from __future__ import annotations
+
+from dataclasses import fields, is_dataclass, replace
+from typing import Any
+
+from .scene import Scene
+from .schema import SceneError, from_dict, to_dict
+
+Path = tuple[str | int, ...]
+
+
+def path_text(path: Path) -> str:
+    out = ""
+    for key in path:
+        out += f"[{key}]" if isinstance(key, int) else (f".{key}" if out else key)
+    return out or "<scene>"
+
+
+def get_at(obj: Any, path: Path) -> Any:
+    for key in path:
+        obj = obj[key] if isinstance(key, int) else getattr(obj, key)
+    return obj
+
+
+def replace_at(obj: Any, path: Path, value: Any) -> Any:
+    """A copy of ``obj`` with the value at ``path`` replaced; everything else is shared."""
+    if not path:
+        return value
+    key, rest = path[0], path[1:]
+    if isinstance(key, int):
+        items = list(obj)
+        items[key] = replace_at(items[key], rest, value)
+        return type(obj)(items)
+    if not (is_dataclass(obj) and key in {f.name for f in fields(obj)}):
+        raise KeyError(f"no field {key!r} in {type(obj).__name__}")
+    return replace(obj, **{key: replace_at(getattr(obj, key), rest, value)})
+
+
+def validated(scene: Scene) -> Scene:
+    """The scene as a file holding it would load: every field checked and normalised (unit
+    vectors), or a SceneError naming the field. Values already valid come back bit-exact."""
+    return from_dict(Scene, to_dict(scene))
+
+
+def apply_edit(scene: Scene, path: Path, value: Any) -> Scene:
+    """Replace the value at ``path`` and validate the result; a SceneError leaves nothing
+    changed (the caller keeps its last valid scene)."""
+    try:
+        return validated(replace_at(scene, path, value))
+    except (KeyError, IndexError, TypeError) as e:
+        raise SceneError(path_text(path), value, f"not a field of this scene ({e})") from None
+
+
+def field_meta(scene: Scene, path: Path) -> dict:
+    """The schema metadata (range, unit, help) of the field at ``path`` (the last name on it)."""
+    names = [k for k in path if isinstance(k, str)]
+    if not names:
+        return {}
+    owner = get_at(scene, path[:max(i for i, k in enumerate(path) if isinstance(k, str))])
+    for f in fields(owner) if is_dataclass(owner) else ():
+        if f.name == names[-1]:
+            return dict(f.metadata)
+    return {}

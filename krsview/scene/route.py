@@ -1,0 +1,127 @@
+"""A tree given by its route [KRS17 §9.2]: the modelling parameters an editor moves.
+
+"Forking positions along one route from the trunk to a twig end must be given. Branches along
+this route are the kernels. Then, a control point on every such branch can be moved to set
+curvature. […] Branch width gives the section radius. Planes of reflection must be placed at
+forking positions, with editable normals."
+
+Entry i of ``levels`` (0: the twig, last: the trunk) is kernel K_i, the branch from the fork
+below it (entry i + 1's ``fork``, or ``base`` for the trunk) to its own ``fork`` P_i, bent
+through ``control``. For i ≥ 1 the entry's ``normal`` is mirror R_{i−1}; its offset follows
+from the fork it must pass through (w = u·P_i), so L_{i−1} and its mirror image both grow
+from P_i. A growth ``[tree]`` bakes into a route (:meth:`Tree.route`) that expands into
+exactly the same KRS.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model import (KRS, MAX_LEVELS, Empty, Kernel, Level, Mirror, ToroidalCapsule, _COLOR,
+                    arc_of)
+from .schema import SceneError, Vec3, param
+
+FORK_SEPARATION = 1e-9   # forks closer than this × the route's size are "on top of each other"
+CLIP_TOLERANCE = 0.5     # × a child's radius: a shallower crossing stays inside the fork joint
+ARC_SAMPLES = 17         # points along a branch checked against its fork's mirror
+
+
+@dataclass(frozen=True)
+class RouteLevel:
+    """One fork of the route and the branch that ends there."""
+    fork: Vec3 = param((0.0, 1.0, 0.0), help="fork point P_i where this branch ends "
+                       "(the twig tip for level 0)")
+    control: Vec3 = param((0.0, 0.5, 0.0), help="point the branch's arc passes through "
+                          "(on the chord: a straight branch)")
+    radius: float = param(0.05, lo=0.0, lo_open=True, hi=1e6, help="branch section radius")
+    color: Vec3 | None = param(None, **_COLOR)
+    normal: Vec3 | None = param(None, unit_vector="normalise",
+                                help="normal of the mirror through this fork (not on level 0)")
+
+
+@dataclass(frozen=True)
+class Route:
+    """Fork points, control points, widths and fork mirrors from twig to trunk."""
+    base: Vec3 = param((0.0, 0.0, 0.0), help="foot of the trunk (where the last level starts)")
+    levels: list[RouteLevel] = param([], help="level 0 (the twig) first, the trunk last")
+    forest: list[Mirror] = param([], help="extra reflections above the trunk, with empty "
+                                 "kernels: 2^k trees from one [KRS17 §9.2]")
+    ground: Kernel | None = param(None, help="kernel of the last forest level: a ground plane, "
+                                  "say")
+
+    def validate(self, path: str) -> None:
+        p = f"{path}.levels"
+        if not self.levels:
+            raise SceneError(p, [], "a route needs at least one level (the trunk)")
+        if len(self.levels) + len(self.forest) > MAX_LEVELS:
+            raise SceneError(p, f"<{len(self.levels)} levels, {len(self.forest)} forest>",
+                             f"levels + forest mirrors must be ≤ {MAX_LEVELS}")
+        if self.levels[0].normal is not None:
+            raise SceneError(f"{p}[0].normal", list(self.levels[0].normal),
+                             "level 0 is the twig: no mirror forks there; remove the normal")
+        for i, lv in enumerate(self.levels[1:], 1):
+            if lv.normal is None:
+                raise SceneError(f"{p}[{i}].normal", "<missing>",
+                                 "every level above 0 needs the normal of its fork's mirror")
+        size = max(float(np.ptp(np.array(self.forks()), axis=0).max()), 1.0)
+        for i, (start, lv) in enumerate(zip(self.starts(), self.levels)):
+            if np.linalg.norm(np.subtract(lv.fork, start)) <= FORK_SEPARATION * size:
+                below = "base" if i == len(self.levels) - 1 else f"levels[{i + 1}].fork"
+                raise SceneError(f"{p}[{i}].fork", list(lv.fork),
+                                 f"must differ from {below} (a branch needs a length)")
+        if self.ground is not None and not self.forest:
+            raise SceneError(f"{path}.ground", "<kernel>", "the ground is the kernel of the "
+                             "last forest level: add at least one forest mirror")
+
+    def forks(self) -> list[Vec3]:
+        return [self.base] + [lv.fork for lv in self.levels]
+
+    def starts(self) -> list[Vec3]:
+        """Where each level's branch starts: the fork of the level above, the base for the trunk."""
+        return [lv.fork for lv in self.levels[1:]] + [self.base]
+
+    def mirror(self, i: int) -> Mirror:
+        """Mirror R_{i−1} of level i ≥ 1: through the fork P_i, normal u, offset w = u·P_i."""
+        lv = self.levels[i]
+        u = np.array(lv.normal)
+        return Mirror(lv.normal, float(u @ np.array(lv.fork)))  # type: ignore[arg-type]
+
+    def kernel(self, i: int) -> ToroidalCapsule:
+        lv = self.levels[i]
+        return ToroidalCapsule(self.starts()[i], lv.control, lv.fork, lv.radius, lv.color)
+
+    def krs(self) -> KRS:
+        """Level i: kernel K_i (the branch ending at P_i) and, for i ≥ 1, mirror R_{i−1}."""
+        levels = [Level(self.kernel(0), None)]
+        levels += [Level(self.kernel(i), self.mirror(i)) for i in range(1, len(self.levels))]
+        for k, m in enumerate(self.forest):
+            last = k == len(self.forest) - 1
+            levels.append(Level(self.ground if last and self.ground is not None else Empty(), m))
+        return KRS(levels)
+
+    def warnings(self) -> list[str]:
+        """Where Alg. 1 clips the route: a child branch reaching across the mirror of the
+        fork it grows from is cut off there (DISTANCE folds every point into the mirror's
+        negative side [KRS14 Fig. 2]), so the drawn tree loses that part."""
+        out = []
+        for i in range(1, len(self.levels)):
+            m = self.mirror(i)
+            child = self.kernel(i - 1)
+            e = arc_points(child) @ np.array(m.normal) - m.offset
+            worst = float(e.max())
+            if worst > CLIP_TOLERANCE * child.radius:
+                out.append(f"levels[{i - 1}]: the branch crosses the mirror at its fork "
+                           f"(levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — "
+                           "turn the normal or move the branch to the mirror's negative side")
+        return out
+
+
+def arc_points(k: ToroidalCapsule, samples: int = ARC_SAMPLES) -> np.ndarray:
+    """Points along a branch's centre line, start to end (the arc, or the chord if straight)."""
+    s = np.linspace(0.0, 1.0, samples)[:, None]
+    a = arc_of(k)
+    if a is None:
+        return np.array(k.start) + s * (np.array(k.end) - np.array(k.start))
+    ang = s * a.phi
+    return np.array(a.center) + a.R * (np.cos(ang) * np.array(a.e1) + np.sin(ang) * np.array(a.e2))
