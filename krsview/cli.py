@@ -128,6 +128,16 @@ def cmd_view(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_edit(args: argparse.Namespace) -> int:
+    from .editor.app import Editor
+    editor = Editor(resolve(args.preset), size=args.size, target_fps=args.fps)
+    print(f"krsview: editing {editor.path} — click a handle, an outline entry or the tree to "
+          "select; drag the gizmo; Ctrl+Z/Ctrl+Shift+Z undo/redo, Ctrl+S save; right-drag "
+          "looks, WASD/QE fly")
+    editor.run()
+    return 0
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     path = resolve(args.preset)
     scene = load_scene(path)
@@ -252,6 +262,22 @@ def build_parser() -> argparse.ArgumentParser:
                         "(default 30)")
     v.add_argument("--no-hud", action="store_true", help="start with the HUD hidden")
     v.set_defaults(func=cmd_view)
+
+    e = sub.add_parser("edit", help="shape a tree: drag forks, control points and mirror "
+                       "normals; undo, save",
+                       description="Open PRESET in the editor. Click a handle (forks orange, "
+                                   "control points cyan, mirror normals pink), an outline entry "
+                                   "or the geometry to select; drag the gizmo to move it (Shift "
+                                   "snaps). A grown [tree] is baked into an editable route with "
+                                   "one click. Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo, "
+                                   "Ctrl+S saves atomically, Ctrl+Shift+S saves as; unsaved "
+                                   "edits are autosaved to PRESET.recovery and offered back "
+                                   "after a crash. The viewer's keys fly the camera.")
+    e.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    e.add_argument("--size", type=_size, default=(1280, 720), help="window size (default 1280x720)")
+    e.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
+                   help="frame rate held while dragging or flying (default 30)")
+    e.set_defaults(func=cmd_edit)
 
     c = sub.add_parser("check", help="validate a scene file and print its statistics",
                        description="Validate PRESET; print levels, kernel instances, effects.")

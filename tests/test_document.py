@@ -11,7 +11,6 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from krsview.editor.document import AUTOSAVE_SECONDS, ConflictError, Document
-from krsview.editor.history import MAX_STEPS
 from krsview.presets import resolve
 from krsview.scene import SceneError, load_scene, save_scene
 from krsview.scene.edits import get_at, path_text
@@ -33,7 +32,7 @@ def test_an_edit_is_validated_and_undoable(route_file):
     doc = Document(route_file)
     before = doc.scene
     doc.apply(FORK, [1.0, 5.0, 0.5])
-    assert get_at(doc.scene, FORK) == (1.0, 5.0, 0.5) and doc.dirty and doc.title.startswith("●")
+    assert get_at(doc.scene, FORK) == (1.0, 5.0, 0.5) and doc.dirty and doc.title.startswith("*")
     assert doc.scene.geometry().levels[5].kernel.end == (1.0, 5.0, 0.5)
     with pytest.raises(SceneError, match=r"route\.levels\[5\]\.radius"):
         doc.apply(("route", "levels", 5, "radius"), -1.0)
@@ -60,18 +59,22 @@ def test_one_drag_is_one_undo_step_and_two_drags_are_two(route_file):
     assert doc.scene == start and not doc.history.can_undo
 
 
-def test_history_forgets_the_oldest_steps_beyond_its_limit(route_file):
+def test_history_forgets_the_oldest_steps_beyond_its_limit(route_file, monkeypatch):
+    monkeypatch.setattr("krsview.editor.history.MAX_STEPS", 30)
     doc = Document(route_file)
-    for k in range(MAX_STEPS + 10):
+    for k in range(40):
         doc.apply(("render", "max_iterations"), 100 + k)
-    assert len(doc.history.steps) == MAX_STEPS
+    assert len(doc.history.steps) == 30
+    while doc.undo():
+        pass
+    assert doc.scene.render.max_iterations == 109, "the oldest steps were not the ones dropped"
 
 
 def test_save_is_atomic_and_clean_and_reopens_equal(route_file):
     doc = Document(route_file)
     doc.apply(FORK, [1.0, 5.0, 0.5])
     doc.save()
-    assert not doc.dirty and not doc.title.startswith("●")
+    assert not doc.dirty and not doc.title.startswith("*")
     assert load_scene(route_file) == doc.scene
     assert [p.name for p in route_file.parent.iterdir()] == ["tree.toml"], "temporary files left"
 

@@ -18,7 +18,8 @@ from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..gpu.context import GL_VERSION
 from ..reference.geometry import compile_geometry, free_radius
-from ..scene.effects import EXCLUSIVE, check_effects
+from ..editor.document import Document
+from ..scene.effects import EXCLUSIVE
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.scene import write_atomic
 from .adaptive import AdaptiveResolution, Refinement
@@ -38,10 +39,9 @@ class WindowError(RuntimeError):
 class Viewer:
     def __init__(self, path: Path, size: tuple[int, int] = (960, 540), hud: bool = True,
                  target_fps: float = 30.0, visible: bool = True, shader_dir: Path = SHADER_DIR):
-        self.path = Path(path)
         self.shader_dir = Path(shader_dir)
-        scene = load_scene(self.path)          # a bad file is a SceneError before any window
-        self.window = _open_window(size, f"krsview — {scene.name}", visible)
+        self.doc = Document(path)              # a bad file is a SceneError before any window
+        self.window = _open_window(size, self.window_title(), visible)
         self.ctx = moderngl.create_context(require=GL_VERSION)
         self.renderer = Renderer(self.ctx, self.shader_dir)
         self.display = Display(self.ctx, self.renderer.programs)
@@ -64,14 +64,27 @@ class Viewer:
         self.frame_seconds: list[float] = []
         self._stamps = self._file_stamps()
         self._last_check = time.perf_counter()
-        self._set_scene(scene, reset_camera=True)
+        self._set_scene(self.doc.scene, reset_camera=True)
         self.load_path()
         self._init_imgui()
         self._install_callbacks()
 
     # ------------------------------------------------------------------------- scene state
+    @property
+    def scene(self) -> Scene:
+        return self.doc.scene
+
+    @property
+    def path(self) -> Path:
+        return self.doc.path
+
+    def window_title(self) -> str:
+        return f"krsview — {self.doc.scene.name}"
+
     def _set_scene(self, scene: Scene, reset_camera: bool = False) -> None:
-        self.scene = scene
+        """Follow the document: a new scene version redraws (and recompiles only if its
+        variant changed: effects, tracer, geometry family)."""
+        self._seen_version = self.doc.version
         self.geometry = scene.geometry()
         self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()
@@ -79,15 +92,19 @@ class Viewer:
             self.camera = FlyCamera.from_camera(scene.camera)
         self.dirty = True
 
+    def _sync(self) -> None:
+        """Redraw when the document changed (an edit, undo, redo, reload)."""
+        if self.doc.version != self._seen_version:
+            self._set_scene(self.doc.scene)
+
     def open_preset(self, path: Path) -> None:
         """Show another scene file from its own camera; it becomes the one watched for edits."""
         try:
-            scene = load_scene(path)
+            self.doc = Document(path)
         except SceneError as e:
             self.error = str(e)
             return
-        self.path = Path(path)
-        self._set_scene(scene, reset_camera=True)
+        self._set_scene(self.doc.scene, reset_camera=True)
         self._stamps, self.error = self._file_stamps(), ""
         self.load_path()
 
@@ -102,16 +119,23 @@ class Viewer:
         self._free: tuple[np.ndarray, float] | None = None  # cached nearest_distance
         self.dirty = True
 
-    def set_render(self, **edits) -> None:
+    def edit(self, path: tuple, value, interaction=None) -> bool:
+        """Apply one edit through the document; a refused value shows its error and leaves
+        the last valid scene in place."""
+        try:
+            self.doc.apply(path, value, interaction)
+        except SceneError as e:
+            self.error = str(e)
+            return False
+        self.error = ""
+        self._sync()
+        return True
+
+    def set_render(self, interaction=None, **edits) -> None:
         """Change render settings (the HUD's knobs). Accuracy knobs are uniforms; a new tracer
         is a new shader variant, compiled once and then fetched from the cache. A MöKRS
         keeps the binary tracer (the HUD shows why another choice is refused)."""
-        try:
-            self.scene.check_tracer(edits.get("tracer", self.scene.render.tracer), "tracer")
-        except SceneError as e:
-            self.error = str(e)
-            return
-        self.scene, self.dirty = replace(self.scene, render=replace(self.scene.render, **edits)), True
+        self.edit(("render",), replace(self.scene.render, **edits), interaction)
 
     def set_effect(self, name: str, on: bool) -> None:
         """Switch an effect: a different define set, so a different (cached) variant. Turning
@@ -120,12 +144,7 @@ class Viewer:
         partners = {b if a == name else a for a, b in EXCLUSIVE if name in (a, b)}
         effects = [e for e in self.scene.effects if e != name and not (on and e in partners)]
         effects += [name] if on else []
-        try:
-            check_effects(effects, self.scene.mokrs is not None, "effect")
-        except SceneError as e:
-            self.error = str(e)
-            return
-        self.scene, self.dirty = replace(self.scene, effects=effects), True
+        self.edit(("effects",), effects)
 
     def view_scene(self) -> Scene:
         """The scene as drawn now: the viewer's camera and settings."""
@@ -149,7 +168,7 @@ class Viewer:
     def run(self) -> None:
         last = time.perf_counter()
         try:
-            while not glfw.window_should_close(self.window):
+            while not self.should_close():
                 if self.is_idle():
                     glfw.wait_events_timeout(0.05)
                 else:
@@ -159,6 +178,10 @@ class Viewer:
                 last = now
         finally:
             self.close()
+
+    def should_close(self) -> bool:
+        """The window was asked to close (the editor first asks about unsaved edits)."""
+        return bool(glfw.window_should_close(self.window))
 
     def is_idle(self) -> bool:
         return (not self.dirty and (self.refinement is None or self.refinement.done)
@@ -172,6 +195,7 @@ class Viewer:
         self._handle_input(dt)
         self._replay()
         self._hot_reload()
+        self._sync()
         self._trace()
         self._present()
         glfw.swap_buffers(self.window)
@@ -236,13 +260,17 @@ class Viewer:
             self.display.show(self.image[0], self.ctx.screen, fb, self.view,
                               self.scene.render.max_iterations, self._depth_scale())
         if self.hud:
-            from .hud import draw_hud
             imgui.backends.opengl3_new_frame()
             imgui.backends.glfw_new_frame()
             imgui.new_frame()
-            draw_hud(self)
+            self.draw_ui(fb)
             imgui.render()
             imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+    def draw_ui(self, fb: tuple[int, int]) -> None:
+        """Everything drawn over the image inside one ImGui frame: the viewer's HUD."""
+        from .hud import draw_hud
+        draw_hud(self)
 
     def _depth_scale(self) -> float:
         return max(float(np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))),
@@ -303,6 +331,16 @@ class Viewer:
                 self.save_path()
         elif action == "replay" and self.path_samples:
             self.replay_start = self.clock
+
+    def shortcut(self, key: int, shift: bool) -> None:
+        """Ctrl+key: the viewer has none; the editor's undo, redo and save."""
+
+    def mouse_claimed(self) -> bool:
+        """A press the camera must not take (the editor's gizmo is under the cursor)."""
+        return False
+
+    def left_button(self, down: bool) -> None:
+        """Left press or release on the image (the editor picks with a click)."""
 
     def path_file(self) -> Path:
         """Where the camera path of this preset is kept: beside it, ``NAME.path.json``."""
@@ -383,14 +421,19 @@ class Viewer:
             return
         preset_changed = stamps[0] != self._stamps[0]
         self._stamps = stamps
-        if preset_changed:
-            try:
-                self._set_scene(load_scene(self.path))
-                self.error, self.message = "", f"reloaded {self.path.name}"
-            except SceneError as e:
-                self.error = str(e)             # keep the last good scene and image
-        else:
+        if preset_changed and self.doc.changed_on_disk():
+            self.file_changed()
+        elif not preset_changed:
             self.reload_shaders()
+
+    def file_changed(self) -> None:
+        """The scene file changed on disk: take it (an undoable step). A viewer has no edits
+        of its own to lose; the editor asks first when it has unsaved ones."""
+        try:
+            self.doc.reload()
+            self.error, self.message = "", f"reloaded {self.path.name}"
+        except SceneError as e:
+            self.error = str(e)             # keep the last good scene and image
 
     def reload_shaders(self) -> None:
         """Compile the current variant from the edited files; on failure keep the old ones."""
@@ -433,7 +476,8 @@ class Viewer:
         b = Bookmark(f"view {len(on_disk.bookmarks) + 1}", self.camera.to_camera())
         save_scene(replace(on_disk, bookmarks=on_disk.bookmarks + [b]), self.path)
         self._stamps = self._file_stamps()      # our own save is not an outside edit
-        self.scene = replace(self.scene, bookmarks=on_disk.bookmarks + [b])
+        self.edit(("bookmarks",), on_disk.bookmarks + [b])
+        self.doc.mark_saved(replace(on_disk, bookmarks=on_disk.bookmarks + [b]))
         self.message = f"saved bookmark {b.name!r} in {self.path.name}"
 
     def read_window(self) -> np.ndarray:
@@ -458,13 +502,20 @@ class Viewer:
 
         def on_key(_w, key, scancode, action, mods):
             b.glfw_key_callback(a, key, scancode, action, mods)
-            if action != glfw.REPEAT and key in GLFW_KEYS and not imgui.get_io().want_capture_keyboard:
+            if imgui.get_io().want_capture_keyboard:
+                return                          # typing in a field
+            if action == glfw.PRESS and mods & glfw.MOD_CONTROL:
+                self.shortcut(key, bool(mods & glfw.MOD_SHIFT))
+            elif action != glfw.REPEAT and key in GLFW_KEYS:
                 self.input.key(GLFW_KEYS[key], action == glfw.PRESS)
 
         def on_button(_w, button, action, mods):
             b.glfw_mouse_button_callback(a, button, action, mods)
-            if button in GLFW_BUTTONS and (action == glfw.RELEASE or
-                                           not imgui.get_io().want_capture_mouse):
+            if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or self.mouse_claimed()):
+                return                          # the HUD's or a gizmo's press, not the camera's
+            if button == glfw.MOUSE_BUTTON_LEFT:
+                self.left_button(action == glfw.PRESS)
+            if button in GLFW_BUTTONS:
                 self.input.button(GLFW_BUTTONS[button], action == glfw.PRESS)
                 look = GLFW_BUTTONS[button] == LOOK_BUTTON
                 if look and self.orbit_pivot is None:

@@ -66,7 +66,7 @@ class Document:
 
     @property
     def title(self) -> str:
-        return f"{'● ' if self.dirty else ''}{self.path.name} — {self._scene.name}"
+        return f"{'* ' if self.dirty else ''}{self.path.name} — {self._scene.name}"
 
     def _set(self, scene: Scene) -> None:
         self._scene = scene
@@ -119,7 +119,7 @@ class Document:
         SceneError for a bad file, keeping the current scene."""
         scene = load_scene(self.path)
         self.commit(scene, f"reload {self.path.name}")
-        self._mark_saved(scene)
+        self.mark_saved(scene)
 
     def save(self, path: str | os.PathLike | None = None, overwrite: bool = False) -> Path:
         """Write the scene atomically (to ``path``: save as). Refuses, with ConflictError, to
@@ -134,13 +134,14 @@ class Document:
             raise SceneError("<file>", str(target), f"cannot save: {e.strerror}") from None
         old_recovery = self.recovery_path
         self.path = target
-        self._mark_saved(self._scene)
+        self.mark_saved(self._scene)
         old_recovery.unlink(missing_ok=True)
         self.recovery_path.unlink(missing_ok=True)
         self.version += 1
         return target
 
-    def _mark_saved(self, scene: Scene) -> None:
+    def mark_saved(self, scene: Scene) -> None:
+        """The file now holds ``scene`` (written here, or by the viewer's bookmark)."""
         self.saved, self.saved_text = scene, scene_to_toml(scene)
         self.stamp = Stamp.of(self.path)
 

@@ -49,3 +49,24 @@ def primary_rays(v: View) -> np.ndarray:
     ny = (2.0 * fy / v.height - 1.0) * v.tan_half
     d = v.forward + nx.reshape(-1, 1) * v.right + ny.reshape(-1, 1) * v.up
     return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+def pixel_ray(v: View, x: float, y: float) -> np.ndarray:
+    """Unit direction through window point (x, y), measured from the top-left corner in
+    pixels (what a mouse reports); pixel centres sit at .5 as in :func:`primary_rays`."""
+    nx = (2.0 * x / v.width - 1.0) * v.tan_half * v.aspect
+    ny = (1.0 - 2.0 * y / v.height) * v.tan_half
+    d = v.forward + nx * v.right + ny * v.up
+    return d / np.linalg.norm(d)
+
+
+def project(v: View, p: np.ndarray) -> tuple[float, float, float]:
+    """Window point (x, y from the top-left, pixels) and distance along the view axis of the
+    world point p; the inverse of :func:`pixel_ray` (z ≤ 0: behind the eye)."""
+    rel = np.asarray(p, dtype=np.float64) - v.origin
+    z = float(rel @ v.forward)
+    if z <= 0:
+        return (math.nan, math.nan, z)
+    nx = float(rel @ v.right) / (z * v.tan_half * v.aspect)
+    ny = float(rel @ v.up) / (z * v.tan_half)
+    return ((nx + 1.0) * 0.5 * v.width, (1.0 - ny) * 0.5 * v.height, z)

@@ -64,7 +64,8 @@ class Route:
             if lv.normal is None:
                 raise SceneError(f"{p}[{i}].normal", "<missing>",
                                  "every level above 0 needs the normal of its fork's mirror")
-        size = max(float(np.ptp(np.array(self.forks()), axis=0).max()), 1.0)
+        forks = np.array([self.base] + [lv.fork for lv in self.levels])
+        size = max(float(np.ptp(forks, axis=0).max()), 1.0)
         for i, (start, lv) in enumerate(zip(self.starts(), self.levels)):
             if np.linalg.norm(np.subtract(lv.fork, start)) <= FORK_SEPARATION * size:
                 below = "base" if i == len(self.levels) - 1 else f"levels[{i + 1}].fork"
@@ -73,9 +74,6 @@ class Route:
         if self.ground is not None and not self.forest:
             raise SceneError(f"{path}.ground", "<kernel>", "the ground is the kernel of the "
                              "last forest level: add at least one forest mirror")
-
-    def forks(self) -> list[Vec3]:
-        return [self.base] + [lv.fork for lv in self.levels]
 
     def starts(self) -> list[Vec3]:
         """Where each level's branch starts: the fork of the level above, the base for the trunk."""

@@ -1,0 +1,76 @@
+"""ImGui widgets generated from the scene schema (the Fragmentarium habit, DESIGN.md): a field's
+type picks the widget, its metadata gives the range, unit and tooltip, so panels never repeat
+a range by hand. A widget returns the new value; the document validates it.
+
+Each widget reports its interaction: a slider or drag held down is one interaction, so the
+many values it produces merge into one undo step (DESIGN.md, One seam for edits)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from imgui_bundle import imgui
+
+LOG_RATIO = 100.0   # a range spanning more than this factor gets a logarithmic slider
+
+
+@dataclass
+class Interactions:
+    """Numbers each press-and-drag of a widget, so its edits merge into one undo step."""
+    count: int = 0
+
+    def key(self, path: tuple) -> tuple:
+        """Call right after the widget: a new number when it was just activated."""
+        if imgui.is_item_activated():
+            self.count += 1
+        return ("panel", path, self.count)
+
+
+def _tooltip(meta: dict) -> None:
+    text = meta.get("help", "")
+    lo, hi, unit = meta.get("lo"), meta.get("hi"), meta.get("unit", "")
+    if lo is not None or hi is not None:
+        text += f" [{'' if lo is None else lo} … {'' if hi is None else hi}{' ' + unit if unit else ''}]"
+    if text and imgui.is_item_hovered():
+        imgui.set_tooltip(text + "\n(ctrl+click or double-click to type a value)")
+
+
+def _speed(value: float, meta: dict) -> float:
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if lo is not None and hi is not None and math.isfinite(hi - lo):
+        return max((hi - lo) / 500.0, 1e-6)
+    return max(abs(value) * 0.01, 1e-3)
+
+
+def field_widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
+    """One widget for one scene field; (changed, new value)."""
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if isinstance(value, bool):
+        changed, value = imgui.checkbox(label, value)
+    elif isinstance(value, str) and meta.get("choices"):
+        choices = list(meta["choices"])
+        changed, k = imgui.combo(label, choices.index(value), choices)
+        value = choices[k]
+    elif isinstance(value, int):
+        changed, value = imgui.drag_int(label, value, 0.2, int(lo or 0), int(hi or 0))
+    elif isinstance(value, float) and lo is not None and hi is not None and lo > 0 \
+            and hi / lo > LOG_RATIO:
+        changed, value = imgui.slider_float(label, value, lo, hi, "%.4g",
+                                            imgui.SliderFlags_.logarithmic)
+    elif isinstance(value, float):
+        changed, value = imgui.drag_float(label, value, _speed(value, meta),
+                                          lo if lo is not None else 0.0,
+                                          hi if hi is not None else 0.0, "%.5g")
+    elif isinstance(value, tuple) and len(value) == 3 and lo == 0.0 and hi == 1.0:
+        changed, rgb = imgui.color_edit3(label, list(value), imgui.ColorEditFlags_.float)
+        value = tuple(rgb)
+    elif isinstance(value, tuple) and len(value) == 3:
+        speed = max(max(abs(c) for c in value) * 0.005, 1e-4)
+        changed, v = imgui.drag_float3(label, list(value), speed, 0.0, 0.0, "%.5g")
+        value = tuple(float(c) for c in v)
+    else:
+        imgui.text_disabled(f"{label}: {value!r}")
+        return False, value
+    _tooltip(meta)
+    return changed, value

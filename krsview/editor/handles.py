@@ -1,0 +1,113 @@
+"""Handles: the points of a scene a person can grab in the 3D view, each tied to the field it
+edits. A route shows its base, forks, control points and fork mirror normals [KRS17 §9.2];
+a plain KRS its kernels' points and its mirrors (a point on the plane and a normal arrow);
+a compound its components' placements. Pure NumPy: the window draws and drags them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..scene import KRS, Capsule, Mirror, Route, Scene, Sphere, ToroidalCapsule
+from ..scene.edits import Path, get_at
+
+ARROW = 0.6  # a normal arrow's length, × its level's branch length (route) or kernel size
+
+
+@dataclass(frozen=True)
+class Handle:
+    path: Path               # the field it edits
+    kind: str                # "point": moves to where it is dragged; "normal": its arrow
+    position: np.ndarray     # where it is drawn and grabbed (world, float64)
+    level: int               # the outline entry (level or component) it belongs to
+    label: str
+    owner: Path              # the table the selection panel shows (a level, a component)
+    pivot: np.ndarray | None = None   # "normal": the arrow's foot (a fork, a point on a mirror)
+
+    def value_at(self, scene: Scene, p: np.ndarray) -> Any:
+        """The field's new value when the handle is dragged to ``p``."""
+        if self.kind == "point" and self.path[-1] == "mirror":   # a point on a KRS mirror
+            m = get_at(scene, self.path)
+            return Mirror(m.normal, float(np.array(m.normal) @ p))
+        if self.kind == "point":
+            return tuple(float(c) for c in p)
+        d = p - self.pivot
+        n = float(np.linalg.norm(d))
+        u = tuple(float(c) for c in (d / n if n > 0 else d))   # zero: the schema says why
+        if self.path[-1] == "mirror":                         # keep the plane on the pivot
+            return Mirror(u, float(np.array(u) @ self.pivot)) if n > 0 else Mirror(u, 0.0)
+        return u
+
+    def same(self, other: "Handle | None") -> bool:
+        return other is not None and (self.path, self.kind) == (other.path, other.kind)
+
+
+def handles(scene: Scene) -> list[Handle]:
+    if scene.route is not None:
+        return route_handles(scene.route, ("route",))
+    if scene.krs is not None:
+        return krs_handles(scene.krs, ("krs",))
+    return [Handle(("compound", k, "position"), "point", np.array(c.position), k,
+                   f"component {k}", ("compound", k)) for k, c in enumerate(scene.compound)]
+
+
+def route_handles(route: Route, at: Path) -> list[Handle]:
+    out = [Handle((*at, "base"), "point", np.array(route.base), len(route.levels) - 1,
+                  "trunk foot", at)]
+    starts = route.starts()
+    for i, lv in enumerate(route.levels):
+        fork = np.array(lv.fork)
+        lev = (*at, "levels", i)
+        out.append(Handle((*lev, "fork"), "point", fork, i, f"fork P{i}", lev))
+        out.append(Handle((*lev, "control"), "point", np.array(lv.control), i, f"control {i}",
+                          lev))
+        if lv.normal is not None:
+            length = ARROW * float(np.linalg.norm(fork - np.array(starts[i])))
+            out.append(Handle((*lev, "normal"), "normal", fork + length * np.array(lv.normal), i,
+                              f"mirror normal R{i - 1}", lev, pivot=fork))
+    return out
+
+
+def krs_handles(krs: KRS, at: Path) -> list[Handle]:
+    out: list[Handle] = []
+    for i, lv in enumerate(krs.levels):
+        k = lv.kernel
+        kp = (*at, "levels", i, "kernel")
+        names = {Sphere: ("center",), Capsule: ("a", "b"),
+                 ToroidalCapsule: ("start", "control", "end")}.get(type(k), ())
+        pts = [np.array(getattr(k, f)) for f in names]
+        lev = (*at, "levels", i)
+        out += [Handle((*kp, f), "point", p, i, f"K{i} {f}", lev) for f, p in zip(names, pts)]
+        if lv.mirror is None:
+            continue
+        u, w = np.array(lv.mirror.normal), lv.mirror.offset
+        centre = np.mean(pts, axis=0) if pts else w * u
+        foot = centre - (u @ centre - w) * u          # the kernel's centre, projected
+        size = max(float(getattr(k, "radius", 0.0)) * 4.0,
+                   float(np.ptp(np.array(pts), axis=0).max()) if len(pts) > 1 else 0.0, 0.25)
+        mp = (*at, "levels", i, "mirror")
+        out.append(Handle(mp, "point", foot, i, f"mirror R{i - 1} position", lev))
+        out.append(Handle(mp, "normal", foot + ARROW * size * u, i, f"mirror R{i - 1} normal",
+                          lev, pivot=foot))
+    return out
+
+
+def outline(scene: Scene) -> list[str]:
+    """One line per selectable entry, in handle ``level`` order."""
+    if scene.route is not None:
+        n = len(scene.route.levels)
+        return [f"L{i} " + ("trunk" if i == n - 1 else "twig" if i == 0 else "branch")
+                for i in range(n)]
+    if scene.krs is not None:
+        return [f"L{i} {lv.kernel.kind}" for i, lv in enumerate(scene.krs.levels)]
+    return [f"component {k}: {'tree' if c.tree else 'route' if c.route else 'KRS'}"
+            for k, c in enumerate(scene.compound)]
+
+
+def polyline(scene: Scene) -> np.ndarray:
+    """The route from the trunk's foot to the twig tip (empty for other scenes)."""
+    if scene.route is None:
+        return np.zeros((0, 3))
+    return np.array([scene.route.base] + [lv.fork for lv in scene.route.levels][::-1])

@@ -1,0 +1,176 @@
+"""The editor's ImGui panels. A panel reads the editor's state and returns commands; it never
+writes the editor or the scene itself (the editor applies the commands through the document),
+so the arrows run one way: editor app → panels."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any
+
+from imgui_bundle import imgui
+
+from ..app.widgets import Interactions, field_widget
+from ..scene.edits import get_at
+from .handles import outline
+
+if TYPE_CHECKING:
+    from .app import Editor
+
+GEOMETRY_TABLES = ("krs", "route")   # a component's own geometry: too big for a panel
+YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
+RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+
+
+@dataclass(frozen=True)
+class Edit:
+    path: tuple
+    value: Any
+    interaction: Any = None
+
+
+@dataclass(frozen=True)
+class Do:
+    action: str          # a method of the editor's command table (Editor.actions)
+    arg: Any = None
+
+
+def edit_panel(e: "Editor", interactions: Interactions) -> list:
+    out: list = []
+    imgui.set_next_window_pos(imgui.ImVec2(e.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever)
+    imgui.set_next_window_size(imgui.ImVec2(340, e.adaptive.full[1] - 16), imgui.Cond_.first_use_ever)
+    imgui.set_next_window_bg_alpha(0.8)
+    imgui.begin("edit")
+    _file(e, out)
+    scene = e.scene
+    if scene.tree is not None:
+        imgui.text_wrapped("This tree is grown from ratios. Bake it into a route to drag its "
+                           "forks, control points and mirror normals [KRS17 §9.2].")
+        if imgui.button("bake into a route"):
+            out.append(Do("bake"))
+    elif scene.mokrs is not None:
+        imgui.text_wrapped("A MöKRS has no handles yet; edit its file (it reloads) or the "
+                           "fields below.")
+    else:
+        for w in scene.route.warnings() if scene.route else []:
+            imgui.text_colored(YELLOW, "route." + w)
+        _outline(e, out)
+        if imgui.collapsing_header("selection", imgui.TreeNodeFlags_.default_open):
+            _selection(e, out, interactions)
+    if imgui.collapsing_header("material"):
+        _fields(scene.material, ("material",), out, interactions)
+    if imgui.collapsing_header("snapping"):
+        changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
+        if changed:
+            out.append(Do("snap", on))
+        imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
+    imgui.end()
+    _modals(e, out)
+    return out
+
+
+def _file(e: "Editor", out: list) -> None:
+    doc = e.doc
+    imgui.text(("* unsaved: " if doc.dirty else "saved: ") + str(doc.path.name))
+    if imgui.button("save (Ctrl+S)"):
+        out.append(Do("save"))
+    imgui.same_line()
+    imgui.set_next_item_width(150)
+    _, e.save_as_text = imgui.input_text("##saveas", e.save_as_text)
+    imgui.same_line()
+    if imgui.button("save as"):
+        out.append(Do("save_as", e.save_as_text))
+    done, undone = doc.history.labels()
+    imgui.begin_disabled(not done)
+    if imgui.button("undo (Ctrl+Z)"):
+        out.append(Do("undo"))
+    imgui.end_disabled()
+    if done and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
+        imgui.set_tooltip("undo: " + done[-1])
+    imgui.same_line()
+    imgui.begin_disabled(not undone)
+    if imgui.button("redo (Ctrl+Shift+Z)"):
+        out.append(Do("redo"))
+    imgui.end_disabled()
+    if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
+        imgui.set_tooltip("redo: " + undone[0])
+    if e.conflict:
+        imgui.text_colored(RED, f"{doc.path.name} changed on disk, and you have unsaved edits.")
+        if imgui.button("take the file (your edits stay undoable)"):
+            out.append(Do("reload"))
+        imgui.same_line()
+        if imgui.button("keep mine"):
+            out.append(Do("keep_mine"))
+
+
+def _outline(e: "Editor", out: list) -> None:
+    entries = outline(e.scene)
+    imgui.text("outline (click an entry, a handle or the geometry)")
+    if imgui.begin_child("outline", imgui.ImVec2(-1, 120), imgui.ChildFlags_.borders):
+        for k in range(len(entries) - 1, -1, -1):          # trunk first, as it grows
+            selected = e.selected is not None and e.selected.level == k
+            clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
+            if clicked:
+                out.append(Do("select_level", k))
+            if selected and e.scroll_outline:
+                imgui.set_scroll_here_y()
+                e.scroll_outline = False
+    imgui.end_child()
+
+
+def _selection(e: "Editor", out: list, interactions: Interactions) -> None:
+    h = e.selected
+    if h is None:
+        imgui.text_disabled("nothing selected")
+        return
+    same_level = [k for k in e.handles if k.level == h.level]
+    for k, other in enumerate(same_level):
+        if imgui.radio_button(f"{other.label}##h{k}", other.same(h)):
+            out.append(Do("select", other))
+        if k % 2 == 0 and k + 1 < len(same_level):
+            imgui.same_line()
+    _fields(get_at(e.scene, h.owner), h.owner, out, interactions)
+
+
+def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
+    """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse."""
+    for f in fields(obj):
+        value = getattr(obj, f.name)
+        path = (*at, f.name)
+        if value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
+            continue
+        if hasattr(value, "__dataclass_fields__"):
+            imgui.separator_text(f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else ""))
+            _fields(value, path, out, interactions)
+            continue
+        changed, new = field_widget(f"{f.name}##{'.'.join(map(str, path))}", value,
+                                    dict(f.metadata))
+        key = interactions.key(path)
+        if changed:
+            out.append(Edit(path, new, key))
+
+
+def _modals(e: "Editor", out: list) -> None:
+    if e.asking is not None and not imgui.is_popup_open("unsaved changes"):
+        imgui.open_popup("unsaved changes")
+    if imgui.begin_popup_modal("unsaved changes", None, imgui.WindowFlags_.always_auto_resize)[0]:
+        what = "closing" if e.asking == ("close", None) else "opening another scene"
+        imgui.text(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
+        for label, action in (("save", "answer_save"), ("discard", "answer_discard"),
+                              ("cancel", "answer_cancel")):
+            if imgui.button(label):
+                out.append(Do(action))
+                imgui.close_current_popup()
+            imgui.same_line()
+        imgui.end_popup()
+    if e.recovered is not None and not imgui.is_popup_open("recover"):
+        imgui.open_popup("recover")
+    if imgui.begin_popup_modal("recover", None, imgui.WindowFlags_.always_auto_resize)[0]:
+        imgui.text(f"{e.doc.recovery_path.name} holds unsaved edits from a session that "
+                   "did not end cleanly.")
+        if imgui.button("restore them"):
+            out.append(Do("restore"))
+            imgui.close_current_popup()
+        imgui.same_line()
+        if imgui.button("discard them"):
+            out.append(Do("discard_recovery"))
+            imgui.close_current_popup()
+        imgui.end_popup()
