@@ -5,8 +5,8 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 # Headless OpenGL through EGL on Mesa (llvmpipe when there is no GPU); Xvfb for the tests
-# that open the real viewer window.
-APT_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglx-mesa0 xvfb xauth
+# that open the real viewer and editor windows, xdotool for real pointer and key events there.
+APT_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool
 STAMP  := $(VENV)/.installed
 
 .PHONY: demo test deps venv clean

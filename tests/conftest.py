@@ -2,6 +2,11 @@
 with the tolerances every pixel test uses."""
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
+import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -93,3 +98,42 @@ def check_against_reference(name: str, gpu: Buffers, ref: Buffers) -> Agreement:
         path = save_diff(name, gpu, ref)
         pytest.fail(f"{name}: " + "; ".join(problems) + f" (images: {path})")
     return a
+
+
+@pytest.fixture(scope="session")
+def display():
+    """An X display: the session's own, or an Xvfb started for the window tests."""
+    if os.environ.get("DISPLAY"):
+        yield os.environ["DISPLAY"]
+        return
+    xvfb = shutil.which("Xvfb")
+    assert xvfb, "Xvfb is needed for the window tests (`make deps` installs it)"
+    for n in range(90, 110):
+        if not Path(f"/tmp/.X{n}-lock").exists():
+            break
+    proc = subprocess.Popen([xvfb, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(100):
+        if Path(f"/tmp/.X11-unix/X{n}").exists():
+            break
+        time.sleep(0.05)
+    os.environ["DISPLAY"] = f":{n}"
+    yield f":{n}"
+    del os.environ["DISPLAY"]
+    proc.terminate()
+    proc.wait(5)
+
+
+def headless_render(scene, path: Path, size: tuple[int, int]) -> np.ndarray:
+    """`krsview render` in its own process (EGL, no window) of ``scene`` saved at
+    ``path``.toml: what a user gets from the command line, for comparing with a window."""
+    from PIL import Image
+    from krsview.scene import save_scene
+    save_scene(scene, path.with_suffix(".toml"))
+    out = path.with_suffix(".png")
+    r = subprocess.run([sys.executable, "-m", "krsview", "render", str(path.with_suffix(".toml")),
+                        "-o", str(out), "--size", f"{size[0]}x{size[1]}", "--repeats", "1"],
+                       capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "DISPLAY": ""})
+    assert r.returncode == 0, r.stderr
+    return np.asarray(Image.open(out).convert("RGB"))

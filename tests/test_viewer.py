@@ -1,47 +1,21 @@
 """The real viewer window under Xvfb, driven through its input layer."""
 from __future__ import annotations
 
-import os
 import shutil
-import subprocess
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from krsview.app.adaptive import AdaptiveResolution, Refinement
 from krsview.presets import resolve
 from krsview.scene import load_scene, save_scene
 
+from .conftest import headless_render
+
 SIZE = (160, 120)
-
-
-@pytest.fixture(scope="module")
-def display():
-    """An X display: the session's own, or an Xvfb started for these tests."""
-    if os.environ.get("DISPLAY"):
-        yield os.environ["DISPLAY"]
-        return
-    xvfb = shutil.which("Xvfb")
-    assert xvfb, "Xvfb is needed for the window tests (`make deps` installs it)"
-    for n in range(90, 110):
-        if not Path(f"/tmp/.X{n}-lock").exists():
-            break
-    proc = subprocess.Popen([xvfb, f":{n}", "-screen", "0", "640x480x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    for _ in range(100):
-        if Path(f"/tmp/.X11-unix/X{n}").exists():
-            break
-        time.sleep(0.05)
-    os.environ["DISPLAY"] = f":{n}"
-    yield f":{n}"
-    del os.environ["DISPLAY"]
-    proc.terminate()
-    proc.wait(5)
 
 
 @pytest.fixture
@@ -70,17 +44,6 @@ def hold(v, key: str, steps: int, dt: float = 0.05) -> None:
     v.input.key(key, False)
 
 
-def headless_render(scene, path: Path) -> np.ndarray:
-    """`krsview render` in its own process (EGL, no window) of the same scene and camera."""
-    save_scene(scene, path.with_suffix(".toml"))
-    out = path.with_suffix(".png")
-    r = subprocess.run([sys.executable, "-m", "krsview", "render", str(path.with_suffix(".toml")),
-                        "-o", str(out), "--size", f"{SIZE[0]}x{SIZE[1]}", "--repeats", "1"],
-                       capture_output=True, text=True, timeout=120, env={**os.environ, "DISPLAY": ""})
-    assert r.returncode == 0, r.stderr
-    return np.asarray(Image.open(out).convert("RGB"))
-
-
 def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_path):
     v = viewer
     settle(v)
@@ -96,7 +59,7 @@ def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_
     assert np.linalg.norm(v.camera.position - p0) > 0.1, "W did not move the camera"
     shot = v.read_window()
     assert np.abs(shot.astype(int) - start).max() > 50, "the view did not change"
-    ref = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "headless")
+    ref = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "headless", SIZE)
     close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
 
