@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+import typing
+from dataclasses import fields
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -10,8 +12,9 @@ from pathlib import Path
 from .presets import DEFAULT_PRESET, preset_names, resolve
 import numpy as np
 
-from .scene import EFFECTS, MAX_LEVELS, TRACERS, Scene, SceneError, load_scene
+from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
 from .scene.effects import check_effects
+from .scene.schema import describe_range, check_value
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
 
@@ -49,6 +52,32 @@ def _int_in(name: str, lo: int, hi: int):
             raise argparse.ArgumentTypeError(f"{name} {text!r}: allowed {lo} ≤ value ≤ {hi}")
         return v
     return parse
+
+
+RENDER_FIELDS = {f.name: f for f in fields(Render)}
+
+
+def render_option(sp: argparse.ArgumentParser, name: str) -> None:
+    """``--NAME`` overriding ``[render] NAME``: type, range and help come from the scene
+    schema, and the value is checked by the schema's own rule (one schema, DESIGN.md)."""
+    f, flag = RENDER_FIELDS[name], "--" + name.replace("_", "-")
+    meta = dict(f.metadata)
+    hint = typing.get_type_hints(Render)[name]
+
+    def parse(text: str):
+        try:
+            value = hint(text) if hint in (int, float) else text
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{flag} {text!r}: expected a "
+                                             f"{'whole ' if hint is int else ''}number") from None
+        try:
+            return check_value(hint, value, flag, meta)
+        except SceneError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+    allowed = describe_range(meta) if not meta.get("choices") else \
+        "one of " + ", ".join(meta["choices"])
+    sp.add_argument(flag, type=parse, metavar=name.split("_")[-1].upper(),
+                    help=f"{meta['help']} ({allowed}; overrides the scene's [render])")
 
 
 def _load(args: argparse.Namespace) -> Scene:
@@ -206,11 +235,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     def accuracy(sp: argparse.ArgumentParser) -> None:
-        sp.add_argument("--epsilon-scale", type=_positive_float("--epsilon-scale", 1e-4, 100.0),
-                        help="LOD threshold in pixels: stop when distance < footprint × depth × "
-                             "scale (overrides the scene; smaller = sharper and slower)")
-        sp.add_argument("--max-iterations", type=_int_in("--max-iterations", 1, 10000),
-                        help="iteration cap per ray (overrides the scene)")
+        render_option(sp, "epsilon_scale")
+        render_option(sp, "max_iterations")
         sp.add_argument("--levels", type=_int_in("--levels", 1, MAX_LEVELS),
                         help="keep only the coarsest N levels (drops the finest detail)")
         sp.add_argument("--effects", metavar="LIST",
@@ -242,9 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--legend-max", type=_int_in("--legend-max", 1, 100000), metavar="N",
                    help="iterations shown as white in --view iterations (default: the image's "
                         "maximum); fix it to compare tracers on one scale")
-    r.add_argument("--tracer", choices=TRACERS,
-                   help="sphere or binary sphere tracing (overrides the scene; a MöKRS needs "
-                        "binary)")
+    render_option(r, "tracer")
     accuracy(r)
     r.set_defaults(func=cmd_render)
 
@@ -294,8 +318,8 @@ def build_parser() -> argparse.ArgumentParser:
     bench_arguments(bl)
     bl.add_argument("--step", type=_int_in("--step", 1, MAX_LEVELS), default=4,
                     help="level increment (default 4)")
-    bl.add_argument("--epsilon-scale", type=_positive_float("--epsilon-scale", 1e-4, 100.0))
-    bl.add_argument("--max-iterations", type=_int_in("--max-iterations", 1, 10000))
+    render_option(bl, "epsilon_scale")
+    render_option(bl, "max_iterations")
     bl.set_defaults(func=cmd_bench_levels)
     bt = bsub.add_parser("tracers", help="sphere vs binary sphere tracing, and a ξ sweep",
                          description="On one scene and view: sphere tracing, binary tracing at "

@@ -37,8 +37,11 @@ def test_reference_render_matches_size(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["render", "tree", "--size", "640"], "expected WIDTHxHEIGHT"),
     (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
-    (["render", "tree", "--epsilon-scale", "nan"], "--epsilon-scale 'nan': allowed"),
-    (["render", "tree", "--max-iterations", "-3"], "--max-iterations '-3': allowed 1"),
+    (["render", "tree", "--epsilon-scale", "nan"], "--epsilon-scale = nan: NaN and infinity are "
+                                                   "not allowed; allowed: 0.0001 ≤ value ≤ 100"),
+    (["render", "tree", "--epsilon-scale", "0"], "--epsilon-scale = 0.0: allowed: 0.0001 ≤ value"),
+    (["render", "tree", "--max-iterations", "-3"], "--max-iterations = -3: allowed: 1 ≤ value ≤ 10000"),
+    (["render", "tree", "--tracer", "bent"], "--tracer = 'bent': allowed: 'sphere', 'binary'"),
     (["render", "no-such-preset"], "not a file and not a preset; presets: forest, grass, grove, inversion"),
     (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
     (["check", "missing.toml"], "no such scene file"),

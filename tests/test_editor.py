@@ -11,12 +11,11 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from krsview.editor.panels import Do, Edit
+from krsview.app.commands import Do, Edit
 from krsview.presets import resolve
 from krsview.scene import load_scene
 
@@ -24,8 +23,6 @@ from .conftest import headless_render
 
 SIZE = (800, 500)
 LEVEL = 19          # a fork near the top of the shipped tree, clear of the panels
-pytestmark = pytest.mark.skipif(shutil.which("xdotool") is None,
-                                reason="xdotool is needed (`make deps` installs it)")
 
 
 @pytest.fixture
@@ -55,6 +52,7 @@ def settle(e, limit: int = 400) -> None:
 
 
 def xdo(*args) -> None:
+    assert shutil.which("xdotool"), "xdotool is needed for real X events (`make deps` installs it)"
     subprocess.run(["xdotool", *map(str, args)], check=True, timeout=10)
 
 
@@ -159,7 +157,7 @@ def test_overlay_is_composited_by_traced_depth(editor):
     import glfw
     e = editor
     e.execute([Do("bake")])
-    e.do_select_level(LEVEL)
+    e.select_level(LEVEL)
     e.hud = False
     settle(e)
     plain = e.read_window().astype(int)
@@ -186,7 +184,7 @@ import os, signal, sys
 from pathlib import Path
 from krsview.editor.app import Editor
 e = Editor(Path(sys.argv[1]), size=(320, 200))
-e.do_bake()
+e.bake()
 e.edit(("route", "levels", 5, "radius"), 0.123, ("gizmo", 1))
 for _ in range(400):
     e.step(0.05)
@@ -208,7 +206,7 @@ def test_killed_mid_edit_the_reopened_editor_offers_the_recovery(display, tmp_pa
     try:
         assert e.recovered is not None
         pump(e)                                   # the modal is drawn (panels run)
-        e.do_restore()
+        e.restore()
         assert e.scene.route.levels[5].radius == 0.123 and e.doc.dirty
         assert e.recovered is None
     finally:
@@ -222,11 +220,11 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
     glfw.set_window_should_close(e.window, True)
     assert not e.should_close() and e.asking == ("close", None)
     pump(e)
-    e.do_answer_cancel()
+    e.answer_cancel()
     assert not e.should_close() and e.doc.dirty
     glfw.set_window_should_close(e.window, True)
     e.should_close()
-    e.do_answer_discard()
+    e.answer_discard()
     assert e.should_close()
     assert load_scene(e.path).render.epsilon_scale == 1.0, "discard wrote the file"
 
@@ -243,11 +241,11 @@ def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor
     time.sleep(0.6)
     pump(e)
     assert e.conflict and e.scene.render.epsilon_scale == 2.0
-    assert not e.do_save() and "changed on disk" in e.error
+    assert not e.save() and "changed on disk" in e.error
     assert load_scene(e.path).name == "changed elsewhere"
-    e.do_reload()
+    e.take_file()
     assert e.scene.name == "changed elsewhere" and not e.doc.dirty
-    e.do_undo()
+    e.undo()
     assert e.scene.render.epsilon_scale == 2.0, "the edits were lost on reload"
 
 
@@ -264,7 +262,7 @@ def test_a_bad_panel_value_keeps_the_last_valid_scene(editor):
 
 def test_save_as_a_bad_name_is_a_clear_error(editor, tmp_path):
     e = editor
-    e.do_save_as(str(tmp_path / "x.png"))
+    e.save_as(str(tmp_path / "x.png"))
     assert "ends in .toml" in e.error or "ending in .toml" in e.error
-    e.do_save_as(str(tmp_path / "copy.toml"))
+    e.save_as(str(tmp_path / "copy.toml"))
     assert e.path == tmp_path / "copy.toml" and load_scene(tmp_path / "copy.toml") == e.scene

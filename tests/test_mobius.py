@@ -11,8 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from krsview.reference import mobius as M
-from krsview.reference import quaternion as Q
+from krsview.algebra import mobius as M
+from krsview.algebra import quaternion as Q
 
 seeds = st.integers(0, 2**32 - 1)
 RTOL = 1e-9  # float64 through ~5 constructors and an inverse: far below 1e-9 unless near a pole

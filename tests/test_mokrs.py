@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from krsview.presets import resolve
-from krsview.reference import mobius, render_reference
+from krsview.algebra import mobius
+from krsview.reference import render_reference
 from krsview.reference.camera import primary_rays, view_of
 from krsview.scene import Camera, SceneError, load_scene, scene_from_toml, scene_to_toml
 from krsview.scene.mokrs import mokrs_of

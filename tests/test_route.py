@@ -11,8 +11,8 @@ import pytest
 from krsview.presets import resolve
 from krsview.reference.compiled import compile_krs
 from krsview.reference.krs import distance
-from krsview.scene import (KRS, Capsule, Level, Route, RouteLevel, SceneError, ToroidalCapsule,
-                           load_scene, save_scene, scene_from_toml)
+from krsview.scene import (KRS, Capsule, Level, Route, RouteLevel, SceneError, load_scene,
+                           save_scene, scene_from_toml)
 from krsview.scene.edits import apply_edit
 
 ALBEDO = (0.5, 0.5, 0.5)

@@ -1,7 +1,9 @@
-"""The ImGui HUD: frame time plot, resolution, accuracy knobs, effects, view mode, presets,
-bookmarks, screenshot, and any error from a hot reload."""
+"""The viewer's ImGui HUD: frame time plot, resolution, accuracy knobs (from the scene schema),
+effects, view mode, presets, bookmarks, screenshot, and any error from a hot reload. It reads
+the viewer and returns commands; it never writes the viewer's fields."""
 from __future__ import annotations
 
+from dataclasses import fields
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -9,33 +11,42 @@ from imgui_bundle import imgui, implot
 
 from ..gpu.display import VIEW_MODES
 from ..presets import preset_names, resolve
-from ..scene import EFFECTS, TRACERS
+from ..scene import EFFECTS, Render
 from ..scene.effects import allowed_effects
+from .commands import Command, Do, Edit
+from .widgets import Interactions, field_widget
 
 if TYPE_CHECKING:
     from .window import Viewer
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+BINARY_ONLY = ("xi_bonus", "xi_penalty")       # knobs of binary sphere tracing
+KNOBS = ("tracer", "epsilon_scale", "max_iterations", *BINARY_ONLY)
+RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
-def draw_hud(v: "Viewer") -> None:
+def draw_hud(v: "Viewer", interactions: Interactions) -> list[Command]:
+    out: list[Command] = []
     imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
     imgui.set_next_window_size(imgui.ImVec2(330, 0), imgui.Cond_.first_use_ever)
     imgui.set_next_window_bg_alpha(0.75)
     imgui.begin("krsview (F1 hides)")
-    _performance(v)
+    _performance(v, out)
     if imgui.collapsing_header("accuracy and view"):
-        _accuracy(v)
+        _accuracy(v, out, interactions)
     if imgui.collapsing_header("scene, camera, output"):
-        _scene(v)
+        _scene(v, out)
     if v.message:
         imgui.text_wrapped(v.message)
     if v.error:
-        imgui.text_colored(RED, v.error)
+        imgui.push_style_color(imgui.Col_.text, RED)
+        imgui.text_wrapped(v.error)
+        imgui.pop_style_color()
     imgui.end()
+    return out
 
 
-def _performance(v: "Viewer") -> None:
+def _performance(v: "Viewer", out: list) -> None:
     times = np.array(v.frame_seconds[-120:] or [0.0], dtype=np.float32) * 1e3
     fps = 1e3 / max(float(np.median(times)), 1e-6)
     w, h = v.adaptive.moving_size()
@@ -52,80 +63,63 @@ def _performance(v: "Viewer") -> None:
         implot.end_plot()
     changed, fps_target = imgui.slider_float("target FPS", v.adaptive.target_fps, 5, 120, "%.0f")
     if changed:
-        v.adaptive.target_fps = fps_target
+        out.append(Do("set_target_fps", fps_target))
     changed, ss = imgui.checkbox("supersample still images 2×2", v.adaptive.supersample == 2)
     if changed:
-        v.adaptive.supersample, v.dirty = (2 if ss else 1), True
+        out.append(Do("set_supersample", 2 if ss else 1))
 
 
-def _accuracy(v: "Viewer") -> None:
+def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:
     r = v.scene.render
-    edits: dict = {}
-    tracers = ["binary"] if v.scene.mokrs is not None else list(TRACERS)
-    changed, k = imgui.combo("tracer", tracers.index(r.tracer), tracers)
-    if changed:
-        edits["tracer"] = tracers[k]
-    if imgui.is_item_hovered():
-        imgui.set_tooltip("sphere tracing or binary sphere tracing [KRS17 Alg. 2]; switching "
-                          "compiles the other variant once")
-    changed, eps = imgui.slider_float("eps scale (px)", r.epsilon_scale, 0.01, 20.0, "%.3f",
-                                      imgui.SliderFlags_.logarithmic)
-    if changed:
-        edits["epsilon_scale"] = eps
-    changed, cap = imgui.slider_int("iteration cap", r.max_iterations, 8, 2048, "%d",
-                                    imgui.SliderFlags_.logarithmic)
-    if changed:
-        edits["max_iterations"] = cap
-    if r.tracer == "binary":
-        changed, bonus = imgui.slider_float("xi bonus", r.xi_bonus, 1.05, 8.0, "%.2f")
+    for name in KNOBS:
+        if name in BINARY_ONLY and r.tracer != "binary":
+            continue
+        meta = RENDER_META[name]
+        if name == "tracer" and v.scene.mokrs is not None:
+            meta = {**meta, "choices": ("binary",)}   # a MöKRS has only unbounding tests
+        changed, value = field_widget(f"{name}##render", getattr(r, name), meta)
+        key = interactions.key(("render", name))
         if changed:
-            edits["xi_bonus"] = bonus
-        changed, penalty = imgui.slider_float("xi penalty", r.xi_penalty, 0.05, 0.95, "%.2f")
-        if changed:
-            edits["xi_penalty"] = penalty
-    if edits:
-        v.set_render(**edits)
+            out.append(Edit(("render", name), value, key))
     total = v.geometry.depth
     changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
     if changed:
-        v.set_levels(levels)
+        out.append(Do("set_levels", levels))
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))
     if changed:
-        v.view = VIEW_MODES[k]
+        out.append(Do("set_view_mode", VIEW_MODES[k]))
     imgui.text("effects (each compiles its own shader variant, cached)")
     for name in allowed_effects(v.scene.mokrs is not None):
         changed, on = imgui.checkbox(name, name in v.scene.effects)
         if changed:
-            v.set_effect(name, on)
+            out.append(Do("set_effect", name, on))
         if imgui.is_item_hovered():
             imgui.set_tooltip(EFFECTS[name].help)
 
 
-def _scene(v: "Viewer") -> None:
+def _scene(v: "Viewer", out: list) -> None:
     names = preset_names()
     current = names.index(v.path.stem) if v.path.stem in names else -1
     changed, k = imgui.combo("preset", current, names)
     if changed:
-        v.open_preset(resolve(names[k]))
+        out.append(Do("open_preset", resolve(names[k])))
     imgui.text(f"speed ×{v.speed_factor:.2f} of the nearest distance "
                f"({v.nearest_distance():.3g}); scroll to change")
-    if imgui.button("screenshot (F12)"):
-        v.act("screenshot")
-    imgui.same_line()
-    if imgui.button("reset view (R)"):
-        v.act("reset")
-    imgui.same_line()
-    if imgui.button("orbit (O)" if v.orbit_pivot is None else "fly (O)"):
-        v.act("orbit")
-    if imgui.button("add bookmark (B)"):
-        v.act("bookmark")
+    for label, action, same_line in (("screenshot (F12)", "screenshot", True),
+                                     ("reset view (R)", "reset", True),
+                                     ("orbit (O)" if v.orbit_pivot is None else "fly (O)",
+                                      "orbit", False),
+                                     ("add bookmark (B)", "bookmark", False)):
+        if imgui.button(label):
+            out.append(Do("act", action))
+        if same_line:
+            imgui.same_line()
     for i, b in enumerate(v.scene.bookmarks):
         imgui.same_line()
         if imgui.button(f"{b.name}##{i}"):
-            v.bookmark_index = i - 1
-            v.act("next_bookmark")
+            out.append(Do("go_to_bookmark", i))
     if imgui.button("stop recording (F5)" if v.recording is not None else "record path (F5)"):
-        v.act("record")
+        out.append(Do("act", "record"))
     imgui.same_line()
     if imgui.button("replay path (F6)"):
-        v.act("replay")
+        out.append(Do("act", "replay"))

@@ -2,7 +2,6 @@
 and hot reload of the preset and the shaders."""
 from __future__ import annotations
 
-import ctypes
 import json
 import time
 from dataclasses import replace
@@ -10,7 +9,7 @@ from pathlib import Path
 
 import moderngl
 import numpy as np
-from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
+from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
 import glfw  # noqa: E402  (order matters)
 
 from ..gpu.display import Display
@@ -23,17 +22,15 @@ from ..scene.effects import EXCLUSIVE
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.scene import write_atomic
 from .adaptive import AdaptiveResolution, Refinement
+from .commands import Command, Edit
+from .hud import draw_hud
+from .widgets import Interactions
 from .camera import FlyCamera
-from .controls import CONTROLS, LOOK_BUTTON, ORBIT_BUTTON, Input
+from .controls import LOOK_BUTTON, ORBIT_BUTTON, Input
+from .platform import Platform
 
 LOOK_RADIANS_PER_PIXEL = 0.004
 RELOAD_INTERVAL = 0.5   # seconds between checks of the preset and shader files
-GLFW_KEYS = {getattr(glfw, f"KEY_{k}"): k for k in set(CONTROLS.values())}
-GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
-
-
-class WindowError(RuntimeError):
-    """No window could be opened (no display, or no OpenGL 4.3+ there)."""
 
 
 class Viewer:
@@ -41,11 +38,13 @@ class Viewer:
                  target_fps: float = 30.0, visible: bool = True, shader_dir: Path = SHADER_DIR):
         self.shader_dir = Path(shader_dir)
         self.doc = Document(path)              # a bad file is a SceneError before any window
-        self.window = _open_window(size, self.window_title(), visible)
+        self.platform = Platform(size, self.window_title(), visible)
+        self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
         self.renderer = Renderer(self.ctx, self.shader_dir)
         self.display = Display(self.ctx, self.renderer.programs)
         self.input = Input()
+        self.interactions = Interactions()
         self.hud = hud
         self.view = "shaded"
         self.levels = 0                         # 0: all of the scene's levels
@@ -66,8 +65,7 @@ class Viewer:
         self._last_check = time.perf_counter()
         self._set_scene(self.doc.scene, reset_camera=True)
         self.load_path()
-        self._init_imgui()
-        self._install_callbacks()
+        self.platform.route_events(self)
 
     # ------------------------------------------------------------------------- scene state
     @property
@@ -202,11 +200,7 @@ class Viewer:
 
     def close(self) -> None:
         if self.window is not None:
-            imgui.backends.opengl3_shutdown()
-            imgui.backends.glfw_shutdown()
-            implot.destroy_context()
-            imgui.destroy_context()
-            glfw.destroy_window(self.window)
+            self.platform.close()
             self.window = None
 
     # -------------------------------------------------------------------------- tracing
@@ -260,17 +254,22 @@ class Viewer:
             self.display.show(self.image[0], self.ctx.screen, fb, self.view,
                               self.scene.render.max_iterations, self._depth_scale())
         if self.hud:
-            imgui.backends.opengl3_new_frame()
-            imgui.backends.glfw_new_frame()
-            imgui.new_frame()
+            self.platform.new_frame()
             self.draw_ui(fb)
-            imgui.render()
-            imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+            self.platform.render()
 
     def draw_ui(self, fb: tuple[int, int]) -> None:
         """Everything drawn over the image inside one ImGui frame: the viewer's HUD."""
-        from .hud import draw_hud
-        draw_hud(self)
+        self.execute(draw_hud(self, self.interactions))
+
+    def execute(self, commands: list[Command]) -> None:
+        """Apply what the panels returned: scene edits through the document, calls of this
+        window's own methods."""
+        for c in commands:
+            if isinstance(c, Edit):
+                self.edit(c.path, c.value, c.interaction)
+            else:
+                getattr(self, c.action)(*c.args)
 
     def _depth_scale(self) -> float:
         return max(float(np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))),
@@ -319,10 +318,7 @@ class Viewer:
         elif action == "bookmark":
             self.add_bookmark()
         elif action == "next_bookmark" and self.scene.bookmarks:
-            self.bookmark_index = (self.bookmark_index + 1) % len(self.scene.bookmarks)
-            b = self.scene.bookmarks[self.bookmark_index]
-            self.camera, self.dirty = FlyCamera.from_camera(b.camera), True
-            self.message = f"bookmark {b.name!r}"
+            self.go_to_bookmark((self.bookmark_index + 1) % len(self.scene.bookmarks))
         elif action == "record":
             if self.recording is None:
                 self.recording, self.message = [], "recording the camera path (F5 stops)"
@@ -331,6 +327,21 @@ class Viewer:
                 self.save_path()
         elif action == "replay" and self.path_samples:
             self.replay_start = self.clock
+
+    def go_to_bookmark(self, index: int) -> None:
+        self.bookmark_index = index
+        b = self.scene.bookmarks[index]
+        self.camera, self.dirty = FlyCamera.from_camera(b.camera), True
+        self.message = f"bookmark {b.name!r}"
+
+    def set_target_fps(self, fps: float) -> None:
+        self.adaptive.target_fps = fps
+
+    def set_supersample(self, factor: int) -> None:
+        self.adaptive.supersample, self.dirty = factor, True
+
+    def set_view_mode(self, mode: str) -> None:
+        self.view = mode
 
     def shortcut(self, key: int, shift: bool) -> None:
         """Ctrl+key: the viewer has none; the editor's undo, redo and save."""
@@ -486,77 +497,3 @@ class Viewer:
         raw = self.ctx.screen.read(viewport=(0, 0, w, h), components=3)
         _ = self.ctx.error  # screen reads can leave a GL error pending (DESIGN.md)
         return np.frombuffer(raw, np.uint8).reshape(h, w, 3)[::-1].copy()
-
-    # ------------------------------------------------------------------ window plumbing
-    def _init_imgui(self) -> None:
-        imgui.create_context()
-        implot.create_context()
-        imgui.get_io().set_ini_filename("")
-        addr = ctypes.cast(self.window, ctypes.c_void_p).value
-        self._addr = addr
-        imgui.backends.glfw_init_for_opengl(addr, False)
-        imgui.backends.opengl3_init("#version 430")
-
-    def _install_callbacks(self) -> None:
-        b, a = imgui.backends, self._addr
-
-        def on_key(_w, key, scancode, action, mods):
-            b.glfw_key_callback(a, key, scancode, action, mods)
-            if imgui.get_io().want_capture_keyboard:
-                return                          # typing in a field
-            if action == glfw.PRESS and mods & glfw.MOD_CONTROL:
-                self.shortcut(key, bool(mods & glfw.MOD_SHIFT))
-            elif action != glfw.REPEAT and key in GLFW_KEYS:
-                self.input.key(GLFW_KEYS[key], action == glfw.PRESS)
-
-        def on_button(_w, button, action, mods):
-            b.glfw_mouse_button_callback(a, button, action, mods)
-            if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or self.mouse_claimed()):
-                return                          # the HUD's or a gizmo's press, not the camera's
-            if button == glfw.MOUSE_BUTTON_LEFT:
-                self.left_button(action == glfw.PRESS)
-            if button in GLFW_BUTTONS:
-                self.input.button(GLFW_BUTTONS[button], action == glfw.PRESS)
-                look = GLFW_BUTTONS[button] == LOOK_BUTTON
-                if look and self.orbit_pivot is None:
-                    mode = glfw.CURSOR_DISABLED if action == glfw.PRESS else glfw.CURSOR_NORMAL
-                    glfw.set_input_mode(self.window, glfw.CURSOR, mode)
-
-        def on_cursor(_w, x, y):
-            b.glfw_cursor_pos_callback(a, x, y)
-            self.input.move_cursor(x, y)
-
-        def on_scroll(_w, dx, dy):
-            b.glfw_scroll_callback(a, dx, dy)
-            if not imgui.get_io().want_capture_mouse:
-                self.input.wheel(dy)
-
-        def on_char(_w, c):
-            b.glfw_char_callback(a, c)
-
-        self._callbacks = (on_key, on_button, on_cursor, on_scroll, on_char)  # keep alive
-        glfw.set_key_callback(self.window, on_key)
-        glfw.set_mouse_button_callback(self.window, on_button)
-        glfw.set_cursor_pos_callback(self.window, on_cursor)
-        glfw.set_scroll_callback(self.window, on_scroll)
-        glfw.set_char_callback(self.window, on_char)
-
-
-def _open_window(size: tuple[int, int], title: str, visible: bool):
-    glfw.ERROR_REPORTING = "ignore"  # failures are reported below, as a WindowError
-    if not glfw.init():
-        raise WindowError("cannot open a window: GLFW found no display (is DISPLAY set? "
-                          "use `krsview render` to render headless)")
-    for minor in (5, 3):  # 4.6 fails on llvmpipe (DESIGN.md)
-        glfw.default_window_hints()
-        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
-        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, minor)
-        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
-        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
-        glfw.window_hint(glfw.VISIBLE, visible)
-        window = glfw.create_window(size[0], size[1], title, None, None)
-        if window:
-            glfw.make_context_current(window)
-            glfw.swap_interval(0)
-            return window
-    raise WindowError("cannot open an OpenGL 4.3+ core window on this display")

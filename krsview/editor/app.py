@@ -16,15 +16,14 @@ import numpy as np
 from imgui_bundle import imgui, imguizmo
 import glfw  # noqa: E402  (after imgui, as the viewer)
 
-from ..app.widgets import Interactions
 from ..app.window import Viewer
 from ..gpu.overlay import FAR, NEAR, Overlay, Shapes, camera_matrices
 from ..reference.camera import View, pixel_ray, project, view_of
 from ..reference.geometry import nearest
-from ..scene import SceneError
+from ..scene import Bookmark, SceneError
 from .document import ConflictError
 from .handles import Handle, handles, polyline
-from .panels import Do, Edit, edit_panel
+from .panels import edit_panel
 
 gizmo = imguizmo.im_guizmo
 PICK_PIXELS = 12.0          # a click this close to a handle grabs it
@@ -54,7 +53,6 @@ class Editor(Viewer):
         self.recovered = self.doc.recovery()                  # offered in a modal
         self.conflict = False
         self.scroll_outline = False
-        self.interactions = Interactions()
         self._gizmo_drag = 0
         self._was_using = False
         self._press: tuple[float, float] | None = None
@@ -85,7 +83,6 @@ class Editor(Viewer):
 
     def add_bookmark(self) -> None:
         """In the editor a bookmark is an edit like any other (saved with the scene)."""
-        from ..scene import Bookmark
         b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.camera.to_camera())
         if self.edit(("bookmarks",), self.scene.bookmarks + [b]):
             self.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
@@ -98,22 +95,15 @@ class Editor(Viewer):
             super().file_changed()
 
     # --------------------------------------------------------------------------- actions
-    def execute(self, commands: list) -> None:
-        for c in commands:
-            if isinstance(c, Edit):
-                self.edit(c.path, c.value, c.interaction)
-            else:
-                getattr(self, f"do_{c.action}")(*(() if c.arg is None else (c.arg,)))
-
-    def do_undo(self) -> None:
+    def undo(self) -> None:
         if self.doc.undo():
             self._sync()
 
-    def do_redo(self) -> None:
+    def redo(self) -> None:
         if self.doc.redo():
             self._sync()
 
-    def do_save(self, path: str | None = None, overwrite: bool = False) -> bool:
+    def save(self, path: str | None = None, overwrite: bool = False) -> bool:
         try:
             saved = self.doc.save(path or None, overwrite=overwrite)
         except ConflictError as e:
@@ -127,56 +117,56 @@ class Editor(Viewer):
         self.save_as_text = str(saved)
         return True
 
-    def do_save_as(self, text: str) -> None:
+    def save_as(self, text: str) -> None:
         target = Path(text.strip()).expanduser()
         if target.suffix != ".toml" or target.is_dir():
             self.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
             return
-        self.do_save(str(target))
+        self.save(str(target))
 
-    def do_bake(self) -> None:
+    def bake(self) -> None:
         """Grown tree → route (one undo step): every fork becomes a handle."""
         t = self.scene.tree
         self.doc.commit(replace(self.scene, tree=None, route=t.route()), "bake the tree into a route")
         self._sync()
         self.message = "baked: drag forks, control points and mirror normals"
 
-    def do_select(self, h: Handle | None) -> None:
+    def select(self, h: Handle | None) -> None:
         self.selected = h
         self.scroll_outline = True
 
-    def do_select_level(self, level: int) -> None:
-        self.do_select(next((h for h in self.handles if h.level == level), None))
+    def select_level(self, level: int) -> None:
+        self.select(next((h for h in self.handles if h.level == level), None))
 
-    def do_snap(self, on: bool) -> None:
+    def set_snap(self, on: bool) -> None:
         self.snap.on = on
 
-    def do_reload(self) -> None:
+    def take_file(self) -> None:
         self.conflict = False
         super().file_changed()
 
-    def do_keep_mine(self) -> None:
+    def keep_mine(self) -> None:
         self.conflict, self.message = False, "kept your edits; saving will ask to overwrite"
 
-    def do_restore(self) -> None:
+    def restore(self) -> None:
         self.doc.restore_recovery()
         self.recovered = None
         self._sync()
         self.message = "restored the unsaved edits (Ctrl+Z undoes the restore)"
 
-    def do_discard_recovery(self) -> None:
+    def discard_recovery(self) -> None:
         self.doc.discard_recovery()
         self.recovered = None
 
-    def do_answer_save(self) -> None:
-        if self.do_save():
+    def answer_save(self) -> None:
+        if self.save():
             self._answered()
 
-    def do_answer_discard(self) -> None:
+    def answer_discard(self) -> None:
         self.doc.discard_recovery()
         self._answered()
 
-    def do_answer_cancel(self) -> None:
+    def answer_cancel(self) -> None:
         self.asking = None
 
     def _answered(self) -> None:
@@ -189,11 +179,11 @@ class Editor(Viewer):
 
     def shortcut(self, key: int, shift: bool) -> None:
         if key == glfw.KEY_Z:
-            self.do_redo() if shift else self.do_undo()
+            self.redo() if shift else self.undo()
         elif key == glfw.KEY_Y:
-            self.do_redo()
+            self.redo()
         elif key == glfw.KEY_S:
-            self.do_save_as(self.save_as_text) if shift else self.do_save()
+            self.save_as(self.save_as_text) if shift else self.save()
 
     # ---------------------------------------------------------------- closing and opening
     def should_close(self) -> bool:
@@ -247,7 +237,7 @@ class Editor(Viewer):
                 best, best_d = h, d
         if best is None:
             best = self._pick_surface(v, x, y)
-        self.do_select(best)
+        self.select(best)
         return best
 
     def _pick_surface(self, v: View, x: float, y: float) -> Handle | None:

@@ -3,11 +3,12 @@ writes the editor or the scene itself (the editor applies the commands through t
 so the arrows run one way: editor app → panels."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from typing import TYPE_CHECKING, Any
 
 from imgui_bundle import imgui
 
+from ..app.commands import Command, Do, Edit
 from ..app.widgets import Interactions, field_widget
 from ..scene.edits import get_at
 from .handles import outline
@@ -20,21 +21,8 @@ YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 
 
-@dataclass(frozen=True)
-class Edit:
-    path: tuple
-    value: Any
-    interaction: Any = None
-
-
-@dataclass(frozen=True)
-class Do:
-    action: str          # a method of the editor's command table (Editor.actions)
-    arg: Any = None
-
-
-def edit_panel(e: "Editor", interactions: Interactions) -> list:
-    out: list = []
+def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
+    out: list[Command] = []
     imgui.set_next_window_pos(imgui.ImVec2(e.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever)
     imgui.set_next_window_size(imgui.ImVec2(340, e.adaptive.full[1] - 16), imgui.Cond_.first_use_ever)
     imgui.set_next_window_bg_alpha(0.8)
@@ -60,7 +48,7 @@ def edit_panel(e: "Editor", interactions: Interactions) -> list:
     if imgui.collapsing_header("snapping"):
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
-            out.append(Do("snap", on))
+            out.append(Do("set_snap", on))
         imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
     imgui.end()
     _modals(e, out)
@@ -95,7 +83,7 @@ def _file(e: "Editor", out: list) -> None:
     if e.conflict:
         imgui.text_colored(RED, f"{doc.path.name} changed on disk, and you have unsaved edits.")
         if imgui.button("take the file (your edits stay undoable)"):
-            out.append(Do("reload"))
+            out.append(Do("take_file"))
         imgui.same_line()
         if imgui.button("keep mine"):
             out.append(Do("keep_mine"))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import MoKRS
-from . import mobius
+from ..algebra import mobius
 from .compiled import kernel_records
 from .kernels import kernel_distance, world_normal
 

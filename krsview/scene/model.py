@@ -9,6 +9,8 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+
 from .schema import SceneError, Tagged, Vec3, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
@@ -226,7 +228,6 @@ class Arc:
 
 def arc_of(k: ToroidalCapsule) -> Arc | None:
     """The arc through start, control, end; None when nearly straight (draw as a capsule)."""
-    import numpy as np
     A, C, B = (np.array(p, dtype=float) for p in (k.start, k.control, k.end))
     a, b = A - C, B - C
     axb = np.cross(a, b)

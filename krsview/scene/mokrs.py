@@ -8,10 +8,13 @@ G_i maps that space into level i+1's (the last level's G maps into the world).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import ClassVar
 
-from .model import Empty, Kernel, check_level_count
+import numpy as np
+
+from ..algebra import mobius
+from .model import Empty, Kernel, Plane, check_level_count
 from .schema import SceneError, Tagged, Vec3, param
 
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
@@ -34,7 +37,6 @@ class Translate(MobiusStep):
     by: Vec3 = param((0.0, 0.0, 0.0), help="translation vector")
 
     def matrix(self):
-        from ..reference import mobius
         return mobius.translation(self.by)
 
 
@@ -45,7 +47,6 @@ class Scale(MobiusStep):
     factor: float = param(1.0, lo=1e-6, hi=1e6, help="dilation factor s")
 
     def matrix(self):
-        from ..reference import mobius
         return mobius.dilation(self.factor)
 
 
@@ -57,7 +58,6 @@ class Rotate(MobiusStep):
     degrees: float = param(0.0, lo=-360.0, hi=360.0, unit="degrees", help="angle (right hand)")
 
     def matrix(self):
-        from ..reference import mobius
         return mobius.rotation(self.axis, math.radians(self.degrees))
 
 
@@ -70,7 +70,7 @@ class Invert(MobiusStep):
     radius: float = param(1.0, lo=1e-6, hi=1e6, help="radius r of the fixed sphere")
 
     def matrix(self):
-        from ..reference import mobius as M
+        M = mobius
         neg = tuple(-v for v in self.center)
         return M.compose(M.translation(self.center), M.dilation(self.radius),
                          M.inversion(), M.dilation(1.0 / self.radius), M.translation(neg))
@@ -86,12 +86,10 @@ class MobiusLevel:
 
     def matrix(self):
         """G_i as a quaternion matrix: the last step applied last (leftmost)."""
-        from ..reference import mobius
         return mobius.compose(mobius.identity(), *[s.matrix() for s in reversed(self.transform)])
 
     def inverse(self):
         """G_i⁻¹, which the tracer applies going inwards, with a rounding-level c zeroed."""
-        from ..reference import mobius
         return mobius.tidy(mobius.inverse(self.matrix()))
 
 
@@ -101,7 +99,6 @@ class MoKRS:
     levels: list[MobiusLevel] = param([], help="level 0 first (finest), last level coarsest")
 
     def validate(self, path: str) -> None:
-        from ..reference import mobius
         p = f"{path}.levels"
         check_level_count(self.levels, p, "a MöKRS needs at least one level")
         for i, lv in enumerate(self.levels):
@@ -145,8 +142,6 @@ POLE_DISTANCE = 1e-6  # a viewpoint closer than this (× the level's scale) to a
 def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
     """Follow a viewpoint into every level (mirror tests on the point, as the tracer does) and
     reject it where a level's inverse transformation sends it to infinity."""
-    import numpy as np
-    from ..reference import mobius
     x = np.array([position], dtype=np.float64)
     for i in range(mokrs.n - 1, -1, -1):
         H = mokrs.levels[i].inverse()
@@ -166,10 +161,6 @@ def mokrs_of(krs) -> MoKRS:
     """The same geometry as a plain KRS, written as a MöKRS with rigid transforms: level i's
     space puts mirror R_i on x = 0 (normal along +x), so folding there is Alg. 1's fold
     (used by the tracer cross-check). The top kernel K_n stays in the world, unreflected."""
-    import numpy as np
-    from dataclasses import fields, replace
-    from ..reference import mobius
-    from .model import Plane
 
     def to_x(u):
         """Axis and degrees of the rotation taking unit u to +x."""

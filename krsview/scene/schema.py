@@ -45,7 +45,7 @@ def param(default: Any = MISSING, *, lo: float | None = None, hi: float | None =
     return field(default=default, metadata=meta)
 
 
-def _describe_range(meta: dict) -> str:
+def describe_range(meta: dict) -> str:
     lo, hi = meta.get("lo"), meta.get("hi")
     unit = f" {meta['unit']}" if meta.get("unit") else ""
     if lo is not None and hi is not None:
@@ -63,11 +63,11 @@ def _check_number(x: Any, path: str, meta: dict, kind: type) -> float | int:
     if kind is int and not isinstance(x, int):
         raise SceneError(path, x, "expected a whole number")
     if not math.isfinite(x):
-        raise SceneError(path, x, "NaN and infinity are not allowed; " + _describe_range(meta))
+        raise SceneError(path, x, "NaN and infinity are not allowed; " + describe_range(meta))
     lo, hi = meta.get("lo"), meta.get("hi")
     below = lo is not None and (x <= lo if meta.get("lo_open") else x < lo)
     if below or (hi is not None and x > hi):
-        raise SceneError(path, x, _describe_range(meta))
+        raise SceneError(path, x, describe_range(meta))
     return kind(x)
 
 

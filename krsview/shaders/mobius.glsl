@@ -1,5 +1,5 @@
 // Möbius transformations H_i = G_i⁻¹ of the MöKRS levels [KRS17 §6.2, App. C]; twin of
-// reference/mobius.py (apply, map_ball, gradient). Record per level: a, b, c, d, then
+// algebra/mobius.py (apply, map_ball, gradient). Record per level: a, b, c, d, then
 // (pole.xyz, flags) with a pole, or (|a|/|d|, 0, 0, flags) for a similarity (c = 0);
 // flags = has_pole + 2 · reflects.
 #include "quaternion.glsl"

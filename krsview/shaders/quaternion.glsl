@@ -1,4 +1,4 @@
-// Quaternions as vec4(real, i, j, k) [KRS17 §6.2]; twin of reference/quaternion.py.
+// Quaternions as vec4(real, i, j, k) [KRS17 §6.2]; twin of algebra/quaternion.py.
 vec4 qpure(vec3 v) { return vec4(0.0, v); }
 
 vec4 qmul(vec4 p, vec4 q) {

@@ -1,0 +1,2 @@
+"""Quaternions and quaternion Möbius maps [KRS17 §6, App. A–C]: NumPy only, used by the scene
+model (to validate and compose MöKRS levels) and by the reference tracer."""

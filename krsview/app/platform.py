@@ -1,0 +1,120 @@
+"""The platform layer: a GLFW window with an OpenGL 4.3+ core context, Dear ImGui's GLFW and
+OpenGL3 backends, and the routing of GLFW events to ImGui first, then to the window's own
+input (keys, buttons, cursor, wheel) unless ImGui or a gizmo wants them."""
+from __future__ import annotations
+
+import ctypes
+from typing import Protocol
+
+from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
+import glfw  # noqa: E402  (order matters)
+
+from .controls import CONTROLS, LOOK_BUTTON, Input
+
+GLFW_KEYS = {getattr(glfw, f"KEY_{k}"): k for k in set(CONTROLS.values())}
+GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
+
+
+class WindowError(RuntimeError):
+    """No window could be opened (no display, or no OpenGL 4.3+ there)."""
+
+
+class Receiver(Protocol):
+    """What the events are delivered to (the viewer, the editor)."""
+    input: Input
+    orbit_pivot: object
+
+    def shortcut(self, key: int, shift: bool) -> None: ...
+    def mouse_claimed(self) -> bool: ...
+    def left_button(self, down: bool) -> None: ...
+
+
+class Platform:
+    def __init__(self, size: tuple[int, int], title: str, visible: bool):
+        self.window = open_window(size, title, visible)
+        imgui.create_context()
+        implot.create_context()
+        imgui.get_io().set_ini_filename("")
+        self.addr = ctypes.cast(self.window, ctypes.c_void_p).value
+        imgui.backends.glfw_init_for_opengl(self.addr, False)
+        imgui.backends.opengl3_init("#version 430")
+
+    def close(self) -> None:
+        imgui.backends.opengl3_shutdown()
+        imgui.backends.glfw_shutdown()
+        implot.destroy_context()
+        imgui.destroy_context()
+        glfw.destroy_window(self.window)
+
+    def route_events(self, to: Receiver) -> None:
+        b, a, window = imgui.backends, self.addr, self.window
+
+        def on_key(_w, key, scancode, action, mods):
+            b.glfw_key_callback(a, key, scancode, action, mods)
+            if imgui.get_io().want_capture_keyboard:
+                return                          # typing in a field
+            if action == glfw.PRESS and mods & glfw.MOD_CONTROL:
+                to.shortcut(key, bool(mods & glfw.MOD_SHIFT))
+            elif action != glfw.REPEAT and key in GLFW_KEYS:
+                to.input.key(GLFW_KEYS[key], action == glfw.PRESS)
+
+        def on_button(_w, button, action, mods):
+            b.glfw_mouse_button_callback(a, button, action, mods)
+            if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or to.mouse_claimed()):
+                return                          # the HUD's or a gizmo's press, not the camera's
+            if button == glfw.MOUSE_BUTTON_LEFT:
+                to.left_button(action == glfw.PRESS)
+            if button in GLFW_BUTTONS:
+                to.input.button(GLFW_BUTTONS[button], action == glfw.PRESS)
+                look = GLFW_BUTTONS[button] == LOOK_BUTTON
+                if look and to.orbit_pivot is None:
+                    mode = glfw.CURSOR_DISABLED if action == glfw.PRESS else glfw.CURSOR_NORMAL
+                    glfw.set_input_mode(window, glfw.CURSOR, mode)
+
+        def on_cursor(_w, x, y):
+            b.glfw_cursor_pos_callback(a, x, y)
+            to.input.move_cursor(x, y)
+
+        def on_scroll(_w, dx, dy):
+            b.glfw_scroll_callback(a, dx, dy)
+            if not imgui.get_io().want_capture_mouse:
+                to.input.wheel(dy)
+
+        def on_char(_w, c):
+            b.glfw_char_callback(a, c)
+
+        self._callbacks = (on_key, on_button, on_cursor, on_scroll, on_char)  # keep alive
+        glfw.set_key_callback(window, on_key)
+        glfw.set_mouse_button_callback(window, on_button)
+        glfw.set_cursor_pos_callback(window, on_cursor)
+        glfw.set_scroll_callback(window, on_scroll)
+        glfw.set_char_callback(window, on_char)
+
+    def new_frame(self) -> None:
+        imgui.backends.opengl3_new_frame()
+        imgui.backends.glfw_new_frame()
+        imgui.new_frame()
+
+    def render(self) -> None:
+        imgui.render()
+        imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+
+def open_window(size: tuple[int, int], title: str, visible: bool):
+    glfw.ERROR_REPORTING = "ignore"  # failures are reported below, as a WindowError
+    if not glfw.init():
+        raise WindowError("cannot open a window: GLFW found no display (is DISPLAY set? "
+                          "use `krsview render` to render headless)")
+    for minor in (5, 3):  # 4.6 fails on llvmpipe (DESIGN.md)
+        glfw.default_window_hints()
+        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
+        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, minor)
+        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
+        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
+        glfw.window_hint(glfw.VISIBLE, visible)
+        window = glfw.create_window(size[0], size[1], title, None, None)
+        if window:
+            glfw.make_context_current(window)
+            glfw.swap_interval(0)
+            return window
+    raise WindowError("cannot open an OpenGL 4.3+ core window on this display")
