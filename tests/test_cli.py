@@ -42,7 +42,7 @@ def test_reference_render_matches_size(tmp_path):
     (["render", "tree", "--epsilon-scale", "0"], "--epsilon-scale = 0.0: allowed: 0.0001 ≤ value"),
     (["render", "tree", "--max-iterations", "-3"], "--max-iterations = -3: allowed: 1 ≤ value ≤ 10000"),
     (["render", "tree", "--tracer", "bent"], "--tracer = 'bent': allowed: 'sphere', 'binary'"),
-    (["render", "no-such-preset"], "not a file and not a preset; presets: forest, grass, grove, inversion"),
+    (["render", "no-such-preset"], "not a file and not a preset; presets: bent-tree, forest, grass, grove"),
     (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
     (["check", "missing.toml"], "no such scene file"),
     (["frobnicate"], "invalid choice"),

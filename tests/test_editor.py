@@ -266,3 +266,18 @@ def test_save_as_a_bad_name_is_a_clear_error(editor, tmp_path):
     assert "ends in .toml" in e.error or "ending in .toml" in e.error
     e.save_as(str(tmp_path / "copy.toml"))
     assert e.path == tmp_path / "copy.toml" and load_scene(tmp_path / "copy.toml") == e.scene
+
+
+def test_opening_another_scene_with_unsaved_edits_asks_first(editor):
+    e = editor
+    assert e.edit(("render", "epsilon_scale"), 2.0)
+    e.doc.autosave(0.0)
+    e.doc.autosave(10.0)
+    recovery = e.doc.recovery_path
+    assert recovery.exists()
+    e.open_preset(resolve("sierpinski"))
+    assert e.asking == ("open", resolve("sierpinski")) and e.scene.name == "tree"
+    pump(e)                                      # the question is drawn as a modal
+    e.answer_discard()
+    assert e.scene.name == "sierpinski" and e.asking is None and not e.doc.dirty
+    assert not recovery.exists(), "discarded edits left a recovery file to be offered later"

@@ -37,14 +37,48 @@ def test_a_route_has_a_fork_and_control_per_level_and_a_normal_above_level_0(rou
     assert np.allclose(line[0], route_scene.route.base) and np.allclose(line[-1], route_scene.route.levels[0].fork)
 
 
-def test_dragging_a_fork_moves_the_branch_end_and_the_childs_start(route_scene):
+def test_dragging_a_fork_alone_moves_the_branch_end_and_the_childs_start(route_scene):
     h = by(handles(route_scene), ("route", "levels", 7, "fork"))
     p = h.position + np.array([0.1, -0.05, 0.2])
-    s = apply_edit(route_scene, h.path, h.value_at(route_scene, p))
+    s = apply_edit(route_scene, *h.edit_to(route_scene, p, carry=False))
     krs = s.geometry()
     assert np.allclose(krs.levels[7].kernel.end, p) and np.allclose(krs.levels[6].kernel.start, p)
+    assert krs.levels[5] == route_scene.geometry().levels[5]
     m = krs.levels[7].mirror                        # the fork's mirror follows the fork
     assert abs(np.array(m.normal) @ p - m.offset) < 1e-12
+
+
+def test_a_dragged_fork_carries_its_subtree_rigidly(route_scene):
+    """Every finer kernel moves by the drag, every finer mirror keeps its normal and passes
+    through its moved fork: the subtree is the same geometry, translated (checked on the
+    expanded KRS with the reference distance), and the crown stays attached."""
+    from krsview.reference.compiled import compile_krs
+    from krsview.reference.krs import distance
+    from krsview.scene import KRS
+    i = 20
+    h = by(handles(route_scene), ("route", "levels", i, "fork"))
+    delta = np.array([-0.6, 0.1, 0.3])
+    s = apply_edit(route_scene, *h.edit_to(route_scene, h.position + delta))
+    assert np.allclose(s.route.levels[i].fork, h.position + delta)
+    sub0 = KRS(route_scene.geometry().levels[:i])
+    sub1 = KRS(s.geometry().levels[:i])
+    pts = np.random.default_rng(5).normal(np.array(h.position), 1.0, (2000, 3))
+    d0 = distance(compile_krs(sub0, (0.5,) * 3), pts)
+    d1 = distance(compile_krs(sub1, (0.5,) * 3), pts + delta)
+    np.testing.assert_allclose(d1, d0, atol=1e-9)
+    assert s.route.warnings() == [], "carrying the subtree made a branch cross its mirror"
+    # negative control: moving the fork alone detaches the crown (Alg. 1 clips it)
+    alone = apply_edit(route_scene, *h.edit_to(route_scene, h.position + delta, carry=False))
+    assert alone.route.warnings()
+
+
+def test_dragging_the_trunk_foot_moves_the_whole_tree(route_scene):
+    h = by(handles(route_scene), ("route", "base"))
+    delta = np.array([1.0, 0.0, -2.0])
+    s = apply_edit(route_scene, *h.edit_to(route_scene, h.position + delta))
+    for k0, k1 in zip(route_scene.geometry().kernels, s.geometry().kernels):
+        assert np.allclose(np.subtract(k1.start, k0.start), delta)
+        assert np.allclose(np.subtract(k1.end, k0.end), delta)
 
 
 def test_dragging_a_normal_tip_turns_the_mirror_about_its_fork(route_scene):

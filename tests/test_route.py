@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -162,3 +163,14 @@ def test_a_child_crossing_its_forks_mirror_is_a_warning_naming_the_level():
     assert w.startswith("levels[0]:") and "levels[1].normal" in w and "clips" in w
     # the shipped trees' small bends stay inside the fork joint: no warning
     assert load_scene(resolve("tree")).tree.route().warnings() == []
+
+
+def test_the_readme_route_example_loads_without_warnings():
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    block = readme[readme.index("```toml\n[route]") + 8:]
+    scene = scene_from_toml(block[:block.index("```")], "README.md")
+    assert scene.route.warnings() == [] and scene.geometry().instance_count() == 3
+    # negative control: turning its mirror puts the twig on the positive side
+    turned = replace(scene.route, levels=[scene.route.levels[0],
+                                          replace(scene.route.levels[1], normal=(-1.0, 0.0, 0.0))])
+    assert turned.warnings()

@@ -48,6 +48,7 @@ class Editor(Viewer):
         super().__init__(path, **kw)
         self.overlay = Overlay(self.ctx, self.renderer.programs)
         self.snap = Snap()
+        self.carry = True                     # a fork drag takes its subtree along
         self.save_as_text = str(self.path)
         self.asking: tuple[str, Path | None] | None = None   # unsaved edits: close / open?
         self.recovered = self.doc.recovery()                  # offered in a modal
@@ -140,6 +141,9 @@ class Editor(Viewer):
 
     def set_snap(self, on: bool) -> None:
         self.snap.on = on
+
+    def set_carry(self, on: bool) -> None:
+        self.carry = on
 
     def take_file(self) -> None:
         self.conflict = False
@@ -332,7 +336,7 @@ class Editor(Viewer):
             p = np.array(m.values[12:15], dtype=np.float64) + v.origin
             if snap and h.kind == "normal":
                 p = h.pivot + _snap_direction(p - h.pivot, self.snap.angle)
-            self.edit(h.path, h.value_at(self.scene, p), ("gizmo", self._gizmo_drag))
+            self.edit(*h.edit_to(self.scene, p, self.carry), ("gizmo", self._gizmo_drag))
 
 
 def _snap_direction(d: np.ndarray, degrees: float) -> np.ndarray:

@@ -5,7 +5,7 @@ a compound its components' placements. Pure NumPy: the window draws and drags th
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -25,6 +25,31 @@ class Handle:
     label: str
     owner: Path              # the table the selection panel shows (a level, a component)
     pivot: np.ndarray | None = None   # "normal": the arrow's foot (a fork, a point on a mirror)
+
+    def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
+        """The edit (field path, new value) that puts the handle at ``p``. With ``carry``, a
+        route fork takes its subtree along (the finer forks and control points move with
+        it, the branch's own control by half, so its bend stays) and the trunk's foot the
+        whole tree: the mirrors at the moved forks move with them, so nothing that grew
+        on the negative side of a mirror crosses it (a bone chain, as people expect)."""
+        if carry and self.kind == "point" and self.path[0] == "route" and \
+                self.path[-1] in ("fork", "base"):
+            return self._carry(scene, p)
+        return self.path, self.value_at(scene, p)
+
+    def _carry(self, scene: Scene, p: np.ndarray) -> tuple[Path, Any]:
+        route = scene.route
+        delta = p - self.position
+        i = len(route.levels) if self.path[-1] == "base" else self.path[2]
+
+        def moved(v: tuple, f: float = 1.0) -> tuple:
+            return tuple(float(c) for c in np.array(v) + f * delta)
+        levels = [replace(lv, fork=moved(lv.fork), control=moved(lv.control)) if j < i else
+                  replace(lv, fork=moved(lv.fork), control=moved(lv.control, 0.5)) if j == i else lv
+                  for j, lv in enumerate(route.levels)]
+        if self.path[-1] == "base":
+            return ("route",), replace(route, base=moved(route.base), levels=levels)
+        return ("route", "levels"), levels
 
     def value_at(self, scene: Scene, p: np.ndarray) -> Any:
         """The field's new value when the handle is dragged to ``p``."""

@@ -39,13 +39,21 @@ def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
                            "fields below.")
     else:
         for w in scene.route.warnings() if scene.route else []:
-            imgui.text_colored(YELLOW, "route." + w)
+            imgui.push_style_color(imgui.Col_.text, YELLOW)
+            imgui.text_wrapped("route." + w)
+            imgui.pop_style_color()
         _outline(e, out)
         if imgui.collapsing_header("selection", imgui.TreeNodeFlags_.default_open):
             _selection(e, out, interactions)
     if imgui.collapsing_header("material"):
         _fields(scene.material, ("material",), out, interactions)
-    if imgui.collapsing_header("snapping"):
+    if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
+        changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
+        if changed:
+            out.append(Do("set_carry", on))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("on: the finer forks, control points and mirrors move with a "
+                              "dragged fork, so the crown stays attached; off: only the fork")
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
             out.append(Do("set_snap", on))
