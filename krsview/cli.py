@@ -243,6 +243,14 @@ def build_parser() -> argparse.ArgumentParser:
                         help="comma-separated effects replacing the scene's, or 'none'; one of: "
                              + ", ".join(EFFECTS))
 
+    def window_arguments(sp: argparse.ArgumentParser, size: tuple[int, int]) -> None:
+        sp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+        sp.add_argument("--size", type=_size, default=size,
+                        help=f"window size (default {size[0]}x{size[1]})")
+        sp.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
+                        help="frame rate held while moving or dragging, by lowering the "
+                             "internal resolution (default 30)")
+
     def bench_arguments(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
         sp.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
@@ -279,11 +287,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "bookmark in the preset, N cycles bookmarks, F5 records and F6 "
                                    "replays a camera path, F12 saves a screenshot, F1 hides the "
                                    "HUD. Editing the preset or a shader reloads it.")
-    v.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    v.add_argument("--size", type=_size, default=(960, 540), help="window size (default 960x540)")
-    v.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
-                   help="frame rate held while moving by lowering the internal resolution "
-                        "(default 30)")
+    window_arguments(v, (960, 540))
     v.add_argument("--no-hud", action="store_true", help="start with the HUD hidden")
     v.set_defaults(func=cmd_view)
 
@@ -297,10 +301,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "Ctrl+S saves atomically, Ctrl+Shift+S saves as; unsaved "
                                    "edits are autosaved to PRESET.recovery and offered back "
                                    "after a crash. The viewer's keys fly the camera.")
-    e.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    e.add_argument("--size", type=_size, default=(1280, 720), help="window size (default 1280x720)")
-    e.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
-                   help="frame rate held while dragging or flying (default 30)")
+    window_arguments(e, (1280, 720))
     e.set_defaults(func=cmd_edit)
 
     c = sub.add_parser("check", help="validate a scene file and print its statistics",

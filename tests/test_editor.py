@@ -281,3 +281,23 @@ def test_opening_another_scene_with_unsaved_edits_asks_first(editor):
     e.answer_discard()
     assert e.scene.name == "sierpinski" and e.asking is None and not e.doc.dirty
     assert not recovery.exists(), "discarded edits left a recovery file to be offered later"
+
+
+@pytest.mark.parametrize("preset, entries", [("rock", 13), ("grove", 8), ("palm", 0)])
+def test_the_editor_opens_every_kind_of_scene(display, tmp_path, preset, entries):
+    """A KRS shows its levels, a compound its components, a MöKRS no handles (and says so);
+    the panels draw without an error."""
+    from krsview.editor.app import Editor
+    from krsview.editor.handles import outline
+    path = tmp_path / f"{preset}.toml"
+    shutil.copy(resolve(preset), path)
+    e = Editor(path, size=(400, 300))
+    try:
+        pump(e, 3)
+        assert len(outline(e.scene)) == entries and not e.error
+        if entries:
+            e.select_level(entries - 1)
+            pump(e, 2)
+            assert e.selected is not None and not e.error
+    finally:
+        e.close()

@@ -47,6 +47,10 @@ def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
             _selection(e, out, interactions)
     if imgui.collapsing_header("material"):
         _fields(scene.material, ("material",), out, interactions)
+    if imgui.collapsing_header("effect settings"):
+        imgui.text_disabled("effects: " + (", ".join(scene.effects) or "none") +
+                            " (switched in the krsview window)")
+        _fields(scene.effect_settings, ("effect_settings",), out, interactions)
     if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
         changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
         if changed:

@@ -109,6 +109,17 @@ def check_level_count(levels: list, path: str, empty: str) -> None:
                          f"too many levels; allowed: at most {MAX_LEVELS}")
 
 
+def check_mirror_per_level(levels: list, path: str, name: str, none_at_0: str,
+                           needed_above: str) -> None:
+    """A KRS's shape [KRS17 §3]: level 0 has no mirror, every level above has one (field
+    ``name`` of each level)."""
+    if getattr(levels[0], name) is not None:
+        raise SceneError(f"{path}[0].{name}", to_dict(getattr(levels[0], name)), none_at_0)
+    for i, lv in enumerate(levels[1:], 1):
+        if getattr(lv, name) is None:
+            raise SceneError(f"{path}[{i}].{name}", "<missing>", needed_above)
+
+
 @dataclass(frozen=True)
 class KRS:
     """A kernel–reflection sequence (K_0..K_n; R_0..R_{n-1}) [KRS17 §3]."""
@@ -117,13 +128,9 @@ class KRS:
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
         check_level_count(self.levels, p, "a KRS needs at least one level (level 0: a kernel)")
-        if self.levels[0].mirror is not None:
-            raise SceneError(f"{p}[0].mirror", to_dict(self.levels[0].mirror),
-                             "level 0 has no mirror (it holds only kernel K_0)")
-        for i, lv in enumerate(self.levels[1:], 1):
-            if lv.mirror is None:
-                raise SceneError(f"{p}[{i}].mirror", "<missing>",
-                                 "every level above 0 needs a mirror {normal, offset}")
+        check_mirror_per_level(self.levels, p, "mirror",
+                               "level 0 has no mirror (it holds only kernel K_0)",
+                               "every level above 0 needs a mirror {normal, offset}")
 
     @property
     def depth(self) -> int:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .model import (KRS, MAX_LEVELS, Empty, Kernel, Level, Mirror, ToroidalCapsule, _COLOR,
-                    arc_of)
+                    arc_of, check_mirror_per_level)
 from .schema import SceneError, Vec3, param
 
 FORK_SEPARATION = 1e-9   # forks closer than this × the route's size are "on top of each other"
@@ -57,13 +57,9 @@ class Route:
         if len(self.levels) + len(self.forest) > MAX_LEVELS:
             raise SceneError(p, f"<{len(self.levels)} levels, {len(self.forest)} forest>",
                              f"levels + forest mirrors must be ≤ {MAX_LEVELS}")
-        if self.levels[0].normal is not None:
-            raise SceneError(f"{p}[0].normal", list(self.levels[0].normal),
-                             "level 0 is the twig: no mirror forks there; remove the normal")
-        for i, lv in enumerate(self.levels[1:], 1):
-            if lv.normal is None:
-                raise SceneError(f"{p}[{i}].normal", "<missing>",
-                                 "every level above 0 needs the normal of its fork's mirror")
+        check_mirror_per_level(self.levels, p, "normal",
+                               "level 0 is the twig: no mirror forks there; remove the normal",
+                               "every level above 0 needs the normal of its fork's mirror")
         forks = np.array([self.base] + [lv.fork for lv in self.levels])
         size = max(float(np.ptp(forks, axis=0).max()), 1.0)
         for i, (start, lv) in enumerate(zip(self.starts(), self.levels)):
