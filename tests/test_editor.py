@@ -301,3 +301,25 @@ def test_the_editor_opens_every_kind_of_scene(display, tmp_path, preset, entries
             assert e.selected is not None and not e.error
     finally:
         e.close()
+
+
+def test_a_panel_drag_is_one_undo_step_and_a_second_drag_another(editor):
+    """Drag the selected branch's radius field in the panel with the real pointer."""
+    e = editor
+    e.execute([Do("bake")])
+    e.select_level(LEVEL)
+    pump(e, 3)
+    path = ("route", "levels", LEVEL, "radius")
+    x0, y0, x1, y1 = e.interactions.rects[path]
+    r0, steps0 = e.scene.route.levels[LEVEL].radius, len(e.doc.history.steps)
+    import glfw
+    wx, wy = glfw.get_window_pos(e.window)
+    drag(e, (wx + (x0 + x1) / 2, wy + (y0 + y1) / 2), (40, 0))
+    r1 = e.scene.route.levels[LEVEL].radius
+    assert r1 > r0 and len(e.doc.history.steps) == steps0 + 1, (r0, r1, e.doc.history.labels())
+    drag(e, (wx + (x0 + x1) / 2, wy + (y0 + y1) / 2), (-20, 0))
+    assert e.scene.route.levels[LEVEL].radius < r1 and len(e.doc.history.steps) == steps0 + 2
+    e.undo()
+    assert e.scene.route.levels[LEVEL].radius == r1
+    e.undo()
+    assert e.scene.route.levels[LEVEL].radius == r0

@@ -6,8 +6,7 @@ Each widget reports its interaction: a slider or drag held down is one interacti
 many values it produces merge into one undo step (DESIGN.md, One seam for edits)."""
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from imgui_bundle import imgui
@@ -17,13 +16,17 @@ LOG_RATIO = 100.0   # a range spanning more than this factor gets a logarithmic 
 
 @dataclass
 class Interactions:
-    """Numbers each press-and-drag of a widget, so its edits merge into one undo step."""
+    """Numbers each press-and-drag of a widget, so its edits merge into one undo step; keeps
+    where each field's widget was drawn (window pixels), for automation and window tests."""
     count: int = 0
+    rects: dict[tuple, tuple[float, float, float, float]] = field(default_factory=dict)
 
     def key(self, path: tuple) -> tuple:
         """Call right after the widget: a new number when it was just activated."""
         if imgui.is_item_activated():
             self.count += 1
+        lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        self.rects[path] = (lo.x, lo.y, hi.x, hi.y)
         return ("panel", path, self.count)
 
 
@@ -37,10 +40,12 @@ def _tooltip(meta: dict) -> None:
 
 
 def _speed(value: float, meta: dict) -> float:
+    """Change per pixel dragged: 1 % of the value, at most 1/500 of a bounded range."""
+    speed = max(abs(value) * 0.01, 1e-4)
     lo, hi = meta.get("lo"), meta.get("hi")
-    if lo is not None and hi is not None and math.isfinite(hi - lo):
-        return max((hi - lo) / 500.0, 1e-6)
-    return max(abs(value) * 0.01, 1e-3)
+    if lo is not None and hi is not None:
+        speed = min(speed, (hi - lo) / 500.0)
+    return speed
 
 
 def field_widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
