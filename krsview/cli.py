@@ -220,6 +220,29 @@ def cmd_bench_effects(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bench_accuracy(args: argparse.Namespace) -> int:
+    from .bench.accuracy import bench_accuracy
+    scene = _load(args)
+    out = Path(args.out) if args.out else Path("out") / "accuracy" / resolve(args.preset).stem
+    check_output_dir(out, "--out")
+    bench_accuracy(scene, args.size, out, rounds=args.rounds,
+                   cache=Path(args.cache) if args.cache else None)
+    return 0
+
+
+def check_output_dir(path: Path, flag: str) -> None:
+    """Before any work: the folder exists or can be made, and is writable."""
+    if path.exists() and not path.is_dir():
+        raise SceneError(flag, str(path), "is a file; give a folder for the report")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as e:
+        raise SceneError(flag, str(path), f"cannot write there: {e.strerror}") from None
+
+
 def build_parser() -> argparse.ArgumentParser:
     presets = ", ".join(preset_names()) or "none found"
     p = argparse.ArgumentParser(
@@ -309,7 +332,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("preset", metavar="PRESET")
     c.set_defaults(func=cmd_check)
 
-    b = sub.add_parser("bench", help="benchmarks (levels, tracers, effects)",
+    b = sub.add_parser("bench", help="benchmarks (levels, tracers, effects, accuracy)",
                        description="Benchmarks that report ratios measured side by side.")
     bsub = b.add_subparsers(dest="bench", required=True, metavar="BENCH")
     bl = bsub.add_parser("levels", help="frame time against level count (O(n) vs 2^n)",
@@ -344,6 +367,25 @@ def build_parser() -> argparse.ArgumentParser:
     bench_arguments(be)
     accuracy(be)
     be.set_defaults(func=cmd_bench_effects)
+    ba = bsub.add_parser("accuracy", help="what accuracy costs: every knob against time and "
+                         "ground truth, as a report with plots",
+                         description="On one view: sweep ε-scale, the iteration cap, the "
+                                     "tracer (sphere, binary with ξ pairs) and the level count; "
+                                     "time each setting on the GPU (interleaved rounds, "
+                                     "medians) and compare its image with the ground truth "
+                                     "(the float64 reference at ε/8, computed once and cached): "
+                                     "holes, false hits, depth error in ε, normal error, PSNR, "
+                                     "SSIM, iterations, capped rays. Writes OUT/README.md, "
+                                     "OUT/accuracy.csv, plots (time vs error per knob, the "
+                                     "Pareto front) and error images.")
+    ba.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    ba.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
+    ba.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=3,
+                    help="interleaved rounds; medians are reported (default 3)")
+    ba.add_argument("--out", metavar="DIR", help="report folder (default out/accuracy/PRESET)")
+    ba.add_argument("--cache", metavar="DIR", help="ground-truth cache (default "
+                    "~/.cache/krsview/truth)")
+    ba.set_defaults(func=cmd_bench_accuracy)
     return p
 
 

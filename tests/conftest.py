@@ -7,12 +7,13 @@ import shutil
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from krsview.bench import metrics
+from krsview.bench.metrics import Agreement
 from krsview.buffers import Buffers
 from krsview.presets import PRESET_DIR
 
@@ -38,38 +39,22 @@ def preset_paths() -> list[Path]:
     return sorted(PRESET_DIR.glob("*.toml"))
 
 
-@dataclass
-class Agreement:
-    hit: float          # fraction of pixels with equal hit mask
-    depth_close: float  # fraction of common hits with relative depth error ≤ DEPTH_REL
-    normal_close: float  # fraction of common hits with normal angle ≤ NORMAL_DEG
-    color: float        # fraction of pixels with every channel within COLOR_TOL
-
-    def failures(self) -> list[str]:
-        out = []
-        if self.hit < HIT_AGREEMENT:
-            out.append(f"hit masks agree on {self.hit:.4%} < {HIT_AGREEMENT:.1%}")
-        if self.depth_close < CLOSE_FRACTION:
-            out.append(f"depth within {DEPTH_REL} on {self.depth_close:.4%} < {CLOSE_FRACTION:.1%}")
-        if self.normal_close < CLOSE_FRACTION:
-            out.append(f"normals within {NORMAL_DEG}° on {self.normal_close:.4%}")
-        if self.color < COLOR_FRACTION:
-            out.append(f"colour within 2/255 on {self.color:.4%} < {COLOR_FRACTION:.0%}")
-        return out
+def failures(a: Agreement) -> list[str]:
+    out = []
+    if a.hit < HIT_AGREEMENT:
+        out.append(f"hit masks agree on {a.hit:.4%} < {HIT_AGREEMENT:.1%}")
+    if a.depth_close < CLOSE_FRACTION:
+        out.append(f"depth within {DEPTH_REL} on {a.depth_close:.4%} < {CLOSE_FRACTION:.1%}")
+    if a.normal_close < CLOSE_FRACTION:
+        out.append(f"normals within {NORMAL_DEG}° on {a.normal_close:.4%}")
+    if a.color < COLOR_FRACTION:
+        out.append(f"colour within 2/255 on {a.color:.4%} < {COLOR_FRACTION:.0%}")
+    return out
 
 
 def agreement(gpu: Buffers, ref: Buffers) -> Agreement:
-    both = gpu.hit & ref.hit
-    t = ref.depth[both]
-    dt = np.abs(gpu.depth[both] - t)
-    cos = np.clip((gpu.normal * ref.normal).sum(-1)[both], -1.0, 1.0)
-    angle = np.degrees(np.arccos(cos))
-    n = max(int(both.sum()), 1)
-    return Agreement(
-        hit=float((gpu.hit == ref.hit).mean()),
-        depth_close=float((dt <= DEPTH_REL * np.maximum(t, 1e-12)).sum() / n) if both.any() else 1.0,
-        normal_close=float((angle <= NORMAL_DEG).sum() / n) if both.any() else 1.0,
-        color=float((np.abs(gpu.color - ref.color).max(-1) <= COLOR_TOL).mean()))
+    """The package's agreement metric at the tolerances above."""
+    return metrics.agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
 
 
 def assert_finite(b: Buffers, max_iterations: int) -> None:
@@ -93,7 +78,7 @@ def save_diff(name: str, gpu: Buffers, ref: Buffers) -> Path:
 
 def check_against_reference(name: str, gpu: Buffers, ref: Buffers) -> Agreement:
     a = agreement(gpu, ref)
-    problems = a.failures()
+    problems = failures(a)
     if problems:
         path = save_diff(name, gpu, ref)
         pytest.fail(f"{name}: " + "; ".join(problems) + f" (images: {path})")

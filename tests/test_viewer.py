@@ -303,3 +303,44 @@ def test_compound_preset_flies_and_the_levels_slider_cuts_every_component(viewer
     hold(v, "W", 3)
     settle(v)
     assert np.isfinite(v.camera.position).all()
+
+
+def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(viewer, tmp_path,
+                                                                              monkeypatch):
+    """A constructed report: the panel knows which row the view draws, and its button puts
+    the view on the most accurate row that fits the frame budget (scaled by pixels)."""
+    from krsview.app import hud, measured
+    from krsview.app.measured import apply_row, best_within, load_measured, matches
+    (tmp_path / "tree").mkdir()
+    (tmp_path / "tree" / "accuracy.csv").write_text(
+        "knob,value,width,height,ms,mask_error\n"
+        "scene,as saved,100,100,50,0.02\nepsilon_scale,0.5,100,100,80,0.01\n"
+        "epsilon_scale,4,100,100,20,0.09\nlevels,12,100,100,10,0.2\n"
+        "tracer,binary 2/0.3,100,100,90,0.015\n")
+    monkeypatch.setattr(measured, "REPORT_DIRS", (tmp_path,))
+    rows = load_measured("tree")
+    v = viewer
+    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels)] == ["as saved"]
+    assert best_within(rows, 60.0, 100 * 100)["value"] == "as saved"
+    assert best_within(rows, 100.0, 100 * 100)["value"] == "0.5"
+    assert best_within(rows, 200.0, 400 * 400)["value"] == "12"     # 16× the pixels
+    assert best_within(rows, 1.0, 100 * 100) is None
+    v.execute(apply_row(rows[1], v.doc.saved))
+    assert v.scene.render.epsilon_scale == 0.5
+    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels)] == ["0.5"]
+    v.execute(apply_row(rows[4], v.doc.saved))
+    assert v.scene.render.tracer == "binary" and matches(rows[4], v.scene, v.doc.saved, v.levels)
+    v.execute(apply_row(rows[3], v.doc.saved))
+    assert v.levels == 12 and v.scene.render == v.doc.saved.render
+    # the panel itself draws inside an ImGui frame and returns commands, not changes
+    v.measured = rows
+    v.platform.new_frame()
+    from imgui_bundle import imgui
+    imgui.begin("test")
+    commands: list = []
+    hud._measured(v, commands)
+    imgui.end()
+    v.platform.render()
+    assert commands == [] and v.levels == 12
+    (tmp_path / "tree" / "accuracy.csv").write_text("knob,value,ms\nscene,x,notanumber\n")
+    assert load_measured("tree") is None

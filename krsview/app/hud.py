@@ -14,6 +14,7 @@ from ..presets import preset_names, resolve
 from ..scene import EFFECTS, Render
 from ..scene.effects import allowed_effects
 from .commands import Command, Do, Edit
+from .measured import apply_row, best_within, matches
 from .widgets import Interactions, field_widget
 
 if TYPE_CHECKING:
@@ -34,6 +35,8 @@ def draw_hud(v: "Viewer", interactions: Interactions) -> list[Command]:
     _performance(v, out)
     if imgui.collapsing_header("accuracy and view"):
         _accuracy(v, out, interactions)
+    if imgui.collapsing_header("measured accuracy"):
+        _measured(v, out)
     if imgui.collapsing_header("scene, camera, output"):
         _scene(v, out)
     if v.message:
@@ -123,3 +126,36 @@ def _scene(v: "Viewer", out: list) -> None:
     imgui.same_line()
     if imgui.button("replay path (F6)"):
         out.append(Do("act", "replay"))
+
+
+def _measured(v: "Viewer", out: list) -> None:
+    """Where the current setting sits on the preset's measured time/error curve, and a
+    button for the most accurate measured setting that fits the frame budget."""
+    rows = v.measured
+    if rows is None:
+        imgui.text_wrapped(f"no accuracy report for {v.path.stem}: run `krsview bench "
+                           f"accuracy {v.path.stem}`")
+        return
+    now = [r for r in rows if matches(r, v.scene, v.doc.saved, v.levels)]
+    w, h = v.adaptive.moving_size()
+    if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
+        implot.setup_axes("ms (report size)", "hit-mask error %")
+        ms = np.array([r["ms"] for r in rows], dtype=np.float32)
+        err = np.array([100 * r["mask_error"] for r in rows], dtype=np.float32)
+        implot.plot_scatter("measured", ms, err)
+        if now:
+            implot.plot_scatter("now", np.array([now[0]["ms"]], np.float32),
+                                np.array([100 * now[0]["mask_error"]], np.float32))
+        implot.end_plot()
+    if now:
+        r = now[0]
+        imgui.text(f"now: {r['knob']} {r['value']}: {r['mask_error']:.2%} error, "
+                   f"{r['ms']:.0f} ms at {r['width']:.0f}×{r['height']:.0f}")
+    else:
+        imgui.text_disabled("the current setting was not measured (change one knob at a time)")
+    budget = 1e3 / v.adaptive.target_fps
+    best = best_within(rows, budget, w * h)
+    if best is None:
+        imgui.text_disabled(f"no measured setting fits {budget:.0f} ms at {w}×{h}")
+    elif imgui.button(f"most accurate within {budget:.0f} ms: {best['knob']} {best['value']}"):
+        out += apply_row(best, v.doc.saved)

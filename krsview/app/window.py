@@ -24,6 +24,7 @@ from ..scene.scene import write_atomic
 from .adaptive import AdaptiveResolution, Refinement
 from .commands import Command, Edit
 from .hud import draw_hud
+from .measured import load_measured
 from .widgets import Interactions
 from .camera import FlyCamera
 from .controls import LOOK_BUTTON, ORBIT_BUTTON, Input
@@ -83,6 +84,8 @@ class Viewer:
         """Follow the document: a new scene version redraws (and recompiles only if its
         variant changed: effects, tracer, geometry family)."""
         self._seen_version = self.doc.version
+        if getattr(self, "_measured_for", None) != self.path.stem:   # per preset, not per edit
+            self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
         self.geometry = scene.geometry()
         self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()

@@ -15,13 +15,12 @@ we trace shadows at full resolution.
 """
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
-from .progress import Progress
+from .harness import Variant, median_times
 from .report import write_csv
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
@@ -60,16 +59,9 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5,
                   csv: str | None = None) -> list[dict]:
     w, h = size
     runs = runs_of(scene)
-    r = Renderer()
-    for name, (s, uber) in runs.items():  # compile every variant before timing any
-        r.time_frame(s, w, h, all_effects=uber)
-    times: dict[str, list[float]] = {name: [] for name in runs}
-    bar = Progress(rounds * len(runs), f"bench effects {scene.name} {w}×{h}")
-    for _ in range(rounds):
-        for name, (s, uber) in runs.items():
-            times[name] += r.time_frame(s, w, h, all_effects=uber)
-            bar.step(name)
-    med = {name: statistics.median(t) for name, t in times.items()}
+    med = median_times(Renderer(), {name: Variant(s, all_effects=uber)
+                                    for name, (s, uber) in runs.items()},
+                       size, rounds, f"bench effects {scene.name}")
     rows = [dict(variant=name, effects="+".join(s.effects) or "none",
                  all_effects_compiled=uber, ms=med[name] * 1e3,
                  ratio_to_plain=med[name] / med["plain"],

@@ -6,12 +6,11 @@ every variant alike.
 """
 from __future__ import annotations
 
-import statistics
 import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene
-from .progress import Progress
+from .harness import Variant, median_times
 from .report import write_csv
 
 
@@ -29,20 +28,14 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
     counts = level_counts(krs.depth, step)
     variants = {m: krs.truncated(m) for m in counts}
     r = Renderer()
-    iters = {}
-    for m, k in variants.items():  # warm-up: compile once, measure iterations per pixel
-        iters[m] = float(r.render(scene, w, h, k).iterations.mean())
-    times: dict[int, list[float]] = {m: [] for m in counts}
-    bar = Progress(rounds * len(counts), f"bench levels {scene.name} {w}×{h}")
-    for _ in range(rounds):
-        for m in counts:
-            times[m] += r.time_frame(scene, w, h, variants[m], repeats=1)
-            bar.step(f"{m} levels")
+    iters = {m: float(r.render(scene, w, h, k).iterations.mean()) for m, k in variants.items()}
+    med = median_times(r, {f"{m} levels": Variant(scene, variants[m]) for m in counts}, size,
+                       rounds, f"bench levels {scene.name}")
     base = counts[0]
-    t_base = statistics.median(times[base])
+    t_base = med[f"{base} levels"]
     rows = []
     for m in counts:
-        t = statistics.median(times[m])
+        t = med[f"{m} levels"]
         rows.append(dict(levels=m, instances=variants[m].instance_count(), ms=t * 1e3,
                          time_ratio=t / t_base, iterations=iters[m],
                          ratio_per_iteration=(t / iters[m]) / (t_base / iters[base])))

@@ -8,14 +8,13 @@ ratios to sphere tracing. "Hit agreement" compares each hit mask with sphere tra
 from __future__ import annotations
 
 import itertools
-import statistics
 from dataclasses import replace
 
 import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
-from .progress import Progress
+from .harness import Variant, median_times
 from .report import write_csv
 
 BONUS = (1.5, 2.0, 3.0)
@@ -43,19 +42,15 @@ def bench_tracers(scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: b
     w, h = size
     runs = variants(scene, sweep)
     r = Renderer()
-    buffers = {name: r.render(s, w, h) for name, s in runs.items()}  # warm-up + iterations
-    times: dict[str, list[float]] = {name: [] for name in runs}
-    bar = Progress(rounds * len(runs), f"bench tracers {scene.name} {w}×{h}")
-    for _ in range(rounds):
-        for name, s in runs.items():
-            times[name] += r.time_frame(s, w, h, repeats=1)
-            bar.step(name)
+    buffers = {name: r.render(s, w, h) for name, s in runs.items()}
+    med = median_times(r, {name: Variant(s) for name, s in runs.items()}, size, rounds,
+                       f"bench tracers {scene.name}")
     base = next(iter(runs))
-    t0 = statistics.median(times[base])
+    t0 = med[base]
     it0 = float(np.mean(buffers[base].iterations))
     rows = []
     for name, s in runs.items():
-        b, t = buffers[name], statistics.median(times[name])
+        b, t = buffers[name], med[name]
         binary = s.render.tracer == "binary"
         rows.append(dict(tracer=s.render.tracer, xi_bonus=s.render.xi_bonus if binary else "",
                          xi_penalty=s.render.xi_penalty if binary else "",

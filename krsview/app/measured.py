@@ -1,0 +1,80 @@
+"""The viewer's view of a preset's measured accuracy report (`krsview bench accuracy`): which
+measured setting the view uses now, and the most accurate one that fits the frame budget."""
+from __future__ import annotations
+
+import csv
+from dataclasses import replace
+from pathlib import Path
+
+from ..presets import PRESET_DIR
+from ..scene import Scene
+from .commands import Command, Do, Edit
+
+# Where reports are looked for: a fresh run first, then the ones shipped with the docs.
+REPORT_DIRS = (Path("out") / "accuracy", PRESET_DIR.parent / "docs" / "accuracy")
+
+
+def load_measured(stem: str) -> list[dict] | None:
+    """The rows of ``accuracy.csv`` for the preset ``stem``, numbers as floats; None if no
+    report exists or it cannot be read."""
+    for d in REPORT_DIRS:
+        f = d / stem / "accuracy.csv"
+        try:
+            with f.open() as fh:
+                rows = list(csv.DictReader(fh))
+        except OSError:
+            continue
+        try:
+            for r in rows:
+                for k, v in r.items():
+                    if k not in ("knob", "value"):
+                        r[k] = float(v)
+        except (TypeError, ValueError):
+            return None
+        return rows or None
+    return None
+
+
+def matches(row: dict, scene: Scene, saved: Scene, levels: int) -> bool:
+    """Whether the view draws with the setting this row measured."""
+    r, s = scene.render, saved.render
+    drawn_levels = levels or scene.geometry().depth
+    full = drawn_levels == scene.geometry().depth
+    same_but = (lambda **kw: replace(s, **kw) == r and full)
+    knob, value = row["knob"], row["value"]
+    if knob == "scene":
+        return r == s and full
+    if knob == "epsilon_scale":
+        return same_but(epsilon_scale=float(value))
+    if knob == "max_iterations":
+        return same_but(max_iterations=int(value))
+    if knob == "tracer":
+        return same_but(**_tracer(value))
+    if knob == "levels":
+        return r == s and drawn_levels == int(value)
+    return False
+
+
+def _tracer(value: str) -> dict:
+    if value == "sphere":
+        return dict(tracer="sphere")
+    b, p = value.split()[1].split("/")
+    return dict(tracer="binary", xi_bonus=float(b), xi_penalty=float(p))
+
+
+def best_within(rows: list[dict], budget_ms: float, pixels: int) -> dict | None:
+    """The measured setting with the least hit-mask error whose time, scaled from the
+    report's resolution to ``pixels``, fits ``budget_ms``; None if none fits."""
+    fits = [r for r in rows if r["ms"] * pixels / (r["width"] * r["height"]) <= budget_ms]
+    return min(fits, key=lambda r: (r["mask_error"], r["ms"])) if fits else None
+
+
+def apply_row(row: dict, saved: Scene) -> list[Command]:
+    """Commands that put the view on a measured setting (the others as saved)."""
+    knob, value = row["knob"], row["value"]
+    base = saved.render
+    render = {"epsilon_scale": lambda: replace(base, epsilon_scale=float(value)),
+              "max_iterations": lambda: replace(base, max_iterations=int(value)),
+              "tracer": lambda: replace(base, **_tracer(value))}.get(knob, lambda: base)()
+    levels = int(value) if knob == "levels" else 0
+    return [Edit(("render",), render), Do("set_levels", levels)]

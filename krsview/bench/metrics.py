@@ -1,0 +1,135 @@
+"""Image error against ground truth: what an accuracy setting loses.
+
+Hit-mask disagreement is split into *holes* (the truth hits, the image misses) and *false
+hits* (the image hits empty space), each also counted off the silhouette, where no LOD
+threshold explains it. Depth error is measured in units of the LOD threshold ε(t) =
+footprint × t [KRS17 §4], so "within 1" means "as close as the tracer was asked to stop".
+The GPU-vs-reference pixel tests use :func:`agreement` from here too.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..buffers import Buffers
+
+SSIM_WINDOW = 7           # pixels on a side of SSIM's local window
+SSIM_C1, SSIM_C2 = 0.01 ** 2, 0.03 ** 2   # Wang et al. 2004's constants for a range of 1
+
+
+def silhouette(hit: np.ndarray) -> np.ndarray:
+    """Pixels with a 4-neighbour of the other hit state (both sides of every outline)."""
+    s = np.zeros_like(hit)
+    s[1:] |= hit[1:] != hit[:-1]
+    s[:-1] |= hit[1:] != hit[:-1]
+    s[:, 1:] |= hit[:, 1:] != hit[:, :-1]
+    s[:, :-1] |= hit[:, 1:] != hit[:, :-1]
+    return s
+
+
+def _box_mean(x: np.ndarray, k: int) -> np.ndarray:
+    """Mean over k×k windows ('valid' positions), by summed-area tables."""
+    c = np.pad(x, ((1, 0), (1, 0))).cumsum(0).cumsum(1)
+    return (c[k:, k:] - c[:-k, k:] - c[k:, :-k] + c[:-k, :-k]) / (k * k)
+
+
+def ssim(a: np.ndarray, b: np.ndarray, k: int = SSIM_WINDOW) -> float:
+    """Mean structural similarity of two images in [0, 1] (luminance of RGB), uniform k×k
+    windows [Wang et al. 2004]; 1 for identical images."""
+    if a.ndim == 3:
+        w = np.array([0.2126, 0.7152, 0.0722])
+        a, b = a @ w, b @ w
+    if min(a.shape) < k:
+        k = min(a.shape)
+    ma, mb = _box_mean(a, k), _box_mean(b, k)
+    va = _box_mean(a * a, k) - ma * ma
+    vb = _box_mean(b * b, k) - mb * mb
+    cov = _box_mean(a * b, k) - ma * mb
+    s = ((2 * ma * mb + SSIM_C1) * (2 * cov + SSIM_C2)) / \
+        ((ma * ma + mb * mb + SSIM_C1) * (va + vb + SSIM_C2))
+    return float(s.mean())
+
+
+def psnr(a: np.ndarray, b: np.ndarray) -> float:
+    """Peak signal-to-noise ratio in dB for images in [0, 1]; inf when identical."""
+    mse = float(np.mean((np.clip(a, 0, 1) - np.clip(b, 0, 1)) ** 2))
+    return math.inf if mse == 0 else 10.0 * math.log10(1.0 / mse)
+
+
+@dataclass(frozen=True)
+class Errors:
+    holes: float               # fraction of pixels: truth hits, image misses
+    false_hits: float          # fraction of pixels: image hits, truth misses
+    holes_off_silhouette: float
+    false_hits_off_silhouette: float
+    depth_eps_median: float    # |t − t_truth| / ε(t_truth) on common hits
+    depth_eps_p99: float
+    normal_deg_median: float   # angle between normals on common hits
+    normal_deg_p99: float
+    psnr: float                # colour, dB
+    ssim: float
+    iterations: float          # mean per pixel
+    capped: float              # fraction of pixels whose ray spent the cap without a verdict
+
+    @property
+    def mask_error(self) -> float:
+        """All hit-mask disagreement: holes + false hits."""
+        return self.holes + self.false_hits
+
+
+def compare(image: Buffers, truth: Buffers, eps_per_t: float, cap: int) -> Errors:
+    """Errors of ``image`` against ``truth``; ``eps_per_t`` is the footprint per unit ray
+    distance (the unit of depth error), ``cap`` the image's iteration cap."""
+    holes = truth.hit & ~image.hit
+    false = image.hit & ~truth.hit
+    off = ~silhouette(truth.hit)
+    both = image.hit & truth.hit
+    t = truth.depth[both]
+    dt = np.abs(image.depth[both] - t) / np.maximum(eps_per_t * t, 1e-300)
+    cos = np.clip((image.normal * truth.normal).sum(-1)[both], -1.0, 1.0)
+    ang = np.degrees(np.arccos(cos))
+    q = (lambda x, p: float(np.percentile(x, p)) if x.size else 0.0)
+    n = holes.size
+    return Errors(
+        holes=holes.sum() / n, false_hits=false.sum() / n,
+        holes_off_silhouette=(holes & off).sum() / n,
+        false_hits_off_silhouette=(false & off).sum() / n,
+        depth_eps_median=q(dt, 50), depth_eps_p99=q(dt, 99),
+        normal_deg_median=q(ang, 50), normal_deg_p99=q(ang, 99),
+        psnr=psnr(image.color, truth.color), ssim=ssim(image.color, truth.color),
+        iterations=float(image.iterations.mean()),
+        capped=float(((image.iterations >= cap) & ~image.hit).mean()))
+
+
+def error_image(image: Buffers, truth: Buffers) -> np.ndarray:
+    """RGB8 picture of the hit-mask errors over the dimmed truth: holes red, false hits blue."""
+    out = (truth.rgb8().astype(np.float64) * 0.35 + 40).astype(np.uint8)
+    out[truth.hit & ~image.hit] = (255, 40, 40)
+    out[image.hit & ~truth.hit] = (60, 120, 255)
+    return out
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """How closely two renders of one scene agree (the GPU-vs-reference pixel tests)."""
+    hit: float           # fraction of pixels with equal hit mask
+    depth_close: float   # fraction of common hits with relative depth error ≤ depth_rel
+    normal_close: float  # fraction of common hits with normal angle ≤ normal_deg
+    color: float         # fraction of pixels with every channel within color_tol
+
+
+def agreement(a: Buffers, b: Buffers, depth_rel: float, normal_deg: float,
+              color_tol: float) -> Agreement:
+    both = a.hit & b.hit
+    t = b.depth[both]
+    dt = np.abs(a.depth[both] - t)
+    cos = np.clip((a.normal * b.normal).sum(-1)[both], -1.0, 1.0)
+    angle = np.degrees(np.arccos(cos))
+    n = max(int(both.sum()), 1)
+    return Agreement(
+        hit=float((a.hit == b.hit).mean()),
+        depth_close=float((dt <= depth_rel * np.maximum(t, 1e-12)).sum() / n) if both.any() else 1.0,
+        normal_close=float((angle <= normal_deg).sum() / n) if both.any() else 1.0,
+        color=float((np.abs(a.color - b.color).max(-1) <= color_tol).mean()))

@@ -1,0 +1,50 @@
+"""Ground truth for the accuracy benchmark: the float64 NumPy reference with a tight LOD
+threshold (ε at 1/8 of the pixel footprint) and a generous iteration cap, computed once per
+scene, view and size and cached on disk under a key made from the scene's content."""
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..buffers import Buffers
+from ..reference import render_reference
+from ..scene import Scene, scene_to_toml
+
+TRUTH_EPSILON_SCALE = 0.125   # × the pixel footprint
+TRUTH_ITERATIONS = 4096
+
+
+def truth_scene(scene: Scene) -> Scene:
+    """The scene at ground-truth accuracy: tight ε, generous cap, its own tracer (a MöKRS
+    keeps binary tracing: it has no distance)."""
+    return replace(scene, render=replace(scene.render, epsilon_scale=TRUTH_EPSILON_SCALE,
+                                         max_iterations=TRUTH_ITERATIONS))
+
+
+def default_cache() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "krsview" / "truth"
+
+
+def cache_key(scene: Scene, size: tuple[int, int]) -> str:
+    text = f"{__version__}\n{size}\n{scene_to_toml(truth_scene(scene))}"
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def ground_truth(scene: Scene, size: tuple[int, int], cache: Path | None = None) -> Buffers:
+    """The reference image at ground-truth accuracy, from the cache when it holds one."""
+    path = (cache or default_cache()) / f"{cache_key(scene, size)}.npz"
+    if path.exists():
+        with np.load(path) as f:
+            return Buffers(f["color"], f["depth"], f["normal"], f["iterations"], f["hit"])
+    b = render_reference(truth_scene(scene), *size)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp.npz")
+    b.save_npz(tmp)
+    tmp.replace(path)
+    return b
