@@ -300,6 +300,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="iterations shown as white in --view iterations (default: the image's "
                         "maximum); fix it to compare tracers on one scale")
     render_option(r, "tracer")
+    render_option(r, "relaxation")
     accuracy(r)
     r.set_defaults(func=cmd_render)
 
@@ -370,7 +371,8 @@ def build_parser() -> argparse.ArgumentParser:
     ba = bsub.add_parser("accuracy", help="what accuracy costs: every knob against time and "
                          "ground truth, as a report with plots",
                          description="On one view: sweep ε-scale, the iteration cap, the "
-                                     "tracer (sphere, binary with ξ pairs) and the level count; "
+                                     "tracer (sphere, over-relaxed with ω, binary with ξ pairs) "
+                                     "and the level count; "
                                      "time each setting on the GPU (interleaved rounds, "
                                      "medians) and compare its image with the ground truth "
                                      "(the float64 reference at ε/8, computed once and cached): "

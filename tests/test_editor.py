@@ -180,16 +180,16 @@ def test_overlay_is_composited_by_traced_depth(editor):
 
 
 RECOVERY_SCRIPT = """
-import os, signal, sys
+import os, signal, sys, time
 from pathlib import Path
 from krsview.editor.app import Editor
 e = Editor(Path(sys.argv[1]), size=(320, 200))
 e.bake()
 e.edit(("route", "levels", 5, "radius"), 0.123, ("gizmo", 1))
-for _ in range(400):
+end = time.monotonic() + 30                 # autosave writes within AUTOSAVE_SECONDS
+while not e.doc.recovery_path.exists() and time.monotonic() < end:
     e.step(0.05)
-    if e.doc.recovery_path.exists():
-        break
+    time.sleep(0.05)
 os.kill(os.getpid(), signal.SIGKILL)
 """
 
@@ -201,6 +201,7 @@ def test_killed_mid_edit_the_reopened_editor_offers_the_recovery(display, tmp_pa
                        capture_output=True, text=True)
     assert r.returncode == -signal.SIGKILL, r.stderr
     assert load_scene(path).tree is not None, "the killed editor saved the scene"
+    assert path.with_name(path.name + ".recovery").exists(), "no autosave before the kill"
     from krsview.editor.app import Editor
     e = Editor(path, size=(320, 200))
     try:

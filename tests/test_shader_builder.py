@@ -65,3 +65,14 @@ def test_variant_contains_only_the_kernels_the_scene_uses(renderer):
     renderer.render(sier, 8, 6)
     renderer.render(sier, 8, 6)                    # same define set: cached
     assert renderer.programs.compiles - before <= 1
+
+
+@pytest.mark.parametrize("defines, emitted", [({"A": None}, "a"), ({"B": None}, "b"),
+                                              ({"A": None, "B": None}, "a"), ({}, "c")])
+def test_elif_emits_the_first_true_branch_only(tmp_path, defines, emitted):
+    (tmp_path / "x.glsl").write_text("#ifdef A\nint a;\n#elif defined(B)\nint b;\n#else\n"
+                                     "int c;\n#endif\n#if defined(B)\nint bb;\n#endif\n")
+    body = Source("x.glsl", defines, tmp_path).text.splitlines()
+    decl = [line for line in body if line.startswith("int ") and len(line) == 6]
+    assert decl == [f"int {emitted};"]
+    assert ("int bb;" in body) == ("B" in defines)

@@ -21,8 +21,8 @@ if TYPE_CHECKING:
     from .window import Viewer
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
-BINARY_ONLY = ("xi_bonus", "xi_penalty")       # knobs of binary sphere tracing
-KNOBS = ("tracer", "epsilon_scale", "max_iterations", *BINARY_ONLY)
+TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
+KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS)
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
@@ -75,7 +75,7 @@ def _performance(v: "Viewer", out: list) -> None:
 def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:
     r = v.scene.render
     for name in KNOBS:
-        if name in BINARY_ONLY and r.tracer != "binary":
+        if TRACER_KNOBS.get(name, r.tracer) != r.tracer:   # another tracer's knob
             continue
         meta = RENDER_META[name]
         if name == "tracer" and v.scene.mokrs is not None:

@@ -58,6 +58,8 @@ def matches(row: dict, scene: Scene, saved: Scene, levels: int) -> bool:
 def _tracer(value: str) -> dict:
     if value == "sphere":
         return dict(tracer="sphere")
+    if value.startswith("relaxed"):
+        return dict(tracer="relaxed", relaxation=float(value.split()[1]))
     b, p = value.split()[1].split("/")
     return dict(tracer="binary", xi_bonus=float(b), xi_penalty=float(p))
 

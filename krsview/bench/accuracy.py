@@ -2,8 +2,8 @@
 view, every setting is timed on the GPU (interleaved, medians) and its image is compared with
 the ground truth (the float64 reference at ε/8); the report says which settings are worth it.
 
-Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / binary with ξ
-pairs [KRS17 Alg. 2]) and level count (LOD by truncation). One run writes a CSV, a Markdown
+Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
+with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]) and level count (LOD by truncation). One run writes a CSV, a Markdown
 report, plots (time against error per knob, the Pareto front over all settings) and error
 images (holes red, false hits blue)."""
 from __future__ import annotations
@@ -24,6 +24,7 @@ from .truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS, ground_truth
 EPSILON_SCALES = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
 CAPS = (16, 32, 64, 128, 256, 1024)
 XI_PAIRS = ((2.0, 0.3), (1.5, 0.2), (3.0, 0.5))
+RELAXATIONS = (1.2, 1.6, 1.9)     # ω of over-relaxed sphere tracing [Keinert et al. 2014]
 LEVEL_CUTS = (12, 8, 4, 2)        # levels dropped from the finest end
 GOOD_ENOUGH = 0.01                # hit-mask error the summary asks for (1 % of the pixels)
 
@@ -50,6 +51,10 @@ def settings(scene: Scene) -> list[Setting]:
         out.append(Setting("max_iterations", f"{cap}", replace(scene, render=replace(r, max_iterations=cap))))
     if scene.mokrs is None:
         out.append(Setting("tracer", "sphere", replace(scene, render=replace(r, tracer="sphere"))))
+    if scene.mokrs is None and not scene.compound:
+        for w in RELAXATIONS:
+            out.append(Setting("tracer", f"relaxed {w:g}", replace(
+                scene, render=replace(r, tracer="relaxed", relaxation=w))))
     for b, p in XI_PAIRS:
         out.append(Setting("tracer", f"binary {b:g}/{p:g}", replace(
             scene, render=replace(r, tracer="binary", xi_bonus=b, xi_penalty=p))))

@@ -21,7 +21,7 @@ class ShaderError(RuntimeError):
     """A shader failed to build; ``str()`` names the .glsl file, line and the offending text."""
 
 
-_DIRECTIVE = re.compile(r"^\s*#\s*(ifdef|ifndef|if|else|endif|define|undef)\b\s*(.*?)\s*(//.*)?$")
+_DIRECTIVE = re.compile(r"^\s*#\s*(ifdef|ifndef|if|elif|else|endif|define|undef)\b\s*(.*?)\s*(//.*)?$")
 _DEFINED = re.compile(r"defined\s*\(?\s*(\w+)\s*\)?")
 
 
@@ -58,13 +58,14 @@ class Source:
             where = f" (included from {stack[-1]})" if stack else ""
             raise ShaderError(f"shader file not found: {name}{where}") from None
         out: list[str] = []
-        active = [True]  # one entry per open conditional: is this branch emitted?
+        # One entry per open conditional: [is this branch emitted, was any branch taken].
+        active = [[True, True]]
         for k, line in enumerate(text.splitlines(), 1):
             d = _DIRECTIVE.match(line)
-            if d and d.group(1) in ("ifdef", "ifndef", "if", "else", "endif"):
+            if d and d.group(1) in ("ifdef", "ifndef", "if", "elif", "else", "endif"):
                 self._conditional(d.group(1), d.group(2), active, name, k)
                 continue
-            if not all(active):
+            if not all(on for on, _ in active):
                 continue
             if d and d.group(1) == "define":
                 self.defined.add(d.group(2).split("(")[0].split()[0])
@@ -80,19 +81,20 @@ class Source:
             raise ShaderError(f"{name}: #if without #endif")
         return out
 
-    def _conditional(self, kind: str, arg: str, active: list[bool], name: str, k: int) -> None:
-        if kind == "ifdef":
-            active.append(arg in self.defined)
-        elif kind == "ifndef":
-            active.append(arg not in self.defined)
-        elif kind == "if":
-            active.append(self._evaluate(arg, name, k))
+    def _conditional(self, kind: str, arg: str, active: list[list[bool]], name: str,
+                     k: int) -> None:
+        if kind in ("ifdef", "ifndef", "if"):
+            on = (arg in self.defined if kind == "ifdef" else arg not in self.defined
+                  if kind == "ifndef" else self._evaluate(arg, name, k))
+            active.append([on, on])
         elif len(active) == 1:
             raise ShaderError(f"{name}:{k}: #{kind} without #if")
-        elif kind == "else":
-            active[-1] = not active[-1]
-        else:
+        elif kind == "endif":
             active.pop()
+        else:                                   # elif / else: the first true branch only
+            taken = active[-1][1]
+            on = not taken and (kind == "else" or self._evaluate(arg, name, k))
+            active[-1] = [on, taken or on]
 
     def _evaluate(self, expr: str, name: str, k: int) -> bool:
         """``#if`` over ``defined(NAME)``, ``!``, ``&&``, ``||`` and parentheses only."""

@@ -31,8 +31,8 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
     else:
         for effect in scene.effects:
             defines[f"KRS_{effect.upper()}"] = None
-    if scene.render.tracer == "binary":
-        defines["KRS_TRACER_BINARY"] = None
+    if scene.render.tracer != "sphere":
+        defines[f"KRS_TRACER_{scene.render.tracer.upper()}"] = None
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -92,6 +92,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_max_distance": scene.render.max_distance,
         "u_xi_bonus": scene.render.xi_bonus,
         "u_xi_penalty": scene.render.xi_penalty,
+        "u_relaxation": scene.render.relaxation,
         "u_light_count": len(lights),
         "u_light_dir": [lt.direction for lt in lights] + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
         "u_light_color": [tuple(c * lt.intensity for c in lt.color) for lt in lights]

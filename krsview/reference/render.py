@@ -10,7 +10,7 @@ from .camera import primary_rays, view_of
 from .distortion import Distortion
 from .geometry import component_distances, component_tests, compile_geometry, nearest
 from .shade import Hits, encode, shade
-from .trace import binary_trace, sphere_trace
+from .trace import binary_trace, relaxed_trace, sphere_trace
 
 
 def render_reference(scene: Scene, width: int, height: int,
@@ -24,6 +24,10 @@ def render_reference(scene: Scene, width: int, height: int,
     if r.tracer == "binary":
         tr = binary_trace(component_tests(c, dist), view.origin, dirs, eps,
                           r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty)
+    elif r.tracer == "relaxed":
+        (d,) = component_distances(c, dist)   # a single KRS (Scene.check_tracer)
+        tr = relaxed_trace(d, view.origin, dirs, eps, r.max_iterations, r.max_distance,
+                           r.relaxation)
     else:
         tr = sphere_trace(component_distances(c, dist), view.origin, dirs, eps,  # type: ignore[arg-type]
                           r.max_iterations, r.max_distance)

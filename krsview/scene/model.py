@@ -14,7 +14,7 @@ import numpy as np
 from .schema import SceneError, Tagged, Vec3, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
-TRACERS = ("sphere", "binary")
+TRACERS = ("sphere", "binary", "relaxed")
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -207,7 +207,9 @@ class Render:
     """Accuracy knobs; each is swept by the benchmark against time."""
     tracer: str = param("sphere", choices=TRACERS,
                         help="sphere: sphere tracing [Har96]; binary: binary sphere tracing "
-                             "with unbounding probes [KRS17 Alg. 2] (required by a MöKRS)")
+                             "with unbounding probes [KRS17 Alg. 2] (required by a MöKRS); "
+                             "relaxed: over-relaxed sphere tracing, steps of ω·d with a "
+                             "fallback [Keinert et al. 2014] (a single KRS)")
     epsilon_scale: float = param(1.0, lo=1e-4, hi=100.0, unit="pixels",
                                  help="stop when distance < footprint × depth × scale")
     max_iterations: int = param(256, lo=1, hi=10000, help="iteration cap per ray")
@@ -216,6 +218,9 @@ class Render:
                             help="binary tracing: probe growth after a free probe [KRS17 §6.1]")
     xi_penalty: float = param(0.3, lo=0.01, hi=0.95,
                               help="binary tracing: probe shrink after a blocked probe")
+    relaxation: float = param(1.6, lo=1.0, hi=1.99,
+                              help="relaxed tracing: step ω·d; a step whose sphere does not "
+                                   "meet the last one is taken back and ω drops to 1")
 
 
 # ------------------------------------------------------------------------------ arc geometry

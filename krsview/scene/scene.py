@@ -60,19 +60,24 @@ class Scene:
         if len(self.lights) > 4:
             raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
         check_effects(self.effects, self.mokrs is not None)
+        self.check_tracer(self.render.tracer)
         if self.mokrs is not None:
-            self.check_tracer(self.render.tracer)
             check_view(self.mokrs, self.camera.position, "camera.position")
             for i, b in enumerate(self.bookmarks):
                 check_view(self.mokrs, b.camera.position, f"bookmarks[{i}].camera.position")
 
     def check_tracer(self, tracer: str, path: str = "render.tracer") -> None:
         """The one rule for a tracer choice, from a file, the CLI or the HUD: a MöKRS needs
-        binary tracing."""
+        binary tracing; over-relaxed tracing is for a single KRS (a compound's per-component
+        free distances must be verified ones)."""
         if self.mokrs is not None and tracer != "binary":
             raise SceneError(path, tracer, "this scene is a MöKRS, which has no distance "
                              "function, only unbounding tests: it needs binary tracing; "
                              "allowed: 'binary'")
+        if self.compound and tracer == "relaxed":
+            raise SceneError(path, tracer, "over-relaxed tracing steps past what is verified "
+                             "free, which a compound's nearest-component rule cannot allow; "
+                             "allowed here: 'sphere', 'binary'")
 
     def geometry(self) -> Geometry:
         """What is drawn: the explicit KRS or MöKRS, the tree expanded [KRS17 §9.2], or the

@@ -41,6 +41,7 @@ uniform float u_eps_per_t;  // pixel footprint × ε-scale
 uniform int u_max_iterations;
 uniform float u_xi_bonus;   // binary tracing [KRS17 Alg. 2]
 uniform float u_xi_penalty;
+uniform float u_relaxation;      // relaxed tracing: ω
 uniform float u_max_distance;
 
 uniform int u_light_count;

@@ -41,6 +41,29 @@ bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
     }
     return false;
 }
+#elif defined(KRS_TRACER_RELAXED)
+// Over-relaxed sphere tracing [Keinert et al. 2014] of a single KRS: step ω·d from the last
+// verified point (ts, ds); if the new free ball and the last one no longer cover [ts, t],
+// go back to ts + ds and trace plainly (ω = 1). Twin of relaxed_trace in reference/trace.py.
+bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
+    float ts = 0.0, ds = 0.0, w = u_relaxation;
+    t = 0.0;
+    for (iterations = 0; iterations < u_max_iterations;) {
+        if (t > u_max_distance) return false;
+        float d = component_distance(0, origin + t * dir);
+        ++iterations;
+        if (w > 1.0 && ds + d < t - ts) {
+            t = ts + ds;
+            w = 1.0;
+            continue;
+        }
+        if (d <= u_eps_per_t * t) return true;
+        ts = t;
+        ds = d;
+        t += w * d;
+    }
+    return false;
+}
 #else
 bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
     float tc[COMPONENT_SLOTS];
