@@ -324,3 +324,19 @@ def test_a_panel_drag_is_one_undo_step_and_a_second_drag_another(editor):
     assert e.scene.route.levels[LEVEL].radius == r1
     e.undo()
     assert e.scene.route.levels[LEVEL].radius == r0
+
+
+def test_picking_the_geometry_with_fewer_levels_drawn_selects_the_right_level(editor):
+    """The levels slider keeps the coarsest levels: a picked kernel slot is offset by the
+    finest levels cut away (the trunk stays the trunk)."""
+    e = editor
+    e.execute([Do("bake")])
+    settle(e)
+    depth = e.geometry.depth
+    click(e, screen_of(e, (0.0, 0.4, -0.2)))
+    assert e.selected.level == depth - 1
+    e.set_levels(6)
+    settle(e)
+    e.select(None)
+    click(e, screen_of(e, (0.0, 0.4, -0.2)))
+    assert e.selected is not None and e.selected.level == depth - 1

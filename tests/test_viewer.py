@@ -320,16 +320,16 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(vi
     monkeypatch.setattr(measured, "REPORT_DIRS", (tmp_path,))
     rows = load_measured("tree")
     v = viewer
-    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels)] == ["as saved"]
+    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)] == ["as saved"]
     assert best_within(rows, 60.0, 100 * 100)["value"] == "as saved"
     assert best_within(rows, 100.0, 100 * 100)["value"] == "0.5"
     assert best_within(rows, 200.0, 400 * 400)["value"] == "12"     # 16× the pixels
     assert best_within(rows, 1.0, 100 * 100) is None
     v.execute(apply_row(rows[1], v.doc.saved))
     assert v.scene.render.epsilon_scale == 0.5
-    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels)] == ["0.5"]
+    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)] == ["0.5"]
     v.execute(apply_row(rows[4], v.doc.saved))
-    assert v.scene.render.tracer == "binary" and matches(rows[4], v.scene, v.doc.saved, v.levels)
+    assert v.scene.render.tracer == "binary" and matches(rows[4], v.scene, v.doc.saved, v.levels, v.geometry.depth)
     v.execute(apply_row(rows[3], v.doc.saved))
     assert v.levels == 12 and v.scene.render == v.doc.saved.render
     # the panel itself draws inside an ImGui frame and returns commands, not changes

@@ -136,7 +136,7 @@ def _measured(v: "Viewer", out: list) -> None:
         imgui.text_wrapped(f"no accuracy report for {v.path.stem}: run `krsview bench "
                            f"accuracy {v.path.stem}`")
         return
-    now = [r for r in rows if matches(r, v.scene, v.doc.saved, v.levels)]
+    now = [r for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)]
     w, h = v.adaptive.moving_size()
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
         implot.setup_axes("ms (report size)", "hit-mask error %")

@@ -35,11 +35,12 @@ def load_measured(stem: str) -> list[dict] | None:
     return None
 
 
-def matches(row: dict, scene: Scene, saved: Scene, levels: int) -> bool:
-    """Whether the view draws with the setting this row measured."""
+def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int) -> bool:
+    """Whether the view draws with the setting this row measured; ``levels`` is the view's
+    level count (0: all ``depth`` levels of the geometry, which the caller already has)."""
     r, s = scene.render, saved.render
-    drawn_levels = levels or scene.geometry().depth
-    full = drawn_levels == scene.geometry().depth
+    drawn_levels = levels or depth
+    full = drawn_levels == depth
     same_but = (lambda **kw: replace(s, **kw) == r and full)
     knob, value = row["knob"], row["value"]
     if knob == "scene":

@@ -45,6 +45,7 @@ class Editor(Viewer):
     def __init__(self, path: Path, **kw):
         self.selected: Handle | None = None
         self.handles: list[Handle] = []
+        self.warnings: list[str] = []
         super().__init__(path, **kw)
         self.overlay = Overlay(self.ctx, self.renderer.programs)
         self.snap = Snap()
@@ -68,6 +69,7 @@ class Editor(Viewer):
     def _set_scene(self, scene, reset_camera: bool = False) -> None:
         super()._set_scene(scene, reset_camera)
         self.handles = handles(scene)
+        self.warnings = scene.route.warnings() if scene.route else []   # per edit, not frame
         if self.selected is not None:      # keep the selection across edits, undo, reload
             self.selected = next((h for h in self.handles if h.same(self.selected)), None)
 
@@ -260,10 +262,11 @@ class Editor(Viewer):
         return next((h for h in self.handles if h.level == level), None)
 
     def _entry_of_slot(self, slot: int) -> int:
-        """Outline entry of a compiled level slot: the level itself, or a compound's
-        component (slots are numbered component after component)."""
+        """Outline entry of a compiled level slot: the level itself (shifted by the finest
+        levels the levels slider cut away), or a compound's component (slots are numbered
+        component after component)."""
         if not self.scene.compound:
-            return slot
+            return slot + self.geometry.depth - self.krs.depth
         bases = list(getattr(self.world, "bases", (0,)))
         return max(k for k, b in enumerate(bases) if b <= slot)
 

@@ -38,7 +38,7 @@ def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
         imgui.text_wrapped("A MöKRS has no handles yet; edit its file (it reloads) or the "
                            "fields below.")
     else:
-        for w in scene.route.warnings() if scene.route else []:
+        for w in e.warnings:
             imgui.push_style_color(imgui.Col_.text, YELLOW)
             imgui.text_wrapped("route." + w)
             imgui.pop_style_color()
