@@ -82,15 +82,11 @@ def render_option(sp: argparse.ArgumentParser, name: str) -> None:
 
 def _load(args: argparse.Namespace) -> Scene:
     scene = load_scene(resolve(args.preset))
-    render = scene.render
-    if getattr(args, "epsilon_scale", None) is not None:
-        render = replace(render, epsilon_scale=args.epsilon_scale)
-    if getattr(args, "max_iterations", None) is not None:
-        render = replace(render, max_iterations=args.max_iterations)
-    if getattr(args, "tracer", None) is not None:
-        scene.check_tracer(args.tracer, "--tracer")
-        render = replace(render, tracer=args.tracer)
-    scene = replace(scene, render=render)
+    given = {name: getattr(args, name) for name in RENDER_FIELDS
+             if getattr(args, name, None) is not None}   # the render_option()s used
+    if "tracer" in given:
+        scene.check_tracer(given["tracer"], "--tracer")
+    scene = replace(scene, render=replace(scene.render, **given))
     effects = getattr(args, "effects", None)
     if effects is not None:
         names = [] if effects.strip() == "none" else [e.strip() for e in effects.split(",")]
@@ -301,6 +297,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "maximum); fix it to compare tracers on one scale")
     render_option(r, "tracer")
     render_option(r, "relaxation")
+    render_option(r, "precision")
     accuracy(r)
     r.set_defaults(func=cmd_render)
 

@@ -63,9 +63,10 @@ def test_pareto_front_keeps_only_undominated_settings():
 
 def test_every_knob_is_swept_and_a_mokrs_skips_what_it_cannot_draw():
     knobs = {s.knob for s in settings(load_scene(resolve("tree")))}
-    assert knobs == {"scene", "epsilon_scale", "max_iterations", "tracer", "levels"}
+    assert knobs == {"scene", "epsilon_scale", "max_iterations", "tracer", "precision", "levels"}
     palm = settings(load_scene(resolve("palm")))
-    assert {s.knob for s in palm} == {"scene", "epsilon_scale", "max_iterations", "tracer"}
+    assert {s.knob for s in palm} == {"scene", "epsilon_scale", "max_iterations", "tracer",
+                                      "precision"}
     assert all(s.scene.render.tracer == "binary" for s in palm)
 
 

@@ -12,7 +12,9 @@ from krsview.scene import (KRS, Camera, Empty, Level, Mirror, Plane, Render, Sce
                            load_scene)
 from krsview.presets import resolve
 
-from .conftest import assert_finite, check_against_reference
+from krsview.bench import hard_cases
+
+from .conftest import agreement, assert_finite, check_against_reference, failures
 
 W, H = 120, 90
 
@@ -118,3 +120,33 @@ def test_deep_zoom_thirty_levels_down_is_stable(renderer):
         np.array(scene.camera.position) + 1e-3 * scene.geometry().kernels[0].radius)))
     again = renderer.render(nudged, W, H)
     assert (again.hit != gpu.hit).mean() < 0.002
+
+
+@pytest.mark.parametrize("name", ["deep-zoom-1e-6", "deep-zoom-1e-9"])
+def test_double_precision_follows_the_reference_where_float_cannot(renderer, name):
+    """precision = "double" [issue 15]: at a deep zoom the float64 shader agrees with the
+    reference; the float32 one (the negative control) does not: the case is a real limit."""
+    case = hard_cases.CASES[name]
+    scene = case.build()
+    assert case.precision_limit
+    ref = render_reference(scene, 48, 27)
+    assert 0.3 < ref.hit.mean() < 0.95, "the horizon is not in view"
+    double = renderer.render(replace(scene, render=replace(scene.render, precision="double")), 48, 27)
+    assert_finite(double, scene.render.max_iterations)
+    check_against_reference(f"hard_{name}_double", double, ref)
+    single = renderer.render(scene, 48, 27)
+    assert scene.render.precision == "float"
+    assert failures(agreement(single, ref)), "float32 followed a 1e-6 zoom: not a hard case"
+
+
+def test_double_precision_uploads_the_geometry_in_float64():
+    from krsview.gpu.uniforms import krs_block
+    from krsview.reference.geometry import compile_geometry
+    s = tree_scene()
+    c = compile_geometry(s.geometry(), s.material.albedo)
+    single, double = krs_block(c, "float"), krs_block(c, "double")
+    assert len(double) == 2 * len(single)
+    mirrors = np.frombuffer(double, np.float64)[:4 * c.n].reshape(c.n, 4)
+    assert np.array_equal(mirrors, c.mirrors)          # not rounded through float32
+    assert not np.array_equal(np.frombuffer(single, np.float32)[:4 * c.n].reshape(c.n, 4)
+                              .astype(np.float64), c.mirrors)

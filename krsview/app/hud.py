@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
-KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS)
+KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision")
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 

@@ -51,6 +51,8 @@ def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int) -> b
         return same_but(max_iterations=int(value))
     if knob == "tracer":
         return same_but(**_tracer(value))
+    if knob == "precision":
+        return same_but(precision=value)
     if knob == "levels":
         return r == s and drawn_levels == int(value)
     return False
@@ -78,6 +80,7 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
     base = saved.render
     render = {"epsilon_scale": lambda: replace(base, epsilon_scale=float(value)),
               "max_iterations": lambda: replace(base, max_iterations=int(value)),
-              "tracer": lambda: replace(base, **_tracer(value))}.get(knob, lambda: base)()
+              "tracer": lambda: replace(base, **_tracer(value)),
+              "precision": lambda: replace(base, precision=value)}.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
     return [Edit(("render",), render), Do("set_levels", levels)]

@@ -60,21 +60,26 @@ class Renderer:
                  all_effects: bool) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
         c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
-        prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c, all_effects))
-        block = krs_block(c)
-        limit = self.ctx.info["GL_MAX_UNIFORM_BLOCK_SIZE"]
+        block = krs_block(c, scene.render.precision)
+        storage = scene.render.precision == "double"  # scene_block.glsl: a storage buffer
+        limit = self.ctx.info["GL_MAX_SHADER_STORAGE_BLOCK_SIZE" if storage
+                              else "GL_MAX_UNIFORM_BLOCK_SIZE"]
         if len(block) > limit:
             raise SceneError("compound", f"<a uniform block of {len(block)} bytes>",
                              f"this GPU's uniform blocks hold at most {limit} bytes, too few "
                              "for a compound's 8 × 64 level slots: render its components as "
                              "separate scenes")
+        prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c, all_effects))
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
         else:
             self._ubo.write(block)
-        if "KRSBlock" in prog:
-            prog["KRSBlock"].binding = 0
-        self._ubo.bind_to_uniform_block(0)
+        if storage:
+            self._ubo.bind_to_storage_buffer(0)
+        else:
+            if "KRSBlock" in prog:
+                prog["KRSBlock"].binding = 0
+            self._ubo.bind_to_uniform_block(0)
         for name, value in view_uniforms(scene, view, c).items():
             if name in prog:
                 prog[name].value = value

@@ -1,4 +1,5 @@
-"""Scene → GPU: the variant's defines and the uniform values, camera-relative in float32."""
+"""Scene → GPU: the variant's defines and the uniform values, camera-relative, in float32 or
+(the geometry of a double-precision variant) float64."""
 from __future__ import annotations
 
 import numpy as np
@@ -33,6 +34,8 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
             defines[f"KRS_{effect.upper()}"] = None
     if scene.render.tracer != "sphere":
         defines[f"KRS_TRACER_{scene.render.tracer.upper()}"] = None
+    if scene.render.precision == "double":
+        defines["KRS_DOUBLE"] = None
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -48,18 +51,20 @@ def slots(c: Compiled) -> int:
     return COMPOUND_SLOTS if isinstance(c, CompiledCompound) else MAX_LEVELS
 
 
-def krs_block(c: Compiled) -> bytes:
-    """The std140 KRSBlock: mirrors (or Möbius records) then kernel records, as float32."""
+def krs_block(c: Compiled, precision: str = "float") -> bytes:
+    """The std140 KRSBlock: mirrors (or Möbius records) then kernel records, as float32 or,
+    for ``precision = "double"`` (dvec4 arrays), float64."""
     n = slots(c)
+    dtype = np.float64 if precision == "double" else np.float32
     if isinstance(c, CompiledMoKRS):
-        head = np.zeros((n, MOBIUS_RECORD, 4), dtype=np.float32)
+        head = np.zeros((n, MOBIUS_RECORD, 4), dtype=dtype)
         head[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
         head[:c.n, 4] = c.poles
     else:
-        head = np.zeros((n, 4), dtype=np.float32)
+        head = np.zeros((n, 4), dtype=dtype)
         for part, first in component_slots(c):
             head[first:first + part.n] = part.mirrors
-    kernels = np.zeros((n, RECORD_VEC4, 4), dtype=np.float32)
+    kernels = np.zeros((n, RECORD_VEC4, 4), dtype=dtype)
     kernels[:len(c.records)] = c.records
     return head.tobytes() + kernels.tobytes()
 

@@ -15,6 +15,7 @@ from .schema import SceneError, Tagged, Vec3, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
 TRACERS = ("sphere", "binary", "relaxed")
+PRECISIONS = ("float", "double")
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -221,6 +222,10 @@ class Render:
     relaxation: float = param(1.6, lo=1.0, hi=1.99,
                               help="relaxed tracing: step ω·d; a step whose sphere does not "
                                    "meet the last one is taken back and ω drops to 1")
+    precision: str = param("float", choices=PRECISIONS,
+                           help="float: the GPU's float32; double: distances, folds, Möbius "
+                                "maps and ray positions in float64 (GL 4 fp64), for deep "
+                                "zooms, at a cost in time")
 
 
 # ------------------------------------------------------------------------------ arc geometry

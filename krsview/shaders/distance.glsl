@@ -11,7 +11,7 @@
 #endif
 
 // Where the undistorted KRS is looked up for the world point p.
-vec3 undistort(vec3 p) {
+vec3r undistort(vec3r p) {
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) return untwist(p);
 #endif
@@ -19,7 +19,7 @@ vec3 undistort(vec3 p) {
 }
 
 // From the undistorted distance D at undistort(p) to a bound that never overshoots at p.
-float distort_distance(vec3 p, float D) {
+real distort_distance(vec3r p, real D) {
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) D = twist_step(p, D);
 #endif
@@ -39,22 +39,22 @@ ivec2 component(int c) {
 #endif
 }
 
-float undistorted_distance(int c, vec3 q) {
+real undistorted_distance(int c, vec3r q) {
     ivec2 k = component(c);
     return krs_distance(k.x, k.y, q);
 }
 
 // The distance bound of component c, which the tracer steps by.
-float component_distance(int c, vec3 p) {
+real component_distance(int c, vec3r p) {
     return distort_distance(p, undistorted_distance(c, undistort(p)));
 }
 
 // The bound of everything drawn: the least over the components (a distortion is monotone in
 // the distance, so it is applied once, after the minimum).
-float scene_distance(vec3 p) {
+real scene_distance(vec3r p) {
 #ifdef KRS_COMPOUND
-    vec3 q = undistort(p);
-    float D = undistorted_distance(0, q);
+    vec3r q = undistort(p);
+    real D = undistorted_distance(0, q);
     for (int c = 1; c < COMPONENTS; ++c) D = min(D, undistorted_distance(c, q));
     return distort_distance(p, D);
 #else
@@ -63,17 +63,17 @@ float scene_distance(vec3 p) {
 }
 
 // A ball is free of component c when its distance bound at the centre covers it.
-bool is_unbounding(int c, vec3 center, float radius) {
+bool is_unbounding(int c, vec3r center, real radius) {
     return component_distance(c, center) >= radius;
 }
 
 // The component nearest to the undistorted point q (ties: the first).
-int nearest_component(vec3 q) {
+int nearest_component(vec3r q) {
     int win = 0;
 #ifdef KRS_COMPOUND
-    float best = undistorted_distance(0, q);
+    real best = undistorted_distance(0, q);
     for (int c = 1; c < COMPONENTS; ++c) {
-        float d = undistorted_distance(c, q);
+        real d = undistorted_distance(c, q);
         if (d < best) { best = d; win = c; }
     }
 #endif
@@ -83,20 +83,21 @@ int nearest_component(vec3 q) {
 // Nearest kernel's level slot, its kernel-space point and the world normal at the hit point
 // p, whose ray distance t sets the smoothing band (at least 2 pixel footprints, against
 // aliasing). In a compound, the component nearest to p is asked (ties: the first).
-void scene_nearest(vec3 p, float t, out int level, out vec3 normal, out vec3 xk) {
-    vec3 q = undistort(p);
+void scene_nearest(vec3r p, real t, out int level, out vec3 normal, out vec3 xk) {
+    vec3r q = undistort(p), xkr;
     float width = 0.0;
 #ifdef KRS_SMOOTH_SHADING
-    width = max(u_smooth_width, 2.0 * u_footprint * t);
+    width = max(u_smooth_width, 2.0 * u_footprint * float(t));
 #endif
     ivec2 k = component(nearest_component(q));
-    float D = krs_nearest(k.x, k.y, q, width, level, normal, xk);
+    real D = krs_nearest(k.x, k.y, q, width, level, normal, xkr);
+    xk = vec3(xkr);
 #ifdef KRS_TWIST
-    if (EFFECT_ON(KRS_TWIST_BIT)) normal = twist_normal(p, q, normal);
+    if (EFFECT_ON(KRS_TWIST_BIT)) normal = twist_normal(vec3(p), vec3(q), normal);
 #endif
 #ifdef KRS_EMPTY_ZONES
     int zone;   // on a cut face the zone's sphere is the surface
     if (EFFECT_ON(KRS_EMPTY_ZONES_BIT) && zone_depth(p, zone) > D)
-        normal = normalize(u_empty_zones[zone].xyz - p);
+        normal = vec3(normalize(u_empty_zones[zone].xyz - p));
 #endif
 }

@@ -6,11 +6,11 @@ uniform int u_empty_zone_count;
 uniform vec4 u_empty_zones[MAX_EMPTY_ZONES];  // camera-relative centre, radius
 
 // The largest r − |p − c| (how deep p is inside a zone) and the index of that zone.
-float zone_depth(vec3 p, out int zone) {
-    float depth = -FAR_AWAY;
+real zone_depth(vec3r p, out int zone) {
+    real depth = -FAR_AWAY;
     zone = -1;
     for (int z = 0; z < u_empty_zone_count; ++z) {
-        float e = u_empty_zones[z].w - length(p - u_empty_zones[z].xyz);
+        real e = u_empty_zones[z].w - length(p - u_empty_zones[z].xyz);
         if (e > depth) { depth = e; zone = z; }
     }
     return depth;

@@ -1,12 +1,13 @@
 // Kernel distances k_i and gradients [KRS17 §3, §9.2]; twin of reference/kernels.py.
 // Sphere, capsule, toroidal capsule = point, segment, arc swept by a ball of radius r:
 // k(p) = |p - core(p)| - r never overshoots. Only the types a scene uses are compiled in.
-vec4 kernel_rec(int i, int k) { return u_kernels[i * KRS_RECORD + k]; }
+vec4r kernel_rec(int i, int k) { return u_kernels[i * KRS_RECORD + k]; }
+vec4 kernel_rec_float(int i, int k) { return vec4(kernel_rec(i, k)); }  // for shading
 
 #ifdef KRS_KERNEL_CAPSULE
-vec3 capsule_core(int i, vec3 p) {
-    vec3 a = kernel_rec(i, 1).xyz, ab = kernel_rec(i, 2).xyz - a;
-    float h = clamp(dot(p - a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+vec3r capsule_core(int i, vec3r p) {
+    vec3r a = kernel_rec(i, 1).xyz, ab = kernel_rec(i, 2).xyz - a;
+    real h = clamp(dot(p - a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
     return a + h * ab;
 }
 #endif
@@ -14,20 +15,20 @@ vec3 capsule_core(int i, vec3 p) {
 #ifdef KRS_KERNEL_TOROIDAL_CAPSULE
 // Is the angle of (x, y) from e1 towards e2 within [0, phi]? y = ρ sin a and
 // s = x sin phi − y cos phi = ρ sin(phi − a); no trigonometry (twin of in_wedge).
-bool in_wedge(int i, float x, float y) {
-    float cos_phi = kernel_rec(i, 4).w, sin_phi = kernel_rec(i, 5).w;
-    float s = x * sin_phi - y * cos_phi;
+bool in_wedge(int i, real x, real y) {
+    real cos_phi = kernel_rec(i, 4).w, sin_phi = kernel_rec(i, 5).w;
+    real s = x * sin_phi - y * cos_phi;
     return sin_phi >= 0.0 ? (y >= 0.0 && s >= 0.0) : (y >= 0.0 || s >= 0.0);
 }
 
 // Torus formula inside the wedge (the arc is nearer than its ends there), else the nearer cap.
-float toroidal_capsule_distance(int i, vec3 p) {
-    vec4 c = kernel_rec(i, 3);
-    vec3 q = p - c.xyz;
-    float x = dot(q, kernel_rec(i, 4).xyz), y = dot(q, kernel_rec(i, 5).xyz);
-    float d;
+real toroidal_capsule_distance(int i, vec3r p) {
+    vec4r c = kernel_rec(i, 3);
+    vec3r q = p - c.xyz;
+    real x = dot(q, kernel_rec(i, 4).xyz), y = dot(q, kernel_rec(i, 5).xyz);
+    real d;
     if (in_wedge(i, x, y)) {
-        float ring = length(vec2(x, y)) - c.w;
+        real ring = length(vec2r(x, y)) - c.w;
         d = sqrt(ring * ring + max(dot(q, q) - x * x - y * y, 0.0));
     } else {
         d = min(length(p - kernel_rec(i, 1).xyz), length(p - kernel_rec(i, 2).xyz));
@@ -35,18 +36,18 @@ float toroidal_capsule_distance(int i, vec3 p) {
     return d - kernel_rec(i, 1).w;
 }
 
-vec3 toroidal_capsule_core(int i, vec3 p) {
-    vec4 c = kernel_rec(i, 3);
-    vec3 e1 = kernel_rec(i, 4).xyz, e2 = kernel_rec(i, 5).xyz, q = p - c.xyz;
-    float x = dot(q, e1), y = dot(q, e2), rho = length(vec2(x, y));
+vec3r toroidal_capsule_core(int i, vec3r p) {
+    vec4r c = kernel_rec(i, 3);
+    vec3r e1 = kernel_rec(i, 4).xyz, e2 = kernel_rec(i, 5).xyz, q = p - c.xyz;
+    real x = dot(q, e1), y = dot(q, e2), rho = length(vec2r(x, y));
     if (in_wedge(i, x, y))
         return c.xyz + c.w * (rho > 0.0 ? (x * e1 + y * e2) / rho : e1);
-    vec3 A = kernel_rec(i, 1).xyz, B = kernel_rec(i, 2).xyz;
+    vec3r A = kernel_rec(i, 1).xyz, B = kernel_rec(i, 2).xyz;
     return dot(p - A, p - A) <= dot(p - B, p - B) ? A : B;
 }
 #endif
 
-float kernel_distance(int i, vec3 p) {
+real kernel_distance(int i, vec3r p) {
     int type = int(kernel_rec(i, 0).w);
 #ifdef KRS_KERNEL_SPHERE
     if (type == KERNEL_SPHERE) return length(p - kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;
@@ -63,9 +64,9 @@ float kernel_distance(int i, vec3 p) {
     return FAR_AWAY;  // empty kernel
 }
 
-vec3 kernel_gradient(int i, vec3 p) {
+vec3r kernel_gradient(int i, vec3r p) {
     int type = int(kernel_rec(i, 0).w);
-    vec3 core = p;
+    vec3r core = p;
 #ifdef KRS_KERNEL_PLANE
     if (type == KERNEL_PLANE) return kernel_rec(i, 1).xyz;
 #endif
@@ -78,7 +79,7 @@ vec3 kernel_gradient(int i, vec3 p) {
 #ifdef KRS_KERNEL_TOROIDAL_CAPSULE
     if (type == KERNEL_TOROIDAL_CAPSULE) core = toroidal_capsule_core(i, p);
 #endif
-    vec3 g = p - core;
-    float len = length(g);
-    return len > 0.0 ? g / len : vec3(0.0, 0.0, 1.0);
+    vec3r g = p - core;
+    real len = length(g);
+    return len > 0.0 ? g / len : vec3r(0.0, 0.0, 1.0);
 }

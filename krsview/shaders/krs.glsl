@@ -3,17 +3,17 @@
 #include "kernels.glsl"
 
 // Reflect p if it lies behind mirror i (u·p − w > 0); returns that signed distance u·p − w.
-float fold(int i, inout vec3 p) {
-    vec4 m = u_mirrors[i];
-    float e = dot(p, m.xyz) - m.w;
+real fold(int i, inout vec3r p) {
+    vec4r m = u_mirrors[i];
+    real e = dot(p, m.xyz) - m.w;
     if (e > 0.0) p -= 2.0 * e * m.xyz;
     return e;
 }
 
 // The KRS whose kernels K_0..K_n and mirrors R_0..R_{n−1} sit in slots first..first + n.
-float krs_distance(int first, int n, vec3 xw) {
-    vec3 x = xw;
-    float d = kernel_distance(first + n, x);
+real krs_distance(int first, int n, vec3r xw) {
+    vec3r x = xw;
+    real d = kernel_distance(first + n, x);
     for (int i = first + n - 1; i >= first; --i) {
         fold(i, x);
         d = min(d, kernel_distance(i, x));
@@ -26,32 +26,32 @@ uniform float u_smooth_width;  // scene units
 
 // [KRS14 Alg. 2]: near mirror i the reflection is blended in over a band of the given width
 // (0 at −width/2, ½ on the plane, 1 at +width/2), so the two copies' normals meet smoothly.
-float mirror_weight(float e, float width) {
+real mirror_weight(real e, float width) {
     return EFFECT_ON(KRS_SMOOTH_SHADING_BIT) ? clamp(e / width + 0.5, 0.0, 1.0)
                                              : (e > 0.0 ? 1.0 : 0.0);
 }
 #else
-float mirror_weight(float e, float width) { return e > 0.0 ? 1.0 : 0.0; }
+real mirror_weight(real e, float width) { return e > 0.0 ? 1.0 : 0.0; }
 #endif
 
 // Winning level slot j (ties to the coarser level), the point x_j in its kernel's space, and the
 // world normal M ∇k_j(x_j) with M = A_{n−1} ⋯ A_j, A_i = I − 2 w_i u_i u_iᵀ accumulated while
 // walking down [KRS14 §6.1]: w_i = 1 where mirror i folded x, else 0 (smoothed near the plane).
-float krs_nearest(int first, int n, vec3 xw, float width, out int level, out vec3 normal,
-                  out vec3 xk) {
-    vec3 x = xw;
+real krs_nearest(int first, int n, vec3r xw, float width, out int level, out vec3 normal,
+                 out vec3r xk) {
+    vec3r x = xw;
     xk = xw;
-    float d = kernel_distance(first + n, x);
+    real d = kernel_distance(first + n, x);
     level = first + n;
-    mat3 M = mat3(1.0), Mk = mat3(1.0);
+    mat3r M = mat3r(1.0), Mk = mat3r(1.0);
     for (int i = first + n - 1; i >= first; --i) {
-        vec3 u = u_mirrors[i].xyz;
-        float e = fold(i, x);
+        vec3r u = u_mirrors[i].xyz;
+        real e = fold(i, x);
         M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
-        float di = kernel_distance(i, x);
+        real di = kernel_distance(i, x);
         if (di < d) { d = di; level = i; xk = x; Mk = M; }
     }
-    vec3 g = Mk * kernel_gradient(level, xk);
-    normal = length(g) > 0.0 ? normalize(g) : kernel_gradient(level, xk);
+    vec3r g = Mk * kernel_gradient(level, xk);
+    normal = vec3(length(g) > 0.0 ? normalize(g) : kernel_gradient(level, xk));
     return d;
 }

@@ -6,7 +6,7 @@
 bool reflects(int i) { return (int(mobius_rec(i, 4).w) & 2) != 0; }
 
 // c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
-bool is_unbounding(int c, vec3 center, float radius) {
+bool is_unbounding(int c, vec3r center, real radius) {
     for (int i = u_n - 1; i >= 0; --i) {
         if (!map_ball(i, center, radius)) return false;   // inside-out
         if (reflects(i)) center.x = -abs(center.x);      // mirror decision on the centre
@@ -17,20 +17,20 @@ bool is_unbounding(int c, vec3 center, float radius) {
 
 // Follow the point inwards accumulating J = d(world → level); k_i / |J e_x| is the world
 // distance to first order; the winner's world normal is Jᵀ ∇k_j.
-void mokrs_nearest(vec3 xw, out int level, out vec3 normal) {
-    vec3 x = xw, xk = xw;
-    mat3 J = mat3(1.0), Jk = mat3(1.0);
-    const mat3 FLIP = mat3(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-    float best = FAR_AWAY;
+void mokrs_nearest(vec3r xw, out int level, out vec3 normal) {
+    vec3r x = xw, xk = xw;
+    mat3r J = mat3r(1.0), Jk = mat3r(1.0);
+    const mat3r FLIP = mat3r(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    real best = FAR_AWAY;
     level = 0;
     for (int i = u_n - 1; i >= 0; --i) {
-        vec3 image = mobius_apply(i, x);
+        vec3r image = mobius_apply(i, x);
         J = mobius_jacobian(i, x, image) * J;
         x = image;
         if (reflects(i) && x.x > 0.0) { x.x = -x.x; J = FLIP * J; }
-        float d = kernel_distance(i, x) / length(J[0]);
+        real d = kernel_distance(i, x) / length(J[0]);
         if (d < best) { best = d; level = i; xk = x; Jk = J; }
     }
-    vec3 g = kernel_gradient(level, xk), gw = transpose(Jk) * g;
-    normal = length(gw) > 0.0 ? normalize(gw) : g;  // as krs_nearest where J degenerates
+    vec3r g = kernel_gradient(level, xk), gw = transpose(Jk) * g;
+    normal = vec3(length(gw) > 0.0 ? normalize(gw) : g);  // as krs_nearest where J degenerates
 }

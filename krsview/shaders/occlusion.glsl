@@ -5,11 +5,11 @@
 uniform float u_ao_step;
 uniform float u_ao_strength;
 
-float ambient_occlusion(vec3 p, vec3 n) {
+float ambient_occlusion(vec3r p, vec3 n) {
     float occlusion = 0.0, weight = 0.5;
     for (int k = 1; k <= AO_SAMPLES; ++k) {
         float h = float(k) * u_ao_step;
-        occlusion += weight * clamp((h - scene_distance(p + h * n)) / h, 0.0, 1.0);
+        occlusion += weight * clamp((h - float(scene_distance(p + h * n))) / h, 0.0, 1.0);
         weight *= 0.5;
     }
     return clamp(1.0 - u_ao_strength * occlusion, 0.0, 1.0);

@@ -11,20 +11,20 @@ layout(location = 2) out vec4 out_iterations; // x
 void main() {
     vec2 ndc = 2.0 * gl_FragCoord.xy / u_resolution - 1.0;
     float aspect = u_resolution.x / u_resolution.y;
-    vec3 dir = normalize(u_forward + ndc.x * u_tan_half * aspect * u_right
-                         + ndc.y * u_tan_half * u_up);
-    float t;
+    vec3r dir = normalize(u_forward + real(ndc.x * u_tan_half * aspect) * u_right
+                          + real(ndc.y * u_tan_half) * u_up);
+    real t;
     int iterations;
-    bool hit = trace_ray(vec3(0.0), dir, t, iterations);
+    bool hit = trace_ray(vec3r(0.0), dir, t, iterations);
     out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
     if (!hit) {
-        out_color = vec4(encode(background(dir)), 0.0);
+        out_color = vec4(encode(background(vec3(dir))), 0.0);
         out_normal = vec4(0.0);
         return;
     }
     int level;
     vec3 n, xk;
     nearest_kernel(t * dir, t, level, n, xk);
-    out_color = vec4(encode(shade(t * dir, dir, t, level, n, xk)), 1.0);
-    out_normal = vec4(n, t);
+    out_color = vec4(encode(shade(t * dir, vec3(dir), t, level, n, xk)), 1.0);
+    out_normal = vec4(n, float(t));
 }

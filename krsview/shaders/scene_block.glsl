@@ -7,15 +7,38 @@
 #define KERNEL_PLANE 4
 #define FAR_AWAY 1e30
 
+// Precision of the geometry (render.precision): `real` and its vectors are what distances,
+// folds, Möbius maps and ray positions are computed in; shading stays in float. GLSL has no
+// double sin/cos, so the twist angle is always a float (twist.glsl).
+#ifdef KRS_DOUBLE
+#define real double
+#define vec2r dvec2
+#define vec3r dvec3
+#define vec4r dvec4
+#define mat3r dmat3
+#else
+#define real float
+#define vec2r vec2
+#define vec3r vec3
+#define vec4r vec4
+#define mat3r mat3
+#endif
+
 // KRS_SLOTS level slots: one per level, or in a compound, component c's level i is slot
 // first_c + i (its mirror and its kernel record share the slot).
-layout(std140) uniform KRSBlock {
-#ifdef KRS_MOBIUS
-    vec4 u_mobius[KRS_SLOTS * MOBIUS_RECORD];   // per level: H_i = G_i⁻¹ (mobius.glsl)
+// In double precision a compound's slots outgrow a 64 KiB uniform block: a storage buffer
+// holds them (same layout: a dvec4 array has a 32-byte stride in std140 and std430).
+#ifdef KRS_DOUBLE
+layout(std430, binding = 0) readonly buffer KRSBlock {
 #else
-    vec4 u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
+layout(std140) uniform KRSBlock {
 #endif
-    vec4 u_kernels[KRS_SLOTS * KRS_RECORD];     // per level: KRS_RECORD vec4s
+#ifdef KRS_MOBIUS
+    vec4r u_mobius[KRS_SLOTS * MOBIUS_RECORD];   // per level: H_i = G_i⁻¹ (mobius.glsl)
+#else
+    vec4r u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
+#endif
+    vec4r u_kernels[KRS_SLOTS * KRS_RECORD];     // per level: KRS_RECORD vec4s
 };
 uniform int u_n;            // KRS: number of mirrors, kernels K_0..K_n; MöKRS: levels
 
@@ -31,9 +54,10 @@ uniform ivec2 u_component[KRS_MAX_COMPONENTS];  // per component: first slot, mi
 #define COMPONENT_SLOTS 1
 #endif
 
-uniform vec3 u_forward;
-uniform vec3 u_right;
-uniform vec3 u_up;
+uniform vec3r u_forward;    // camera basis in `real`: rounded to float it turns the view by
+                            // ~1e-7 rad, many pixels of a deep zoom
+uniform vec3r u_right;
+uniform vec3r u_up;
 uniform vec2 u_resolution;
 uniform float u_tan_half;
 uniform float u_footprint;  // pixel size at unit distance (the LOD measure [KRS17 §4])

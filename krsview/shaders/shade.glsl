@@ -21,12 +21,13 @@ vec3 encode(vec3 linear) {
 
 // Linear radiance of the hit at p (ray distance t along dir) on kernel `level` with world
 // normal n and kernel-space point xk.
-vec3 shade(vec3 p, vec3 dir, float t, int level, vec3 n, vec3 xk) {
-    vec3 albedo = kernel_rec(level, 0).rgb;
+vec3 shade(vec3r p, vec3 dir, real t_ray, int level, vec3 n, vec3 xk) {
+    float t = float(t_ray);
+    vec3 albedo = kernel_rec_float(level, 0).rgb;
     float footprint = u_footprint * t;
 #ifdef KRS_TRIPLANAR_TEXTURE
     if (EFFECT_ON(KRS_TRIPLANAR_TEXTURE_BIT))
-        albedo *= texture_modulation(triplanar(p + u_eye, n, footprint));
+        albedo *= texture_modulation(triplanar(vec3(p) + u_eye, n, footprint));
 #endif
 #ifdef KRS_KERNEL_TEXTURE
     if (EFFECT_ON(KRS_KERNEL_TEXTURE_BIT))

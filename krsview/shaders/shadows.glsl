@@ -23,15 +23,16 @@ bool shadows_on() {
 
 // Visibility in [0, 1] of the light in direction l from the hit point p with normal n, where
 // the primary ray stopped at threshold eps; the shadow ray stops at the same threshold.
-float shadow_visibility(vec3 p, vec3 n, vec3 l, float eps) {
+float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
     bool soft = soft_shadows_on();
-    vec3 o = p + SHADOW_OFFSET * eps * n;
-    float vis = 1.0, t = 0.0;
+    vec3r o = p + SHADOW_OFFSET * eps * n;
+    float vis = 1.0;
+    real t = 0.0;
 #ifdef KRS_MOBIUS
-    float s = INITIAL_PROBE;
+    real s = INITIAL_PROBE;
     for (int i = 0; i < u_max_iterations; ++i) {
         if (is_unbounding(0, o + (t + s) * l, s)) {
-            if (soft) vis = min(vis, u_shadow_softness * s / (t + s));
+            if (soft) vis = min(vis, u_shadow_softness * float(s / (t + s)));
             t += 2.0 * s;
             s *= u_xi_bonus;
             if (t > u_max_distance) break;
@@ -41,15 +42,15 @@ float shadow_visibility(vec3 p, vec3 n, vec3 l, float eps) {
         }
     }
 #else
-    float tc[COMPONENT_SLOTS];  // one free distance per component, as in trace.glsl
+    real tc[COMPONENT_SLOTS];  // one free distance per component, as in trace.glsl
     for (int c = 0; c < COMPONENT_SLOTS; ++c) tc[c] = 0.0;
     for (int i = 0; i < u_max_iterations; ++i) {
         int c = front(tc);
         t = tc[c];
         if (t > u_max_distance) break;
-        float d = component_distance(c, o + t * l);
+        real d = component_distance(c, o + t * l);
         if (d <= eps) return 0.0;
-        if (soft && t > 0.0) vis = min(vis, u_shadow_softness * d / t);
+        if (soft && t > 0.0) vis = min(vis, u_shadow_softness * float(d / t));
         tc[c] = t + d;
     }
 #endif

@@ -61,25 +61,25 @@ vec3 perpendicular(vec3 d) {
 // (along, around) in scene units on kernel `level` at its kernel-space point xk
 // (camera-relative; eye = the camera's world position, which planes need).
 vec2 kernel_uv(int level, vec3 xk, vec3 eye) {
-    int type = int(kernel_rec(level, 0).w);
-    float r = kernel_rec(level, 1).w;
+    int type = int(kernel_rec_float(level, 0).w);
+    float r = kernel_rec_float(level, 1).w;
     if (type == KERNEL_SPHERE) {
-        vec3 q = xk - kernel_rec(level, 1).xyz;
+        vec3 q = xk - kernel_rec_float(level, 1).xyz;
         return r * vec2(atan(q.z, q.x), acos(clamp(q.y / max(length(q), 1e-30), -1.0, 1.0)));
     }
     if (type == KERNEL_CAPSULE) {
-        vec3 a = kernel_rec(level, 1).xyz, d = normalize(kernel_rec(level, 2).xyz - a);
+        vec3 a = kernel_rec_float(level, 1).xyz, d = normalize(kernel_rec_float(level, 2).xyz - a);
         vec3 e1 = perpendicular(d), e2 = cross(d, e1), q = xk - a;
         return vec2(dot(q, d), r * atan(dot(q, e2), dot(q, e1)));
     }
     if (type == KERNEL_TOROIDAL_CAPSULE) {
-        vec4 c = kernel_rec(level, 3);
-        vec3 e1 = kernel_rec(level, 4).xyz, e2 = kernel_rec(level, 5).xyz, q = xk - c.xyz;
+        vec4 c = kernel_rec_float(level, 3);
+        vec3 e1 = kernel_rec_float(level, 4).xyz, e2 = kernel_rec_float(level, 5).xyz, q = xk - c.xyz;
         float x = dot(q, e1), y = dot(q, e2), rho = max(length(vec2(x, y)), 1e-30);
         vec3 radial = (x * e1 + y * e2) / rho, tube = q - c.w * radial;
         return vec2(c.w * atan(y, x), r * atan(dot(tube, cross(e1, e2)), dot(tube, radial)));
     }
-    vec3 u = kernel_rec(level, 1).xyz, e1 = perpendicular(u), q = xk + eye;  // plane
+    vec3 u = kernel_rec_float(level, 1).xyz, e1 = perpendicular(u), q = xk + eye;  // plane
     return vec2(dot(q, e1), dot(q, cross(u, e1)));
 }
 

@@ -10,7 +10,7 @@
 #endif
 
 // The component with the least free distance (ties: the first).
-int front(float tc[COMPONENT_SLOTS]) {
+int front(real tc[COMPONENT_SLOTS]) {
     int f = 0;
     for (int c = 1; c < COMPONENTS; ++c) if (tc[c] < tc[f]) f = c;
     return f;
@@ -21,14 +21,14 @@ int front(float tc[COMPONENT_SLOTS]) {
 
 // Probe the ball of radius s touching the free point t: free → advance 2s, grow s;
 // blocked → converged if s ≤ ε(t), else shrink s (see reference/trace.py for why).
-bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
-    float tc[COMPONENT_SLOTS], sc[COMPONENT_SLOTS];
+bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
+    real tc[COMPONENT_SLOTS], sc[COMPONENT_SLOTS];
     for (int c = 0; c < COMPONENT_SLOTS; ++c) { tc[c] = 0.0; sc[c] = INITIAL_PROBE; }
     for (iterations = 0; iterations < u_max_iterations;) {
         int c = front(tc);
         t = tc[c];
         if (t > u_max_distance) return false;
-        float s = sc[c];
+        real s = sc[c];
         bool free = is_unbounding(c, origin + (t + s) * dir, s);
         ++iterations;
         if (free) {
@@ -45,12 +45,12 @@ bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
 // Over-relaxed sphere tracing [Keinert et al. 2014] of a single KRS: step ω·d from the last
 // verified point (ts, ds); if the new free ball and the last one no longer cover [ts, t],
 // go back to ts + ds and trace plainly (ω = 1). Twin of relaxed_trace in reference/trace.py.
-bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
-    float ts = 0.0, ds = 0.0, w = u_relaxation;
+bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
+    real ts = 0.0, ds = 0.0, w = u_relaxation;
     t = 0.0;
     for (iterations = 0; iterations < u_max_iterations;) {
         if (t > u_max_distance) return false;
-        float d = component_distance(0, origin + t * dir);
+        real d = component_distance(0, origin + t * dir);
         ++iterations;
         if (w > 1.0 && ds + d < t - ts) {
             t = ts + ds;
@@ -65,14 +65,14 @@ bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
     return false;
 }
 #else
-bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
-    float tc[COMPONENT_SLOTS];
+bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
+    real tc[COMPONENT_SLOTS];
     for (int c = 0; c < COMPONENT_SLOTS; ++c) tc[c] = 0.0;
     for (iterations = 0; iterations < u_max_iterations;) {
         int c = front(tc);
         t = tc[c];
         if (t > u_max_distance) return false;
-        float d = component_distance(c, origin + t * dir);
+        real d = component_distance(c, origin + t * dir);
         ++iterations;
         if (d <= u_eps_per_t * t) return true;
         tc[c] = t + d;
@@ -83,10 +83,10 @@ bool trace_ray(vec3 origin, vec3 dir, out float t, out int iterations) {
 
 // The kernel level nearest to a hit point at ray distance t, the world normal there, and the
 // point in that kernel's own space (for kernel texture coordinates).
-void nearest_kernel(vec3 p, float t, out int level, out vec3 normal, out vec3 xk) {
+void nearest_kernel(vec3r p, real t, out int level, out vec3 normal, out vec3 xk) {
 #ifdef KRS_MOBIUS
     mokrs_nearest(p, level, normal);
-    xk = p;
+    xk = vec3(p);
 #else
     scene_nearest(p, t, level, normal, xk);
 #endif

@@ -4,20 +4,23 @@
 uniform float u_twist;         // radians per unit height
 uniform vec3 u_twist_center;
 
-vec2 turn(vec2 v, float a) { return vec2(v.x * cos(a) - v.y * sin(a), v.x * sin(a) + v.y * cos(a)); }
+vec2r turn(vec2r v, float a) {
+    real c = cos(a), s = sin(a);
+    return vec2r(v.x * c - v.y * s, v.x * s + v.y * c);
+}
 
 // g = f⁻¹: where the untwisted geometry is looked up for the world point p.
-vec3 untwist(vec3 p) {
-    vec3 r = p - u_twist_center;
-    return u_twist_center + vec3(turn(r.xz, -u_twist * r.y), r.y).xzy;
+vec3r untwist(vec3r p) {
+    vec3r r = p - u_twist_center;
+    return u_twist_center + vec3r(turn(r.xz, -u_twist * float(r.y)), r.y).xzy;
 }
 
 // A safe step from the untwisted distance D: ‖Dg‖ ≤ 1 + |k|ρ at axis distance ρ, so over the
 // ball of radius δ around p it is ≤ 1 + |k|(ρ + δ); δ(1 + |k|ρ + |k|δ) = D is solved in its
 // cancellation-free form, and δ = D when k = 0.
-float twist_step(vec3 p, float D) {
+real twist_step(vec3r p, real D) {
     if (D <= 0.0) return D;
-    float k = abs(u_twist), a = 1.0 + k * length(p.xz - u_twist_center.xz);
+    real k = abs(u_twist), a = 1.0 + k * length(p.xz - u_twist_center.xz);
     return 2.0 * D / (a + sqrt(a * a + 4.0 * k * D));
 }
 
