@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import typing
 from dataclasses import fields
@@ -9,6 +10,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from . import __version__
 from .presets import DEFAULT_PRESET, preset_names, resolve
 import numpy as np
 
@@ -74,7 +76,7 @@ def render_option(sp: argparse.ArgumentParser, name: str) -> None:
             return check_value(hint, value, flag, meta)
         except SceneError as e:
             raise argparse.ArgumentTypeError(str(e)) from None
-    allowed = describe_range(meta) if not meta.get("choices") else \
+    allowed = describe_range(meta, hint) if not meta.get("choices") else \
         "one of " + ", ".join(meta["choices"])
     sp.add_argument(flag, type=parse, metavar=name.split("_")[-1].upper(),
                     help=f"{meta['help']} ({allowed}; overrides the scene's [render])")
@@ -104,6 +106,9 @@ def _load(args: argparse.Namespace) -> Scene:
 
 def cmd_render(args: argparse.Namespace) -> int:
     scene = _load(args)
+    out = check_output_file(args.output, "-o", ".png")
+    if args.buffers:
+        check_output_file(args.buffers, "--buffers", ".npz")
     w, h = args.size
     krs = scene.geometry()
     print(f"krsview: {scene.name}: {krs.depth} levels, {krs.instance_count():,} kernel "
@@ -125,8 +130,6 @@ def cmd_render(args: argparse.Namespace) -> int:
         print(f"  frame time {frame * 1e3:.1f} ms (median of {args.repeats}), "
               f"{buffers.iterations.mean():.1f} iterations/pixel, "
               f"{buffers.hit.mean() * 100:.0f}% of pixels hit")
-    out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     if args.view == "iterations":
         from .heatmap import save_heatmap
         it = buffers.iterations
@@ -196,23 +199,34 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def _bench_csv(args: argparse.Namespace) -> str | None:
+    if args.csv:
+        check_output_file(args.csv, "--csv", ".csv")
+    return args.csv
+
+
 def cmd_bench_levels(args: argparse.Namespace) -> int:
     from .bench.levels import bench_levels
     scene = _load(args)
+    _bench_csv(args)
     bench_levels(scene, args.size, step=args.step, rounds=args.rounds, csv=args.csv)
     return 0
 
 
 def cmd_bench_tracers(args: argparse.Namespace) -> int:
     from .bench.tracers import bench_tracers
-    bench_tracers(_load(args), args.size, rounds=args.rounds, sweep=not args.no_sweep,
+    scene = _load(args)
+    _bench_csv(args)
+    bench_tracers(scene, args.size, rounds=args.rounds, sweep=not args.no_sweep,
                   csv=args.csv)
     return 0
 
 
 def cmd_bench_effects(args: argparse.Namespace) -> int:
     from .bench.effects import bench_effects
-    bench_effects(_load(args), args.size, rounds=args.rounds, csv=args.csv)
+    scene = _load(args)
+    _bench_csv(args)
+    bench_effects(scene, args.size, rounds=args.rounds, csv=args.csv)
     return 0
 
 
@@ -224,6 +238,25 @@ def cmd_bench_accuracy(args: argparse.Namespace) -> int:
     bench_accuracy(scene, args.size, out, rounds=args.rounds,
                    cache=Path(args.cache) if args.cache else None)
     return 0
+
+
+def check_output_file(path: str, flag: str, suffix: str) -> Path:
+    """Before any work: the file has the format's extension, is not a folder, and its folder
+    exists or can be made and is writable (a render must not fail after it ran)."""
+    p = Path(path)
+    if p.suffix.lower() != suffix:
+        raise SceneError(flag, path, f"the file must end in {suffix} (it is written as "
+                         f"{suffix[1:].upper()})")
+    if p.is_dir():
+        raise SceneError(flag, path, "is a folder; give a file name ending in " + suffix)
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        probe = p.parent / f".{p.name}.write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as e:
+        raise SceneError(flag, path, f"cannot write there: {e.strerror}") from None
+    return p
 
 
 def check_output_dir(path: Path, flag: str) -> None:
@@ -247,10 +280,11 @@ def build_parser() -> argparse.ArgumentParser:
                     "A PRESET is a scene file (.toml) or the name of a shipped preset: "
                     f"{presets}.",
         epilog="examples:\n  krsview render tree -o tree.png --size 640x360\n"
-               "  krsview check presets/grass.toml\n  krsview bench levels tree\n"
+               "  krsview check grass\n  krsview bench levels tree\n"
                "  krsview render palm --view iterations -o palm-iterations.png\n"
                "  krsview bench tracers tree",
         formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"krsview {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     def accuracy(sp: argparse.ArgumentParser) -> None:
@@ -275,16 +309,19 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
         sp.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=5,
                         help="interleaved rounds; medians are reported (default 5)")
-        sp.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
+        sp.add_argument("--csv", metavar="PATH", help="also write the table to this file, "
+                        "ending in .csv")
 
     r = sub.add_parser("render", help="render a scene headless to PNG (and raw buffers)",
                        description="Render PRESET headless through EGL and write a PNG; prints "
                                    "the measured frame time.")
     r.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    r.add_argument("-o", "--output", default="out/render.png", help="PNG path (default %(default)s)")
+    r.add_argument("-o", "--output", default="out/render.png",
+                   help="PNG file to write, ending in .png (default %(default)s)")
     r.add_argument("--size", type=_size, default=(640, 360), help="WIDTHxHEIGHT (default 640x360)")
     r.add_argument("--buffers", metavar="NPZ",
-                   help="also write color, depth, normal, iterations and hit arrays (.npz)")
+                   help="also write color, depth, normal, iterations and hit arrays to this "
+                        "NumPy file, ending in .npz")
     r.add_argument("--reference", action="store_true",
                    help="render with the float64 NumPy reference instead of the GPU (slow)")
     r.add_argument("--repeats", type=_int_in("--repeats", 1, 1000), default=5,
@@ -388,7 +425,23 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+_NEGATIVE = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
+
+
+def join_negative_values(argv: list[str]) -> list[str]:
+    """``--size -5x3`` → ``--size=-5x3``: argparse takes a value that starts with '-' for an
+    option ("expected one argument"); joined, the option's own check says what is wrong."""
+    out: list[str] = []
+    for token in argv:
+        if out and out[-1].startswith("--") and "=" not in out[-1] and _NEGATIVE.match(token):
+            out[-1] += "=" + token
+        else:
+            out.append(token)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -46,12 +47,29 @@ def test_reference_render_matches_size(tmp_path):
     (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
     (["check", "missing.toml"], "no such scene file"),
     (["frobnicate"], "invalid choice"),
+    # values starting with '-' reach the option's own check (not "expected one argument")
+    (["render", "tree", "--size", "-5x3"], "--size '-5x3': each side must be 1..8192"),
+    (["render", "tree", "--epsilon-scale", "-inf"], "--epsilon-scale = -inf: NaN and infinity"),
+    # outputs are checked before the render runs
+    (["render", "tree", "-o", "x.jpg"], "-o = 'x.jpg': the file must end in .png"),
+    (["render", "tree", "-o", "/tmp"], "-o = '/tmp': the file must end in .png"),
+    (["render", "tree", "-o", "/proc/no/such.png"], "-o = '/proc/no/such.png': cannot write there"),
+    (["render", "tree", "--buffers", "x.txt"], "--buffers = 'x.txt': the file must end in .npz"),
+    (["bench", "levels", "tree", "--csv", "/tmp"], "--csv = '/tmp': the file must end in .csv"),
+    (["check", "tree.toml"], "no such scene file; the preset of that name is `tree` (no .toml)"),
+    (["check", "/tmp"], "'/tmp': is a folder"),
 ])
 def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):
     r = run(*args)
     assert r.returncode != 0
     assert message in r.stderr, r.stderr
     assert "Traceback" not in r.stderr
+    assert "frame time" not in r.stdout     # refused before any work
+
+
+def test_version():
+    r = run("--version")
+    assert r.returncode == 0 and r.stdout.strip().startswith("krsview 0.")
 
 
 def test_bad_scene_file_gets_file_field_value(tmp_path):
@@ -59,7 +77,7 @@ def test_bad_scene_file_gets_file_field_value(tmp_path):
     bad.write_text("[tree]\nlevels = 12\nbranch_angle = -5.0\n")
     r = run("check", str(bad))
     assert r.returncode == 2 and "Traceback" not in r.stderr
-    assert f"{bad}: tree.branch_angle = -5.0: allowed: 0.0 ≤ value ≤ 89.0 degrees" in r.stderr
+    assert f"{bad}: tree.branch_angle = -5.0: allowed: 0 ≤ value ≤ 89 degrees" in r.stderr
 
 
 def test_check_prints_statistics(capsys):
@@ -126,3 +144,21 @@ def test_bench_tracers_prints_ratios_and_best_pair(capsys):
     out = capsys.readouterr().out
     assert "| sphere |" in out and "| binary | 2.0 | 0.3 |" in out
     assert out.count("| binary |") == 9 and "fastest ξ pair:" in out
+
+
+def test_every_complete_scene_in_the_readme_renders_something(renderer):
+    """The README's scene examples (those with a camera) load and draw: an example that
+    passes `check` but shows an empty sky teaches nothing."""
+    from krsview.scene import scene_from_toml
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    blocks = [b.split("```")[0] for b in readme.split("```toml\n")[1:]]
+    complete = [b for b in blocks if "[camera]" in b]
+    assert len(complete) >= 2            # the KRS and the MöKRS examples
+    for text in complete:
+        scene = scene_from_toml(text, "README.md")
+        assert renderer.render(scene, 64, 36).hit.mean() > 0.01, scene.name
+    # negative control: the MöKRS example looking the other way shows an empty sky
+    mokrs = next(b for b in complete if "[[mokrs.levels]]" in b)
+    away = mokrs.replace("target = [0.0, 0.5, 0.0]", "target = [0.0, 2.0, -20.0]")
+    assert away != mokrs
+    assert renderer.render(scene_from_toml(away, "README.md"), 64, 36).hit.mean() == 0

@@ -42,7 +42,7 @@ def test_good_scene_loads():
      "[0.0, 0.0, 0.0]", "zero vector"),
     ("normal = [1.0, 0.0, 0.0]", "normal = [2.0, 0.0, 0.0]", "krs.levels[1].mirror.normal",
      "[2.0, 0.0, 0.0]", "unit vector"),
-    ("radius = 0.5", "radius = -0.5", "krs.levels[0].kernel.radius", "-0.5", "value > 0"),
+    ("radius = 0.5", "radius = -0.5", "krs.levels[0].kernel.radius", "-0.5", "0 < value ≤ 1e+09"),
     ("radius = 0.5", "radius = nan", "krs.levels[0].kernel.radius", "nan", "NaN"),
     ("offset = 1.0", "offset = inf", "krs.levels[1].mirror.offset", "inf", "NaN and infinity"),
     ('type = "sphere"', 'type = "cube"', "krs.levels[0].kernel.type", "'cube'",
@@ -50,7 +50,7 @@ def test_good_scene_loads():
     ("radius = 0.5 }", "radius = 0.5, colour = [1, 0, 0] }", "krs.levels[0].kernel.colour",
      "[1, 0, 0]", "unknown field; allowed fields: center, color, radius"),
     ("target = [0.0, 1.0, 0.0]", "target = [0.0, 1.0, -5.0]", "camera.target",
-     "[0.0, 1.0, -5.0]", "must differ from position"),
+     "[0.0, 1.0, -5.0]", "must be at least 1e-09 from position (it is 0 away)"),
     ("radius = 0.5", 'radius = "big"', "krs.levels[0].kernel.radius", "'big'",
      "expected a number"),
 ])
@@ -155,3 +155,50 @@ def test_truncation_keeps_the_coarsest_levels_and_something_to_draw():
                                          for i in range(1, 6)])
     cut = ifs.truncated(2)
     assert cut.kernels[0] == Sphere() and cut.n == 1 and cut.mirrors == ifs.mirrors[-1:]
+
+
+
+SPHERE = 'kernel = { type = "sphere", center = [0.0, 0.0, 0.0], radius = 0.5 }\n'
+PALM_ROTATE = ('[[mokrs.levels]]\n' + SPHERE + '[[mokrs.levels.transform]]\n'
+               'type = "rotate"\naxis = AXIS\ndegrees = 10.0\n')
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"\x89PNG\r\n\x1a\n\x00\x00garbage", "<file> = 'byte 0x89 at offset 0': a scene file is UTF-8 text"),
+    ("[camera]\nfov_y = 40.0\n".encode("utf-16"), "this one is UTF-16: save it as UTF-8"),
+    (('[[krs.levels]]\nkernel = { type = ["sphere"] }\n').encode(),
+     "krs.levels[0].kernel.type = ['sphere']: unknown kernel type"),
+    (PALM_ROTATE.replace("rotate", "['rotate']", 1).replace('"[', '[').replace(']"', ']')
+     .replace("AXIS", "[1.0, 0.0, 0.0]").encode(), "transform[0].type = ['rotate']: unknown Möbius step"),
+    (PALM_ROTATE.replace("AXIS", "[1e308, 0.0, 0.0]").encode(),
+     "transform[0].axis[0] = 1e+308: allowed: -1e+09 ≤ value ≤ 1e+09"),
+    (("[[krs.levels]]\n" + SPHERE.replace("0.5 }", "1e30 }")).encode(),
+     "krs.levels[0].kernel.radius = 1e+30: allowed: 0 < value ≤ 1e+09"),
+    (b"[camera]\nposition = [1e20, 0.0, 0.0]\n", "camera.position[0] = 1e+20: allowed"),
+    (b"[camera]\nposition = [1.0, 2.0, 3.0]\ntarget = [1.0, 2.0, 3.000000000001]\n",
+     "must be at least 1e-09 from position (it is 1e-12 away)"),
+    (("[[compound]]\n[compound.mokrs]\n[[compound.mokrs.levels]]\n" + SPHERE).encode(),
+     "compound[0].mokrs = {a table with levels}: a MöKRS cannot join a compound"),
+    (("[krs]\n" + "[[krs.levels]]\n" * 2000).encode(),
+     "krs.levels = '<a list of 2,000 items>': too long; allowed: at most 1024 items"),
+])
+def test_bad_scene_files_get_one_clear_line(tmp_path, content, message):
+    """Bad input found by trying the tool as a new user [issue 16]: each used to end in a
+    traceback (UnicodeDecodeError, unhashable list, SVD failure) or a flat overflowing image."""
+    path = tmp_path / "bad.toml"
+    path.write_bytes(content)
+    with pytest.raises(SceneError) as e:
+        load_scene(path)
+    text = str(e.value)
+    assert message in text and text.startswith(f"{path}: ") and "\n" not in text
+
+
+def test_an_oversized_scene_file_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    from krsview.scene import scene as scene_module
+    path = tmp_path / "huge.toml"
+    path.write_text("# " + "x" * 2000 + "\n[camera]\nfov_y = 40.0\n[[krs.levels]]\n" + SPHERE)
+    assert load_scene(path).camera.fov_y == 40.0     # control: the same file under the limit
+    monkeypatch.setattr(scene_module, "MAX_FILE_BYTES", 1000)
+    monkeypatch.setattr(scene_module.tomllib, "loads", lambda _: pytest.fail("parsed"))
+    with pytest.raises(SceneError, match="scene files hold at most 1,000 bytes"):
+        load_scene(path)

@@ -6,12 +6,11 @@ import csv
 from dataclasses import replace
 from pathlib import Path
 
-from ..presets import PRESET_DIR
 from ..scene import Scene
 from .commands import Command, Do, Edit
 
-# Where reports are looked for: a fresh run first, then the ones shipped with the docs.
-REPORT_DIRS = (Path("out") / "accuracy", PRESET_DIR.parent / "docs" / "accuracy")
+# Reports made here, then the ones committed in a clone (an installed wheel has none).
+REPORT_DIRS = (Path("out") / "accuracy", Path(__file__).resolve().parents[2] / "docs" / "accuracy")
 
 
 def load_measured(stem: str) -> list[dict] | None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 
@@ -74,6 +75,9 @@ class Placement:
 class Component:
     """One member of a ``[[compound]]`` list: a KRS or a tree, rotated by ``angle`` about
     ``axis``, scaled, then moved to ``position``."""
+    UNKNOWN_FIELDS: ClassVar[dict[str, str]] = {
+        "mokrs": "a MöKRS cannot join a compound: it has no distance function, and the "
+                 "compound's tracer steps by each component's distance [KRS17 §5.1]"}
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
     route: Route | None = param(None, help="a tree given by its route (instead of krs)")

@@ -169,6 +169,9 @@ class KRS:
 
 
 # ------------------------------------------------------------------------ view and render
+TARGET_DISTANCE = 1e-9   # below this the view direction is lost to rounding
+
+
 @dataclass(frozen=True)
 class Camera:
     """Pinhole camera; the renderer keeps it in float64 and gives the GPU camera-relative data."""
@@ -179,8 +182,10 @@ class Camera:
 
     def validate(self, path: str) -> None:
         fwd = _sub(self.target, self.position)
-        if _norm(fwd) < 1e-9:
-            raise SceneError(f"{path}.target", list(self.target), "must differ from position")
+        if _norm(fwd) < TARGET_DISTANCE:
+            raise SceneError(f"{path}.target", list(self.target),
+                             f"must be at least {TARGET_DISTANCE:g} from position (it is "
+                             f"{_norm(fwd):.3g} away): the view direction comes from the two")
         f = tuple(c / _norm(fwd) for c in fwd)
         cos = abs(sum(a * b for a, b in zip(f, self.up)))
         if cos > 1 - 1e-9:

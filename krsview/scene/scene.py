@@ -99,6 +99,9 @@ class Scene:
         return replace(self, **{**none, "krs": geometry})
 
 
+MAX_FILE_BYTES = 4 * 1024 * 1024
+
+
 def scene_from_toml(text: str, file: str = "<string>") -> Scene:
     try:
         data = tomllib.loads(text)
@@ -114,9 +117,22 @@ def load_scene(path: str | os.PathLike) -> Scene:
     """Read and validate a scene file; every mistake raises SceneError naming file and field."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        size = p.stat().st_size
+        if size > MAX_FILE_BYTES:   # refuse before parsing: 500,000 levels took 100 s and 900 MB
+            raise SceneError("<file>", f"{size:,} bytes", f"scene files hold at most "
+                             f"{MAX_FILE_BYTES:,} bytes (a compound of 8 × 64 levels is far "
+                             "smaller)", str(p))
+        raw = p.read_bytes()
     except OSError as e:
         raise SceneError("<file>", str(p), f"cannot read: {e.strerror}", str(p)) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        bom = raw[:2] in (b"\xff\xfe", b"\xfe\xff")
+        raise SceneError("<file>", f"byte 0x{raw[e.start]:02x} at offset {e.start}",
+                         "a scene file is UTF-8 text (TOML)" +
+                         ("; this one is UTF-16: save it as UTF-8" if bom else ""),
+                         str(p)) from None
     return scene_from_toml(text, str(p))
 
 

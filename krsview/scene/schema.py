@@ -16,6 +16,15 @@ Vec3 = tuple[float, float, float]
 UNIT_TOLERANCE = 1e-6  # how far a plane normal's length may be from 1 before it is an error
 
 
+def _brief(value: Any, limit: int = 60) -> str:
+    """A value as it is shown in an error: one short line (a table is not printed whole)."""
+    if isinstance(value, dict):
+        return "{a table with " + (", ".join(map(str, value)) or "no fields") + "}" \
+            if len(repr(value)) > limit else repr(value)
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 1] + "…"
+
+
 class SceneError(ValueError):
     """A user mistake in a scene: names the file, the field path, the value and what is allowed."""
 
@@ -25,7 +34,7 @@ class SceneError(ValueError):
 
     def _text(self) -> str:
         where = f"{self.file}: " if self.file else ""
-        return f"{where}{self.path} = {self.value!r}: {self.allowed}"
+        return f"{where}{self.path} = {_brief(self.value)}: {self.allowed}"
 
     def in_file(self, file: str) -> "SceneError":
         return SceneError(self.path, self.value, self.allowed, file)
@@ -45,8 +54,29 @@ def param(default: Any = MISSING, *, lo: float | None = None, hi: float | None =
     return field(default=default, metadata=meta)
 
 
-def describe_range(meta: dict) -> str:
+MAX_ITEMS = 1024   # any list in a scene file (the fields' own limits are far lower)
+
+# Scene lengths and coordinates without a range of their own: the GPU squares them in
+# float32 (max 3.4e38), so beyond 1e9 a distance overflows to infinity and the image is flat.
+COORDINATE_LIMIT = 1e9
+
+
+def _bounds(meta: dict, kind: type = float) -> tuple[float | None, float | None]:
     lo, hi = meta.get("lo"), meta.get("hi")
+    if kind is float and meta.get("choices") is None:
+        lo = -COORDINATE_LIMIT if lo is None else lo
+        hi = COORDINATE_LIMIT if hi is None else hi
+    return lo, hi
+
+
+class _Short(float):
+    """A bound as people write it: 1e+09, not 1000000000.0; 89, not 89.0."""
+    def __str__(self) -> str:
+        return f"{float(self):g}"
+
+
+def describe_range(meta: dict, kind: type = float) -> str:
+    lo, hi = (x if x is None or isinstance(x, int) else _Short(x) for x in _bounds(meta, kind))
     unit = f" {meta['unit']}" if meta.get("unit") else ""
     if lo is not None and hi is not None:
         return f"allowed: {lo} {'<' if meta.get('lo_open') else '≤'} value ≤ {hi}{unit}"
@@ -63,11 +93,11 @@ def _check_number(x: Any, path: str, meta: dict, kind: type) -> float | int:
     if kind is int and not isinstance(x, int):
         raise SceneError(path, x, "expected a whole number")
     if not math.isfinite(x):
-        raise SceneError(path, x, "NaN and infinity are not allowed; " + describe_range(meta))
-    lo, hi = meta.get("lo"), meta.get("hi")
+        raise SceneError(path, x, "NaN and infinity are not allowed; " + describe_range(meta, kind))
+    lo, hi = _bounds(meta, kind)
     below = lo is not None and (x <= lo if meta.get("lo_open") else x < lo)
     if below or (hi is not None and x > hi):
-        raise SceneError(path, x, describe_range(meta))
+        raise SceneError(path, x, describe_range(meta, kind))
     return kind(x)
 
 
@@ -77,7 +107,7 @@ def _check_vec3(x: Any, path: str, meta: dict) -> Vec3:
     v = tuple(_check_number(c, f"{path}[{i}]", meta, float) for i, c in enumerate(x))
     mode = meta.get("unit_vector")
     if mode:
-        n = math.sqrt(sum(c * c for c in v))
+        n = math.hypot(*v)   # no overflow for huge components
         if n < 1e-9:
             raise SceneError(path, list(x), "a direction must not be the zero vector")
         if mode == "require" and abs(n - 1.0) > UNIT_TOLERANCE:
@@ -120,6 +150,10 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
     if origin is list:
         if not isinstance(x, list):
             raise SceneError(path, x, "expected a list")
+        if len(x) > MAX_ITEMS:   # before converting: 500,000 levels took 100 s and 900 MB
+            raise SceneError(path, f"<a list of {len(x):,} items>",
+                             f"too long; allowed: at most {MAX_ITEMS} items (64 levels, 8 "
+                             "components, 4 lights, … are the real limits)")
         (inner,) = args
         return [check_value(inner, v, f"{path}[{i}]", meta) for i, v in enumerate(x)]
     if is_dataclass(hint):
@@ -137,8 +171,9 @@ def from_dict(cls: type, data: Any, path: str = "") -> Any:
     known = {f.name for f in fields(cls) if f.init}
     for key in data:
         if key not in known:
+            why = getattr(cls, "UNKNOWN_FIELDS", {}).get(key, "unknown field")
             raise SceneError(_join(path, key), data[key],
-                             f"unknown field; allowed fields: {', '.join(sorted(known))}")
+                             f"{why}; allowed fields: {', '.join(sorted(known))}")
     kwargs = {}
     for f in fields(cls):
         if not f.init:
@@ -193,7 +228,7 @@ class Tagged:
             raise SceneError(path, data, f"expected a {cls.noun} table with a 'type'; "
                              f"allowed types: {allowed}")
         kind = data["type"]
-        if kind not in cls.registry:
+        if not isinstance(kind, str) or kind not in cls.registry:
             raise SceneError(f"{path}.type", kind, f"unknown {cls.noun} type; allowed: {allowed}")
         return from_dict(cls.registry[kind], {k: v for k, v in data.items() if k != "type"}, path)
 
