@@ -12,6 +12,7 @@ from pathlib import Path
 
 from . import __version__
 from .presets import DEFAULT_PRESET, preset_names, resolve
+from .progress import Progress
 import numpy as np
 
 from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
@@ -19,6 +20,8 @@ from .scene.effects import check_effects
 from .scene.schema import describe_range, check_value
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
+
+SILENT_SECONDS = 1.0   # work quicker than this shows no progress bar
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -116,16 +119,22 @@ def cmd_render(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     if args.reference:
         from .reference import render_reference
-        buffers = render_reference(scene, w, h)
+        buffers = render_reference(scene, w, h, progress=Progress(1, "  rays", SILENT_SECONDS))
         frame = time.perf_counter() - t0
         print(f"  traced in {frame * 1e3:.0f} ms (float64 reference)")
     else:
         from .gpu.renderer import Renderer
         r = Renderer()
-        print("  compiling shader variant …", end="", flush=True)
-        buffers = r.render(scene, w, h)
-        print(f" {(time.perf_counter() - t0) * 1e3:.0f} ms (first frame)", flush=True)
-        times = r.time_frame(scene, w, h, repeats=args.repeats)
+        print("  compiling shader variant …", flush=True)
+        buffers = r.render(scene, w, h, progress=Progress(1, "  first frame, rows",
+                                                          SILENT_SECONDS))
+        print(f"  first frame {(time.perf_counter() - t0) * 1e3:.0f} ms (with compiling)",
+              flush=True)
+        bar = Progress(args.repeats, "  timing frames", SILENT_SECONDS)
+        times = []
+        for _ in range(args.repeats):
+            times += r.time_frame(scene, w, h, repeats=1)
+            bar.step()
         frame = sorted(times)[len(times) // 2]
         print(f"  frame time {frame * 1e3:.1f} ms (median of {args.repeats}), "
               f"{buffers.iterations.mean():.1f} iterations/pixel, "

@@ -162,3 +162,29 @@ def test_every_complete_scene_in_the_readme_renders_something(renderer):
     away = mokrs.replace("target = [0.0, 0.5, 0.0]", "target = [0.0, 2.0, -20.0]")
     assert away != mokrs
     assert renderer.render(scene_from_toml(away, "README.md"), 64, 36).hit.mean() == 0
+
+
+def test_progress_reporting_does_not_change_the_image(renderer, monkeypatch):
+    """Slow renders show progress: the reference in chunks of rays, the GPU's first frame in
+    bands of rows; the pixels are the same as in one piece, and progress reaches the end."""
+    from krsview.presets import resolve
+    from krsview.reference import render as reference_render
+    from krsview.scene import load_scene
+    scene = load_scene(resolve("sierpinski"))
+    monkeypatch.setattr(reference_render, "PROGRESS_CHUNK", 100)
+    calls: list = []
+    whole = reference_render.render_reference(scene, 24, 10)
+    chunked = reference_render.render_reference(scene, 24, 10, progress=lambda d, n: calls.append((d, n)))
+    assert calls[-1] == (240, 240) and len(calls) == 3
+    for name in ("color", "depth", "normal", "iterations", "hit"):
+        assert np.array_equal(getattr(whole, name), getattr(chunked, name)), name
+    calls.clear()
+    one = renderer.render(scene, 40, 20)
+    from dataclasses import replace
+    away = replace(scene, camera=replace(scene.camera, target=tuple(
+        2 * np.array(scene.camera.position) - np.array(scene.camera.target))))
+    assert not renderer.render(away, 40, 20).hit.any()   # the framebuffer now holds sky
+    banded = renderer.render(scene, 40, 20, progress=lambda d, n: calls.append((d, n)))
+    assert calls[-1] == (16, 16)
+    assert np.array_equal(one.color, banded.color) and np.array_equal(one.hit, banded.hit)
+    assert one.hit.any() and not one.hit.all()

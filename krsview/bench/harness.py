@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 from ..gpu.renderer import Renderer
 from ..scene import Geometry, Scene
-from .progress import Progress
+from ..progress import Progress
 
 
 @dataclass(frozen=True)

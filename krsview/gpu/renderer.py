@@ -3,8 +3,8 @@ float32 render targets, read back as :class:`Buffers` in image order (rows top â
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from collections.abc import Iterator
 from contextlib import contextmanager
 
 import moderngl
@@ -17,6 +17,8 @@ from ..scene import Geometry, Scene, SceneError
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
+
+PROGRESS_BANDS = 16   # bands of rows of a first frame drawn with progress
 
 
 class Renderer:
@@ -111,10 +113,21 @@ class Renderer:
             self._vaos[prog] = self.ctx.vertex_array(prog, [])
         return self._vaos[prog]
 
-    def render(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None) -> Buffers:
+    def render(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
+               progress: Callable[[int, int], None] | None = None) -> Buffers:
+        """The image; with ``progress`` it is drawn in PROGRESS_BANDS bands of rows, each
+        finished before progress(done, total) is called (the same pixels either way)."""
         with self.current():
             prog = self.prepare(scene, width, height, geometry)
-            return read_buffers(self.draw(prog, width, height), width, height)
+            if progress is None:
+                return read_buffers(self.draw(prog, width, height), width, height)
+            bands = min(PROGRESS_BANDS, height)
+            for k in range(bands):
+                y0, y1 = height * k // bands, height * (k + 1) // bands
+                fbo = self.draw(prog, width, height, (0, y0, width, y1 - y0))
+                self.ctx.finish()
+                progress(k + 1, bands)
+            return read_buffers(fbo, width, height)
 
     def time_frame(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
                    repeats: int = 1, all_effects: bool = False) -> list[float]:

@@ -1,24 +1,47 @@
 """Whole-image reference render: the same outputs as the GPU, in float64."""
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ..buffers import Buffers
 from ..scene import Geometry, Scene
 from .atmosphere import background
-from .camera import primary_rays, view_of
+from .camera import View, primary_rays, view_of
 from .distortion import Distortion
 from .geometry import component_distances, component_tests, compile_geometry, nearest
 from .shade import Hits, encode, shade
 from .trace import binary_trace, relaxed_trace, sphere_trace
 
 
-def render_reference(scene: Scene, width: int, height: int,
-                     geometry: Geometry | None = None) -> Buffers:
+PROGRESS_CHUNK = 8192   # rays per chunk when progress is reported
+
+
+def render_reference(scene: Scene, width: int, height: int, geometry: Geometry | None = None,
+                     progress: Callable[[int, int], None] | None = None) -> Buffers:
+    """The image in float64. With ``progress``, rays go in chunks and progress(done, total)
+    is called after each (every ray is independent: the image is the same)."""
     view = view_of(scene.camera, width, height)
     c = compile_geometry(geometry or scene.geometry(), scene.material.albedo)
     dist = Distortion.of(scene)
     dirs = primary_rays(view)
+    N = len(dirs)
+    step = PROGRESS_CHUNK if progress else N
+    parts = []
+    for k in range(0, N, step):
+        parts.append(_trace_and_shade(scene, c, dist, view, dirs[k:k + step]))
+        if progress:
+            progress(min(k + step, N), N)
+    color, depth, normal, iterations, hit = (np.concatenate(a) for a in zip(*parts))
+    H, W = height, width
+    return Buffers(color.reshape(H, W, 3), depth.reshape(H, W), normal.reshape(H, W, 3),
+                   iterations.reshape(H, W), hit.reshape(H, W))
+
+
+def _trace_and_shade(scene: Scene, c, dist: Distortion | None, view: View, dirs: np.ndarray
+                     ) -> tuple[np.ndarray, ...]:
+    """Colour, depth (0 on a miss), normal, iterations and hit of the rays ``dirs``."""
     r = scene.render
     eps = view.footprint * r.epsilon_scale
     if r.tracer == "binary":
@@ -43,6 +66,4 @@ def render_reference(scene: Scene, width: int, height: int,
         normal[h] = g
         hits = Hits(p, dirs[h], tr.t[h], level, g, xk)
         color[h] = encode(scene, shade(scene, c, dist, hits, view.footprint, eps))
-    H, W = height, width
-    return Buffers(color.reshape(H, W, 3), np.where(tr.hit, tr.t, 0.0).reshape(H, W),
-                   normal.reshape(H, W, 3), tr.iterations.reshape(H, W), tr.hit.reshape(H, W))
+    return color, np.where(tr.hit, tr.t, 0.0), normal, tr.iterations, tr.hit
