@@ -149,3 +149,42 @@ def test_mokrs_round_trips_through_toml():
     assert again == s
     np.testing.assert_array_equal(again.mokrs.levels[3].matrix(), s.mokrs.levels[3].matrix())
     assert mobius.condition(s.mokrs.levels[0].matrix()) < 10
+
+
+@pytest.mark.parametrize("levels", [21, 12, 2, 1])
+def test_truncating_inversion_keeps_its_sphere_carried_by_the_maps(levels):
+    """`inversion` has one kernel, at level 0 [issue 16]: a cut used to leave an empty sky.
+    The kept finest level now holds K_0 carried up by G_0 … G_{cut−1}: checked point by point
+    against applying the maps to points of the original sphere (apply vs map_ball)."""
+    scene = load_scene(resolve("inversion"))
+    m = scene.mokrs
+    cut = m.depth - levels
+    t = m.truncated(levels)
+    k = t.levels[0].kernel
+    assert t.depth == levels and k.kind == "sphere"
+    rng = np.random.default_rng(levels)
+    d = rng.normal(size=(200, 3))
+    pts = np.array(m.levels[0].kernel.center) + m.levels[0].kernel.radius * (
+        d / np.linalg.norm(d, axis=1, keepdims=True))
+    for i in range(cut):
+        pts = mobius.apply(m.levels[i].matrix(), pts)
+    r = np.linalg.norm(pts - np.array(k.center), axis=1)
+    assert np.allclose(r, k.radius, rtol=1e-9), "the carried sphere is not the image"
+    k0 = m.levels[0].kernel
+    if cut >= 3:   # the maps really moved or resized it (inversion's levels map in threes)
+        assert (np.linalg.norm(np.subtract(k.center, k0.center)) > k0.radius
+                or abs(k.radius - k0.radius) > 0.01 * k0.radius)
+    # negative control: a radius off by one part in a million fails the comparison
+    assert not np.allclose(r, k.radius * (1 + 1e-6), rtol=1e-9)
+    image = render_reference(scene.with_geometry(t), 48, 27)
+    assert image.hit.any(), f"--levels {levels} draws nothing"
+
+
+def test_a_cut_that_cannot_carry_its_kernel_is_refused():
+    doc = tomllib.loads(scene_to_toml(load_scene(resolve("inversion"))))
+    doc["mokrs"]["levels"][0]["kernel"] = {"type": "capsule", "a": [0.0, 0.0, 0.0],
+                                           "b": [0.0, 1.0, 0.0], "radius": 0.2}
+    m = scene_from_toml(dumps(doc)).mokrs
+    with pytest.raises(SceneError, match="level 0's capsule cannot be carried up to level 1"):
+        m.truncated(m.depth - 1)
+    assert m.truncated(m.depth).levels[0].kernel.kind == "capsule"

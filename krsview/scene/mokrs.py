@@ -1,9 +1,17 @@
 """Möbius kernel–reflection sequences [KRS17 §7]: each level is conformally transformed.
 
 Level i holds a kernel K_i, a Möbius transformation G_i (a list of elementary steps from
-[KRS17 Table 1]) and whether it reflects: L_i = G_i(K_i ∪ L_{i−1} ∪ R(L_{i−1})), R the
-reflection across x = 0 of the level's own space. Kernels are written in their level's space;
-G_i maps that space into level i+1's (the last level's G maps into the world).
+[KRS17 Table 1]) and whether it reflects. What is drawn is
+
+    L_i = G_i(S_i ∪ R(S_i)),  S_i = K_i ∪ L_{i−1}   (without reflection: L_i = G_i(S_i)),
+
+R the reflection across x = 0 of the level's own space: a reflecting level doubles its own
+kernel too. §7's formula writes G_i(K_i ∪ L_{i−1} ∪ R(L_{i−1})), K_i unreflected, but
+[KRS17 Alg. 3] — and the tracer here, its twin — makes the level's mirror decision on the
+point first and tests k_i after it, which sees K_i on both sides of x = 0. Drawing §7's set
+exactly would cost a second kernel test per level; a kernel that is its own mirror image
+across x = 0 is drawn the same either way. Kernels are written in
+their level's space; G_i maps that space into level i+1's (the last level's G into the world).
 """
 from __future__ import annotations
 
@@ -14,7 +22,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..algebra import mobius
-from .model import Empty, Kernel, Plane, check_level_count
+from .model import Empty, Kernel, Plane, Sphere, check_level_count
 from .schema import SceneError, Tagged, Vec3, param
 
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
@@ -82,7 +90,8 @@ class MobiusLevel:
     kernel: Kernel = param(Empty(), help="kernel K_i, in this level's space")
     transform: list[MobiusStep] = param([], help="G_i: steps applied in order, into the "
                                                  "next level's space (world for the last)")
-    reflect: bool = param(True, help="double the level below by the reflection across x = 0")
+    reflect: bool = param(True, help="double this level's kernel and the levels below by "
+                                         "the reflection across x = 0")
 
     def matrix(self):
         """G_i as a quaternion matrix: the last step applied last (leftmost)."""
@@ -132,8 +141,33 @@ class MoKRS:
         return total
 
     def truncated(self, levels: int) -> "MoKRS":
-        """Keep the coarsest ``levels`` levels, dropping the finest."""
-        return MoKRS(list(self.levels[len(self.levels) - levels:]))
+        """Keep the coarsest ``levels`` levels, dropping the finest. If none of them has a
+        kernel (an IFS-like MöKRS whose only shape is K_0, as ``inversion``), the nearest
+        kernel below the cut is carried into the new finest level's space by G_j … G_{cut−1},
+        so something is drawn, as a KRS's truncation promotes a kernel [KRS17 §4]. A sphere
+        maps to a sphere under a Möbius map; it must not hold a pole on the way."""
+        cut = len(self.levels) - levels
+        keep = list(self.levels[cut:])
+        below = [j for j in range(cut) if not isinstance(self.levels[j].kernel, Empty)]
+        if all(isinstance(lv.kernel, Empty) for lv in keep) and below:
+            j = below[-1]
+            k = self.levels[j].kernel
+            if not isinstance(k, Sphere):
+                raise SceneError("levels", levels, f"the kept levels have no kernel, and "
+                                 f"level {j}'s {k.kind} cannot be carried up to level {cut} "
+                                 f"(only a sphere stays a sphere under Möbius maps); allowed: "
+                                 f"more than {len(self.levels) - 1 - j} levels")
+            c, r = np.array([k.center], dtype=np.float64), np.array([k.radius])
+            for i in range(j, cut):
+                c, r, ok = mobius.map_ball(self.levels[i].matrix(), c, r)
+                if not ok[0]:
+                    raise SceneError("levels", levels, f"level {j}'s sphere holds the pole "
+                                     f"of level {i}'s transformation, so its image is not a "
+                                     f"ball; allowed: more than {len(self.levels) - 1 - i} "
+                                     "levels")
+            keep[0] = replace(keep[0], kernel=Sphere(tuple(float(v) for v in c[0]),
+                                                     float(r[0]), k.color))
+        return MoKRS(keep)
 
 
 POLE_DISTANCE = 1e-6  # a viewpoint closer than this (× the level's scale) to a pole is rejected
