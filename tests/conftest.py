@@ -19,14 +19,7 @@ from krsview.presets import PRESET_DIR
 
 TEST_OUTPUT = Path(__file__).resolve().parent.parent / "test-output"
 
-# Tolerances of GPU (float32) against the reference (float64), and why:
-HIT_AGREEMENT = 0.995    # a ray whose last distance lands within float32 rounding of ε flips
-DEPTH_REL = 1e-3         # same stopping step ⇒ depths agree to float32 accumulation over ~100 steps
-NORMAL_DEG = 2.0         # same winning kernel ⇒ same analytic gradient up to float32 rounding
-CLOSE_FRACTION = 0.995   # …except where one side stopped a step later (|Δt| ≈ ε(t)), slipped past
-                         # a silhouette onto a surface behind, or a kernel tie at a crease flipped
-COLOR_TOL = 2.0 / 255.0  # one rounding of each channel plus float32 shading error
-COLOR_FRACTION = 0.99
+# The GPU-vs-reference tolerances live in krsview.bench.metrics, with why each holds.
 
 
 @pytest.fixture(scope="session")
@@ -39,22 +32,8 @@ def preset_paths() -> list[Path]:
     return sorted(PRESET_DIR.glob("*.toml"))
 
 
-def failures(a: Agreement) -> list[str]:
-    out = []
-    if a.hit < HIT_AGREEMENT:
-        out.append(f"hit masks agree on {a.hit:.4%} < {HIT_AGREEMENT:.1%}")
-    if a.depth_close < CLOSE_FRACTION:
-        out.append(f"depth within {DEPTH_REL} on {a.depth_close:.4%} < {CLOSE_FRACTION:.1%}")
-    if a.normal_close < CLOSE_FRACTION:
-        out.append(f"normals within {NORMAL_DEG}° on {a.normal_close:.4%}")
-    if a.color < COLOR_FRACTION:
-        out.append(f"colour within 2/255 on {a.color:.4%} < {COLOR_FRACTION:.0%}")
-    return out
-
-
-def agreement(gpu: Buffers, ref: Buffers) -> Agreement:
-    """The package's agreement metric at the tolerances above."""
-    return metrics.agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
+failures = metrics.tolerance_failures
+agreement = metrics.gpu_reference_agreement
 
 
 def assert_finite(b: Buffers, max_iterations: int) -> None:

@@ -61,12 +61,12 @@ def test_pareto_front_keeps_only_undominated_settings():
     assert pareto(rows) == [rows[0], rows[2], rows[4]]
 
 
-def test_every_knob_is_swept_and_a_mokrs_skips_what_it_cannot_draw():
+def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
     knobs = {s.knob for s in settings(load_scene(resolve("tree")))}
     assert knobs == {"scene", "epsilon_scale", "max_iterations", "tracer", "precision", "levels"}
     palm = settings(load_scene(resolve("palm")))
     assert {s.knob for s in palm} == {"scene", "epsilon_scale", "max_iterations", "tracer",
-                                      "precision"}
+                                      "precision", "levels"}
     assert all(s.scene.render.tracer == "binary" for s in palm)
 
 

@@ -188,3 +188,14 @@ def test_progress_reporting_does_not_change_the_image(renderer, monkeypatch):
     assert calls[-1] == (16, 16)
     assert np.array_equal(one.color, banded.color) and np.array_equal(one.hit, banded.hit)
     assert one.hit.any() and not one.hit.all()
+
+
+def test_check_stability_prints_the_table_and_fails_when_an_invariant_does(capsys, monkeypatch):
+    assert main(["check", "--stability", "hard:points-on-planes"]) == 0
+    out = capsys.readouterr().out
+    assert "| points-on-planes | 3% | yes | yes | 0 / 0 |" in out and out.rstrip().endswith("| ok |")
+    from krsview.bench import stability
+    monkeypatch.setattr(stability, "CONTINUITY", -1.0)      # no image can meet this
+    assert main(["check", "--stability", "sierpinski"]) == 1
+    assert capsys.readouterr().out.rstrip().endswith("| FAILS |")
+    assert main(["check", "--stability", "hard:nope"]) == 2

@@ -19,7 +19,9 @@ from krsview.scene import (Compound, EffectSettings, EmptyZone, SceneError, Tree
                            scene_from_toml, scene_to_toml)
 from krsview.scene.compound import Placement
 
-from .conftest import HIT_AGREEMENT, assert_finite, check_against_reference
+from krsview.bench.metrics import HIT_AGREEMENT
+
+from .conftest import assert_finite, check_against_reference
 
 W, H = 96, 72
 CAP = 2048  # far above what any pixel needs, so the cap never cuts a trace short

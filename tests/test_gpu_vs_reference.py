@@ -1,6 +1,8 @@
 """Every preset: the GLSL tracer agrees with the float64 NumPy reference pixel by pixel."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from krsview.reference import render_reference
@@ -19,3 +21,36 @@ def test_preset_matches_reference(renderer, path):
     assert_finite(gpu, scene.render.max_iterations)
     assert ref.hit.mean() > 0.02, "the preset's camera sees (almost) nothing"
     check_against_reference(path.stem, gpu, ref)
+
+
+@pytest.mark.parametrize("broken", [
+    # a sphere 0.2 % too large
+    ("kernels.glsl", "return length(p - kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;",
+     "return length(p - kernel_rec(i, 1).xyz) - 1.002 * kernel_rec(i, 1).w;"),
+    # a fold that leaves points within 0.01 behind a mirror unreflected
+    ("krs.glsl", "if (e > 0.0) p -= 2.0 * e * m.xyz;", "if (e > 1e-2) p -= 2.0 * e * m.xyz;"),
+])
+def test_a_deliberately_broken_shader_fails_the_comparison(tmp_path, broken):
+    """Negative control of the pixel comparison [issue 16]: a copy of the shaders with a
+    small, deliberate error must fail it, while the intact copy passes. Both errors pass the
+    old rule (fractions of pixels only): the every-pixel rule away from outlines finds them."""
+    import shutil
+    from krsview.gpu.program import SHADER_DIR
+    from krsview.gpu.renderer import Renderer
+    from krsview.presets import resolve
+    from .conftest import agreement, failures
+    shutil.copytree(SHADER_DIR, tmp_path / "shaders")
+    scene = load_scene(resolve("sierpinski"))
+    ref = render_reference(scene, W, H)
+    intact = Renderer(shader_dir=tmp_path / "shaders")
+    assert failures(agreement(intact.render(scene, W, H), ref)) == []
+    name, old, new = broken
+    path = tmp_path / "shaders" / name
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new))
+    a = agreement(Renderer(shader_dir=tmp_path / "shaders").render(scene, W, H), ref)
+    problems = failures(a)
+    assert problems, "a broken shader passed the comparison"
+    assert problems[0].startswith("away from outlines every pixel must agree")
+    assert failures(replace(a, off_edge_hit=0, off_edge_depth=0.0, off_edge_color=0.0)) == []

@@ -1,5 +1,6 @@
-"""Hard cases are inputs, not accidents (DESIGN.md): finite pixels, bounded iterations, and
-GPU/reference agreement with the same tolerances as the presets."""
+"""Hard cases are inputs, not accidents (DESIGN.md): the catalogue in krsview.bench.hard_cases,
+each case with its invariants (finite, within the cap and capped rays counted, continuous,
+GPU = reference or a documented precision limit) and the behaviour written beside it."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -7,84 +8,80 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from krsview.bench import hard_cases, stability
+from krsview.bench.hard_cases import CASES
 from krsview.reference import render_reference
-from krsview.scene import (KRS, Camera, Empty, Level, Mirror, Plane, Render, Scene, Sphere,
-                           load_scene)
-from krsview.presets import resolve
-
-from krsview.bench import hard_cases
 
 from .conftest import agreement, assert_finite, check_against_reference, failures
 
 W, H = 120, 90
 
 
-def tree_scene() -> Scene:
-    return load_scene(resolve("tree"))
-
-
-def camera_on_top_mirror() -> Scene:
-    """The eye exactly on mirror R_{n-1} (the first fork's plane), looking along it."""
-    s = tree_scene()
-    m = s.geometry().mirrors[-1]
-    u, w = np.array(m.normal), m.offset
-    project = lambda p: np.array(p) - (np.array(p) @ u - w) * u  # noqa: E731
-    eye, target = project(s.camera.position), project(s.camera.target)
-    assert abs(eye @ u - w) < 1e-12
-    return replace(s, camera=replace(s.camera, position=tuple(eye), target=tuple(target)))
-
-
-def grazing_plane() -> Scene:
-    """Rays skimming a ground plane and sphere silhouettes; a low iteration cap is hit."""
-    levels = [Level(Sphere((0.0, 0.3, 0.0), 0.3), None),
-              Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.8)),
-              Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), Mirror((0.0, 0.0, 1.0), 1.5))]
-    return Scene(name="grazing", camera=Camera((0.0, 0.02, -4.0), (0.0, 0.0, 10.0)),
-                 render=Render(max_iterations=48, max_distance=60.0), krs=KRS(levels))
-
-
-def camera_inside_trunk() -> Scene:
-    s = tree_scene()
-    return replace(s, camera=replace(s.camera, position=(0.02, 0.5, 0.01), target=(0.0, 3.0, 1.0)))
-
-
-def thirty_levels() -> Scene:
-    s = tree_scene()
-    return replace(s, tree=replace(s.tree, levels=30))
-
-
-CASES = {"camera_on_mirror": camera_on_top_mirror, "grazing": grazing_plane,
-         "inside_kernel": camera_inside_trunk, "levels_30": thirty_levels}
+def test_the_catalogue_names_at_least_fifteen_cases_with_expectations():
+    assert len(CASES) >= 15
+    for name, case in CASES.items():
+        assert case.name == name and len(case.expect) > 20
 
 
 @pytest.mark.parametrize("name", CASES)
-def test_hard_case_is_finite_bounded_and_matches_reference(renderer, name):
-    scene = CASES[name]()
-    gpu = renderer.render(scene, W, H)
-    ref = render_reference(scene, W, H)
-    assert_finite(gpu, scene.render.max_iterations)
-    assert_finite(ref, scene.render.max_iterations)
-    check_against_reference(f"hard_{name}", gpu, ref)
+def test_hard_case_keeps_its_invariants(renderer, name):
+    case = CASES[name]
+    o = stability.check(case.build(), renderer)
+    assert o.finite and o.within_cap, o
+    assert o.changed <= stability.CONTINUITY, f"a 1/100-pixel nudge changed {o.changed:.2%}"
+    assert o.agreement == "ok", o.agreement
+    # a documented float32 limit is met by the double shader, and only such a case needs it
+    assert o.precision == ("double" if case.precision_limit else "float"), o.precision
+    # capped rays are expected (and then counted on both sides) or absent
+    if case.capped:
+        assert o.capped_reference > 0 and abs(o.capped_gpu - o.capped_reference) <= \
+            0.01 * np.prod(stability.SIZE), o
+    else:
+        assert o.capped_reference == 0 and o.capped_gpu == 0, o
+
+
+def test_continuity_measure_sees_a_real_move(renderer):
+    """Negative control of the continuity invariant: a 10-pixel move changes many pixels."""
+    scene = CASES["camera-on-mirror"].build()
+    a = renderer.render(scene, *stability.SIZE)
+    moved = scene
+    for _ in range(1000):   # 1000 nudges of 1/100 pixel
+        moved = stability.nudged(moved, stability.SIZE)
+    b = renderer.render(moved, *stability.SIZE)
+    assert (a.hit != b.hit).mean() > stability.CONTINUITY
 
 
 def test_grazing_rays_reach_the_cap_and_stop_there(renderer):
-    scene = grazing_plane()
+    scene = CASES["grazing-ground"].build()
     gpu = renderer.render(scene, W, H)
     assert gpu.iterations.max() == scene.render.max_iterations  # the case really is hard
 
 
 def test_inside_a_kernel_every_ray_hits_at_the_eye(renderer):
-    gpu = renderer.render(camera_inside_trunk(), W, H)
+    gpu = renderer.render(CASES["inside-kernel"].build(), W, H)
     assert gpu.hit.all() and np.all(gpu.depth == 0.0) and np.all(gpu.iterations == 1)
 
 
-def test_thirty_levels_has_a_billion_instances():
-    assert thirty_levels().geometry().instance_count() >= 2**30
+def test_inside_a_mobius_solid_every_ray_hits_at_the_eye(renderer):
+    """Binary tracing at t = 0 inside a solid: ε(0) = 0, so a blocked probe converges at
+    MIN_PROBE on both sides (the float32 probe used to underflow to 0 and hit while the
+    float64 one reached the cap)."""
+    scene = CASES["mobius-alpha-zero"].build()
+    inside = replace(scene, camera=replace(scene.camera, position=(0.3, 0.4, -3.0)))
+    gpu, ref = renderer.render(inside, 32, 18), render_reference(inside, 32, 18)
+    for b in (gpu, ref):
+        assert b.hit.all() and np.all(b.depth == 0.0)
+    assert np.array_equal(gpu.iterations, ref.iterations)
 
 
-def test_image_changes_little_when_the_camera_moves_little(renderer):
+def test_levels_cases_have_the_instances_they_claim():
+    assert CASES["levels-30"].build().geometry().instance_count() >= 2**30
+    assert CASES["levels-63"].build().geometry().instance_count() == 2**64 - 1
+
+
+def test_image_changes_little_when_the_camera_crosses_a_mirror(renderer):
     """Continuity: a 1e-6 nudge of the eye across the mirror plane changes few pixels."""
-    s = camera_on_top_mirror()
+    s = CASES["camera-on-mirror"].build()
     u = np.array(s.geometry().mirrors[-1].normal)
     a = renderer.render(replace(s, camera=replace(
         s.camera, position=tuple(np.array(s.camera.position) - 1e-6 * u))), W, H)
@@ -94,21 +91,20 @@ def test_image_changes_little_when_the_camera_moves_little(renderer):
     assert (np.abs(a.color - b.color).max(-1) > 4 / 255).mean() < 0.005
 
 
-def deep_zoom() -> Scene:
+def deep_zoom_thirty_levels():
     """The eye a few twig radii from the finest kernel of a 30-level tree: that twig is
     1e-5 of the tree's size, drawn from camera-relative float32 data."""
-    s = thirty_levels()
+    s = CASES["levels-30"].build()
     twig = s.geometry().kernels[0]
     mid = (np.array(twig.start) + np.array(twig.end)) / 2
     axis = np.array(twig.end) - np.array(twig.start)
     side = np.cross(axis, (0.0, 1.0, 0.0))
     side /= np.linalg.norm(side)
-    eye = mid + 12 * twig.radius * side
-    return replace(s, camera=replace(s.camera, position=tuple(eye), target=tuple(mid)))
+    return hard_cases.look(s, mid + 12 * twig.radius * side, mid)
 
 
 def test_deep_zoom_thirty_levels_down_is_stable(renderer):
-    scene = deep_zoom()
+    scene = deep_zoom_thirty_levels()
     assert scene.geometry().kernels[0].radius < 3e-5
     gpu = renderer.render(scene, W, H)
     ref = render_reference(scene, W, H)
@@ -126,7 +122,7 @@ def test_deep_zoom_thirty_levels_down_is_stable(renderer):
 def test_double_precision_follows_the_reference_where_float_cannot(renderer, name):
     """precision = "double" [issue 15]: at a deep zoom the float64 shader agrees with the
     reference; the float32 one (the negative control) does not: the case is a real limit."""
-    case = hard_cases.CASES[name]
+    case = CASES[name]
     scene = case.build()
     assert case.precision_limit
     ref = render_reference(scene, 48, 27)
@@ -142,7 +138,7 @@ def test_double_precision_follows_the_reference_where_float_cannot(renderer, nam
 def test_double_precision_uploads_the_geometry_in_float64():
     from krsview.gpu.uniforms import krs_block
     from krsview.reference.geometry import compile_geometry
-    s = tree_scene()
+    s = hard_cases.preset("tree")
     c = compile_geometry(s.geometry(), s.material.albedo)
     single, double = krs_block(c, "float"), krs_block(c, "double")
     assert len(double) == 2 * len(single)

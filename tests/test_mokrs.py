@@ -188,3 +188,84 @@ def test_a_cut_that_cannot_carry_its_kernel_is_refused():
     with pytest.raises(SceneError, match="level 0's capsule cannot be carried up to level 1"):
         m.truncated(m.depth - 1)
     assert m.truncated(m.depth).levels[0].kernel.kind == "capsule"
+
+
+def expand_spheres(m, upto: int) -> tuple[np.ndarray, np.ndarray]:
+    """Brute force: every sphere instance of levels 0..upto in level upto's own space (before
+    G_upto), by mapping balls level by level — the MöKRS's set, written out."""
+    C, R = np.zeros((0, 3)), np.zeros(0)
+    for i, lv in enumerate(m.levels[:upto + 1]):
+        if lv.kernel.kind == "sphere":
+            C, R = np.vstack([C, [lv.kernel.center]]), np.append(R, lv.kernel.radius)
+        if lv.reflect:
+            C, R = np.vstack([C, C * [-1.0, 1.0, 1.0]]), np.append(R, R)
+        if i < upto:
+            C, R, ok = mobius.map_ball(lv.matrix(), C, R)
+            assert ok.all()
+    return C, R
+
+
+@pytest.mark.parametrize("preset, levels", [("inversion", 13), ("shell", 64)])
+def test_level_bounds_hold_every_instance_below(preset, levels):
+    """Each level's bounding ball (reference/mokrs.py) holds the brute-force expansion of that
+    level and all below it, in the level's own space."""
+    from krsview.reference.mokrs import level_bounds
+    m = load_scene(resolve(preset)).mokrs
+    m = m.truncated(levels)
+    bounds = level_bounds(m)
+    for i in range(0, m.depth, 4):
+        C, R = expand_spheres(m, i)
+        b = bounds[i]
+        assert b[3] > 0 and len(C)
+        reach = np.linalg.norm(C - b[:3], axis=1) + R
+        assert reach.max() <= b[3] * (1 + 1e-9), f"level {i}: an instance outside its bound"
+        assert reach.max() > 0.5 * b[3]      # and not vacuously huge
+
+
+def test_arc_bound_holds_the_arc():
+    from krsview.reference.mokrs import kernel_ball
+    from krsview.scene.model import ToroidalCapsule, arc_of
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        s, c, e = rng.normal(size=(3, 3))
+        k = ToroidalCapsule(tuple(s), tuple(c), tuple(e), 0.1)
+        arc = arc_of(k)
+        ball = kernel_ball(k)
+        if arc is None:
+            continue
+        a = np.linspace(0, arc.phi, 400)[:, None]
+        pts = np.array(arc.center) + arc.R * (np.cos(a) * arc.e1 + np.sin(a) * arc.e2)
+        assert (np.linalg.norm(pts - ball[:3], axis=1) + 0.1).max() <= ball[3] * (1 + 1e-12)
+
+
+def test_rays_passing_a_pole_in_empty_space_are_not_stopped(renderer):
+    """[issue 16] A probe holding a pole maps to a ball's exterior; Alg. 3 calls it blocked,
+    so rays within a fraction of ε of `inversion`'s pole (24.8 units from every sphere, by
+    brute force) stopped in empty space. With the level bounds they pass, on the reference and
+    the GPU; the negative control (Alg. 3's rule) still stops some."""
+    from krsview.reference.mokrs import compile_mokrs, is_unbounding
+    from krsview.reference.trace import binary_trace
+    scene = load_scene(resolve("inversion"))
+    c = compile_mokrs(scene.mokrs, (1.0, 1.0, 1.0))
+    pole = mobius.pole(c.inverse[-1])
+    C, R = expand_spheres(scene.mokrs, scene.mokrs.depth - 1)
+    C, R, _ = mobius.map_ball(scene.mokrs.levels[-1].matrix(), C, R)
+    assert (np.linalg.norm(C - pole, axis=1) - R).min() > 20.0    # empty space
+    view = view_of(scene.camera, 320, 180)
+    d = pole - view.origin
+    t = np.linalg.norm(d)
+    d /= t
+    e1 = np.cross(d, (0.0, 1.0, 0.0))
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(e1, d)
+    off = np.random.default_rng(0).uniform(-3, 3, size=(4000, 2)) * view.footprint * t
+    q = pole + off[:, :1] * e1 + off[:, 1:] * e2
+    dirs = (q - view.origin) / np.linalg.norm(q - view.origin, axis=1, keepdims=True)
+    trace = lambda rule: binary_trace([rule], view.origin, dirs, view.footprint, 256,  # noqa: E731
+                                      1000.0, 2.0, 0.3).hit
+    assert not trace(lambda x, s: is_unbounding(c, x, s)).any()
+    assert trace(lambda x, s: is_unbounding(c, x, s, pole_bounds=False)).sum() > 5
+    # the GPU: a 1° view centred on the pole, same as the reference
+    near = replace(scene, camera=replace(scene.camera, target=tuple(pole), fov_y=1.0))
+    gpu, ref = renderer.render(near, 32, 32), render_reference(near, 32, 32)
+    assert not ref.hit.any() and not gpu.hit.any()

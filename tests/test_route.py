@@ -136,7 +136,7 @@ def test_a_tiny_but_valid_normal_is_normalised():
 
 def test_zero_radius_and_fork_on_fork_are_clear_errors():
     scene = scene_of(small_route())
-    with pytest.raises(SceneError, match=r"route\.levels\[0\]\.radius = 0\.0: allowed: 0\.0 < value"):
+    with pytest.raises(SceneError, match=r"route\.levels\[0\]\.radius = 0\.0: allowed: 0 < value"):
         apply_edit(scene, ("route", "levels", 0, "radius"), 0.0)
     with pytest.raises(SceneError, match=r"route\.levels\[0\]\.fork .*must differ from "
                                          r"levels\[1\]\.fork"):

@@ -155,9 +155,10 @@ def transform_sphere(H: np.ndarray, alpha, beta, gamma):
     return a2[..., 0], b2, g2[..., 0]
 
 
-def map_ball(M: np.ndarray, center: np.ndarray, radius: np.ndarray):
+def map_ball(M: np.ndarray, center: np.ndarray, radius: np.ndarray, exterior: bool = False):
     """The image of balls (center (N, 3), radius (N,)) under L_M, as (center', radius', ok);
-    ok is False where the ball holds the pole of M (its image is a ball's exterior).
+    ok is False where the ball holds the pole of M: its image is a ball's exterior, and with
+    ``exterior`` (center', radius') is that ball (the same diameter construction), else 0.
 
     Same sphere as App. A applied with M⁻¹, computed from two points instead: the diameter
     on the line through the pole maps to a diameter of the image (both are symmetric about
@@ -170,8 +171,9 @@ def map_ball(M: np.ndarray, center: np.ndarray, radius: np.ndarray):
     off = center - p
     dist = np.linalg.norm(off, axis=-1)
     ok = dist > radius
-    u = off / np.where(dist > 0, dist, 1.0)[:, None]
-    r = np.where(ok, radius, 0.0)[:, None]
+    u = np.where((dist > 0)[:, None], off / np.where(dist > 0, dist, 1.0)[:, None],
+                 [1.0, 0.0, 0.0])   # a pole at the centre: any diameter passes through it
+    r = (radius if exterior else np.where(ok, radius, 0.0))[:, None]
     x1, x2 = apply(M, center + r * u), apply(M, center - r * u)
     return 0.5 * (x1 + x2), 0.5 * np.linalg.norm(x1 - x2, axis=-1), ok
 

@@ -4,8 +4,9 @@ the ground truth (the float64 reference at ε/8); the report says which settings
 
 Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
-float64 shader) and level count (LOD by truncation). One run writes a CSV, a Markdown report, plots (time against error per knob, the Pareto front over all settings) and error
-images (holes red, false hits blue)."""
+float64 shader) and level count (LOD by truncation). One run writes a CSV, a Markdown report,
+plots (time against error per knob, the Pareto front over all settings) and error images
+(holes red, false hits blue)."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
@@ -15,7 +16,7 @@ import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..reference.camera import view_of
-from ..scene import Geometry, Scene
+from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PRECISIONS
 from .harness import Variant, median_times
 from .metrics import compare, error_image
@@ -64,10 +65,12 @@ def settings(scene: Scene) -> list[Setting]:
             out.append(Setting("precision", precision,
                                replace(scene, render=replace(r, precision=precision))))
     g = scene.geometry()
-    if scene.mokrs is None:   # a MöKRS's truncation may leave nothing to draw (issue 16)
-        for cut in LEVEL_CUTS:
-            if g.depth - cut >= 1:
+    for cut in LEVEL_CUTS:
+        if g.depth - cut >= 1:
+            try:
                 out.append(Setting("levels", f"{g.depth - cut}", scene, g.truncated(g.depth - cut)))
+            except SceneError:   # a MöKRS cut that cannot carry its kernel up: not a setting
+                pass
     return out
 
 

@@ -31,8 +31,13 @@ def default_cache() -> Path:
     return Path(base) / "krsview" / "truth"
 
 
+# Bumped whenever the reference draws differently, so no cache outlives its images
+# (2: a MöKRS probe holding a pole is free when the level's bound lies outside it).
+REFERENCE_REVISION = 2
+
+
 def cache_key(scene: Scene, size: tuple[int, int]) -> str:
-    text = f"{__version__}\n{size}\n{scene_to_toml(truth_scene(scene))}"
+    text = f"{__version__}.{REFERENCE_REVISION}\n{size}\n{scene_to_toml(truth_scene(scene))}"
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 

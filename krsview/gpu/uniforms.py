@@ -12,7 +12,7 @@ from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS
 from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
 
-MOBIUS_RECORD = 5  # vec4s per MöKRS level: a, b, c, d of H_i, then its pole record
+MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record, its bound
 
 
 def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
@@ -60,6 +60,7 @@ def krs_block(c: Compiled, precision: str = "float") -> bytes:
         head = np.zeros((n, MOBIUS_RECORD, 4), dtype=dtype)
         head[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
         head[:c.n, 4] = c.poles
+        head[:c.n, 5] = c.bounds
     else:
         head = np.zeros((n, 4), dtype=dtype)
         for part, first in component_slots(c):

@@ -2,18 +2,83 @@
 normal [KRS17 §8.1, App. C]. Twin of ``shaders/mokrs.glsl``.
 
 The tracer walks levels from the world inwards: the probe ball is mapped by H_i = G_i⁻¹,
-folded across x = 0 on its centre, and tested against K_i.
+folded across x = 0 on its centre, and tested against K_i. A probe that holds H_i's pole maps
+to the exterior of a ball; Alg. 3 rejects it outright ("inside-out"), which stops rays that
+merely pass near a pole in empty space. Here it is free when everything level i and the
+levels below it hold — inside the level's bounding ball, computed once per scene — lies
+inside that ball.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..scene import MoKRS
+from ..scene.model import Capsule, Empty, Kernel, Sphere, ToroidalCapsule, arc_of
 from ..algebra import mobius
 from .compiled import kernel_records
 from .kernels import kernel_distance, world_normal
+
+
+UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])   # a bound record for "no bounding ball"
+
+
+def kernel_ball(k: Kernel) -> np.ndarray | None:
+    """(centre, radius) of a ball holding the kernel; None for an unbounded plane or empty.
+    An arc of at most π stays within the rectangle of its chord c and sagitta h, so within
+    √((c/2)² + h²) of the chord's midpoint; a longer arc within R of its circle's centre."""
+    if isinstance(k, Sphere):
+        return np.array([*k.center, k.radius])
+    if isinstance(k, Capsule):
+        a, b = np.array(k.a), np.array(k.b)
+        return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
+    if isinstance(k, ToroidalCapsule):
+        arc = arc_of(k)
+        a, b = np.array(k.start), np.array(k.end)
+        if arc is None:
+            return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
+        if arc.phi > math.pi:
+            return np.array([*arc.center, arc.R + k.radius])
+        half = np.linalg.norm(b - a) / 2
+        sagitta = arc.R * (1 - math.cos(arc.phi / 2))
+        return np.array([*(a + b) / 2, math.hypot(half, sagitta) + k.radius])
+    return None
+
+
+def union_ball(p: np.ndarray | None, q: np.ndarray | None) -> np.ndarray | None:
+    """The smallest ball holding balls p and q (None: nothing)."""
+    if p is None or q is None:
+        return q if p is None else p
+    d = float(np.linalg.norm(q[:3] - p[:3]))
+    if d + q[3] <= p[3]:
+        return p
+    if d + p[3] <= q[3]:
+        return q
+    r = (d + p[3] + q[3]) / 2
+    return np.array([*(p[:3] + (r - p[3]) / d * (q[:3] - p[:3])), r])
+
+
+def level_bounds(m: MoKRS) -> np.ndarray:
+    """(n, 4): per level i, a ball in level i's space holding everything the tracer still
+    tests at level i and below: K_i ∪ L_{i−1}, doubled by R when the level reflects; radius −1
+    where unbounded (a plane kernel, or a ball carried through a pole)."""
+    out, below = [], None           # below: bound of L_{i−1} in level i's space
+    unbounded = False
+    for lv in m.levels:
+        if not unbounded:
+            k = kernel_ball(lv.kernel)
+            unbounded = k is None and not isinstance(lv.kernel, Empty)
+            ball = union_ball(below, k)
+            if ball is not None and lv.reflect:
+                ball = union_ball(ball, ball * [-1.0, 1.0, 1.0, 1.0])
+        out.append(UNBOUNDED if unbounded or ball is None else ball)
+        if not unbounded and ball is not None:
+            c, r, ok = mobius.map_ball(lv.matrix(), ball[None, :3], ball[3:])
+            unbounded = not ok[0] or not np.isfinite(r[0])
+            below = np.array([*c[0], r[0]])
+    return np.array(out)
 
 
 @dataclass(frozen=True)
@@ -23,6 +88,7 @@ class CompiledMoKRS:
     records: np.ndarray      # (n, RECORD_VEC4, 4), in each level's own space
     types: tuple[str, ...]
     poles: np.ndarray        # (n, 4): (pole.xyz | (|a|/|d|, 0, 0), has_pole + 2·reflects)
+    bounds: np.ndarray       # (n, 4): level_bounds, in each level's own space
 
     @property
     def n(self) -> int:
@@ -34,7 +100,8 @@ class CompiledMoKRS:
         inverse, poles = self.inverse.copy(), self.poles.copy()
         inverse[-1] = mobius.tidy(mobius.compose(inverse[-1], mobius.translation(origin)))
         poles[-1] = pole_record(inverse[-1], self.reflect[-1])
-        return CompiledMoKRS(inverse, self.reflect, self.records, self.types, poles)
+        return CompiledMoKRS(inverse, self.reflect, self.records, self.types, poles,
+                             self.bounds)   # level spaces do not move
 
 
 def pole_record(H: np.ndarray, reflect: bool) -> np.ndarray:
@@ -50,25 +117,34 @@ def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS
     reflect = np.array([lv.reflect for lv in m.levels])
     records, types = kernel_records(m.kernels, albedo)
     poles = np.array([pole_record(H, r) for H, r in zip(inverse, reflect)])
-    return CompiledMoKRS(inverse, reflect, records, types, poles)
+    return CompiledMoKRS(inverse, reflect, records, types, poles, level_bounds(m))
 
 
-def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray) -> np.ndarray:
+def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray,
+                  pole_bounds: bool = True) -> np.ndarray:
     """ISUNBOUNDING(κ_w, ρ_w) [KRS17 Alg. 3] for balls (N, 3), (N,): whether each ball is free
-    of the MöKRS. A ball that holds a level's pole maps to a ball's exterior ("inside-out")
-    and is rejected. The mirror decision is taken on the ball's centre, as in the paper."""
+    of the MöKRS. A ball that holds a level's pole maps to a ball's exterior: it is free when
+    the level's bound lies inside that ball, else blocked (``pole_bounds=False``: always
+    blocked, Alg. 3's inside-out rule). The mirror decision is taken on the ball's centre, as
+    in the paper."""
     free = np.ones(len(center), dtype=bool)
-    live = np.arange(len(center))          # balls not yet rejected (the shader returns early)
+    live = np.arange(len(center))          # balls not yet decided (the shader returns early)
     kappa, rho = center, radius
     with np.errstate(all="ignore"):
         for i in range(c.n - 1, -1, -1):
-            kappa, rho, ok = mobius.map_ball(c.inverse[i], kappa, rho)
+            kappa, rho, ok = mobius.map_ball(c.inverse[i], kappa, rho, exterior=True)
+            if not ok.all():
+                b = c.bounds[i]
+                inside = (b[3] >= 0) & (np.linalg.norm(kappa - b[:3], axis=1) + b[3] < rho)
+                outside = ~ok
+                free[live[outside & ~(inside & pole_bounds)]] = False
+                live, kappa, rho = live[ok], kappa[ok], rho[ok]   # decided: leave the walk
             if c.reflect[i]:
                 kappa = kappa * np.where(kappa[:, :1] > 0.0, [-1.0, 1.0, 1.0], 1.0)
             if c.types[i] != "empty":
-                ok &= kernel_distance(c.types[i], c.records[i], kappa) >= rho
-            free[live[~ok]] = False
-            live, kappa, rho = live[ok], kappa[ok], rho[ok]
+                ok = kernel_distance(c.types[i], c.records[i], kappa) >= rho
+                free[live[~ok]] = False
+                live, kappa, rho = live[ok], kappa[ok], rho[ok]
     return free
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scene import Render
-from .trace import INITIAL_PROBE, Distance, Test, by_component, front
+from .trace import INITIAL_PROBE, MIN_PROBE, Distance, Test, by_component, front
 
 SHADOW_OFFSET = 2.0
 AO_SAMPLES = 5
@@ -55,7 +55,7 @@ def shadow_by_probes(is_free: Test, o: np.ndarray,
         free = is_free(o[live] + (tl + sl)[:, None] * l, sl)
         if k is not None:
             vis[live] = np.where(free, np.minimum(vis[live], k * sl / (tl + sl)), vis[live])
-        blocked = ~free & (sl <= eps[live])
+        blocked = ~free & (sl <= np.maximum(eps[live], MIN_PROBE))
         vis[live[blocked]] = 0.0
         t[live] = np.where(free, tl + 2.0 * sl, tl)
         s[live] = np.where(free, sl * r.xi_bonus, sl * r.xi_penalty)

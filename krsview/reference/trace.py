@@ -12,6 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 Alg. 2 line 2]
+# A blocked probe this small has converged even where ε(t) = 0 (an eye inside a solid): in
+# exact arithmetic it would shrink forever, in float32 it underflows to 0 after ~600 probes.
+MIN_PROBE = 1e-30
 
 
 @dataclass
@@ -142,7 +145,7 @@ def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_pe
         t[active], sa = ta, sc[active, c]
         free = by_component(tests, c, origin + (ta + sa)[:, None] * dirs[active], sa)
         iters[active] += 1
-        converged = ~free & (sa <= eps_per_t * ta)
+        converged = ~free & (sa <= np.maximum(eps_per_t * ta, MIN_PROBE))
         hit[active[converged]] = True
         tc[active, c] = np.where(free, ta + 2.0 * sa, ta)
         sc[active, c] = np.where(free, sa * xi_bonus, sa * xi_penalty)

@@ -1,7 +1,8 @@
 // Möbius transformations H_i = G_i⁻¹ of the MöKRS levels [KRS17 §6.2, App. C]; twin of
 // algebra/mobius.py (apply, map_ball, gradient). Record per level: a, b, c, d, then
 // (pole.xyz, flags) with a pole, or (|a|/|d|, 0, 0, flags) for a similarity (c = 0);
-// flags = has_pole + 2 · reflects.
+// flags = has_pole + 2 · reflects; then the level's bounding ball (centre, radius; radius < 0:
+// unbounded), in the level's own space (reference/mokrs.py, level_bounds).
 #include "quaternion.glsl"
 
 vec4r mobius_rec(int i, int k) { return u_mobius[i * MOBIUS_RECORD + k]; }
@@ -15,7 +16,8 @@ vec3r mobius_apply(int i, vec3r p) {
 }
 
 // The image of a ball under L_H, from the diameter on the line through the pole (it maps
-// to a diameter of the image); false if the ball holds the pole (image: an exterior).
+// to a diameter of the image); false if the ball holds the pole: then the image is the
+// exterior of the returned ball.
 // Float32-safe, unlike App. A's ρ² = |κ|² − γ. A similarity needs only the centre.
 bool map_ball(int i, inout vec3r center, inout real radius) {
     vec4r pf = mobius_rec(i, 4);
@@ -26,12 +28,12 @@ bool map_ball(int i, inout vec3r center, inout real radius) {
     }
     vec3r off = center - pf.xyz;
     real dist = length(off);
-    if (dist <= radius) return false;
-    vec3r u = off / dist;
+    bool outside = dist > radius;
+    vec3r u = dist > 0.0 ? off / dist : vec3r(1.0, 0.0, 0.0);  // centred pole: any diameter
     vec3r x1 = mobius_apply(i, center + radius * u), x2 = mobius_apply(i, center - radius * u);
     center = 0.5 * (x1 + x2);
     radius = 0.5 * length(x1 - x2);
-    return true;
+    return outside;
 }
 
 // dL_H at p as a matrix: columns (a − L_H(p) c) e_k (cp + d)⁻¹ [KRS17 App. C, Eq. 3].

@@ -5,10 +5,18 @@
 
 bool reflects(int i) { return (int(mobius_rec(i, 4).w) & 2) != 0; }
 
+// A probe holding level i's pole maps to the exterior of the ball (center, radius): it is
+// free when everything at level i and below (the level's bounding ball) lies inside that
+// ball; Alg. 3 rejects it outright, stopping rays that only pass near a pole.
+bool exterior_is_free(int i, vec3r center, real radius) {
+    vec4r bound = mobius_rec(i, 5);
+    return bound.w >= 0.0 && length(bound.xyz - center) + bound.w < radius;
+}
+
 // c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
 bool is_unbounding(int c, vec3r center, real radius) {
     for (int i = u_n - 1; i >= 0; --i) {
-        if (!map_ball(i, center, radius)) return false;   // inside-out
+        if (!map_ball(i, center, radius)) return exterior_is_free(i, center, radius);
         if (reflects(i)) center.x = -abs(center.x);      // mirror decision on the centre
         if (kernel_distance(i, center) < radius) return false;
     }

@@ -37,7 +37,7 @@ float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
             s *= u_xi_bonus;
             if (t > u_max_distance) break;
         } else {
-            if (s <= eps) return 0.0;
+            if (s <= max(eps, MIN_PROBE)) return 0.0;
             s *= u_xi_penalty;
         }
     }

@@ -18,6 +18,7 @@ int front(real tc[COMPONENT_SLOTS]) {
 
 #ifdef KRS_TRACER_BINARY
 #define INITIAL_PROBE 1.0
+#define MIN_PROBE 1e-30   // converged even where ε(t) = 0 (reference/trace.py)
 
 // Probe the ball of radius s touching the free point t: free → advance 2s, grow s;
 // blocked → converged if s ≤ ε(t), else shrink s (see reference/trace.py for why).
@@ -35,7 +36,7 @@ bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
             tc[c] = t + 2.0 * s;
             sc[c] = s * u_xi_bonus;
         } else {
-            if (s <= u_eps_per_t * t) return true;
+            if (s <= max(u_eps_per_t * t, MIN_PROBE)) return true;
             sc[c] = s * u_xi_penalty;
         }
     }
