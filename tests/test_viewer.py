@@ -206,6 +206,22 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     assert programs.compiles == before + 1
 
 
+def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
+    """render.precision from the HUD: a double variant compiles, the window shows the same
+    picture as float32 at the preset's view (to rounding), and no error appears."""
+    v = viewer
+    settle(v)
+    single = v.read_window()
+    v.set_render(precision="double")
+    settle(v)
+    assert any(("KRS_DOUBLE", None) in key[2] for key in v.renderer.programs._programs)
+    double = v.read_window()
+    assert not v.error and v.scene.render.precision == "double"
+    assert (np.abs(double.astype(int) - single).max(-1) > 2).mean() < 0.01
+    v.set_render(precision="float")
+    settle(v)
+
+
 def test_mokrs_presets_fly_in_the_viewer(viewer):
     v = viewer
     for name in ("palm", "shell", "inversion"):
