@@ -178,6 +178,8 @@ def cmd_edit(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     if args.stability:
         return check_stability(args.preset, args.size)
+    if args.oracle:
+        return check_oracle(args.preset, args.size)
     path = resolve(args.preset)
     scene = load_scene(path)
     krs = scene.geometry()
@@ -239,6 +241,34 @@ def check_stability(name: str, size: tuple[int, int]) -> int:
         bar.step(case.name)
     print(stability.table(outcomes))
     return 0 if all(o.ok for o in outcomes) else 1
+
+
+def check_oracle(name: str, size: tuple[int, int]) -> int:
+    """Certified holes and false hits of the sphere and binary tracers on a KRS scene (or a
+    hard case, hard:NAME), with the oracle's work in interval and affine arithmetic."""
+    from .bench.hard_cases import CASES
+    from .gpu.renderer import Renderer
+    from .oracle.certify import count_errors
+    if name.startswith("hard:"):
+        if name[5:] not in CASES:
+            raise SceneError("PRESET", name, "no such hard case; cases: " + ", ".join(CASES))
+        scene = replace(CASES[name[5:]].build(), name=name[5:])
+    else:
+        scene = load_scene(resolve(name))
+    if scene.mokrs is not None or {"twist", "empty_zones"} & set(scene.effects):
+        raise SceneError("PRESET", name, "the oracle covers KRS scenes and compounds without "
+                         "twist or empty zones (a MöKRS has no distance to enclose)")
+    r = Renderer()
+    print(f"| {scene.name} {size[0]}×{size[1]} | rays | hits | holes | false hits beyond ε | "
+          "undecided | affine: segments, s | interval: segments, s |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    for tracer in ("sphere", "binary"):
+        traced = replace(scene, render=replace(scene.render, tracer=tracer))
+        c = count_errors(traced, r.render(traced, *size))
+        (sa, ta), (si, ti) = c.work["affine"], c.work["interval"]
+        print(f"| {tracer} | {c.rays} | {c.hits} | {c.holes} | {c.false_hits} | "
+              f"{c.undecided} | {sa:,}, {ta:.1f} | {si:,}, {ti:.1f} |", flush=True)
+    return 0
 
 
 def cmd_bench_levels(args: argparse.Namespace) -> int:
@@ -410,8 +440,11 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("preset", metavar="PRESET")
     c.add_argument("--stability", action="store_true",
                    help="run the stability invariants and print their table")
+    c.add_argument("--oracle", action="store_true",
+                   help="count the sphere and binary tracers' certified holes and false hits "
+                        "with the interval / affine arithmetic oracle [RAA09] (KRS scenes)")
     c.add_argument("--size", type=_size, default=(48, 27),
-                   help="image size for --stability (default 48x27)")
+                   help="image size for --stability and --oracle (default 48x27)")
     c.set_defaults(func=cmd_check)
 
     b = sub.add_parser("bench", help="benchmarks (levels, tracers, effects, accuracy)",

@@ -11,7 +11,8 @@ PACKAGE = Path(__file__).resolve().parent.parent / "krsview"
 FORBIDDEN = {
     "algebra": {"scene", "reference", "gpu", "app", "editor", "bench", "cli"},
     "scene": {"reference", "gpu", "app", "editor", "bench", "cli"},
-    "reference": {"gpu", "app", "editor", "bench", "cli"},
+    "reference": {"gpu", "app", "editor", "bench", "cli", "oracle"},
+    "oracle": {"gpu", "app", "editor", "bench", "cli"},
     "gpu": {"app", "editor", "bench", "cli"},
     "bench": {"app", "editor", "cli"},
     "app": {"bench", "cli"},

@@ -1,0 +1,142 @@
+"""Certify what a ray meets, by recursive subdivision of its segments [RAA09 §4]: a segment
+whose enclosure of the distance is > 0 holds no surface; one of at most δ whose ends are
+certified on either side of 0 holds one (the distance is continuous). With those, count the
+rays a tracer got wrong:
+
+- **hole**: a surface certified on [0, T], T = ε(t_hit) before the tracer's hit (or the far
+  limit on a miss): the tracer went past geometry that exists;
+- **false hit beyond ε**: the box of half-size ε(t_hit) around the tracer's hit point is
+  certified free of the surface (boxes subdivided up to BOX_DEPTH times): the tracer stopped
+  where nothing lies within ε;
+- **undecided**: the budget ran out, or a segment of size δ touches 0 without a certified
+  crossing (tangent rays): counted, never guessed.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..buffers import Buffers
+from ..reference.camera import primary_rays, view_of
+from ..reference.geometry import compile_geometry
+from ..scene import Scene
+from .distance import in_box, on_segments, scene_distance
+
+DELTA_PIXELS = 0.25        # a crossing is certified within a quarter pixel footprint
+REFINE = 1024              # a segment δ/REFINE long that touches 0 without a crossing: undecided
+MAX_SEGMENTS = 4000        # per ray: past this the ray is undecided
+BOX_DEPTH = 3              # octree subdivisions of an ε-box (up to 8³ boxes)
+ARITHMETICS = ("affine", "interval")
+
+
+@dataclass
+class Certified:
+    """Per ray: +1 a surface certified on [0, T], 0 certified none there, −1 undecided; and
+    the work it took."""
+    surface: np.ndarray
+    segments: int = 0        # enclosures evaluated (subdivisions + 1 per ray)
+    seconds: float = 0.0
+
+
+def enclosure(c, origin, dirs, a, b, arithmetic: str) -> tuple[np.ndarray, np.ndarray]:
+    return scene_distance(c, on_segments(origin, dirs, a, b, arithmetic)).range()
+
+
+def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, delta: np.ndarray,
+                    arithmetic: str, max_segments: int = MAX_SEGMENTS) -> Certified:
+    """For each ray (dirs (N, 3)), whether a surface is certified on [0, T]; δ per ray is the
+    segment size at which a crossing is looked for."""
+    t0 = time.perf_counter()
+    N = len(dirs)
+    surface = np.zeros(N, dtype=np.int64)
+    budget = np.full(N, max_segments)
+    ray, a, b = np.arange(N), np.zeros(N), np.asarray(T, dtype=np.float64).copy()
+    total = 0
+    while ray.size:
+        lo, _ = enclosure(c, origin, dirs[ray], a, b, arithmetic)
+        total += ray.size
+        np.subtract.at(budget, ray, 1)
+        live = (lo <= 0) & (surface[ray] == 0)       # may hold a surface, ray not decided
+        small = live & (b - a <= delta[ray])
+        if small.any():
+            r, sa, sb = ray[small], a[small], b[small]
+            pa = enclosure(c, origin, dirs[r], sa, sa, "interval")
+            pb = enclosure(c, origin, dirs[r], sb, sb, "interval")
+            crossing = ((pa[0] > 0) & (pb[1] < 0)) | (pa[1] < 0)   # or already inside
+            surface[r[crossing]] = 1
+            tiny = ~crossing & (sb - sa <= delta[r] / REFINE)       # touches 0: give up
+            surface[r[tiny]] = np.where(surface[r[tiny]] == 0, -1, surface[r[tiny]])
+        split = live & (surface[ray] == 0)
+        out = budget[ray] <= 0
+        surface[ray[split & out & (surface[ray] == 0)]] = -1
+        split &= ~out
+        mid = 0.5 * (a[split] + b[split])
+        ray = np.concatenate([ray[split], ray[split]])
+        a, b = np.concatenate([a[split], mid]), np.concatenate([mid, b[split]])
+    return Certified(surface, total, time.perf_counter() - t0)
+
+
+def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Whether each box centre ± half holds no surface (interval enclosures > 0 after up to
+    BOX_DEPTH octree subdivisions)."""
+    N = len(centers)
+    free = np.ones(N, dtype=bool)
+    idx, ctr, h = np.arange(N), centers, np.asarray(half, dtype=np.float64)
+    for depth in range(BOX_DEPTH + 1):
+        lo, _ = scene_distance(c, in_box(ctr, h)).range()
+        open_ = lo <= 0
+        if depth == BOX_DEPTH:
+            free[idx[open_]] = False
+            break
+        if not open_.any():
+            break
+        idx, ctr, h = idx[open_], ctr[open_], h[open_] / 2
+        offsets = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+        idx = np.repeat(idx, 8)
+        ctr = (ctr[:, None, :] + offsets[None] * h[:, None, None]).reshape(-1, 3)
+        h = np.repeat(h, 8)
+    return free
+
+
+@dataclass
+class Counts:
+    rays: int
+    hits: int
+    holes: int
+    false_hits: int
+    undecided: int
+    work: dict = field(default_factory=dict)    # arithmetic → (segments, seconds)
+
+
+def count_errors(scene: Scene, image: Buffers, arithmetics=ARITHMETICS,
+                 max_segments: int = MAX_SEGMENTS) -> Counts:
+    """Certified holes and false hits of a traced image (GPU or reference) of ``scene``.
+    A plain KRS or compound only: a MöKRS has no distance to enclose, and the twist and
+    empty zones are not in the oracle."""
+    if scene.mokrs is not None or {"twist", "empty_zones"} & set(scene.effects):
+        raise ValueError(f"{scene.name}: the oracle covers KRS scenes without twist or "
+                         "empty zones")
+    h, w = image.hit.shape
+    view = view_of(scene.camera, w, h)
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    dirs = primary_rays(view)
+    hit, t = image.hit.ravel(), image.depth.ravel()
+    eps = view.footprint * scene.render.epsilon_scale * t
+    capped = (image.iterations.ravel() >= scene.render.max_iterations) & ~hit
+    T = np.where(hit, t - eps, scene.render.max_distance)
+    check = ~capped & (T > 0)
+    delta = DELTA_PIXELS * view.footprint * np.maximum(T, 1e-12)
+    work, surface = {}, None
+    for arithmetic in arithmetics:   # both are sound: a ray either decides counts
+        cert = surfaces_before(c, view.origin, dirs[check], T[check], delta[check], arithmetic,
+                               max_segments)
+        work[arithmetic] = (cert.segments, cert.seconds)
+        surface = cert.surface if surface is None else np.where(surface == -1, cert.surface,
+                                                                 surface)
+    holes = int((surface == 1).sum())
+    undecided = int((surface == -1).sum())
+    centres = view.origin + t[hit, None] * dirs[hit]
+    false_hits = int(free_boxes(c, centres, eps[hit]).sum())
+    return Counts(len(hit), int(hit.sum()), holes, false_hits, undecided, work)

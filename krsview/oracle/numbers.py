@@ -1,0 +1,200 @@
+"""Reliable numbers for the oracle [RAA09]: intervals with outward rounding, and revised affine
+forms x̂ = x0 + x1·ε1 ± e with one noise symbol ε1 ∈ [−1, 1] (the ray parameter over a
+segment) and an accumulated error e ≥ 0. Both are vectorised (every field an array over a
+batch of segments) and offer the same operations, so Alg. 1 is written once for both
+(``oracle/distance.py``). Every operation's result contains every value the real operation
+can take on its arguments (the inclusion property), float64 rounding included: intervals step
+one ulp outwards (+, −, ×, √ are correctly rounded to within half an ulp), affine forms add
+ROUNDING × their magnitude to e.
+
+Non-affine operations of the affine forms use the min-range (√) and Chebyshev (|x|, max(0, x))
+approximations: f(x) ≈ αx + ζ ± δ over the argument's range [a, b], with f − αx monotone or
+bounded by hand on [a, b] [RAA09 §3.4, dS97]. Conditionals whose outcome the range cannot
+decide take the hull of both branches, as RAA09 does.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+ROUNDING = 2.0 ** -49   # relative error added per affine operation (≥ a few ulps of float64)
+
+
+def _down(x):
+    return np.nextafter(x, -np.inf)
+
+
+def _up(x):
+    return np.nextafter(x, np.inf)
+
+
+class Interval:
+    """[lo, hi] per element; constants (float arrays) are exact degenerate intervals."""
+    __slots__ = ("lo", "hi")
+
+    def __init__(self, lo, hi=None):
+        self.lo = np.asarray(lo, dtype=np.float64)
+        self.hi = self.lo if hi is None else np.asarray(hi, dtype=np.float64)
+
+    @staticmethod
+    def outward(lo, hi) -> "Interval":
+        """[lo, hi] widened by an ulp each way (for bounds computed in float64)."""
+        return Interval(_down(lo), _up(hi))
+
+    @staticmethod
+    def lift(x) -> "Interval":
+        return x if isinstance(x, Interval) else Interval(x)
+
+    def range(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.lo, self.hi
+
+    def __add__(self, o):
+        o = Interval.lift(o)
+        return Interval(_down(self.lo + o.lo), _up(self.hi + o.hi))
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return Interval(-self.hi, -self.lo)
+
+    def __sub__(self, o):
+        return self + (-Interval.lift(o))
+
+    def __rsub__(self, o):
+        return Interval.lift(o) + (-self)
+
+    def __mul__(self, o):
+        o = Interval.lift(o)
+        p = [self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi]
+        return Interval(_down(np.minimum.reduce(p)), _up(np.maximum.reduce(p)))
+
+    __rmul__ = __mul__
+
+    def sqr(self):
+        a, b = np.abs(self.lo), np.abs(self.hi)
+        straddle = (self.lo < 0) & (self.hi > 0)
+        lo = np.where(straddle, 0.0, np.minimum(a, b) ** 2)
+        return Interval(np.maximum(_down(lo), 0.0), _up(np.maximum(a, b) ** 2))
+
+    def sqrt(self):
+        return Interval(np.maximum(_down(np.sqrt(np.maximum(self.lo, 0.0))), 0.0),
+                        _up(np.sqrt(np.maximum(self.hi, 0.0))))
+
+    def relu(self):
+        return Interval(np.maximum(self.lo, 0.0), np.maximum(self.hi, 0.0))
+
+    def minimum(self, o):
+        o = Interval.lift(o)
+        return Interval(np.minimum(self.lo, o.lo), np.minimum(self.hi, o.hi))
+
+    def hull(self, o):
+        return Interval(np.minimum(self.lo, o.lo), np.maximum(self.hi, o.hi))
+
+    def select(self, yes: np.ndarray, no: np.ndarray, other: "Interval") -> "Interval":
+        """Where ``yes``: self; where ``no``: other; elsewhere the hull of both."""
+        h = self.hull(other)
+        return Interval(np.where(yes, self.lo, np.where(no, other.lo, h.lo)),
+                        np.where(yes, self.hi, np.where(no, other.hi, h.hi)))
+
+
+class Affine:
+    """x0 + x1·ε1 ± e per element (revised affine form with one noise symbol)."""
+    __slots__ = ("x0", "x1", "e")
+
+    def __init__(self, x0, x1=0.0, e=0.0):
+        self.x0 = np.asarray(x0, dtype=np.float64)
+        self.x1 = np.broadcast_to(np.asarray(x1, dtype=np.float64), self.x0.shape)
+        self.e = np.broadcast_to(np.asarray(e, dtype=np.float64), self.x0.shape)
+
+    @staticmethod
+    def lift(x) -> "Affine":
+        return x if isinstance(x, Affine) else Affine(x)
+
+    @staticmethod
+    def rounded(x0, x1, e=0.0) -> "Affine":
+        """The form with e grown by the rounding of the float64 computation of its parts."""
+        return Affine(x0, x1, e + ROUNDING * (np.abs(x0) + np.abs(x1) + e))
+
+    def range(self) -> tuple[np.ndarray, np.ndarray]:
+        r = _up(np.abs(self.x1) + self.e)
+        r = _up(r + ROUNDING * (np.abs(self.x0) + r))
+        return _down(self.x0 - r), _up(self.x0 + r)
+
+    def interval(self) -> Interval:
+        return Interval(*self.range())
+
+    @staticmethod
+    def of_interval(i: Interval) -> "Affine":
+        mid = 0.5 * (i.lo + i.hi)
+        return Affine.rounded(mid, 0.0, np.maximum(i.hi - mid, mid - i.lo))
+
+    def __add__(self, o):
+        o = Affine.lift(o)
+        return Affine.rounded(self.x0 + o.x0, self.x1 + o.x1, self.e + o.e)
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return Affine(-self.x0, -self.x1, self.e)
+
+    def __sub__(self, o):
+        return self + (-Affine.lift(o))
+
+    def __rsub__(self, o):
+        return Affine.lift(o) + (-self)
+
+    def __mul__(self, o):
+        if not isinstance(o, Affine):   # by a constant: exact up to rounding
+            c = np.asarray(o, dtype=np.float64)
+            return Affine.rounded(c * self.x0, c * self.x1, np.abs(c) * self.e)
+        # (x0 + x1ε + η)(y0 + y1ε + θ): the ε² term x1·y1·ε² lies in ±|x1·y1|
+        e = (np.abs(self.x0) * o.e + np.abs(o.x0) * self.e
+             + (np.abs(self.x1) + self.e) * (np.abs(o.x1) + o.e))
+        return Affine.rounded(self.x0 * o.x0, self.x0 * o.x1 + self.x1 * o.x0, e)
+
+    __rmul__ = __mul__
+
+    def sqr(self):
+        # (x0 + x1ε + η)² = x0² + 2x0x1ε + x1²ε² + 2(x0 + x1ε)η + η², x1²ε² ∈ x1²/2 ± x1²/2
+        h = 0.5 * self.x1 * self.x1
+        e = h + 2.0 * (np.abs(self.x0) + np.abs(self.x1)) * self.e + self.e * self.e
+        return Affine.rounded(self.x0 * self.x0 + h, 2.0 * self.x0 * self.x1, e)
+
+    def _linearised(self, alpha, zeta, delta) -> "Affine":
+        """f(x) ≈ αx + ζ ± δ applied to this form."""
+        return Affine.rounded(alpha * self.x0 + zeta, alpha * self.x1,
+                             np.abs(alpha) * self.e + delta)
+
+    def sqrt(self):
+        """Min-range: α = f'(b); f − αx increases on [a, b], so it spans [g(a), g(b)]."""
+        a, b = self.range()
+        a, b = np.maximum(a, 0.0), np.maximum(b, 0.0)
+        pos = b > 0
+        alpha = np.where(pos, 0.5 / np.sqrt(np.where(pos, b, 1.0)), 0.0)
+        ga, gb = np.sqrt(a) - alpha * a, np.sqrt(b) - alpha * b
+        lo, hi = np.minimum(ga, gb), np.maximum(ga, gb)
+        return self._linearised(alpha, 0.5 * (lo + hi), 0.5 * (hi - lo))
+
+    def relu(self):
+        """Chebyshev: on a < 0 < b, max(0, x) − αx with α = b/(b − a) spans [0, −ab/(b − a)]."""
+        a, b = self.range()
+        straddle = (a < 0) & (b > 0)
+        w = np.where(straddle, b - a, 1.0)
+        alpha = np.where(straddle, b / w, np.where(a >= 0, 1.0, 0.0))
+        top = np.where(straddle, -a * b / w, 0.0)
+        return self._linearised(alpha, 0.5 * top, 0.5 * top)
+
+    def minimum(self, o):
+        """min(x, y) = x − max(0, x − y): exact where the ranges decide it."""
+        o = Affine.lift(o)
+        return self - (self - o).relu()
+
+    def select(self, yes: np.ndarray, no: np.ndarray, other: "Affine") -> "Affine":
+        """Where ``yes``: self; where ``no``: other; elsewhere the hull of both (as an
+        interval, turned back into a form)."""
+        h = Affine.of_interval(self.interval().hull(other.interval()))
+        pick = lambda f: np.where(yes, getattr(self, f), np.where(no, getattr(other, f),  # noqa: E731
+                                                                   getattr(h, f)))
+        return Affine(pick("x0"), pick("x1"), pick("e"))
+
+
+Number = Interval | Affine
