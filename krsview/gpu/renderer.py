@@ -19,6 +19,7 @@ from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
 
 PROGRESS_BANDS = 16   # bands of rows of a first frame drawn with progress
+MAX_TARGETS = 8       # render-target sizes kept (least recently used released)
 
 
 class Renderer:
@@ -46,10 +47,20 @@ class Renderer:
                 self.ctx.__exit__(None, None, None)
 
     def _framebuffer(self, width: int, height: int) -> moderngl.Framebuffer:
-        if (width, height) not in self._targets:
+        """Render targets per size, the most recently used MAX_TARGETS kept: the viewer's
+        adaptive resolution and window resizes visit many sizes, and each holds 3 textures."""
+        key = (width, height)
+        if key in self._targets:
+            self._targets[key] = self._targets.pop(key)       # most recent last
+        else:
+            while len(self._targets) >= MAX_TARGETS:
+                old = self._targets.pop(next(iter(self._targets)))
+                for tex in old.color_attachments:
+                    tex.release()
+                old.release()
             tex = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(3)]
-            self._targets[(width, height)] = self.ctx.framebuffer(color_attachments=tex)
-        return self._targets[(width, height)]
+            self._targets[key] = self.ctx.framebuffer(color_attachments=tex)
+        return self._targets[key]
 
     def prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
                 all_effects: bool = False) -> moderngl.Program:
