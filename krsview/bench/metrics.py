@@ -163,8 +163,8 @@ def agreement(a: Buffers, b: Buffers, depth_rel: float, normal_deg: float,
 
 
 # Tolerances of the GPU (float32) against the reference (float64), and why; the pixel tests
-# and the stability invariants use these. Away from occlusion edges (:func:`edges`) every
-# pixel must be within them; the fractions apply only to what lies on the edges:
+# and the stability invariants use these. The fractions hold for the whole image; away from
+# occlusion edges (:func:`edges`) every pixel must also meet OFF_EDGE_* below:
 HIT_AGREEMENT = 0.995    # a ray whose last distance lands within float32 rounding of ε flips
 DEPTH_REL = 1e-3         # same stopping step ⇒ depths agree to float32 accumulation over ~100 steps
 NORMAL_DEG = 2.0         # same winning kernel ⇒ same analytic gradient up to float32 rounding
@@ -172,6 +172,11 @@ CLOSE_FRACTION = 0.995   # …except where one side stopped a step later (|Δt| 
                          # past an outline onto a surface behind
 COLOR_TOL = 2.0 / 255.0  # one rounding of each channel plus float32 shading error
 COLOR_FRACTION = 0.99
+# Away from occlusion edges, the worst pixel: equal hit state, and at most one tracer step
+# apart — a step is ≤ ε(t) = footprint × t, under 2 % of t at the tests' image sizes — with
+# the colour that small move gives (5/255):
+OFF_EDGE_DEPTH = 0.02
+OFF_EDGE_COLOR = 5.0 / 255.0
 
 
 def gpu_reference_agreement(gpu: Buffers, ref: Buffers) -> Agreement:
@@ -181,10 +186,10 @@ def gpu_reference_agreement(gpu: Buffers, ref: Buffers) -> Agreement:
 def tolerance_failures(a: Agreement) -> list[str]:
     """What falls short of the GPU-vs-reference tolerances; empty when all hold."""
     out = []
-    if a.off_edge_hit or a.off_edge_depth > DEPTH_REL or a.off_edge_color > COLOR_TOL:
+    if a.off_edge_hit or a.off_edge_depth > OFF_EDGE_DEPTH or a.off_edge_color > OFF_EDGE_COLOR:
         out.append(f"away from outlines every pixel must agree: {a.off_edge_hit} hit "
-                   f"mismatches, depth error up to {a.off_edge_depth:.2g} (≤ {DEPTH_REL}), "
-                   f"colour error up to {a.off_edge_color:.3f} (≤ {COLOR_TOL:.4f})")
+                   f"mismatches, depth error up to {a.off_edge_depth:.2g} (≤ {OFF_EDGE_DEPTH}), "
+                   f"colour error up to {a.off_edge_color:.3f} (≤ {OFF_EDGE_COLOR})")
     if a.hit < HIT_AGREEMENT:
         out.append(f"hit masks agree on {a.hit:.4%} < {HIT_AGREEMENT:.1%}")
     if a.depth_close < CLOSE_FRACTION:
