@@ -438,11 +438,13 @@ def build_parser() -> argparse.ArgumentParser:
                                    "may also be 'hard' (the whole hard-case catalogue) or "
                                    "'hard:NAME' (one case). Exit status 1 if one fails.")
     c.add_argument("preset", metavar="PRESET")
-    c.add_argument("--stability", action="store_true",
-                   help="run the stability invariants and print their table")
-    c.add_argument("--oracle", action="store_true",
-                   help="count the sphere and binary tracers' certified holes and false hits "
-                        "with the interval / affine arithmetic oracle [RAA09] (KRS scenes)")
+    mode = c.add_mutually_exclusive_group()
+    mode.add_argument("--stability", action="store_true",
+                      help="run the stability invariants and print their table")
+    mode.add_argument("--oracle", action="store_true",
+                      help="count the sphere and binary tracers' certified holes and false "
+                           "hits with the interval / affine arithmetic oracle [RAA09] (KRS "
+                           "scenes; a deep tree takes about a minute)")
     c.add_argument("--size", type=_size, default=(48, 27),
                    help="image size for --stability and --oracle (default 48x27)")
     c.set_defaults(func=cmd_check)

@@ -199,3 +199,11 @@ def test_check_stability_prints_the_table_and_fails_when_an_invariant_does(capsy
     assert main(["check", "--stability", "sierpinski"]) == 1
     assert capsys.readouterr().out.rstrip().endswith("| FAILS |")
     assert main(["check", "--stability", "hard:nope"]) == 2
+
+
+def test_check_oracle_prints_certified_counts(capsys):
+    assert main(["check", "--oracle", "sierpinski", "--size", "24x14"]) == 0
+    out = capsys.readouterr().out
+    assert "| sphere | 336 | 111 | 0 | 0 | 0 |" in out and "| binary | 336 |" in out
+    assert main(["check", "--oracle", "palm"]) == 2
+    assert "a MöKRS has no distance to enclose" in capsys.readouterr().err

@@ -26,7 +26,7 @@ from .distance import in_box, on_segments, scene_distance
 
 DELTA_PIXELS = 0.25        # a crossing is certified within a quarter pixel footprint
 REFINE = 1024              # a segment δ/REFINE long that touches 0 without a crossing: undecided
-MAX_SEGMENTS = 4000        # per ray: past this the ray is undecided
+MAX_SEGMENTS = 500         # per ray: past this the ray is undecided
 BOX_DEPTH = 3              # octree subdivisions of an ε-box (up to 8³ boxes)
 ARITHMETICS = ("affine", "interval")
 
