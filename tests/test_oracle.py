@@ -138,7 +138,7 @@ def test_a_certified_surface_and_certified_empty_space():
     dirs = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
     for arithmetic in ("interval", "affine"):
         cert = surfaces_before(c, eye, dirs, np.array([10.0, 10.0]), np.array([1e-3, 1e-3]),
-                               arithmetic)
+                               arithmetic, max_segments=4000)
         assert list(cert.surface) == [1, 0], arithmetic
 
 
