@@ -146,3 +146,25 @@ def test_double_precision_uploads_the_geometry_in_float64():
     assert np.array_equal(mirrors, c.mirrors)          # not rounded through float32
     assert not np.array_equal(np.frombuffer(single, np.float32)[:4 * c.n].reshape(c.n, 4)
                               .astype(np.float64), c.mirrors)
+
+
+def test_a_twisted_ground_plane_stays_a_plane(monkeypatch):
+    """A horizontal plane is invariant under a twist about a vertical axis, so twisting it
+    must not add a single hit [issue 16: the horizon rose]. Far rays may run out of
+    iterations (counted as capped, drawn as sky) — never stop above the ground. Negative
+    control: with ε not scaled by the twist's Lipschitz bound, the horizon rises again."""
+    from krsview.reference import distortion
+    from krsview.scene import KRS, Camera, Level, Plane, Render, Scene
+    plane = Scene(name="ground", camera=Camera((0.0, 2.0, -10.0), (0.0, 1.5, 10.0)),
+                  render=Render(max_distance=100.0),
+                  krs=KRS([Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), None)]))
+    flat = render_reference(plane, 80, 45)
+    twisted = replace(plane, effects=["twist"],
+                      effect_settings=replace(plane.effect_settings, twist=8.0))
+    t = render_reference(twisted, 80, 45)
+    assert not (t.hit & ~flat.hit).any()
+    capped = (t.iterations >= plane.render.max_iterations) & ~t.hit
+    assert (flat.hit & ~t.hit & ~capped).sum() == 0     # every lost ground pixel is counted
+    monkeypatch.setattr(distortion.Distortion, "lod_scale", lambda self, p: np.ones(len(p)))
+    rose = render_reference(twisted, 80, 45)
+    assert (rose.hit & ~flat.hit).sum() > 100

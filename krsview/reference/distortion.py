@@ -68,6 +68,16 @@ class Distortion:
         k = np.argmax(depth, axis=1)
         return depth[np.arange(len(p)), k], k
 
+    def lod_scale(self, p: np.ndarray) -> np.ndarray:
+        """1 / (1 + |k|ρ): the twist's safe step is D / (1 + |k|ρ) to first order, so a ray
+        that converged on it at ε(t) stopped up to (1 + |k|ρ)·ε(t) from the surface — far from
+        the axis, high above a twisted ground (the horizon rose). Scaling ε by the same factor
+        makes it converge where the undistorted distance is within ε(t)."""
+        if self.twist == 0.0:
+            return np.ones(len(p))
+        rho = np.hypot(p[:, 0] - self.center[0], p[:, 2] - self.center[2])
+        return 1.0 / (1.0 + abs(self.twist) * rho)
+
     def undistort(self, p: np.ndarray) -> np.ndarray:
         return self.untwist(p) if self.twist != 0.0 else p
 

@@ -13,14 +13,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..scene import Render
-from .trace import INITIAL_PROBE, MIN_PROBE, Distance, Test, by_component, front
+from .trace import INITIAL_PROBE, MIN_PROBE, Distance, Scale, Test, by_component, front, lod
 
 SHADOW_OFFSET = 2.0
 AO_SAMPLES = 5
 
 
 def shadow_by_distance(distances: list[Distance], o: np.ndarray, l: np.ndarray,
-                       eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
+                       eps: np.ndarray, r: Render, k: float | None,
+                       lod_scale: Scale | None = None) -> np.ndarray:
     """Visibility of direction l from points o, sphere tracing each component's distance
     (the least free distance steps, as in :func:`trace.sphere_trace`); k None: hard shadows.
     The ray is blocked when any step converges; soft visibility is the least k·d/t met."""
@@ -31,8 +32,9 @@ def shadow_by_distance(distances: list[Distance], o: np.ndarray, l: np.ndarray,
         live, c, tl = front(tc, live, r.max_distance)
         if live.size == 0:
             break
-        d = by_component(distances, c, o[live] + tl[:, None] * l)
-        blocked = d <= eps[live]
+        p = o[live] + tl[:, None] * l
+        d = by_component(distances, c, p)
+        blocked = d <= eps[live] * lod(lod_scale, p)
         vis[live[blocked]] = 0.0
         if k is not None:
             ratio = np.where(tl > 0.0, k * d / np.where(tl > 0.0, tl, 1.0), np.inf)

@@ -44,16 +44,17 @@ def _trace_and_shade(scene: Scene, c, dist: Distortion | None, view: View, dirs:
     """Colour, depth (0 on a miss), normal, iterations and hit of the rays ``dirs``."""
     r = scene.render
     eps = view.footprint * r.epsilon_scale
+    scale = dist.lod_scale if dist is not None else None
     if r.tracer == "binary":
         tr = binary_trace(component_tests(c, dist), view.origin, dirs, eps,
-                          r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty)
+                          r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty, scale)
     elif r.tracer == "relaxed":
         (d,) = component_distances(c, dist)   # a single KRS (Scene.check_tracer)
         tr = relaxed_trace(d, view.origin, dirs, eps, r.max_iterations, r.max_distance,
-                           r.relaxation)
+                           r.relaxation, scale)
     else:
         tr = sphere_trace(component_distances(c, dist), view.origin, dirs, eps,  # type: ignore[arg-type]
-                          r.max_iterations, r.max_distance)
+                          r.max_iterations, r.max_distance, scale)
     N = len(dirs)
     normal = np.zeros((N, 3))
     color = encode(scene, background(scene, dirs))

@@ -79,7 +79,8 @@ def shade(scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint
                                                  eps[lit], scene.render, k)
             else:
                 vis = occlusion.shadow_by_distance(component_distances(c, dist), o, l,  # type: ignore[arg-type]
-                                                   eps[lit], scene.render, k)
+                                                   eps[lit], scene.render, k,
+                                                   dist.lod_scale if dist is not None else None)
             cos[lit] *= vis
         light = light + lt.intensity * cos[:, None] * np.array(lt.color)
     color = albedo(scene, c, h, fp) * light

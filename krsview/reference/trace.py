@@ -26,6 +26,10 @@ class Trace:
 
 Distance = Callable[[np.ndarray], np.ndarray]
 Test = Callable[[np.ndarray, np.ndarray], np.ndarray]
+# The factor of ε(t) at points (N, 3): a distortion's safe step shrinks by its Lipschitz bound,
+# and the threshold shrinks with it, so rays converge where the surface is, not where the
+# step is small (reference/distortion.py, lod_scale).
+Scale = Callable[[np.ndarray], np.ndarray]
 
 
 def by_component(fns: list, c: np.ndarray, *args: np.ndarray) -> np.ndarray:
@@ -55,8 +59,14 @@ def front(tc: np.ndarray, rays: np.ndarray, max_distance: float
     return rays[live], c[live], t[live]
 
 
+def lod(scale: Scale | None, points: np.ndarray) -> np.ndarray | float:
+    """The LOD threshold's factor at each point (1 without a distortion)."""
+    return 1.0 if scale is None else scale(points)
+
+
 def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray,
-                 eps_per_t: float, max_iterations: int, max_distance: float) -> Trace:
+                 eps_per_t: float, max_iterations: int, max_distance: float,
+                 lod_scale: Scale | None = None) -> Trace:
     """Sphere tracing of the components' distance bounds (points (N, 3) → (N,)), each with
     its own free distance t_c along the ray [KRS17 §5.1]: the component with the least t_c
     (ties: the first) takes the step, and the ray converges when that step does. So it
@@ -73,9 +83,10 @@ def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray
         if active.size == 0:
             break
         t[active] = ta
-        d = by_component(distances, c, origin + ta[:, None] * dirs[active])
+        p = origin + ta[:, None] * dirs[active]
+        d = by_component(distances, c, p)
         iters[active] += 1
-        converged = d <= eps_per_t * ta
+        converged = d <= eps_per_t * ta * lod(lod_scale, p)
         hit[active[converged]] = True
         tc[active, c] = ta + d
         active = active[~converged]
@@ -83,7 +94,8 @@ def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray
 
 
 def relaxed_trace(distance: Distance, origin: np.ndarray, dirs: np.ndarray, eps_per_t: float,
-                  max_iterations: int, max_distance: float, omega: float) -> Trace:
+                  max_iterations: int, max_distance: float, omega: float,
+                  lod_scale: Scale | None = None) -> Trace:
     """Over-relaxed sphere tracing [Keinert et al. 2014] of one distance bound: from the last
     verified point t_s (free ball of radius d_s) step ω·d; at the new point t, if the two free
     balls no longer cover [t_s, t] (d_s + d < t − t_s) a surface may lie between, so go back
@@ -110,7 +122,7 @@ def relaxed_trace(distance: Distance, origin: np.ndarray, dirs: np.ndarray, eps_
         t[back], w[back] = ts[back] + ds[back], 1.0
         ok = active[~gap]
         dk = d[~gap]
-        converged = dk <= eps_per_t * t[ok]
+        converged = dk <= eps_per_t * t[ok] * lod(lod_scale, origin + t[ok, None] * dirs[ok])
         hit[ok[converged]] = True
         go = ok[~converged]
         ts[go], ds[go] = t[go], dk[~converged]
@@ -121,7 +133,7 @@ def relaxed_trace(distance: Distance, origin: np.ndarray, dirs: np.ndarray, eps_
 
 def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_per_t: float,
                  max_iterations: int, max_distance: float, xi_bonus: float,
-                 xi_penalty: float) -> Trace:
+                 xi_penalty: float, lod_scale: Scale | None = None) -> Trace:
     """BINARYTRACE [KRS17 Alg. 2]: probe the ball of radius s that touches the free point t;
     if it is unbounding, advance by its diameter 2s and grow s by ξ_bonus, else shrink s by
     ξ_penalty. Iterations count probes. Two departures from the paper's listing: we advance
@@ -145,7 +157,8 @@ def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_pe
         t[active], sa = ta, sc[active, c]
         free = by_component(tests, c, origin + (ta + sa)[:, None] * dirs[active], sa)
         iters[active] += 1
-        converged = ~free & (sa <= np.maximum(eps_per_t * ta, MIN_PROBE))
+        eps = eps_per_t * ta * lod(lod_scale, origin + ta[:, None] * dirs[active])
+        converged = ~free & (sa <= np.maximum(eps, MIN_PROBE))
         hit[active[converged]] = True
         tc[active, c] = np.where(free, ta + 2.0 * sa, ta)
         sc[active, c] = np.where(free, sa * xi_bonus, sa * xi_penalty)

@@ -18,6 +18,17 @@ vec3r undistort(vec3r p) {
     return p;
 }
 
+// The factor of the LOD threshold ε(t) at p: the twist's safe step is D / (1 + |k|ρ) to
+// first order, so ε shrinks by the same factor and rays converge where the undistorted
+// distance is within ε(t), not high above a twisted ground (distortion.py, lod_scale).
+real lod_scale(vec3r p) {
+#ifdef KRS_TWIST
+    if (EFFECT_ON(KRS_TWIST_BIT))
+        return 1.0 / (1.0 + abs(u_twist) * length(vec2(p.xz - u_twist_center.xz)));
+#endif
+    return 1.0;
+}
+
 // From the undistorted distance D at undistort(p) to a bound that never overshoots at p.
 real distort_distance(vec3r p, real D) {
 #ifdef KRS_TWIST

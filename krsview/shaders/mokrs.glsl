@@ -13,6 +13,8 @@ bool exterior_is_free(int i, vec3r center, real radius) {
     return bound.w >= 0.0 && length(bound.xyz - center) + bound.w < radius;
 }
 
+real lod_scale(vec3r p) { return 1.0; }   // a MöKRS takes no distortion
+
 // c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
 bool is_unbounding(int c, vec3r center, real radius) {
     for (int i = u_n - 1; i >= 0; --i) {

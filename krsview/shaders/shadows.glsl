@@ -49,7 +49,7 @@ float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
         t = tc[c];
         if (t > u_max_distance) break;
         real d = component_distance(c, o + t * l);
-        if (d <= eps) return 0.0;
+        if (d <= eps * lod_scale(o + t * l)) return 0.0;
         if (soft && t > 0.0) vis = min(vis, u_shadow_softness * float(d / t));
         tc[c] = t + d;
     }

@@ -36,7 +36,7 @@ bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
             tc[c] = t + 2.0 * s;
             sc[c] = s * u_xi_bonus;
         } else {
-            if (s <= max(u_eps_per_t * t, MIN_PROBE)) return true;
+            if (s <= max(u_eps_per_t * t * lod_scale(origin + t * dir), MIN_PROBE)) return true;
             sc[c] = s * u_xi_penalty;
         }
     }
@@ -58,7 +58,7 @@ bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
             w = 1.0;
             continue;
         }
-        if (d <= u_eps_per_t * t) return true;
+        if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) return true;
         ts = t;
         ds = d;
         t += w * d;
@@ -75,7 +75,7 @@ bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
         if (t > u_max_distance) return false;
         real d = component_distance(c, origin + t * dir);
         ++iterations;
-        if (d <= u_eps_per_t * t) return true;
+        if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) return true;
         tc[c] = t + d;
     }
     return false;
