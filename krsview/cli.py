@@ -244,8 +244,8 @@ def check_stability(name: str, size: tuple[int, int]) -> int:
 
 
 def check_oracle(name: str, size: tuple[int, int]) -> int:
-    """Certified holes and false hits of the sphere and binary tracers on a KRS scene (or a
-    hard case, hard:NAME), with the oracle's work in interval and affine arithmetic."""
+    """Certified holes and false hits of the tracers on a scene (or a hard case, hard:NAME),
+    with the oracle's work in interval and affine arithmetic."""
     from .bench.hard_cases import CASES
     from .gpu.renderer import Renderer
     from .oracle.certify import count_errors
@@ -255,14 +255,14 @@ def check_oracle(name: str, size: tuple[int, int]) -> int:
         scene = replace(CASES[name[5:]].build(), name=name[5:])
     else:
         scene = load_scene(resolve(name))
-    if scene.mokrs is not None or {"twist", "empty_zones"} & set(scene.effects):
-        raise SceneError("PRESET", name, "the oracle covers KRS scenes and compounds without "
-                         "twist or empty zones (a MöKRS has no distance to enclose)")
+    if {"twist", "empty_zones"} & set(scene.effects):
+        raise SceneError("PRESET", name, "the oracle covers scenes without twist or empty "
+                         "zones (their distortions are not in it)")
     r = Renderer()
     print(f"| {scene.name} {size[0]}×{size[1]} | rays | hits | holes | false hits beyond ε | "
           "undecided | affine: segments, s | interval: segments, s |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
-    for tracer in ("sphere", "binary"):
+    for tracer in ("binary",) if scene.mokrs is not None else ("sphere", "binary"):
         traced = replace(scene, render=replace(scene.render, tracer=tracer))
         c = count_errors(traced, r.render(traced, *size))
         (sa, ta), (si, ti) = c.work["affine"], c.work["interval"]
@@ -443,8 +443,8 @@ def build_parser() -> argparse.ArgumentParser:
                       help="run the stability invariants and print their table")
     mode.add_argument("--oracle", action="store_true",
                       help="count the sphere and binary tracers' certified holes and false "
-                           "hits with the interval / affine arithmetic oracle [RAA09] (KRS "
-                           "scenes; a deep tree takes about a minute)")
+                           "hits with the interval / affine arithmetic oracle [RAA09] (a deep "
+                           "tree takes about a minute)")
     c.add_argument("--size", type=_size, default=(48, 27),
                    help="image size for --stability and --oracle (default 48x27)")
     c.set_defaults(func=cmd_check)

@@ -205,5 +205,5 @@ def test_check_oracle_prints_certified_counts(capsys):
     assert main(["check", "--oracle", "sierpinski", "--size", "24x14"]) == 0
     out = capsys.readouterr().out
     assert "| sphere | 336 | 111 | 0 | 0 | 0 |" in out and "| binary | 336 |" in out
-    assert main(["check", "--oracle", "palm"]) == 2
-    assert "a MöKRS has no distance to enclose" in capsys.readouterr().err
+    assert main(["check", "--oracle", "hard:twist-ground"]) == 2
+    assert "the oracle covers scenes without twist or empty zones" in capsys.readouterr().err

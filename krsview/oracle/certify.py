@@ -41,7 +41,9 @@ class Certified:
 
 
 def enclosure(c, origin, dirs, a, b, arithmetic: str) -> tuple[np.ndarray, np.ndarray]:
-    return scene_distance(c, on_segments(origin, dirs, a, b, arithmetic)).range()
+    """Bounds of the distance over the segments; NaN (∞ · 0 near a pole) means unknown."""
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        return scene_distance(c, on_segments(origin, dirs, a, b, arithmetic)).range()
 
 
 def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, delta: np.ndarray,
@@ -58,7 +60,7 @@ def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, delt
         lo, _ = enclosure(c, origin, dirs[ray], a, b, arithmetic)
         total += ray.size
         np.subtract.at(budget, ray, 1)
-        live = (lo <= 0) & (surface[ray] == 0)       # may hold a surface, ray not decided
+        live = ~(lo > 0) & (surface[ray] == 0)     # may hold a surface (NaN: unknown)
         small = live & (b - a <= delta[ray])
         if small.any():
             r, sa, sb = ray[small], a[small], b[small]
@@ -85,8 +87,9 @@ def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
     free = np.ones(N, dtype=bool)
     idx, ctr, h = np.arange(N), centers, np.asarray(half, dtype=np.float64)
     for depth in range(BOX_DEPTH + 1):
-        lo, _ = scene_distance(c, in_box(ctr, h)).range()
-        open_ = lo <= 0
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+            lo, _ = scene_distance(c, in_box(ctr, h)).range()
+        open_ = ~(lo > 0)                           # NaN (through a pole): unknown
         if depth == BOX_DEPTH:
             free[idx[open_]] = False
             break
@@ -112,12 +115,11 @@ class Counts:
 
 def count_errors(scene: Scene, image: Buffers, arithmetics=ARITHMETICS,
                  max_segments: int = MAX_SEGMENTS) -> Counts:
-    """Certified holes and false hits of a traced image (GPU or reference) of ``scene``.
-    A plain KRS or compound only: a MöKRS has no distance to enclose, and the twist and
-    empty zones are not in the oracle."""
-    if scene.mokrs is not None or {"twist", "empty_zones"} & set(scene.effects):
-        raise ValueError(f"{scene.name}: the oracle covers KRS scenes without twist or "
-                         "empty zones")
+    """Certified holes and false hits of a traced image (GPU or reference) of ``scene``: a
+    KRS, compound or MöKRS (the twist and empty zones are not in the oracle)."""
+    if {"twist", "empty_zones"} & set(scene.effects):
+        raise ValueError(f"{scene.name}: the oracle covers scenes without twist or empty "
+                         "zones")
     h, w = image.hit.shape
     view = view_of(scene.camera, w, h)
     c = compile_geometry(scene.geometry(), scene.material.albedo)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..reference.compiled import CompiledCompound, CompiledKRS
+from ..reference.mokrs import CompiledMoKRS
 from .numbers import Affine, Interval, Number
 
 Vec = tuple  # three Numbers
@@ -81,8 +82,48 @@ def krs_distance(c: CompiledKRS, x: Vec) -> Number:
     return d
 
 
-def scene_distance(c: CompiledKRS | CompiledCompound, x: Vec) -> Number:
-    """The least over a compound's components, as the tracer draws it."""
+def qmul(p, q):
+    """Quaternion product; each side four Numbers or four floats (real, i, j, k)."""
+    pw, px, py, pz = p
+    qw, qx, qy, qz = q
+    return (pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw)
+
+
+def mobius_apply(H, x: Vec) -> Vec:
+    """L_H(x) = (a q + b)(c q + d)⁻¹, q = (0, x) [KRS17 Eq. 1], as algebra/mobius.apply."""
+    q = (0.0, *x)
+    const = lambda v: tuple(float(c) for c in v)  # noqa: E731
+    num = tuple(u + float(v) for u, v in zip(qmul(const(H[0, 0]), q), H[0, 1]))
+    den = tuple(u + float(v) for u, v in zip(qmul(const(H[1, 0]), q), H[1, 1]))
+    r = (den[0].sqr() + den[1].sqr() + den[2].sqr() + den[3].sqr()).recip()
+    inv = (den[0] * r, -den[1] * r, -den[2] * r, -den[3] * r)
+    return qmul(num, inv)[1:]
+
+
+def mokrs_value(c: CompiledMoKRS, x: Vec) -> Number:
+    """What a MöKRS draws, as a sign: min_i k_i(x_i), x_i the point followed inwards through
+    H_i = G_i⁻¹ and folded to x ≤ 0 where the level reflects, as ISUNBOUNDING [KRS17 Alg. 3]
+    tests it. Not a distance (the maps scale lengths) but continuous where the maps are
+    defined (+∞ towards a pole), so its sign certifies surfaces and empty space alike."""
+    d = None
+    for i in range(c.n - 1, -1, -1):
+        x = mobius_apply(c.inverse[i], x)
+        if c.reflect[i]:
+            x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
+        k = kernel(c.types[i], c.records[i], x)
+        if k is not None:
+            d = k if d is None else d.minimum(k)
+    if d is None:
+        raise ValueError("a MöKRS without kernels")
+    return d
+
+
+def scene_distance(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:
+    """The least over a compound's components, as the tracer draws it (a MöKRS: the sign
+    function of :func:`mokrs_value`)."""
+    if isinstance(c, CompiledMoKRS):
+        return mokrs_value(c, x)
     parts = c.parts if isinstance(c, CompiledCompound) else (c,)
     d = krs_distance(parts[0], x)
     for part in parts[1:]:

@@ -82,6 +82,13 @@ class Interval:
     def relu(self):
         return Interval(np.maximum(self.lo, 0.0), np.maximum(self.hi, 0.0))
 
+    def recip(self):
+        """1/x; the whole line where the interval holds 0."""
+        safe = (self.lo > 0) | (self.hi < 0)
+        lo = np.where(safe, _down(1.0 / np.where(safe, self.hi, 1.0)), -np.inf)
+        hi = np.where(safe, _up(1.0 / np.where(safe, self.lo, 1.0)), np.inf)
+        return Interval(lo, hi)
+
     def minimum(self, o):
         o = Interval.lift(o)
         return Interval(np.minimum(self.lo, o.lo), np.minimum(self.hi, o.hi))
@@ -173,6 +180,20 @@ class Affine:
         ga, gb = np.sqrt(a) - alpha * a, np.sqrt(b) - alpha * b
         lo, hi = np.minimum(ga, gb), np.maximum(ga, gb)
         return self._linearised(alpha, 0.5 * (lo + hi), 0.5 * (hi - lo))
+
+    def recip(self):
+        """Min-range on a range [a, b] without 0: α = f′ at the end farther from 0, where |f′|
+        is least, so 1/x − αx is monotone on [a, b]; unbounded where the range holds 0."""
+        a, b = self.range()
+        safe = (a > 0) | (b < 0)
+        far = np.where(safe, np.where(a > 0, b, a), 1.0)     # the end with the smaller |f'|
+        near = np.where(safe, np.where(a > 0, a, b), 1.0)
+        alpha = -1.0 / (far * far)
+        g_far, g_near = 1.0 / far - alpha * far, 1.0 / near - alpha * near
+        lo, hi = np.minimum(g_far, g_near), np.maximum(g_far, g_near)
+        out = self._linearised(alpha, 0.5 * (lo + hi), 0.5 * (hi - lo))
+        return Affine(np.where(safe, out.x0, 0.0), np.where(safe, out.x1, 0.0),
+                      np.where(safe, out.e, np.inf))
 
     def relu(self):
         """Chebyshev: on a < 0 < b, max(0, x) − αx with α = b/(b − a) spans [0, −ab/(b − a)]."""
