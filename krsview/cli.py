@@ -212,10 +212,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
-def _bench_csv(args: argparse.Namespace) -> str | None:
+def check_bench_csv(args: argparse.Namespace) -> None:
+    """--csv is checked before the bench runs (the check_output_file rules)."""
     if args.csv:
         check_output_file(args.csv, "--csv", ".csv")
-    return args.csv
 
 
 def check_stability(name: str, size: tuple[int, int]) -> int:
@@ -274,7 +274,7 @@ def check_oracle(name: str, size: tuple[int, int]) -> int:
 def cmd_bench_levels(args: argparse.Namespace) -> int:
     from .bench.levels import bench_levels
     scene = _load(args)
-    _bench_csv(args)
+    check_bench_csv(args)
     bench_levels(scene, args.size, step=args.step, rounds=args.rounds, csv=args.csv)
     return 0
 
@@ -282,7 +282,7 @@ def cmd_bench_levels(args: argparse.Namespace) -> int:
 def cmd_bench_tracers(args: argparse.Namespace) -> int:
     from .bench.tracers import bench_tracers
     scene = _load(args)
-    _bench_csv(args)
+    check_bench_csv(args)
     bench_tracers(scene, args.size, rounds=args.rounds, sweep=not args.no_sweep,
                   csv=args.csv)
     return 0
@@ -291,7 +291,7 @@ def cmd_bench_tracers(args: argparse.Namespace) -> int:
 def cmd_bench_effects(args: argparse.Namespace) -> int:
     from .bench.effects import bench_effects
     scene = _load(args)
-    _bench_csv(args)
+    check_bench_csv(args)
     bench_effects(scene, args.size, rounds=args.rounds, csv=args.csv)
     return 0
 

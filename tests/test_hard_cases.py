@@ -168,3 +168,9 @@ def test_a_twisted_ground_plane_stays_a_plane(monkeypatch):
     monkeypatch.setattr(distortion.Distortion, "lod_scale", lambda self, p: np.ones(len(p)))
     rose = render_reference(twisted, 80, 45)
     assert (rose.hit & ~flat.hit).sum() > 100
+
+
+def test_control_on_chord_really_degenerates_to_a_capsule():
+    from krsview.reference.compiled import compile_krs
+    types = compile_krs(CASES["control-on-chord"].build().geometry(), (1.0, 1.0, 1.0)).types
+    assert types[-1] == "capsule" and types[-2] == "toroidal_capsule"

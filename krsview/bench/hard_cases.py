@@ -271,8 +271,3 @@ CASES: dict[str, HardCase] = {c.name: c for c in [
              "a branch with its control point on the chord is a straight capsule: "
              "GPU = reference"),
 ]}
-
-
-def case_names() -> list[str]:
-    return list(CASES)
-
