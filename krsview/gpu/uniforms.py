@@ -52,8 +52,8 @@ def slots(c: Compiled) -> int:
 
 
 def krs_block(c: Compiled, precision: str = "float") -> bytes:
-    """The std140 KRSBlock: mirrors (or Möbius records) then kernel records, as float32 or,
-    for ``precision = "double"`` (dvec4 arrays), float64."""
+    """The std140 KRSBlock: mirrors and culling balls (or Möbius records), then kernel
+    records, as float32 or, for ``precision = "double"`` (dvec4 arrays), float64."""
     n = slots(c)
     dtype = np.float64 if precision == "double" else np.float32
     if isinstance(c, CompiledMoKRS):
@@ -62,9 +62,11 @@ def krs_block(c: Compiled, precision: str = "float") -> bytes:
         head[:c.n, 4] = c.poles
         head[:c.n, 5] = c.bounds
     else:
-        head = np.zeros((n, 4), dtype=dtype)
+        head = np.zeros((2, n, 4), dtype=dtype)        # mirrors, then culling balls
+        head[1, :, 3] = -1.0
         for part, first in component_slots(c):
-            head[first:first + part.n] = part.mirrors
+            head[0, first:first + part.n] = part.mirrors
+            head[1, first:first + part.n] = part.bounds
     kernels = np.zeros((n, RECORD_VEC4, 4), dtype=dtype)
     kernels[:len(c.records)] = c.records
     return head.tobytes() + kernels.tobytes()

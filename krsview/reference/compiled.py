@@ -7,12 +7,13 @@ keeps the camera in float64 (DESIGN.md, Precision).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
-from ..scene import KRS, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
+from ..scene import KRS, Capsule, Empty, Kernel, Plane, Sphere, ToroidalCapsule, arc_of
 
 # Kernel type codes, equal to the KERNEL_* defines in kernels.glsl.
 KERNEL_CODES = {"empty": 0, "sphere": 1, "capsule": 2, "toroidal_capsule": 3, "plane": 4}
@@ -25,13 +26,79 @@ RECORD_VEC4 = 6
 # record[5] = arc (e2: unit, in-plane ⟂ e1, sin phi)
 
 
+CULL_MARGIN = 1e-6   # relative growth of the culling balls, against rounding
+
 # Record slots holding a position (xyz), per kernel type: what moves when the origin moves.
 POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1, 2, 3)}
+
+
+UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])   # a bound record for "no bounding ball"
+
+
+def kernel_ball(k: Kernel) -> np.ndarray | None:
+    """(centre, radius) of a ball holding the kernel; None for an unbounded plane or empty.
+    An arc of at most π stays within the rectangle of its chord c and sagitta h, so within
+    √((c/2)² + h²) of the chord's midpoint; a longer arc within R of its circle's centre."""
+    if isinstance(k, Sphere):
+        return np.array([*k.center, k.radius])
+    if isinstance(k, Capsule):
+        a, b = np.array(k.a), np.array(k.b)
+        return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
+    if isinstance(k, ToroidalCapsule):
+        arc = arc_of(k)
+        a, b = np.array(k.start), np.array(k.end)
+        if arc is None:
+            return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
+        if arc.phi > math.pi:
+            return np.array([*arc.center, arc.R + k.radius])
+        half = np.linalg.norm(b - a) / 2
+        sagitta = arc.R * (1 - math.cos(arc.phi / 2))
+        return np.array([*(a + b) / 2, math.hypot(half, sagitta) + k.radius])
+    return None
+
+
+def union_ball(p: np.ndarray | None, q: np.ndarray | None) -> np.ndarray | None:
+    """The smallest ball holding balls p and q (None: nothing)."""
+    if p is None or q is None:
+        return q if p is None else p
+    d = float(np.linalg.norm(q[:3] - p[:3]))
+    if d + q[3] <= p[3]:
+        return p
+    if d + p[3] <= q[3]:
+        return q
+    r = (d + p[3] + q[3]) / 2
+    return np.array([*(p[:3] + (r - p[3]) / d * (q[:3] - p[:3])), r])
+
+
+def krs_bounds(krs: KRS) -> np.ndarray:
+    """(n, 4): per mirror slot i, a ball C_i holding everything Alg. 1 still tests before
+    folding at level i — K_i and the levels below, doubled by R_i: C_i = S ∪ R_i(S),
+    S = ball(K_i) ∪ C_{i−1} (radius −1: unbounded, from a plane kernel on). A point x with
+    d ≤ dist(x, C_i) cannot lower d any more: the walk stops there with the same value
+    [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding."""
+    out, below = [], None
+    unbounded = False
+    for k, m in zip(krs.kernels, krs.mirrors):
+        ball = kernel_ball(k)
+        unbounded |= ball is None and not isinstance(k, Empty)
+        if not unbounded:
+            S = union_ball(below, ball)
+            if S is not None:
+                u, w = np.array(m.normal), m.offset
+                mirrored = np.array([*(S[:3] - 2.0 * (S[:3] @ u - w) * u), S[3]])
+                below = union_ball(S, mirrored)
+        if unbounded or below is None:
+            out.append(UNBOUNDED)
+        else:
+            out.append(np.array([*below[:3], below[3] * (1 + CULL_MARGIN)
+                                 + CULL_MARGIN * float(np.abs(below[:3]).max())]))
+    return np.array(out, dtype=np.float64).reshape(-1, 4)
 
 
 @dataclass(frozen=True)
 class CompiledKRS:
     mirrors: np.ndarray   # (n, 4): u.xyz, w  (the plane u·x = w)
+    bounds: np.ndarray    # (n, 4): krs_bounds, the culling ball before fold i (r < 0: none)
     records: np.ndarray   # (n+1, RECORD_VEC4, 4) float64
     types: tuple[str, ...]  # kernel type per level (after arc → capsule degeneration)
 
@@ -51,7 +118,9 @@ class CompiledKRS:
                 records[i, slot, :3] -= o
             if kind == "plane":
                 records[i, 1, 3] -= records[i, 1, :3] @ o
-        return CompiledKRS(mirrors, records, self.types)
+        bounds = self.bounds.copy()
+        bounds[:, :3] -= np.where(bounds[:, 3:] >= 0, o, 0.0)
+        return CompiledKRS(mirrors, bounds, records, self.types)
 
 
 def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
@@ -59,7 +128,7 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
     mirrors = np.array([[*m.normal, m.offset] for m in krs.mirrors],
                        dtype=np.float64).reshape(-1, 4)
     records, types = kernel_records(krs.kernels, albedo)
-    return CompiledKRS(mirrors, records, types)
+    return CompiledKRS(mirrors, krs_bounds(krs), records, types)
 
 
 def kernel_records(kernels: list, albedo: tuple[float, float, float]

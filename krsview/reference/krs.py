@@ -19,14 +19,20 @@ def fold(m: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.where((e > 0.0)[:, None], x - 2.0 * e[:, None] * m[:3], x), e
 
 
-def distance(c: CompiledKRS, xw: np.ndarray) -> np.ndarray:
-    """DISTANCE(x_w) [KRS17 Alg. 1] for points (N, 3)."""
+def distance(c: CompiledKRS, xw: np.ndarray, cull: bool = True) -> np.ndarray:
+    """DISTANCE(x_w) [KRS17 Alg. 1] for points (N, 3). With ``cull``, a point stops walking
+    at level i once d ≤ dist(x, C_i), the ball of all it would still test (compiled.py,
+    krs_bounds): the value is the same, the shader saves the levels below."""
     x = xw
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
+    live = np.ones(len(x), dtype=bool)
     for i in range(c.n - 1, -1, -1):
+        b = c.bounds[i]
+        if cull and b[3] >= 0:
+            live &= np.linalg.norm(x - b[:3], axis=1) - b[3] < d
         x, _ = fold(c.mirrors[i], x)
         if c.types[i] != "empty":
-            d = np.minimum(d, kernel_distance(c.types[i], c.records[i], x))
+            d = np.where(live, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
     return d
 
 

@@ -10,54 +10,15 @@ inside that ball.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..scene import MoKRS
-from ..scene.model import Capsule, Empty, Kernel, Sphere, ToroidalCapsule, arc_of
+from ..scene.model import Empty
 from ..algebra import mobius
-from .compiled import kernel_records
+from .compiled import UNBOUNDED, kernel_ball, kernel_records, union_ball
 from .kernels import kernel_distance, world_normal
-
-
-UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])   # a bound record for "no bounding ball"
-
-
-def kernel_ball(k: Kernel) -> np.ndarray | None:
-    """(centre, radius) of a ball holding the kernel; None for an unbounded plane or empty.
-    An arc of at most π stays within the rectangle of its chord c and sagitta h, so within
-    √((c/2)² + h²) of the chord's midpoint; a longer arc within R of its circle's centre."""
-    if isinstance(k, Sphere):
-        return np.array([*k.center, k.radius])
-    if isinstance(k, Capsule):
-        a, b = np.array(k.a), np.array(k.b)
-        return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
-    if isinstance(k, ToroidalCapsule):
-        arc = arc_of(k)
-        a, b = np.array(k.start), np.array(k.end)
-        if arc is None:
-            return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
-        if arc.phi > math.pi:
-            return np.array([*arc.center, arc.R + k.radius])
-        half = np.linalg.norm(b - a) / 2
-        sagitta = arc.R * (1 - math.cos(arc.phi / 2))
-        return np.array([*(a + b) / 2, math.hypot(half, sagitta) + k.radius])
-    return None
-
-
-def union_ball(p: np.ndarray | None, q: np.ndarray | None) -> np.ndarray | None:
-    """The smallest ball holding balls p and q (None: nothing)."""
-    if p is None or q is None:
-        return q if p is None else p
-    d = float(np.linalg.norm(q[:3] - p[:3]))
-    if d + q[3] <= p[3]:
-        return p
-    if d + p[3] <= q[3]:
-        return q
-    r = (d + p[3] + q[3]) / 2
-    return np.array([*(p[:3] + (r - p[3]) / d * (q[:3] - p[:3])), r])
 
 
 def level_bounds(m: MoKRS) -> np.ndarray:

@@ -11,10 +11,15 @@ real fold(int i, inout vec3r p) {
 }
 
 // The KRS whose kernels K_0..K_n and mirrors R_0..R_{n−1} sit in slots first..first + n.
+// Exact level culling [issue 17]: once d ≤ dist(x, C_i), the ball of everything levels i..0
+// would still test (reference/compiled.py, krs_bounds; r < 0: none), the walk stops with the
+// same value. Most rays far from the finer levels pay for a few levels instead of n.
 real krs_distance(int first, int n, vec3r xw) {
     vec3r x = xw;
     real d = kernel_distance(first + n, x);
     for (int i = first + n - 1; i >= first; --i) {
+        vec4r b = u_bounds[i];
+        if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
         fold(i, x);
         d = min(d, kernel_distance(i, x));
     }

@@ -37,6 +37,7 @@ layout(std140) uniform KRSBlock {
     vec4r u_mobius[KRS_SLOTS * MOBIUS_RECORD];   // per level: H_i = G_i⁻¹ (mobius.glsl)
 #else
     vec4r u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
+    vec4r u_bounds[KRS_SLOTS];                   // culling ball before fold i (krs.glsl)
 #endif
     vec4r u_kernels[KRS_SLOTS * KRS_RECORD];     // per level: KRS_RECORD vec4s
 };

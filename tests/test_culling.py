@@ -1,0 +1,77 @@
+"""Exact level culling [issue 17 §1]: the walk of Alg. 1 stops once d ≤ dist(x, C_i), the
+ball of everything levels i..0 still test; the distance is the same as the full walk's."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from krsview.presets import resolve
+from krsview.reference import krs
+from krsview.reference.compiled import compile_krs, krs_bounds
+from krsview.scene import load_scene
+
+
+def points(scene, n=3000, seed=0):
+    rng = np.random.default_rng(seed)
+    c = np.array(scene.camera.target)
+    return c + rng.normal(size=(n, 3)) * np.linalg.norm(np.subtract(scene.camera.position, c)) / 3
+
+
+@pytest.mark.parametrize("name", ["tree", "sierpinski", "grass", "rock", "bent-tree"])
+def test_culled_distance_equals_the_full_walk(name):
+    scene = load_scene(resolve(name))
+    c = compile_krs(scene.geometry(), (1.0, 1.0, 1.0))
+    x = points(scene)
+    full, culled = krs.distance(c, x, cull=False), krs.distance(c, x, cull=True)
+    assert np.array_equal(full, culled)
+
+
+def test_every_culling_ball_holds_what_it_claims():
+    """C_i holds the expansion of levels ≤ i: brute force over every copy of every kernel's
+    bounding ball (kernel_ball, tested against sampled arcs in test_mokrs) under the
+    reflection products R_i^b_i ⋯ R_j^b_j, on a 12-level tree and the rock."""
+    from krsview.reference.compiled import kernel_ball
+    for name, levels in (("tree", 12), ("rock", None)):
+        g = load_scene(resolve(name)).geometry()
+        g = g.truncated(levels) if levels else g
+        bounds = krs_bounds(g)
+        balls = np.zeros((0, 4))
+        for i in range(g.n):
+            b = kernel_ball(g.kernels[i])
+            if b is not None:
+                balls = np.vstack([balls, b])
+            u, w = np.array(g.mirrors[i].normal), g.mirrors[i].offset
+            mirrored = balls.copy()
+            mirrored[:, :3] -= 2.0 * (balls[:, :3] @ u - w)[:, None] * u
+            balls = np.vstack([balls, mirrored])
+            c = bounds[i]
+            reach = np.linalg.norm(balls[:, :3] - c[:3], axis=1) + balls[:, 3]
+            assert reach.max() <= c[3], (name, i)
+            assert reach.max() > 0.5 * c[3], (name, i)     # and not absurdly large
+
+
+def test_a_ball_one_kernel_too_small_changes_the_distance():
+    """Negative control: leaving K_i out of C_i (a ball one kernel too small) culls walks
+    that still had a smaller value: the distance differs from the full walk somewhere."""
+    scene = load_scene(resolve("tree"))
+    c = compile_krs(scene.geometry(), (1.0, 1.0, 1.0))
+    shrunk = c.bounds.copy()
+    shrunk[:, 3] *= 0.5
+    broken = replace(c, bounds=shrunk)
+    x = points(scene)
+    assert not np.array_equal(krs.distance(c, x, cull=False), krs.distance(broken, x))
+
+
+def test_culling_walks_fewer_levels_far_from_the_tree():
+    scene = load_scene(resolve("tree"))
+    c = compile_krs(scene.geometry(), (1.0, 1.0, 1.0))
+    x = points(scene)
+    walked = np.zeros(len(x))
+    d = krs.distance(c, x, cull=False)
+    for i in range(c.n - 1, -1, -1):
+        b = c.bounds[i]
+        live = np.linalg.norm(x - b[:3], axis=1) - b[3] < d
+        walked += live
+    assert walked.mean() < 0.8 * c.n
