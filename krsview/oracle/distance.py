@@ -70,16 +70,24 @@ def kernel(kind: str, rec, p: Vec) -> Number | None:
     return ring.select(yes, no, cap) - r
 
 
-def krs_distance(c: CompiledKRS, x: Vec) -> Number:
-    d = kernel(c.types[c.n], c.records[c.n], x)
-    for i in range(c.n - 1, -1, -1):
-        x = fold(c.mirrors[i], x)
-        k = kernel(c.types[i], c.records[i], x)
+def least(values) -> Number:
+    """The minimum of the kernels' values, empty kernels (None) left out."""
+    d = None
+    for k in values:
         if k is not None:
             d = k if d is None else d.minimum(k)
     if d is None:
-        raise ValueError("a KRS without kernels")
+        raise ValueError("a scene without kernels")
     return d
+
+
+def krs_distance(c: CompiledKRS, x: Vec) -> Number:
+    def walk(x):
+        yield kernel(c.types[c.n], c.records[c.n], x)
+        for i in range(c.n - 1, -1, -1):
+            x = fold(c.mirrors[i], x)
+            yield kernel(c.types[i], c.records[i], x)
+    return least(walk(x))
 
 
 def qmul(p, q):
@@ -106,17 +114,13 @@ def mokrs_value(c: CompiledMoKRS, x: Vec) -> Number:
     H_i = G_i⁻¹ and folded to x ≤ 0 where the level reflects, as ISUNBOUNDING [KRS17 Alg. 3]
     tests it. Not a distance (the maps scale lengths) but continuous where the maps are
     defined (+∞ towards a pole), so its sign certifies surfaces and empty space alike."""
-    d = None
-    for i in range(c.n - 1, -1, -1):
-        x = mobius_apply(c.inverse[i], x)
-        if c.reflect[i]:
-            x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
-        k = kernel(c.types[i], c.records[i], x)
-        if k is not None:
-            d = k if d is None else d.minimum(k)
-    if d is None:
-        raise ValueError("a MöKRS without kernels")
-    return d
+    def walk(x):
+        for i in range(c.n - 1, -1, -1):
+            x = mobius_apply(c.inverse[i], x)
+            if c.reflect[i]:
+                x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
+            yield kernel(c.types[i], c.records[i], x)
+    return least(walk(x))
 
 
 def scene_distance(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:
