@@ -260,14 +260,14 @@ def check_oracle(name: str, size: tuple[int, int]) -> int:
                          "zones (their distortions are not in it)")
     r = Renderer()
     print(f"| {scene.name} {size[0]}×{size[1]} | rays | hits | holes | false hits beyond ε | "
-          "undecided | affine: segments, s | interval: segments, s |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+          "below LOD | undecided | affine: segments, s | interval: segments, s |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for tracer in ("binary",) if scene.mokrs is not None else ("sphere", "binary"):
         traced = replace(scene, render=replace(scene.render, tracer=tracer))
         c = count_errors(traced, r.render(traced, *size))
         (sa, ta), (si, ti) = c.work["affine"], c.work["interval"]
         print(f"| {tracer} | {c.rays} | {c.hits} | {c.holes} | {c.false_hits} | "
-              f"{c.undecided} | {sa:,}, {ta:.1f} | {si:,}, {ti:.1f} |", flush=True)
+              f"{c.below_lod} | {c.undecided} | {sa:,}, {ta:.1f} | {si:,}, {ti:.1f} |", flush=True)
     return 0
 
 

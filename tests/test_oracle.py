@@ -3,12 +3,14 @@ python-flint's arb balls (an independent arbitrary-precision evaluation of Alg. 
 certifies the holes and false hits it is built to find."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from flint import arb, ctx
 
 from krsview.oracle.certify import count_errors, free_boxes, surfaces_before
-from krsview.oracle.distance import on_segments, scene_distance
+from krsview.oracle.distance import on_segments, value
 from krsview.presets import resolve
 from krsview.reference.geometry import compile_geometry
 from krsview.scene import load_scene
@@ -60,6 +62,9 @@ def akernel(kind, rec, p):
 
 
 def arb_distance(c, point):
+    if hasattr(c, "parts"):          # a compound: the least over its components
+        ds = [arb_distance(part, point) for part in c.parts]
+        return functools.reduce(lambda d, k: (d + k - abs(d - k)) / 2, ds)
     x = [arb(float(v)) for v in point]
     d = akernel(c.types[c.n], c.records[c.n], x)
     for i in range(c.n - 1, -1, -1):
@@ -114,7 +119,7 @@ def segments(scene_name, n, length, seed):
 def enclosures_contain_arb(c, origin, starts, dirs, a, b, arithmetic, samples=4, narrow=False):
     """Count samples t in [a, b] whose arb value is not inside the segment's enclosure."""
     pts = origin + starts
-    d = scene_distance(c, on_segments(pts, dirs, a, b, arithmetic))
+    d = value(c, on_segments(pts, dirs, a, b, arithmetic))
     lo, hi = d.range()
     if narrow:            # negative control: the affine form without its error term
         lo, hi = d.x0 - np.abs(d.x1), d.x0 + np.abs(d.x1)
@@ -145,7 +150,7 @@ def test_mokrs_enclosures_contain_the_arb_value(scene_name, arithmetic):
     intervals and affine forms contain the arb value of min_i k_i(x_i)."""
     c, origin, starts, dirs, a, b = segments(scene_name, 6, 0.05, seed=4)
     with np.errstate(all="ignore"):
-        lo, hi = scene_distance(c, on_segments(origin + starts, dirs, a, b, arithmetic)).range()
+        lo, hi = value(c, on_segments(origin + starts, dirs, a, b, arithmetic)).range()
         assert np.isfinite(lo).all() and np.isfinite(hi).all()   # not vacuously wide
         assert enclosures_contain_arb(c, origin, starts, dirs, a, b, arithmetic, samples=3) == 0
 
@@ -163,7 +168,7 @@ def test_affine_forms_avoid_the_wrapping_that_widens_intervals():
     c, origin, starts, dirs, a, b = segments("tree", 100, 1e-3, seed=3)
     widths = {}
     for arithmetic in ("interval", "affine"):
-        lo, hi = scene_distance(c, on_segments(origin + starts, dirs, a, b, arithmetic)).range()
+        lo, hi = value(c, on_segments(origin + starts, dirs, a, b, arithmetic)).range()
         widths[arithmetic] = np.median((hi - lo) / b)
     assert widths["affine"] < 2.0 < 100.0 < widths["interval"]
 
@@ -177,7 +182,7 @@ def test_a_certified_surface_and_certified_empty_space():
     eye = center + np.array([0.0, 0.0, -5.0])
     dirs = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
     for arithmetic in ("interval", "affine"):
-        cert = surfaces_before(c, eye, dirs, np.array([10.0, 10.0]), np.array([1e-3, 1e-3]),
+        cert = surfaces_before(c, eye, dirs, np.array([10.0, 10.0]), 4e-4,
                                arithmetic, max_segments=4000)
         assert list(cert.surface) == [1, 0], arithmetic
 
@@ -209,3 +214,93 @@ def test_counts_on_a_traced_image(renderer):
     broken = Buffers(img.color, fake_t, img.normal, img.iterations, ~img.hit)
     counts = count_errors(s, broken)
     assert counts.holes > 0 and counts.false_hits > 0
+
+
+# --------------------------------------------------- the levels' balls and the level of detail
+def signs_hold(c, origin, starts, dirs, a, b, arithmetic, lod, samples=3, numeric=True):
+    """Count samples whose arb value breaks what the walk with balls certifies: v ≥ lower
+    (only its sign for a MöKRS, whose balls live in scaled frames) and v ≤ hi."""
+    from krsview.oracle.distance import bounds
+    from krsview.reference.mokrs import CompiledMoKRS
+    pts = origin + starts
+    with np.errstate(all="ignore"):
+        e = bounds(c, on_segments(pts, dirs, a, b, arithmetic), lod)
+    exact = arb_mokrs if isinstance(c, CompiledMoKRS) else arb_distance
+    broken = 0
+    for i in range(len(dirs)):
+        for t in np.linspace(a[i], b[i], samples):
+            v = exact(c, pts[i] + t * dirs[i])
+            low = arb(float(e.lower[i])) if numeric else (arb(0) if e.lower[i] > 0 else None)
+            if (low is not None and np.isfinite(e.lower[i]) and not low <= v) or \
+                    (np.isfinite(e.hi[i]) and not v <= arb(float(e.hi[i]))):
+                broken += 1
+    return broken, e
+
+
+@pytest.mark.parametrize("scene_name", ["tree", "grove", "grass"])
+def test_balls_bound_what_the_levels_below_them_hold(scene_name):
+    """The walk with balls: v ≥ min(kernels walked, clear balls, balls cut at the level of
+    detail) and v ≤ the kernels walked (a subset of the scene), at arb values along segments
+    long enough that many walks end at a ball."""
+    c, origin, starts, dirs, a, b = segments(scene_name, 16, 0.4, seed=5)
+    starts *= 2.0                              # reach out of the crown too
+    broken, e = signs_hold(c, origin, starts, dirs, a, b, "affine", lod=b - a)
+    assert broken == 0
+    assert np.isfinite(e.cut).any() and (e.lower > 0).any()   # both kinds of ball were used
+
+
+@pytest.mark.parametrize("scene_name, reach", [("palm", 4), ("inversion", 60),
+                                               ("tree-mokrs", 4)])
+def test_mokrs_balls_keep_the_sign(scene_name, reach):
+    """A MöKRS's level bounds, mapped out past each level's pole: where the walk certifies
+    a sign, the arb value has it."""
+    c, origin, starts, dirs, a, b = segments(scene_name, 10, 0.3, seed=6)
+    starts *= reach                            # out of the geometry too
+    broken, e = signs_hold(c, origin, starts, dirs, a, b, "interval", lod=b - a,
+                           numeric=False)
+    assert broken == 0 and (e.lower > 0).any()
+
+
+def test_a_ball_too_small_breaks_the_bound():
+    """Negative control: the tree's culling balls at half their radius claim clear space
+    (or a bound) where the levels below them reach lower."""
+    from dataclasses import replace
+    c, origin, starts, dirs, a, b = segments("tree", 16, 0.4, seed=5)
+    starts *= 2.0
+    shrunk = c.bounds.copy()
+    shrunk[:, 3] = np.where(shrunk[:, 3] >= 0, shrunk[:, 3] / 2, shrunk[:, 3])
+    broken, _ = signs_hold(replace(c, bounds=shrunk), origin, starts, dirs, a, b, "affine",
+                           lod=b - a)
+    assert broken > 0
+
+
+def test_the_level_of_detail_decides_a_full_depth_tree(renderer):
+    """At full depth (22 levels, twigs a thousandth of a pixel) the exact walk leaves every
+    ray undecided; leaving out detail below a quarter pixel decides them, with no hole and
+    no false hit beyond ε. Negative control: the image with its hit mask inverted has both."""
+    from krsview.buffers import Buffers
+    s = load_scene(resolve("tree"))
+    img = renderer.render(s, 16, 9)
+    counts = count_errors(s, img, arithmetics=("affine",))
+    assert (counts.holes, counts.false_hits) == (0, 0), counts
+    assert counts.undecided <= 0.02 * counts.rays and counts.hits > 20, counts
+    broken = Buffers(img.color, np.where(img.hit, 0.0, 60.0), img.normal, img.iterations,
+                     ~img.hit)
+    counts = count_errors(s, broken, arithmetics=("affine",))
+    assert counts.holes > 0 and counts.false_hits > 0, counts
+
+
+def test_a_ray_through_a_pole_is_decided():
+    """In `inversion` a ray through the pole of its outer level: the enclosure of H(x) is
+    unbounded there, but the level's bound mapped out by H⁻¹ lies clear of the pole, so the
+    ray is certified (before: undecided, NaN)."""
+    from krsview.bench.hard_cases import CASES
+    from krsview.reference.camera import primary_rays, view_of
+    s = CASES["mobius-pole-in-view"].build()
+    c = compile_geometry(s.geometry(), s.material.albedo)
+    view = view_of(s.camera, 9, 9)
+    dirs = primary_rays(view)[40:41]                       # the centre ray, at the pole
+    for arithmetic in ("interval", "affine"):
+        cert = surfaces_before(c, view.origin, dirs, np.array([s.render.max_distance]),
+                               view.footprint, arithmetic)
+        assert list(cert.surface) == [0], arithmetic

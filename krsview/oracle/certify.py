@@ -8,8 +8,16 @@ rays a tracer got wrong:
 - **false hit beyond ε**: the box of half-size ε(t_hit) around the tracer's hit point is
   certified free of the surface (boxes subdivided up to BOX_DEPTH times): the tracer stopped
   where nothing lies within ε;
+- **below the level of detail**: no surface on [0, T] except, perhaps, inside balls of
+  radius ≤ δ (a quarter pixel) that hold whole subtrees the walk left out: the ray passes
+  sub-pixel detail, which a tracer whose ε grows with the pixel may hit or pass;
 - **undecided**: the budget ran out, or a segment of size δ touches 0 without a certified
   crossing (tangent rays): counted, never guessed.
+
+A segment is walked with the levels' balls (``distance.bounds``): a ball it clears ends the
+walk (culling), and a ball no larger than LOD_BALL × the segment stands for its levels, so a
+long segment costs a few levels and only short ones near the geometry walk deep — the
+level-of-detail oracle that decides trees at full depth.
 """
 from __future__ import annotations
 
@@ -22,61 +30,83 @@ from ..buffers import Buffers
 from ..reference.camera import primary_rays, view_of
 from ..reference.geometry import compile_geometry
 from ..scene import Scene
-from .distance import in_box, on_segments, scene_distance
+from .distance import Bounds, bounds, in_box, on_segments
 
 DELTA_PIXELS = 0.25        # a crossing is certified within a quarter pixel footprint
 REFINE = 1024              # a segment δ/REFINE long that touches 0 without a crossing: undecided
 MAX_SEGMENTS = 500         # per ray: past this the ray is undecided
 BOX_DEPTH = 3              # octree subdivisions of an ε-box (up to 8³ boxes)
+LOD_BALL = 1.0             # a segment walks no level whose ball is ≤ this × its length
+SURFACE, NONE, UNDECIDED, BELOW_LOD = 1, 0, -1, 2   # per-ray outcomes
+DECIDED = np.array([0, 2, 3, 1])   # at outcome + 1: undecided < below LOD < none < surface
 ARITHMETICS = ("affine", "interval")
 
 
 @dataclass
 class Certified:
-    """Per ray: +1 a surface certified on [0, T], 0 certified none there, −1 undecided; and
-    the work it took."""
+    """Per ray: SURFACE certified on [0, T], NONE certified there, BELOW_LOD (none but
+    perhaps sub-pixel detail), UNDECIDED; and the work it took."""
     surface: np.ndarray
     segments: int = 0        # enclosures evaluated (subdivisions + 1 per ray)
     seconds: float = 0.0
 
 
-def enclosure(c, origin, dirs, a, b, arithmetic: str) -> tuple[np.ndarray, np.ndarray]:
-    """Bounds of the distance over the segments; NaN (∞ · 0 near a pole) means unknown."""
+def enclosure(c, origin, dirs, a, b, arithmetic: str, lod: bool = False) -> Bounds:
+    """Bounds of the value over the segments (with ``lod``, detail below LOD_BALL × their
+    length left out); NaN (∞ · 0 near a pole) means unknown."""
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        return scene_distance(c, on_segments(origin, dirs, a, b, arithmetic)).range()
+        return bounds(c, on_segments(origin, dirs, a, b, arithmetic),
+                      LOD_BALL * (b - a) if lod else None)
 
 
-def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, delta: np.ndarray,
-                    arithmetic: str, max_segments: int = MAX_SEGMENTS) -> Certified:
-    """For each ray (dirs (N, 3)), whether a surface is certified on [0, T]; δ per ray is the
-    segment size at which a crossing is looked for."""
+def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, footprint: float,
+                    arithmetic: str, max_segments: int = MAX_SEGMENTS,
+                    lod: bool = True) -> Certified:
+    """For each ray (dirs (N, 3)), whether a surface is certified on [0, T]. ``footprint``
+    is a pixel's angle: a segment ending at t is small at δ = DELTA_PIXELS × footprint × t,
+    where a crossing is looked for and left-out detail is accepted as below the level of
+    detail. Rays found below it are then walked without leaving detail out (``lod`` False),
+    within the same budget, which may still certify a surface or none."""
     t0 = time.perf_counter()
     N = len(dirs)
-    surface = np.zeros(N, dtype=np.int64)
+    surface = np.full(N, NONE)
+    below_lod = np.zeros(N, dtype=bool)
     budget = np.full(N, max_segments)
     ray, a, b = np.arange(N), np.zeros(N), np.asarray(T, dtype=np.float64).copy()
     total = 0
     while ray.size:
-        lo, _ = enclosure(c, origin, dirs[ray], a, b, arithmetic)
+        e = enclosure(c, origin, dirs[ray], a, b, arithmetic, lod)
         total += ray.size
         np.subtract.at(budget, ray, 1)
-        live = ~(lo > 0) & (surface[ray] == 0)     # may hold a surface (NaN: unknown)
-        small = live & (b - a <= delta[ray])
+        live = ~(e.lower > 0) & (surface[ray] == NONE)   # may hold a surface (NaN: unknown)
+        delta = DELTA_PIXELS * footprint * b     # a quarter pixel where the segment ends
+        small = live & (b - a <= delta)
+        detail = small & (e.lo > 0)          # only a left-out ball reaches 0: sub-pixel detail
+        below_lod[ray[detail]] = True
+        small &= ~detail
+        live &= ~detail
         if small.any():
             r, sa, sb = ray[small], a[small], b[small]
             pa = enclosure(c, origin, dirs[r], sa, sa, "interval")
             pb = enclosure(c, origin, dirs[r], sb, sb, "interval")
-            crossing = ((pa[0] > 0) & (pb[1] < 0)) | (pa[1] < 0)   # or already inside
-            surface[r[crossing]] = 1
-            tiny = ~crossing & (sb - sa <= delta[r] / REFINE)       # touches 0: give up
-            surface[r[tiny]] = np.where(surface[r[tiny]] == 0, -1, surface[r[tiny]])
-        split = live & (surface[ray] == 0)
+            crossing = ((pa.lower > 0) & (pb.hi < 0)) | (pa.hi < 0)   # or already inside
+            surface[r[crossing]] = SURFACE
+            tiny = ~crossing & (sb - sa <= delta[small] / REFINE)       # touches 0: give up
+            surface[r[tiny]] = np.where(surface[r[tiny]] == NONE, UNDECIDED, surface[r[tiny]])
+        split = live & (surface[ray] == NONE)
         out = budget[ray] <= 0
-        surface[ray[split & out & (surface[ray] == 0)]] = -1
+        surface[ray[split & out & (surface[ray] == NONE)]] = UNDECIDED
         split &= ~out
         mid = 0.5 * (a[split] + b[split])
         ray = np.concatenate([ray[split], ray[split]])
         a, b = np.concatenate([a[split], mid]), np.concatenate([mid, b[split]])
+    surface[(surface == NONE) & below_lod] = BELOW_LOD
+    again = np.nonzero(surface == BELOW_LOD)[0]
+    if lod and again.size:
+        exact = surfaces_before(c, origin, dirs[again], T[again], footprint, arithmetic,
+                                max_segments, lod=False)
+        surface[again] = np.where(exact.surface == UNDECIDED, BELOW_LOD, exact.surface)
+        total += exact.segments
     return Certified(surface, total, time.perf_counter() - t0)
 
 
@@ -88,8 +118,8 @@ def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
     idx, ctr, h = np.arange(N), centers, np.asarray(half, dtype=np.float64)
     for depth in range(BOX_DEPTH + 1):
         with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-            lo, _ = scene_distance(c, in_box(ctr, h)).range()
-        open_ = ~(lo > 0)                           # NaN (through a pole): unknown
+            lower = bounds(c, in_box(ctr, h)).lower
+        open_ = ~(lower > 0)                           # NaN (through a pole): unknown
         if depth == BOX_DEPTH:
             free[idx[open_]] = False
             break
@@ -109,6 +139,7 @@ class Counts:
     hits: int
     holes: int
     false_hits: int
+    below_lod: int
     undecided: int
     work: dict = field(default_factory=dict)    # arithmetic → (segments, seconds)
 
@@ -129,16 +160,14 @@ def count_errors(scene: Scene, image: Buffers, arithmetics=ARITHMETICS,
     capped = (image.iterations.ravel() >= scene.render.max_iterations) & ~hit
     T = np.where(hit, t - eps, scene.render.max_distance)
     check = ~capped & (T > 0)
-    delta = DELTA_PIXELS * view.footprint * np.maximum(T, 1e-12)
     work, surface = {}, None
-    for arithmetic in arithmetics:   # both are sound: a ray either decides counts
-        cert = surfaces_before(c, view.origin, dirs[check], T[check], delta[check], arithmetic,
+    for arithmetic in arithmetics:   # both are sound: the more decided answer counts
+        cert = surfaces_before(c, view.origin, dirs[check], T[check], view.footprint, arithmetic,
                                max_segments)
         work[arithmetic] = (cert.segments, cert.seconds)
-        surface = cert.surface if surface is None else np.where(surface == -1, cert.surface,
-                                                                 surface)
-    holes = int((surface == 1).sum())
-    undecided = int((surface == -1).sum())
+        surface = cert.surface if surface is None else np.where(
+            DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
     centres = view.origin + t[hit, None] * dirs[hit]
     false_hits = int(free_boxes(c, centres, eps[hit]).sum())
-    return Counts(len(hit), int(hit.sum()), holes, false_hits, undecided, work)
+    return Counts(len(hit), int(hit.sum()), int((surface == SURFACE).sum()), false_hits,
+                  int((surface == BELOW_LOD).sum()), int((surface == UNDECIDED).sum()), work)

@@ -6,9 +6,12 @@ range cannot decide it. The result encloses the real-number value of the distanc
 approximates, on the compiled scene's exact float64 constants."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ..reference.compiled import CompiledCompound, CompiledKRS
+from ..algebra import mobius
+from ..reference.compiled import CULL_MARGIN, CompiledCompound, CompiledKRS
 from ..reference.mokrs import CompiledMoKRS
 from .numbers import Affine, Interval, Number
 
@@ -81,15 +84,6 @@ def least(values) -> Number:
     return d
 
 
-def krs_distance(c: CompiledKRS, x: Vec) -> Number:
-    def walk(x):
-        yield kernel(c.types[c.n], c.records[c.n], x)
-        for i in range(c.n - 1, -1, -1):
-            x = fold(c.mirrors[i], x)
-            yield kernel(c.types[i], c.records[i], x)
-    return least(walk(x))
-
-
 def qmul(p, q):
     """Quaternion product; each side four Numbers or four floats (real, i, j, k)."""
     pw, px, py, pz = p
@@ -109,30 +103,114 @@ def mobius_apply(H, x: Vec) -> Vec:
     return qmul(num, inv)[1:]
 
 
-def mokrs_value(c: CompiledMoKRS, x: Vec) -> Number:
-    """What a MöKRS draws, as a sign: min_i k_i(x_i), x_i the point followed inwards through
-    H_i = G_i⁻¹ and folded to x ≤ 0 where the level reflects, as ISUNBOUNDING [KRS17 Alg. 3]
-    tests it. Not a distance (the maps scale lengths) but continuous where the maps are
-    defined (+∞ towards a pole), so its sign certifies surfaces and empty space alike."""
-    def walk(x):
-        for i in range(c.n - 1, -1, -1):
-            x = mobius_apply(c.inverse[i], x)
-            if c.reflect[i]:
-                x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
-            yield kernel(c.types[i], c.records[i], x)
-    return least(walk(x))
+def steps(c: CompiledKRS | CompiledMoKRS):
+    """The walk as (ball, size, move, kind, record) per kernel, outermost first: ``move``
+    takes the point into the kernel's frame; ``ball`` (centre, radius, in the frame before
+    ``move``; None: no bound) holds everything this and the later steps test; ``size`` is
+    its radius in world lengths (∞ where the frame's scale varies).
 
-
-def scene_distance(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:
-    """The least over a compound's components, as the tracer draws it (a MöKRS: the sign
-    function of :func:`mokrs_value`)."""
+    KRS [KRS17 Alg. 1]: the top kernel, then per level i a fold and k_i; the ball is the
+    culling ball C_i (``reference/compiled.krs_bounds``). MöKRS [KRS17 Alg. 3]: per level
+    x ← H_i(x), folded to x ≤ 0 where it reflects, then k_i; the ball is the level's bound
+    mapped out by G_i = H_i⁻¹, so it is tested before H_i, where a pole of H_i is not."""
     if isinstance(c, CompiledMoKRS):
-        return mokrs_value(c, x)
+        scale = 1.0          # world length per unit of the current frame, while similarities
+        for i in range(c.n - 1, -1, -1):
+            ball = outer_ball(c, i)
+            move = lambda x, H=c.inverse[i], r=c.reflect[i]: inwards(H, r, x)  # noqa: E731
+            yield ball, np.inf if ball is None else ball[3] * scale, move, c.types[i], \
+                c.records[i]
+            G = mobius.inverse(c.inverse[i])
+            scale = np.inf if mobius.pole(G) is not None else scale * mobius.affine_scale(G)
+        return
+    yield None, np.inf, lambda x: x, c.types[c.n], c.records[c.n]
+    for i in range(c.n - 1, -1, -1):
+        ball = c.bounds[i] if c.bounds[i, 3] >= 0 else None
+        yield ball, np.inf if ball is None else ball[3], lambda x, m=c.mirrors[i]: fold(m, x), \
+            c.types[i], c.records[i]
+
+
+def inwards(H, reflect: bool, x: Vec) -> Vec:
+    """One MöKRS level inwards: x ← H(x), then −|x| where the level reflects."""
+    x = mobius_apply(H, x)
+    if reflect:
+        x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
+    return x
+
+
+def outer_ball(c: CompiledMoKRS, i: int) -> np.ndarray | None:
+    """Level i's bound mapped into the space before H_i (by G_i = H_i⁻¹), widened by
+    CULL_MARGIN against the rounding of the float64 map; None where unbounded or where the
+    bound holds G_i's pole (its image is not a ball)."""
+    b = c.bounds[i]
+    if b[3] < 0:
+        return None
+    centre, radius, ok = mobius.map_ball(mobius.inverse(c.inverse[i]), b[None, :3], b[3:])
+    if not ok[0] or not np.isfinite(radius[0]) or not np.isfinite(centre).all():
+        return None
+    return np.array([*centre[0], radius[0] * (1 + CULL_MARGIN)
+                     + CULL_MARGIN * float(np.abs(centre[0]).max())])
+
+
+def value(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:
+    """The whole walk as one Number: Alg. 1's distance, or for a MöKRS min_i k_i(x_i), x_i
+    the point followed inwards as Alg. 3 tests it — not a distance (the maps scale lengths)
+    but continuous where the maps are defined (+∞ towards a pole), so its sign certifies
+    surfaces and empty space alike. A compound takes the least over its components."""
+    def terms(part, x):
+        for _, _, move, kind, rec in steps(part):
+            x = move(x)
+            yield kernel(kind, rec, x)
     parts = c.parts if isinstance(c, CompiledCompound) else (c,)
-    d = krs_distance(parts[0], x)
-    for part in parts[1:]:
-        d = d.minimum(krs_distance(part, x))
-    return d
+    return least(k for part in parts for k in terms(part, x))
+
+
+@dataclass
+class Bounds:
+    """Per batch element, what the walk certifies about the scene's value v (only signs are
+    used): ``lo`` ≤ v from the kernels walked and the balls found clear; ``hi`` ≥ v from the
+    kernels walked (a subset of the scene); ``cut`` ≤ v from the balls of levels left out
+    at the level of detail (+∞ where none), so v ≥ min(lo, cut)."""
+    lo: np.ndarray
+    hi: np.ndarray
+    cut: np.ndarray
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.minimum(self.lo, self.cut)
+
+
+def bounds(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec,
+           lod: np.ndarray | None = None) -> Bounds:
+    """Bounds of the value over the batch ``x`` walked with the levels' balls: where a
+    point's ball lies clear (its enclosure > 0) the levels below cannot reach 0 and its
+    walk ends (culling, which for a MöKRS also steps around the poles); with ``lod`` (a
+    length per element) a walk also ends at the first ball of radius ≤ lod, whose distance
+    then stands for the levels below — detail smaller than the level of detail asked for."""
+    n = x[0].size
+    out = Bounds(np.full(n, np.inf), np.full(n, np.inf), np.full(n, np.inf))
+    parts = c.parts if isinstance(c, CompiledCompound) else (c,)
+    for part in parts:
+        rows, y = np.arange(n), x
+        for ball, size, move, kind, rec in steps(part):
+            if ball is not None:
+                blo = (norm(minus(y, ball[:3])) - float(ball[3])).range()[0]
+                clear = blo > 0                          # NaN: not clear
+                cut = ~clear & (size <= lod[rows]) if lod is not None else np.zeros_like(clear)
+                out.lo[rows[clear]] = np.minimum(out.lo[rows[clear]], blo[clear])
+                out.cut[rows[cut]] = np.minimum(out.cut[rows[cut]], blo[cut])
+                if (clear | cut).any():
+                    keep = ~(clear | cut)
+                    rows, y = rows[keep], tuple(v.take(keep) for v in y)
+                    if not rows.size:
+                        break
+            y = move(y)
+            k = kernel(kind, rec, y)
+            if k is not None:
+                klo, khi = k.range()
+                out.lo[rows] = np.minimum(out.lo[rows], klo)
+                out.hi[rows] = np.minimum(out.hi[rows], khi)
+    return out
 
 
 def on_segments(origin, dirs, a, b, arithmetic: str) -> Vec:

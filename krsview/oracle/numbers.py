@@ -47,6 +47,14 @@ class Interval:
     def range(self) -> tuple[np.ndarray, np.ndarray]:
         return self.lo, self.hi
 
+    @property
+    def size(self) -> int:
+        return np.broadcast(self.lo, self.hi).size
+
+    def take(self, keep: np.ndarray) -> "Interval":
+        """The elements where ``keep``."""
+        return Interval(self.lo[keep], self.hi[keep])
+
     def __add__(self, o):
         o = Interval.lift(o)
         return Interval(_down(self.lo + o.lo), _up(self.hi + o.hi))
@@ -125,6 +133,14 @@ class Affine:
         r = _up(np.abs(self.x1) + self.e)
         r = _up(r + ROUNDING * (np.abs(self.x0) + r))
         return _down(self.x0 - r), _up(self.x0 + r)
+
+    @property
+    def size(self) -> int:
+        return self.x0.size
+
+    def take(self, keep: np.ndarray) -> "Affine":
+        """The elements where ``keep``."""
+        return Affine(self.x0[keep], self.x1[keep], self.e[keep])
 
     def interval(self) -> Interval:
         return Interval(*self.range())
