@@ -158,7 +158,7 @@ def cmd_render(args: argparse.Namespace) -> int:
 def cmd_view(args: argparse.Namespace) -> int:
     from .app.window import Viewer
     viewer = Viewer(resolve(args.preset), size=args.size, hud=not args.no_hud,
-                    target_fps=args.fps)
+                    target_fps=args.fps, prepass=args.prepass)
     print(f"krsview: viewing {viewer.path} — WASD/QE fly, right-drag look, scroll speed, "
           "O orbit, R reset, B bookmark, F5/F6 record/replay, F12 screenshot, F1 HUD")
     viewer.run()
@@ -276,6 +276,14 @@ def cmd_bench_levels(args: argparse.Namespace) -> int:
     scene = _load(args)
     check_bench_csv(args)
     bench_levels(scene, args.size, step=args.step, rounds=args.rounds, csv=args.csv)
+    return 0
+
+
+def cmd_bench_paths(args: argparse.Namespace) -> int:
+    from .bench.paths import bench_paths
+    scene = _load(args)
+    check_bench_csv(args)
+    bench_paths(scene, args.size, rounds=args.rounds, csv=args.csv)
     return 0
 
 
@@ -401,6 +409,8 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(r, "tracer")
     render_option(r, "relaxation")
     render_option(r, "precision")
+    render_option(r, "culling")
+    render_option(r, "prepass")
     accuracy(r)
     r.set_defaults(func=cmd_render)
 
@@ -413,6 +423,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "HUD. Editing the preset or a shader reloads it.")
     window_arguments(v, (960, 540))
     v.add_argument("--no-hud", action="store_true", help="start with the HUD hidden")
+    v.add_argument("--prepass", type=_int_in("--prepass", 0, 64), metavar="TILE",
+                   help="tile size of the low-resolution pre-pass while viewing (default: "
+                        "the scene's [render] prepass, else 8; 0: off)")
     v.set_defaults(func=cmd_view)
 
     e = sub.add_parser("edit", help="shape a tree: drag forks, control points and mirror "
@@ -462,6 +475,14 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(bl, "epsilon_scale")
     render_option(bl, "max_iterations")
     bl.set_defaults(func=cmd_bench_levels)
+    bp = bsub.add_parser("paths", help="what culling and the pre-pass buy, side by side",
+                         description="Exact level culling off/on × the low-resolution pre-pass "
+                                     "off and at tiles 4, 8, 16, at --size and twice it, "
+                                     "interleaved: frame time and speed-up against the plain "
+                                     "frame, iterations per pixel, the coarse pass's share.")
+    bench_arguments(bp)
+    render_option(bp, "tracer")
+    bp.set_defaults(func=cmd_bench_paths)
     bt = bsub.add_parser("tracers", help="sphere vs binary sphere tracing, and a ξ sweep",
                          description="On one scene and view: sphere tracing, binary tracing at "
                                      "the paper's ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over "

@@ -140,11 +140,13 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     e.dirty = True
     settle(e)
     shot = e.read_window()
-    ref = headless_render(load_scene(e.path), tmp_path / "saved", SIZE)
+    same_prepass = ("--prepass", str(e.prepass))     # the window's pre-pass tile
+    ref = headless_render(load_scene(e.path), tmp_path / "saved", SIZE, *same_prepass)
     close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
     # negative control: the unedited tree differs where the fork moved
-    before = headless_render(load_scene(resolve("tree")), tmp_path / "before", SIZE)
+    before = headless_render(load_scene(resolve("tree")), tmp_path / "before", SIZE,
+                             *same_prepass)
     same = np.abs(shot.astype(int) - before.astype(int)).max(-1) <= 2
     assert same.mean() < 0.97, f"the edit changed only {1 - same.mean():.2%} of the pixels"
     from PIL import Image

@@ -1,9 +1,13 @@
 """Every preset: the GLSL tracer agrees with the float64 NumPy reference pixel by pixel."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
+from krsview.bench.metrics import gpu_reference_agreement
 from krsview.reference import render_reference
+from krsview.reference.camera import view_of
 from krsview.scene import load_scene
 
 from .conftest import assert_finite, check_against_reference, preset_paths
@@ -13,12 +17,23 @@ W, H = 160, 120
 
 @pytest.mark.parametrize("path", preset_paths(), ids=lambda p: p.stem)
 def test_preset_matches_reference(renderer, path):
+    """The fragment tracer against the reference, and the same with the low-resolution
+    pre-pass [issue 17 §2]. Without it both take the same steps, so every tolerance holds.
+    With it a ray starts from its tile's free distance and steps elsewhere: it stops at
+    another point within ε of the surface (binary tracing: 2 ε), on sub-pixel detail often
+    of another kernel, so normals and colours are not compared; away from outlines every
+    hit state must still agree, and on outlines grazing rays may flip (≤ 1.5 %)."""
     scene = load_scene(path)
-    gpu = renderer.render(scene, W, H)
     ref = render_reference(scene, W, H)
-    assert_finite(gpu, scene.render.max_iterations)
     assert ref.hit.mean() > 0.02, "the preset's camera sees (almost) nothing"
+    gpu = renderer.render(scene, W, H)
+    assert_finite(gpu, scene.render.max_iterations)
     check_against_reference(path.stem, gpu, ref)
+    fast = renderer.render(replace(scene, render=replace(scene.render, prepass=8)), W, H)
+    assert_finite(fast, scene.render.max_iterations, prepass=True)
+    a = gpu_reference_agreement(fast, ref)
+    eps = view_of(scene.camera, W, H).footprint * scene.render.epsilon_scale
+    assert a.off_edge_hit == 0 and a.off_edge_depth <= 2.0 * eps and a.hit >= 0.985, a
 
 
 @pytest.mark.parametrize("broken", [

@@ -186,8 +186,9 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
 
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
-    """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once;
-    switching back, and moving accuracy knobs, compile nothing."""
+    """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once
+    (its tracing program and its pre-pass); switching back, and moving accuracy knobs,
+    compile nothing."""
     v = viewer
     settle(v)
     programs = v.renderer.programs
@@ -195,7 +196,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     sphere_image = v.read_window()
     v.set_render(tracer="binary")
     settle(v)
-    assert programs.compiles == before + 1
+    assert v.prepass and programs.compiles == before + 2
     assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
     binary_image = v.read_window()
     assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
@@ -203,7 +204,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     settle(v)
     v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
     settle(v)
-    assert programs.compiles == before + 1
+    assert programs.compiles == before + 2
 
 
 def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
@@ -278,7 +279,8 @@ def test_preset_picker_and_levels_slider(viewer):
 
 def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     """The HUD's effect checkboxes go through Viewer.set_effect: a new effect set compiles one
-    variant with its define; switching back and forth again compiles nothing."""
+    variant with its define (tracing and pre-pass programs); switching back and forth again
+    compiles nothing."""
     v = viewer
     v.open_preset(resolve("sierpinski"))
     settle(v)
@@ -287,7 +289,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     plain = v.read_window()
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 1
+    assert programs.compiles == before + 2
     assert any(("KRS_SHADOWS", None) in key[2] for key in programs._programs)
     assert np.abs(v.read_window().astype(int) - plain).max() > 0
     v.set_effect("soft_shadows", True)  # replaces the hard shadows: they exclude each other
@@ -297,7 +299,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     settle(v)
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 2
+    assert programs.compiles == before + 4
     v.open_preset(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error
@@ -363,3 +365,19 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(vi
     assert commands == [] and v.levels == 12
     (tmp_path / "tree" / "accuracy.csv").write_text("knob,value,ms\nscene,x,notanumber\n")
     assert load_measured("tree") is None
+
+
+def test_the_viewer_draws_with_the_prepass_and_can_turn_it_off(viewer):
+    """The viewer flies with the pre-pass (tile 8) unless told otherwise; the HUD's slider
+    goes through Viewer.set_prepass, and off or on, the window shows the same tree (pixels
+    change only on outlines, where grazing rays may flip)."""
+    from krsview.app.window import VIEW_PREPASS
+    v = viewer
+    settle(v)
+    assert v.prepass == VIEW_PREPASS and v.view_scene().render.prepass == VIEW_PREPASS
+    with_prepass = v.read_window().astype(int)
+    v.set_prepass(0)
+    settle(v)
+    assert v.view_scene().render.prepass == 0
+    changed = (np.abs(v.read_window().astype(int) - with_prepass).max(-1) > 40).mean()
+    assert 0 < changed < 0.02

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
-KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision")
+KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision", "culling")
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
@@ -84,6 +84,11 @@ def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:
         key = interactions.key(("render", name))
         if changed:
             out.append(Edit(("render", name), value, key))
+    changed, tile = imgui.slider_int("pre-pass tile", v.prepass, 0, 32)
+    if changed:
+        out.append(Do("set_prepass", tile))
+    if imgui.is_item_hovered():
+        imgui.set_tooltip(RENDER_META["prepass"]["help"])
     total = v.geometry.depth
     changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
     if changed:
@@ -136,7 +141,8 @@ def _measured(v: "Viewer", out: list) -> None:
         imgui.text_wrapped(f"no accuracy report for {v.path.stem}: run `krsview bench "
                            f"accuracy {v.path.stem}`")
         return
-    now = [r for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)]
+    now = [r for r in rows
+           if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth, v.prepass)]
     w, h = v.adaptive.moving_size()
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
         implot.setup_axes("ms (report size)", "hit-mask error %")

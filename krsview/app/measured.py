@@ -34,9 +34,11 @@ def load_measured(stem: str) -> list[dict] | None:
     return None
 
 
-def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int) -> bool:
+def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int,
+            prepass: int = 0) -> bool:
     """Whether the view draws with the setting this row measured; ``levels`` is the view's
-    level count (0: all ``depth`` levels of the geometry, which the caller already has)."""
+    level count (0: all ``depth`` levels of the geometry, which the caller already has),
+    ``prepass`` the viewer's pre-pass tile."""
     r, s = scene.render, saved.render
     drawn_levels = levels or depth
     full = drawn_levels == depth
@@ -50,8 +52,10 @@ def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int) -> b
         return same_but(max_iterations=int(value))
     if knob == "tracer":
         return same_but(**_tracer(value))
-    if knob == "precision":
-        return same_but(precision=value)
+    if knob in ("precision", "culling"):
+        return same_but(**{knob: value})
+    if knob == "prepass":
+        return r == s and full and prepass == int(value)
     if knob == "levels":
         return r == s and drawn_levels == int(value)
     return False
@@ -80,6 +84,10 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
     render = {"epsilon_scale": lambda: replace(base, epsilon_scale=float(value)),
               "max_iterations": lambda: replace(base, max_iterations=int(value)),
               "tracer": lambda: replace(base, **_tracer(value)),
-              "precision": lambda: replace(base, precision=value)}.get(knob, lambda: base)()
+              "precision": lambda: replace(base, precision=value),
+              "culling": lambda: replace(base, culling=value)}.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
-    return [Edit(("render",), render), Do("set_levels", levels)]
+    out = [Edit(("render",), render), Do("set_levels", levels)]
+    if knob == "prepass":
+        out.append(Do("set_prepass", int(value)))
+    return out

@@ -4,9 +4,9 @@ the ground truth (the float64 reference at ε/8); the report says which settings
 
 Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
-float64 shader) and level count (LOD by truncation). One run writes a CSV, a Markdown report,
-plots (time against error per knob, the Pareto front over all settings) and error images
-(holes red, false hits blue)."""
+float64 shader), exact level culling, the pre-pass tile and level count (LOD by
+truncation). One run writes a CSV, a Markdown report, plots (time against error per knob,
+the Pareto front over all settings) and error images (holes red, false hits blue)."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
@@ -20,6 +20,7 @@ from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PRECISIONS
 from .harness import Variant, median_times
 from .metrics import compare, error_image
+from .paths import TILES as PREPASS_TILES
 from .report import write_csv
 from .truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS, ground_truth
 
@@ -64,6 +65,12 @@ def settings(scene: Scene) -> list[Setting]:
         if precision != r.precision:
             out.append(Setting("precision", precision,
                                replace(scene, render=replace(r, precision=precision))))
+    if r.culling == "on" and scene.mokrs is None:       # Alg. 1's culling; not in a MöKRS
+        out.append(Setting("culling", "off", replace(scene, render=replace(r, culling="off"))))
+    for tile in PREPASS_TILES:
+        if tile != r.prepass:
+            out.append(Setting("prepass", f"{tile}",
+                               replace(scene, render=replace(r, prepass=tile))))
     g = scene.geometry()
     for cut in LEVEL_CUTS:
         if g.depth - cut >= 1:

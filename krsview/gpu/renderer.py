@@ -1,5 +1,7 @@
 """Fragment-shader path: one full-screen pass writes colour, normal+depth and iterations to
-float32 render targets, read back as :class:`Buffers` in image order (rows top → bottom)."""
+float32 render targets, read back as :class:`Buffers` in image order (rows top → bottom).
+With ``[render] prepass`` a coarse pass over tiles first writes each tile's free distances
+(prepass.glsl), which the full pass starts its rays from."""
 from __future__ import annotations
 
 import time
@@ -27,7 +29,8 @@ class Renderer:
         self.ctx = ctx or headless_context()
         self.programs = ProgramCache(self.ctx, shader_dir)
         self._ubo: moderngl.Buffer | None = None
-        self._targets: dict[tuple[int, int], moderngl.Framebuffer] = {}
+        self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
+        self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int]] = {}  # pre-pass
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
@@ -46,10 +49,11 @@ class Renderer:
             if self._depth == 0:
                 self.ctx.__exit__(None, None, None)
 
-    def _framebuffer(self, width: int, height: int) -> moderngl.Framebuffer:
+    def _framebuffer(self, width: int, height: int, layers: int = 3) -> moderngl.Framebuffer:
         """Render targets per size, the most recently used MAX_TARGETS kept: the viewer's
-        adaptive resolution and window resizes visit many sizes, and each holds 3 textures."""
-        key = (width, height)
+        adaptive resolution and window resizes visit many sizes, and each holds 3 textures
+        (a pre-pass's: 2)."""
+        key = (width, height, layers)
         if key in self._targets:
             self._targets[key] = self._targets.pop(key)       # most recent last
         else:
@@ -58,7 +62,7 @@ class Renderer:
                 for tex in old.color_attachments:
                     tex.release()
                 old.release()
-            tex = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(3)]
+            tex = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(layers)]
             self._targets[key] = self.ctx.framebuffer(color_attachments=tex)
         return self._targets[key]
 
@@ -82,7 +86,16 @@ class Renderer:
                              f"this GPU's uniform blocks hold at most {limit} bytes, too few "
                              "for a compound's 8 × 64 level slots: render its components as "
                              "separate scenes")
-        prog = self.programs.get("fullscreen.vert", "render.frag", variant_defines(scene, c, all_effects))
+        defines = variant_defines(scene, c, all_effects)
+        prog = self.programs.get("fullscreen.vert", "render.frag", defines)
+        progs = [prog]
+        if scene.render.prepass:
+            coarse = self.programs.get("fullscreen.vert", "prepass.frag", defines)
+            self._coarse[prog] = (coarse, scene.render.prepass)
+            progs.append(coarse)
+            for unit, name in enumerate(("u_free0", "u_free1")):  # unused ones compile away
+                if name in prog:
+                    prog[name].value = unit
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
         else:
@@ -90,12 +103,14 @@ class Renderer:
         if storage:
             self._ubo.bind_to_storage_buffer(0)
         else:
-            if "KRSBlock" in prog:
-                prog["KRSBlock"].binding = 0
             self._ubo.bind_to_uniform_block(0)
-        for name, value in view_uniforms(scene, view, c).items():
-            if name in prog:
-                prog[name].value = value
+        uniforms = view_uniforms(scene, view, c)
+        for p in progs:
+            if not storage and "KRSBlock" in p:
+                p["KRSBlock"].binding = 0
+            for name, value in uniforms.items():
+                if name in p:
+                    p[name].value = value
         return prog
 
     def _world(self, geometry: Geometry, albedo: tuple) -> Compiled:
@@ -111,6 +126,8 @@ class Renderer:
         """Trace the whole image, or only ``tile`` = (x, y, w, h) in GL pixel coordinates, so a
         slow full-resolution frame can be spread over several event-loop turns."""
         with self.current():
+            if prog in self._coarse:
+                self._prepass(prog, width, height, tile)
             fbo = self._framebuffer(width, height)
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
@@ -118,6 +135,24 @@ class Renderer:
             self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
             self.ctx.scissor = None
             return fbo
+
+    def _prepass(self, prog: moderngl.Program, width: int, height: int,
+                 tile: tuple[int, int, int, int] | None) -> None:
+        """The coarse pass of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
+        its free distances left bound to texture units 0 and 1."""
+        coarse, size = self._coarse[prog]
+        cw, ch = -(-width // size), -(-height // size)
+        fbo = self._framebuffer(cw, ch, layers=2)
+        fbo.use()
+        self.ctx.viewport = (0, 0, cw, ch)
+        if tile is not None:
+            x, y, w, h = tile
+            x0, y0 = x // size, y // size
+            self.ctx.scissor = (x0, y0, -(-(x + w) // size) - x0, -(-(y + h) // size) - y0)
+        self._vao(coarse).render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.scissor = None
+        for unit, tex in enumerate(fbo.color_attachments):
+            tex.use(unit)
 
     def _vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -140,17 +175,36 @@ class Renderer:
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
 
+    def free_distances(self, scene: Scene, width: int, height: int) -> np.ndarray:
+        """The pre-pass's free distance per tile and component, (rows top → bottom, columns,
+        8), for a scene with ``[render] prepass`` > 0: what each of the tile's rays starts
+        from."""
+        with self.current():
+            prog = self.prepare(scene, width, height)
+            size = self._coarse[prog][1]
+            self._prepass(prog, width, height, None)
+            cw, ch = -(-width // size), -(-height // size)
+            fbo = self._framebuffer(cw, ch, layers=2)
+            planes = [np.frombuffer(fbo.read(attachment=k, components=4, dtype="f4"),
+                                    dtype=np.float32).reshape(ch, cw, 4)[::-1]
+                      for k in range(2)]
+            return np.concatenate(planes, axis=-1).astype(np.float64)
+
     def time_frame(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                   repeats: int = 1, all_effects: bool = False) -> list[float]:
-        """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up."""
+                   repeats: int = 1, all_effects: bool = False,
+                   prepass_only: bool = False) -> list[float]:
+        """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up;
+        ``prepass_only``: of the pre-pass's coarse pass alone."""
         with self.current():
             prog = self.prepare(scene, width, height, geometry, all_effects)
-            self.draw(prog, width, height)
+            draw = (lambda: self._prepass(prog, width, height, None)) if prepass_only else \
+                (lambda: self.draw(prog, width, height))
+            draw()
             self.ctx.finish()
             times = []
             for _ in range(repeats):
                 t0 = time.perf_counter()
-                self.draw(prog, width, height)
+                draw()
                 self.ctx.finish()
                 times.append(time.perf_counter() - t0)
             return times

@@ -17,8 +17,8 @@ MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record,
 
 def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
                     ) -> dict[str, str | int | None]:
-    """One define per kernel type present, per enabled effect, for the tracer, for the
-    Möbius geometry family and for a compound: nothing else is compiled. ``all_effects``
+    """One define per kernel type present, per enabled effect, for the tracer, culling, the
+    pre-pass, the Möbius geometry family and a compound: nothing else is compiled. ``all_effects``
     compiles every effect the geometry allows, each switched by its bit of ``u_effects``
     (the benchmark's baseline)."""
     defines: dict[str, str | int | None] = {"KRS_SLOTS": slots(c), "KRS_RECORD": RECORD_VEC4}
@@ -36,6 +36,12 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines[f"KRS_TRACER_{scene.render.tracer.upper()}"] = None
     if scene.render.precision == "double":
         defines["KRS_DOUBLE"] = None
+    if scene.render.culling == "on" and any((part.bounds[:, 3] >= 0).any()
+                                            for part, _ in component_slots(c)
+                                            if not isinstance(part, CompiledMoKRS)):
+        defines["KRS_CULLING"] = None     # only where some level has a ball to test
+    if scene.render.prepass:
+        defines["KRS_PREPASS"] = None
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -101,6 +107,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_xi_bonus": scene.render.xi_bonus,
         "u_xi_penalty": scene.render.xi_penalty,
         "u_relaxation": scene.render.relaxation,
+        "u_tile": scene.render.prepass,
         "u_light_count": len(lights),
         "u_light_dir": [lt.direction for lt in lights] + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
         "u_light_color": [tuple(c * lt.intensity for c in lt.color) for lt in lights]

@@ -75,7 +75,8 @@ def krs_bounds(krs: KRS) -> np.ndarray:
     folding at level i — K_i and the levels below, doubled by R_i: C_i = S ∪ R_i(S),
     S = ball(K_i) ∪ C_{i−1} (radius −1: unbounded, from a plane kernel on). A point x with
     d ≤ dist(x, C_i) cannot lower d any more: the walk stops there with the same value
-    [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding."""
+    [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding.
+    Slots below only empty kernels get no ball (the walk's d is still ∞ there)."""
     out, below = [], None
     unbounded = False
     for k, m in zip(krs.kernels, krs.mirrors):
@@ -92,6 +93,12 @@ def krs_bounds(krs: KRS) -> np.ndarray:
         else:
             out.append(np.array([*below[:3], below[3] * (1 + CULL_MARGIN)
                                  + CULL_MARGIN * float(np.abs(below[:3]).max())]))
+    # where every kernel above slot i is empty the walk still has d = ∞ there and can never
+    # stop: no ball, so the test is not paid for (sierpinski: all but K_0 empty)
+    solid = np.cumsum([not isinstance(k, Empty) for k in krs.kernels[::-1]])[::-1]
+    for i in range(len(out)):
+        if solid[i + 1] == 0:
+            out[i] = UNBOUNDED
     return np.array(out, dtype=np.float64).reshape(-1, 4)
 
 

@@ -16,6 +16,7 @@ from .schema import SceneError, Tagged, Vec3, param, to_dict
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
 TRACERS = ("sphere", "binary", "relaxed")
 PRECISIONS = ("float", "double")
+SWITCH = ("on", "off")
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -231,6 +232,14 @@ class Render:
                            help="float: the GPU's float32; double: distances, folds, Möbius "
                                 "maps and ray positions in float64 (GL 4 fp64), for deep "
                                 "zooms, at a cost in time")
+    culling: str = param("on", choices=SWITCH,
+                         help="exact level culling: Alg. 1 stops at the first level whose "
+                              "bounding ball is no nearer than the distance found (the same "
+                              "value, fewer levels walked)")
+    prepass: int = param(0, lo=0, hi=64, unit="pixels",
+                         help="tile size of the low-resolution pre-pass: one cone per tile "
+                              "finds how far all its rays are free, and each ray starts there "
+                              "(0: off)")
 
 
 # ------------------------------------------------------------------------------ arc geometry

@@ -18,8 +18,10 @@ real krs_distance(int first, int n, vec3r xw) {
     vec3r x = xw;
     real d = kernel_distance(first + n, x);
     for (int i = first + n - 1; i >= first; --i) {
+#ifdef KRS_CULLING
         vec4r b = u_bounds[i];
         if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
+#endif
         fold(i, x);
         d = min(d, kernel_distance(i, x));
     }

@@ -2,6 +2,7 @@
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
+#include "prepass.glsl"
 #include "shade.glsl"
 
 layout(location = 0) out vec4 out_color;      // rgb, hit
@@ -9,13 +10,12 @@ layout(location = 1) out vec4 out_normal;     // xyz, depth t
 layout(location = 2) out vec4 out_iterations; // x
 
 void main() {
-    vec2 ndc = 2.0 * gl_FragCoord.xy / u_resolution - 1.0;
-    float aspect = u_resolution.x / u_resolution.y;
-    vec3r dir = normalize(u_forward + real(ndc.x * u_tan_half * aspect) * u_right
-                          + real(ndc.y * u_tan_half) * u_up);
+    vec3r dir = pixel_ray(gl_FragCoord.xy);
+    real start[COMPONENT_SLOTS];
+    ray_start(start);
     real t;
     int iterations;
-    bool hit = trace_ray(vec3r(0.0), dir, t, iterations);
+    bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);
     out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
     if (!hit) {
         out_color = vec4(encode(background(vec3(dir))), 0.0);

@@ -69,6 +69,14 @@ uniform float u_xi_penalty;
 uniform float u_relaxation;      // relaxed tracing: ω
 uniform float u_max_distance;
 
+// The primary ray through the pixel centre at window position `frag`.
+vec3r pixel_ray(vec2 frag) {
+    vec2 ndc = 2.0 * frag / u_resolution - 1.0;
+    float aspect = u_resolution.x / u_resolution.y;
+    return normalize(u_forward + real(ndc.x * u_tan_half * aspect) * u_right
+                     + real(ndc.y * u_tan_half) * u_up);
+}
+
 uniform int u_light_count;
 uniform vec3 u_light_dir[4];
 uniform vec3 u_light_color[4];  // colour × intensity

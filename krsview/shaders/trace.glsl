@@ -2,7 +2,8 @@
 // ε = footprint × t × ε-scale [KRS17 §4]; twin of reference/trace.py. One tracer and one
 // geometry family are compiled in. Each component c keeps its own free distance t_c along
 // the ray; the one with the least t_c takes the step, and the ray converges when that step
-// does: at the nearest of the components' own hits [KRS17 §5.1].
+// does: at the nearest of the components' own hits [KRS17 §5.1]. Each t_c starts at
+// start[c]: 0, or the pre-pass's free distance of the pixel's tile (prepass.glsl).
 #ifdef KRS_MOBIUS
 #include "mokrs.glsl"
 #else
@@ -22,9 +23,10 @@ int front(real tc[COMPONENT_SLOTS]) {
 
 // Probe the ball of radius s touching the free point t: free → advance 2s, grow s;
 // blocked → converged if s ≤ ε(t), else shrink s (see reference/trace.py for why).
-bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
-    real tc[COMPONENT_SLOTS], sc[COMPONENT_SLOTS];
-    for (int c = 0; c < COMPONENT_SLOTS; ++c) { tc[c] = 0.0; sc[c] = INITIAL_PROBE; }
+bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
+               out int iterations) {
+    real tc[COMPONENT_SLOTS] = start, sc[COMPONENT_SLOTS];
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) sc[c] = INITIAL_PROBE;
     for (iterations = 0; iterations < u_max_iterations;) {
         int c = front(tc);
         t = tc[c];
@@ -46,9 +48,10 @@ bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
 // Over-relaxed sphere tracing [Keinert et al. 2014] of a single KRS: step ω·d from the last
 // verified point (ts, ds); if the new free ball and the last one no longer cover [ts, t],
 // go back to ts + ds and trace plainly (ω = 1). Twin of relaxed_trace in reference/trace.py.
-bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
-    real ts = 0.0, ds = 0.0, w = u_relaxation;
-    t = 0.0;
+bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
+               out int iterations) {
+    real ts = start[0], ds = 0.0, w = u_relaxation;
+    t = ts;
     for (iterations = 0; iterations < u_max_iterations;) {
         if (t > u_max_distance) return false;
         real d = component_distance(0, origin + t * dir);
@@ -66,9 +69,9 @@ bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
     return false;
 }
 #else
-bool trace_ray(vec3r origin, vec3r dir, out real t, out int iterations) {
-    real tc[COMPONENT_SLOTS];
-    for (int c = 0; c < COMPONENT_SLOTS; ++c) tc[c] = 0.0;
+bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
+               out int iterations) {
+    real tc[COMPONENT_SLOTS] = start;
     for (iterations = 0; iterations < u_max_iterations;) {
         int c = front(tc);
         t = tc[c];

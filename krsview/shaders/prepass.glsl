@@ -1,0 +1,55 @@
+// Low-resolution pre-pass [KRS17 §10, KRS14 §4; issue 17 §2]: one cone per tile of
+// u_tile × u_tile pixels finds how far every ray of the tile is free, per component, and
+// each full-resolution ray starts there (tests: the hit mask equals the one without it).
+//
+// The cone: the tile's rays leave the eye with directions within σ of the centre ray's
+// (σ = the largest |dir_q − dir_centre| over the tile's corner pixels; the angle is largest
+// at a corner). At parameter u a ray is within u·σ of the centre ray's point, and the ray
+// stops where its distance is below ε(u) ≤ u·ε_per_t, so with σ' = σ + ε_per_t the ball of
+// radius s + (t + 2s)·σ' around the centre ray's point t + s holds every tile ray's points on
+// [t, t + 2s] with their ε-balls. Probed as the binary tracer does [KRS17 Alg. 2]: free →
+// t += 2s and s grows; blocked → s shrinks, until s is no larger than the cone's own width.
+uniform int u_tile;
+
+#ifdef KRS_PREPASS_COARSE
+real cone_free(int c, vec3r dir, real sigma) {
+    real t = 0.0, s = 1.0;
+    for (int i = 0; i < u_max_iterations; ++i) {
+        if (t > u_max_distance) break;
+        if (is_unbounding(c, (t + s) * dir, s + (t + 2.0 * s) * sigma)) {
+            t += 2.0 * s;
+            s *= u_xi_bonus;
+        } else {
+            if (s <= t * sigma) break;
+            s *= u_xi_penalty;
+        }
+    }
+    return t;
+}
+
+// The tile's spread σ' (see above), for the tile whose first pixel is `corner`.
+real cone_spread(vec2 corner, vec3r centre) {
+    real sigma = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        vec2 q = corner + 0.5 + vec2(k & 1, k >> 1) * float(u_tile - 1);
+        sigma = max(sigma, length(pixel_ray(q) - centre));
+    }
+    return sigma + real(u_eps_per_t);
+}
+#endif
+
+#ifdef KRS_PREPASS
+uniform sampler2D u_free0;   // free distance per component: 0..3
+uniform sampler2D u_free1;   // 4..7
+
+// Where this pixel's ray starts, per component: its tile's free distance.
+void ray_start(out real start[COMPONENT_SLOTS]) {
+    ivec2 tile = ivec2(gl_FragCoord.xy) / u_tile;
+    vec4 t[2] = vec4[2](texelFetch(u_free0, tile, 0), texelFetch(u_free1, tile, 0));
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = real(t[c / 4][c % 4]);
+}
+#else
+void ray_start(out real start[COMPONENT_SLOTS]) {
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = 0.0;
+}
+#endif
