@@ -17,6 +17,7 @@ import numpy as np
 
 from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
 from .scene.effects import check_effects
+from .oracle.certify import MAX_SEGMENTS
 from .scene.schema import describe_range, check_value
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
@@ -179,7 +180,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.stability:
         return check_stability(args.preset, args.size)
     if args.oracle:
-        return check_oracle(args.preset, args.size)
+        return check_oracle(args.preset, args.size, args.segments)
     path = resolve(args.preset)
     scene = load_scene(path)
     krs = scene.geometry()
@@ -243,7 +244,7 @@ def check_stability(name: str, size: tuple[int, int]) -> int:
     return 0 if all(o.ok for o in outcomes) else 1
 
 
-def check_oracle(name: str, size: tuple[int, int]) -> int:
+def check_oracle(name: str, size: tuple[int, int], segments: int) -> int:
     """Certified holes and false hits of the tracers on a scene (or a hard case, hard:NAME),
     with the oracle's work in interval and affine arithmetic."""
     from .bench.hard_cases import CASES
@@ -264,7 +265,7 @@ def check_oracle(name: str, size: tuple[int, int]) -> int:
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for tracer in ("binary",) if scene.mokrs is not None else ("sphere", "binary"):
         traced = replace(scene, render=replace(scene.render, tracer=tracer))
-        c = count_errors(traced, r.render(traced, *size))
+        c = count_errors(traced, r.render(traced, *size), max_segments=segments)
         (sa, ta), (si, ti) = c.work["affine"], c.work["interval"]
         print(f"| {tracer} | {c.rays} | {c.hits} | {c.holes} | {c.false_hits} | "
               f"{c.below_lod} | {c.undecided} | {sa:,}, {ta:.1f} | {si:,}, {ti:.1f} |", flush=True)
@@ -458,6 +459,9 @@ def build_parser() -> argparse.ArgumentParser:
                       help="count the sphere and binary tracers' certified holes and false "
                            "hits with the interval / affine arithmetic oracle [RAA09] (a deep "
                            "tree takes about a minute)")
+    c.add_argument("--segments", type=_int_in("--segments", 1, 1_000_000), default=MAX_SEGMENTS,
+                   metavar="N", help="--oracle: segments per ray before it counts as undecided "
+                                     f"(default {MAX_SEGMENTS})")
     c.add_argument("--size", type=_size, default=(48, 27),
                    help="image size for --stability and --oracle (default 48x27)")
     c.set_defaults(func=cmd_check)

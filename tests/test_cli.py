@@ -204,6 +204,10 @@ def test_check_stability_prints_the_table_and_fails_when_an_invariant_does(capsy
 def test_check_oracle_prints_certified_counts(capsys):
     assert main(["check", "--oracle", "sierpinski", "--size", "24x14"]) == 0
     out = capsys.readouterr().out
-    assert "| sphere | 336 | 111 | 0 | 0 | 0 |" in out and "| binary | 336 |" in out
+    assert "| sphere | 336 | 111 | 0 | 0 | 0 | 0 |" in out and "| binary | 336 |" in out
+    # a budget of one segment per ray decides only rays whose whole segment clears at once
+    assert main(["check", "--oracle", "sierpinski", "--size", "24x14", "--segments", "1"]) == 0
+    row = capsys.readouterr().out.splitlines()[2].split("|")
+    assert int(row[7]) > 0                          # the undecided column
     assert main(["check", "--oracle", "hard:twist-ground"]) == 2
     assert "the oracle covers scenes without twist or empty zones" in capsys.readouterr().err
