@@ -185,10 +185,8 @@ class Renderer:
             self._prepass(prog, width, height, None)
             cw, ch = -(-width // size), -(-height // size)
             fbo = self._framebuffer(cw, ch, layers=2)
-            planes = [np.frombuffer(fbo.read(attachment=k, components=4, dtype="f4"),
-                                    dtype=np.float32).reshape(ch, cw, 4)[::-1]
-                      for k in range(2)]
-            return np.concatenate(planes, axis=-1).astype(np.float64)
+            return np.concatenate([read_plane(fbo, k, cw, ch) for k in range(2)],
+                                  axis=-1).astype(np.float64)
 
     def time_frame(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
                    repeats: int = 1, all_effects: bool = False,
@@ -210,11 +208,14 @@ class Renderer:
             return times
 
 
+def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:
+    """Colour attachment k as (rows top → bottom, columns, 4) float32."""
+    raw = fbo.read(attachment=k, components=4, dtype="f4")
+    return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)[::-1]
+
+
 def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Buffers:
-    def plane(k: int) -> np.ndarray:
-        raw = fbo.read(attachment=k, components=4, dtype="f4")
-        return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)[::-1]
-    c, nd, it = plane(0), plane(1), plane(2)
+    c, nd, it = (read_plane(fbo, k, width, height) for k in range(3))
     hit = c[..., 3] > 0.5
     return Buffers(c[..., :3].astype(np.float64), nd[..., 3].astype(np.float64),
                    nd[..., :3].astype(np.float64), it[..., 0].astype(np.int64), hit)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..algebra import mobius
-from ..reference.compiled import CULL_MARGIN, CompiledCompound, CompiledKRS
+from ..reference.compiled import CompiledCompound, CompiledKRS
 from ..reference.mokrs import CompiledMoKRS
 from .numbers import Affine, Interval, Number
 
@@ -112,11 +112,12 @@ def steps(c: CompiledKRS | CompiledMoKRS):
     KRS [KRS17 Alg. 1]: the top kernel, then per level i a fold and k_i; the ball is the
     culling ball C_i (``reference/compiled.krs_bounds``). MöKRS [KRS17 Alg. 3]: per level
     x ← H_i(x), folded to x ≤ 0 where it reflects, then k_i; the ball is the level's bound
-    mapped out by G_i = H_i⁻¹, so it is tested before H_i, where a pole of H_i is not."""
+    mapped out by G_i = H_i⁻¹ (``reference/mokrs.bounds_in_and_out``), so it is tested before
+    H_i, where a pole of H_i is not."""
     if isinstance(c, CompiledMoKRS):
         scale = 1.0          # world length per unit of the current frame, while similarities
         for i in range(c.n - 1, -1, -1):
-            ball = outer_ball(c, i)
+            ball = c.outer[i] if c.outer[i, 3] >= 0 else None
             move = lambda x, H=c.inverse[i], r=c.reflect[i]: inwards(H, r, x)  # noqa: E731
             yield ball, np.inf if ball is None else ball[3] * scale, move, c.types[i], \
                 c.records[i]
@@ -136,20 +137,6 @@ def inwards(H, reflect: bool, x: Vec) -> Vec:
     if reflect:
         x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
     return x
-
-
-def outer_ball(c: CompiledMoKRS, i: int) -> np.ndarray | None:
-    """Level i's bound mapped into the space before H_i (by G_i = H_i⁻¹), widened by
-    CULL_MARGIN against the rounding of the float64 map; None where unbounded or where the
-    bound holds G_i's pole (its image is not a ball)."""
-    b = c.bounds[i]
-    if b[3] < 0:
-        return None
-    centre, radius, ok = mobius.map_ball(mobius.inverse(c.inverse[i]), b[None, :3], b[3:])
-    if not ok[0] or not np.isfinite(radius[0]) or not np.isfinite(centre).all():
-        return None
-    return np.array([*centre[0], radius[0] * (1 + CULL_MARGIN)
-                     + CULL_MARGIN * float(np.abs(centre[0]).max())])
 
 
 def value(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:

@@ -17,7 +17,7 @@ import numpy as np
 from ..scene import MoKRS
 from ..scene.model import Empty
 from ..algebra import mobius
-from .compiled import UNBOUNDED, kernel_ball, kernel_records, union_ball
+from .compiled import CULL_MARGIN, UNBOUNDED, kernel_ball, kernel_records, union_ball
 from .kernels import kernel_distance, world_normal
 
 
@@ -25,7 +25,15 @@ def level_bounds(m: MoKRS) -> np.ndarray:
     """(n, 4): per level i, a ball in level i's space holding everything the tracer still
     tests at level i and below: K_i ∪ L_{i−1}, doubled by R when the level reflects; radius −1
     where unbounded (a plane kernel, or a ball carried through a pole)."""
-    out, below = [], None           # below: bound of L_{i−1} in level i's space
+    return bounds_in_and_out(m)[0]
+
+
+def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`level_bounds`, and each mapped out by G_i into the space before H_i (level
+    i+1's; the world for the outermost), widened by CULL_MARGIN against the float64 map's
+    rounding (the oracle tests them before H_i, away from its pole); radius −1 where
+    unbounded or where the bound holds G_i's pole (its image is no ball)."""
+    out, outer, below = [], [], None    # below: bound of L_{i−1} in level i's space
     unbounded = False
     for lv in m.levels:
         if not unbounded:
@@ -37,9 +45,12 @@ def level_bounds(m: MoKRS) -> np.ndarray:
         out.append(UNBOUNDED if unbounded or ball is None else ball)
         if not unbounded and ball is not None:
             c, r, ok = mobius.map_ball(lv.matrix(), ball[None, :3], ball[3:])
-            unbounded = not ok[0] or not np.isfinite(r[0])
+            unbounded = not ok[0] or not np.isfinite(r[0]) or not np.isfinite(c).all()
             below = np.array([*c[0], r[0]])
-    return np.array(out)
+        margin = CULL_MARGIN * float(np.abs(below[:3]).max()) if below is not None else 0.0
+        outer.append(UNBOUNDED if unbounded or ball is None else
+                     np.array([*below[:3], below[3] * (1 + CULL_MARGIN) + margin]))
+    return np.array(out), np.array(outer)
 
 
 @dataclass(frozen=True)
@@ -50,6 +61,7 @@ class CompiledMoKRS:
     types: tuple[str, ...]
     poles: np.ndarray        # (n, 4): (pole.xyz | (|a|/|d|, 0, 0), has_pole + 2·reflects)
     bounds: np.ndarray       # (n, 4): level_bounds, in each level's own space
+    outer: np.ndarray        # (n, 4): each mapped out by G_i (bounds_in_and_out)
 
     @property
     def n(self) -> int:
@@ -61,8 +73,11 @@ class CompiledMoKRS:
         inverse, poles = self.inverse.copy(), self.poles.copy()
         inverse[-1] = mobius.tidy(mobius.compose(inverse[-1], mobius.translation(origin)))
         poles[-1] = pole_record(inverse[-1], self.reflect[-1])
+        outer = self.outer.copy()         # the outermost lives in the world
+        if outer[-1, 3] >= 0:
+            outer[-1, :3] -= np.asarray(origin, dtype=np.float64)
         return CompiledMoKRS(inverse, self.reflect, self.records, self.types, poles,
-                             self.bounds)   # level spaces do not move
+                             self.bounds, outer)   # level spaces do not move
 
 
 def pole_record(H: np.ndarray, reflect: bool) -> np.ndarray:
@@ -78,7 +93,7 @@ def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS
     reflect = np.array([lv.reflect for lv in m.levels])
     records, types = kernel_records(m.kernels, albedo)
     poles = np.array([pole_record(H, r) for H, r in zip(inverse, reflect)])
-    return CompiledMoKRS(inverse, reflect, records, types, poles, level_bounds(m))
+    return CompiledMoKRS(inverse, reflect, records, types, poles, *bounds_in_and_out(m))
 
 
 def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray,
