@@ -412,6 +412,8 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(r, "precision")
     render_option(r, "culling")
     render_option(r, "prepass")
+    render_option(r, "path")
+    render_option(r, "steps")
     accuracy(r)
     r.set_defaults(func=cmd_render)
 
@@ -479,11 +481,13 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(bl, "epsilon_scale")
     render_option(bl, "max_iterations")
     bl.set_defaults(func=cmd_bench_levels)
-    bp = bsub.add_parser("paths", help="what culling and the pre-pass buy, side by side",
+    bp = bsub.add_parser("paths", help="what culling, the pre-pass and the compute path buy",
                          description="Exact level culling off/on × the low-resolution pre-pass "
-                                     "off and at tiles 4, 8, 16, at --size and twice it, "
-                                     "interleaved: frame time and speed-up against the plain "
-                                     "frame, iterations per pixel, the coarse pass's share.")
+                                     "off and at tiles 4, 8, 16 on the fragment path, and the "
+                                     "compute path at 4, 8, 16, 32 iterations per round, at "
+                                     "--size and twice it, interleaved: frame time and "
+                                     "speed-up against the plain frame, iterations per pixel, "
+                                     "the coarse pass's share.")
     bench_arguments(bp)
     render_option(bp, "tracer")
     bp.set_defaults(func=cmd_bench_paths)

@@ -64,10 +64,10 @@ def test_pareto_front_keeps_only_undominated_settings():
 def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
     knobs = {s.knob for s in settings(load_scene(resolve("tree")))}
     assert knobs == {"scene", "epsilon_scale", "max_iterations", "tracer", "precision",
-                     "culling", "prepass", "levels"}
+                     "culling", "path", "prepass", "levels"}
     palm = settings(load_scene(resolve("palm")))
     assert {s.knob for s in palm} == {"scene", "epsilon_scale", "max_iterations", "tracer",
-                                      "precision", "prepass", "levels"}
+                                      "precision", "path", "prepass", "levels"}
     assert all(s.scene.render.tracer == "binary" for s in palm)
 
 

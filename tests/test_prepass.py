@@ -94,9 +94,10 @@ def test_culling_changes_no_pixel(renderer, name):
 
 
 def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
-    """`krsview bench paths` times culling × pre-pass tiles at --size and twice it; its CSV
-    has every combination, the plain frame as the unit, and fewer full-pass iterations with
-    the pre-pass (no wall-time assertion: only what the rows must contain)."""
+    """`krsview bench paths` times culling × pre-pass tiles on the fragment path and the
+    compute path's round sizes, at --size and twice it; its CSV has every combination, the
+    plain frame as the unit, and fewer full-pass iterations with the pre-pass (no wall-time
+    assertion: only what the rows must contain)."""
     import csv
     import subprocess
     import sys
@@ -106,14 +107,17 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     rows = list(csv.DictReader(out.open()))
-    assert {(row["size"], row["culling"], row["prepass"]) for row in rows} == {
-        (size, c, str(t)) for size in ("32x18", "64x36") for c in ("on", "off")
-        for t in (0, 4, 8, 16)}
+    sizes = ("32x18", "64x36")
+    assert {(row["size"], row["path"], row["culling"], row["prepass"], row["steps"])
+            for row in rows} == {
+        (size, "fragment", c, str(t), "0") for size in sizes for c in ("on", "off")
+        for t in (0, 4, 8, 16)} | {(size, "compute", "on", "8", str(s)) for size in sizes
+                                   for s in (4, 8, 16, 32)}
     for row in rows:
-        plain = float(row["speedup"]) if (row["culling"], row["prepass"]) == ("off", "0") \
-            else None
-        assert plain in (None, 1.0)
+        if (row["path"], row["culling"], row["prepass"]) == ("fragment", "off", "0"):
+            assert float(row["speedup"]) == 1.0
         assert (float(row["coarse_share"]) > 0) == (row["prepass"] != "0")
-    iters = {(row["size"], row["prepass"]): float(row["iterations"]) for row in rows
-             if row["culling"] == "on"}
-    assert iters[("64x36", "4")] < iters[("64x36", "0")]
+    iters = {(row["size"], row["path"], row["prepass"], row["steps"]): float(row["iterations"])
+             for row in rows if row["culling"] == "on"}
+    assert iters[("64x36", "fragment", "4", "0")] < iters[("64x36", "fragment", "0", "0")]
+    assert iters[("64x36", "compute", "8", "4")] == iters[("64x36", "fragment", "8", "0")]

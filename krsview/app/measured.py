@@ -52,7 +52,7 @@ def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int,
         return same_but(max_iterations=int(value))
     if knob == "tracer":
         return same_but(**_tracer(value))
-    if knob in ("precision", "culling"):
+    if knob in ("precision", "culling", "path"):
         return same_but(**{knob: value})
     if knob == "prepass":
         return r == s and full and prepass == int(value)
@@ -85,7 +85,8 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
               "max_iterations": lambda: replace(base, max_iterations=int(value)),
               "tracer": lambda: replace(base, **_tracer(value)),
               "precision": lambda: replace(base, precision=value),
-              "culling": lambda: replace(base, culling=value)}.get(knob, lambda: base)()
+              "culling": lambda: replace(base, culling=value),
+              "path": lambda: replace(base, path=value)}.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
     out = [Edit(("render",), render), Do("set_levels", levels)]
     if knob == "prepass":

@@ -4,8 +4,8 @@ the ground truth (the float64 reference at ε/8); the report says which settings
 
 Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
-float64 shader), exact level culling, the pre-pass tile and level count (LOD by
-truncation). One run writes a CSV, a Markdown report, plots (time against error per knob,
+float64 shader), exact level culling, the pre-pass tile, the path (fragment or compute)
+and level count (LOD by truncation). One run writes a CSV, a Markdown report, plots (time against error per knob,
 the Pareto front over all settings) and error images (holes red, false hits blue)."""
 from __future__ import annotations
 
@@ -67,6 +67,8 @@ def settings(scene: Scene) -> list[Setting]:
                                replace(scene, render=replace(r, precision=precision))))
     if r.culling == "on" and scene.mokrs is None:       # Alg. 1's culling; not in a MöKRS
         out.append(Setting("culling", "off", replace(scene, render=replace(r, culling="off"))))
+    if r.path == "fragment":
+        out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
     for tile in PREPASS_TILES:
         if tile != r.prepass:
             out.append(Setting("prepass", f"{tile}",

@@ -1,7 +1,8 @@
 """`krsview bench paths`: what each speed lever of issue 17 buys, measured side by side —
-exact level culling on and off, the low-resolution pre-pass off and at several tile sizes,
-at two resolutions; frame-time ratios against the plain frame (no culling, no pre-pass),
-iterations per pixel of the full pass, and the coarse pass's share of the frame.
+exact level culling on and off and the low-resolution pre-pass off and at several tile sizes
+on the fragment path, and the compute path at several iterations per round, at two
+resolutions; frame-time ratios against the plain frame (fragment path, no culling, no
+pre-pass), iterations per pixel of the full pass, and the coarse pass's share of the frame.
 Variants are interleaved round by round (bench/harness.py)."""
 from __future__ import annotations
 
@@ -12,11 +13,23 @@ from ..scene import Scene
 from .harness import Variant, median_times
 from .report import write_csv
 
-TILES = (0, 4, 8, 16)    # pre-pass tile sizes compared (0: off)
+TILES = (0, 4, 8, 16)        # pre-pass tile sizes compared (0: off)
+STEPS = (4, 8, 16, 32)       # compute path: iterations per ray per round
+COMPUTE_TILE = 8             # the compute path is timed with culling and this pre-pass
 
 
-def lever(scene: Scene, culling: str, tile: int) -> Scene:
-    return replace(scene, render=replace(scene.render, culling=culling, prepass=tile))
+def lever(scene: Scene, path: str, culling: str, tile: int, steps: int) -> Scene:
+    return replace(scene, render=replace(scene.render, path=path, culling=culling,
+                                         prepass=tile, steps=steps))
+
+
+def levers(scene: Scene) -> dict[tuple, Scene]:
+    """(path, culling, tile, steps) → the scene drawn so; steps 0 on the fragment path."""
+    out = {("fragment", c, t, 0): lever(scene, "fragment", c, t, scene.render.steps)
+           for c in ("off", "on") for t in TILES}
+    out.update({("compute", "on", COMPUTE_TILE, s): lever(scene, "compute", "on", COMPUTE_TILE, s)
+                for s in STEPS})
+    return out
 
 
 def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5,
@@ -25,29 +38,31 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5,
     sizes = [size, (2 * size[0], 2 * size[1])]
     rows = []
     for w, h in sizes:
-        levers = {(c, t): lever(scene, c, t) for c in ("off", "on") for t in TILES}
-        names = {k: f"culling {k[0]}, pre-pass {k[1] or 'off'}" for k in levers}
-        med = median_times(r, {names[k]: Variant(s) for k, s in levers.items()}, (w, h),
+        variants = levers(scene)
+        names = {k: f"{k[0]}, culling {k[1]}, pre-pass {k[2] or 'off'}"
+                 + (f", {k[3]} per round" if k[3] else "") for k in variants}
+        med = median_times(r, {names[k]: Variant(s) for k, s in variants.items()}, (w, h),
                            rounds, f"bench paths {scene.name}")
-        coarse = {k: median_times(r, {names[k]: Variant(s, prepass_only=True)}, (w, h),
-                                  rounds, "pre-pass alone")[names[k]]
-                  for k, s in levers.items() if k[1]}
-        base = med[names[("off", 0)]]
-        for k, s in levers.items():
+        tiles = {k[1:3]: s for k, s in variants.items() if k[2]}
+        coarse = {k: median_times(r, {"pre-pass": Variant(s, prepass_only=True)}, (w, h),
+                                  rounds, "pre-pass alone")["pre-pass"]
+                  for k, s in tiles.items()}
+        base = med[names[("fragment", "off", 0, 0)]]
+        for k, s in variants.items():
             t = med[names[k]]
-            rows.append(dict(size=f"{w}x{h}", culling=k[0], prepass=k[1], ms=t * 1e3,
-                             speedup=base / t,
+            rows.append(dict(size=f"{w}x{h}", path=k[0], culling=k[1], prepass=k[2],
+                             steps=k[3], ms=t * 1e3, speedup=base / t,
                              iterations=float(r.render(s, w, h).iterations.mean()),
-                             coarse_share=coarse.get(k, 0.0) / t))
+                             coarse_share=coarse.get(k[1:3], 0.0) / t))
     print(f"\nSpeed levers — {scene.name}, median of {rounds} interleaved rounds; speed-up "
-          "against culling off, pre-pass off at the same size\n")
-    print("| size | culling | pre-pass tile | ms/frame | speed-up | iterations/px (full pass) "
-          "| coarse pass share |")
-    print("|---|---|---:|---:|---:|---:|---:|")
+          "against the fragment path without culling or pre-pass at the same size\n")
+    print("| size | path | culling | pre-pass tile | iterations per round | ms/frame | "
+          "speed-up | iterations/px (full pass) | coarse pass share |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|")
     for row in rows:
-        print(f"| {row['size']} | {row['culling']} | {row['prepass'] or 'off'} | "
-              f"{row['ms']:.1f} | {row['speedup']:.2f}× | {row['iterations']:.1f} | "
-              f"{row['coarse_share']:.0%} |")
+        print(f"| {row['size']} | {row['path']} | {row['culling']} | {row['prepass'] or 'off'} "
+              f"| {row['steps'] or '—'} | {row['ms']:.1f} | {row['speedup']:.2f}× | "
+              f"{row['iterations']:.1f} | {row['coarse_share']:.0%} |")
     if csv:
         write_csv(rows, csv)
     return rows

@@ -137,6 +137,16 @@ def build_program(ctx: moderngl.Context, vertex: str, fragment: str,
                           + stage.map_log(msg)) from None
 
 
+def build_compute(ctx: moderngl.Context, entry: str,
+                  defines: dict[str, str | int | float | None],
+                  shader_dir: Path = SHADER_DIR) -> moderngl.ComputeShader:
+    cs = Source(entry, defines, shader_dir)
+    try:
+        return ctx.compute_shader(cs.text)
+    except moderngl.Error as e:
+        raise ShaderError(f"{entry} failed to compile:\n" + cs.map_log(str(e))) from None
+
+
 class ProgramCache:
     """Compiled variants keyed by their define set: a variant compiles once per context."""
 
@@ -151,5 +161,13 @@ class ProgramCache:
         if key not in self._programs:
             self._programs[key] = build_program(self.ctx, vertex, fragment, defines,
                                                 self.shader_dir)
+            self.compiles += 1
+        return self._programs[key]
+
+    def compute(self, entry: str,
+                defines: dict[str, str | int | float | None]) -> moderngl.ComputeShader:
+        key = (entry, None, tuple(sorted(defines.items())))
+        if key not in self._programs:
+            self._programs[key] = build_compute(self.ctx, entry, defines, self.shader_dir)
             self.compiles += 1
         return self._programs[key]

@@ -15,13 +15,14 @@ import numpy as np
 from ..buffers import Buffers
 from ..reference.camera import view_of
 from ..reference.geometry import Compiled, compile_geometry
-from ..scene import Geometry, Scene, SceneError
+from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
 
 PROGRESS_BANDS = 16   # bands of rows of a first frame drawn with progress
 MAX_TARGETS = 8       # render-target sizes kept (least recently used released)
+COMPUTE_GROUP = 64    # compute.comp's local size
 
 
 class Renderer:
@@ -31,6 +32,8 @@ class Renderer:
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
         self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int]] = {}  # pre-pass
+        self._compute: dict[moderngl.Program, tuple] = {}   # deferred → compute, its sizes
+        self._rays: dict[int, moderngl.Buffer] = {}   # the compute path's buffers, by binding
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
@@ -87,15 +90,26 @@ class Renderer:
                              "for a compound's 8 × 64 level slots: render its components as "
                              "separate scenes")
         defines = variant_defines(scene, c, all_effects)
-        prog = self.programs.get("fullscreen.vert", "render.frag", defines)
-        progs = [prog]
+        if scene.render.path == "compute":        # trace in rounds, then a shading pass
+            prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
+            comp = self.programs.compute("compute.comp", defines)
+            components = MAX_COMPONENTS if "KRS_COMPOUND" in defines else 1
+            real = 8 if scene.render.precision == "double" else 4
+            ray_bytes = (2 * components + 4) * real + 8      # trace.glsl's Ray in std430
+            self._compute[prog] = (comp, scene.render.steps, scene.render.max_iterations,
+                                   ray_bytes)
+            progs = [prog, comp]
+        else:
+            prog = self.programs.get("fullscreen.vert", "render.frag", defines)
+            progs = [prog]
         if scene.render.prepass:
             coarse = self.programs.get("fullscreen.vert", "prepass.frag", defines)
             self._coarse[prog] = (coarse, scene.render.prepass)
             progs.append(coarse)
-            for unit, name in enumerate(("u_free0", "u_free1")):  # unused ones compile away
-                if name in prog:
-                    prog[name].value = unit
+            for p in progs:
+                for unit, name in enumerate(("u_free0", "u_free1")):  # unused: compiled away
+                    if name in p:
+                        p[name].value = unit
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
         else:
@@ -128,6 +142,8 @@ class Renderer:
         with self.current():
             if prog in self._coarse:
                 self._prepass(prog, width, height, tile)
+            if prog in self._compute:
+                self._trace_rays(prog, width, height, tile)
             fbo = self._framebuffer(width, height)
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
@@ -174,6 +190,39 @@ class Renderer:
                 self.ctx.finish()
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
+
+    def _trace_rays(self, prog: moderngl.Program, width: int, height: int,
+                    tile: tuple[int, int, int, int] | None) -> None:
+        """The compute path (compute.comp): start the rays of ``tile`` (or all), run rounds
+        of at most ``steps`` iterations, each sized by the GPU from the rays still live, and
+        leave the ray buffer bound for the shading pass (deferred.frag). Rounds enough for
+        the iteration cap are issued without reading anything back."""
+        comp, steps, cap, ray_bytes = self._compute[prog]
+        x, y, w, h = tile or (0, 0, width, height)
+        area = w * h
+        sizes = {1: area * ray_bytes, 2: 2 * area * 4, 3: 5 * 4}
+        for binding, size in sizes.items():
+            if binding not in self._rays or self._rays[binding].size < size:
+                if binding in self._rays:
+                    self._rays[binding].release()
+                self._rays[binding] = self.ctx.buffer(reserve=max(size, 16))
+            self._rays[binding].bind_to_storage_buffer(binding)
+        groups = -(-area // COMPUTE_GROUP)
+        self._rays[3].write(np.array([area, 0, groups, 1, 1], dtype=np.uint32))
+        prog["u_tile_rect"].value = (x, y, w, h)
+        for name, value in (("u_tile_rect", (x, y, w, h)), ("u_area", area),
+                            ("u_steps", steps), ("u_phase", 0)):
+            if name in comp:
+                comp[name].value = value
+        comp.run(groups)
+        for k in range(-(-cap // steps) + 1):
+            self.ctx.memory_barrier()
+            comp["u_parity"].value, comp["u_phase"].value = k % 2, 1
+            comp.run_indirect(self._rays[3], offset=8)
+            self.ctx.memory_barrier()
+            comp["u_phase"].value = 2
+            comp.run(1)
+        self.ctx.memory_barrier()
 
     def free_distances(self, scene: Scene, width: int, height: int) -> np.ndarray:
         """The pre-pass's free distance per tile and component, (rows top → bottom, columns,

@@ -17,6 +17,7 @@ MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's 
 TRACERS = ("sphere", "binary", "relaxed")
 PRECISIONS = ("float", "double")
 SWITCH = ("on", "off")
+PATHS = ("fragment", "compute")
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -236,6 +237,13 @@ class Render:
                          help="exact level culling: Alg. 1 stops at the first level whose "
                               "bounding ball is no nearer than the distance found (the same "
                               "value, fewer levels walked)")
+    path: str = param("fragment", choices=PATHS,
+                      help="fragment: one full-screen pass traces and shades each pixel; "
+                           "compute: rays in a storage buffer traced in rounds of "
+                           "--steps iterations, finished rays leaving the queue, then "
+                           "shaded in a deferred pass (the same image)")
+    steps: int = param(16, lo=1, hi=1024,
+                       help="compute path: iterations per ray per round (dispatch)")
     prepass: int = param(0, lo=0, hi=64, unit="pixels",
                          help="tile size of the low-resolution pre-pass: one cone per tile "
                               "finds how far all its rays are free, and each ray starts there "

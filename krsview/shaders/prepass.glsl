@@ -42,14 +42,14 @@ real cone_spread(vec2 corner, vec3r centre) {
 uniform sampler2D u_free0;   // free distance per component: 0..3
 uniform sampler2D u_free1;   // 4..7
 
-// Where this pixel's ray starts, per component: its tile's free distance.
-void ray_start(out real start[COMPONENT_SLOTS]) {
-    ivec2 tile = ivec2(gl_FragCoord.xy) / u_tile;
+// Where the ray of `pixel` starts, per component: its tile's free distance.
+void ray_start(ivec2 pixel, out real start[COMPONENT_SLOTS]) {
+    ivec2 tile = pixel / u_tile;
     vec4 t[2] = vec4[2](texelFetch(u_free0, tile, 0), texelFetch(u_free1, tile, 0));
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = real(t[c / 4][c % 4]);
 }
 #else
-void ray_start(out real start[COMPONENT_SLOTS]) {
+void ray_start(ivec2 pixel, out real start[COMPONENT_SLOTS]) {
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = 0.0;
 }
 #endif

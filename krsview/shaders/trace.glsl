@@ -17,73 +17,103 @@ int front(real tc[COMPONENT_SLOTS]) {
     return f;
 }
 
-#ifdef KRS_TRACER_BINARY
-#define INITIAL_PROBE 1.0
+// A ray between steps: what the fragment path keeps in registers and the compute path
+// saves in a storage buffer between dispatches (compute.comp). One step is one iteration;
+// trace_ray takes steps until the ray is done, so both paths take the same steps.
+#define RAY_LIVE 0
+#define RAY_HIT 1
+#define RAY_MISS 2
+struct Ray {
+    real tc[COMPONENT_SLOTS];   // free distance per component
+    real sc[COMPONENT_SLOTS];   // binary: probe radius per component
+    real ts, ds, w;             // relaxed: last verified point, its distance, ω
+    real t;                     // the ray distance of the last step (the hit's, once hit)
+    int iterations;
+    int state;                  // RAY_LIVE, RAY_HIT or RAY_MISS
+};
+
+#define INITIAL_PROBE 1.0 // binary tracing's first probe radius (reference/trace.py)
 #define MIN_PROBE 1e-30   // converged even where ε(t) = 0 (reference/trace.py)
 
+Ray ray_begin(real start[COMPONENT_SLOTS]) {
+    Ray r;
+    r.tc = start;
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) r.sc[c] = INITIAL_PROBE;
+    r.ts = start[0];
+    r.ds = 0.0;
+    r.w = real(u_relaxation);
+    r.t = start[0];
+    r.iterations = 0;
+    r.state = RAY_LIVE;
+    return r;
+}
+
+#ifdef KRS_TRACER_BINARY
 // Probe the ball of radius s touching the free point t: free → advance 2s, grow s;
 // blocked → converged if s ≤ ε(t), else shrink s (see reference/trace.py for why).
-bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
-               out int iterations) {
-    real tc[COMPONENT_SLOTS] = start, sc[COMPONENT_SLOTS];
-    for (int c = 0; c < COMPONENT_SLOTS; ++c) sc[c] = INITIAL_PROBE;
-    for (iterations = 0; iterations < u_max_iterations;) {
-        int c = front(tc);
-        t = tc[c];
-        if (t > u_max_distance) return false;
-        real s = sc[c];
-        bool free = is_unbounding(c, origin + (t + s) * dir, s);
-        ++iterations;
-        if (free) {
-            tc[c] = t + 2.0 * s;
-            sc[c] = s * u_xi_bonus;
-        } else {
-            if (s <= max(u_eps_per_t * t * lod_scale(origin + t * dir), MIN_PROBE)) return true;
-            sc[c] = s * u_xi_penalty;
+void ray_step(inout Ray r, vec3r origin, vec3r dir) {
+    if (r.iterations >= u_max_iterations) { r.state = RAY_MISS; return; }
+    int c = front(r.tc);
+    real t = r.tc[c];
+    r.t = t;
+    if (t > u_max_distance) { r.state = RAY_MISS; return; }
+    real s = r.sc[c];
+    bool free = is_unbounding(c, origin + (t + s) * dir, s);
+    ++r.iterations;
+    if (free) {
+        r.tc[c] = t + 2.0 * s;
+        r.sc[c] = s * u_xi_bonus;
+    } else {
+        if (s <= max(u_eps_per_t * t * lod_scale(origin + t * dir), MIN_PROBE)) {
+            r.state = RAY_HIT;
+            return;
         }
+        r.sc[c] = s * u_xi_penalty;
     }
-    return false;
 }
 #elif defined(KRS_TRACER_RELAXED)
 // Over-relaxed sphere tracing [Keinert et al. 2014] of a single KRS: step ω·d from the last
 // verified point (ts, ds); if the new free ball and the last one no longer cover [ts, t],
 // go back to ts + ds and trace plainly (ω = 1). Twin of relaxed_trace in reference/trace.py.
-bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
-               out int iterations) {
-    real ts = start[0], ds = 0.0, w = u_relaxation;
-    t = ts;
-    for (iterations = 0; iterations < u_max_iterations;) {
-        if (t > u_max_distance) return false;
-        real d = component_distance(0, origin + t * dir);
-        ++iterations;
-        if (w > 1.0 && ds + d < t - ts) {
-            t = ts + ds;
-            w = 1.0;
-            continue;
-        }
-        if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) return true;
-        ts = t;
-        ds = d;
-        t += w * d;
+void ray_step(inout Ray r, vec3r origin, vec3r dir) {
+    if (r.iterations >= u_max_iterations) { r.state = RAY_MISS; return; }
+    real t = r.t;
+    if (t > u_max_distance) { r.state = RAY_MISS; return; }
+    real d = component_distance(0, origin + t * dir);
+    ++r.iterations;
+    if (r.w > 1.0 && r.ds + d < t - r.ts) {
+        r.t = r.ts + r.ds;
+        r.w = 1.0;
+        return;
     }
-    return false;
+    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+    r.ts = t;
+    r.ds = d;
+    r.t = t + r.w * d;
 }
 #else
-bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
-               out int iterations) {
-    real tc[COMPONENT_SLOTS] = start;
-    for (iterations = 0; iterations < u_max_iterations;) {
-        int c = front(tc);
-        t = tc[c];
-        if (t > u_max_distance) return false;
-        real d = component_distance(c, origin + t * dir);
-        ++iterations;
-        if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) return true;
-        tc[c] = t + d;
-    }
-    return false;
+void ray_step(inout Ray r, vec3r origin, vec3r dir) {
+    if (r.iterations >= u_max_iterations) { r.state = RAY_MISS; return; }
+    int c = front(r.tc);
+    real t = r.tc[c];
+    r.t = t;
+    if (t > u_max_distance) { r.state = RAY_MISS; return; }
+    real d = component_distance(c, origin + t * dir);
+    ++r.iterations;
+    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+    r.tc[c] = t + d;
 }
 #endif
+
+// The whole trace of one ray: steps until it hits, leaves or reaches the cap.
+bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
+               out int iterations) {
+    Ray r = ray_begin(start);
+    while (r.state == RAY_LIVE) ray_step(r, origin, dir);
+    t = r.t;
+    iterations = r.iterations;
+    return r.state == RAY_HIT;
+}
 
 // The kernel level nearest to a hit point at ray distance t, the world normal there, and the
 // point in that kernel's own space (for kernel texture coordinates).

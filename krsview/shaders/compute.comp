@@ -1,0 +1,59 @@
+// The compute path [issue 17 §3]: rays live in a storage buffer (rays.glsl) and are traced
+// in rounds. Each round advances every live ray by at most u_steps iterations (trace.glsl's
+// ray_step: the same steps as the fragment path); a ray that is done stays in the buffer for
+// the shading pass (deferred.frag) and leaves the queue, the others are appended to the next
+// round's queue (an atomic counter: compaction), and the next round's dispatch size is
+// written by the GPU (u_phase 2) for an indirect dispatch: no read-back between rounds. The
+// queues alternate by u_parity.
+#include "effects.glsl"
+#include "scene_block.glsl"
+#include "trace.glsl"
+#include "prepass.glsl"
+#include "rays.glsl"
+
+#define GROUP 64
+layout(local_size_x = GROUP) in;
+
+layout(std430, binding = 2) buffer Queues { uint queue[]; };     // two of u_area entries
+layout(std430, binding = 3) buffer Counts {
+    uint count[2];       // live rays in each queue
+    uint groups[3];      // the next dispatch's size (glDispatchComputeIndirect)
+};
+
+uniform int u_phase;     // 0: start the rays of the tile, 1: a round, 2: size the next round
+uniform int u_parity;    // the queue this round reads
+uniform int u_steps;     // iterations per ray per round
+uniform uint u_area;     // width × height of u_tile_rect: the length of each queue
+
+void main() {
+    uint k = gl_GlobalInvocationID.x;
+    if (u_phase == 2) {                       // one invocation sizes the next round
+        if (k == 0u) {
+            uint next = count[1 - u_parity];
+            groups[0] = (next + uint(GROUP) - 1u) / uint(GROUP);
+            groups[1] = 1u;
+            groups[2] = 1u;
+            count[u_parity] = 0u;
+        }
+        return;
+    }
+    if (u_phase == 0) {
+        if (k >= u_area) return;
+        ivec2 pixel = u_tile_rect.xy + ivec2(int(k) % u_tile_rect.z, int(k) / u_tile_rect.z);
+        real start[COMPONENT_SLOTS];
+        ray_start(pixel, start);
+        rays[k] = ray_begin(start);
+        queue[k] = k;
+        return;
+    }
+    if (k >= count[u_parity]) return;
+    uint ray = queue[uint(u_parity) * u_area + k];
+    ivec2 pixel = u_tile_rect.xy + ivec2(int(ray) % u_tile_rect.z, int(ray) / u_tile_rect.z);
+    vec3r dir = pixel_ray(vec2(pixel) + 0.5);
+    Ray r = rays[ray];
+    for (int i = 0; i < u_steps && r.state == RAY_LIVE; ++i) ray_step(r, vec3r(0.0), dir);
+    rays[ray] = r;
+    if (r.state == RAY_LIVE) {
+        queue[uint(1 - u_parity) * u_area + atomicAdd(count[1 - u_parity], 1u)] = ray;
+    }
+}

@@ -1,0 +1,70 @@
+"""The compute path [issue 17 §3]: rays in a storage buffer, traced in rounds of a few
+iterations, finished rays leaving the queue, the next round sized by the GPU (indirect
+dispatch), shading deferred over a G-buffer. It takes the same steps as the fragment path,
+so the image is the same, bit for bit, for every tracer and geometry family, with and without
+the pre-pass, whole or drawn in bands. Negative control: rounds that drop the rays still
+live (no requeue) lose them."""
+from __future__ import annotations
+
+import shutil
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from krsview.gpu.program import SHADER_DIR
+from krsview.gpu.renderer import Renderer
+from krsview.presets import resolve
+from krsview.scene import load_scene
+
+W, H = 64, 36
+FIELDS = ("color", "depth", "normal", "iterations", "hit")
+
+
+def on_path(scene, path, **render):
+    return replace(scene, render=replace(scene.render, path=path, **render))
+
+
+def same(a, b) -> bool:
+    return all(np.array_equal(getattr(a, f), getattr(b, f)) for f in FIELDS)
+
+
+@pytest.mark.parametrize("name, tracer", [("tree", "sphere"), ("tree", "binary"),
+                                          ("tree", "relaxed"), ("grove", "sphere"),
+                                          ("grove", "binary"), ("palm", "binary"),
+                                          ("inversion", "binary"), ("sierpinski", "sphere")])
+@pytest.mark.parametrize("prepass", [0, 8])
+def test_compute_image_equals_fragment_image(renderer, name, tracer, prepass):
+    scene = on_path(load_scene(resolve(name)), "fragment", tracer=tracer, prepass=prepass)
+    fragment = renderer.render(scene, W, H)
+    compute = renderer.render(on_path(scene, "compute", steps=4), W, H)
+    assert same(fragment, compute)
+    assert fragment.hit.any() and (fragment.iterations > 4).any()  # several rounds ran
+
+
+def test_compute_in_bands_double_precision_and_any_round_size(renderer):
+    """Drawn in progress bands (each band its own rays and rounds), in double precision,
+    and with rounds of 1 or 1000 iterations: the same image."""
+    scene = load_scene(resolve("tree"))
+    fragment = renderer.render(on_path(scene, "fragment", precision="double"), W, H)
+    banded = renderer.render(on_path(scene, "compute", precision="double", steps=3), W, H,
+                             progress=lambda done, total: None)
+    assert same(fragment, banded)
+    plain = renderer.render(scene, W, H)
+    for steps in (1, 1000):
+        assert same(plain, renderer.render(on_path(scene, "compute", steps=steps), W, H))
+
+
+def test_rounds_that_drop_live_rays_lose_them(tmp_path, renderer):
+    """Negative control: a copy of the compute shader that does not requeue the rays still
+    live after a round leaves them out of the image."""
+    shutil.copytree(SHADER_DIR, tmp_path / "shaders")
+    path = tmp_path / "shaders" / "compute.comp"
+    text = path.read_text()
+    old = "queue[uint(1 - u_parity) * u_area + atomicAdd(count[1 - u_parity], 1u)] = ray;"
+    assert old in text
+    path.write_text(text.replace(old, ""))
+    scene = on_path(load_scene(resolve("tree")), "compute", steps=2)
+    broken = Renderer(shader_dir=tmp_path / "shaders").render(scene, W, H)
+    assert not same(renderer.render(scene, W, H), broken)
+    assert not same(renderer.render(on_path(scene, "fragment"), W, H), broken)
