@@ -381,3 +381,16 @@ def test_the_viewer_draws_with_the_prepass_and_can_turn_it_off(viewer):
     assert v.view_scene().render.prepass == 0
     changed = (np.abs(v.read_window().astype(int) - with_prepass).max(-1) > 40).mean()
     assert 0 < changed < 0.02
+
+
+def test_the_compute_path_draws_the_same_window(viewer):
+    """The HUD's path knob: the compute path (rays traced in rounds, shaded in a deferred
+    pass) shows the window the fragment path shows, pixel for pixel, while the adaptive
+    resolution and the refinement tiles draw it."""
+    v = viewer
+    settle(v)
+    fragment = v.read_window()
+    v.set_render(path="compute", steps=4)
+    settle(v)
+    assert v.view_scene().render.path == "compute"
+    assert np.array_equal(v.read_window(), fragment)
