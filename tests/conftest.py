@@ -90,6 +90,20 @@ def display():
     proc.wait(5)
 
 
+def broken_shaders(tmp_path: Path, name: str, old: str, new: str) -> Path:
+    """A copy of the shaders with ``old`` replaced by ``new`` in ``name`` (a negative
+    control's deliberately broken shader); the folder to pass as ``shader_dir``."""
+    import shutil
+    from krsview.gpu.program import SHADER_DIR
+    shaders = tmp_path / "shaders"
+    shutil.copytree(SHADER_DIR, shaders)
+    path = shaders / name
+    text = path.read_text()
+    assert old in text, f"{name} no longer holds {old!r}"
+    path.write_text(text.replace(old, new))
+    return shaders
+
+
 def headless_render(scene, path: Path, size: tuple[int, int], *options: str) -> np.ndarray:
     """`krsview render [options]` in its own process (EGL, no window) of ``scene`` saved at
     ``path``.toml: what a user gets from the command line, for comparing with a window."""

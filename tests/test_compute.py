@@ -6,16 +6,16 @@ the pre-pass, whole or drawn in bands. Negative control: rounds that drop the ra
 live (no requeue) lose them."""
 from __future__ import annotations
 
-import shutil
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from krsview.gpu.program import SHADER_DIR
 from krsview.gpu.renderer import Renderer
 from krsview.presets import resolve
 from krsview.scene import load_scene
+
+from .conftest import broken_shaders
 
 W, H = 64, 36
 FIELDS = ("color", "depth", "normal", "iterations", "hit")
@@ -58,13 +58,9 @@ def test_compute_in_bands_double_precision_and_any_round_size(renderer):
 def test_rounds_that_drop_live_rays_lose_them(tmp_path, renderer):
     """Negative control: a copy of the compute shader that does not requeue the rays still
     live after a round leaves them out of the image."""
-    shutil.copytree(SHADER_DIR, tmp_path / "shaders")
-    path = tmp_path / "shaders" / "compute.comp"
-    text = path.read_text()
-    old = "queue[uint(1 - u_parity) * u_area + atomicAdd(count[1 - u_parity], 1u)] = ray;"
-    assert old in text
-    path.write_text(text.replace(old, ""))
+    shaders = broken_shaders(tmp_path, "compute.comp", "queue[uint(1 - u_parity) * u_area + "
+                             "atomicAdd(count[1 - u_parity], 1u)] = ray;", "")
     scene = on_path(load_scene(resolve("tree")), "compute", steps=2)
-    broken = Renderer(shader_dir=tmp_path / "shaders").render(scene, W, H)
+    broken = Renderer(shader_dir=shaders).render(scene, W, H)
     assert not same(renderer.render(scene, W, H), broken)
     assert not same(renderer.render(on_path(scene, "fragment"), W, H), broken)

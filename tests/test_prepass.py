@@ -4,7 +4,6 @@ presets and hard cases — it changes hit decisions only on grazing rays, and it
 iterations. Negative control: a cone without its spread starts rays past surfaces."""
 from __future__ import annotations
 
-import shutil
 from dataclasses import replace
 
 import numpy as np
@@ -12,12 +11,13 @@ import pytest
 
 from krsview.bench.hard_cases import CASES
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
-from krsview.gpu.program import SHADER_DIR
 from krsview.gpu.renderer import Renderer
 from krsview.oracle.certify import count_errors
 from krsview.presets import resolve
 from krsview.reference.camera import view_of
 from krsview.scene import load_scene
+
+from .conftest import broken_shaders
 
 W, H = 48, 27
 
@@ -56,14 +56,10 @@ def test_the_prepass_skips_no_surface(renderer, name):
 def test_a_cone_without_its_spread_skips_surfaces(tmp_path):
     """Negative control: a pre-pass that marches the tile's centre ray alone (no spread, no
     ε margin) starts the tile's other rays past twigs the centre ray missed."""
-    shutil.copytree(SHADER_DIR, tmp_path / "shaders")
-    path = tmp_path / "shaders" / "prepass.glsl"
-    text = path.read_text()
-    old = "return sigma + real(u_eps_per_t);"
-    assert old in text
-    path.write_text(text.replace(old, "return 0.0;"))
+    shaders = broken_shaders(tmp_path, "prepass.glsl", "return sigma + real(u_eps_per_t);",
+                             "return 0.0;")
     scene = with_prepass(load_scene(resolve("tree")), 8)
-    img = Renderer(shader_dir=tmp_path / "shaders").render(scene, W, H)
+    img = Renderer(shader_dir=shaders).render(scene, W, H)
     assert count_errors(scene, img, arithmetics=("affine",)).holes > 0
 
 

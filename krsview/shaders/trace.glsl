@@ -48,15 +48,24 @@ Ray ray_begin(real start[COMPONENT_SLOTS]) {
     return r;
 }
 
+// The component that steps next and its free distance; false when the ray is done instead
+// (a miss: the iteration cap, or past the far limit).
+bool next_step(inout Ray r, out int c, out real t) {
+    if (r.iterations >= u_max_iterations) { r.state = RAY_MISS; return false; }
+    c = front(r.tc);
+    t = r.tc[c];
+    r.t = t;
+    if (t > u_max_distance) { r.state = RAY_MISS; return false; }
+    return true;
+}
+
 #ifdef KRS_TRACER_BINARY
 // Probe the ball of radius s touching the free point t: free → advance 2s, grow s;
 // blocked → converged if s ≤ ε(t), else shrink s (see reference/trace.py for why).
 void ray_step(inout Ray r, vec3r origin, vec3r dir) {
-    if (r.iterations >= u_max_iterations) { r.state = RAY_MISS; return; }
-    int c = front(r.tc);
-    real t = r.tc[c];
-    r.t = t;
-    if (t > u_max_distance) { r.state = RAY_MISS; return; }
+    int c;
+    real t;
+    if (!next_step(r, c, t)) return;
     real s = r.sc[c];
     bool free = is_unbounding(c, origin + (t + s) * dir, s);
     ++r.iterations;
@@ -93,11 +102,9 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
 }
 #else
 void ray_step(inout Ray r, vec3r origin, vec3r dir) {
-    if (r.iterations >= u_max_iterations) { r.state = RAY_MISS; return; }
-    int c = front(r.tc);
-    real t = r.tc[c];
-    r.t = t;
-    if (t > u_max_distance) { r.state = RAY_MISS; return; }
+    int c;
+    real t;
+    if (!next_step(r, c, t)) return;
     real d = component_distance(c, origin + t * dir);
     ++r.iterations;
     if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
