@@ -75,3 +75,21 @@ def test_culling_walks_fewer_levels_far_from_the_tree():
         live = np.linalg.norm(x - b[:3], axis=1) - b[3] < d
         walked += live
     assert walked.mean() < 0.8 * c.n
+
+
+def test_levels_walked_on_the_gpu_match_the_walks_and_drop_with_culling(renderer):
+    """The GPU's count of levels walked while tracing (Renderer.levels): without culling
+    every step walks all n levels of the tree, so the count is exactly iterations × n;
+    with culling no pixel walks more and many walk fewer — far more in `forest`, whose
+    steps are mostly far from the finer levels, than in `tree`, whose are in the crown."""
+    share = {}
+    for name in ("tree", "forest"):
+        scene = load_scene(resolve(name))
+        off = replace(scene, render=replace(scene.render, culling="off"))
+        walked_off, walked_on = renderer.levels(off, 64, 36), renderer.levels(scene, 64, 36)
+        if name == "tree":
+            n = len(scene.geometry().mirrors)
+            assert np.array_equal(walked_off, renderer.render(off, 64, 36).iterations * n)
+        assert (walked_on <= walked_off).all() and (walked_on < walked_off).any()
+        share[name] = walked_on.sum() / walked_off.sum()
+    assert share["forest"] < 0.8 < share["tree"]

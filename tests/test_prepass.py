@@ -109,10 +109,13 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
         (size, "fragment", c, str(t), "0") for size in sizes for c in ("on", "off")
         for t in (0, 4, 8, 16)} | {(size, "compute", "on", "8", str(s)) for size in sizes
                                    for s in (4, 8, 16, 32)}
+    n = len(load_scene(resolve("sierpinski")).geometry().mirrors)
     for row in rows:
         if (row["path"], row["culling"], row["prepass"]) == ("fragment", "off", "0"):
             assert float(row["speedup"]) == 1.0
         assert (float(row["coarse_share"]) > 0) == (row["prepass"] != "0")
+        # no level of sierpinski has a ball: every step walks all n levels
+        assert float(row["levels"]) == pytest.approx(n * float(row["iterations"]))
     iters = {(row["size"], row["path"], row["prepass"], row["steps"]): float(row["iterations"])
              for row in rows if row["culling"] == "on"}
     assert iters[("64x36", "fragment", "4", "0")] < iters[("64x36", "fragment", "0", "0")]

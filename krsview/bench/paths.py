@@ -2,7 +2,8 @@
 exact level culling on and off and the low-resolution pre-pass off and at several tile sizes
 on the fragment path, and the compute path at several iterations per round, at two
 resolutions; frame-time ratios against the plain frame (fragment path, no culling, no
-pre-pass), iterations per pixel of the full pass, and the coarse pass's share of the frame.
+pre-pass), iterations and levels of Alg. 1 walked per pixel in the full pass (a KRS), and
+the coarse pass's share of the frame.
 Variants are interleaved round by round (bench/harness.py)."""
 from __future__ import annotations
 
@@ -53,16 +54,18 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5,
             rows.append(dict(size=f"{w}x{h}", path=k[0], culling=k[1], prepass=k[2],
                              steps=k[3], ms=t * 1e3, speedup=base / t,
                              iterations=float(r.render(s, w, h).iterations.mean()),
-                             coarse_share=coarse.get(k[1:3], 0.0) / t))
+                             levels=float(r.levels(s, w, h).mean()) if not scene.mokrs
+                             else 0.0, coarse_share=coarse.get(k[1:3], 0.0) / t))
     print(f"\nSpeed levers — {scene.name}, median of {rounds} interleaved rounds; speed-up "
           "against the fragment path without culling or pre-pass at the same size\n")
     print("| size | path | culling | pre-pass tile | iterations per round | ms/frame | "
-          "speed-up | iterations/px (full pass) | coarse pass share |")
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|")
+          "speed-up | iterations/px (full pass) | levels walked/px | coarse pass share |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|")
     for row in rows:
+        levels = f"{row['levels']:.1f}" if row["levels"] else "—"      # not counted in a MöKRS
         print(f"| {row['size']} | {row['path']} | {row['culling']} | {row['prepass'] or 'off'} "
               f"| {row['steps'] or '—'} | {row['ms']:.1f} | {row['speedup']:.2f}× | "
-              f"{row['iterations']:.1f} | {row['coarse_share']:.0%} |")
+              f"{row['iterations']:.1f} | {levels} | {row['coarse_share']:.0%} |")
     if csv:
         write_csv(rows, csv)
     return rows

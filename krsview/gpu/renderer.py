@@ -5,6 +5,7 @@ With ``[render] prepass`` a coarse pass over tiles first writes each tile's free
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from contextlib import contextmanager
@@ -70,14 +71,15 @@ class Renderer:
         return self._targets[key]
 
     def prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                all_effects: bool = False) -> moderngl.Program:
+                all_effects: bool = False, count_levels: bool = False) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
-        picks the variant with every effect compiled in and switched by uniforms."""
+        picks the variant with every effect compiled in and switched by uniforms,
+        ``count_levels`` one that also counts the levels Alg. 1 walks (:meth:`levels`)."""
         with self.current():
-            return self._prepare(scene, width, height, geometry, all_effects)
+            return self._prepare(scene, width, height, geometry, all_effects, count_levels)
 
     def _prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None,
-                 all_effects: bool) -> moderngl.Program:
+                 all_effects: bool, count_levels: bool = False) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
         c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         block = krs_block(c, scene.render.precision)
@@ -90,6 +92,9 @@ class Renderer:
                              "for a compound's 8 × 64 level slots: render its components as "
                              "separate scenes")
         defines = variant_defines(scene, c, all_effects)
+        if count_levels:
+            defines["KRS_COUNT_LEVELS"] = None
+            scene = replace(scene, render=replace(scene.render, path="fragment"))
         if scene.render.path == "compute":        # trace in rounds, then a shading pass
             prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
             comp = self.programs.compute("compute.comp", defines)
@@ -223,6 +228,15 @@ class Renderer:
             comp["u_phase"].value = 2
             comp.run(1)
         self.ctx.memory_barrier()
+
+    def levels(self, scene: Scene, width: int, height: int) -> np.ndarray:
+        """Per pixel (rows top → bottom), the levels Alg. 1 walked while tracing the ray (not
+        shading it), summed over its steps: with culling, fewer than steps × n. Counted by
+        a variant of the fragment path (the compute path takes the same steps)."""
+        with self.current():
+            prog = self.prepare(scene, width, height, count_levels=True)
+            fbo = self.draw(prog, width, height)
+            return read_plane(fbo, 2, width, height)[..., 1].astype(np.int64)
 
     def free_distances(self, scene: Scene, width: int, height: int) -> np.ndarray:
         """The pre-pass's free distance per tile and component, (rows top → bottom, columns,

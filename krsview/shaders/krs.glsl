@@ -14,10 +14,16 @@ real fold(int i, inout vec3r p) {
 // Exact level culling [issue 17]: once d ≤ dist(x, C_i), the ball of everything levels i..0
 // would still test (reference/compiled.py, krs_bounds; r < 0: none), the walk stops with the
 // same value. Most rays far from the finer levels pay for a few levels instead of n.
+#ifdef KRS_COUNT_LEVELS
+int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
+#endif
 real krs_distance(int first, int n, vec3r xw) {
     vec3r x = xw;
     real d = kernel_distance(first + n, x);
     for (int i = first + n - 1; i >= first; --i) {
+#ifdef KRS_COUNT_LEVELS
+        ++g_levels;
+#endif
 #ifdef KRS_CULLING
         vec4r b = u_bounds[i];
         if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;

@@ -5,7 +5,7 @@
 
 layout(location = 0) out vec4 out_color;      // rgb, hit
 layout(location = 1) out vec4 out_normal;     // xyz, depth t
-layout(location = 2) out vec4 out_iterations; // x
+layout(location = 2) out vec4 out_iterations; // x; y: levels walked (KRS_COUNT_LEVELS)
 
 void write_pixel(vec3r dir, bool hit, real t, int iterations) {
     out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);

@@ -13,5 +13,11 @@ void main() {
     real t;
     int iterations;
     bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);
+#ifdef KRS_COUNT_LEVELS
+    int levels = g_levels;   // the tracing's, before shading walks more
+#endif
     write_pixel(dir, hit, t, iterations);
+#ifdef KRS_COUNT_LEVELS
+    out_iterations.y = float(levels);
+#endif
 }
