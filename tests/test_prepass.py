@@ -77,6 +77,8 @@ def test_rays_start_at_their_tiles_free_distance(renderer, name):
     assert free.shape[:2] == (-(-90 // 8), -(-160 // 8))
     assert np.isfinite(free).all() and (free >= 0).all() and (free > 0).mean() > 0.9
     assert img.iterations.mean() < 0.6 * plain.iterations.mean()
+    with pytest.raises(ValueError, match="prepass > 0"):    # no pre-pass: nothing to read
+        renderer.free_distances(scene, 160, 90)
 
 
 @pytest.mark.parametrize("name", ["tree", "grove", "forest"])

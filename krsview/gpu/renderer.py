@@ -242,6 +242,8 @@ class Renderer:
         """The pre-pass's free distance per tile and component, (rows top → bottom, columns,
         8), for a scene with ``[render] prepass`` > 0: what each of the tile's rays starts
         from."""
+        if not scene.render.prepass:
+            raise ValueError(f"{scene.name}: free distances need [render] prepass > 0")
         with self.current():
             prog = self.prepare(scene, width, height)
             size = self._coarse[prog][1]

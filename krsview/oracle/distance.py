@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..algebra import mobius
 from ..reference.compiled import CompiledCompound, CompiledKRS
 from ..reference.mokrs import CompiledMoKRS
 from .numbers import Affine, Interval, Number
@@ -115,14 +114,10 @@ def steps(c: CompiledKRS | CompiledMoKRS):
     mapped out by G_i = H_i⁻¹ (``reference/mokrs.bounds_in_and_out``), so it is tested before
     H_i, where a pole of H_i is not."""
     if isinstance(c, CompiledMoKRS):
-        scale = 1.0          # world length per unit of the current frame, while similarities
         for i in range(c.n - 1, -1, -1):
             ball = c.outer[i] if c.outer[i, 3] >= 0 else None
             move = lambda x, H=c.inverse[i], r=c.reflect[i]: inwards(H, r, x)  # noqa: E731
-            yield ball, np.inf if ball is None else ball[3] * scale, move, c.types[i], \
-                c.records[i]
-            G = mobius.inverse(c.inverse[i])
-            scale = np.inf if mobius.pole(G) is not None else scale * mobius.affine_scale(G)
+            yield ball, c.outer_size[i], move, c.types[i], c.records[i]
         return
     yield None, np.inf, lambda x: x, c.types[c.n], c.records[c.n]
     for i in range(c.n - 1, -1, -1):

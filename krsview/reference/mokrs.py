@@ -28,11 +28,13 @@ def level_bounds(m: MoKRS) -> np.ndarray:
     return bounds_in_and_out(m)[0]
 
 
-def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray]:
+def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`level_bounds`, and each mapped out by G_i into the space before H_i (level
     i+1's; the world for the outermost), widened by CULL_MARGIN against the float64 map's
     rounding (the oracle tests them before H_i, away from its pole); radius −1 where
-    unbounded or where the bound holds G_i's pole (its image is no ball)."""
+    unbounded or where the bound holds G_i's pole (its image is no ball). Third, each mapped
+    ball's radius in world lengths: scaled by the maps above it while they are similarities,
+    ∞ below a map with a pole (its scale varies) or where unbounded."""
     out, outer, below = [], [], None    # below: bound of L_{i−1} in level i's space
     unbounded = False
     for lv in m.levels:
@@ -50,7 +52,14 @@ def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray]:
         margin = CULL_MARGIN * float(np.abs(below[:3]).max()) if below is not None else 0.0
         outer.append(UNBOUNDED if unbounded or ball is None else
                      np.array([*below[:3], below[3] * (1 + CULL_MARGIN) + margin]))
-    return np.array(out), np.array(outer)
+    outer = np.array(outer)
+    size, scale = np.full(len(outer), np.inf), 1.0   # world length per unit of level i+1
+    for i in range(len(outer) - 1, -1, -1):
+        if outer[i, 3] >= 0:
+            size[i] = outer[i, 3] * scale
+        G = m.levels[i].matrix()
+        scale = np.inf if mobius.pole(G) is not None else scale * mobius.affine_scale(G)
+    return np.array(out), outer, size
 
 
 @dataclass(frozen=True)
@@ -62,6 +71,7 @@ class CompiledMoKRS:
     poles: np.ndarray        # (n, 4): (pole.xyz | (|a|/|d|, 0, 0), has_pole + 2·reflects)
     bounds: np.ndarray       # (n, 4): level_bounds, in each level's own space
     outer: np.ndarray        # (n, 4): each mapped out by G_i (bounds_in_and_out)
+    outer_size: np.ndarray   # (n,): their radii in world lengths (∞: the scale varies)
 
     @property
     def n(self) -> int:
@@ -77,7 +87,7 @@ class CompiledMoKRS:
         if outer[-1, 3] >= 0:
             outer[-1, :3] -= np.asarray(origin, dtype=np.float64)
         return CompiledMoKRS(inverse, self.reflect, self.records, self.types, poles,
-                             self.bounds, outer)   # level spaces do not move
+                             self.bounds, outer, self.outer_size)   # level spaces stay
 
 
 def pole_record(H: np.ndarray, reflect: bool) -> np.ndarray:
