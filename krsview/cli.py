@@ -159,7 +159,8 @@ def cmd_render(args: argparse.Namespace) -> int:
 def cmd_view(args: argparse.Namespace) -> int:
     from .app.window import Viewer
     viewer = Viewer(resolve(args.preset), size=args.size, hud=not args.no_hud,
-                    target_fps=args.fps, prepass=args.prepass)
+                    target_fps=args.fps, prepass=args.prepass,
+                    moving_effects=args.moving_effects)
     print(f"krsview: viewing {viewer.path} — WASD/QE fly, right-drag look, scroll speed, "
           "O orbit, R reset, B bookmark, F5/F6 record/replay, F12 screenshot, F1 HUD")
     viewer.run()
@@ -429,6 +430,9 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--prepass", type=_int_in("--prepass", 0, 64), metavar="TILE",
                    help="tile size of the low-resolution pre-pass while viewing (default: "
                         "the scene's [render] prepass, else 8; 0: off)")
+    v.add_argument("--moving-effects", action="store_true",
+                   help="keep shadows and ambient occlusion in moving frames too (default: "
+                        "they appear when the view stops, so moving frames stay sharp)")
     v.set_defaults(func=cmd_view)
 
     e = sub.add_parser("edit", help="shape a tree: drag forks, control points and mirror "

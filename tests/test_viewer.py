@@ -187,7 +187,8 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once
-    (its tracing program and its pre-pass); switching back, and moving accuracy knobs,
+    (its tracing program and its pre-pass, for the moving frames without the tree's soft
+    shadows and for the still image with them); switching back, and moving accuracy knobs,
     compile nothing."""
     v = viewer
     settle(v)
@@ -196,7 +197,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     sphere_image = v.read_window()
     v.set_render(tracer="binary")
     settle(v)
-    assert v.prepass and programs.compiles == before + 2
+    assert v.prepass and programs.compiles == before + 4
     assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
     binary_image = v.read_window()
     assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
@@ -204,7 +205,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     settle(v)
     v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
     settle(v)
-    assert programs.compiles == before + 2
+    assert programs.compiles == before + 4
 
 
 def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
@@ -394,3 +395,33 @@ def test_the_compute_path_draws_the_same_window(viewer):
     settle(v)
     assert v.view_scene().render.path == "compute"
     assert np.array_equal(v.read_window(), fragment)
+
+
+def test_moving_frames_leave_out_shadow_rays_and_the_still_image_has_them(viewer, tmp_path):
+    """While the view moves, frames skip the effects that trace the geometry again per pixel
+    (the tree's soft shadows), so the adaptive resolution can stay higher; the still image and
+    `--moving-effects` have them. Each frame is compared with a headless render of the same
+    view with and without the shadows (negative control: the other one differs)."""
+    v = viewer
+    v.adaptive.target_fps, v.adaptive.scale = 0.5, 1.0   # every frame fits: moving = full size
+
+    def agree(shot, ref):
+        return (np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2).mean()
+
+    hold(v, "W", 1)
+    assert not v.refined and v.image[1] == SIZE       # full size, but shadows still to come
+    moving = v.read_window()
+    assert "soft_shadows" in v.scene.effects
+    assert "soft_shadows" not in v.view_scene(moving=True).effects
+    light = headless_render(v.view_scene(moving=True).with_geometry(v.krs), tmp_path / "m", SIZE)
+    full = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "f", SIZE)
+    shadowed = agree(light, full)
+    assert shadowed < 0.97, "the view has no shadows to leave out"
+    assert agree(moving, light) >= 0.99
+    settle(v)
+    assert agree(v.read_window(), full) >= 0.99
+    v.set_moving_effects(True)
+    hold(v, "S", 1)
+    full = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "f2", SIZE)
+    assert v.view_scene(moving=True).effects == v.scene.effects
+    assert agree(v.read_window(), full) >= 0.99

@@ -71,6 +71,13 @@ def _performance(v: "Viewer", out: list) -> None:
     changed, ss = imgui.checkbox("supersample still images 2×2", v.adaptive.supersample == 2)
     if changed:
         out.append(Do("set_supersample", 2 if ss else 1))
+    changed, on = imgui.checkbox("shadows and occlusion while moving", v.moving_effects)
+    if changed:
+        out.append(Do("set_moving_effects", on))
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("off: moving frames skip the effects that trace the geometry again "
+                          "per pixel, for a sharper image at the target FPS; the still image "
+                          "always has them")
 
 
 def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:

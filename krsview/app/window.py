@@ -18,7 +18,7 @@ from ..gpu.renderer import Renderer
 from ..gpu.context import GL_VERSION
 from ..reference.geometry import compile_geometry, free_radius
 from ..editor.document import Document
-from ..scene.effects import EXCLUSIVE
+from ..scene.effects import EFFECTS, EXCLUSIVE
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.scene import write_atomic
 from .adaptive import AdaptiveResolution, Refinement
@@ -38,12 +38,13 @@ VIEW_PREPASS = 8         # pre-pass tile while flying: 2.2–3× faster frames (
 class Viewer:
     def __init__(self, path: Path, size: tuple[int, int] = (960, 540), hud: bool = True,
                  target_fps: float = 30.0, visible: bool = True, shader_dir: Path = SHADER_DIR,
-                 prepass: int | None = None):
+                 prepass: int | None = None, moving_effects: bool = False):
         self.shader_dir = Path(shader_dir)
         self.doc = Document(path)              # a bad file is a SceneError before any window
         # the pre-pass tile the viewer draws with: given, else the file's, else VIEW_PREPASS
         self.prepass = prepass if prepass is not None else \
             self.doc.scene.render.prepass or VIEW_PREPASS
+        self.moving_effects = moving_effects    # False: moving frames skip secondary effects
         self.platform = Platform(size, self.window_title(), visible)
         self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
@@ -152,9 +153,14 @@ class Viewer:
         effects += [name] if on else []
         self.edit(("effects",), effects)
 
-    def view_scene(self) -> Scene:
-        """The scene as drawn now: the viewer's camera and settings."""
-        return replace(self.scene, camera=self.camera.to_camera(),
+    def view_scene(self, moving: bool = False) -> Scene:
+        """The scene as drawn now: the viewer's camera and settings. A moving frame leaves out
+        the effects that trace the geometry again per pixel (shadow rays, occlusion samples:
+        40 % of a `tree` frame) unless ``moving_effects``; the still image has them all."""
+        effects = self.scene.effects
+        if moving and not self.moving_effects:
+            effects = [e for e in effects if not EFFECTS[e].secondary]
+        return replace(self.scene, camera=self.camera.to_camera(), effects=effects,
                        render=replace(self.scene.render, prepass=self.prepass))
 
     def nearest_distance(self) -> float:
@@ -218,8 +224,9 @@ class Viewer:
         if self.dirty:
             size = self.adaptive.moving_size()
             t0 = time.perf_counter()
+            moving = self.view_scene(moving=True)
             try:
-                prog = self.renderer.prepare(scene, *size, self.krs)
+                prog = self.renderer.prepare(moving, *size, self.krs)
             except ShaderError as e:
                 self.error, self.dirty = str(e), False
                 return
@@ -230,7 +237,8 @@ class Viewer:
             self.frame_seconds = (self.frame_seconds + [seconds])[-240:]
             self.image = (fbo, size)
             still = self.adaptive.still_size()
-            self.refinement = Refinement(still) if still != size else None
+            final = still == size and moving.effects == scene.effects
+            self.refinement = None if final else Refinement(still)
             self.dirty = False
         elif self.refinement is not None and not self.refinement.done:
             r = self.refinement
@@ -345,6 +353,9 @@ class Viewer:
 
     def set_prepass(self, tile: int) -> None:
         self.prepass, self.dirty = tile, True
+
+    def set_moving_effects(self, on: bool) -> None:
+        self.moving_effects, self.dirty = on, True
 
     def set_target_fps(self, fps: float) -> None:
         self.adaptive.target_fps = fps

@@ -7,7 +7,7 @@ distance function or its mirror planes, which a MöKRS does not have [KRS17 §7]
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from .schema import SceneError, Vec3, param
 
@@ -18,6 +18,8 @@ class Effect:
     help: str
     needs_distance: bool = False  # a KRS distance function and mirror planes (not a MöKRS)
     bit: int = 0                  # its bit in u_effects when all effects are compiled in
+    secondary: bool = False       # evaluates the geometry again per hit pixel (a shadow ray,
+                                  # occlusion samples): the viewer drops it while moving
 
 
 _LIST = [
@@ -27,11 +29,11 @@ _LIST = [
            "filtered by the pixel footprint [KRS17 §8.2]"),
     Effect("kernel_texture", "procedural bark-like texture in each kernel's own coordinates "
            "(along / around a capsule) [KRS17 §8.2]", needs_distance=True),
-    Effect("shadows", "hard shadows: one shadow ray per light [KRS17 §8.5]"),
+    Effect("shadows", "hard shadows: one shadow ray per light [KRS17 §8.5]", secondary=True),
     Effect("soft_shadows", "soft shadows from the closest free distance along the shadow ray "
-           "[KRS17 §8.5]"),
+           "[KRS17 §8.5]", secondary=True),
     Effect("ambient_occlusion", "darken creases by sampling the distance along the normal "
-           "[KRS17 §8.5]", needs_distance=True),
+           "[KRS17 §8.5]", needs_distance=True, secondary=True),
     Effect("twist", "twist the geometry around a vertical axis, steps kept safe by the "
            "twist's Lipschitz bound [KRS17 §5.2]", needs_distance=True),
     Effect("empty_zones", "remove the geometry inside given spheres [KRS17 §8.4]",
@@ -40,8 +42,7 @@ _LIST = [
     Effect("fog", "exponential distance fog towards the sky colour"),
     Effect("tone_mapping", "exposure and filmic (ACES) tone curve before gamma"),
 ]
-EFFECTS: dict[str, Effect] = {e.name: Effect(e.name, e.help, e.needs_distance, 1 << k)
-                              for k, e in enumerate(_LIST)}
+EFFECTS: dict[str, Effect] = {e.name: replace(e, bit=1 << k) for k, e in enumerate(_LIST)}
 EXCLUSIVE = [("shadows", "soft_shadows")]  # pairs a scene may not list together
 MAX_EMPTY_ZONES = 8
 
