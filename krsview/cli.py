@@ -110,7 +110,12 @@ def _load(args: argparse.Namespace) -> Scene:
 
 def cmd_render(args: argparse.Namespace) -> int:
     scene = _load(args)
-    out = check_output_file(args.output, "-o", ".png")
+    if args.camera_path is not None:
+        return render_camera_path(args, scene)
+    for flag in ("frames", "video"):
+        if getattr(args, flag) is not None:
+            raise SceneError(f"--{flag}", getattr(args, flag), "needs --camera-path FILE")
+    out = check_output_file(args.output or "out/render.png", "-o", ".png")
     if args.buffers:
         check_output_file(args.buffers, "--buffers", ".npz")
     w, h = args.size
@@ -153,6 +158,43 @@ def cmd_render(args: argparse.Namespace) -> int:
     if args.buffers:
         buffers.save_npz(args.buffers)
         print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")
+    return 0
+
+
+def frame_job(args: argparse.Namespace, scene: Scene):
+    """The frames ``--camera-path``, ``--frames``, ``--fps``, ``--size`` and ``-o`` ask for,
+    checked before any frame is drawn."""
+    from .scene.camera_path import load_camera_path
+    from .share.frames import FrameJob, parse_frames
+    path = load_camera_path(args.camera_path)
+    folder = Path(args.output or "out/frames")
+    if folder.suffix.lower() == ".png":
+        raise SceneError("-o", str(folder), "with --camera-path, give a folder for the frames")
+    check_output_dir(folder, "-o")
+    job = FrameJob(scene, path, args.fps, args.size, folder)
+    return job, parse_frames(args.frames, job.count)
+
+
+def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
+    from .share.frames import render_frames, write_video
+    job, frames = frame_job(args, scene)
+    video = check_output_file(args.video, "--video", ".mp4") if args.video else None
+    if video is not None and (job.size[0] % 2 or job.size[1] % 2):
+        raise SceneError("--size", f"{job.size[0]}x{job.size[1]}",
+                         "--video needs an even width and height (H.264, 4:2:0 colour)")
+    todo = job.missing(frames)
+    print(f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of "
+          f"{job.count} ({job.path.duration:.2f} s at {job.fps:g} fps), "
+          f"{job.size[0]}×{job.size[1]} → {job.folder}/; "
+          f"{len(frames) - len(todo)} already there, {len(todo)} to render", flush=True)
+    if todo:
+        from .gpu.renderer import Renderer
+        bar = Progress(len(todo), "  frames")
+        render_frames(job, todo, Renderer(), lambda k: bar.step(f"frame {k}"))
+    if video is not None:
+        bar = Progress(len(frames), "  video")
+        write_video(job.folder, frames, job.fps, video, lambda k: bar.step())
+        print(f"  wrote {video.resolve()}")
     return 0
 
 
@@ -392,8 +434,9 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Render PRESET headless through EGL and write a PNG; prints "
                                    "the measured frame time.")
     r.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    r.add_argument("-o", "--output", default="out/render.png",
-                   help="PNG file to write, ending in .png (default %(default)s)")
+    r.add_argument("-o", "--output",
+                   help="PNG file to write, ending in .png (default out/render.png); with "
+                        "--camera-path, the folder for the frames (default out/frames)")
     r.add_argument("--size", type=_size, default=(640, 360), help="WIDTHxHEIGHT (default 640x360)")
     r.add_argument("--buffers", metavar="NPZ",
                    help="also write color, depth, normal, iterations and hit arrays to this "
@@ -416,6 +459,17 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(r, "path")
     render_option(r, "steps")
     accuracy(r)
+    cp = r.add_argument_group(
+        "camera paths", "Render the frames of a path recorded in the viewer (F5; saved as "
+        "NAME.path.json beside the preset) to frame_00000.png, … in the -o folder. Frames "
+        "already there are skipped, so an interrupted run resumes where it stopped.")
+    cp.add_argument("--camera-path", metavar="FILE", help="a NAME.path.json camera path")
+    cp.add_argument("--frames", metavar="A-B",
+                    help="render only frames A to B, inclusive (default: all the path's)")
+    cp.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
+                    help="frames per second of path time (default 30)")
+    cp.add_argument("--video", metavar="MP4", help="also write the frames as an H.264 video, "
+                    "ending in .mp4 (needs an even width and height)")
     r.set_defaults(func=cmd_render)
 
     v = sub.add_parser("view", help="fly through a scene in a window",

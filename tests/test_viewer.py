@@ -171,18 +171,18 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
     v.act("record")
     hold(v, "W", 4)
     v.act("record")
-    end, recorded = v.camera.position.copy(), len(v.path_samples)
+    end, recorded = v.camera.position.copy(), len(v.camera_path.poses)
     assert v.path_file().exists() and v.path_file().name == "tree.path.json"
-    v.path_samples = []
+    v.camera_path = None
     v.open_preset(v.path)  # as a new session would: the path comes from the file
-    assert len(v.path_samples) == recorded > 0
+    assert len(v.camera_path.poses) == recorded > 0
     v.act("replay")
     for _ in range(20):
         v.step(0.05)
     assert np.allclose(v.camera.position, end)
     v.path_file().write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
     v.open_preset(v.path)
-    assert v.path_samples == [] and "tree.path.json: not a camera path" in v.error
+    assert v.camera_path is None and "tree.path.json: poses[0]" in v.error
 
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):

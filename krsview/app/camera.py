@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..scene import Camera
+from ..scene.camera_path import horizontal_axes, look_direction
 
 MAX_PITCH = math.radians(89.0)
 
@@ -25,17 +26,14 @@ class FlyCamera:
         up = np.array(cam.up, dtype=np.float64)
         f = np.array(cam.target, dtype=np.float64) - np.array(cam.position, dtype=np.float64)
         f /= np.linalg.norm(f)
-        east, north = _horizontal_axes(up)
+        east, north = horizontal_axes(up)
         pitch = math.asin(max(-1.0, min(1.0, float(f @ up))))
         yaw = math.atan2(float(f @ east), float(f @ north))
         return cls(np.array(cam.position, dtype=np.float64), yaw,
                    max(-MAX_PITCH, min(MAX_PITCH, pitch)), cam.fov_y, up)
 
     def forward(self) -> np.ndarray:
-        east, north = _horizontal_axes(self.world_up)
-        cp = math.cos(self.pitch)
-        return (cp * math.sin(self.yaw) * east + cp * math.cos(self.yaw) * north
-                + math.sin(self.pitch) * self.world_up)
+        return look_direction(self.yaw, self.pitch, self.world_up)
 
     def right(self) -> np.ndarray:
         r = np.cross(self.forward(), self.world_up)
@@ -67,12 +65,3 @@ class FlyCamera:
     def dolly(self, pivot: np.ndarray, factor: float) -> None:
         """Scale the distance to ``pivot`` (orbit mode's W/S)."""
         self.position = pivot + (self.position - pivot) * factor
-
-
-def _horizontal_axes(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit axes ⟂ up; yaw 0 looks along ``north`` (+z for a y-up world)."""
-    ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    north = ref - (ref @ up) * up
-    north /= np.linalg.norm(north)
-    east = np.cross(up, north)
-    return east, north

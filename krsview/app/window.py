@@ -2,7 +2,6 @@
 and hot reload of the preset and the shaders."""
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -21,6 +20,7 @@ from ..editor.document import Document
 from ..scene.effects import EFFECTS, EXCLUSIVE
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.scene import write_atomic
+from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
 from .adaptive import AdaptiveResolution, Refinement
 from .commands import Command, Edit
 from .hud import draw_hud
@@ -58,8 +58,8 @@ class Viewer:
         self.speed_factor = 1.0                 # × distance to the nearest surface, per second
         self.orbit_pivot: np.ndarray | None = None
         self.message, self.error = "", ""
-        self.recording: list[tuple[float, np.ndarray, float, float]] | None = None
-        self.path_samples: list[tuple[float, np.ndarray, float, float]] = []
+        self.recording: list[Pose] | None = None
+        self.camera_path: CameraPath | None = None     # NAME.path.json, recorded or loaded
         self.replay_start: float | None = None
         self.bookmark_index = -1
         self.clock = 0.0
@@ -340,9 +340,11 @@ class Viewer:
             if self.recording is None:
                 self.recording, self.message = [], "recording the camera path (F5 stops)"
             else:
-                self.path_samples, self.recording = self.recording, None
-                self.save_path()
-        elif action == "replay" and self.path_samples:
+                if self.recording:
+                    self.camera_path = CameraPath(tuple(self.recording))
+                    self.save_path()
+                self.recording = None
+        elif action == "replay" and self.camera_path is not None:
             self.replay_start = self.clock
 
     def go_to_bookmark(self, index: int) -> None:
@@ -381,31 +383,23 @@ class Viewer:
         return self.path.with_name(self.path.stem + ".path.json")
 
     def save_path(self) -> None:
-        samples = [dict(t=t, position=[float(c) for c in pos], yaw=yaw, pitch=pitch)
-                   for t, pos, yaw, pitch in self.path_samples]
+        poses = list(self.camera_path.poses)
         try:
-            write_atomic(self.path_file(), json.dumps({"poses": samples}, indent=1))
-            self.message = (f"recorded {len(samples)} poses to {self.path_file().name} "
-                            "(F6 replays)")
+            write_atomic(self.path_file(), camera_path_json(poses))
+            self.message = (f"recorded {len(poses)} poses to {self.path_file().name} "
+                            "(F6 replays; `krsview render --camera-path` renders its frames)")
         except OSError as e:
             self.error = f"{self.path_file()}: cannot save the camera path: {e.strerror}"
 
     def load_path(self) -> None:
         """The preset's saved camera path, if any; a damaged file is reported, not fatal."""
         f = self.path_file()
-        self.path_samples = []
-        if not f.exists():
-            return
-        try:
-            poses = json.loads(f.read_text())["poses"]
-            self.path_samples = [(float(p["t"]), np.array(p["position"], dtype=np.float64),
-                                  float(p["yaw"]), float(p["pitch"])) for p in poses]
-            if not all(np.isfinite(s[1]).all() and s[1].shape == (3,) for s in self.path_samples):
-                raise ValueError("non-finite or malformed position")
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            self.path_samples = []
-            self.error = (f"{f}: not a camera path ({e}); expected "
-                          '{"poses": [{"t", "position": [x, y, z], "yaw", "pitch"}, …]}')
+        self.camera_path = None
+        if f.exists():
+            try:
+                self.camera_path = load_camera_path(f)
+            except SceneError as e:
+                self.error = str(e)
 
     def pick_center(self) -> np.ndarray:
         """The surface point under the window centre, from the last traced depth; else a point
@@ -421,18 +415,17 @@ class Viewer:
 
     def _replay(self) -> None:
         if self.recording is not None:
-            self.recording.append((self.clock, self.camera.position.copy(), self.camera.yaw,
-                                   self.camera.pitch))
+            self.recording.append(Pose(self.clock, tuple(float(c) for c in self.camera.position),
+                                       self.camera.yaw, self.camera.pitch))
         if self.replay_start is None:
             return
-        t = self.clock - self.replay_start + self.path_samples[0][0]
-        times = [s[0] for s in self.path_samples]
-        k = int(np.searchsorted(times, t))
-        if k >= len(times):
+        path = self.camera_path
+        t = self.clock - self.replay_start
+        if t >= path.duration:
             self.replay_start, self.message = None, "replay finished"
-            k = len(times) - 1
-        _, pos, yaw, pitch = self.path_samples[k]
-        self.camera.position, self.camera.yaw, self.camera.pitch = pos.copy(), yaw, pitch
+        pose = path.pose_at(t)
+        self.camera.position = np.array(pose.position, dtype=np.float64)
+        self.camera.yaw, self.camera.pitch = pose.yaw, pose.pitch
         self.dirty = True
 
     # ------------------------------------------------------------------ files and output

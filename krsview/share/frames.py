@@ -1,0 +1,100 @@
+"""Frames of a camera path, and a video of them: what ``krsview render --camera-path`` and
+each worker of ``krsview batch`` do. Frame k is ``frame_00042.png`` in the output folder,
+written atomically, so a folder holds only whole frames; a run skips the frames already
+there, which makes an interrupted run resumable and lets chunks be rendered anywhere."""
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Callable
+
+from ..scene import Scene, SceneError
+from ..scene.camera_path import CameraPath
+
+DEFAULT_FPS = 30.0
+
+
+def frame_file(folder: Path, k: int) -> Path:
+    return Path(folder) / f"frame_{k:05d}.png"
+
+
+@dataclass(frozen=True)
+class FrameJob:
+    """Everything a renderer needs for frames of one path: plain data, so it can be sent
+    to another process or machine (``krsview batch``)."""
+    scene: Scene
+    path: CameraPath
+    fps: float
+    size: tuple[int, int]
+    folder: Path
+
+    @property
+    def count(self) -> int:
+        return self.path.frame_count(self.fps)
+
+    def frame_scene(self, k: int) -> Scene:
+        return replace(self.scene, camera=self.path.camera(k, self.fps, self.scene.camera))
+
+    def missing(self, frames: range) -> list[int]:
+        """Frames of ``frames`` with no file yet (what a resumed run still renders)."""
+        return [k for k in frames if not frame_file(self.folder, k).exists()]
+
+
+def parse_frames(text: str | None, count: int, flag: str = "--frames") -> range:
+    """``A-B`` (inclusive), ``A`` or None (all) → a range within 0 … count−1."""
+    if text is None:
+        return range(count)
+    try:
+        a, _, b = text.partition("-")
+        lo, hi = int(a), int(b) if b else int(a)
+    except ValueError:
+        raise SceneError(flag, text, "expected FIRST-LAST or one frame number, e.g. 0-119")
+    if not 0 <= lo <= hi < count:
+        raise SceneError(flag, text, f"the path has frames 0-{count - 1} at this frame rate; "
+                                     "allowed 0 ≤ FIRST ≤ LAST ≤ " + str(count - 1))
+    return range(lo, hi + 1)
+
+
+def render_frames(job: FrameJob, frames: list[int], renderer,
+                  done: Callable[[int], None] | None = None) -> None:
+    """Render ``frames`` of ``job`` with ``renderer`` (a gpu Renderer), each written to a
+    temporary file and renamed into place; ``done(k)`` after each."""
+    w, h = job.size
+    for k in frames:
+        buffers = renderer.render(job.frame_scene(k), w, h)
+        target = frame_file(job.folder, k)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".png", dir=job.folder)
+        os.close(fd)
+        try:
+            buffers.save_png(tmp)
+            os.replace(tmp, target)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        if done is not None:
+            done(k)
+
+
+def write_video(folder: Path, frames: range, fps: float, video: Path,
+                done: Callable[[int], None] | None = None) -> None:
+    """An H.264 MP4 of the frames' PNGs (imageio-ffmpeg ships its own ffmpeg), written to a
+    temporary file first so a failed run leaves no half video."""
+    import imageio.v3 as iio
+    import imageio_ffmpeg
+    first = iio.imread(frame_file(folder, frames[0]))
+    h, w = first.shape[:2]
+    tmp = video.with_name(f".{video.name}.tmp{video.suffix}")
+    writer = imageio_ffmpeg.write_frames(str(tmp), (w, h), fps=fps, codec="libx264",
+                                         pix_fmt_out="yuv420p", macro_block_size=1,
+                                         quality=8)
+    writer.send(None)
+    try:
+        for k in frames:
+            writer.send(iio.imread(frame_file(folder, k))[..., :3].copy(order="C"))
+            if done is not None:
+                done(k)
+    finally:
+        writer.close()
+    os.replace(tmp, video)

@@ -1,0 +1,175 @@
+"""Camera-path frames and video [issue 18 §3]: each frame is the headless render of its
+camera (computed here from the pose by the fly camera's formula, not by the code under test),
+chunks and resumed runs give the same files, and the video holds the frames."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from krsview.presets import resolve
+from krsview.scene import Camera, SceneError, load_scene
+from krsview.scene.camera_path import CameraPath, Pose, load_camera_path
+from krsview.share.frames import FrameJob, frame_file, parse_frames, render_frames
+
+from .conftest import headless_render
+
+SIZE = (64, 36)
+FPS = 4.0
+# tree's camera looks along +z with y up; three poses 0.5 s apart, turning and climbing
+POSES = [dict(t=10.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
+         dict(t=10.5, position=[0.5, 2.5, -8.0], yaw=0.3, pitch=0.1),
+         dict(t=11.0, position=[1.0, 2.5, -7.0], yaw=-0.2, pitch=0.1)]
+
+
+@pytest.fixture
+def path_file(tmp_path):
+    f = tmp_path / "tree.path.json"
+    f.write_text(json.dumps({"poses": POSES}))
+    return f
+
+
+def krsview(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "krsview", *args], capture_output=True,
+                          text=True, timeout=300, env={**os.environ, "DISPLAY": ""})
+
+
+def read(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(path).convert("RGB")).astype(int)
+
+
+def expected_camera(position, yaw: float, pitch: float, base: Camera) -> Camera:
+    """y up: yaw 0 looks along +z, yaw > 0 turns towards +x, pitch > 0 looks up."""
+    d = (math.cos(pitch) * math.sin(yaw), math.sin(pitch), math.cos(pitch) * math.cos(yaw))
+    target = tuple(p + c for p, c in zip(position, d))
+    return Camera(tuple(position), target, base.up, base.fov_y)
+
+
+def test_poses_interpolate_linearly_and_clamp(path_file):
+    path = load_camera_path(path_file)
+    assert path.duration == 1.0 and path.frame_count(FPS) == 5
+    mid = path.pose_at(0.25)
+    assert np.allclose(mid.position, [0.25, 2.25, -8.5]) and math.isclose(mid.yaw, 0.15)
+    assert path.pose_at(-1).position == (0.0, 2.0, -9.0)
+    assert path.pose_at(5).yaw == -0.2
+    # yaw turns the short way round across ±π
+    wrap = CameraPath((Pose(0, (0, 0, 0), 3.0, 0), Pose(1, (0, 0, 0), -3.0, 0)))
+    assert math.isclose(wrap.pose_at(0.5).yaw, math.pi, rel_tol=1e-12)
+
+
+def test_each_frame_is_the_headless_render_of_its_camera(path_file, tmp_path):
+    r = krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
+                "--fps", str(FPS), "-o", str(tmp_path / "frames"))
+    assert r.returncode == 0, r.stderr
+    assert "frames 0-4 of 5" in r.stdout and "0 already there, 5 to render" in r.stdout
+    scene = load_scene(resolve("tree"))
+    for k, pose in ((0, POSES[0]), (2, POSES[1]), (4, POSES[2])):
+        cam = expected_camera(pose["position"], pose["yaw"], pose["pitch"], scene.camera)
+        ref = headless_render(replace(scene, camera=cam), tmp_path / f"ref{k}", SIZE)
+        frame = read(frame_file(tmp_path / "frames", k))
+        assert (np.abs(frame - ref).max(-1) <= 2).mean() >= 0.999, k
+    # negative control: a frame is not its neighbour
+    assert (np.abs(read(frame_file(tmp_path / "frames", 1)) - ref).max(-1) > 2).mean() > 0.05
+
+
+def test_chunks_and_an_interrupted_run_give_the_same_files(path_file, tmp_path, renderer):
+    scene = load_scene(resolve("tree"))
+    path = load_camera_path(path_file)
+    whole, chunks = tmp_path / "whole", tmp_path / "chunks"
+    whole.mkdir(), chunks.mkdir()
+    render_frames(FrameJob(scene, path, FPS, SIZE, whole), list(range(5)), renderer)
+
+    class Interrupted(Exception):
+        pass
+
+    def stop_after_two(k):
+        if k == 1:
+            raise Interrupted
+    job = FrameJob(scene, path, FPS, SIZE, chunks)
+    with pytest.raises(Interrupted):
+        render_frames(job, [3, 4, 0, 1, 2], renderer, stop_after_two)  # a chunk, then a crash
+    assert sorted(p.name for p in chunks.iterdir()) == [frame_file(chunks, k).name
+                                                        for k in (0, 1, 3, 4)]   # whole files
+    assert job.missing(range(5)) == [2]
+    render_frames(job, job.missing(range(5)), renderer)
+    for k in range(5):
+        assert np.array_equal(read(frame_file(whole, k)), read(frame_file(chunks, k))), k
+
+
+def test_a_resumed_run_skips_the_frames_already_written(path_file, tmp_path):
+    out = tmp_path / "frames"
+    assert krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
+                   "--fps", "4", "-o", str(out), "--frames", "1-3").returncode == 0
+    assert sorted(p.name for p in out.iterdir()) == [f"frame_0000{k}.png" for k in (1, 2, 3)]
+    stamps = {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)}
+    r = krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
+                "--fps", "4", "-o", str(out))
+    assert "3 already there, 2 to render" in r.stdout
+    assert {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)} == stamps
+    assert len(list(out.iterdir())) == 5
+
+
+def test_the_video_holds_the_frames(path_file, tmp_path):
+    import imageio_ffmpeg
+    out, video = tmp_path / "frames", tmp_path / "fly.mp4"
+    r = krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
+                "--fps", "4", "-o", str(out), "--video", str(video))
+    assert r.returncode == 0, r.stderr
+    reader = imageio_ffmpeg.read_frames(str(video))
+    meta = next(reader)
+    assert tuple(meta["size"]) == SIZE and meta["fps"] == 4.0
+    decoded = [np.frombuffer(f, np.uint8).reshape(SIZE[1], SIZE[0], 3).astype(int)
+               for f in reader]
+    assert len(decoded) == 5
+    for k in range(5):
+        assert np.abs(decoded[k] - read(frame_file(out, k))).mean() < 4, k   # lossy, close
+    assert np.abs(decoded[0] - read(frame_file(out, 4))).mean() > 8           # and in order
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--frames", "3-9"], "--frames = '3-9': the path has frames 0-4 at this frame rate"),
+    (["--frames", "x"], "--frames = 'x': expected FIRST-LAST or one frame number"),
+    (["--video", "v.avi"], "--video = 'v.avi': the file must end in .mp4"),
+    (["--size", "63x36", "--video", "v.mp4"], "--video needs an even width and height"),
+    (["-o", "f.png"], "-o = 'f.png': with --camera-path, give a folder for the frames"),
+])
+def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, message):
+    r = krsview("render", "tree", "--camera-path", str(path_file), "--fps", "4",
+                *(["-o", str(tmp_path / "f")] if "-o" not in args else []), *args)
+    assert r.returncode == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1, \
+        r.stderr
+    assert not (tmp_path / "f").exists() or not any((tmp_path / "f").iterdir())
+
+
+@pytest.mark.parametrize("text, message", [
+    ("{", "not JSON"),
+    ('{"poses": []}', "poses = []: a non-empty list"),
+    ('{"poses": [{"t": 0, "position": [1, "x", 0], "yaw": 0, "pitch": 0}]}', "poses[0]"),
+    ('{"poses": [{"t": 0, "position": [1, 2], "yaw": 0, "pitch": 0}]}', "3-vector"),
+    ('{"poses": [{"t": 1, "position": [0, 0, 0], "yaw": 0, "pitch": 0},'
+     ' {"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 0}]}', "poses[1].t = 0.0: times must"),
+    ('{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 2}]}', "−π/2 < pitch"),
+    ('{"poses": [{"t": 0, "position": [0, 0, NaN], "yaw": 0, "pitch": 0}]}', "finite"),
+])
+def test_a_damaged_path_file_names_the_file_and_the_pose(tmp_path, text, message):
+    f = tmp_path / "bad.path.json"
+    f.write_text(text)
+    with pytest.raises(SceneError) as e:
+        load_camera_path(f)
+    assert message in str(e.value) and str(f) in str(e.value)
+    r = krsview("render", "tree", "--camera-path", str(f), "-o", str(tmp_path / "out"))
+    assert r.returncode == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1
+
+
+def test_frames_outside_the_path_are_refused():
+    assert parse_frames(None, 5) == range(5) and parse_frames("2", 5) == range(2, 3)
+    with pytest.raises(SceneError, match="allowed 0 ≤ FIRST ≤ LAST ≤ 4"):
+        parse_frames("4-2", 5)
