@@ -5,8 +5,10 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 # Headless OpenGL through EGL on Mesa (llvmpipe when there is no GPU); Xvfb for the tests
-# that open the real viewer and editor windows, xdotool for real pointer and key events there.
-APT_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool
+# that open the real viewer and editor windows, xdotool for real pointer and key events there;
+# chromium (headless WebGL2 on SwiftShader) and glslang-tools test the web export.
+APT_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool \
+                chromium glslang-tools
 STAMP  := $(VENV)/.installed
 
 .PHONY: demo test deps venv clean

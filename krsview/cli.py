@@ -198,6 +198,20 @@ def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
     return 0
 
 
+def cmd_export_web(args: argparse.Namespace) -> int:
+    from .scene.scene import write_atomic
+    from .share.web import export_notes, html_page, shadertoy_source
+    scene = _load(args)
+    out = check_output_file(args.output, "-o", args.suffix)
+    notes = export_notes(scene)
+    text = html_page(scene) if args.format == "html" else shadertoy_source(scene)
+    write_atomic(out, text)
+    for note in notes:
+        print(f"  note: {note}")
+    print(f"krsview: {scene.name}: wrote {out.resolve()} ({len(text) / 1024:.0f} KiB)")
+    return 0
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     from .app.window import Viewer
     viewer = Viewer(resolve(args.preset), size=args.size, hud=not args.no_hud,
@@ -525,6 +539,26 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--size", type=_size, default=(48, 27),
                    help="image size for --stability and --oracle (default 48x27)")
     c.set_defaults(func=cmd_check)
+
+    x = sub.add_parser("export", help="a web page, a Shadertoy shader or a mesh of a scene",
+                       description="Take a scene out of krsview.")
+    xsub = x.add_subparsers(dest="format", required=True, metavar="FORMAT")
+    for fmt, suffix, text in (
+            ("html", ".html", "one self-contained page (no server, no network) that runs the "
+             "scene's own specialised tracer in WebGL2: drag to orbit, wheel to zoom, "
+             "double-click to reset. Open it in any current browser."),
+            ("shadertoy", ".glsl", "the same shader as one Shadertoy mainImage (scene baked "
+             "in as constants; iResolution, iTime and iMouse drive the camera). Paste it into "
+             "a new shader on shadertoy.com.")):
+        xp = xsub.add_parser(fmt, help=text.split(" (")[0].split(":")[0],
+                             description=text + " Double precision cannot be exported "
+                             "(GLSL ES 3.00 has no fp64); the pre-pass and the compute path "
+                             "are left out (the same surfaces, one fragment pass).")
+        xp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+        xp.add_argument("-o", "--output", required=True,
+                        help=f"file to write, ending in {suffix}")
+        accuracy(xp)
+        xp.set_defaults(func=cmd_export_web, suffix=suffix)
 
     b = sub.add_parser("bench", help="benchmarks (levels, tracers, effects, accuracy)",
                        description="Benchmarks that report ratios measured side by side.")

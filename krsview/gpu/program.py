@@ -12,6 +12,9 @@ import moderngl
 from .context import GL_VERSION
 
 SHADER_DIR = Path(str(resources.files("krsview") / "shaders"))
+CORE_HEADER = (f"#version {GL_VERSION} core",)
+# WebGL2 (share/web.py): GLSL ES 3.00 has no default float precision in fragment shaders
+ES_HEADER = ("#version 300 es", "precision highp float;", "precision highp int;")
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 # Mesa: "0:12(5): error"; NVIDIA: "0(12) : error". The line is in the assembled source.
 _LOCATION = re.compile(r"\b\d+(?::(\d+)\((\d+)\)|\((\d+)\))")
@@ -34,9 +37,9 @@ class Source:
     compiles none of that effect's code (DESIGN.md, Specialise, don't branch)."""
 
     def __init__(self, entry: str, defines: dict[str, str | int | float | None],
-                 shader_dir: Path = SHADER_DIR):
+                 shader_dir: Path = SHADER_DIR, header: tuple[str, ...] = CORE_HEADER):
         self.shader_dir = shader_dir
-        head = [f"#version {GL_VERSION} core"]
+        head = list(header)
         head += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
                  sorted(defines.items())]
         self.origin: list[tuple[str, int]] = [("<defines>", k) for k in range(1, len(head) + 1)]

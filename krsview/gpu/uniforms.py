@@ -60,22 +60,27 @@ def slots(c: Compiled) -> int:
 def krs_block(c: Compiled, precision: str = "float") -> bytes:
     """The std140 KRSBlock: mirrors and culling balls (or Möbius records), then kernel
     records, as float32 or, for ``precision = "double"`` (dvec4 arrays), float64."""
-    n = slots(c)
+    return b"".join(a.tobytes() for a in block_arrays(c, precision, slots(c)).values())
+
+
+def block_arrays(c: Compiled, precision: str, n: int) -> dict[str, np.ndarray]:
+    """KRSBlock's members in order, each (vec4s, 4), for ``n`` level slots (at least
+    ``len(c.records)``, the slots in use; unused slots stay zero, balls −1: none)."""
     dtype = np.float64 if precision == "double" else np.float32
+    kernels = np.zeros((n, RECORD_VEC4, 4), dtype=dtype)
+    kernels[:len(c.records)] = c.records
     if isinstance(c, CompiledMoKRS):
         head = np.zeros((n, MOBIUS_RECORD, 4), dtype=dtype)
         head[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
         head[:c.n, 4] = c.poles
         head[:c.n, 5] = c.bounds
-    else:
-        head = np.zeros((2, n, 4), dtype=dtype)        # mirrors, then culling balls
-        head[1, :, 3] = -1.0
-        for part, first in component_slots(c):
-            head[0, first:first + part.n] = part.mirrors
-            head[1, first:first + part.n] = part.bounds
-    kernels = np.zeros((n, RECORD_VEC4, 4), dtype=dtype)
-    kernels[:len(c.records)] = c.records
-    return head.tobytes() + kernels.tobytes()
+        return {"u_mobius": head.reshape(-1, 4), "u_kernels": kernels.reshape(-1, 4)}
+    mirrors, bounds = np.zeros((n, 4), dtype=dtype), np.zeros((n, 4), dtype=dtype)
+    bounds[:, 3] = -1.0
+    for part, first in component_slots(c):
+        mirrors[first:first + part.n] = part.mirrors
+        bounds[first:first + part.n] = part.bounds
+    return {"u_mirrors": mirrors, "u_bounds": bounds, "u_kernels": kernels.reshape(-1, 4)}
 
 
 def component_slots(c: Compiled) -> list[tuple]:

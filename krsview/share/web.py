@@ -1,0 +1,163 @@
+"""`krsview export html|shadertoy`: the scene's own specialised tracer in GLSL ES 3.00 for
+WebGL2 [issue 18 §1]. The fragment stage is assembled from the app's shader files
+(``web.frag`` includes the same tracer and shading as ``render.frag``) with the scene's
+defines; then every uniform the renderer would upload is baked into a constant, relative to
+the exported camera's eye O, and the camera's uniforms become globals that
+``orbit_camera`` sets from the mouse. The page is one file with no server or network; the
+Shadertoy file is one ``mainImage``.
+
+What cannot be exported: double precision (GLSL ES has no fp64). The compute path and the
+pre-pass are speed-ups of the desktop renderer (a storage buffer, float render targets): the
+page traces every pixel in one fragment pass, the same surfaces."""
+from __future__ import annotations
+
+import html
+import json
+import math
+import re
+from dataclasses import replace
+from importlib import resources
+
+import numpy as np
+
+from ..gpu.program import ES_HEADER, Source
+from ..gpu.uniforms import block_arrays, variant_defines, view_uniforms
+from ..reference.camera import view_of
+from ..reference.geometry import compile_geometry
+from ..scene import Scene, SceneError
+from ..scene.camera_path import horizontal_axes
+
+# Set per pixel by orbit_camera (web.frag): declared as plain globals.
+CAMERA = ("u_eye_shift", "u_forward", "u_right", "u_up", "u_resolution", "u_footprint",
+          "u_eps_per_t")
+PAGE = ("u_orbit", "u_canvas")   # the page's own uniforms (Shadertoy has iMouse instead)
+_UNIFORM = re.compile(r"^\s*uniform\s+(\w+)\s+(\w+)\s*(\[\s*(\w+)\s*\])?\s*;.*$", re.M)
+_BLOCK = re.compile(r"layout\(std140\) uniform KRSBlock \{.*?\};", re.S)
+_REAL = {"real": "float", "vec2r": "vec2", "vec3r": "vec3", "vec4r": "vec4", "mat3r": "mat3"}
+
+
+def export_notes(scene: Scene) -> list[str]:
+    """What the export leaves out, one line each; a scene that cannot be exported at all
+    is a SceneError naming the field."""
+    r = scene.render
+    if r.precision == "double":
+        raise SceneError("render.precision", "double", 'a web page or Shadertoy cannot draw '
+                         'it: GLSL ES 3.00 (WebGL2) has no fp64; export with precision = '
+                         '"float"')
+    notes = []
+    if r.path == "compute":
+        notes.append("render.path = \"compute\": the page traces in one fragment pass "
+                     "(WebGL2 has no compute shaders; the same image)")
+    if r.prepass:
+        notes.append(f"render.prepass = {r.prepass}: the page traces without the pre-pass "
+                     "(the same surfaces, a slower frame)")
+    return notes
+
+
+def web_shader(scene: Scene, shadertoy: bool = False) -> str:
+    """The fragment stage of the page (``#version 300 es``), or Shadertoy's body (Shadertoy
+    adds the version, precision and its uniforms)."""
+    export_notes(scene)
+    scene = replace(scene, render=replace(scene.render, prepass=0, path="fragment"))
+    view = view_of(scene.camera, 640, 360)   # only its eye O matters: the rest is live
+    c = compile_geometry(scene.geometry(), scene.material.albedo).relative_to(view.origin)
+    defines = variant_defines(scene, c)
+    defines["KRS_SLOTS"] = len(c.records)                  # the slots in use, no more
+    if shadertoy:
+        defines["KRS_SHADERTOY"] = None
+    text = Source("web.frag", defines, header=() if shadertoy else ES_HEADER).text
+    values = {**view_uniforms(scene, view, c), **orbit_uniforms(scene, view.origin),
+              "u_epsilon_scale": scene.render.epsilon_scale}
+    blocks = block_arrays(c, "float", len(c.records))
+    text = _BLOCK.sub(lambda m: "\n".join(const_array("vec4", k, v) for k, v in blocks.items()),
+                      text)
+    return _UNIFORM.sub(lambda m: _bake(m, values, shadertoy), text)
+
+
+def orbit_uniforms(scene: Scene, origin: np.ndarray) -> dict[str, object]:
+    """The orbit of web.frag's orbit_camera: around the scene camera's target, starting at
+    its eye (relative to O, the eye itself)."""
+    cam = scene.camera
+    up = np.array(cam.up, dtype=np.float64)
+    up /= np.linalg.norm(up)
+    east, north = horizontal_axes(up)
+    target = np.array(cam.target, dtype=np.float64) - origin
+    away = -target / np.linalg.norm(target)
+    return {"u_orbit_target": tuple(target), "u_orbit_east": tuple(east),
+            "u_orbit_north": tuple(north), "u_orbit_up": tuple(up),
+            "u_orbit_start": (math.atan2(away @ east, away @ north),
+                              math.asin(max(-1.0, min(1.0, away @ up))),
+                              float(np.linalg.norm(target)))}
+
+
+def _bake(m: re.Match, values: dict, shadertoy: bool) -> str:
+    kind, name, count = _REAL.get(m.group(1), m.group(1)), m.group(2), m.group(4)
+    if name in CAMERA:
+        return f"{kind} {name}{m.group(3) or ''};"
+    if name in PAGE and not shadertoy:
+        return m.group(0)
+    if name not in values:
+        raise RuntimeError(f"web export: no value for uniform {name} (web.py, values)")
+    if count is None:
+        return f"const {kind} {name} = {literal(kind, values[name])};"
+    return const_array(kind, name, values[name])
+
+
+def const_array(kind: str, name: str, rows) -> str:
+    rows = list(rows)
+    items = ",\n    ".join(literal(kind, r) for r in rows)
+    return f"const {kind} {name}[{len(rows)}] = {kind}[{len(rows)}](\n    {items});"
+
+
+def literal(kind: str, value) -> str:
+    """A GLSL ES constant of type ``kind`` (float32 values written to round-trip)."""
+    flat = np.atleast_1d(np.asarray(value, dtype=np.float64)).ravel()
+    if not np.isfinite(flat).all():
+        raise RuntimeError(f"web export: a {kind} constant is not finite: {value!r}")
+    if kind in ("int", "ivec2", "ivec3", "ivec4", "bool"):
+        parts = [str(int(v)) for v in flat] if kind != "bool" else [str(bool(flat[0])).lower()]
+    else:
+        parts = [_float(v) for v in flat]
+    return parts[0] if kind in ("int", "float", "bool") else f"{kind}({', '.join(parts)})"
+
+
+def _float(v: float) -> str:
+    text = format(float(np.float32(v)), ".9g")
+    return text if ("." in text or "e" in text) else text + ".0"
+
+
+def vertex_shader() -> str:
+    """The app's full-screen triangle, in GLSL ES."""
+    return Source("fullscreen.vert", {}, header=ES_HEADER).text
+
+
+def html_page(scene: Scene) -> str:
+    """One self-contained page: canvas, the two shaders, and a few lines of WebGL2."""
+    template = resources.files("krsview.share").joinpath("page.html").read_text("utf-8")
+    notes = export_notes(scene)
+    return (template
+            .replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
+            .replace("{{NOTES}}", html.escape(" · ".join(notes)))
+            .replace("{{VERTEX}}", json.dumps(vertex_shader()))
+            .replace("{{FRAGMENT}}", json.dumps(web_shader(scene))))
+
+
+def shadertoy_source(scene: Scene) -> str:
+    """The scene as one Shadertoy ``mainImage``: drag the mouse to orbit (x: around, y: up
+    and down), and the view turns slowly with time."""
+    head = (f"// krsview — {scene.name}: a Kernel–Reflection Sequence scene exported by "
+            "`krsview export shadertoy` [KRS17].\n// Drag to orbit; the view turns slowly "
+            "with time.\n")
+    notes = "".join(f"// note: {n}\n" for n in export_notes(scene))
+    body = web_shader(scene, shadertoy=True)
+    return head + notes + body + SHADERTOY_MAIN
+
+
+SHADERTOY_MAIN = """
+void mainImage(out vec4 fragColor, in vec2 fragCoord) {
+    vec3 orbit = vec3(0.05 * iTime, 0.0, 1.0);
+    if (iMouse.z > 0.0) orbit.xy += vec2(-6.0, 3.0) * (iMouse.xy / iResolution.xy - 0.5);
+    orbit_camera(iResolution.xy, orbit);
+    fragColor = krs_image(fragCoord);
+}
+"""

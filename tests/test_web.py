@@ -1,0 +1,192 @@
+"""Web page and Shadertoy export [issue 18 §1], checked in a real browser: Debian's chromium,
+headless, WebGL2 on its SwiftShader rasteriser. Each screenshot is compared with `krsview
+render` (EGL, llvmpipe) of the same view; the orbit is checked against cameras computed here
+from the orbit formula, and every preset and hard case compiles as GLSL ES 3.00
+(glslangValidator)."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from krsview.bench.hard_cases import CASES
+from krsview.presets import preset_names, resolve
+from krsview.scene import Camera, SceneError, load_scene, save_scene
+from krsview.share.web import html_page, shadertoy_source, web_shader
+
+from .conftest import headless_render
+
+SIZE = (160, 90)
+BROWSER = ["chromium", "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
+           "--enable-unsafe-swiftshader", "--hide-scrollbars", "--virtual-time-budget=8000"]
+# Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
+# main that calls mainImage (iMouse released, iTime 0).
+TOY_PAGE_SHADER = ("#version 300 es\nprecision highp float;\nprecision highp int;\n"
+                   "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\n"
+                   "{body}\nout vec4 toy_out;\n"
+                   "void main() {{ mainImage(toy_out, gl_FragCoord.xy); }}\n")
+
+
+def screenshot(page: Path, out: Path, fragment: str = "bare") -> np.ndarray:
+    """The page at SIZE in headless chromium (software WebGL2), rows top → bottom."""
+    assert shutil.which("chromium"), "chromium is missing: `make deps` installs it"
+    r = subprocess.run([*BROWSER, f"--window-size={SIZE[0]},{SIZE[1]}",
+                        f"--screenshot={out}", f"{page.resolve().as_uri()}#{fragment}"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and out.exists(), r.stderr[-2000:]
+    return np.asarray(Image.open(out).convert("RGB")).astype(int)
+
+
+def reference(scene, tmp_path: Path, name: str) -> np.ndarray:
+    """`krsview render` of the scene (no pre-pass: the page has none)."""
+    return headless_render(scene, tmp_path / name, SIZE, "--prepass", "0").astype(int)
+
+
+def agreement(a: np.ndarray, b: np.ndarray, tolerance: int) -> float:
+    return float((np.abs(a - b).max(-1) <= tolerance).mean())
+
+
+def export_page(scene, tmp_path: Path, name: str) -> Path:
+    page = tmp_path / f"{name}.html"
+    page.write_text(html_page(scene), encoding="utf-8")
+    return page
+
+
+@pytest.mark.parametrize("name", ["tree", "palm", "grove", "sierpinski", "grass"])
+def test_the_page_draws_what_krsview_render_draws(name, tmp_path):
+    """Colour within 16 of 255 on ≥ 97 % of pixels and a mean difference ≤ 2: two different
+    software rasterisers round differently, which shows on sub-pixel leaves and blades."""
+    scene = load_scene(resolve(name))
+    shot = screenshot(export_page(scene, tmp_path, name), tmp_path / "shot.png")
+    ref = reference(scene, tmp_path, "ref")
+    assert agreement(shot, ref, 16) >= 0.97 and np.abs(shot - ref).max(-1).mean() <= 2.0
+    # negative control: the view a little turned is another picture
+    turned = screenshot(tmp_path / f"{name}.html", tmp_path / "turned.png", "bare&orbit=0.1,0,1")
+    assert agreement(turned, ref, 16) < 0.95
+
+
+def silhouette(scene):
+    """The scene with flat colours: hits lit by ambient 1 alone (no lights, no effects),
+    misses black, so a screenshot is its hit mask."""
+    material = replace(scene.material, background=(0.0, 0.0, 0.0), ambient=(1.0, 1.0, 1.0))
+    return replace(scene, effects=[], lights=[], material=material)
+
+
+@pytest.mark.parametrize("name", ["tree", "palm"])
+def test_the_page_hits_what_krsview_render_hits(name, tmp_path):
+    scene = silhouette(load_scene(resolve(name)))
+    shot = screenshot(export_page(scene, tmp_path, name), tmp_path / "shot.png")
+    ref = reference(scene, tmp_path, "ref")
+    hit_page, hit_ref = shot.max(-1) > 10, ref.max(-1) > 10
+    assert 0.05 < hit_ref.mean() < 0.6
+    assert (hit_page == hit_ref).mean() >= 0.99
+
+
+def orbit_camera(scene, yaw: float, pitch: float, zoom: float) -> Camera:
+    """The page's orbit, computed here: around the camera's target, y up, yaw 0 looking
+    along +z (towards the target from −z), the distance scaled by zoom."""
+    cam = scene.camera
+    target, eye = np.array(cam.target), np.array(cam.position)
+    away = (eye - target) / np.linalg.norm(eye - target)
+    yaw0 = math.atan2(away[0], away[2])
+    pitch0 = math.asin(away[1])
+    y, p = yaw0 + yaw, pitch0 + pitch
+    d = np.linalg.norm(eye - target) * zoom
+    new_eye = target + d * np.array([math.cos(p) * math.sin(y), math.sin(p),
+                                     math.cos(p) * math.cos(y)])
+    return Camera(tuple(new_eye), cam.target, cam.up, cam.fov_y)
+
+
+def test_the_orbit_moves_the_camera_as_the_formula_says(tmp_path):
+    scene = load_scene(resolve("tree"))
+    assert scene.camera.up == (0.0, 1.0, 0.0)
+    page = export_page(scene, tmp_path, "tree")
+    shot = screenshot(page, tmp_path / "shot.png", "bare&orbit=0.7,0.25,0.8")
+    ref = reference(replace(scene, camera=orbit_camera(scene, 0.7, 0.25, 0.8)), tmp_path, "r")
+    assert agreement(shot, ref, 16) >= 0.97
+    assert agreement(shot, reference(scene, tmp_path, "still"), 16) < 0.8
+
+
+def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
+    """The .glsl file inside Shadertoy's wrapper (version, iResolution, iTime 0, iMouse 0)."""
+    scene = load_scene(resolve("palm"))
+    page = export_page(scene, tmp_path, "palm")
+    body = shadertoy_source(scene)
+    assert "void mainImage(out vec4 fragColor, in vec2 fragCoord)" in body
+    assert "#version" not in body
+    assert not [line for line in body.splitlines() if line.lstrip().startswith("uniform")]
+    text = page.read_text(encoding="utf-8")
+    start = text.index("const FRAGMENT = ") + len("const FRAGMENT = ")
+    end = text.index(";\nconst canvas")
+    toy = page.with_name("toy.html")
+    toy.write_text(text[:start] + json.dumps(TOY_PAGE_SHADER.format(body=body)) + text[end:]
+                   .replace('gl.getUniformLocation(program, "u_orbit")',
+                            'gl.getUniformLocation(program, "iMouse")')
+                   .replace('gl.getUniformLocation(program, "u_canvas")',
+                            'gl.getUniformLocation(program, "iResolution")')
+                   .replace("gl.uniform3fv(uOrbit, orbit);", "gl.uniform4f(uOrbit, 0, 0, 0, 0);")
+                   .replace("gl.uniform2f(uCanvas, w, h);", "gl.uniform3f(uCanvas, w, h, 1);"),
+                   encoding="utf-8")
+    shot = screenshot(toy, tmp_path / "toy.png")
+    ref = reference(scene, tmp_path, "ref")
+    assert agreement(shot, ref, 16) >= 0.97
+
+
+def glsl_es_errors(text: str, tmp_path: Path) -> str:
+    f = tmp_path / "stage.frag"
+    f.write_text(text, encoding="utf-8")
+    r = subprocess.run(["glslangValidator", "-S", "frag", str(f)], capture_output=True,
+                       text=True, timeout=60)
+    return "" if r.returncode == 0 else r.stdout + r.stderr
+
+
+def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
+    assert shutil.which("glslangValidator"), "glslang-tools is missing: `make deps`"
+    scenes = [(n, load_scene(resolve(n))) for n in preset_names()]
+    scenes += [(f"hard:{c.name}", c.build()) for c in CASES.values()]
+    exported = refused = 0
+    for name, scene in scenes:
+        try:
+            page, toy = web_shader(scene), shadertoy_source(scene)
+        except SceneError as e:
+            assert scene.render.precision == "double" and "no fp64" in str(e), name
+            refused += 1
+            continue
+        assert not glsl_es_errors(page, tmp_path), name
+        assert not glsl_es_errors(TOY_PAGE_SHADER.format(body=toy), tmp_path), name
+        exported += 1
+    assert exported == len(scenes) - refused and exported > len(preset_names())
+    # negative control: the validator does reject what GLSL ES forbids
+    assert glsl_es_errors(web_shader(load_scene(resolve("tree"))).replace(
+        "precision highp float;", "") + "\ndouble x;", tmp_path)
+
+
+def test_export_on_the_command_line_and_its_refusals(tmp_path):
+    run = lambda *a: subprocess.run([sys.executable, "-m", "krsview", "export", *a],  # noqa
+                                    capture_output=True, text=True, timeout=120,
+                                    env={**os.environ, "DISPLAY": ""})
+    r = run("html", "tree", "-o", str(tmp_path / "t.html"), "--levels", "8")
+    assert r.returncode == 0 and "wrote" in r.stdout, r.stderr
+    r = run("shadertoy", "palm", "-o", str(tmp_path / "p.glsl"))
+    assert r.returncode == 0 and (tmp_path / "p.glsl").read_text().count("mainImage") == 1
+    bad = run("html", "tree", "-o", str(tmp_path / "t.htm"))
+    assert bad.returncode == 2 and "-o = " in bad.stderr and "must end in .html" in bad.stderr
+    deep = load_scene(resolve("tree"))
+    save_scene(replace(deep, render=replace(deep.render, precision="double", prepass=8)),
+               tmp_path / "deep.toml")
+    r = run("html", str(tmp_path / "deep.toml"), "-o", str(tmp_path / "d.html"))
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1
+    assert "render.precision = 'double'" in r.stderr and "no fp64" in r.stderr
+    assert not (tmp_path / "d.html").exists()
+    save_scene(replace(deep, render=replace(deep.render, prepass=8)), tmp_path / "pre.toml")
+    r = run("html", str(tmp_path / "pre.toml"), "-o", str(tmp_path / "p.html"))
+    assert r.returncode == 0 and "note: render.prepass = 8" in r.stdout
