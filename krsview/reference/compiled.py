@@ -70,15 +70,10 @@ def union_ball(p: np.ndarray | None, q: np.ndarray | None) -> np.ndarray | None:
     return np.array([*(p[:3] + (r - p[3]) / d * (q[:3] - p[:3])), r])
 
 
-def krs_bounds(krs: KRS) -> np.ndarray:
-    """(n, 4): per mirror slot i, a ball C_i holding everything Alg. 1 still tests before
-    folding at level i — K_i and the levels below, doubled by R_i: C_i = S ∪ R_i(S),
-    S = ball(K_i) ∪ C_{i−1} (radius −1: unbounded, from a plane kernel on). A point x with
-    d ≤ dist(x, C_i) cannot lower d any more: the walk stops there with the same value
-    [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding.
-    Slots below only empty kernels get no ball (the walk's d is still ∞ there)."""
-    out, below = [], None
-    unbounded = False
+def level_balls(krs: KRS) -> list[np.ndarray | None]:
+    """Per mirror slot i, the ball C_i = S ∪ R_i(S), S = ball(K_i) ∪ C_{i−1} (krs_bounds),
+    exactly; None where it is unbounded (a plane kernel at or below i) or holds nothing."""
+    out, below, unbounded = [], None, False
     for k, m in zip(krs.kernels, krs.mirrors):
         ball = kernel_ball(k)
         unbounded |= ball is None and not isinstance(k, Empty)
@@ -88,7 +83,30 @@ def krs_bounds(krs: KRS) -> np.ndarray:
                 u, w = np.array(m.normal), m.offset
                 mirrored = np.array([*(S[:3] - 2.0 * (S[:3] @ u - w) * u), S[3]])
                 below = union_ball(S, mirrored)
-        if unbounded or below is None:
+        out.append(None if unbounded else below)
+    return out
+
+
+def krs_ball(krs: KRS) -> np.ndarray | None:
+    """A ball (centre, radius) holding the whole KRS, all 2^n instances; None when a plane
+    kernel makes it unbounded."""
+    top = krs.kernels[-1]
+    if any(kernel_ball(k) is None and not isinstance(k, Empty) for k in krs.kernels):
+        return None
+    below = level_balls(krs)[-1] if krs.mirrors else None
+    return union_ball(kernel_ball(top), below)
+
+
+def krs_bounds(krs: KRS) -> np.ndarray:
+    """(n, 4): per mirror slot i, a ball C_i holding everything Alg. 1 still tests before
+    folding at level i — K_i and the levels below, doubled by R_i: C_i = S ∪ R_i(S),
+    S = ball(K_i) ∪ C_{i−1} (radius −1: unbounded, from a plane kernel on). A point x with
+    d ≤ dist(x, C_i) cannot lower d any more: the walk stops there with the same value
+    [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding.
+    Slots below only empty kernels get no ball (the walk's d is still ∞ there)."""
+    out = []
+    for below in level_balls(krs):
+        if below is None:
             out.append(UNBOUNDED)
         else:
             out.append(np.array([*below[:3], below[3] * (1 + CULL_MARGIN)

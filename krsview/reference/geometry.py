@@ -3,11 +3,13 @@ compile, give each component's distance or unbounding test to the tracer, find t
 kernel and its world normal. A single KRS or MöKRS is the compound of one [KRS17 §5.1]."""
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from ..scene import Compound, Geometry, MoKRS
 from . import krs, mokrs
-from .compiled import CompiledCompound, CompiledKRS, compile_krs
+from .compiled import CompiledCompound, CompiledKRS, compile_krs, krs_ball, union_ball
 from .distortion import Distortion
 from .trace import Distance, Test
 
@@ -92,3 +94,36 @@ def free_radius(c: Compiled, x: np.ndarray) -> float:
         return abs(float(scene_distance(c, x[None])[0]))
     free = mokrs.is_unbounding(c, np.broadcast_to(x, (len(FREE_RADII), 3)), FREE_RADII)
     return float(FREE_RADII[free].max()) if free.any() else 0.0
+
+
+def scene_ball(g: Geometry, c: Compiled) -> np.ndarray | None:
+    """A world ball (centre, radius) holding everything ``g`` draws; None when it is unbounded
+    (a plane kernel, or a MöKRS whose outermost bound is not a ball)."""
+    if isinstance(c, mokrs.CompiledMoKRS):
+        top = c.outer[-1]
+        return top.copy() if top[3] >= 0 and np.isfinite(top).all() else None
+    balls = [krs_ball(p) for p in (g.parts if isinstance(g, Compound) else (g,))]
+    if any(b is None for b in balls):
+        return None
+    out = None
+    for b in balls:
+        out = union_ball(out, b)
+    return out
+
+
+def surface_field(c: Compiled, dist: Distortion | None = None
+                  ) -> tuple[Callable[[np.ndarray], np.ndarray],
+                             Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """(value, is_empty) for sampling the surface: value(x) is negative inside and zero on
+    the surface (a KRS's distance bound; for a MöKRS, which has no distance function, the
+    first-order world distance to the nearest kernel, mokrs.distance_estimate); is_empty(x, r)
+    certifies balls free of the surface (the distance bound, or Alg. 3)."""
+    if isinstance(c, mokrs.CompiledMoKRS):      # Alg. 3 certifies free balls only
+        return lambda x: mokrs.distance_estimate(c, x), lambda x, r: mokrs.is_unbounding(c, x, r)
+
+    def is_empty(x: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Free (d ≥ r), or inside one kernel instance (d ≤ −r: kernels' distances are exact
+        and reflections are isometries); a distortion certifies only the free side."""
+        d = scene_distance(c, x, dist)
+        return (d >= r) | ((d <= -r) & (dist is None))
+    return lambda x: scene_distance(c, x, dist), is_empty

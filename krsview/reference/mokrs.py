@@ -136,11 +136,23 @@ def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray,
 
 def nearest(c: CompiledMoKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The level j whose kernel is nearest to world points xw (N, 3) and the world normal there.
-
-    The point is followed inwards while J, the Jacobian of world → level space, accumulates
-    (columns from App. C). A conformal J scales lengths by |J e_x|, so k_i(x_i)/|J e_x| is the
-    world distance to first order, comparable across levels (ties go to the coarser level).
     The world gradient of k_j ∘ (world → level j) is Jᵀ ∇k_j [KRS17 §8.1]."""
+    _, level, xk, Jk = _walk(c, xw)
+    return level, world_normal(c.types, c.records, level, xk, np.swapaxes(Jk, 1, 2))
+
+
+def distance_estimate(c: CompiledMoKRS, xw: np.ndarray) -> np.ndarray:
+    """The first-order world distance to the nearest kernel (N,): negative inside, zero
+    exactly on the surface, but not a bound (a MöKRS has no distance function [KRS17 §7]):
+    the scalar field the mesh export samples."""
+    return _walk(c, xw)[0]
+
+
+def _walk(c: CompiledMoKRS, xw: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(k_j(x_j)/|J e_x|, j, x_j, J) of the nearest level j. The point is followed inwards
+    while J, the Jacobian of world → level space, accumulates (columns from App. C). A
+    conformal J scales lengths by |J e_x|, so k_i(x_i)/|J e_x| is the world distance to
+    first order, comparable across levels (ties go to the coarser level)."""
     N = len(xw)
     x = xw
     J = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
@@ -164,4 +176,4 @@ def nearest(c: CompiledMoKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             level = np.where(better, i, level)
             xk = np.where(better[:, None], x, xk)
             Jk = np.where(better[:, None, None], J, Jk)
-    return level, world_normal(c.types, c.records, level, xk, np.swapaxes(Jk, 1, 2))
+    return best, level, xk, Jk
