@@ -192,10 +192,7 @@ def frame_job(args: argparse.Namespace, scene: Scene):
 def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
     from .share.frames import render_frames, write_video
     job, frames = frame_job(args, scene)
-    video = check_output_file(args.video, "--video", ".mp4") if args.video else None
-    if video is not None and (job.size[0] % 2 or job.size[1] % 2):
-        raise SceneError("--size", f"{job.size[0]}x{job.size[1]}",
-                         "--video needs an even width and height (H.264, 4:2:0 colour)")
+    video = check_video(args.video, job.size)
     todo = job.missing(frames)
     print(f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of "
           f"{job.count} ({job.path.duration:.2f} s at {job.fps:g} fps), "
@@ -260,6 +257,46 @@ def require(*modules: str, extra: str, what: str) -> None:
 
 class MissingExtra(RuntimeError):
     """An optional dependency is not installed (exit status 3, as for GL problems)."""
+
+
+def cmd_batch(args: argparse.Namespace) -> int:
+    from .share.batch import run_batch
+    from .share.frames import write_video
+    require("ray", extra="cluster", what="batch")
+    scene = _load(args)
+    job, frames = frame_job(args, scene)
+    video = check_video(args.video, job.size)
+    where = args.address or "a local Ray cluster"
+    print(f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of {job.count}, "
+          f"{job.size[0]}×{job.size[1]} → {job.folder}/ on {args.workers} worker(s) of "
+          f"{where}, {args.chunk} frames per chunk", flush=True)
+    bar = Progress(max(1, len(job.missing(frames))), "  frames")
+    report = run_batch(job, frames, args.workers, args.chunk, args.address, args.retries,
+                       lambda k: bar.step(f"frame {k}"))
+    print(f"  {report.skipped} already there, {report.frames} rendered; start-up "
+          f"{report.startup:.1f} s, then {report.seconds:.1f} s ({report.fps:.2f} frames/s)"
+          + (f"; {len(report.retried)} chunk(s) retried" if report.retried else ""))
+    if report.failed:
+        lost = ", ".join(f"{c[0]}-{c[-1]}" for c in report.failed)
+        print(f"krsview: error: chunks {lost} failed {args.retries + 1} times; run the "
+              "same command again to retry only those", file=sys.stderr)
+        return 1
+    if video is not None:
+        vbar = Progress(len(frames), "  video")
+        write_video(job.folder, frames, job.fps, video, lambda k: vbar.step())
+        print(f"  wrote {video.resolve()}")
+    return 0
+
+
+def check_video(text: str | None, size: tuple[int, int]) -> Path | None:
+    """``--video``: an .mp4 that can be written, of a size H.264 4:2:0 takes."""
+    if text is None:
+        return None
+    video = check_output_file(text, "--video", ".mp4")
+    if size[0] % 2 or size[1] % 2:
+        raise SceneError("--size", f"{size[0]}x{size[1]}",
+                         "--video needs an even width and height (H.264, 4:2:0 colour)")
+    return video
 
 
 def cmd_view(args: argparse.Namespace) -> int:
@@ -631,6 +668,34 @@ def build_parser() -> argparse.ArgumentParser:
     xm.add_argument("--levels", type=_int_in("--levels", 1, MAX_LEVELS),
                     help="keep only the coarsest N levels")
     xm.set_defaults(func=cmd_export_mesh)
+
+    bt = sub.add_parser("batch", help="render a camera path's frames on a Ray cluster",
+                        description="Render the frames of a camera path on a pool of Ray "
+                        "actors, each holding one EGL context and the compiled shader, over "
+                        "chunks of frames. Frames already in the -o folder are skipped, so a "
+                        "batch resumes where it stopped; a failed chunk is retried; the files "
+                        "are those `krsview render --camera-path` writes. Needs pip install "
+                        "'krsview[cluster]'.")
+    bt.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    bt.add_argument("--camera-path", required=True, metavar="FILE",
+                    help="a NAME.path.json camera path (recorded in the viewer with F5)")
+    bt.add_argument("-o", "--output", help="folder for the frames (default out/frames)")
+    bt.add_argument("--frames", metavar="A-B", help="frames A to B, inclusive (default: all)")
+    bt.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
+                    help="frames per second of path time (default 30)")
+    bt.add_argument("--size", type=_size, default=(640, 360), help="default 640x360")
+    bt.add_argument("--workers", type=_int_in("--workers", 1, 1024), default=2,
+                    help="actors, one EGL context each (default 2)")
+    bt.add_argument("--chunk", type=_int_in("--chunk", 1, 100000), default=8,
+                    help="frames per task (default 8): larger chunks amortise scheduling")
+    bt.add_argument("--retries", type=_int_in("--retries", 0, 100), default=2,
+                    help="times a failed chunk is tried again (default 2)")
+    bt.add_argument("--address", metavar="ADDRESS",
+                    help="an existing Ray cluster (ray://HOST:10001, or 'auto'); default: "
+                         "start a local one")
+    bt.add_argument("--video", metavar="MP4", help="also write the frames as an H.264 video")
+    accuracy(bt)
+    bt.set_defaults(func=cmd_batch)
 
     b = sub.add_parser("bench", help="benchmarks (levels, tracers, effects, accuracy)",
                        description="Benchmarks that report ratios measured side by side.")

@@ -4,11 +4,14 @@ written atomically, so a folder holds only whole frames; a run skips the frames 
 there, which makes an interrupted run resumable and lets chunks be rendered anywhere."""
 from __future__ import annotations
 
+import io
 import os
 import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
+
+from PIL import Image
 
 from ..scene import Scene, SceneError
 from ..scene.camera_path import CameraPath
@@ -59,22 +62,34 @@ def parse_frames(text: str | None, count: int, flag: str = "--frames") -> range:
 
 def render_frames(job: FrameJob, frames: list[int], renderer,
                   done: Callable[[int], None] | None = None) -> None:
-    """Render ``frames`` of ``job`` with ``renderer`` (a gpu Renderer), each written to a
-    temporary file and renamed into place; ``done(k)`` after each."""
-    w, h = job.size
+    """Render ``frames`` of ``job`` with ``renderer`` (a gpu Renderer) into its folder;
+    ``done(k)`` after each."""
     for k in frames:
-        buffers = renderer.render(job.frame_scene(k), w, h)
-        target = frame_file(job.folder, k)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".png", dir=job.folder)
-        os.close(fd)
-        try:
-            buffers.save_png(tmp)
-            os.replace(tmp, target)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        write_frame(job.folder, k, frame_png(job, k, renderer))
         if done is not None:
             done(k)
+
+
+def frame_png(job: FrameJob, k: int, renderer) -> bytes:
+    """Frame k as PNG bytes: what a batch worker sends back (no shared disk needed)."""
+    w, h = job.size
+    buffers = renderer.render(job.frame_scene(k), w, h)
+    out = io.BytesIO()
+    Image.fromarray(buffers.rgb8(), "RGB").save(out, format="png")
+    return out.getvalue()
+
+
+def write_frame(folder: Path, k: int, png: bytes) -> None:
+    """Write a temporary file, then rename it into place: the folder holds whole frames."""
+    target = frame_file(folder, k)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".png", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(png)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 def write_video(folder: Path, frames: range, fps: float, video: Path,

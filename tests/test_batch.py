@@ -1,0 +1,126 @@
+"""Batch rendering on Ray [issue 18 §4]: a local Ray with two workers writes the same frames
+as a local render, skips finished frames on restart, and retries chunks whose task failed
+or whose actor died."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import ray
+from PIL import Image
+
+from krsview.presets import resolve
+from krsview.scene import load_scene
+from krsview.scene.camera_path import load_camera_path
+from krsview.share.batch import FrameWorker, run_batch
+from krsview.share.frames import FrameJob, frame_file, render_frames
+
+SIZE = (64, 36)
+POSES = [dict(t=0.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
+         dict(t=1.0, position=[1.0, 2.5, -7.0], yaw=-0.3, pitch=0.1)]
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
+             configure_logging=False, runtime_env={"env_vars": {"LP_NUM_THREADS": "1"}})
+    ray.cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the failing workers
+    yield
+    ray.shutdown()
+
+
+@pytest.fixture
+def job(tmp_path):
+    path = tmp_path / "tree.path.json"
+    path.write_text(json.dumps({"poses": POSES}))
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    return FrameJob(load_scene(resolve("tree")), load_camera_path(path), 8.0, SIZE, folder)
+
+
+def read(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(path).convert("RGB"))
+
+
+def local_frames(job: FrameJob, tmp_path: Path, renderer) -> Path:
+    folder = tmp_path / "local"
+    folder.mkdir()
+    render_frames(FrameJob(job.scene, job.path, job.fps, job.size, folder),
+                  list(range(job.count)), renderer)
+    return folder
+
+
+def test_two_workers_write_the_frames_a_local_render_writes(cluster, job, tmp_path, renderer):
+    report = run_batch(job, range(job.count), workers=2, chunk=3)
+    assert report.frames == job.count == 9 and not report.failed and not report.retried
+    local = local_frames(job, tmp_path, renderer)
+    assert sorted(p.name for p in job.folder.iterdir()) == sorted(p.name for p in local.iterdir())
+    for k in range(job.count):
+        assert np.array_equal(read(frame_file(job.folder, k)), read(frame_file(local, k))), k
+    # negative control: neighbouring frames differ, so equality above means something
+    assert not np.array_equal(read(frame_file(local, 0)), read(frame_file(local, 1)))
+    # a restart skips the finished frames and renders only what is missing
+    frame_file(job.folder, 4).unlink()
+    again = run_batch(job, range(job.count), workers=2, chunk=3)
+    assert again.skipped == 8 and again.frames == 1
+    assert np.array_equal(read(frame_file(job.folder, 4)), read(frame_file(local, 4)))
+
+
+class FailsOnce(FrameWorker):
+    """Raises on the first chunk holding frame 2 (a marker file remembers across actors)."""
+
+    def render(self, frames):
+        marker = self.job.folder.parent / "failed-once"
+        if 2 in frames and not marker.exists():
+            marker.write_text("")
+            raise RuntimeError("a flaky worker")
+        return super().render(frames)
+
+
+class DiesOnce(FrameWorker):
+    """Its process exits in the middle of the first chunk holding frame 5: the actor dies."""
+
+    def render(self, frames):
+        marker = self.job.folder.parent / "died-once"
+        if 5 in frames and not marker.exists():
+            marker.write_text("")
+            os._exit(1)
+        return super().render(frames)
+
+
+class AlwaysFails(FrameWorker):
+    def render(self, frames):
+        if 7 in frames:
+            raise RuntimeError("a broken frame")
+        return super().render(frames)
+
+
+@pytest.mark.parametrize("worker", [FailsOnce, DiesOnce])
+def test_a_failed_chunk_is_retried_and_the_frames_are_complete(cluster, job, worker):
+    report = run_batch(job, range(job.count), workers=2, chunk=2, worker=worker)
+    assert len(report.retried) == 1 and not report.failed
+    assert report.frames == job.count and job.missing(range(job.count)) == []
+
+
+def test_a_chunk_out_of_retries_is_reported_and_the_rest_is_written(cluster, job):
+    report = run_batch(job, range(job.count), workers=2, chunk=2, retries=1, worker=AlwaysFails)
+    assert report.failed == [[6, 7]] and len(report.retried) == 2
+    assert job.missing(range(job.count)) == [6, 7]
+
+
+def test_batch_on_the_command_line(tmp_path):
+    """`krsview batch` with a local Ray of two workers, then a resumed run."""
+    path = tmp_path / "tree.path.json"
+    path.write_text(json.dumps({"poses": POSES}))
+    args = [sys.executable, "-m", "krsview", "batch", "tree", "--camera-path", str(path),
+            "--fps", "4", "--size", "64x36", "-o", str(tmp_path / "f"), "--workers", "2"]
+    env = {**os.environ, "DISPLAY": ""}
+    r = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
+    assert r.returncode == 0 and "0 already there, 5 rendered" in r.stdout, r.stderr[-3000:]
+    r = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
+    assert r.returncode == 0 and "5 already there, 0 rendered" in r.stdout
