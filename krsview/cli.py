@@ -451,12 +451,35 @@ def cmd_bench_effects(args: argparse.Namespace) -> int:
 
 def cmd_bench_accuracy(args: argparse.Namespace) -> int:
     from .bench.accuracy import bench_accuracy
-    scene = _load(args)
-    out = Path(args.out) if args.out else Path("out") / "accuracy" / resolve(args.preset).stem
-    check_output_dir(out, "--out")
-    bench_accuracy(scene, args.size, out, rounds=args.rounds,
-                   cache=Path(args.cache) if args.cache else None)
-    return 0
+    names = args.preset or [DEFAULT_PRESET]
+    scenes = {n: _load(argparse.Namespace(**{**vars(args), "preset": n})) for n in names}
+    if len(set(names)) != len(names):
+        raise SceneError("PRESET", " ".join(names), "each preset once")
+    outs = {n: (Path(args.out) / resolve(n).stem if args.out and len(names) > 1 else
+                Path(args.out) if args.out else Path("out") / "accuracy" / resolve(n).stem)
+            for n in names}
+    for out in outs.values():
+        check_output_dir(out, "--out")
+    if args.workers == 1 and args.address is None:       # here, one after the other
+        for n in names:
+            bench_accuracy(scenes[n], args.size, outs[n], rounds=args.rounds,
+                           cache=Path(args.cache) if args.cache else None)
+        return 0
+    from .share.batch import run_accuracy_sweep
+    require("ray", extra="cluster", what="bench accuracy --workers/--address")
+    print(f"krsview: accuracy of {len(names)} preset(s) on {args.workers} Ray worker(s) of "
+          f"{args.address or 'a local cluster'}; each report when its task ends", flush=True)
+
+    def done(name: str, lines: list[str] | None, error: str) -> None:
+        if lines is None:
+            print(f"krsview: error: {name}: {error}", file=sys.stderr)
+            return
+        print(f"{name}: wrote {outs[name].resolve()}/")
+        for line in lines:
+            print(f"  {line}")
+    failed = run_accuracy_sweep(scenes, args.size, args.rounds, outs, args.workers,
+                                args.address, done)
+    return 1 if failed else 0
 
 
 def check_output_file(path: str, flag: str, suffix: str) -> Path:
@@ -754,11 +777,18 @@ def build_parser() -> argparse.ArgumentParser:
                                      "SSIM, iterations, capped rays. Writes OUT/README.md, "
                                      "OUT/accuracy.csv, plots (time vs error per knob, the "
                                      "Pareto front) and error images.")
-    ba.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+    ba.add_argument("preset", nargs="*", metavar="PRESET",
+                    help="one or more presets (default tree); several write OUT/PRESET each")
     ba.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
+    ba.add_argument("--workers", type=_int_in("--workers", 1, 1024), default=1,
+                    help="run the presets as tasks on this many Ray workers (default 1: "
+                         "here, one after the other); needs 'krsview[cluster]'")
+    ba.add_argument("--address", metavar="ADDRESS",
+                    help="run them on an existing Ray cluster (ray://HOST:10001 or 'auto')")
     ba.add_argument("--rounds", type=_int_in("--rounds", 1, 100), default=3,
                     help="interleaved rounds; medians are reported (default 3)")
-    ba.add_argument("--out", metavar="DIR", help="report folder (default out/accuracy/PRESET)")
+    ba.add_argument("--out", metavar="DIR", help="report folder (default out/accuracy/PRESET; "
+                    "with several presets, DIR/PRESET)")
     ba.add_argument("--cache", metavar="DIR", help="ground-truth cache (default "
                     "~/.cache/krsview/truth)")
     ba.set_defaults(func=cmd_bench_accuracy)

@@ -17,7 +17,7 @@ FORBIDDEN = {
     "bench": {"app", "editor", "cli"},
     "app": {"bench", "cli"},
     "editor": {"bench", "cli"},
-    "share": {"app", "editor", "bench", "cli"},
+    "share": {"app", "editor", "cli"},
 }
 
 

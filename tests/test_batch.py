@@ -124,3 +124,30 @@ def test_batch_on_the_command_line(tmp_path):
     assert r.returncode == 0 and "0 already there, 5 rendered" in r.stdout, r.stderr[-3000:]
     r = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
     assert r.returncode == 0 and "5 already there, 0 rendered" in r.stdout
+
+
+def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster, tmp_path):
+    """Two presets as two tasks: each report's error columns equal a local run's (times
+    differ; errors are a function of the images and the ground truth)."""
+    import csv
+    from krsview.bench.accuracy import bench_accuracy
+    from krsview.share.batch import run_accuracy_sweep
+    names = ("sierpinski", "rock")
+    scenes = {n: load_scene(resolve(n)) for n in names}
+    outs = {n: tmp_path / "ray" / n for n in names}
+    seen = {}
+    failed = run_accuracy_sweep(scenes, (32, 18), 1, outs, 2, None,
+                                lambda n, lines, err: seen.setdefault(n, (lines, err)))
+    assert failed == [] and set(seen) == set(names) and all(v[0] for v in seen.values())
+    columns = ("knob", "value", "holes", "false_hits", "mask_error", "depth_eps_p99")
+    for n in names:
+        assert (outs[n] / "README.md").exists() and (outs[n] / "pareto.png").exists()
+        local = tmp_path / "local" / n
+        bench_accuracy(scenes[n], (32, 18), local, rounds=1)
+        rows = [[list(csv.DictReader(open(d / "accuracy.csv")))] for d in (outs[n], local)]
+        ray_rows, local_rows = rows[0][0], rows[1][0]
+        assert [[r[c] for c in columns] for r in ray_rows] == \
+               [[r[c] for c in columns] for r in local_rows]
+    # negative control: the two presets' reports differ
+    a, b = (list(csv.DictReader(open(outs[n] / "accuracy.csv"))) for n in names)
+    assert [r["mask_error"] for r in a] != [r["mask_error"] for r in b]

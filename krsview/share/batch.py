@@ -9,14 +9,20 @@ if its actor died; the result is the same set of files a local `krsview render
 --camera-path` writes (frames are a pure function of scene, path and frame number).
 
 Ray starts a local cluster unless given the address of an existing one (``ray://…`` or
-``auto``)."""
+``auto``). The accuracy bench of many presets runs the same way, one task per preset
+(`krsview bench accuracy P1 P2 … --workers N`)."""
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import tempfile
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable
 
+from ..scene import Scene
 from .frames import FrameJob, frame_png, write_frame
 
 
@@ -50,6 +56,18 @@ class FrameWorker:
         return [(k, frame_png(self.job, k, self.renderer)) for k in frames]
 
 
+def start_ray(workers: int, address: str | None) -> None:
+    """Join ``address``, or start a local cluster with one CPU per worker; each worker's
+    llvmpipe gets its share of the cores (on a GPU machine the variable is ignored)."""
+    import ray
+    if ray.is_initialized():
+        return
+    threads = max(1, (os.cpu_count() or 1) // workers)
+    ray.init(address=address, num_cpus=None if address else workers,
+             include_dashboard=False, log_to_driver=False, configure_logging=False,
+             runtime_env={"env_vars": {"LP_NUM_THREADS": str(threads), "DISPLAY": ""}})
+
+
 def chunks_of(frames: list[int], size: int) -> list[list[int]]:
     return [frames[k:k + size] for k in range(0, len(frames), size)]
 
@@ -68,11 +86,7 @@ def run_batch(job: FrameJob, frames: range, workers: int = 2, chunk: int = 8,
     if not todo:
         return report
     t0 = time.perf_counter()
-    threads = max(1, (os.cpu_count() or 1) // workers)   # llvmpipe threads per actor
-    if not ray.is_initialized():
-        ray.init(address=address, num_cpus=None if address else workers,
-                 include_dashboard=False, log_to_driver=False, configure_logging=False,
-                 runtime_env={"env_vars": {"LP_NUM_THREADS": str(threads), "DISPLAY": ""}})
+    start_ray(workers, address)
     actor = ray.remote(num_cpus=1, max_restarts=0)(worker)
     pool = [actor.remote(job) for _ in range(workers)]
     actors = list(pool)                                   # every actor started, to stop them
@@ -116,3 +130,45 @@ def _requeue(queue: list, report: BatchReport, frames: list[int], attempt: int,
         queue.append((frames, attempt + 1))
     else:
         report.failed.append(frames)
+
+
+def accuracy_report(scene: Scene, size: tuple[int, int], rounds: int
+                    ) -> tuple[dict[str, bytes], list[str]]:
+    """One preset's `bench accuracy` (bench/accuracy.py) in a scratch folder: its files as
+    bytes, so the driver writes them wherever it likes, and the report's verdict."""
+    from ..bench.accuracy import bench_accuracy, verdict
+    with tempfile.TemporaryDirectory() as d:
+        with contextlib.redirect_stdout(io.StringIO()):     # the report is in the files
+            rows = bench_accuracy(scene, size, Path(d), rounds)
+        files = {str(p.relative_to(d)): p.read_bytes() for p in Path(d).rglob("*")
+                 if p.is_file()}
+    return files, verdict(rows)
+
+
+def run_accuracy_sweep(scenes: dict[str, Scene], size: tuple[int, int], rounds: int,
+                       outs: dict[str, Path], workers: int, address: str | None,
+                       done: Callable[[str, list[str] | None, str], None]) -> list[str]:
+    """The accuracy bench of every scene as one Ray task each (retried if its worker dies);
+    each report is written to ``outs[name]`` as it arrives and ``done(name, verdict, error)``
+    called. Returns the names that failed. Time ratios are measured within each task, side
+    by side; tasks sharing one machine's cores inflate absolute times, not the ratios' sense."""
+    import ray
+    start_ray(workers, address)
+    task = ray.remote(num_cpus=1, max_retries=2)(accuracy_report)
+    running = {task.remote(scene, size, rounds): name for name, scene in scenes.items()}
+    failed = []
+    while running:
+        ready, _ = ray.wait(list(running), num_returns=1)
+        name = running.pop(ready[0])
+        try:
+            files, lines = ray.get(ready[0])
+        except ray.exceptions.RayError as e:
+            failed.append(name)
+            done(name, None, str(e).strip().splitlines()[-1])
+            continue
+        for rel, data in files.items():
+            target = outs[name] / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+        done(name, lines, "")
+    return failed
