@@ -546,6 +546,16 @@ def build_parser() -> argparse.ArgumentParser:
                         help="frame rate held while moving or dragging, by lowering the "
                              "internal resolution (default 30)")
 
+    def camera_path_arguments(sp, required: bool) -> None:
+        sp.add_argument("--camera-path", required=required, metavar="FILE",
+                        help="a NAME.path.json camera path (recorded in the viewer with F5)")
+        sp.add_argument("--frames", metavar="A-B",
+                        help="only frames A to B, inclusive (default: all the path's)")
+        sp.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
+                        help="frames per second of path time (default 30)")
+        sp.add_argument("--video", metavar="MP4", help="also write the frames as an H.264 "
+                        "video, ending in .mp4 (needs an even width and height)")
+
     def bench_arguments(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
         sp.add_argument("--size", type=_size, default=(320, 180), help="default 320x180")
@@ -587,13 +597,7 @@ def build_parser() -> argparse.ArgumentParser:
         "camera paths", "Render the frames of a path recorded in the viewer (F5; saved as "
         "NAME.path.json beside the preset) to frame_00000.png, … in the -o folder. Frames "
         "already there are skipped, so an interrupted run resumes where it stopped.")
-    cp.add_argument("--camera-path", metavar="FILE", help="a NAME.path.json camera path")
-    cp.add_argument("--frames", metavar="A-B",
-                    help="render only frames A to B, inclusive (default: all the path's)")
-    cp.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
-                    help="frames per second of path time (default 30)")
-    cp.add_argument("--video", metavar="MP4", help="also write the frames as an H.264 video, "
-                    "ending in .mp4 (needs an even width and height)")
+    camera_path_arguments(cp, required=False)
     r.set_defaults(func=cmd_render)
 
     v = sub.add_parser("view", help="fly through a scene in a window",
@@ -700,12 +704,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "are those `krsview render --camera-path` writes. Needs pip install "
                         "'krsview[cluster]'.")
     bt.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
-    bt.add_argument("--camera-path", required=True, metavar="FILE",
-                    help="a NAME.path.json camera path (recorded in the viewer with F5)")
+    camera_path_arguments(bt, required=True)
     bt.add_argument("-o", "--output", help="folder for the frames (default out/frames)")
-    bt.add_argument("--frames", metavar="A-B", help="frames A to B, inclusive (default: all)")
-    bt.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
-                    help="frames per second of path time (default 30)")
     bt.add_argument("--size", type=_size, default=(640, 360), help="default 640x360")
     bt.add_argument("--workers", type=_int_in("--workers", 1, 1024), default=2,
                     help="actors, one EGL context each (default 2)")
@@ -716,7 +716,6 @@ def build_parser() -> argparse.ArgumentParser:
     bt.add_argument("--address", metavar="ADDRESS",
                     help="an existing Ray cluster (ray://HOST:10001, or 'auto'); default: "
                          "start a local one")
-    bt.add_argument("--video", metavar="MP4", help="also write the frames as an H.264 video")
     accuracy(bt)
     bt.set_defaults(func=cmd_batch)
 

@@ -116,6 +116,32 @@ def test_the_orbit_moves_the_camera_as_the_formula_says(tmp_path):
     assert agreement(shot, reference(scene, tmp_path, "still"), 16) < 0.8
 
 
+def test_dragging_and_scrolling_orbit_and_zoom(tmp_path):
+    """The page's own pointer and wheel handlers, driven by events dispatched in the page:
+    a drag of (−50, 20) pixels turns by 0.006 rad per pixel, a wheel of 223 zooms by
+    e^(0.001·223) ≈ 1.25."""
+    scene = load_scene(resolve("tree"))
+    page = export_page(scene, tmp_path, "tree")
+    events = """
+<script>
+const at = (x, y) => ({clientX: x, clientY: y, pointerId: 1, bubbles: true});
+canvas.dispatchEvent(new PointerEvent("pointerdown", at(100, 40)));
+canvas.dispatchEvent(new PointerEvent("pointermove", at(50, 60)));
+canvas.dispatchEvent(new PointerEvent("pointerup", at(50, 60)));
+canvas.dispatchEvent(new WheelEvent("wheel", {deltaY: 223, bubbles: true, cancelable: true}));
+</script>
+</body>"""
+    page.write_text(page.read_text(encoding="utf-8").replace("</body>", events),
+                    encoding="utf-8")
+    shot = screenshot(page, tmp_path / "shot.png")
+    yaw, pitch, zoom = 0.006 * 50, 0.006 * 20, math.exp(0.001 * 223)
+    ref = reference(replace(scene, camera=orbit_camera(scene, yaw, pitch, zoom)), tmp_path, "r")
+    assert agreement(shot, ref, 16) >= 0.97
+    # negative control: the drag without the zoom is another view
+    near = reference(replace(scene, camera=orbit_camera(scene, yaw, pitch, 1.0)), tmp_path, "n")
+    assert agreement(shot, near, 16) < 0.95
+
+
 def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
     """The .glsl file inside Shadertoy's wrapper (version, iResolution, iTime 0, iMouse 0)."""
     scene = load_scene(resolve("palm"))
