@@ -64,3 +64,39 @@ def test_rounds_that_drop_live_rays_lose_them(tmp_path, renderer):
     broken = Renderer(shader_dir=shaders).render(scene, W, H)
     assert not same(renderer.render(scene, W, H), broken)
     assert not same(renderer.render(on_path(scene, "fragment"), W, H), broken)
+
+
+@pytest.mark.parametrize("name, effects, tracer", [
+    ("tree", None, "sphere"),                    # soft shadows, a KRS
+    ("grove", None, "binary"),                   # soft shadows, a compound
+    ("palm", ["shadows", "sky"], "binary"),      # hard shadows, a MöKRS
+    ("palm", ["soft_shadows"], "binary"),
+    ("rock", None, "sphere"),                    # soft shadows with occlusion and textures
+])
+def test_shadow_rays_traced_as_tasks_shade_the_same_image(renderer, name, effects, tracer):
+    """The compute path traces shadow rays as tasks of their own (one per hit pixel and
+    light, in rounds through the same queues) and shades with their visibilities: the image
+    equals the fragment path's, where shade() traces them inline."""
+    scene = load_scene(resolve(name))
+    scene = on_path(replace(scene, effects=effects if effects is not None else scene.effects),
+                    "fragment", tracer=tracer)
+    from krsview.gpu.uniforms import variant_defines
+    from krsview.reference.geometry import compile_geometry
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    assert "KRS_SHADOW_TASKS" in variant_defines(on_path(scene, "compute"), c)
+    fragment = renderer.render(scene, W, H)
+    assert same(fragment, renderer.render(on_path(scene, "compute", steps=3), W, H))
+    unshadowed = replace(scene, effects=[e for e in scene.effects if "shadows" not in e])
+    assert not np.array_equal(fragment.color, renderer.render(unshadowed, W, H).color)
+
+
+def test_shadow_rounds_that_drop_live_tasks_lose_the_shadows(tmp_path, renderer):
+    """Negative control: shadow tasks not requeued after a round count as lit."""
+    shaders = broken_shaders(tmp_path, "compute.comp",
+                             "queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], "
+                             "1u)] = slot;", "")
+    scene = on_path(replace(load_scene(resolve("palm")), effects=["shadows"]), "compute",
+                    steps=2)
+    broken = Renderer(shader_dir=shaders).render(scene, W, H)
+    good = renderer.render(scene, W, H)
+    assert np.array_equal(good.hit, broken.hit) and not np.array_equal(good.color, broken.color)

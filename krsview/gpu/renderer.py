@@ -16,6 +16,7 @@ import numpy as np
 from ..buffers import Buffers
 from ..reference.camera import view_of
 from ..reference.geometry import Compiled, compile_geometry
+from ..scene.scene import MAX_LIGHTS
 from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
@@ -101,8 +102,12 @@ class Renderer:
             components = MAX_COMPONENTS if "KRS_COMPOUND" in defines else 1
             real = 8 if scene.render.precision == "double" else 4
             ray_bytes = (2 * components + 4) * real + 8      # trace.glsl's Ray in std430
+            shadow_bytes = 0                                 # shadows.glsl's Shadow
+            if "KRS_SHADOW_TASKS" in defines:
+                align = max(4 * real, 16)
+                shadow_bytes = -(-(4 * real + 16 + (components + 1) * real + 12) // align) * align
             self._compute[prog] = (comp, scene.render.steps, scene.render.max_iterations,
-                                   ray_bytes)
+                                   ray_bytes, shadow_bytes)
             progs = [prog, comp]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
@@ -202,10 +207,13 @@ class Renderer:
         of at most ``steps`` iterations, each sized by the GPU from the rays still live, and
         leave the ray buffer bound for the shading pass (deferred.frag). Rounds enough for
         the iteration cap are issued without reading anything back."""
-        comp, steps, cap, ray_bytes = self._compute[prog]
+        comp, steps, cap, ray_bytes, shadow_bytes = self._compute[prog]
         x, y, w, h = tile or (0, 0, width, height)
         area = w * h
-        sizes = {1: area * ray_bytes, 2: 2 * area * 4, 3: 5 * 4}
+        tasks = area * (MAX_LIGHTS if shadow_bytes else 1)     # the longest queue
+        sizes = {1: area * ray_bytes, 2: 2 * tasks * 4, 3: 5 * 4}
+        if shadow_bytes:
+            sizes[4] = area * MAX_LIGHTS * shadow_bytes
         for binding, size in sizes.items():
             if binding not in self._rays or self._rays[binding].size < size:
                 if binding in self._rays:
@@ -216,18 +224,32 @@ class Renderer:
         self._rays[3].write(np.array([area, 0, groups, 1, 1], dtype=np.uint32))
         prog["u_tile_rect"].value = (x, y, w, h)
         for name, value in (("u_tile_rect", (x, y, w, h)), ("u_area", area),
-                            ("u_steps", steps), ("u_phase", 0)):
+                            ("u_queue", tasks), ("u_steps", steps), ("u_phase", 0)):
             if name in comp:
                 comp[name].value = value
         comp.run(groups)
-        for k in range(-(-cap // steps) + 1):
+        self._rounds(comp, 1, -(-cap // steps) + 1)
+        if shadow_bytes:            # shadow rays as tasks of their own, through the same queues
             self.ctx.memory_barrier()
-            comp["u_parity"].value, comp["u_phase"].value = k % 2, 1
+            self._rays[3].write(np.array([0, 0, 0, 1, 1], dtype=np.uint32))
+            comp["u_phase"].value = 3
+            comp.run(groups)
+            self.ctx.memory_barrier()
+            comp["u_parity"].value, comp["u_phase"].value = 1, 2   # size round 0 from queue 0
+            comp.run(1)
+            self._rounds(comp, 4, -(-cap // steps) + 1)
+        self.ctx.memory_barrier()
+
+    def _rounds(self, comp: moderngl.ComputeShader, phase: int, rounds: int) -> None:
+        """``rounds`` rounds of ``phase`` (1: rays, 4: shadow tasks), each sized by the GPU
+        from what the last one left live, with no read-back."""
+        for k in range(rounds):
+            self.ctx.memory_barrier()
+            comp["u_parity"].value, comp["u_phase"].value = k % 2, phase
             comp.run_indirect(self._rays[3], offset=8)
             self.ctx.memory_barrier()
             comp["u_phase"].value = 2
             comp.run(1)
-        self.ctx.memory_barrier()
 
     def levels(self, scene: Scene, width: int, height: int) -> np.ndarray:
         """Per pixel (rows top → bottom), the levels Alg. 1 walked while tracing the ray (not

@@ -10,6 +10,7 @@ from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS
+from ..scene.scene import MAX_LIGHTS
 from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
 
 MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record, its bound
@@ -21,7 +22,8 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
     pre-pass, the Möbius geometry family and a compound: nothing else is compiled. ``all_effects``
     compiles every effect the geometry allows, each switched by its bit of ``u_effects``
     (the benchmark's baseline)."""
-    defines: dict[str, str | int | None] = {"KRS_SLOTS": slots(c), "KRS_RECORD": RECORD_VEC4}
+    defines: dict[str, str | int | None] = {"KRS_SLOTS": slots(c), "KRS_RECORD": RECORD_VEC4,
+                                            "LIGHT_SLOTS": MAX_LIGHTS}
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
     if all_effects:
@@ -42,6 +44,8 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines["KRS_CULLING"] = None     # only where some level has a ball to test
     if scene.render.prepass:
         defines["KRS_PREPASS"] = None
+    if scene.render.path == "compute" and {"shadows", "soft_shadows"} & set(scene.effects):
+        defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -114,9 +118,10 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_relaxation": scene.render.relaxation,
         "u_tile": scene.render.prepass,
         "u_light_count": len(lights),
-        "u_light_dir": [lt.direction for lt in lights] + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
+        "u_light_dir": [lt.direction for lt in lights]
+                       + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
         "u_light_color": [tuple(c * lt.intensity for c in lt.color) for lt in lights]
-                         + [(0.0, 0.0, 0.0)] * (4 - len(lights)),
+                         + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
         "u_ambient": scene.material.ambient,
         "u_background": scene.material.background,
         "u_effects": sum(EFFECTS[e].bit for e in scene.effects),

@@ -29,12 +29,15 @@ class Bookmark:
     camera: Camera = param(Camera())
 
 
+MAX_LIGHTS = 4   # the shaders' light slots (LIGHT_SLOTS)
+
+
 @dataclass(frozen=True)
 class Scene:
     name: str = param("untitled", help="shown in the viewer and reports")
     description: str = param("", help="one line about the scene")
     camera: Camera = param(Camera())
-    lights: list[Light] = param([Light()], help="directional lights (at most 4)")
+    lights: list[Light] = param([Light()], help=f"directional lights (at most {MAX_LIGHTS})")
     material: Material = param(Material())
     render: Render = param(Render())
     effects: list[str] = param([], help="effects compiled into this scene's shader; "
@@ -57,8 +60,9 @@ class Scene:
                              "a scene has exactly one geometry: a [krs], [tree], [route] or "
                              "[mokrs] table, or a [[compound]] list")
         check_compound(self.compound)
-        if len(self.lights) > 4:
-            raise SceneError("lights", f"<{len(self.lights)} lights>", "allowed: at most 4")
+        if len(self.lights) > MAX_LIGHTS:
+            raise SceneError("lights", f"<{len(self.lights)} lights>",
+                             f"allowed: at most {MAX_LIGHTS}")
         check_effects(self.effects, self.mokrs is not None)
         self.check_tracer(self.render.tracer)
         if self.mokrs is not None:

@@ -5,11 +5,19 @@
 // round's queue (an atomic counter: compaction), and the next round's dispatch size is
 // written by the GPU (u_phase 2) for an indirect dispatch: no read-back between rounds. The
 // queues alternate by u_parity.
+// Shadow rays are tasks of their own (KRS_SHADOW_TASKS): once the primary rays are done,
+// u_phase 3 starts one per hit pixel and light that shade() would trace (slot
+// ray × LIGHT_SLOTS + light), and u_phase 4 runs their rounds through the same queues and
+// sizing; deferred.frag then shades with their visibilities.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
 #include "prepass.glsl"
 #include "rays.glsl"
+#ifdef KRS_SHADOW_TASKS
+#include "shadows.glsl"
+layout(std430, binding = 4) buffer Shadows { Shadow shadows[]; };
+#endif
 
 #define GROUP 64
 layout(local_size_x = GROUP) in;
@@ -20,10 +28,12 @@ layout(std430, binding = 3) buffer Counts {
     uint groups[3];      // the next dispatch's size (glDispatchComputeIndirect)
 };
 
-uniform int u_phase;     // 0: start the rays of the tile, 1: a round, 2: size the next round
+uniform int u_phase;     // 0: start the rays of the tile, 1: a round, 2: size the next
+                         // round, 3: start the shadow tasks, 4: a round of shadow tasks
 uniform int u_parity;    // the queue this round reads
 uniform int u_steps;     // iterations per ray per round
-uniform uint u_area;     // width × height of u_tile_rect: the length of each queue
+uniform uint u_area;     // width × height of u_tile_rect: the rays
+uniform uint u_queue;    // the length of each queue: u_area, or u_area × LIGHT_SLOTS
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
@@ -46,6 +56,40 @@ void main() {
         queue[k] = k;
         return;
     }
+#ifdef KRS_SHADOW_TASKS
+    if (u_phase == 3) {                       // the shadow rays shade() would trace
+        if (k >= u_area) return;
+        Ray r = rays[k];
+        for (int j = 0; j < LIGHT_SLOTS; ++j) {
+            shadows[k * uint(LIGHT_SLOTS) + uint(j)].vis = 1.0;
+            shadows[k * uint(LIGHT_SLOTS) + uint(j)].state = SHADOW_DONE;
+        }
+        if (r.state != RAY_HIT || !shadows_on()) return;
+        ivec2 pixel = u_tile_rect.xy + ivec2(int(k) % u_tile_rect.z, int(k) / u_tile_rect.z);
+        vec3r dir = pixel_ray(vec2(pixel) + 0.5);
+        int level;
+        vec3 n, xk;
+        nearest_kernel(r.t * dir, r.t, level, n, xk);     // as pixel.glsl, then shade()
+        for (int j = 0; j < u_light_count; ++j) {
+            if (max(dot(n, u_light_dir[j]), 0.0) <= 0.0) continue;
+            uint slot = k * uint(LIGHT_SLOTS) + uint(j);
+            shadows[slot] = shadow_begin(r.t * dir, n, u_light_dir[j],
+                                         u_eps_per_t * float(r.t));
+            queue[atomicAdd(count[0], 1u)] = slot;
+        }
+        return;
+    }
+    if (u_phase == 4) {
+        if (k >= count[u_parity]) return;
+        uint slot = queue[uint(u_parity) * u_queue + k];
+        Shadow sh = shadows[slot];
+        for (int i = 0; i < u_steps && sh.state == SHADOW_LIVE; ++i) shadow_step(sh);
+        shadows[slot] = sh;
+        if (sh.state == SHADOW_LIVE)
+            queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = slot;
+        return;
+    }
+#endif
     if (k >= count[u_parity]) return;
     uint ray = queue[uint(u_parity) * u_area + k];
     ivec2 pixel = u_tile_rect.xy + ivec2(int(ray) % u_tile_rect.z, int(ray) / u_tile_rect.z);

@@ -1,12 +1,21 @@
 // The compute path's shading pass: each pixel's ray as compute.comp left it in the ray
-// buffer, shaded and written as render.frag writes it.
+// buffer (and its shadow rays' visibilities, with KRS_SHADOW_TASKS), shaded and written as
+// render.frag writes it.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
 #include "rays.glsl"
 #include "pixel.glsl"
 
+#ifdef KRS_SHADOW_TASKS
+layout(std430, binding = 4) readonly buffer Shadows { Shadow shadows[]; };
+#endif
+
 void main() {
-    Ray r = rays[ray_index(ivec2(gl_FragCoord.xy))];
+    int index = ray_index(ivec2(gl_FragCoord.xy));
+    Ray r = rays[index];
+#ifdef KRS_SHADOW_TASKS
+    for (int j = 0; j < LIGHT_SLOTS; ++j) g_shadow[j] = shadows[index * LIGHT_SLOTS + j].vis;
+#endif
     write_pixel(pixel_ray(gl_FragCoord.xy), r.state == RAY_HIT, r.t, r.iterations);
 }

@@ -77,8 +77,8 @@ vec3r pixel_ray(vec2 frag) {
                      + real(ndc.y * u_tan_half) * u_up);
 }
 
-uniform int u_light_count;
-uniform vec3 u_light_dir[4];
-uniform vec3 u_light_color[4];  // colour × intensity
+uniform int u_light_count;  // lights in the first of LIGHT_SLOTS (scene.MAX_LIGHTS) slots
+uniform vec3 u_light_dir[LIGHT_SLOTS];
+uniform vec3 u_light_color[LIGHT_SLOTS];  // colour × intensity
 uniform vec3 u_ambient;
 uniform vec3 u_background;

@@ -41,7 +41,7 @@ vec3 shade(vec3r p, vec3 dir, real t_ray, int level, vec3 n, vec3 xk) {
         float cos_l = max(dot(n, u_light_dir[k]), 0.0);
 #if defined(KRS_SHADOWS) || defined(KRS_SOFT_SHADOWS)
         if (cos_l > 0.0 && shadows_on())
-            cos_l *= shadow_visibility(p, n, u_light_dir[k], u_eps_per_t * t);
+            cos_l *= light_visibility(k, p, n, u_eps_per_t * t);
 #endif
         light += cos_l * u_light_color[k];
     }

@@ -21,38 +21,82 @@ bool shadows_on() {
     return soft_shadows_on();
 }
 
+// A shadow ray between steps: what shadow_visibility keeps in registers and the compute
+// path's shadow tasks keep in a storage buffer between rounds (compute.comp), so both take
+// the same steps and reach the same visibility.
+#define SHADOW_LIVE 0
+#define SHADOW_DONE 1
+struct Shadow {
+    vec4r o;                    // xyz: the start, lifted SHADOW_OFFSET ε off the surface
+    vec4 l;                     // xyz: towards the light; w: ε, the primary ray's threshold
+    real tc[COMPONENT_SLOTS];   // KRS: free distance per component; MöKRS: tc[0] only
+    real s;                     // MöKRS: the probe radius
+    float vis;                  // visibility so far (0 once blocked)
+    int iterations;
+    int state;                  // SHADOW_LIVE or SHADOW_DONE
+};
+
+// The shadow ray from the hit point p with normal n towards the light l.
+Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
+    Shadow sh;
+    sh.o = vec4r(p + SHADOW_OFFSET * eps * n, 0.0);
+    sh.l = vec4(l, eps);
+    for (int c = 0; c < COMPONENT_SLOTS; ++c) sh.tc[c] = 0.0;
+    sh.s = INITIAL_PROBE;
+    sh.vis = 1.0;
+    sh.iterations = 0;
+    sh.state = SHADOW_LIVE;
+    return sh;
+}
+
+// One iteration of a live shadow ray; done at the cap, past the far limit, or blocked.
+void shadow_step(inout Shadow sh) {
+    if (sh.iterations >= u_max_iterations) { sh.state = SHADOW_DONE; return; }
+    ++sh.iterations;
+    bool soft = soft_shadows_on();
+    vec3r o = sh.o.xyz;
+    vec3 l = sh.l.xyz;
+    float eps = sh.l.w;
+#ifdef KRS_MOBIUS
+    real t = sh.tc[0], s = sh.s;
+    if (is_unbounding(0, o + (t + s) * l, s)) {
+        if (soft) sh.vis = min(sh.vis, u_shadow_softness * float(s / (t + s)));
+        sh.tc[0] = t + 2.0 * s;
+        sh.s = s * u_xi_bonus;
+        if (sh.tc[0] > u_max_distance) sh.state = SHADOW_DONE;
+    } else {
+        if (s <= max(eps, MIN_PROBE)) { sh.vis = 0.0; sh.state = SHADOW_DONE; return; }
+        sh.s = s * u_xi_penalty;
+    }
+#else
+    int c = front(sh.tc);
+    real t = sh.tc[c];
+    if (t > u_max_distance) { sh.state = SHADOW_DONE; return; }
+    real d = component_distance(c, o + t * l);
+    if (d <= eps * lod_scale(o + t * l)) { sh.vis = 0.0; sh.state = SHADOW_DONE; return; }
+    if (soft && t > 0.0) sh.vis = min(sh.vis, u_shadow_softness * float(d / t));
+    sh.tc[c] = t + d;
+#endif
+}
+
 // Visibility in [0, 1] of the light in direction l from the hit point p with normal n, where
 // the primary ray stopped at threshold eps; the shadow ray stops at the same threshold.
 float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
-    bool soft = soft_shadows_on();
-    vec3r o = p + SHADOW_OFFSET * eps * n;
-    float vis = 1.0;
-    real t = 0.0;
-#ifdef KRS_MOBIUS
-    real s = INITIAL_PROBE;
-    for (int i = 0; i < u_max_iterations; ++i) {
-        if (is_unbounding(0, o + (t + s) * l, s)) {
-            if (soft) vis = min(vis, u_shadow_softness * float(s / (t + s)));
-            t += 2.0 * s;
-            s *= u_xi_bonus;
-            if (t > u_max_distance) break;
-        } else {
-            if (s <= max(eps, MIN_PROBE)) return 0.0;
-            s *= u_xi_penalty;
-        }
-    }
-#else
-    real tc[COMPONENT_SLOTS];  // one free distance per component, as in trace.glsl
-    for (int c = 0; c < COMPONENT_SLOTS; ++c) tc[c] = 0.0;
-    for (int i = 0; i < u_max_iterations; ++i) {
-        int c = front(tc);
-        t = tc[c];
-        if (t > u_max_distance) break;
-        real d = component_distance(c, o + t * l);
-        if (d <= eps * lod_scale(o + t * l)) return 0.0;
-        if (soft && t > 0.0) vis = min(vis, u_shadow_softness * float(d / t));
-        tc[c] = t + d;
-    }
+    Shadow sh = shadow_begin(p, n, l, eps);
+    while (sh.state == SHADOW_LIVE) shadow_step(sh);
+    return sh.vis;
+}
+
+#ifdef KRS_SHADOW_TASKS
+float g_shadow[LIGHT_SLOTS];   // the compute path: each light's visibility, traced as tasks
+                               // (compute.comp) and loaded by deferred.frag before shading
 #endif
-    return vis;
+
+// The visibility of light k that shade() multiplies in.
+float light_visibility(int k, vec3r p, vec3 n, float eps) {
+#ifdef KRS_SHADOW_TASKS
+    return g_shadow[k];
+#else
+    return shadow_visibility(p, n, u_light_dir[k], eps);
+#endif
 }
