@@ -86,6 +86,9 @@ def test_shadow_rays_traced_as_tasks_shade_the_same_image(renderer, name, effect
     assert "KRS_SHADOW_TASKS" in variant_defines(on_path(scene, "compute"), c)
     fragment = renderer.render(scene, W, H)
     assert same(fragment, renderer.render(on_path(scene, "compute", steps=3), W, H))
+    inline = on_path(scene, "compute", steps=3, shadow_tasks="off")   # the knob's other side
+    assert "KRS_SHADOW_TASKS" not in variant_defines(inline, c)
+    assert same(fragment, renderer.render(inline, W, H))
     unshadowed = replace(scene, effects=[e for e in scene.effects if "shadows" not in e])
     assert not np.array_equal(fragment.color, renderer.render(unshadowed, W, H).color)
 

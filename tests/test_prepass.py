@@ -122,3 +122,7 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
              for row in rows if row["culling"] == "on"}
     assert iters[("64x36", "fragment", "4", "0")] < iters[("64x36", "fragment", "0", "0")]
     assert iters[("64x36", "compute", "8", "4")] == iters[("64x36", "fragment", "8", "0")]
+    assert {row["shadow_rays"] for row in rows} == {""}      # sierpinski has no shadows
+    from krsview.bench.paths import levers
+    shadowed = {k[3:] for k in levers(load_scene(resolve("tree"))) if k[0] == "compute"}
+    assert shadowed == {(s, kind) for s in (4, 8, 16, 32) for kind in ("tasks", "inline")}

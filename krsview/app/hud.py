@@ -23,7 +23,8 @@ if TYPE_CHECKING:
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
 KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision", "culling",
-         "path", "steps")
+         "path", "steps", "shadow_tasks")
+COMPUTE_KNOBS = ("steps", "shadow_tasks")   # shown on the compute path only
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
@@ -85,7 +86,7 @@ def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:
     for name in KNOBS:
         if TRACER_KNOBS.get(name, r.tracer) != r.tracer:   # another tracer's knob
             continue
-        if name == "steps" and r.path != "compute":         # the compute path's knob
+        if name in COMPUTE_KNOBS and r.path != "compute":
             continue
         meta = RENDER_META[name]
         if name == "tracer" and v.scene.mokrs is not None:

@@ -44,7 +44,8 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines["KRS_CULLING"] = None     # only where some level has a ball to test
     if scene.render.prepass:
         defines["KRS_PREPASS"] = None
-    if scene.render.path == "compute" and {"shadows", "soft_shadows"} & set(scene.effects):
+    if (scene.render.path == "compute" and scene.render.shadow_tasks == "on"
+            and {"shadows", "soft_shadows"} & set(scene.effects)):
         defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None

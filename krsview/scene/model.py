@@ -244,6 +244,10 @@ class Render:
                            "shaded in a deferred pass (the same image)")
     steps: int = param(16, lo=1, hi=1024,
                        help="compute path: iterations per ray per round (dispatch)")
+    shadow_tasks: str = param("on", choices=SWITCH,
+                              help="compute path: shadow rays as tasks of their own, traced "
+                                   "in rounds like the primary rays (on), or inline while "
+                                   "shading (off); the same image")
     prepass: int = param(0, lo=0, hi=64, unit="pixels",
                          help="tile size of the low-resolution pre-pass: one cone per tile "
                               "finds how far all its rays are free, and each ray starts there "
