@@ -125,6 +125,11 @@ def _load(args: argparse.Namespace) -> Scene:
 def cmd_render(args: argparse.Namespace) -> int:
     scene = _load(args)
     if args.camera_path is not None:
+        for flag, given in (("--buffers", args.buffers), ("--reference", args.reference),
+                            ("--view", args.view != "shaded")):
+            if given:
+                raise SceneError(flag, getattr(args, flag[2:]), "cannot be combined with "
+                                 "--camera-path (it writes shaded frames)")
         return render_camera_path(args, scene)
     for flag in ("frames", "video"):
         if getattr(args, flag) is not None:
@@ -263,6 +268,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from .share.batch import run_batch
     from .share.frames import write_video
     require("ray", extra="cluster", what="batch")
+    from .share.batch import check_address
+    check_address(args.address)
     scene = _load(args)
     job, frames = frame_job(args, scene)
     video = check_video(args.video, job.size)
@@ -465,8 +472,9 @@ def cmd_bench_accuracy(args: argparse.Namespace) -> int:
             bench_accuracy(scenes[n], args.size, outs[n], rounds=args.rounds,
                            cache=Path(args.cache) if args.cache else None)
         return 0
-    from .share.batch import run_accuracy_sweep
     require("ray", extra="cluster", what="bench accuracy --workers/--address")
+    from .share.batch import check_address, run_accuracy_sweep
+    check_address(args.address)
     print(f"krsview: accuracy of {len(names)} preset(s) on {args.workers} Ray worker(s) of "
           f"{args.address or 'a local cluster'}; each report when its task ends", flush=True)
 

@@ -151,3 +151,24 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     # negative control: the two presets' reports differ
     a, b = (list(csv.DictReader(open(outs[n] / "accuracy.csv"))) for n in names)
     assert [r["mask_error"] for r in a] != [r["mask_error"] for r in b]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--address", "ray://127.0.0.1:1"], "--address = 'ray://127.0.0.1:1': cannot reach "
+                                         "127.0.0.1:1"),
+    (["--address", "http://x"], "expected ray://HOST:PORT"),
+    (["--address", "auto"], "Ray at auto: Could not find any running Ray instance"),
+    (["--workers", "0"], "--workers '0': allowed 1 ≤ value"),
+])
+def test_bad_cluster_options_are_one_line_errors(tmp_path, args, message):
+    """An address where nothing listens is refused at once (Ray alone waits 30 s, or for
+    ever); no cluster running for 'auto' is one line too."""
+    path = tmp_path / "tree.path.json"
+    path.write_text(json.dumps({"poses": POSES}))
+    r = subprocess.run([sys.executable, "-m", "krsview", "batch", "tree", "--camera-path",
+                        str(path), "-o", str(tmp_path / "f"), *args], capture_output=True,
+                       text=True, timeout=120, env={**os.environ, "DISPLAY": "",
+                                                    "RAY_ADDRESS": ""})
+    assert r.returncode in (2, 3) and message in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr
+    assert len([line for line in r.stderr.splitlines() if "error" in line]) == 1

@@ -140,6 +140,8 @@ def test_the_video_holds_the_frames(path_file, tmp_path):
     (["--video", "v.avi"], "--video = 'v.avi': the file must end in .mp4"),
     (["--size", "63x36", "--video", "v.mp4"], "--video needs an even width and height"),
     (["-o", "f.png"], "-o = 'f.png': with --camera-path, give a folder for the frames"),
+    (["--buffers", "b.npz"], "--buffers = 'b.npz': cannot be combined with --camera-path"),
+    (["--view", "iterations"], "--view = 'iterations': cannot be combined with"),
 ])
 def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, message):
     r = krsview("render", "tree", "--camera-path", str(path_file), "--fps", "4",

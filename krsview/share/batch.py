@@ -16,13 +16,15 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
+import socket
 import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from ..scene import Scene
+from ..scene import Scene, SceneError
 from .frames import FrameJob, frame_png, write_frame
 
 
@@ -56,6 +58,26 @@ class FrameWorker:
         return [(k, frame_png(self.job, k, self.renderer)) for k in frames]
 
 
+class ClusterError(RuntimeError):
+    """Ray could not be started or joined (one line, exit status 3)."""
+
+
+def check_address(address: str | None, flag: str = "--address") -> None:
+    """Before any work: the address has a form Ray takes, and its host answers (Ray itself
+    waits a long time, or for ever, on an address where nothing listens)."""
+    if address is None or address == "auto":
+        return
+    m = re.fullmatch(r"(ray://)?([^:/\s]+):(\d{1,5})", address)
+    if m is None:
+        raise SceneError(flag, address, "expected ray://HOST:PORT (the Ray client), "
+                                        "HOST:PORT (a head node's GCS) or auto")
+    try:
+        socket.create_connection((m.group(2), int(m.group(3))), timeout=5).close()
+    except OSError as e:
+        raise SceneError(flag, address, f"cannot reach {m.group(2)}:{m.group(3)}: "
+                                        f"{e.strerror or e}") from None
+
+
 def start_ray(workers: int, address: str | None) -> None:
     """Join ``address``, or start a local cluster with one CPU per worker; each worker's
     llvmpipe gets its share of the cores (on a GPU machine the variable is ignored)."""
@@ -63,9 +85,13 @@ def start_ray(workers: int, address: str | None) -> None:
     if ray.is_initialized():
         return
     threads = max(1, (os.cpu_count() or 1) // workers)
-    ray.init(address=address, num_cpus=None if address else workers,
-             include_dashboard=False, log_to_driver=False, configure_logging=False,
-             runtime_env={"env_vars": {"LP_NUM_THREADS": str(threads), "DISPLAY": ""}})
+    try:
+        ray.init(address=address, num_cpus=None if address else workers,
+                 include_dashboard=False, log_to_driver=False, configure_logging=False,
+                 runtime_env={"env_vars": {"LP_NUM_THREADS": str(threads), "DISPLAY": ""}})
+    except (ConnectionError, TimeoutError, RuntimeError, ValueError) as e:
+        where = address or "a local cluster"
+        raise ClusterError(f"Ray at {where}: {str(e).strip().splitlines()[-1]}") from None
 
 
 def chunks_of(frames: list[int], size: int) -> list[list[int]]:
