@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 import typing
@@ -241,7 +242,12 @@ def cmd_export_mesh(args: argparse.Namespace) -> int:
           f"{args.lod:g} voxel out …", flush=True)
     bar = Progress(1, "  bricks", SILENT_SECONDS)
     mesh, st = build_mesh(scene, args.resolution, args.box, args.lod, bar)
-    mesh.export(out)
+    tmp = out.with_name(f".{out.name}.tmp{out.suffix}")   # whole file or none
+    try:
+        mesh.export(tmp)
+        os.replace(tmp, out)
+    finally:
+        tmp.unlink(missing_ok=True)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"  {st.triangles:,} triangles, {'watertight' if st.watertight else 'open'}; "
           f"{st.bricks} bricks of {(st.resolution // 16) ** 3} sampled, "
