@@ -1,9 +1,9 @@
 """`krsview bench paths`: what each speed lever of issue 17 buys, measured side by side —
 exact level culling on and off and the low-resolution pre-pass off and at several tile sizes
 on the fragment path, and the compute path at several iterations per round (shadow rays as
-tasks and inline, where the scene has shadows), at two resolutions; frame-time ratios against the plain frame (fragment path, no culling, no
-pre-pass), iterations and levels of Alg. 1 walked per pixel in the full pass (a KRS), and
-the coarse pass's share of the frame.
+tasks and inline, where the scene has shadows), at two resolutions; frame-time ratios
+against the plain frame (fragment path, no culling, no pre-pass), iterations and levels of
+Alg. 1 walked per pixel in the full pass (a KRS), and the coarse pass's share of the frame.
 Variants are interleaved round by round (bench/harness.py)."""
 from __future__ import annotations
 
