@@ -149,13 +149,14 @@ def save_scene(scene: Scene, path: str | os.PathLike) -> None:
     write_atomic(path, scene_to_toml(scene))
 
 
-def write_atomic(path: str | os.PathLike, text: str) -> None:
-    """Write a temporary file beside the target, then rename it over the target."""
+def write_atomic(path: str | os.PathLike, data: str | bytes) -> None:
+    """Write a temporary file beside the target, then rename it over the target: text as
+    UTF-8, bytes as they are."""
     p = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent or ".")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data.encode("utf-8") if isinstance(data, str) else data)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, p)

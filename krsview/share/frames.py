@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import io
 import os
-import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
@@ -15,6 +14,7 @@ from PIL import Image
 
 from ..scene import Scene, SceneError
 from ..scene.camera_path import CameraPath
+from ..scene.scene import write_atomic
 
 DEFAULT_FPS = 30.0
 
@@ -80,16 +80,8 @@ def frame_png(job: FrameJob, k: int, renderer) -> bytes:
 
 
 def write_frame(folder: Path, k: int, png: bytes) -> None:
-    """Write a temporary file, then rename it into place: the folder holds whole frames."""
-    target = frame_file(folder, k)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".png", dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(png)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Frame k, written atomically: the folder only ever holds whole frames."""
+    write_atomic(frame_file(folder, k), png)
 
 
 def write_video(folder: Path, frames: range, fps: float, video: Path,
