@@ -20,7 +20,7 @@ from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
 from .scene.effects import check_effects
 from .oracle.certify import MAX_SEGMENTS
 from .scene.schema import describe_range, check_value
-from .share.mesh import FORMATS as MESH_FORMATS
+from .share.mesh import BRICK as MESH_BRICK, FORMATS as MESH_FORMATS
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
 
@@ -250,7 +250,7 @@ def cmd_export_mesh(args: argparse.Namespace) -> int:
         tmp.unlink(missing_ok=True)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"  {st.triangles:,} triangles, {'watertight' if st.watertight else 'open'}; "
-          f"{st.bricks} bricks of {(st.resolution // 16) ** 3} sampled, "
+          f"{st.bricks} bricks of {(st.resolution // MESH_BRICK) ** 3} sampled, "
           f"{st.samples:,} reference samples ({st.samples / (st.resolution + 1) ** 3:.1%} of "
           f"a dense grid); {st.seconds:.1f} s, peak memory {peak:.0f} MiB")
     print(f"  wrote {out.resolve()}")
@@ -271,10 +271,9 @@ class MissingExtra(RuntimeError):
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
-    from .share.batch import run_batch
-    from .share.frames import write_video
     require("ray", extra="cluster", what="batch")
-    from .share.batch import check_address
+    from .share.batch import check_address, run_batch
+    from .share.frames import write_video
     check_address(args.address)
     scene = _load(args)
     job, frames = frame_job(args, scene)
@@ -492,7 +491,7 @@ def cmd_bench_accuracy(args: argparse.Namespace) -> int:
         for line in lines:
             print(f"  {line}")
     failed = run_accuracy_sweep(scenes, args.size, args.rounds, outs, args.workers,
-                                args.address, done)
+                                args.address, done, Path(args.cache) if args.cache else None)
     return 1 if failed else 0
 
 

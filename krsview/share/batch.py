@@ -158,14 +158,15 @@ def _requeue(queue: list, report: BatchReport, frames: list[int], attempt: int,
         report.failed.append(frames)
 
 
-def accuracy_report(scene: Scene, size: tuple[int, int], rounds: int
-                    ) -> tuple[dict[str, bytes], list[str]]:
+def accuracy_report(scene: Scene, size: tuple[int, int], rounds: int,
+                    cache: Path | None = None) -> tuple[dict[str, bytes], list[str]]:
     """One preset's `bench accuracy` (bench/accuracy.py) in a scratch folder: its files as
-    bytes, so the driver writes them wherever it likes, and the report's verdict."""
+    bytes, so the driver writes them wherever it likes, and the report's verdict. ``cache``:
+    the ground-truth cache on the worker's machine (None: its default)."""
     from ..bench.accuracy import bench_accuracy, verdict
     with tempfile.TemporaryDirectory() as d:
         with contextlib.redirect_stdout(io.StringIO()):     # the report is in the files
-            rows = bench_accuracy(scene, size, Path(d), rounds)
+            rows = bench_accuracy(scene, size, Path(d), rounds, cache)
         files = {str(p.relative_to(d)): p.read_bytes() for p in Path(d).rglob("*")
                  if p.is_file()}
     return files, verdict(rows)
@@ -173,7 +174,8 @@ def accuracy_report(scene: Scene, size: tuple[int, int], rounds: int
 
 def run_accuracy_sweep(scenes: dict[str, Scene], size: tuple[int, int], rounds: int,
                        outs: dict[str, Path], workers: int, address: str | None,
-                       done: Callable[[str, list[str] | None, str], None]) -> list[str]:
+                       done: Callable[[str, list[str] | None, str], None],
+                       cache: Path | None = None) -> list[str]:
     """The accuracy bench of every scene as one Ray task each (retried if its worker dies);
     each report is written to ``outs[name]`` as it arrives and ``done(name, verdict, error)``
     called. Returns the names that failed. Time ratios are measured within each task, side
@@ -181,7 +183,7 @@ def run_accuracy_sweep(scenes: dict[str, Scene], size: tuple[int, int], rounds: 
     import ray
     start_ray(workers, address)
     task = ray.remote(num_cpus=1, max_retries=2)(accuracy_report)
-    running = {task.remote(scene, size, rounds): name for name, scene in scenes.items()}
+    running = {task.remote(scene, size, rounds, cache): name for name, scene in scenes.items()}
     failed = []
     while running:
         ready, _ = ray.wait(list(running), num_returns=1)
