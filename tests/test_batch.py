@@ -157,12 +157,12 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     (["--address", "ray://127.0.0.1:1"], "--address = 'ray://127.0.0.1:1': cannot reach "
                                          "127.0.0.1:1"),
     (["--address", "http://x"], "expected ray://HOST:PORT"),
-    (["--address", "auto"], "Ray at auto: Could not find any running Ray instance"),
     (["--workers", "0"], "--workers '0': allowed 1 ≤ value"),
 ])
 def test_bad_cluster_options_are_one_line_errors(tmp_path, args, message):
     """An address where nothing listens is refused at once (Ray alone waits 30 s, or for
-    ever); no cluster running for 'auto' is one line too."""
+    ever). ('auto' with no cluster running is one line too, but whether one runs depends on
+    the machine: this module's own fixture starts one.)"""
     path = tmp_path / "tree.path.json"
     path.write_text(json.dumps({"poses": POSES}))
     r = subprocess.run([sys.executable, "-m", "krsview", "batch", "tree", "--camera-path",
