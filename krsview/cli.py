@@ -20,6 +20,7 @@ from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
 from .scene.effects import check_effects
 from .oracle.certify import MAX_SEGMENTS
 from .scene.schema import describe_range, check_value
+from .share.frames import DEFAULT_FPS
 from .share.mesh import BRICK as MESH_BRICK, FORMATS as MESH_FORMATS
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
@@ -564,8 +565,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="a NAME.path.json camera path (recorded in the viewer with F5)")
         sp.add_argument("--frames", metavar="A-B",
                         help="only frames A to B, inclusive (default: all the path's)")
-        sp.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0), default=30.0,
-                        help="frames per second of path time (default 30)")
+        sp.add_argument("--fps", type=_positive_float("--fps", 1.0, 240.0),
+                        default=DEFAULT_FPS, help="frames per second of path time (default "
+                        f"{DEFAULT_FPS:g})")
         sp.add_argument("--video", metavar="MP4", help="also write the frames as an H.264 "
                         "video, ending in .mp4 (needs an even width and height)")
 

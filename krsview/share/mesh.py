@@ -121,9 +121,10 @@ def build_mesh(scene: Scene, resolution: int, box: tuple[float, ...] | None = No
     return mesh, stats
 
 
-def _batched(f, x: np.ndarray, r: np.ndarray) -> np.ndarray:
-    return np.concatenate([f(x[k:k + BATCH], r[k:k + BATCH]) for k in range(0, len(x), BATCH)]
-                          or [np.zeros(0, dtype=bool)])
+def _batched(f: Callable, *xs: np.ndarray) -> np.ndarray:
+    """f over the rows of ``xs`` (at least one) in slices of BATCH rows: memory stays flat."""
+    return np.concatenate([f(*(x[k:k + BATCH] for x in xs))
+                           for k in range(0, len(xs[0]), BATCH)])
 
 
 def refine(g: np.ndarray, f: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
@@ -144,10 +145,10 @@ def refine(g: np.ndarray, f: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     rows = np.arange(len(idx))
     a[rows, axis] = np.floor(g[idx, axis])
     b[rows, axis] = np.ceil(g[idx, axis])
-    fa = np.concatenate([f(a[k:k + BATCH]) for k in range(0, len(a), BATCH)])
+    fa = _batched(f, a)
     for _ in range(REFINE_STEPS):
         m = (a + b) / 2
-        fm = np.concatenate([f(m[k:k + BATCH]) for k in range(0, len(m), BATCH)])
+        fm = _batched(f, m)
         same = (fm < 0) == (fa < 0)           # the sign change lies in [m, b]
         a = np.where(same[:, None], m, a)
         fa = np.where(same, fm, fa)
