@@ -605,6 +605,7 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(r, "precision")
     render_option(r, "culling")
     render_option(r, "prepass")
+    render_option(r, "prepass_levels")
     render_option(r, "path")
     render_option(r, "steps")
     render_option(r, "shadow_tasks")

@@ -63,6 +63,42 @@ def test_a_cone_without_its_spread_skips_surfaces(tmp_path):
     assert count_errors(scene, img, arithmetics=("affine",)).holes > 0
 
 
+def passes(scene, tile, levels):
+    return replace(scene, render=replace(scene.render, prepass=tile, prepass_levels=levels))
+
+
+@pytest.mark.parametrize("name", ["tree", "grove"])
+def test_coarser_passes_skip_no_surface_and_each_starts_where_the_coarser_stopped(renderer,
+                                                                                   name):
+    """Three coarse passes (tiles of 32, 8 and 2 pixels): the oracle still certifies no hole
+    and no false hit. Each cone starts at the free distance of the coarser tile around it, so
+    no tile's free distance is below that tile's (the coarsest pass alone is a one-pass
+    pre-pass at its tile size), and most get further."""
+    scene = scene_of(name)
+    deep = passes(scene, 2, 3)
+    img = renderer.render(deep, W, H)
+    counts = count_errors(deep, img, arithmetics=("affine",))
+    assert (counts.holes, counts.false_hits) == (0, 0), counts
+    used = len(getattr(scene.geometry(), "parts", [None]))     # components: the rest are 0
+    fine = renderer.free_distances(passes(scene, 8, 2), W, H)[::-1, :, :used]  # rows bottom
+    parent = renderer.free_distances(passes(scene, 32, 1), W, H)[::-1, :, :used]  # → top
+    below = parent[np.arange(fine.shape[0])[:, None] // 4, np.arange(fine.shape[1]) // 4]
+    assert (fine >= below * (1 - 2e-6)).all()
+    assert (fine > below).mean() > 0.5        # the finer cones get further
+
+
+def test_a_finer_pass_that_reads_the_wrong_coarse_tile_skips_surfaces(tmp_path):
+    """Negative control: a finer cone that starts at the free distance of another coarse
+    tile than the one around it (the shader assuming half the renderer's tile ratio) starts
+    rays past surfaces."""
+    shaders = broken_shaders(tmp_path, "prepass.frag",
+                             "ivec2(gl_FragCoord.xy) / u_parent_ratio",
+                             "ivec2(gl_FragCoord.xy) / (u_parent_ratio / 2)")
+    scene = passes(load_scene(resolve("tree")), 2, 2)
+    img = Renderer(shader_dir=shaders).render(scene, W, H)
+    assert count_errors(scene, img, arithmetics=("affine",)).holes > 0
+
+
 @pytest.mark.parametrize("name", ["tree", "grove", "palm"])
 def test_rays_start_at_their_tiles_free_distance(renderer, name):
     """Every ray starts no nearer than 0 and walks fewer steps: the free distances are
@@ -106,11 +142,12 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
     assert r.returncode == 0, r.stderr
     rows = list(csv.DictReader(out.open()))
     sizes = ("32x18", "64x36")
-    assert {(row["size"], row["path"], row["culling"], row["prepass"], row["steps"])
-            for row in rows} == {
-        (size, "fragment", c, str(t), "0") for size in sizes for c in ("on", "off")
-        for t in (0, 4, 8, 16)} | {(size, "compute", "on", "8", str(s)) for size in sizes
-                                   for s in (4, 8, 16, 32)}
+    key = ("size", "path", "culling", "prepass", "coarse_passes", "steps")
+    assert {tuple(row[k] for k in key) for row in rows} == {
+        (size, "fragment", c, str(t), "2" if t else "0", "0") for size in sizes
+        for c in ("on", "off") for t in (0, 4, 8, 16)} | {
+        (size, "fragment", "on", str(t), "1", "0") for size in sizes for t in (4, 8)} | {
+        (size, "compute", "on", "8", "2", str(s)) for size in sizes for s in (4, 8, 16, 32)}
     n = len(load_scene(resolve("sierpinski")).geometry().mirrors)
     for row in rows:
         if (row["path"], row["culling"], row["prepass"]) == ("fragment", "off", "0"):
@@ -118,11 +155,13 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
         assert (float(row["coarse_share"]) > 0) == (row["prepass"] != "0")
         # no level of sierpinski has a ball: every step walks all n levels
         assert float(row["levels"]) == pytest.approx(n * float(row["iterations"]))
-    iters = {(row["size"], row["path"], row["prepass"], row["steps"]): float(row["iterations"])
+    iters = {tuple(row[k] for k in key): float(row["iterations"])
              for row in rows if row["culling"] == "on"}
-    assert iters[("64x36", "fragment", "4", "0")] < iters[("64x36", "fragment", "0", "0")]
-    assert iters[("64x36", "compute", "8", "4")] == iters[("64x36", "fragment", "8", "0")]
+    assert (iters[("64x36", "fragment", "on", "4", "2", "0")]
+            < iters[("64x36", "fragment", "on", "0", "0", "0")])
+    assert (iters[("64x36", "compute", "on", "8", "2", "4")]
+            == iters[("64x36", "fragment", "on", "8", "2", "0")])
     assert {row["shadow_rays"] for row in rows} == {""}      # sierpinski has no shadows
     from krsview.bench.paths import levers
-    shadowed = {k[3:] for k in levers(load_scene(resolve("tree"))) if k[0] == "compute"}
+    shadowed = {k[4:] for k in levers(load_scene(resolve("tree"))) if k[0] == "compute"}
     assert shadowed == {(s, kind) for s in (4, 8, 16, 32) for kind in ("tasks", "inline")}

@@ -17,6 +17,7 @@ from ..buffers import Buffers
 from ..reference.camera import view_of
 from ..reference.geometry import Compiled, compile_geometry
 from ..scene.scene import MAX_LIGHTS
+from ..scene.model import PREPASS_RATIO
 from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
@@ -114,11 +115,11 @@ class Renderer:
             progs = [prog]
         if scene.render.prepass:
             coarse = self.programs.get("fullscreen.vert", "prepass.frag", defines)
-            self._coarse[prog] = (coarse, scene.render.prepass)
+            self._coarse[prog] = (coarse, scene.render.prepass, scene.render.prepass_levels)
             progs.append(coarse)
-            for p in progs:
-                for unit, name in enumerate(("u_free0", "u_free1")):  # unused: compiled away
-                    if name in p:
+            for p in progs:    # the finest coarse pass's output, and the coarser one's before it
+                for unit, name in enumerate(("u_free0", "u_free1", "u_parent0", "u_parent1")):
+                    if name in p:                                    # unused: compiled away
                         p[name].value = unit
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
@@ -164,20 +165,35 @@ class Renderer:
 
     def _prepass(self, prog: moderngl.Program, width: int, height: int,
                  tile: tuple[int, int, int, int] | None) -> None:
-        """The coarse pass of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
-        its free distances left bound to texture units 0 and 1."""
-        coarse, size = self._coarse[prog]
-        cw, ch = -(-width // size), -(-height // size)
-        fbo = self._framebuffer(cw, ch, layers=2)
-        fbo.use()
-        self.ctx.viewport = (0, 0, cw, ch)
-        if tile is not None:
-            x, y, w, h = tile
-            x0, y0 = x // size, y // size
-            self.ctx.scissor = (x0, y0, -(-(x + w) // size) - x0, -(-(y + h) // size) - y0)
-        self._vao(coarse).render(moderngl.TRIANGLES, vertices=3)
-        self.ctx.scissor = None
-        for unit, tex in enumerate(fbo.color_attachments):
+        """The coarse passes of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
+        coarsest first, each reading the one before's free distances from texture units 2
+        and 3; the finest's are left bound to units 0 and 1 for the full pass."""
+        coarse, size, levels = self._coarse[prog]
+        passes: list[tuple[int, int, int]] = []      # (tile size, columns, rows), finest first
+        for k in range(levels):
+            t = size * PREPASS_RATIO ** k
+            grid = (t, -(-width // t), -(-height // t))
+            if passes and passes[-1][1:] == grid[1:]:
+                break                                # as coarse as the image allows
+            passes.append(grid)
+        parent = None
+        for t, cw, ch in reversed(passes):
+            fbo = self._framebuffer(cw, ch, layers=2)
+            fbo.use()
+            self.ctx.viewport = (0, 0, cw, ch)
+            coarse["u_tile"].value = t
+            coarse["u_parent_ratio"].value = PREPASS_RATIO if parent else 0
+            if parent:
+                for unit, tex in enumerate(parent.color_attachments):
+                    tex.use(2 + unit)
+            if tile is not None:
+                x, y, w, h = tile
+                x0, y0 = x // t, y // t
+                self.ctx.scissor = (x0, y0, -(-(x + w) // t) - x0, -(-(y + h) // t) - y0)
+            self._vao(coarse).render(moderngl.TRIANGLES, vertices=3)
+            self.ctx.scissor = None
+            parent = fbo
+        for unit, tex in enumerate(parent.color_attachments):
             tex.use(unit)
 
     def _vao(self, prog: moderngl.Program) -> moderngl.VertexArray:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..reference.camera import View
-from ..reference.compiled import RECORD_VEC4, CompiledCompound
+from ..reference.compiled import KERNEL_CODES, RECORD_VEC4, CompiledCompound
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
@@ -26,6 +26,10 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
                                             "LIGHT_SLOTS": MAX_LIGHTS}
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
+    if not isinstance(c, CompiledMoKRS):
+        parts = [part for part, _ in component_slots(c)]
+        defines["KRS_TOP_KERNELS"] = kernel_mask(part.types[-1] for part in parts)
+        defines["KRS_LEVEL_KERNELS"] = kernel_mask(k for part in parts for k in part.types[:-1])
     if all_effects:
         defines["KRS_ALL_EFFECTS"] = None
         for name in allowed_effects(isinstance(c, CompiledMoKRS)):
@@ -54,6 +58,14 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines["KRS_COMPOUND"] = None
         defines["KRS_MAX_COMPONENTS"] = MAX_COMPONENTS
     return defines
+
+
+def kernel_mask(kinds) -> int:
+    """Bit KERNEL_CODES[kind] set per kind (kernels.glsl's kernel_distance_of): a call that
+    can only meet these kinds compiles no other kind's code. llvmpipe runs the code of every
+    branch, taken or not, so a level loop that compiled the trunk's capsule beside the
+    branches' arcs paid for both at every level (docs/speed.md)."""
+    return sum(1 << KERNEL_CODES[k] for k in set(kinds) - {"empty"})
 
 
 def slots(c: Compiled) -> int:

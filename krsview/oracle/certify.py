@@ -133,6 +133,13 @@ def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
     return free
 
 
+# How near a hit is to a surface, in ε(t): a sphere-traced hit stops where the distance bound
+# is below ε; a binary one at a free point t whose blocked probe (centre t + s, radius s ≤ ε)
+# holds a surface, so within 2ε (reference/trace.py, binary_trace). A hit whose box of this
+# half-size is certified empty is a false hit.
+HIT_REACH = {"sphere": 1.0, "relaxed": 1.0, "binary": 2.0}
+
+
 @dataclass
 class Counts:
     rays: int
@@ -168,6 +175,6 @@ def count_errors(scene: Scene, image: Buffers, arithmetics=ARITHMETICS,
         surface = cert.surface if surface is None else np.where(
             DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
     centres = view.origin + t[hit, None] * dirs[hit]
-    false_hits = int(free_boxes(c, centres, eps[hit]).sum())
+    false_hits = int(free_boxes(c, centres, HIT_REACH[scene.render.tracer] * eps[hit]).sum())
     return Counts(len(hit), int(hit.sum()), int((surface == SURFACE).sum()), false_hits,
                   int((surface == BELOW_LOD).sum()), int((surface == UNDECIDED).sum()), work)

@@ -18,6 +18,7 @@ TRACERS = ("sphere", "binary", "relaxed")
 PRECISIONS = ("float", "double")
 SWITCH = ("on", "off")
 PATHS = ("fragment", "compute")
+PREPASS_RATIO = 4   # pre-pass: a coarse pass's tiles are this many times as wide as the next's
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -252,6 +253,11 @@ class Render:
                          help="tile size of the low-resolution pre-pass: one cone per tile "
                               "finds how far all its rays are free, and each ray starts there "
                               "(0: off)")
+    prepass_levels: int = param(2, lo=1, hi=4,
+                                help=f"pre-pass: coarse passes, coarsest first, each with "
+                                     f"tiles {PREPASS_RATIO}× as wide as the next; a cone "
+                                     "starts where the coarser cone around it stopped (1: "
+                                     "one coarse pass)")
 
 
 # ------------------------------------------------------------------------------ arc geometry

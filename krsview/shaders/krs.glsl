@@ -19,7 +19,7 @@ int g_levels = 0;   // levels walked so far by this invocation (bench paths' mea
 #endif
 real krs_distance(int first, int n, vec3r xw) {
     vec3r x = xw;
-    real d = kernel_distance(first + n, x);
+    real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
     for (int i = first + n - 1; i >= first; --i) {
 #ifdef KRS_COUNT_LEVELS
         ++g_levels;
@@ -29,7 +29,7 @@ real krs_distance(int first, int n, vec3r xw) {
         if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
 #endif
         fold(i, x);
-        d = min(d, kernel_distance(i, x));
+        d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
     }
     return d;
 }
@@ -54,17 +54,17 @@ real krs_nearest(int first, int n, vec3r xw, float width, out int level, out vec
                  out vec3r xk) {
     vec3r x = xw;
     xk = xw;
-    real d = kernel_distance(first + n, x);
+    real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
     level = first + n;
     mat3r M = mat3r(1.0), Mk = mat3r(1.0);
     for (int i = first + n - 1; i >= first; --i) {
         vec3r u = u_mirrors[i].xyz;
         real e = fold(i, x);
         M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
-        real di = kernel_distance(i, x);
+        real di = kernel_distance_of(i, x, KRS_LEVEL_KERNELS);
         if (di < d) { d = di; level = i; xk = x; Mk = M; }
     }
-    vec3r g = Mk * kernel_gradient(level, xk);
-    normal = vec3(length(g) > 0.0 ? normalize(g) : kernel_gradient(level, xk));
+    vec3r gk = kernel_gradient(level, xk), g = Mk * gk;
+    normal = vec3(length(g) > 0.0 ? normalize(g) : gk);
     return d;
 }

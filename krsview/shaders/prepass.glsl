@@ -9,11 +9,13 @@
 // radius s + (t + 2s)·σ' around the centre ray's point t + s holds every tile ray's points on
 // [t, t + 2s] with their ε-balls. Probed as the binary tracer does [KRS17 Alg. 2]: free →
 // t += 2s and s grows; blocked → s shrinks, until s is no larger than the cone's own width.
+// The probing starts at t0: 0, or where the cone of the coarser tile around this one stopped
+// (prepass.frag; render.prepass_levels).
 uniform int u_tile;
 
 #ifdef KRS_PREPASS_COARSE
-real cone_free(int c, vec3r dir, real sigma) {
-    real t = 0.0, s = 1.0;
+real cone_free(int c, vec3r dir, real sigma, real t0) {
+    real t = t0, s = 1.0;
     for (int i = 0; i < u_max_iterations; ++i) {
         if (t > u_max_distance) break;
         if (is_unbounding(c, (t + s) * dir, s + (t + 2.0 * s) * sigma)) {
