@@ -445,6 +445,14 @@ def cmd_bench_paths(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bench_split(args: argparse.Namespace) -> int:
+    from .bench.split import bench_split
+    scene = _load(args)
+    check_bench_csv(args)
+    bench_split(scene, args.size, rounds=args.rounds, csv=args.csv)
+    return 0
+
+
 def cmd_bench_tracers(args: argparse.Namespace) -> int:
     from .bench.tracers import bench_tracers
     scene = _load(args)
@@ -751,7 +759,8 @@ def build_parser() -> argparse.ArgumentParser:
     bl.set_defaults(func=cmd_bench_levels)
     bp = bsub.add_parser("paths", help="what culling, the pre-pass and the compute path buy",
                          description="Exact level culling off/on × the low-resolution pre-pass "
-                                     "off and at tiles 4, 8, 16 on the fragment path, and the "
+                                     "off and at tiles 4, 8, 16 (tiles 4 and 8 also with one "
+                                     "coarse pass) on the fragment path, and the "
                                      "compute path at 4, 8, 16, 32 iterations per round, at "
                                      "--size and twice it, interleaved: frame time and "
                                      "speed-up against the plain frame, iterations per pixel, "
@@ -759,6 +768,19 @@ def build_parser() -> argparse.ArgumentParser:
     bench_arguments(bp)
     render_option(bp, "tracer")
     bp.set_defaults(func=cmd_bench_paths)
+    bs = bsub.add_parser("split", help="where a frame's time goes: coarse passes, tracing, "
+                         "shading, shadow rays",
+                         description="On one scene and view, the fragment path: the frame, "
+                                     "the frame without secondary effects (shadow rays, "
+                                     "occlusion; what the viewer's moving frames leave out), "
+                                     "the tracing alone and the coarse passes alone, "
+                                     "interleaved; each part of the frame is the difference "
+                                     "of two of them. Example: krsview bench split tree "
+                                     "--prepass 8 (the viewer's pre-pass).")
+    bench_arguments(bs)
+    for name in ("culling", "prepass", "prepass_levels"):
+        render_option(bs, name)
+    bs.set_defaults(func=cmd_bench_split)
     bt = bsub.add_parser("tracers", help="sphere vs binary sphere tracing, and a ξ sweep",
                          description="On one scene and view: sphere tracing, binary tracing at "
                                      "the paper's ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over "

@@ -16,7 +16,8 @@ class Variant:
     scene: Scene
     geometry: Geometry | None = None   # None: the scene's own
     all_effects: bool = False          # the variant with every effect switched by uniforms
-    prepass_only: bool = False         # time the pre-pass's coarse pass alone
+    prepass_only: bool = False         # time the pre-pass's coarse passes alone
+    probes: tuple[str, ...] = ()       # a measuring variant's defines (Renderer.prepare)
 
 
 def median_times(r: Renderer, variants: dict[str, Variant], size: tuple[int, int],
@@ -25,13 +26,13 @@ def median_times(r: Renderer, variants: dict[str, Variant], size: tuple[int, int
     w, h = size
     for v in variants.values():
         r.time_frame(v.scene, w, h, v.geometry, all_effects=v.all_effects,
-                     prepass_only=v.prepass_only)
+                     prepass_only=v.prepass_only, probes=v.probes)
     times: dict[str, list[float]] = {name: [] for name in variants}
     bar = Progress(rounds * len(variants), f"{label} {w}×{h}")
     for _ in range(rounds):
         for name, v in variants.items():
             times[name] += r.time_frame(v.scene, w, h, v.geometry, repeats=1,
                                         all_effects=v.all_effects,
-                                        prepass_only=v.prepass_only)
+                                        prepass_only=v.prepass_only, probes=v.probes)
             bar.step(name)
     return {name: statistics.median(t) for name, t in times.items()}

@@ -73,15 +73,17 @@ class Renderer:
         return self._targets[key]
 
     def prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                all_effects: bool = False, count_levels: bool = False) -> moderngl.Program:
+                all_effects: bool = False, probes: tuple[str, ...] = ()) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms,
-        ``count_levels`` one that also counts the levels Alg. 1 walks (:meth:`levels`)."""
+        ``probes`` the defines of a measuring variant, drawn on the fragment path:
+        KRS_COUNT_LEVELS counts the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY
+        traces without shading (bench split)."""
         with self.current():
-            return self._prepare(scene, width, height, geometry, all_effects, count_levels)
+            return self._prepare(scene, width, height, geometry, all_effects, probes)
 
     def _prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None,
-                 all_effects: bool, count_levels: bool = False) -> moderngl.Program:
+                 all_effects: bool, probes: tuple[str, ...] = ()) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
         c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         block = krs_block(c, scene.render.precision)
@@ -94,8 +96,8 @@ class Renderer:
                              "for a compound's 8 × 64 level slots: render its components as "
                              "separate scenes")
         defines = variant_defines(scene, c, all_effects)
-        if count_levels:
-            defines["KRS_COUNT_LEVELS"] = None
+        if probes:
+            defines.update(dict.fromkeys(probes))
             scene = replace(scene, render=replace(scene.render, path="fragment"))
         if scene.render.path == "compute":        # trace in rounds, then a shading pass
             prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
@@ -272,7 +274,7 @@ class Renderer:
         shading it), summed over its steps: with culling, fewer than steps × n. Counted by
         a variant of the fragment path (the compute path takes the same steps)."""
         with self.current():
-            prog = self.prepare(scene, width, height, count_levels=True)
+            prog = self.prepare(scene, width, height, probes=("KRS_COUNT_LEVELS",))
             fbo = self.draw(prog, width, height)
             return read_plane(fbo, 2, width, height)[..., 1].astype(np.int64)
 
@@ -292,12 +294,12 @@ class Renderer:
                                   axis=-1).astype(np.float64)
 
     def time_frame(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                   repeats: int = 1, all_effects: bool = False,
-                   prepass_only: bool = False) -> list[float]:
+                   repeats: int = 1, all_effects: bool = False, prepass_only: bool = False,
+                   probes: tuple[str, ...] = ()) -> list[float]:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up;
-        ``prepass_only``: of the pre-pass's coarse pass alone."""
+        ``prepass_only``: of the pre-pass's coarse passes alone; ``probes``: see prepare."""
         with self.current():
-            prog = self.prepare(scene, width, height, geometry, all_effects)
+            prog = self.prepare(scene, width, height, geometry, all_effects, probes)
             draw = (lambda: self._prepass(prog, width, height, None)) if prepass_only else \
                 (lambda: self.draw(prog, width, height))
             draw()

@@ -16,7 +16,13 @@ void main() {
 #ifdef KRS_COUNT_LEVELS
     int levels = g_levels;   // the tracing's, before shading walks more
 #endif
+#ifdef KRS_TRACE_ONLY   // bench split: the tracing alone, its result kept, nothing shaded
+    out_color = vec4(0.0, 0.0, 0.0, hit ? 1.0 : 0.0);
+    out_normal = vec4(0.0, 0.0, 0.0, float(t));
+    out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
+#else
     write_pixel(dir, hit, t, iterations);
+#endif
 #ifdef KRS_COUNT_LEVELS
     out_iterations.y = float(levels);
 #endif
