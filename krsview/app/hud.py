@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
 KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision", "culling",
-         "prepass_levels", "path", "steps", "shadow_tasks")
+         "path", "steps", "shadow_tasks", "prepass_levels")   # the last beside the tile slider
 COMPUTE_KNOBS = ("steps", "shadow_tasks")   # shown on the compute path only
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
