@@ -34,7 +34,8 @@ class Renderer:
         self.programs = ProgramCache(self.ctx, shader_dir)
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
-        self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int]] = {}  # pre-pass
+        self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int, int]] = {}  # pre-pass
+        self._blank: moderngl.Texture | None = None   # bound where the coarsest pass's parent is
         self._compute: dict[moderngl.Program, tuple] = {}   # deferred → compute, its sizes
         self._rays: dict[int, moderngl.Buffer] = {}   # the compute path's buffers, by binding
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
@@ -185,9 +186,11 @@ class Renderer:
             self.ctx.viewport = (0, 0, cw, ch)
             coarse["u_tile"].value = t
             coarse["u_parent_ratio"].value = PREPASS_RATIO if parent else 0
-            if parent:
-                for unit, tex in enumerate(parent.color_attachments):
-                    tex.use(2 + unit)
+            # the coarsest pass reads no parent: its samplers get a texture no pass draws
+            # into, so no target is ever bound for sampling while it is drawn into
+            for unit, tex in enumerate(parent.color_attachments if parent else
+                                       (self._blank_texture(),) * 2):
+                tex.use(2 + unit)
             if tile is not None:
                 x, y, w, h = tile
                 x0, y0 = x // t, y // t
@@ -197,6 +200,11 @@ class Renderer:
             parent = fbo
         for unit, tex in enumerate(parent.color_attachments):
             tex.use(unit)
+
+    def _blank_texture(self) -> moderngl.Texture:
+        if self._blank is None:
+            self._blank = self.ctx.texture((1, 1), 4, bytes(16), dtype="f4")
+        return self._blank
 
     def _vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
