@@ -73,7 +73,8 @@ def test_coarser_passes_skip_no_surface_and_each_starts_where_the_coarser_stoppe
     """Three coarse passes (tiles of 32, 8 and 2 pixels): the oracle still certifies no hole
     and no false hit. Each cone starts at the free distance of the coarser tile around it, so
     no tile's free distance is below that tile's (the coarsest pass alone is a one-pass
-    pre-pass at its tile size), and most get further."""
+    pre-pass at its tile size), and most get further. Negative control in the last line: a
+    finer pass that ignores the coarser one gives the one-pass pre-pass's distances."""
     scene = scene_of(name)
     deep = passes(scene, 2, 3)
     img = renderer.render(deep, W, H)
@@ -85,6 +86,10 @@ def test_coarser_passes_skip_no_surface_and_each_starts_where_the_coarser_stoppe
     below = parent[np.arange(fine.shape[0])[:, None] // 4, np.arange(fine.shape[1]) // 4]
     assert (fine >= below * (1 - 2e-6)).all()
     assert (fine > below).mean() > 0.5        # the finer cones get further
+    # and they started at the coarser tile's distance: a finer cone marched from the eye (as
+    # in a one-pass pre-pass) also gets further, but stops at other points
+    one = renderer.free_distances(passes(scene, 8, 1), W, H)[::-1, :, :used]
+    assert (fine != one).mean() > 0.5
 
 
 def test_a_finer_pass_that_reads_the_wrong_coarse_tile_skips_surfaces(tmp_path):
