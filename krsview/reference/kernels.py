@@ -53,13 +53,13 @@ def kernel_distance(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
         return np.full(len(p), np.inf)
     if kind == "plane":
         return p @ rec[1, :3] - rec[1, 3]
-    if kind == "toroidal_capsule":  # torus formula inside the wedge, else the nearer cap
+    if kind == "toroidal_capsule":  # see kernels.glsl: |p − core(p)|² = z² + w, in the arc's frame
         q, x, y = _arc_frame(rec, p)
-        z2 = np.maximum(_dot(q, q) - x * x - y * y, 0.0)
-        ring = np.sqrt((np.hypot(x, y) - rec[3, 3]) ** 2 + z2)
-        cap = np.minimum(np.linalg.norm(p - rec[1, :3], axis=1),
-                         np.linalg.norm(p - rec[2, :3], axis=1))
-        return np.where(in_wedge(rec, x, y), ring, cap) - rec[1, 3]
+        z = _dot(q, np.cross(rec[4, :3], rec[5, :3]))
+        R, cos_phi, sin_phi = rec[3, 3], rec[4, 3], rec[5, 3]
+        ring = (np.hypot(x, y) - R) ** 2
+        cap = np.minimum((x - R) ** 2 + y ** 2, (x - R * cos_phi) ** 2 + (y - R * sin_phi) ** 2)
+        return np.sqrt(np.where(in_wedge(rec, x, y), ring, cap) + z * z) - rec[1, 3]
     return np.linalg.norm(p - core_point(kind, rec, p), axis=1) - rec[1, 3]
 def kernel_gradient(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Unit gradient of k_i at p (the outward surface normal)."""

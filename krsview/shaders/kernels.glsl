@@ -21,19 +21,23 @@ bool in_wedge(int i, real x, real y) {
     return sin_phi >= 0.0 ? (y >= 0.0 && s >= 0.0) : (y >= 0.0 || s >= 0.0);
 }
 
-// Torus formula inside the wedge (the arc is nearer than its ends there), else the nearer cap.
+// In the arc's frame (x, y along e1, e2, z along their normal n), |p − core(p)|² = z² + w,
+// where w is the squared distance in the arc's plane: to the circle inside the wedge (the arc
+// is nearer than its ends there), else to the nearer end A = (R, 0), B = R (cos phi, sin phi).
+// Two square roots in all; z comes from n, not from |q|² − x² − y², so no cancellation.
 real toroidal_capsule_distance(int i, vec3r p) {
-    vec4r c = kernel_rec(i, 3);
+    vec4r c = kernel_rec(i, 3), f1 = kernel_rec(i, 4), f2 = kernel_rec(i, 5);
     vec3r q = p - c.xyz;
-    real x = dot(q, kernel_rec(i, 4).xyz), y = dot(q, kernel_rec(i, 5).xyz);
-    real d;
+    real x = dot(q, f1.xyz), y = dot(q, f2.xyz), z = dot(q, cross(f1.xyz, f2.xyz));
+    real w;
     if (in_wedge(i, x, y)) {
         real ring = length(vec2r(x, y)) - c.w;
-        d = sqrt(ring * ring + max(dot(q, q) - x * x - y * y, 0.0));
+        w = ring * ring;
     } else {
-        d = min(length(p - kernel_rec(i, 1).xyz), length(p - kernel_rec(i, 2).xyz));
+        vec2r a = vec2r(x - c.w, y), b = vec2r(x, y) - c.w * vec2r(f1.w, f2.w);
+        w = min(dot(a, a), dot(b, b));
     }
-    return d - kernel_rec(i, 1).w;
+    return sqrt(w + z * z) - kernel_rec(i, 1).w;
 }
 
 vec3r toroidal_capsule_core(int i, vec3r p) {
