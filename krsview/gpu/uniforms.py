@@ -61,11 +61,12 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
 
 
 def kernel_mask(kinds) -> int:
-    """Bit KERNEL_CODES[kind] set per kind (kernels.glsl's kernel_distance_of): a call that
-    can only meet these kinds compiles no other kind's code. llvmpipe runs the code of every
-    branch, taken or not, so a level loop that compiled the trunk's capsule beside the
-    branches' arcs paid for both at every level (docs/speed.md)."""
-    return sum(1 << KERNEL_CODES[k] for k in set(kinds) - {"empty"})
+    """Bit KERNEL_CODES[kind] set per kind, empty included (kernels.glsl's
+    kernel_distance_of): a call that can only meet these kinds compiles no other kind's code,
+    and one that meets a single kind reads no type. llvmpipe runs the code of every branch,
+    taken or not, so a level loop that compiled the trunk's capsule beside the branches' arcs
+    paid for both at every level (docs/speed.md)."""
+    return sum(1 << KERNEL_CODES[k] for k in set(kinds))
 
 
 def slots(c: Compiled) -> int:

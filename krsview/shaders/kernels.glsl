@@ -51,10 +51,11 @@ vec3r toroidal_capsule_core(int i, vec3r p) {
 }
 #endif
 
-// k_i(p) where kernel i is one of the kinds in the bit mask `kinds` (bit KERNEL_*): the mask
-// is a constant at each call, so no other kind's code is compiled there. llvmpipe runs every
-// branch's code whether any pixel takes it or not (docs/speed.md): Alg. 1's level loop,
-// which meets only the branches' kinds, no longer pays for the trunk's kind at every level.
+// k_i(p) where kernel i is one of the kinds in the bit mask `kinds` (bit KERNEL_*, the empty
+// kernel's included): the mask is a constant at each call, so no other kind's code is
+// compiled there, and where it holds a single kind the type is not even read. llvmpipe runs
+// every branch's code whether any pixel takes it or not (docs/speed.md): Alg. 1's level
+// loop, which meets only the branches' kinds, no longer pays for the trunk's kind.
 #define KERNEL_BIT(type) (1 << (type))
 #ifndef KRS_TOP_KERNELS           // the kinds of each component's top kernel K_n (uniforms.py)
 #define KRS_TOP_KERNELS (~0)
@@ -62,26 +63,25 @@ vec3r toroidal_capsule_core(int i, vec3r p) {
 #ifndef KRS_LEVEL_KERNELS         // the kinds of the kernels below it, K_0..K_{n-1}
 #define KRS_LEVEL_KERNELS (~0)
 #endif
+#define KIND_IS(kind) ((kinds & KERNEL_BIT(kind)) != 0 && \
+                       (kinds == KERNEL_BIT(kind) || type == (kind)))
 real kernel_distance_of(int i, vec3r p, int kinds) {
     int type = int(kernel_rec(i, 0).w);
 #ifdef KRS_KERNEL_SPHERE
-    if ((kinds & KERNEL_BIT(KERNEL_SPHERE)) != 0 && type == KERNEL_SPHERE)
-        return length(p - kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;
+    if (KIND_IS(KERNEL_SPHERE)) return length(p - kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;
 #endif
 #ifdef KRS_KERNEL_CAPSULE
-    if ((kinds & KERNEL_BIT(KERNEL_CAPSULE)) != 0 && type == KERNEL_CAPSULE)
-        return length(p - capsule_core(i, p)) - kernel_rec(i, 1).w;
+    if (KIND_IS(KERNEL_CAPSULE)) return length(p - capsule_core(i, p)) - kernel_rec(i, 1).w;
 #endif
 #ifdef KRS_KERNEL_TOROIDAL_CAPSULE
-    if ((kinds & KERNEL_BIT(KERNEL_TOROIDAL_CAPSULE)) != 0 && type == KERNEL_TOROIDAL_CAPSULE)
-        return toroidal_capsule_distance(i, p);
+    if (KIND_IS(KERNEL_TOROIDAL_CAPSULE)) return toroidal_capsule_distance(i, p);
 #endif
 #ifdef KRS_KERNEL_PLANE
-    if ((kinds & KERNEL_BIT(KERNEL_PLANE)) != 0 && type == KERNEL_PLANE)
-        return dot(p, kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;
+    if (KIND_IS(KERNEL_PLANE)) return dot(p, kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;
 #endif
     return FAR_AWAY;  // empty kernel
 }
+#undef KIND_IS
 
 // Any kind the scene uses.
 real kernel_distance(int i, vec3r p) { return kernel_distance_of(i, p, ~0); }

@@ -6,7 +6,7 @@
 real fold(int i, inout vec3r p) {
     vec4r m = u_mirrors[i];
     real e = dot(p, m.xyz) - m.w;
-    if (e > 0.0) p -= 2.0 * e * m.xyz;
+    p -= 2.0 * max(e, 0.0) * m.xyz;  // no branch: llvmpipe would run it anyway
     return e;
 }
 
