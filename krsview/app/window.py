@@ -32,7 +32,7 @@ from .platform import Platform
 
 LOOK_RADIANS_PER_PIXEL = 0.004
 RELOAD_INTERVAL = 0.5   # seconds between checks of the preset and shader files
-VIEW_PREPASS = 8         # pre-pass tile while flying: 2.2–3× faster frames (docs/architecture.md)
+VIEW_PREPASS = 4         # pre-pass tile: the best or tied at 320×180 and 640×360 (docs/speed.md)
 
 
 class Viewer:
