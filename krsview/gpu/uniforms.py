@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..reference.camera import View
-from ..reference.compiled import KERNEL_CODES, RECORD_VEC4, CompiledCompound
+from ..reference.compiled import (KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound,
+                                  CompiledKRS)
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
@@ -51,6 +52,8 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
     if (scene.render.path == "compute" and scene.render.shadow_tasks == "on"
             and {"shadows", "soft_shadows"} & set(scene.effects)):
         defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
+    if isinstance(c, CompiledKRS) and c.ball[3] >= 0 and "KRS_TWIST" not in defines:
+        defines["KRS_SHADOW_EXIT"] = None    # shadow rays end once past the scene's ball
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -141,6 +144,8 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_effects": sum(EFFECTS[e].bit for e in scene.effects),
         "u_smooth_width": fx.smooth_width,
         "u_shadow_softness": fx.shadow_softness,
+        "u_scene_ball": tuple(float(v) for v in
+                              (UNBOUNDED if isinstance(c, CompiledMoKRS) else c.ball)),
         "u_ao_step": fx.ao_step,
         "u_ao_strength": fx.ao_strength,
         "u_texture_scale": fx.texture_scale,

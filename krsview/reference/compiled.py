@@ -97,6 +97,15 @@ def krs_ball(krs: KRS) -> np.ndarray | None:
     return union_ball(kernel_ball(top), below)
 
 
+def grown(ball: np.ndarray | None) -> np.ndarray:
+    """A ball record for the GPU: ``ball`` grown by CULL_MARGIN against rounding, or
+    UNBOUNDED for None."""
+    if ball is None:
+        return UNBOUNDED.copy()
+    return np.array([*ball[:3], ball[3] * (1 + CULL_MARGIN)
+                     + CULL_MARGIN * float(np.abs(ball[:3]).max())])
+
+
 def krs_bounds(krs: KRS) -> np.ndarray:
     """(n, 4): per mirror slot i, a ball C_i holding everything Alg. 1 still tests before
     folding at level i — K_i and the levels below, doubled by R_i: C_i = S ∪ R_i(S),
@@ -104,13 +113,7 @@ def krs_bounds(krs: KRS) -> np.ndarray:
     d ≤ dist(x, C_i) cannot lower d any more: the walk stops there with the same value
     [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding.
     Slots below only empty kernels get no ball (the walk's d is still ∞ there)."""
-    out = []
-    for below in level_balls(krs):
-        if below is None:
-            out.append(UNBOUNDED)
-        else:
-            out.append(np.array([*below[:3], below[3] * (1 + CULL_MARGIN)
-                                 + CULL_MARGIN * float(np.abs(below[:3]).max())]))
+    out = [grown(below) for below in level_balls(krs)]
     # where every kernel above slot i is empty the walk still has d = ∞ there and can never
     # stop: no ball, so the test is not paid for (sierpinski: all but K_0 empty)
     solid = np.cumsum([not isinstance(k, Empty) for k in krs.kernels[::-1]])[::-1]
@@ -126,6 +129,7 @@ class CompiledKRS:
     bounds: np.ndarray    # (n, 4): krs_bounds, the culling ball before fold i (r < 0: none)
     records: np.ndarray   # (n+1, RECORD_VEC4, 4) float64
     types: tuple[str, ...]  # kernel type per level (after arc → capsule degeneration)
+    ball: np.ndarray      # (4,): grown(krs_ball), everything drawn (r < 0: unbounded)
 
     @property
     def n(self) -> int:
@@ -145,7 +149,8 @@ class CompiledKRS:
                 records[i, 1, 3] -= records[i, 1, :3] @ o
         bounds = self.bounds.copy()
         bounds[:, :3] -= np.where(bounds[:, 3:] >= 0, o, 0.0)
-        return CompiledKRS(mirrors, bounds, records, self.types)
+        ball = self.ball - np.array([*o, 0.0]) if self.ball[3] >= 0 else self.ball
+        return CompiledKRS(mirrors, bounds, records, self.types, ball)
 
 
 def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
@@ -153,7 +158,7 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
     mirrors = np.array([[*m.normal, m.offset] for m in krs.mirrors],
                        dtype=np.float64).reshape(-1, 4)
     records, types = kernel_records(krs.kernels, albedo)
-    return CompiledKRS(mirrors, krs_bounds(krs), records, types)
+    return CompiledKRS(mirrors, krs_bounds(krs), records, types, grown(krs_ball(krs)))
 
 
 def kernel_records(kernels: list, albedo: tuple[float, float, float]
@@ -207,6 +212,16 @@ class CompiledCompound:
     @cached_property
     def types(self) -> tuple[str, ...]:
         return tuple(t for p in self.parts for t in p.types)
+
+    @cached_property
+    def ball(self) -> np.ndarray:
+        """Everything drawn, as CompiledKRS.ball: the least ball around the parts' balls."""
+        if any(p.ball[3] < 0 for p in self.parts):
+            return UNBOUNDED.copy()
+        out = None
+        for p in self.parts:
+            out = union_ball(out, p.ball)
+        return out
 
     def relative_to(self, origin: np.ndarray | tuple) -> "CompiledCompound":
         return CompiledCompound(tuple(p.relative_to(origin) for p in self.parts))

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..scene import Compound, Geometry, MoKRS
 from . import krs, mokrs
-from .compiled import CompiledCompound, CompiledKRS, compile_krs, krs_ball, union_ball
+from .compiled import CompiledCompound, CompiledKRS, compile_krs
 from .distortion import Distortion
 from .trace import Distance, Test
 
@@ -96,19 +96,13 @@ def free_radius(c: Compiled, x: np.ndarray) -> float:
     return float(FREE_RADII[free].max()) if free.any() else 0.0
 
 
-def scene_ball(g: Geometry, c: Compiled) -> np.ndarray | None:
-    """A world ball (centre, radius) holding everything ``g`` draws; None when it is unbounded
+def scene_ball(c: Compiled) -> np.ndarray | None:
+    """A world ball (centre, radius) holding everything ``c`` draws; None when it is unbounded
     (a plane kernel, or a MöKRS whose outermost bound is not a ball)."""
     if isinstance(c, mokrs.CompiledMoKRS):
         top = c.outer[-1]
         return top.copy() if top[3] >= 0 and np.isfinite(top).all() else None
-    balls = [krs_ball(p) for p in (g.parts if isinstance(g, Compound) else (g,))]
-    if any(b is None for b in balls):
-        return None
-    out = None
-    for b in balls:
-        out = union_ball(out, b)
-    return out
+    return c.ball.copy() if c.ball[3] >= 0 else None
 
 
 def surface_field(c: Compiled, dist: Distortion | None = None

@@ -49,7 +49,33 @@ Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
     return sh;
 }
 
-// One iteration of a live shadow ray; done at the cap, past the far limit, or blocked.
+#ifdef KRS_SHADOW_EXIT      // a single bounded KRS, not twisted (uniforms.variant_defines)
+uniform vec4 u_scene_ball;  // everything drawn: centre (camera-relative), radius
+
+// Whether no later step of the shadow ray, at x = o + t l with scene distance d there (0
+// when unknown), can change its visibility: then it is done with the same value [issue 17].
+// For every t' in [t, T] (T: the far limit), d(t') ≥ L(t') = max(d − (t' − t), near +
+// g (t' − t)): the distance is 1-Lipschitz, and past the scene's ball (C, R) it is at least
+// |x + (t' − t) l − C| − R, which lies above its tangent (near = |x − C| − R, g = l·(x −
+// C)/|x − C|). The first bound falls, the second rises, so L is least where they cross, t*,
+// and L(t')/t' is least at t* or at T. The ray is clear when L(t*) > ε (no hard hit) and,
+// for soft shadows, k·min(L(t*)/t*, L(T)/T) ≥ vis.
+bool shadow_clear(vec3r x, real t, real d, vec3 l, float eps, float vis, bool soft) {
+    if (t <= 0.0) return false;
+    vec3 v = vec3(x) - u_scene_ball.xyz;
+    float rho = length(v), g = dot(l, v) / rho, near = rho - u_scene_ball.w;
+    float t0 = float(t), T = u_max_distance, d0 = float(d);
+    float ts = min(t0 + max(d0 - near, 0.0) / max(1.0 + g, 1e-6), T);
+    float Ls = max(d0 - (ts - t0), near + g * (ts - t0));
+    float LT = max(d0 - (T - t0), near + g * (T - t0));
+    bool clear = Ls > eps;
+    if (soft) clear = clear && u_shadow_softness * min(Ls / ts, LT / T) >= vis;
+    return clear;
+}
+#endif
+
+// One iteration of a live shadow ray; done at the cap, past the far limit, blocked, or clear
+// of the scene's ball.
 void shadow_step(inout Shadow sh) {
     if (sh.iterations >= u_max_iterations) { sh.state = SHADOW_DONE; return; }
     ++sh.iterations;
@@ -76,6 +102,10 @@ void shadow_step(inout Shadow sh) {
     if (d <= eps * lod_scale(o + t * l)) { sh.vis = 0.0; sh.state = SHADOW_DONE; return; }
     if (soft && t > 0.0) sh.vis = min(sh.vis, u_shadow_softness * float(d / t));
     sh.tc[c] = t + d;
+#ifdef KRS_SHADOW_EXIT
+    if (shadow_clear(o + t * l, t, d, l, eps, sh.vis, soft))
+        sh.state = SHADOW_DONE;
+#endif
 #endif
 }
 

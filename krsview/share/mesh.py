@@ -43,7 +43,7 @@ def box_of(scene: Scene, c, box: tuple[float, ...] | None) -> tuple[np.ndarray, 
         lo, hi = np.array(box[:3], dtype=float), np.array(box[3:], dtype=float)
         side = float((hi - lo).max())
         return (lo + hi) / 2 - side / 2, side
-    ball = scene_ball(scene.geometry(), c)
+    ball = scene_ball(c)
     if ball is None:
         raise SceneError("geometry", scene.name, "is unbounded (a ground plane, or a MöKRS "
                          "whose outer bound is not a ball): give the region to mesh with "
