@@ -86,6 +86,7 @@ def test_levels_walked_on_the_gpu_match_the_walks_and_drop_with_culling(renderer
     for name in ("tree", "forest"):
         scene = load_scene(resolve(name))
         off = replace(scene, render=replace(scene.render, culling="off"))
+        scene = replace(scene, render=replace(scene.render, culling="on"))
         walked_off, walked_on = renderer.levels(off, 64, 36), renderer.levels(scene, 64, 36)
         if name == "tree":
             n = len(scene.geometry().mirrors)

@@ -126,7 +126,7 @@ def test_rays_start_at_their_tiles_free_distance(renderer, name):
 def test_culling_changes_no_pixel(renderer, name):
     """Exact level culling off and on: the same value, so the same image, bit for bit."""
     scene = load_scene(resolve(name))
-    on = renderer.render(scene, 96, 54)
+    on = renderer.render(replace(scene, render=replace(scene.render, culling="on")), 96, 54)
     off = renderer.render(replace(scene, render=replace(scene.render, culling="off")), 96, 54)
     for field in ("color", "depth", "normal", "iterations", "hit"):
         assert np.array_equal(getattr(on, field), getattr(off, field)), field

@@ -65,8 +65,9 @@ def settings(scene: Scene) -> list[Setting]:
         if precision != r.precision:
             out.append(Setting("precision", precision,
                                replace(scene, render=replace(r, precision=precision))))
-    if r.culling == "on" and scene.mokrs is None:       # Alg. 1's culling; not in a MöKRS
-        out.append(Setting("culling", "off", replace(scene, render=replace(r, culling="off"))))
+    if scene.mokrs is None:                      # Alg. 1's culling; not in a MöKRS
+        other = "off" if r.culling == "on" else "on"
+        out.append(Setting("culling", other, replace(scene, render=replace(r, culling=other))))
     if r.path == "fragment":
         out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
     for tile in PREPASS_TILES:
