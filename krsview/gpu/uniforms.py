@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..reference.camera import View
-from ..reference.compiled import (KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound,
-                                  CompiledKRS)
+from ..reference.compiled import KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound
 from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
@@ -52,8 +51,9 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
     if (scene.render.path == "compute" and scene.render.shadow_tasks == "on"
             and {"shadows", "soft_shadows"} & set(scene.effects)):
         defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
-    if isinstance(c, CompiledKRS) and c.ball[3] >= 0 and "KRS_TWIST" not in defines:
-        defines["KRS_SHADOW_EXIT"] = None    # shadow rays end once past the scene's ball
+    if (not isinstance(c, CompiledMoKRS) and "KRS_TWIST" not in defines
+            and any(ball[3] >= 0 for ball in component_balls(c))):
+        defines["KRS_SHADOW_EXIT"] = None    # shadow rays leave the components' balls
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -111,6 +111,16 @@ def component_slots(c: Compiled) -> list[tuple]:
     return [(c, 0)]
 
 
+def component_balls(c: Compiled) -> list[tuple[float, ...]]:
+    """Each component's ball (CompiledKRS.ball), one per slot of a compound's component
+    arrays (MAX_COMPONENTS); unbounded for a MöKRS and unused slots."""
+    if isinstance(c, CompiledMoKRS):
+        return [tuple(UNBOUNDED)]
+    balls = [tuple(float(v) for v in part.ball) for part, _ in component_slots(c)]
+    return balls + [tuple(UNBOUNDED)] * (MAX_COMPONENTS - len(balls)) \
+        if isinstance(c, CompiledCompound) else balls
+
+
 def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     """Per-frame values; positions are camera-relative (the eye is the origin)."""
     lights = scene.lights
@@ -144,8 +154,8 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_effects": sum(EFFECTS[e].bit for e in scene.effects),
         "u_smooth_width": fx.smooth_width,
         "u_shadow_softness": fx.shadow_softness,
-        "u_scene_ball": tuple(float(v) for v in
-                              (UNBOUNDED if isinstance(c, CompiledMoKRS) else c.ball)),
+        "u_component_ball": (component_balls(c) if isinstance(c, CompiledCompound)
+                             else component_balls(c)[0]),     # an array only in a compound
         "u_ao_step": fx.ao_step,
         "u_ao_strength": fx.ao_strength,
         "u_texture_scale": fx.texture_scale,

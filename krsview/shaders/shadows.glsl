@@ -49,21 +49,29 @@ Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
     return sh;
 }
 
-#ifdef KRS_SHADOW_EXIT      // a single bounded KRS, not twisted (uniforms.variant_defines)
-uniform vec4 u_scene_ball;  // everything drawn: centre (camera-relative), radius
+#ifdef KRS_SHADOW_EXIT  // bounded KRS components, not twisted (uniforms.variant_defines)
+#ifdef KRS_COMPOUND  // per component: centre (camera-relative), radius (< 0: none)
+uniform vec4 u_component_ball[COMPONENT_SLOTS];
+#define COMPONENT_BALL(c) u_component_ball[c]
+#else
+uniform vec4 u_component_ball;
+#define COMPONENT_BALL(c) u_component_ball
+#endif
 
-// Whether no later step of the shadow ray, at x = o + t l with scene distance d there (0
-// when unknown), can change its visibility: then it is done with the same value [issue 17].
-// For every t' in [t, T] (T: the far limit), d(t') ≥ L(t') = max(d − (t' − t), near +
-// g (t' − t)): the distance is 1-Lipschitz, and past the scene's ball (C, R) it is at least
-// |x + (t' − t) l − C| − R, which lies above its tangent (near = |x − C| − R, g = l·(x −
-// C)/|x − C|). The first bound falls, the second rises, so L is least where they cross, t*,
-// and L(t')/t' is least at t* or at T. The ray is clear when L(t*) > ε (no hard hit) and,
-// for soft shadows, k·min(L(t*)/t*, L(T)/T) ≥ vis.
-bool shadow_clear(vec3r x, real t, real d, vec3 l, float eps, float vis, bool soft) {
-    if (t <= 0.0) return false;
-    vec3 v = vec3(x) - u_scene_ball.xyz;
-    float rho = length(v), g = dot(l, v) / rho, near = rho - u_scene_ball.w;
+// Whether no later step of component c along the shadow ray, now at x = o + t l with c's
+// distance d there, can change the visibility: then c leaves the ray, and the ray is done
+// with the same value once every component has left [issue 17]. For every t' in [t, T]
+// (T: the far limit), d(t') ≥ L(t') = max(d − (t' − t), near + g (t' − t)): the distance
+// is 1-Lipschitz, and past c's ball (C, R) it is at least |x + (t' − t) l − C| − R, which
+// lies above its tangent (near = |x − C| − R, g = l·(x − C)/|x − C|). The first bound falls,
+// the second rises, so L is least where they cross, t*, and L(t')/t' is least at t* or at T.
+// c has left when L(t*) > ε (no hard hit) and, for soft shadows, k·min(L(t*)/t*, L(T)/T) ≥
+// vis: the visibility only falls, so c's later steps could never lower it.
+bool shadow_clear(int c, vec3r x, real t, real d, vec3 l, float eps, float vis, bool soft) {
+    vec4 ball = COMPONENT_BALL(c);
+    if (ball.w < 0.0 || t <= 0.0) return false;
+    vec3 v = vec3(x) - ball.xyz;
+    float rho = length(v), g = dot(l, v) / rho, near = rho - ball.w;
     float t0 = float(t), T = u_max_distance, d0 = float(d);
     float ts = min(t0 + max(d0 - near, 0.0) / max(1.0 + g, 1e-6), T);
     float Ls = max(d0 - (ts - t0), near + g * (ts - t0));
@@ -74,8 +82,8 @@ bool shadow_clear(vec3r x, real t, real d, vec3 l, float eps, float vis, bool so
 }
 #endif
 
-// One iteration of a live shadow ray; done at the cap, past the far limit, blocked, or clear
-// of the scene's ball.
+// One iteration of a live shadow ray; done at the cap, past the far limit, blocked, or once
+// every component has left it (shadow_clear).
 void shadow_step(inout Shadow sh) {
     if (sh.iterations >= u_max_iterations) { sh.state = SHADOW_DONE; return; }
     ++sh.iterations;
@@ -103,8 +111,10 @@ void shadow_step(inout Shadow sh) {
     if (soft && t > 0.0) sh.vis = min(sh.vis, u_shadow_softness * float(d / t));
     sh.tc[c] = t + d;
 #ifdef KRS_SHADOW_EXIT
-    if (shadow_clear(o + t * l, t, d, l, eps, sh.vis, soft))
-        sh.state = SHADOW_DONE;
+    if (shadow_clear(c, o + t * l, t, d, l, eps, sh.vis, soft)) {
+        sh.tc[c] = FAR_AWAY;
+        if (sh.tc[front(sh.tc)] > u_max_distance) sh.state = SHADOW_DONE;
+    }
 #endif
 #endif
 }
