@@ -53,7 +53,7 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
     if (not isinstance(c, CompiledMoKRS) and "KRS_TWIST" not in defines
             and any(ball[3] >= 0 for ball in component_balls(c))):
-        defines["KRS_SHADOW_EXIT"] = None    # shadow rays leave the components' balls
+        defines["KRS_BALL_EXIT"] = None    # rays leave the components' balls (trace.glsl)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD

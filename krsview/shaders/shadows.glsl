@@ -49,41 +49,9 @@ Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
     return sh;
 }
 
-#ifdef KRS_SHADOW_EXIT  // bounded KRS components, not twisted (uniforms.variant_defines)
-#ifdef KRS_COMPOUND  // per component: centre (camera-relative), radius (< 0: none)
-uniform vec4 u_component_ball[COMPONENT_SLOTS];
-#define COMPONENT_BALL(c) u_component_ball[c]
-#else
-uniform vec4 u_component_ball;
-#define COMPONENT_BALL(c) u_component_ball
-#endif
-
-// Whether no later step of component c along the shadow ray, now at x = o + t l with c's
-// distance d there, can change the visibility: then c leaves the ray, and the ray is done
-// with the same value once every component has left [issue 17]. For every t' in [t, T]
-// (T: the far limit), d(t') ≥ L(t') = max(d − (t' − t), near + g (t' − t)): the distance
-// is 1-Lipschitz, and past c's ball (C, R) it is at least |x + (t' − t) l − C| − R, which
-// lies above its tangent (near = |x − C| − R, g = l·(x − C)/|x − C|). The first bound falls,
-// the second rises, so L is least where they cross, t*, and L(t')/t' is least at t* or at T.
-// c has left when L(t*) > ε (no hard hit) and, for soft shadows, k·min(L(t*)/t*, L(T)/T) ≥
-// vis: the visibility only falls, so c's later steps could never lower it.
-bool shadow_clear(int c, vec3r x, real t, real d, vec3 l, float eps, float vis, bool soft) {
-    vec4 ball = COMPONENT_BALL(c);
-    if (ball.w < 0.0 || t <= 0.0) return false;
-    vec3 v = vec3(x) - ball.xyz;
-    float rho = length(v), g = dot(l, v) / rho, near = rho - ball.w;
-    float t0 = float(t), T = u_max_distance, d0 = float(d);
-    float ts = min(t0 + max(d0 - near, 0.0) / max(1.0 + g, 1e-6), T);
-    float Ls = max(d0 - (ts - t0), near + g * (ts - t0));
-    float LT = max(d0 - (T - t0), near + g * (T - t0));
-    bool clear = Ls > eps;
-    if (soft) clear = clear && u_shadow_softness * min(Ls / ts, LT / T) >= vis;
-    return clear;
-}
-#endif
 
 // One iteration of a live shadow ray; done at the cap, past the far limit, blocked, or once
-// every component has left it (shadow_clear).
+// every component has left it (bound_ahead in trace.glsl).
 void shadow_step(inout Shadow sh) {
     if (sh.iterations >= u_max_iterations) { sh.state = SHADOW_DONE; return; }
     ++sh.iterations;
@@ -110,11 +78,12 @@ void shadow_step(inout Shadow sh) {
     if (d <= eps * lod_scale(o + t * l)) { sh.vis = 0.0; sh.state = SHADOW_DONE; return; }
     if (soft && t > 0.0) sh.vis = min(sh.vis, u_shadow_softness * float(d / t));
     sh.tc[c] = t + d;
-#ifdef KRS_SHADOW_EXIT
-    if (shadow_clear(c, o + t * l, t, d, l, eps, sh.vis, soft)) {
-        sh.tc[c] = FAR_AWAY;
-        if (sh.tc[front(sh.tc)] > u_max_distance) sh.state = SHADOW_DONE;
-    }
+#ifdef KRS_BALL_EXIT
+    // c leaves once it can neither block (L > ε) nor lower the visibility (vis only falls)
+    vec3 b = bound_ahead(c, o + t * l, t, d, l);
+    if (b.x > eps && (!soft || u_shadow_softness * min(b.x / b.y, b.z / u_max_distance)
+                               >= sh.vis) && leave(sh.tc, c))
+        sh.state = SHADOW_DONE;
 #endif
 #endif
 }
