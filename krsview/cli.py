@@ -18,6 +18,7 @@ import numpy as np
 
 from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
 from .scene.effects import check_effects
+from .scene.model import VIEW_PREPASS
 from .oracle.certify import MAX_SEGMENTS
 from .scene.schema import describe_range, check_value
 from .share.frames import DEFAULT_FPS
@@ -636,7 +637,7 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--no-hud", action="store_true", help="start with the HUD hidden")
     v.add_argument("--prepass", type=_int_in("--prepass", 0, 64), metavar="TILE",
                    help="tile size of the low-resolution pre-pass while viewing (default: "
-                        "the scene's [render] prepass, else 8; 0: off)")
+                        f"the scene's [render] prepass, else {VIEW_PREPASS}; 0: off)")
     v.add_argument("--moving-effects", action="store_true",
                    help="keep shadows and ambient occlusion in moving frames too (default: "
                         "they appear when the view stops, so moving frames stay sharp)")
@@ -776,7 +777,7 @@ def build_parser() -> argparse.ArgumentParser:
                                      "the tracing alone and the coarse passes alone, "
                                      "interleaved; each part of the frame is the difference "
                                      "of two of them. Example: krsview bench split tree "
-                                     "--prepass 8 (the viewer's pre-pass).")
+                                     f"--prepass {VIEW_PREPASS} (the viewer's pre-pass).")
     bench_arguments(bs)
     for name in ("culling", "prepass", "prepass_levels"):
         render_option(bs, name)

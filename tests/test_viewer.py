@@ -372,7 +372,7 @@ def test_the_viewer_draws_with_the_prepass_and_can_turn_it_off(viewer):
     """The viewer flies with the pre-pass (tile 8) unless told otherwise; the HUD's slider
     goes through Viewer.set_prepass, and off or on, the window shows the same tree (pixels
     change only on outlines, where grazing rays may flip)."""
-    from krsview.app.window import VIEW_PREPASS
+    from krsview.scene.model import VIEW_PREPASS
     v = viewer
     settle(v)
     assert v.prepass == VIEW_PREPASS and v.view_scene().render.prepass == VIEW_PREPASS

@@ -19,6 +19,7 @@ from ..reference.geometry import compile_geometry, free_radius
 from ..editor.document import Document
 from ..scene.effects import EFFECTS, EXCLUSIVE
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
+from ..scene.model import VIEW_PREPASS
 from ..scene.scene import write_atomic
 from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
 from .adaptive import AdaptiveResolution, Refinement
@@ -32,7 +33,6 @@ from .platform import Platform
 
 LOOK_RADIANS_PER_PIXEL = 0.004
 RELOAD_INTERVAL = 0.5   # seconds between checks of the preset and shader files
-VIEW_PREPASS = 4         # pre-pass tile: the best or tied at 320×180 and 640×360 (docs/speed.md)
 
 
 class Viewer:

@@ -19,6 +19,7 @@ PRECISIONS = ("float", "double")
 SWITCH = ("on", "off")
 PATHS = ("fragment", "compute")
 PREPASS_RATIO = 4   # pre-pass: a coarse pass's tiles are this many times as wide as the next's
+VIEW_PREPASS = 4    # the viewer's pre-pass tile where the file has none (docs/speed.md)
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
