@@ -154,7 +154,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_effects": sum(EFFECTS[e].bit for e in scene.effects),
         "u_smooth_width": fx.smooth_width,
         "u_shadow_softness": fx.shadow_softness,
-        "u_component_ball": (component_balls(c) if isinstance(c, CompiledCompound)
+        "u_bounding_ball": (component_balls(c) if isinstance(c, CompiledCompound)
                              else component_balls(c)[0]),     # an array only in a compound
         "u_ao_step": fx.ao_step,
         "u_ao_strength": fx.ao_strength,

@@ -61,11 +61,11 @@ bool next_step(inout Ray r, out int c, out real t) {
 
 #ifdef KRS_BALL_EXIT  // bounded KRS components, not twisted (uniforms.variant_defines)
 #ifdef KRS_COMPOUND  // per component: centre (camera-relative), radius (< 0: none)
-uniform vec4 u_component_ball[COMPONENT_SLOTS];
-#define COMPONENT_BALL(c) u_component_ball[c]
+uniform vec4 u_bounding_ball[COMPONENT_SLOTS];
+#define COMPONENT_BALL(c) u_bounding_ball[c]
 #else
-uniform vec4 u_component_ball;
-#define COMPONENT_BALL(c) u_component_ball
+uniform vec4 u_bounding_ball;
+#define COMPONENT_BALL(c) u_bounding_ball
 #endif
 
 // What is left of component c ahead on a ray from o along dir, now at x = o + t dir with
