@@ -618,6 +618,7 @@ def build_parser() -> argparse.ArgumentParser:
     render_option(r, "path")
     render_option(r, "steps")
     render_option(r, "shadow_tasks")
+    render_option(r, "component_tasks")
     accuracy(r)
     cp = r.add_argument_group(
         "camera paths", "Render the frames of a path recorded in the viewer (F5; saved as "

@@ -58,7 +58,7 @@ def test_compute_in_bands_double_precision_and_any_round_size(renderer):
 def test_rounds_that_drop_live_rays_lose_them(tmp_path, renderer):
     """Negative control: a copy of the compute shader that does not requeue the rays still
     live after a round leaves them out of the image."""
-    shaders = broken_shaders(tmp_path, "compute.comp", "queue[uint(1 - u_parity) * u_area + "
+    shaders = broken_shaders(tmp_path, "compute.comp", "queue[uint(1 - u_parity) * u_queue + "
                              "atomicAdd(count[1 - u_parity], 1u)] = ray;", "")
     scene = on_path(load_scene(resolve("tree")), "compute", steps=2)
     broken = Renderer(shader_dir=shaders).render(scene, W, H)
@@ -103,3 +103,47 @@ def test_shadow_rounds_that_drop_live_tasks_lose_the_shadows(tmp_path, renderer)
     broken = Renderer(shader_dir=shaders).render(scene, W, H)
     good = renderer.render(scene, W, H)
     assert np.array_equal(good.hit, broken.hit) and not np.array_equal(good.color, broken.color)
+
+
+@pytest.mark.parametrize("tracer, prepass", [("sphere", 0), ("binary", 0), ("sphere", 8)])
+def test_a_task_per_component_keeps_every_hit(renderer, tracer, prepass):
+    """A compound on the compute path with a task per pixel and component: each component
+    traced to its own hit, the nearest kept. The ray's nearest component converges at the
+    same point whether or not the others are interleaved with it, so colour, depth, normal
+    and hits equal the fragment path's; the tasks do more work (the others run on past the
+    nearest hit), and the iterations are their sum."""
+    from krsview.gpu.uniforms import variant_defines
+    from krsview.reference.geometry import compile_geometry
+    scene = on_path(load_scene(resolve("grove")), "fragment", tracer=tracer, prepass=prepass)
+    tasks = on_path(scene, "compute", steps=4, component_tasks="on")
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    assert "KRS_COMPONENT_TASKS" in variant_defines(tasks, c)
+    assert "KRS_COMPONENT_TASKS" not in variant_defines(on_path(scene, "compute"), c)
+    fragment, traced = renderer.render(scene, W, H), renderer.render(tasks, W, H)
+    for field in ("color", "depth", "normal", "hit"):
+        assert np.array_equal(getattr(fragment, field), getattr(traced, field)), field
+    assert fragment.hit.any() and (traced.iterations >= fragment.iterations).all()
+    assert (traced.iterations > fragment.iterations).any()
+
+
+def test_component_tasks_count_the_cap_per_task(renderer):
+    """The iteration cap counts each task's steps: where the fragment path's ray stopped
+    short of the cap, the image is the same; some capped rays find their hit as tasks."""
+    scene = on_path(load_scene(resolve("grove")), "fragment", max_iterations=12)
+    fragment = renderer.render(scene, W, H)
+    traced = renderer.render(on_path(scene, "compute", component_tasks="on"), W, H)
+    free = fragment.iterations < 12
+    assert (~free).any()
+    for field in ("color", "depth", "hit"):
+        assert np.array_equal(getattr(fragment, field)[free], getattr(traced, field)[free])
+    assert (traced.hit & ~fragment.hit).any()
+
+
+def test_keeping_the_farthest_component_hit_fails(tmp_path, renderer):
+    """Negative control: a resolve pass that keeps the farthest of a pixel's component hits
+    draws trees behind the ones in front."""
+    shaders = broken_shaders(tmp_path, "compute.comp", "q.t < r.t", "q.t > r.t")
+    scene = on_path(load_scene(resolve("grove")), "compute", component_tasks="on")
+    broken = Renderer(shader_dir=shaders).render(scene, W, H)
+    good = renderer.render(scene, W, H)
+    assert np.array_equal(good.hit, broken.hit) and not np.array_equal(good.depth, broken.depth)

@@ -22,9 +22,10 @@ if TYPE_CHECKING:
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
+# the last one sits beside the pre-pass tile slider
 KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision", "culling",
-         "path", "steps", "shadow_tasks", "prepass_levels")   # the last beside the tile slider
-COMPUTE_KNOBS = ("steps", "shadow_tasks")   # shown on the compute path only
+         "path", "steps", "shadow_tasks", "component_tasks", "prepass_levels")
+COMPUTE_KNOBS = ("steps", "shadow_tasks", "component_tasks")   # on the compute path only
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 

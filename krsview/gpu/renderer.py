@@ -110,8 +110,9 @@ class Renderer:
             if "KRS_SHADOW_TASKS" in defines:
                 align = max(4 * real, 16)
                 shadow_bytes = -(-(4 * real + 16 + (components + 1) * real + 12) // align) * align
+            per_pixel = components if "KRS_COMPONENT_TASKS" in defines else 0
             self._compute[prog] = (comp, scene.render.steps, scene.render.max_iterations,
-                                   ray_bytes, shadow_bytes)
+                                   ray_bytes, shadow_bytes, per_pixel)
             progs = [prog, comp]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
@@ -232,14 +233,19 @@ class Renderer:
         """The compute path (compute.comp): start the rays of ``tile`` (or all), run rounds
         of at most ``steps`` iterations, each sized by the GPU from the rays still live, and
         leave the ray buffer bound for the shading pass (deferred.frag). Rounds enough for
-        the iteration cap are issued without reading anything back."""
-        comp, steps, cap, ray_bytes, shadow_bytes = self._compute[prog]
+        the iteration cap are issued without reading anything back. With a task per pixel
+        and component (``per_pixel`` of them), those are traced instead, and a last pass
+        keeps each pixel's nearest hit in its ray."""
+        comp, steps, cap, ray_bytes, shadow_bytes, per_pixel = self._compute[prog]
         x, y, w, h = tile or (0, 0, width, height)
         area = w * h
-        tasks = area * (MAX_LIGHTS if shadow_bytes else 1)     # the longest queue
-        sizes = {1: area * ray_bytes, 2: 2 * tasks * 4, 3: 5 * 4}
+        traced = area * max(per_pixel, 1)                      # rays traced in rounds
+        queue = max(traced, area * MAX_LIGHTS if shadow_bytes else area)  # the longest queue
+        sizes = {1: area * ray_bytes, 2: 2 * queue * 4, 3: 5 * 4}
         if shadow_bytes:
             sizes[4] = area * MAX_LIGHTS * shadow_bytes
+        if per_pixel:
+            sizes[5] = traced * ray_bytes
         for binding, size in sizes.items():
             if binding not in self._rays or self._rays[binding].size < size:
                 if binding in self._rays:
@@ -247,14 +253,20 @@ class Renderer:
                 self._rays[binding] = self.ctx.buffer(reserve=max(size, 16))
             self._rays[binding].bind_to_storage_buffer(binding)
         groups = -(-area // COMPUTE_GROUP)
-        self._rays[3].write(np.array([area, 0, groups, 1, 1], dtype=np.uint32))
+        self._rays[3].write(np.array([traced, 0, -(-traced // COMPUTE_GROUP), 1, 1],
+                                     dtype=np.uint32))
         prog["u_tile_rect"].value = (x, y, w, h)
         for name, value in (("u_tile_rect", (x, y, w, h)), ("u_area", area),
-                            ("u_queue", tasks), ("u_steps", steps), ("u_phase", 0)):
+                            ("u_queue", queue), ("u_tasks", traced), ("u_steps", steps),
+                            ("u_phase", 0)):
             if name in comp:
                 comp[name].value = value
-        comp.run(groups)
+        comp.run(-(-traced // COMPUTE_GROUP))
         self._rounds(comp, 1, -(-cap // steps) + 1)
+        if per_pixel:               # each pixel's ray: the nearest of its components' hits
+            self.ctx.memory_barrier()
+            comp["u_phase"].value = 5
+            comp.run(groups)
         if shadow_bytes:            # shadow rays as tasks of their own, through the same queues
             self.ctx.memory_barrier()
             self._rays[3].write(np.array([0, 0, 0, 1, 1], dtype=np.uint32))

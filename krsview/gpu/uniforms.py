@@ -51,6 +51,9 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
     if (scene.render.path == "compute" and scene.render.shadow_tasks == "on"
             and {"shadows", "soft_shadows"} & set(scene.effects)):
         defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
+    if (scene.render.path == "compute" and scene.render.component_tasks == "on"
+            and isinstance(c, CompiledCompound)):
+        defines["KRS_COMPONENT_TASKS"] = None  # a task per pixel and component (compute.comp)
     if (not isinstance(c, CompiledMoKRS) and "KRS_TWIST" not in defines
             and any(ball[3] >= 0 for ball in component_balls(c))):
         defines["KRS_BALL_EXIT"] = None    # rays leave the components' balls (trace.glsl)

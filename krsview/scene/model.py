@@ -250,6 +250,12 @@ class Render:
                               help="compute path: shadow rays as tasks of their own, traced "
                                    "in rounds like the primary rays (on), or inline while "
                                    "shading (off); the same image")
+    component_tasks: str = param("off", choices=SWITCH,
+                                 help="compute path, compound: a task per pixel and "
+                                      "component, each traced to its own hit, the nearest "
+                                      "kept [KRS17 §5.1] (on); or one ray stepping its nearest "
+                                      "component (off). The same hits except where a ray "
+                                      "reaches the iteration cap, which counts per task")
     prepass: int = param(0, lo=0, hi=64, unit="pixels",
                          help="tile size of the low-resolution pre-pass: one cone per tile "
                               "finds how far all its rays are free, and each ray starts there "
