@@ -49,7 +49,6 @@ Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
     return sh;
 }
 
-
 // One iteration of a live shadow ray; done at the cap, past the far limit, blocked, or once
 // every component has left it (bound_ahead in trace.glsl).
 void shadow_step(inout Shadow sh) {
