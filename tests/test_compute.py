@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from krsview.gpu.renderer import Renderer
-from krsview.presets import resolve
+from krsview.presets import preset_names, resolve
+from krsview.scene.model import VIEW_PREPASS
 from krsview.scene import load_scene
 
 from .conftest import broken_shaders
@@ -40,6 +41,15 @@ def test_compute_image_equals_fragment_image(renderer, name, tracer, prepass):
     compute = renderer.render(on_path(scene, "compute", steps=4), W, H)
     assert same(fragment, compute)
     assert fragment.hit.any() and (fragment.iterations > 4).any()  # several rounds ran
+
+
+@pytest.mark.parametrize("name", preset_names())
+def test_every_preset_draws_the_same_on_both_paths(renderer, name):
+    """Every preset with its own tracer and effects, at the viewer's pre-pass: the compute
+    path's image equals the fragment path's, bit for bit."""
+    scene = on_path(load_scene(resolve(name)), "fragment", prepass=VIEW_PREPASS)
+    assert same(renderer.render(scene, W, H),
+                renderer.render(on_path(scene, "compute", steps=4), W, H))
 
 
 def test_compute_in_bands_double_precision_and_any_round_size(renderer):

@@ -13,7 +13,7 @@ from krsview.bench.hard_cases import CASES
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
 from krsview.gpu.renderer import Renderer
 from krsview.oracle.certify import count_errors
-from krsview.presets import resolve
+from krsview.presets import preset_names, resolve
 from krsview.reference.camera import view_of
 from krsview.scene import load_scene
 
@@ -26,7 +26,7 @@ def with_prepass(scene, tile):
     return replace(scene, render=replace(scene.render, prepass=tile))
 
 
-SCENES = ["tree", "grove", "palm", "sierpinski", "forest", "shell"]
+SCENES = preset_names()          # every preset
 HARD = ["camera-on-mirror", "grazing-ground", "inside-crown", "compound-overlap",
         "mobius-pole-in-view"]
 
@@ -47,7 +47,9 @@ def test_the_prepass_skips_no_surface(renderer, name):
     img = renderer.render(with_prepass(scene, 4), W, H)
     counts = count_errors(with_prepass(scene, 4), img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
-    assert counts.undecided <= 0.02 * counts.rays, counts
+    if counts.undecided > 0.02 * counts.rays:   # as many undecided without the pre-pass?
+        alone = count_errors(scene, plain, arithmetics=("affine",))   # (inversion's poles)
+        assert counts.undecided <= alone.undecided + 0.02 * counts.rays, (counts, alone)
     a = agreement(img, plain, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
     eps_per_t = view_of(scene.camera, W, H).footprint * scene.render.epsilon_scale
     assert a.off_edge_hit == 0 and a.off_edge_depth <= 1.5 * eps_per_t, a
@@ -122,7 +124,7 @@ def test_rays_start_at_their_tiles_free_distance(renderer, name):
         renderer.free_distances(scene, 160, 90)
 
 
-@pytest.mark.parametrize("name", ["tree", "grove", "forest"])
+@pytest.mark.parametrize("name", preset_names())
 def test_culling_changes_no_pixel(renderer, name):
     """Exact level culling off and on: the same value, so the same image, bit for bit."""
     scene = load_scene(resolve(name))
