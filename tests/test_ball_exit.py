@@ -31,9 +31,11 @@ RAY_EXIT = "    if (min(b.x / b.y, b.z / u_max_distance) > u_eps_per_t && leave(
 def scenes():
     tree = load_scene(resolve("tree"))
     hard = replace(tree, effects=["shadows", "sky"])
-    plain = replace(tree, render=replace(tree.render, prepass=0))
+    plain = replace(tree, render=replace(tree.render, prepass=0, culling="off"))
+    prepass = replace(tree, render=replace(tree.render, prepass=4))
     smooth = replace(tree, effects=tree.effects + ["smooth_shading", "ambient_occlusion"])
-    return {"tree": tree, "tree-hard": hard, "tree-plain": plain, "tree-smooth": smooth,
+    return {"tree": tree, "tree-hard": hard, "tree-plain": plain, "tree-prepass": prepass,
+            "tree-smooth": smooth,
             "bent-tree": load_scene(resolve("bent-tree")), "grove": load_scene(resolve("grove"))}
 
 
