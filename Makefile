@@ -19,6 +19,8 @@ demo: $(STAMP)
 	else $(BIN)/krsview render tree -o out/demo.png --size 640x360; fi
 
 test: $(STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
 	$(BIN)/python -m pytest -q
 
 # System packages: installed only when one is missing (needs root or sudo).

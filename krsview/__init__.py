@@ -1,2 +1,3 @@
 """krsview: real-time viewer, editor and benchmark for Kernel–Reflection Sequences [KRS17]."""
+
 __version__ = "0.1.0"

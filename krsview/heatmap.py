@@ -2,6 +2,7 @@
 
 ``heat`` is the twin of ``heat()`` in shaders/display.frag, so the viewer's iterations view
 and the PNG written by ``krsview render --view iterations`` use the same colours."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -15,7 +16,7 @@ LEGEND_BACKGROUND = (32, 32, 36)  # dark, so the white end of the bar shows
 def heat(x: np.ndarray) -> np.ndarray:
     """Black → purple → orange → white for x in [0, 1]; returns (..., 3) in [0, 1]."""
     x = np.clip(x, 0.0, 1.0)
-    rgb = np.stack([1.6 * x, 1.15 * x * x - 0.15, 0.9 * np.sin(np.pi * x) + x ** 3], axis=-1)
+    rgb = np.stack([1.6 * x, 1.15 * x * x - 0.15, 0.9 * np.sin(np.pi * x) + x**3], axis=-1)
     return np.clip(rgb, 0.0, 1.0)
 
 
@@ -23,6 +24,7 @@ def heatmap_image(iterations: np.ndarray, vmax: int, label: str):
     """The heat map of ``iterations`` (H, W) scaled to ``vmax``, above a legend bar with
     ticks at 0, vmax/2 and vmax and ``label``; a PIL image."""
     from PIL import Image, ImageDraw
+
     H, W = iterations.shape
     top = np.round(heat(iterations / max(vmax, 1)) * 255).astype(np.uint8)
     canvas = Image.new("RGB", (W, H + LEGEND_HEIGHT), LEGEND_BACKGROUND)
@@ -35,8 +37,9 @@ def heatmap_image(iterations: np.ndarray, vmax: int, label: str):
     draw = ImageDraw.Draw(canvas)
     y = H + 3 + bar_h + 2
     for frac, anchor in ((0.0, "la"), (0.5, "ma"), (1.0, "ra")):
-        draw.text((x0 + frac * (x1 - x0), y), f"{round(frac * vmax)}", fill=(255, 255, 255),
-                  anchor=anchor)
+        draw.text(
+            (x0 + frac * (x1 - x0), y), f"{round(frac * vmax)}", fill=(255, 255, 255), anchor=anchor
+        )
     draw.text((W / 2, y + 13), label, fill=(200, 200, 200), anchor="ma")
     return canvas
 

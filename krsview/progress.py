@@ -1,4 +1,5 @@
 """A one-line progress bar on stderr for long work (sweeps, slow renders)."""
+
 from __future__ import annotations
 
 import sys
@@ -26,8 +27,12 @@ class Progress:
         filled = width * self.done // self.total
         bar = "█" * filled + "·" * (width - filled)
         end = "\n" if self.done == self.total else ""
-        print(f"\r{self.label} [{bar}] {self.done}/{self.total} {note:<24}", end=end,
-              file=sys.stderr, flush=True)
+        print(
+            f"\r{self.label} [{bar}] {self.done}/{self.total} {note:<24}",
+            end=end,
+            file=sys.stderr,
+            flush=True,
+        )
 
     def __call__(self, done: int, total: int) -> None:
         """As a ``progress(done, total)`` callback of the renderers."""

@@ -1,5 +1,6 @@
 """Shared fixtures: one headless GL context per session, and the GPU-vs-reference comparison
 with the tolerances every pixel test uses."""
+
 from __future__ import annotations
 
 import os
@@ -25,6 +26,7 @@ TEST_OUTPUT = Path(__file__).resolve().parent.parent / "test-output"
 @pytest.fixture(scope="session")
 def renderer():
     from krsview.gpu.renderer import Renderer
+
     return Renderer()
 
 
@@ -48,6 +50,7 @@ def assert_finite(b: Buffers, max_iterations: int, prepass: bool = False) -> Non
 def save_diff(name: str, gpu: Buffers, ref: Buffers) -> Path:
     """GPU | reference | amplified difference, side by side, for a failing pixel test."""
     from PIL import Image
+
     TEST_OUTPUT.mkdir(exist_ok=True)
     diff = np.clip(np.abs(gpu.color - ref.color) * 10.0, 0, 1)
     diff[gpu.hit != ref.hit] = (1.0, 0.0, 1.0)
@@ -77,8 +80,11 @@ def display():
     for n in range(90, 110):
         if not Path(f"/tmp/.X{n}-lock").exists():
             break
-    proc = subprocess.Popen([xvfb, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        [xvfb, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     for _ in range(100):
         if Path(f"/tmp/.X11-unix/X{n}").exists():
             break
@@ -94,7 +100,9 @@ def broken_shaders(tmp_path: Path, name: str, old: str, new: str) -> Path:
     """A copy of the shaders with ``old`` replaced by ``new`` in ``name`` (a negative
     control's deliberately broken shader); the folder to pass as ``shader_dir``."""
     import shutil
+
     from krsview.gpu.program import SHADER_DIR
+
     shaders = tmp_path / "shaders"
     shutil.copytree(SHADER_DIR, shaders)
     path = shaders / name
@@ -108,12 +116,30 @@ def headless_render(scene, path: Path, size: tuple[int, int], *options: str) -> 
     """`krsview render [options]` in its own process (EGL, no window) of ``scene`` saved at
     ``path``.toml: what a user gets from the command line, for comparing with a window."""
     from PIL import Image
+
     from krsview.scene import save_scene
+
     save_scene(scene, path.with_suffix(".toml"))
     out = path.with_suffix(".png")
-    r = subprocess.run([sys.executable, "-m", "krsview", "render", str(path.with_suffix(".toml")),
-                        "-o", str(out), "--size", f"{size[0]}x{size[1]}", "--repeats", "1", *options],
-                       capture_output=True, text=True, timeout=120,
-                       env={**os.environ, "DISPLAY": ""})
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "krsview",
+            "render",
+            str(path.with_suffix(".toml")),
+            "-o",
+            str(out),
+            "--size",
+            f"{size[0]}x{size[1]}",
+            "--repeats",
+            "1",
+            *options,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "DISPLAY": ""},
+    )
     assert r.returncode == 0, r.stderr
     return np.asarray(Image.open(out).convert("RGB"))

@@ -1,5 +1,6 @@
 """The accuracy benchmark: hit sets are nested in ε (so the errors it reports move the right
 way), the Pareto front, the ground-truth cache, and the report a run writes."""
+
 from __future__ import annotations
 
 import os
@@ -25,8 +26,9 @@ def with_render(scene, **kw):
     return replace(scene, render=replace(scene.render, **kw))
 
 
-@pytest.mark.parametrize("preset, tracer", [("sierpinski", "sphere"), ("rock", "sphere"),
-                                            ("sierpinski", "binary")])
+@pytest.mark.parametrize(
+    "preset, tracer", [("sierpinski", "sphere"), ("rock", "sphere"), ("sierpinski", "binary")]
+)
 def test_a_looser_epsilon_hits_a_superset_and_never_has_more_false_hits(preset, tracer):
     """Both tracers take the same steps at every ε until a ray converges, and a looser ε
     converges no later: so, with a cap that is never reached, the hit sets are nested,
@@ -56,18 +58,40 @@ def test_where_a_tighter_epsilon_legitimately_has_more_holes_a_small_cap():
 
 
 def test_pareto_front_keeps_only_undominated_settings():
-    rows = [dict(ms=10, mask_error=0.2), dict(ms=12, mask_error=0.3), dict(ms=15, mask_error=0.1),
-            dict(ms=20, mask_error=0.1), dict(ms=25, mask_error=0.0)]
+    rows = [
+        dict(ms=10, mask_error=0.2),
+        dict(ms=12, mask_error=0.3),
+        dict(ms=15, mask_error=0.1),
+        dict(ms=20, mask_error=0.1),
+        dict(ms=25, mask_error=0.0),
+    ]
     assert pareto(rows) == [rows[0], rows[2], rows[4]]
 
 
 def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
     knobs = {s.knob for s in settings(load_scene(resolve("tree")))}
-    assert knobs == {"scene", "epsilon_scale", "max_iterations", "tracer", "precision",
-                     "culling", "path", "prepass", "levels"}
+    assert knobs == {
+        "scene",
+        "epsilon_scale",
+        "max_iterations",
+        "tracer",
+        "precision",
+        "culling",
+        "path",
+        "prepass",
+        "levels",
+    }
     palm = settings(load_scene(resolve("palm")))
-    assert {s.knob for s in palm} == {"scene", "epsilon_scale", "max_iterations", "tracer",
-                                      "precision", "path", "prepass", "levels"}
+    assert {s.knob for s in palm} == {
+        "scene",
+        "epsilon_scale",
+        "max_iterations",
+        "tracer",
+        "precision",
+        "path",
+        "prepass",
+        "levels",
+    }
     assert all(s.scene.render.tracer == "binary" for s in palm)
 
 
@@ -88,14 +112,30 @@ def test_ground_truth_is_cached_by_content(tmp_path):
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "krsview", *args], capture_output=True,
-                          text=True, timeout=300, env={**os.environ, "DISPLAY": ""})
+    return subprocess.run(
+        [sys.executable, "-m", "krsview", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "DISPLAY": ""},
+    )
 
 
 def test_bench_accuracy_writes_a_readable_report(tmp_path):
     out = tmp_path / "report"
-    r = run("bench", "accuracy", "sierpinski", "--size", "48x27", "--rounds", "1",
-            "--out", str(out), "--cache", str(tmp_path / "cache"))
+    r = run(
+        "bench",
+        "accuracy",
+        "sierpinski",
+        "--size",
+        "48x27",
+        "--rounds",
+        "1",
+        "--out",
+        str(out),
+        "--cache",
+        str(tmp_path / "cache"),
+    )
     assert r.returncode == 0, r.stderr
     names = {p.name for p in out.iterdir()}
     assert {"README.md", "accuracy.csv", "time-vs-error.png", "pareto.png"} <= names

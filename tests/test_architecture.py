@@ -1,5 +1,6 @@
 """The dependency arrows of DESIGN.md, checked from the imports: lower layers never import
 higher ones, and no two modules import each other (directly or round a cycle)."""
+
 from __future__ import annotations
 
 import ast
@@ -41,7 +42,7 @@ def imports(source: str, module: str, top_level_only: bool = False) -> set[str]:
             if isinstance(child, ast.ImportFrom):
                 base = package.split(".")
                 if child.level:
-                    base = base[:len(base) - child.level + 1]
+                    base = base[: len(base) - child.level + 1]
                     name = ".".join(base + ([child.module] if child.module else []))
                 else:
                     name = child.module or ""
@@ -51,6 +52,7 @@ def imports(source: str, module: str, top_level_only: bool = False) -> set[str]:
             elif isinstance(child, ast.Import):
                 out.update(a.name for a in child.names if a.name.startswith("krsview"))
             visit(child, top)
+
     visit(tree, True)
     return out
 
@@ -77,7 +79,10 @@ def violations(module: str, imported: set[str]) -> list[str]:
 def test_lower_layers_never_import_higher_ones():
     found = []
     for name, path in modules().items():
-        found += violations(name, imports(path.read_text(), name + (".__init__" if path.name == "__init__.py" else "")))
+        found += violations(
+            name,
+            imports(path.read_text(), name + (".__init__" if path.name == "__init__.py" else "")),
+        )
     assert not found, "\n".join(found)
 
 
@@ -87,7 +92,8 @@ def test_the_check_catches_a_violation():
     src = "def f():\n    from ..reference import mobius\n"
     assert violations("krsview.scene.mokrs", imports(src, "krsview.scene.mokrs")) == [
         "krsview.scene.mokrs imports krsview.reference",
-        "krsview.scene.mokrs imports krsview.reference.mobius"]
+        "krsview.scene.mokrs imports krsview.reference.mobius",
+    ]
 
 
 def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
@@ -100,12 +106,13 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
         stack.append(n)
         for m in sorted(graph.get(n, ())):
             if state.get(m) == 1:
-                return stack[stack.index(m):] + [m]
+                return stack[stack.index(m) :] + [m]
             if m not in state and (found := walk(m)):
                 return found
         stack.pop()
         state[n] = 2
         return None
+
     for n in sorted(graph):
         if n not in state and (found := walk(n)):
             return found
@@ -119,8 +126,11 @@ def test_no_import_cycles_between_modules():
     graph = {}
     for name, path in mods.items():
         me = name + (".__init__" if path.name == "__init__.py" else "")
-        graph[name] = {m for m in imports(path.read_text(), me, top_level_only=True)
-                       if m in mods and m != name and not name.startswith(m + ".")}
+        graph[name] = {
+            m
+            for m in imports(path.read_text(), me, top_level_only=True)
+            if m in mods and m != name and not name.startswith(m + ".")
+        }
     assert len(graph["krsview.app.window"]) > 5, "the import graph is empty: nothing is checked"
     cycle = find_cycle(graph)
     assert cycle is None, "import cycle: " + " → ".join(cycle)

@@ -3,6 +3,7 @@ visibility), and the ray ends once every component has left (trace.glsl, bound_a
 the component's ball a lower bound of its distance stays above ε(t) on a primary ray, and
 keeps k·d/t at or above the visibility reached on a shadow ray. Misses end early, shadow
 rays end early, and the image is the same bit for bit."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -10,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from krsview.gpu.renderer import Renderer
 from krsview.gpu.uniforms import variant_defines
@@ -34,9 +36,15 @@ def scenes():
     plain = replace(tree, render=replace(tree.render, prepass=0, culling="off"))
     prepass = replace(tree, render=replace(tree.render, prepass=4))
     smooth = replace(tree, effects=tree.effects + ["smooth_shading", "ambient_occlusion"])
-    return {"tree": tree, "tree-hard": hard, "tree-plain": plain, "tree-prepass": prepass,
-            "tree-smooth": smooth,
-            "bent-tree": load_scene(resolve("bent-tree")), "grove": load_scene(resolve("grove"))}
+    return {
+        "tree": tree,
+        "tree-hard": hard,
+        "tree-plain": plain,
+        "tree-prepass": prepass,
+        "tree-smooth": smooth,
+        "bent-tree": load_scene(resolve("bent-tree")),
+        "grove": load_scene(resolve("grove")),
+    }
 
 
 def shaders_without(tmp: Path, shadow: str | None, ray: str | None) -> Path:
@@ -50,8 +58,11 @@ def shaders_without(tmp: Path, shadow: str | None, ray: str | None) -> Path:
 
 @pytest.fixture(scope="module")
 def without_exits(tmp_path_factory):
-    return Renderer(shader_dir=shaders_without(tmp_path_factory.mktemp("none"),
-                                               "    if (false && (!soft", "    if (false) {"))
+    return Renderer(
+        shader_dir=shaders_without(
+            tmp_path_factory.mktemp("none"), "    if (false && (!soft", "    if (false) {"
+        )
+    )
 
 
 @pytest.mark.parametrize("name", list(scenes()))
@@ -62,7 +73,7 @@ def test_the_exits_change_no_pixel(name, renderer, without_exits):
     for field in ("color", "depth", "normal", "hit"):
         assert np.array_equal(getattr(a, field), getattr(b, field)), field
     assert (a.iterations <= b.iterations).all()
-    if "grove" not in name:   # misses end early (not in a compound: it costs more there)
+    if "grove" not in name:  # misses end early (not in a compound: it costs more there)
         assert (a.iterations < b.iterations).any()
     else:
         assert np.array_equal(a.iterations, b.iterations)
@@ -71,13 +82,20 @@ def test_the_exits_change_no_pixel(name, renderer, without_exits):
 def test_the_shadow_exit_is_taken(tmp_path, renderer):
     """Shadow rays that leave by the exit drawn black: the image changes, so the test above
     compares images where the exit ended shadow rays."""
-    marked = broken_shaders(tmp_path, "shadows.glsl", LEAVE_SHADOW,
-                            LEAVE_SHADOW.replace("sh.state = SHADOW_DONE;",
-                                                 "{ sh.vis = 0.0; sh.state = SHADOW_DONE; }"))
+    marked = broken_shaders(
+        tmp_path,
+        "shadows.glsl",
+        LEAVE_SHADOW,
+        LEAVE_SHADOW.replace(
+            "sh.state = SHADOW_DONE;", "{ sh.vis = 0.0; sh.state = SHADOW_DONE; }"
+        ),
+    )
     for name in ("tree", "grove"):
         scene = scenes()[name]
-        assert not np.array_equal(renderer.render(scene, W, H).color,
-                                  Renderer(shader_dir=marked).render(scene, W, H).color), name
+        assert not np.array_equal(
+            renderer.render(scene, W, H).color,
+            Renderer(shader_dir=marked).render(scene, W, H).color,
+        ), name
 
 
 @pytest.mark.parametrize("exit_", ["shadow", "ray"])
@@ -85,10 +103,11 @@ def test_a_ball_too_small_changes_the_image(tmp_path, renderer, exit_):
     """Negative control: with a quarter of the components' radius, shadow rays end while a
     branch could still shade them (the ball is loose: at half the radius no pixel changes
     here), and primary rays miss branches they would have hit."""
-    shaders = broken_shaders(tmp_path, "trace.glsl", "near = rho - ball.w",
-                             "near = rho - 0.25 * ball.w")
+    shaders = broken_shaders(
+        tmp_path, "trace.glsl", "near = rho - ball.w", "near = rho - 0.25 * ball.w"
+    )
     scene = scenes()["tree"]
-    if exit_ == "shadow":   # the primary exit off, so only the shadows can differ
+    if exit_ == "shadow":  # the primary exit off, so only the shadows can differ
         path = shaders / "trace.glsl"
         path.write_text(path.read_text().replace(RAY_EXIT, "    if (false) {"))
     good, bad = renderer.render(scene, W, H), Renderer(shader_dir=shaders).render(scene, W, H)
@@ -108,8 +127,9 @@ def test_no_exit_where_no_ball_bounds_it(name):
     assert "KRS_BALL_EXIT" not in variant_defines(scene, c)
     tree = load_scene(resolve("tree"))
     twisted = replace(tree, effects=tree.effects + ["twist"])
-    assert "KRS_BALL_EXIT" not in variant_defines(twisted, compile_geometry(tree.geometry(),
-                                                                           ALBEDO))
+    assert "KRS_BALL_EXIT" not in variant_defines(
+        twisted, compile_geometry(tree.geometry(), ALBEDO)
+    )
 
 
 @settings(max_examples=25, deadline=None)

@@ -1,6 +1,7 @@
 """Batch rendering on Ray [issue 18 §4]: a local Ray with two workers writes the same frames
 as a local render, skips finished frames on restart, and retries chunks whose task failed
 or whose actor died."""
+
 from __future__ import annotations
 
 import json
@@ -21,14 +22,21 @@ from krsview.share.batch import FrameWorker, run_batch
 from krsview.share.frames import FrameJob, frame_file, render_frames
 
 SIZE = (64, 36)
-POSES = [dict(t=0.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
-         dict(t=1.0, position=[1.0, 2.5, -7.0], yaw=-0.3, pitch=0.1)]
+POSES = [
+    dict(t=0.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
+    dict(t=1.0, position=[1.0, 2.5, -7.0], yaw=-0.3, pitch=0.1),
+]
 
 
 @pytest.fixture(scope="module")
 def cluster():
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
-             configure_logging=False, runtime_env={"env_vars": {"LP_NUM_THREADS": "1"}})
+    ray.init(
+        num_cpus=2,
+        include_dashboard=False,
+        log_to_driver=False,
+        configure_logging=False,
+        runtime_env={"env_vars": {"LP_NUM_THREADS": "1"}},
+    )
     ray.cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the failing workers
     yield
     ray.shutdown()
@@ -50,8 +58,9 @@ def read(path: Path) -> np.ndarray:
 def local_frames(job: FrameJob, tmp_path: Path, renderer) -> Path:
     folder = tmp_path / "local"
     folder.mkdir()
-    render_frames(FrameJob(job.scene, job.path, job.fps, job.size, folder),
-                  list(range(job.count)), renderer)
+    render_frames(
+        FrameJob(job.scene, job.path, job.fps, job.size, folder), list(range(job.count)), renderer
+    )
     return folder
 
 
@@ -117,8 +126,23 @@ def test_batch_on_the_command_line(tmp_path):
     """`krsview batch` with a local Ray of two workers, then a resumed run."""
     path = tmp_path / "tree.path.json"
     path.write_text(json.dumps({"poses": POSES}))
-    args = [sys.executable, "-m", "krsview", "batch", "tree", "--camera-path", str(path),
-            "--fps", "4", "--size", "64x36", "-o", str(tmp_path / "f"), "--workers", "2"]
+    args = [
+        sys.executable,
+        "-m",
+        "krsview",
+        "batch",
+        "tree",
+        "--camera-path",
+        str(path),
+        "--fps",
+        "4",
+        "--size",
+        "64x36",
+        "-o",
+        str(tmp_path / "f"),
+        "--workers",
+        "2",
+    ]
     env = {**os.environ, "DISPLAY": ""}
     r = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
     assert r.returncode == 0 and "0 already there, 5 rendered" in r.stdout, r.stderr[-3000:]
@@ -130,45 +154,70 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     """Two presets as two tasks: each report's error columns equal a local run's (times
     differ; errors are a function of the images and the ground truth)."""
     import csv
+
     from krsview.bench.accuracy import bench_accuracy
     from krsview.share.batch import run_accuracy_sweep
+
     names = ("sierpinski", "rock")
     scenes = {n: load_scene(resolve(n)) for n in names}
     outs = {n: tmp_path / "ray" / n for n in names}
     seen = {}
-    failed = run_accuracy_sweep(scenes, (32, 18), 1, outs, 2, None,
-                                lambda n, lines, err: seen.setdefault(n, (lines, err)))
+    failed = run_accuracy_sweep(
+        scenes, (32, 18), 1, outs, 2, None, lambda n, lines, err: seen.setdefault(n, (lines, err))
+    )
     assert failed == [] and set(seen) == set(names) and all(v[0] for v in seen.values())
     columns = ("knob", "value", "holes", "false_hits", "mask_error", "depth_eps_p99")
     for n in names:
         assert (outs[n] / "README.md").exists() and (outs[n] / "pareto.png").exists()
         local = tmp_path / "local" / n
         bench_accuracy(scenes[n], (32, 18), local, rounds=1)
-        rows = [[list(csv.DictReader(open(d / "accuracy.csv")))] for d in (outs[n], local)]
+        rows = [[list(csv.DictReader((d / "accuracy.csv").open()))] for d in (outs[n], local)]
         ray_rows, local_rows = rows[0][0], rows[1][0]
-        assert [[r[c] for c in columns] for r in ray_rows] == \
-               [[r[c] for c in columns] for r in local_rows]
+        assert [[r[c] for c in columns] for r in ray_rows] == [
+            [r[c] for c in columns] for r in local_rows
+        ]
     # negative control: the two presets' reports differ
-    a, b = (list(csv.DictReader(open(outs[n] / "accuracy.csv"))) for n in names)
+    a, b = (
+        list(csv.DictReader((outs[n] / "accuracy.csv").read_text().splitlines())) for n in names
+    )
     assert [r["mask_error"] for r in a] != [r["mask_error"] for r in b]
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--address", "ray://127.0.0.1:1"], "--address = 'ray://127.0.0.1:1': cannot reach "
-                                         "127.0.0.1:1"),
-    (["--address", "http://x"], "expected ray://HOST:PORT"),
-    (["--workers", "0"], "--workers '0': allowed 1 ≤ value"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (
+            ["--address", "ray://127.0.0.1:1"],
+            "--address = 'ray://127.0.0.1:1': cannot reach 127.0.0.1:1",
+        ),
+        (["--address", "http://x"], "expected ray://HOST:PORT"),
+        (["--workers", "0"], "--workers '0': allowed 1 ≤ value"),
+    ],
+)
 def test_bad_cluster_options_are_one_line_errors(tmp_path, args, message):
     """An address where nothing listens is refused at once (Ray alone waits 30 s, or for
     ever). ('auto' with no cluster running is one line too, but whether one runs depends on
     the machine: this module's own fixture starts one.)"""
     path = tmp_path / "tree.path.json"
     path.write_text(json.dumps({"poses": POSES}))
-    r = subprocess.run([sys.executable, "-m", "krsview", "batch", "tree", "--camera-path",
-                        str(path), "-o", str(tmp_path / "f"), *args], capture_output=True,
-                       text=True, timeout=120, env={**os.environ, "DISPLAY": "",
-                                                    "RAY_ADDRESS": ""})
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "krsview",
+            "batch",
+            "tree",
+            "--camera-path",
+            str(path),
+            "-o",
+            str(tmp_path / "f"),
+            *args,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "DISPLAY": "", "RAY_ADDRESS": ""},
+    )
     assert r.returncode in (2, 3) and message in r.stderr, r.stderr
     assert "Traceback" not in r.stderr
     assert len([line for line in r.stderr.splitlines() if "error" in line]) == 1

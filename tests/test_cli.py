@@ -1,4 +1,5 @@
 """The command line: renders valid PNGs, validates files, and rejects bad input clearly."""
+
 from __future__ import annotations
 
 import subprocess
@@ -13,14 +14,25 @@ from krsview.cli import main
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "krsview", *args], capture_output=True,
-                          text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "krsview", *args], capture_output=True, text=True, timeout=300
+    )
 
 
 def test_render_writes_png_of_requested_size_and_buffers(tmp_path):
     out, npz = tmp_path / "a.png", tmp_path / "a.npz"
-    r = run("render", "sierpinski", "-o", str(out), "--size", "96x64", "--buffers", str(npz),
-            "--repeats", "1")
+    r = run(
+        "render",
+        "sierpinski",
+        "-o",
+        str(out),
+        "--size",
+        "96x64",
+        "--buffers",
+        str(npz),
+        "--repeats",
+        "1",
+    )
     assert r.returncode == 0, r.stderr
     assert "frame time" in r.stdout and str(out) in r.stdout
     im = Image.open(out)
@@ -35,36 +47,60 @@ def test_reference_render_matches_size(tmp_path):
     assert Image.open(out).size == (40, 30)
 
 
-@pytest.mark.parametrize("args, message", [
-    (["render", "tree", "--size", "640"], "expected WIDTHxHEIGHT"),
-    (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
-    (["render", "tree", "--epsilon-scale", "nan"], "--epsilon-scale = nan: NaN and infinity are "
-                                                   "not allowed; allowed: 0.0001 ≤ value ≤ 100"),
-    (["render", "tree", "--epsilon-scale", "0"], "--epsilon-scale = 0.0: allowed: 0.0001 ≤ value"),
-    (["render", "tree", "--max-iterations", "-3"], "--max-iterations = -3: allowed: 1 ≤ value ≤ 10000"),
-    (["render", "tree", "--tracer", "bent"], "--tracer = 'bent': allowed: 'sphere', 'binary'"),
-    (["render", "no-such-preset"], "not a file and not a preset; presets: bent-tree, forest, grass, grove"),
-    (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
-    (["check", "missing.toml"], "no such scene file"),
-    (["frobnicate"], "invalid choice"),
-    # values starting with '-' reach the option's own check (not "expected one argument")
-    (["render", "tree", "--size", "-5x3"], "--size '-5x3': each side must be 1..8192"),
-    (["render", "tree", "--epsilon-scale", "-inf"], "--epsilon-scale = -inf: NaN and infinity"),
-    # outputs are checked before the render runs
-    (["render", "tree", "-o", "x.jpg"], "-o = 'x.jpg': the file must end in .png"),
-    (["render", "tree", "-o", "/tmp"], "-o = '/tmp': the file must end in .png"),
-    (["render", "tree", "-o", "/proc/no/such.png"], "-o = '/proc/no/such.png': cannot write there"),
-    (["render", "tree", "--buffers", "x.txt"], "--buffers = 'x.txt': the file must end in .npz"),
-    (["bench", "levels", "tree", "--csv", "/tmp"], "--csv = '/tmp': the file must end in .csv"),
-    (["check", "tree.toml"], "no such scene file; the preset of that name is `tree` (no .toml)"),
-    (["check", "/tmp"], "'/tmp': is a folder"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["render", "tree", "--size", "640"], "expected WIDTHxHEIGHT"),
+        (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
+        (
+            ["render", "tree", "--epsilon-scale", "nan"],
+            "--epsilon-scale = nan: NaN and infinity are "
+            "not allowed; allowed: 0.0001 ≤ value ≤ 100",
+        ),
+        (
+            ["render", "tree", "--epsilon-scale", "0"],
+            "--epsilon-scale = 0.0: allowed: 0.0001 ≤ value",
+        ),
+        (
+            ["render", "tree", "--max-iterations", "-3"],
+            "--max-iterations = -3: allowed: 1 ≤ value ≤ 10000",
+        ),
+        (["render", "tree", "--tracer", "bent"], "--tracer = 'bent': allowed: 'sphere', 'binary'"),
+        (
+            ["render", "no-such-preset"],
+            "not a file and not a preset; presets: bent-tree, forest, grass, grove",
+        ),
+        (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
+        (["check", "missing.toml"], "no such scene file"),
+        (["frobnicate"], "invalid choice"),
+        # values starting with '-' reach the option's own check (not "expected one argument")
+        (["render", "tree", "--size", "-5x3"], "--size '-5x3': each side must be 1..8192"),
+        (["render", "tree", "--epsilon-scale", "-inf"], "--epsilon-scale = -inf: NaN and infinity"),
+        # outputs are checked before the render runs
+        (["render", "tree", "-o", "x.jpg"], "-o = 'x.jpg': the file must end in .png"),
+        (["render", "tree", "-o", "/tmp"], "-o = '/tmp': the file must end in .png"),
+        (
+            ["render", "tree", "-o", "/proc/no/such.png"],
+            "-o = '/proc/no/such.png': cannot write there",
+        ),
+        (
+            ["render", "tree", "--buffers", "x.txt"],
+            "--buffers = 'x.txt': the file must end in .npz",
+        ),
+        (["bench", "levels", "tree", "--csv", "/tmp"], "--csv = '/tmp': the file must end in .csv"),
+        (
+            ["check", "tree.toml"],
+            "no such scene file; the preset of that name is `tree` (no .toml)",
+        ),
+        (["check", "/tmp"], "'/tmp': is a folder"),
+    ],
+)
 def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):
     r = run(*args)
     assert r.returncode != 0
     assert message in r.stderr, r.stderr
     assert "Traceback" not in r.stderr
-    assert "frame time" not in r.stdout     # refused before any work
+    assert "frame time" not in r.stdout  # refused before any work
 
 
 def test_version():
@@ -88,8 +124,10 @@ def test_check_prints_statistics(capsys):
 
 
 def test_bench_levels_prints_the_ratio_table(capsys):
-    assert main(["bench", "levels", "sierpinski", "--size", "48x32", "--rounds", "1",
-                 "--step", "8"]) == 0
+    assert (
+        main(["bench", "levels", "sierpinski", "--size", "48x32", "--rounds", "1", "--step", "8"])
+        == 0
+    )
     out = capsys.readouterr().out
     assert "| levels | kernel instances |" in out
     rows = [line for line in out.splitlines() if line.startswith("| ") and line[2].isdigit()]
@@ -99,33 +137,58 @@ def test_bench_levels_prints_the_ratio_table(capsys):
 
 def test_view_without_a_display_says_what_to_do():
     import os
-    r = subprocess.run([sys.executable, "-m", "krsview", "view", "tree"], capture_output=True,
-                       text=True, timeout=60, env={k: v for k, v in os.environ.items()
-                                                   if k not in ("DISPLAY", "WAYLAND_DISPLAY")})
+
+    r = subprocess.run(
+        [sys.executable, "-m", "krsview", "view", "tree"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")},
+    )
     assert r.returncode == 3 and "Traceback" not in r.stderr
-    assert r.stderr.strip() == ("krsview: error: cannot open a window: GLFW found no display "
-                                "(is DISPLAY set? use `krsview render` to render headless)")
+    assert r.stderr.strip() == (
+        "krsview: error: cannot open a window: GLFW found no display "
+        "(is DISPLAY set? use `krsview render` to render headless)"
+    )
 
 
 @pytest.mark.parametrize("tracer", ["sphere", "binary"])
 def test_iterations_view_writes_a_heat_map_with_legend(tmp_path, tracer):
     from krsview.heatmap import LEGEND_HEIGHT, heat
+
     out, npz = tmp_path / "it.png", tmp_path / "b.npz"
-    r = run("render", "tree", "--view", "iterations", "--tracer", tracer, "--legend-max", "60",
-            "-o", str(out), "--size", "96x64", "--buffers", str(npz), "--repeats", "1")
+    r = run(
+        "render",
+        "tree",
+        "--view",
+        "iterations",
+        "--tracer",
+        tracer,
+        "--legend-max",
+        "60",
+        "-o",
+        str(out),
+        "--size",
+        "96x64",
+        "--buffers",
+        str(npz),
+        "--repeats",
+        "1",
+    )
     assert r.returncode == 0, r.stderr
     img = np.asarray(Image.open(out).convert("RGB")).astype(int)
     assert img.shape == (64 + LEGEND_HEIGHT, 96, 3)
     it = np.load(npz)["iterations"]
     want = np.round(heat(it / 60) * 255)
-    assert np.abs(img[:64] - want).max() <= 1                 # the image is the iteration count
-    assert img[64:].max() >= 250 and img[64:].min() <= 40     # the legend's bar runs dark → white
+    assert np.abs(img[:64] - want).max() <= 1  # the image is the iteration count
+    assert img[64:].max() >= 250 and img[64:].min() <= 40  # the legend's bar runs dark → white
     assert "iterations per pixel: median" in r.stdout
 
 
 def test_heat_ramp_runs_from_black_to_white_and_brightens():
     """Every count must map to a distinct brightness: no flat white top of the scale."""
     from krsview.heatmap import heat
+
     x = np.linspace(0, 1, 101)
     lum = heat(x) @ [0.2126, 0.7152, 0.0722]
     assert np.allclose(heat(np.array([0.0, 1.0])), [[0, 0, 0], [1, 1, 1]])
@@ -140,6 +203,7 @@ def test_sphere_tracer_on_a_mokrs_is_refused():
 
 def test_bench_tracers_prints_ratios_and_best_pair(capsys):
     from krsview.cli import main
+
     assert main(["bench", "tracers", "tree", "--size", "32x24", "--rounds", "1"]) == 0
     out = capsys.readouterr().out
     assert "| sphere |" in out and "| binary | 2.0 | 0.3 |" in out
@@ -150,10 +214,11 @@ def test_every_complete_scene_in_the_readme_renders_something(renderer):
     """The README's scene examples (those with a camera) load and draw: an example that
     passes `check` but shows an empty sky teaches nothing."""
     from krsview.scene import scene_from_toml
+
     readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
     blocks = [b.split("```")[0] for b in readme.split("```toml\n")[1:]]
     complete = [b for b in blocks if "[camera]" in b]
-    assert len(complete) >= 2            # the KRS and the MöKRS examples
+    assert len(complete) >= 2  # the KRS and the MöKRS examples
     for text in complete:
         scene = scene_from_toml(text, "README.md")
         assert renderer.render(scene, 64, 36).hit.mean() > 0.01, scene.name
@@ -170,20 +235,29 @@ def test_progress_reporting_does_not_change_the_image(renderer, monkeypatch):
     from krsview.presets import resolve
     from krsview.reference import render as reference_render
     from krsview.scene import load_scene
+
     scene = load_scene(resolve("sierpinski"))
     monkeypatch.setattr(reference_render, "PROGRESS_CHUNK", 100)
     calls: list = []
     whole = reference_render.render_reference(scene, 24, 10)
-    chunked = reference_render.render_reference(scene, 24, 10, progress=lambda d, n: calls.append((d, n)))
+    chunked = reference_render.render_reference(
+        scene, 24, 10, progress=lambda d, n: calls.append((d, n))
+    )
     assert calls[-1] == (240, 240) and len(calls) == 3
     for name in ("color", "depth", "normal", "iterations", "hit"):
         assert np.array_equal(getattr(whole, name), getattr(chunked, name)), name
     calls.clear()
     one = renderer.render(scene, 40, 20)
     from dataclasses import replace
-    away = replace(scene, camera=replace(scene.camera, target=tuple(
-        2 * np.array(scene.camera.position) - np.array(scene.camera.target))))
-    assert not renderer.render(away, 40, 20).hit.any()   # the framebuffer now holds sky
+
+    away = replace(
+        scene,
+        camera=replace(
+            scene.camera,
+            target=tuple(2 * np.array(scene.camera.position) - np.array(scene.camera.target)),
+        ),
+    )
+    assert not renderer.render(away, 40, 20).hit.any()  # the framebuffer now holds sky
     banded = renderer.render(scene, 40, 20, progress=lambda d, n: calls.append((d, n)))
     assert calls[-1] == (16, 16)
     assert np.array_equal(one.color, banded.color) and np.array_equal(one.hit, banded.hit)
@@ -193,9 +267,12 @@ def test_progress_reporting_does_not_change_the_image(renderer, monkeypatch):
 def test_check_stability_prints_the_table_and_fails_when_an_invariant_does(capsys, monkeypatch):
     assert main(["check", "--stability", "hard:points-on-planes"]) == 0
     out = capsys.readouterr().out
-    assert "| points-on-planes | 3% | yes | yes | 0 / 0 |" in out and out.rstrip().endswith("| ok |")
+    assert "| points-on-planes | 3% | yes | yes | 0 / 0 |" in out and out.rstrip().endswith(
+        "| ok |"
+    )
     from krsview.bench import stability
-    monkeypatch.setattr(stability, "CONTINUITY", -1.0)      # no image can meet this
+
+    monkeypatch.setattr(stability, "CONTINUITY", -1.0)  # no image can meet this
     assert main(["check", "--stability", "sierpinski"]) == 1
     assert capsys.readouterr().out.rstrip().endswith("| FAILS |")
     assert main(["check", "--stability", "hard:nope"]) == 2
@@ -208,6 +285,6 @@ def test_check_oracle_prints_certified_counts(capsys):
     # a budget of one segment per ray decides only rays whose whole segment clears at once
     assert main(["check", "--oracle", "sierpinski", "--size", "24x14", "--segments", "1"]) == 0
     row = capsys.readouterr().out.splitlines()[2].split("|")
-    assert int(row[7]) > 0                          # the undecided column
+    assert int(row[7]) > 0  # the undecided column
     assert main(["check", "--oracle", "hard:twist-ground"]) == 2
     assert "the oracle covers scenes without twist or empty zones" in capsys.readouterr().err

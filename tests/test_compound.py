@@ -1,6 +1,7 @@
 """Compound of KRSs [KRS17 §5.1]: the tracer with one free distance per component draws the
 per-pixel nearest of the components drawn alone, with no more work than all of them alone;
 placing a component moves its distance as a similarity; bad compounds get clear errors."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -10,16 +11,22 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from krsview.bench.metrics import HIT_AGREEMENT
 from krsview.buffers import Buffers
 from krsview.gpu.program import Source
 from krsview.gpu.uniforms import variant_defines
 from krsview.reference import compile_krs, distance, render_reference
 from krsview.reference.geometry import compile_geometry
-from krsview.scene import (Compound, EffectSettings, EmptyZone, SceneError, Tree,
-                           scene_from_toml, scene_to_toml)
+from krsview.scene import (
+    Compound,
+    EffectSettings,
+    EmptyZone,
+    SceneError,
+    Tree,
+    scene_from_toml,
+    scene_to_toml,
+)
 from krsview.scene.compound import Placement
-
-from krsview.bench.metrics import HIT_AGREEMENT
 
 from .conftest import assert_finite, check_against_reference
 
@@ -94,11 +101,16 @@ def test_compound_is_the_nearest_of_its_components(tracer):
 DISTORTED = EffectSettings(twist=12.0, empty_zones=[EmptyZone((-1.2, 2.2, 0.0), 0.8)])
 
 
-@pytest.mark.parametrize("tracer, effects", [
-    ("sphere", []), ("binary", []),
-    ("sphere", ["twist", "empty_zones"]),
-    ("sphere", ["smooth_shading", "kernel_texture", "ambient_occlusion"]),
-], ids=lambda v: "+".join(v) if isinstance(v, list) else v)
+@pytest.mark.parametrize(
+    "tracer, effects",
+    [
+        ("sphere", []),
+        ("binary", []),
+        ("sphere", ["twist", "empty_zones"]),
+        ("sphere", ["smooth_shading", "kernel_texture", "ambient_occlusion"]),
+    ],
+    ids=lambda v: "+".join(v) if isinstance(v, list) else v,
+)
 def test_gpu_compound_matches_reference(renderer, tracer, effects):
     """Both tracers, and effects that act per component (distortions, nearest-kernel
     shading) or on the whole compound (AO samples the least distance)."""
@@ -107,8 +119,12 @@ def test_gpu_compound_matches_reference(renderer, tracer, effects):
     assert_finite(gpu, CAP)
     ref = render_reference(s, W, H)
     if effects:
-        assert np.mean(np.abs(ref.color - render_reference(compound_scene(), W, H).color)
-                       .max(-1) > 0.02) > 0.01, "the effects changed nothing"
+        assert (
+            np.mean(
+                np.abs(ref.color - render_reference(compound_scene(), W, H).color).max(-1) > 0.02
+            )
+            > 0.01
+        ), "the effects changed nothing"
     check_against_reference(f"compound-{tracer}-{'+'.join(effects)}", gpu, ref)
 
 
@@ -117,8 +133,7 @@ def test_gpu_compound_is_the_nearest_of_its_components(renderer):
     of each component."""
     s = compound_scene()
     comp = renderer.render(s, W, H)
-    hit, win, depth = nearest_of([renderer.render(s, W, H, geometry=p)
-                                  for p in s.geometry().parts])
+    hit, win, depth = nearest_of([renderer.render(s, W, H, geometry=p) for p in s.geometry().parts])
     assert (comp.hit == hit).mean() >= HIT_AGREEMENT
     both = comp.hit & hit
     rel = np.abs(comp.depth[both] - depth[both]) / depth[both]
@@ -140,21 +155,32 @@ def test_compound_shadows_fall_across_components(renderer):
 def test_single_scene_compiles_no_compound_code():
     s = compound_scene()
     single = s.with_geometry(s.geometry().parts[0])
-    src_single = Source("render.frag", variant_defines(single, compile_geometry(
-        single.geometry(), (1, 1, 1)))).text
-    src_comp = Source("render.frag", variant_defines(s, compile_geometry(
-        s.geometry(), (1, 1, 1)))).text
+    src_single = Source(
+        "render.frag", variant_defines(single, compile_geometry(single.geometry(), (1, 1, 1)))
+    ).text
+    src_comp = Source(
+        "render.frag", variant_defines(s, compile_geometry(s.geometry(), (1, 1, 1)))
+    ).text
     assert "u_component" not in src_single and "u_component" in src_comp
 
 
-small_trees = st.builds(lambda lv, a, b: Tree(levels=lv, branch_angle=a, bend=b),
-                        st.integers(1, 6), st.floats(5, 60), st.floats(-0.3, 0.3))
+small_trees = st.builds(
+    lambda lv, a, b: Tree(levels=lv, branch_angle=a, bend=b),
+    st.integers(1, 6),
+    st.floats(5, 60),
+    st.floats(-0.3, 0.3),
+)
 placements = st.builds(
-    lambda axis, angle, scale, pos: Placement(position=pos, axis=tuple(axis / np.linalg.norm(axis)),
-                                              angle=angle, scale=scale),
-    st.lists(st.floats(-1, 1), min_size=3, max_size=3).map(np.array).filter(
-        lambda v: np.linalg.norm(v) > 0.1),
-    st.floats(-360, 360), st.floats(0.05, 20), st.tuples(*[st.floats(-50, 50)] * 3))
+    lambda axis, angle, scale, pos: Placement(
+        position=pos, axis=tuple(axis / np.linalg.norm(axis)), angle=angle, scale=scale
+    ),
+    st.lists(st.floats(-1, 1), min_size=3, max_size=3)
+    .map(np.array)
+    .filter(lambda v: np.linalg.norm(v) > 0.1),
+    st.floats(-360, 360),
+    st.floats(0.05, 20),
+    st.tuples(*[st.floats(-50, 50)] * 3),
+)
 
 
 @settings(max_examples=40, deadline=None)
@@ -180,8 +206,9 @@ def test_bad_compounds_get_clear_errors():
     tree = "[[compound]]\n[compound.tree]\nlevels = 3\n"
     msg = error_of(tree * 9)
     assert "grove.toml" in msg and "<9 components>" in msg and "at most 8" in msg
-    msg = error_of("[[compound]]\n[compound.tree]\n[compound.krs]\n"
-                   "levels = [{kernel = {type = 'sphere'}}]\n")
+    msg = error_of(
+        "[[compound]]\n[compound.tree]\n[compound.krs]\nlevels = [{kernel = {type = 'sphere'}}]\n"
+    )
     assert "compound[0].krs / compound[0].tree" in msg and "exactly one" in msg
     assert "MöKRS cannot join" in error_of("[[compound]]\n")
     msg = error_of("[[compound]]\nmokrs = {}\n")

@@ -4,6 +4,7 @@ dispatch), shading deferred over a G-buffer. It takes the same steps as the frag
 so the image is the same, bit for bit, for every tracer and geometry family, with and without
 the pre-pass, whole or drawn in bands. Negative control: rounds that drop the rays still
 live (no requeue) lose them."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -13,8 +14,8 @@ import pytest
 
 from krsview.gpu.renderer import Renderer
 from krsview.presets import preset_names, resolve
-from krsview.scene.model import VIEW_PREPASS
 from krsview.scene import load_scene
+from krsview.scene.model import VIEW_PREPASS
 
 from .conftest import broken_shaders
 
@@ -30,10 +31,19 @@ def same(a, b) -> bool:
     return all(np.array_equal(getattr(a, f), getattr(b, f)) for f in FIELDS)
 
 
-@pytest.mark.parametrize("name, tracer", [("tree", "sphere"), ("tree", "binary"),
-                                          ("tree", "relaxed"), ("grove", "sphere"),
-                                          ("grove", "binary"), ("palm", "binary"),
-                                          ("inversion", "binary"), ("sierpinski", "sphere")])
+@pytest.mark.parametrize(
+    "name, tracer",
+    [
+        ("tree", "sphere"),
+        ("tree", "binary"),
+        ("tree", "relaxed"),
+        ("grove", "sphere"),
+        ("grove", "binary"),
+        ("palm", "binary"),
+        ("inversion", "binary"),
+        ("sierpinski", "sphere"),
+    ],
+)
 @pytest.mark.parametrize("prepass", [0, 8])
 def test_compute_image_equals_fragment_image(renderer, name, tracer, prepass):
     scene = on_path(load_scene(resolve(name)), "fragment", tracer=tracer, prepass=prepass)
@@ -48,8 +58,9 @@ def test_every_preset_draws_the_same_on_both_paths(renderer, name):
     """Every preset with its own tracer and effects, at the viewer's pre-pass: the compute
     path's image equals the fragment path's, bit for bit."""
     scene = on_path(load_scene(resolve(name)), "fragment", prepass=VIEW_PREPASS)
-    assert same(renderer.render(scene, W, H),
-                renderer.render(on_path(scene, "compute", steps=4), W, H))
+    assert same(
+        renderer.render(scene, W, H), renderer.render(on_path(scene, "compute", steps=4), W, H)
+    )
 
 
 def test_compute_in_bands_double_precision_and_any_round_size(renderer):
@@ -57,8 +68,12 @@ def test_compute_in_bands_double_precision_and_any_round_size(renderer):
     and with rounds of 1 or 1000 iterations: the same image."""
     scene = load_scene(resolve("tree"))
     fragment = renderer.render(on_path(scene, "fragment", precision="double"), W, H)
-    banded = renderer.render(on_path(scene, "compute", precision="double", steps=3), W, H,
-                             progress=lambda done, total: None)
+    banded = renderer.render(
+        on_path(scene, "compute", precision="double", steps=3),
+        W,
+        H,
+        progress=lambda done, total: None,
+    )
     assert same(fragment, banded)
     plain = renderer.render(scene, W, H)
     for steps in (1, 1000):
@@ -68,35 +83,46 @@ def test_compute_in_bands_double_precision_and_any_round_size(renderer):
 def test_rounds_that_drop_live_rays_lose_them(tmp_path, renderer):
     """Negative control: a copy of the compute shader that does not requeue the rays still
     live after a round leaves them out of the image."""
-    shaders = broken_shaders(tmp_path, "compute.comp", "queue[uint(1 - u_parity) * u_queue + "
-                             "atomicAdd(count[1 - u_parity], 1u)] = ray;", "")
+    shaders = broken_shaders(
+        tmp_path,
+        "compute.comp",
+        "queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = ray;",
+        "",
+    )
     scene = on_path(load_scene(resolve("tree")), "compute", steps=2)
     broken = Renderer(shader_dir=shaders).render(scene, W, H)
     assert not same(renderer.render(scene, W, H), broken)
     assert not same(renderer.render(on_path(scene, "fragment"), W, H), broken)
 
 
-@pytest.mark.parametrize("name, effects, tracer", [
-    ("tree", None, "sphere"),                    # soft shadows, a KRS
-    ("grove", None, "binary"),                   # soft shadows, a compound
-    ("palm", ["shadows", "sky"], "binary"),      # hard shadows, a MöKRS
-    ("palm", ["soft_shadows"], "binary"),
-    ("rock", None, "sphere"),                    # soft shadows with occlusion and textures
-])
+@pytest.mark.parametrize(
+    "name, effects, tracer",
+    [
+        ("tree", None, "sphere"),  # soft shadows, a KRS
+        ("grove", None, "binary"),  # soft shadows, a compound
+        ("palm", ["shadows", "sky"], "binary"),  # hard shadows, a MöKRS
+        ("palm", ["soft_shadows"], "binary"),
+        ("rock", None, "sphere"),  # soft shadows with occlusion and textures
+    ],
+)
 def test_shadow_rays_traced_as_tasks_shade_the_same_image(renderer, name, effects, tracer):
     """The compute path traces shadow rays as tasks of their own (one per hit pixel and
     light, in rounds through the same queues) and shades with their visibilities: the image
     equals the fragment path's, where shade() traces them inline."""
     scene = load_scene(resolve(name))
-    scene = on_path(replace(scene, effects=effects if effects is not None else scene.effects),
-                    "fragment", tracer=tracer)
+    scene = on_path(
+        replace(scene, effects=effects if effects is not None else scene.effects),
+        "fragment",
+        tracer=tracer,
+    )
     from krsview.gpu.uniforms import variant_defines
     from krsview.reference.geometry import compile_geometry
+
     c = compile_geometry(scene.geometry(), scene.material.albedo)
     assert "KRS_SHADOW_TASKS" in variant_defines(on_path(scene, "compute"), c)
     fragment = renderer.render(scene, W, H)
     assert same(fragment, renderer.render(on_path(scene, "compute", steps=3), W, H))
-    inline = on_path(scene, "compute", steps=3, shadow_tasks="off")   # the knob's other side
+    inline = on_path(scene, "compute", steps=3, shadow_tasks="off")  # the knob's other side
     assert "KRS_SHADOW_TASKS" not in variant_defines(inline, c)
     assert same(fragment, renderer.render(inline, W, H))
     unshadowed = replace(scene, effects=[e for e in scene.effects if "shadows" not in e])
@@ -105,11 +131,13 @@ def test_shadow_rays_traced_as_tasks_shade_the_same_image(renderer, name, effect
 
 def test_shadow_rounds_that_drop_live_tasks_lose_the_shadows(tmp_path, renderer):
     """Negative control: shadow tasks not requeued after a round count as lit."""
-    shaders = broken_shaders(tmp_path, "compute.comp",
-                             "queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], "
-                             "1u)] = slot;", "")
-    scene = on_path(replace(load_scene(resolve("palm")), effects=["shadows"]), "compute",
-                    steps=2)
+    shaders = broken_shaders(
+        tmp_path,
+        "compute.comp",
+        "queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = slot;",
+        "",
+    )
+    scene = on_path(replace(load_scene(resolve("palm")), effects=["shadows"]), "compute", steps=2)
     broken = Renderer(shader_dir=shaders).render(scene, W, H)
     good = renderer.render(scene, W, H)
     assert np.array_equal(good.hit, broken.hit) and not np.array_equal(good.color, broken.color)
@@ -124,6 +152,7 @@ def test_a_task_per_component_keeps_every_hit(renderer, tracer, prepass):
     nearest hit), and the iterations are their sum."""
     from krsview.gpu.uniforms import variant_defines
     from krsview.reference.geometry import compile_geometry
+
     scene = on_path(load_scene(resolve("grove")), "fragment", tracer=tracer, prepass=prepass)
     tasks = on_path(scene, "compute", steps=4, component_tasks="on")
     c = compile_geometry(scene.geometry(), scene.material.albedo)

@@ -1,5 +1,6 @@
 """Exact level culling [issue 17 §1]: the walk of Alg. 1 stops once d ≤ dist(x, C_i), the
 ball of everything levels i..0 still test; the distance is the same as the full walk's."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -33,6 +34,7 @@ def test_every_culling_ball_holds_what_it_claims():
     bounding ball (kernel_ball, tested against sampled arcs in test_mokrs) under the
     reflection products R_i^b_i ⋯ R_j^b_j, on a 12-level tree and the rock."""
     from krsview.reference.compiled import kernel_ball
+
     for name, levels in (("tree", 12), ("rock", None)):
         g = load_scene(resolve(name)).geometry()
         g = g.truncated(levels) if levels else g
@@ -49,7 +51,7 @@ def test_every_culling_ball_holds_what_it_claims():
             c = bounds[i]
             reach = np.linalg.norm(balls[:, :3] - c[:3], axis=1) + balls[:, 3]
             assert reach.max() <= c[3], (name, i)
-            assert reach.max() > 0.5 * c[3], (name, i)     # and not absurdly large
+            assert reach.max() > 0.5 * c[3], (name, i)  # and not absurdly large
 
 
 def test_a_ball_one_kernel_too_small_changes_the_distance():

@@ -8,6 +8,7 @@ Alg. 1 folds each level into its mirror's negative half-space, which clips the l
   instances (a subset of the geometry, so its distance can only be larger).
 Kernel distances themselves are checked against dense samples of their cores.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -75,7 +76,7 @@ def separated_krs(rng: np.random.Generator, n: int) -> KRS:
         u = unit(rng)
         gap = rho * rng.uniform(1.05, 1.5)  # plane distance from L's centre, beyond its ball
         w = float(u @ c + gap)
-        c, rho = c + gap * u, gap + rho     # the ball of L ∪ RL, centred on the plane
+        c, rho = c + gap * u, gap + rho  # the ball of L ∪ RL, centred on the plane
         k = random_kernel(rng, c, 0.5 * rho)
         rho = max(rho, extent(k, c) * 1.001)
         levels.append(Level(k, Mirror(tuple(u), w)))
@@ -84,12 +85,19 @@ def separated_krs(rng: np.random.Generator, n: int) -> KRS:
 
 def arbitrary_krs(rng: np.random.Generator, n: int) -> KRS:
     """Mirrors cut through the geometry: no separation at all."""
-    levels = [Level(random_kernel(rng, np.zeros(3), 1.0) if rng.random() < 0.8
-                    else Sphere((0, 0, 0), 0.4))]
+    levels = [
+        Level(
+            random_kernel(rng, np.zeros(3), 1.0) if rng.random() < 0.8 else Sphere((0, 0, 0), 0.4)
+        )
+    ]
     for i in range(n):
         u = unit(rng)
-        levels.append(Level(random_kernel(rng, rng.normal(size=3), 1.0),
-                            Mirror(tuple(u), float(rng.uniform(-0.5, 1.0) * (1 + 0.3 * i)))))
+        levels.append(
+            Level(
+                random_kernel(rng, rng.normal(size=3), 1.0),
+                Mirror(tuple(u), float(rng.uniform(-0.5, 1.0) * (1 + 0.3 * i))),
+            )
+        )
     return KRS(levels)
 
 
@@ -146,7 +154,7 @@ def clipped_samples(krs: KRS, rng: np.random.Generator, per_kernel: int) -> np.n
         p = rng.uniform(lo, hi, size=(per_kernel * 8, 3))
         p = p[kernel_distance(c.types[j], rec, p) <= 0][:per_kernel]
         y = p
-        for i in range(j, c.n):          # instance = R_{n-1}^{b} … R_j^{b} applied to K_j
+        for i in range(j, c.n):  # instance = R_{n-1}^{b} … R_j^{b} applied to K_j
             if path[i]:
                 y = reflect(c.mirrors[i], y)
         z, keep = y, np.ones(len(y), dtype=bool)
@@ -164,7 +172,7 @@ def test_alg1_never_overshoots_the_clipped_expansion(seed, n):
     rng = np.random.default_rng(seed)
     krs = arbitrary_krs(rng, n)
     samples = clipped_samples(krs, rng, 400)
-    assume(len(samples) > 0)   # discarded, not passed: Hypothesis fails if too many are
+    assume(len(samples) > 0)  # discarded, not passed: Hypothesis fails if too many are
     x = rng.normal(size=(200, 3)) * 3.0
     alg1 = distance(compile_krs(krs, ALBEDO), x)
     to_samples = np.min(np.linalg.norm(x[:, None] - samples[None], axis=2), axis=1)
@@ -178,7 +186,7 @@ def test_unclipped_brute_force_is_not_a_bound_without_separation():
     x = np.array([[-1.0, 0.0, 0.0]])
     alg1 = distance(compile_krs(krs, ALBEDO), x)[0]
     assert brute_force_distance(krs, x)[0] < alg1  # the mirrored copy at −0.2 is nearer …
-    assert alg1 == 0.7                              # … than the clipped original at +0.2
+    assert alg1 == 0.7  # … than the clipped original at +0.2
 
 
 @given(seed=seeds)
@@ -207,10 +215,17 @@ def test_camera_relative_compile_is_a_pure_translation(seed, n):
     rng = np.random.default_rng(seed)
     krs = arbitrary_krs(rng, n)
     u = unit(rng)
-    krs = KRS(krs.levels + [Level(Plane(tuple(u), float(rng.normal())),
-                                  Mirror(tuple(unit(rng)), float(rng.normal())))])
+    krs = KRS(
+        krs.levels
+        + [
+            Level(
+                Plane(tuple(u), float(rng.normal())), Mirror(tuple(unit(rng)), float(rng.normal()))
+            )
+        ]
+    )
     world = compile_krs(krs, ALBEDO)
     o = rng.normal(size=3) * 10.0
     x = rng.normal(size=(200, 3)) * 3.0
-    assert np.allclose(distance(world.relative_to(o), x - o), distance(world, x),
-                       rtol=1e-9, atol=1e-9)
+    assert np.allclose(
+        distance(world.relative_to(o), x - o), distance(world, x), rtol=1e-9, atol=1e-9
+    )

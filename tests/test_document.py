@@ -1,5 +1,6 @@
 """The editor's document: edits through one seam, undo/redo with drags merged by interaction,
 atomic saves, autosave and recovery, and files changed on disk never overwritten silently."""
+
 from __future__ import annotations
 
 import os
@@ -45,7 +46,7 @@ def test_an_edit_is_validated_and_undoable(route_file):
 def test_one_drag_is_one_undo_step_and_two_drags_are_two(route_file):
     doc = Document(route_file)
     start = doc.scene
-    for k in range(20):                         # one gizmo drag: many small moves
+    for k in range(20):  # one gizmo drag: many small moves
         doc.apply(FORK, [0.5 + 0.01 * k, 4.0, 0.4], interaction=("drag", 1))
     after_first = doc.scene
     for k in range(5):
@@ -115,7 +116,7 @@ def test_reload_takes_the_disk_version_and_is_undoable(route_file):
     doc.reload()
     assert doc.scene.name == "new" and not doc.dirty
     doc.undo()
-    assert doc.scene == before and doc.dirty      # the old version is now an unsaved edit
+    assert doc.scene == before and doc.dirty  # the old version is now an unsaved edit
 
 
 def test_autosave_writes_a_recovery_file_while_dirty_and_removes_it_when_clean(route_file):
@@ -137,7 +138,7 @@ def test_a_newer_recovery_file_is_offered_and_restores_the_edit(route_file):
     doc.autosave(0.0)
     doc.autosave(AUTOSAVE_SECONDS)
     edited = doc.scene
-    del doc                                       # the editor died without saving
+    del doc  # the editor died without saving
     again = Document(route_file)
     assert again.recovery() == edited
     again.restore_recovery()
@@ -159,10 +160,13 @@ EDIT = st.one_of(
 )
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(edits=st.lists(st.tuples(EDIT, st.sampled_from([None, 1, 2])), min_size=1, max_size=12))
 def test_random_edits_undo_to_the_original_redo_to_the_final_and_round_trip(
-        route_file, tmp_path_factory, edits):
+    route_file, tmp_path_factory, edits
+):
     doc = Document(route_file)
     original = doc.scene
     applied = 0
@@ -180,7 +184,7 @@ def test_random_edits_undo_to_the_original_redo_to_the_final_and_round_trip(
     while doc.redo():
         pass
     assert doc.scene == final
-    if applied:                                   # a sequence of only rejected edits: nothing to save
+    if applied:  # a sequence of only rejected edits: nothing to save
         out = tmp_path_factory.mktemp("rt") / "saved.toml"
         doc.save(out)
         assert load_scene(out) == final and load_scene(out).geometry() == final.geometry()
@@ -192,6 +196,7 @@ def test_random_edit_sequences_do_apply_edits():
     scene = load_scene(resolve("tree"))
     doc_scene = replace(scene, tree=None, route=scene.tree.route())
     from krsview.scene.edits import apply_edit
+
     for k in range(20):
         try:
             apply_edit(doc_scene, ("route", "levels", k, "fork"), [0.1 * k, 3.0, 0.2])
@@ -216,7 +221,7 @@ def test_an_unknown_path_is_a_clear_error(route_file):
 
 def test_a_read_only_folder_fails_the_save_clearly_and_keeps_the_edit(route_file, tmp_path):
     if os.geteuid() == 0:
-        target = tmp_path / "no-such-dir" / "x.toml"   # root may write anywhere: a missing folder
+        target = tmp_path / "no-such-dir" / "x.toml"  # root may write anywhere: a missing folder
     else:
         ro = tmp_path / "ro"
         ro.mkdir()

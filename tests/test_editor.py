@@ -2,6 +2,7 @@
 select by clicking, drag the gizmo and a normal's arrow tip, undo/redo/save by keyboard, and
 compare the saved file's headless render with the window. Also: killed mid-edit, the
 recovery is offered; closing or a disk change with unsaved edits asks first."""
+
 from __future__ import annotations
 
 import math
@@ -22,12 +23,13 @@ from krsview.scene import load_scene
 from .conftest import headless_render
 
 SIZE = (800, 500)
-LEVEL = 19          # a fork near the top of the shipped tree, clear of the panels
+LEVEL = 19  # a fork near the top of the shipped tree, clear of the panels
 
 
 @pytest.fixture
 def editor(display, tmp_path):
     from krsview.editor.app import Editor
+
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     e = Editor(path, size=SIZE)
@@ -38,6 +40,7 @@ def editor(display, tmp_path):
 def pump(e, turns: int = 3) -> None:
     """Event-loop turns as `run` makes them: deliver the X events, then step."""
     import glfw
+
     for _ in range(turns):
         glfw.poll_events()
         e.step(0.02)
@@ -58,7 +61,9 @@ def xdo(*args) -> None:
 
 def screen_of(e, world) -> tuple[float, float]:
     import glfw
+
     from krsview.reference.camera import project
+
     x, y, z = project(e.window_view(), np.asarray(world))
     assert z > 0
     wx, wy = glfw.get_window_pos(e.window)
@@ -105,8 +110,11 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     new = np.array(e.scene.route.levels[LEVEL].fork)
     v = e.window_view()
     depth = float((old - v.origin) @ v.forward)
-    expected = 40 * 2 * v.tan_half * depth / v.height * v.right   # the screen-plane move
-    assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected), (new - old, expected)
+    expected = 40 * 2 * v.tan_half * depth / v.height * v.right  # the screen-plane move
+    assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected), (
+        new - old,
+        expected,
+    )
     assert len(e.doc.history.steps) == 2, "the drag was not one undo step (bake + drag)"
     # the mirror normal of that fork, by its arrow tip: 30 px up
     normal_path = ("route", "levels", LEVEL, "normal")
@@ -140,16 +148,16 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     e.dirty = True
     settle(e)
     shot = e.read_window()
-    same_prepass = ("--prepass", str(e.prepass))     # the window's pre-pass tile
+    same_prepass = ("--prepass", str(e.prepass))  # the window's pre-pass tile
     ref = headless_render(load_scene(e.path), tmp_path / "saved", SIZE, *same_prepass)
     close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
     # negative control: the unedited tree differs where the fork moved
-    before = headless_render(load_scene(resolve("tree")), tmp_path / "before", SIZE,
-                             *same_prepass)
+    before = headless_render(load_scene(resolve("tree")), tmp_path / "before", SIZE, *same_prepass)
     same = np.abs(shot.astype(int) - before.astype(int)).max(-1) <= 2
     assert same.mean() < 0.97, f"the edit changed only {1 - same.mean():.2%} of the pixels"
     from PIL import Image
+
     Image.fromarray(shot).save(tmp_path / "edited-window.png")
 
 
@@ -157,6 +165,7 @@ def test_overlay_is_composited_by_traced_depth(editor):
     """Overlay fragments behind the traced surface are hidden (drawn at HIDDEN_ALPHA, here
     set to 0 to see them vanish, then to 1 as the negative control)."""
     import glfw
+
     e = editor
     e.execute([Do("bake")])
     e.select_level(LEVEL)
@@ -172,10 +181,14 @@ def test_overlay_is_composited_by_traced_depth(editor):
         wx, wy = glfw.get_window_pos(e.window)
         x, y = screen_of(e, world)
         px, py = round(x - wx), round(y - wy)
-        return float(np.abs(shot[py - 1:py + 2, px - 1:px + 2]
-                            - plain[py - 1:py + 2, px - 1:px + 2]).max())
-    inside = e.scene.route.levels[-1].control          # on the trunk's axis: behind its surface
-    tip = handle(e, ("route", "levels", LEVEL, "normal")).position   # in the open
+        return float(
+            np.abs(
+                shot[py - 1 : py + 2, px - 1 : px + 2] - plain[py - 1 : py + 2, px - 1 : px + 2]
+            ).max()
+        )
+
+    inside = e.scene.route.levels[-1].control  # on the trunk's axis: behind its surface
+    tip = handle(e, ("route", "levels", LEVEL, "normal")).position  # in the open
     assert overlay_change(0.0, tip) > 80, "a visible handle is not drawn"
     assert overlay_change(0.0, inside) == 0, "a handle behind the trunk shows through"
     assert overlay_change(1.0, inside) > 80, "negative control: unhidden, it must show"
@@ -199,16 +212,21 @@ os.kill(os.getpid(), signal.SIGKILL)
 def test_killed_mid_edit_the_reopened_editor_offers_the_recovery(display, tmp_path):
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
-    r = subprocess.run([sys.executable, "-c", RECOVERY_SCRIPT, str(path)], timeout=180,
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-c", RECOVERY_SCRIPT, str(path)],
+        timeout=180,
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == -signal.SIGKILL, r.stderr
     assert load_scene(path).tree is not None, "the killed editor saved the scene"
     assert path.with_name(path.name + ".recovery").exists(), "no autosave before the kill"
     from krsview.editor.app import Editor
+
     e = Editor(path, size=(320, 200))
     try:
         assert e.recovered is not None
-        pump(e)                                   # the modal is drawn (panels run)
+        pump(e)  # the modal is drawn (panels run)
         e.restore()
         assert e.scene.route.levels[5].radius == 0.123 and e.doc.dirty
         assert e.recovered is None
@@ -218,6 +236,7 @@ def test_killed_mid_edit_the_reopened_editor_offers_the_recovery(display, tmp_pa
 
 def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
     import glfw
+
     e = editor
     assert e.edit(("render", "epsilon_scale"), 2.0)
     glfw.set_window_should_close(e.window, True)
@@ -234,7 +253,9 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
 
 def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor):
     from dataclasses import replace
+
     from krsview.scene import save_scene
+
     e = editor
     assert e.edit(("render", "epsilon_scale"), 2.0)
     other = replace(load_scene(e.path), name="changed elsewhere")
@@ -260,7 +281,7 @@ def test_a_bad_panel_value_keeps_the_last_valid_scene(editor):
     assert e.scene == before and "route.levels[3].normal" in e.error
     e.execute([Edit(("route", "levels", 3, "radius"), float("nan"))])
     assert e.scene == before and "NaN" in e.error
-    pump(e)                                     # the error shows; nothing breaks
+    pump(e)  # the error shows; nothing breaks
 
 
 def test_save_as_a_bad_name_is_a_clear_error(editor, tmp_path):
@@ -280,7 +301,7 @@ def test_opening_another_scene_with_unsaved_edits_asks_first(editor):
     assert recovery.exists()
     e.open_preset(resolve("sierpinski"))
     assert e.asking == ("open", resolve("sierpinski")) and e.scene.name == "tree"
-    pump(e)                                      # the question is drawn as a modal
+    pump(e)  # the question is drawn as a modal
     e.answer_discard()
     assert e.scene.name == "sierpinski" and e.asking is None and not e.doc.dirty
     assert not recovery.exists(), "discarded edits left a recovery file to be offered later"
@@ -292,6 +313,7 @@ def test_the_editor_opens_every_kind_of_scene(display, tmp_path, preset, entries
     the panels draw without an error."""
     from krsview.editor.app import Editor
     from krsview.editor.handles import outline
+
     path = tmp_path / f"{preset}.toml"
     shutil.copy(resolve(preset), path)
     e = Editor(path, size=(400, 300))
@@ -316,6 +338,7 @@ def test_a_panel_drag_is_one_undo_step_and_a_second_drag_another(editor):
     x0, y0, x1, y1 = e.interactions.rects[path]
     r0, steps0 = e.scene.route.levels[LEVEL].radius, len(e.doc.history.steps)
     import glfw
+
     wx, wy = glfw.get_window_pos(e.window)
     drag(e, (wx + (x0 + x1) / 2, wy + (y0 + y1) / 2), (40, 0))
     r1 = e.scene.route.levels[LEVEL].radius

@@ -1,6 +1,7 @@
 """Effects [KRS17 §5, §8; KRS14 §6]: each one against the float64 reference on a small
 scene, specialisation proven on the compiled source, and the properties the issue names
 (smooth shading removes the crease, distortions never overshoot)."""
+
 from __future__ import annotations
 
 import re
@@ -16,8 +17,16 @@ from krsview.presets import resolve
 from krsview.reference import compile_krs, distance, render_reference
 from krsview.reference.distortion import Distortion
 from krsview.reference.geometry import compile_geometry, scene_distance
-from krsview.scene import (EFFECTS, KRS, EffectSettings, EmptyZone, Level, Plane,
-                           load_scene, scene_from_toml)
+from krsview.scene import (
+    EFFECTS,
+    KRS,
+    EffectSettings,
+    EmptyZone,
+    Level,
+    Plane,
+    load_scene,
+    scene_from_toml,
+)
 
 from .conftest import assert_finite, check_against_reference
 from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples
@@ -26,8 +35,9 @@ W, H = 160, 120
 
 
 def with_effects(scene, effects, **settings):
-    return replace(scene, effects=effects,
-                   effect_settings=replace(scene.effect_settings, **settings))
+    return replace(
+        scene, effects=effects, effect_settings=replace(scene.effect_settings, **settings)
+    )
 
 
 def tree():
@@ -38,23 +48,32 @@ def tree():
 # (test id, scene factory): every effect appears at least once; MöKRS where it is allowed.
 CASES = {
     "smooth_shading": lambda: with_effects(load_scene(resolve("rock")), ["smooth_shading"]),
-    "triplanar_texture": lambda: with_effects(load_scene(resolve("rock")), ["triplanar_texture"],
-                                              texture_strength=1.0),
-    "kernel_texture": lambda: with_effects(tree(), ["kernel_texture"], texture_scale=0.5,
-                                           texture_strength=1.0),
+    "triplanar_texture": lambda: with_effects(
+        load_scene(resolve("rock")), ["triplanar_texture"], texture_strength=1.0
+    ),
+    "kernel_texture": lambda: with_effects(
+        tree(), ["kernel_texture"], texture_scale=0.5, texture_strength=1.0
+    ),
     "shadows": lambda: with_effects(tree(), ["shadows"]),
     "soft_shadows": lambda: with_effects(load_scene(resolve("rock")), ["soft_shadows"]),
-    "ambient_occlusion": lambda: with_effects(load_scene(resolve("rock")), ["ambient_occlusion"],
-                                              ao_step=0.2, ao_strength=2.0),
+    "ambient_occlusion": lambda: with_effects(
+        load_scene(resolve("rock")), ["ambient_occlusion"], ao_step=0.2, ao_strength=2.0
+    ),
     "twist": lambda: with_effects(tree(), ["twist"], twist=25.0),
-    "empty_zones": lambda: with_effects(tree(), ["empty_zones"], empty_zones=[
-        EmptyZone((1.0, 4.0, 0.0), 1.6), EmptyZone((-2.0, 3.0, 0.5), 0.8)]),
-    "sky+fog+tone_mapping": lambda: with_effects(tree(), ["sky", "fog", "tone_mapping"],
-                                                 fog_density=0.08),
-    "mokrs-shadows+sky": lambda: with_effects(load_scene(resolve("tree-mokrs")),
-                                              ["shadows", "sky", "triplanar_texture"]),
-    "mokrs-soft_shadows+fog": lambda: with_effects(load_scene(resolve("shell")),
-                                                   ["soft_shadows", "fog", "tone_mapping"]),
+    "empty_zones": lambda: with_effects(
+        tree(),
+        ["empty_zones"],
+        empty_zones=[EmptyZone((1.0, 4.0, 0.0), 1.6), EmptyZone((-2.0, 3.0, 0.5), 0.8)],
+    ),
+    "sky+fog+tone_mapping": lambda: with_effects(
+        tree(), ["sky", "fog", "tone_mapping"], fog_density=0.08
+    ),
+    "mokrs-shadows+sky": lambda: with_effects(
+        load_scene(resolve("tree-mokrs")), ["shadows", "sky", "triplanar_texture"]
+    ),
+    "mokrs-soft_shadows+fog": lambda: with_effects(
+        load_scene(resolve("shell")), ["soft_shadows", "fog", "tone_mapping"]
+    ),
 }
 
 
@@ -101,8 +120,9 @@ def effect_lines(effect: str) -> set[tuple[str, int]]:
             d = re.match(r"\s*#\s*(ifdef|ifndef|if|else|endif)\b(.*)", line)
             if d and d.group(1) in ("ifdef", "if"):
                 # a disjunction (#if defined(A) || defined(B)) is not owned by A alone
-                stack.append(re.search(rf"\b{macro}\b", d.group(2)) is not None
-                             and "||" not in d.group(2))
+                stack.append(
+                    re.search(rf"\b{macro}\b", d.group(2)) is not None and "||" not in d.group(2)
+                )
             elif d and d.group(1) == "ifndef":
                 stack.append(False)
             elif d and d.group(1) == "else":
@@ -136,8 +156,13 @@ def test_a_plain_scene_compiles_no_optional_file():
     c = compile_geometry(scene.geometry(), scene.material.albedo)
     src = Source("render.frag", variant_defines(scene, c))
     files = {f for f, _ in src.origin}
-    for name in ("shadows.glsl", "occlusion.glsl", "texture.glsl", "twist.glsl",
-                 "empty_zones.glsl"):
+    for name in (
+        "shadows.glsl",
+        "occlusion.glsl",
+        "texture.glsl",
+        "twist.glsl",
+        "empty_zones.glsl",
+    ):
         assert name not in files
     assert "uniform int u_effects" not in src.text and "shadow_visibility" not in src.text
 
@@ -174,8 +199,9 @@ def test_smooth_shading_removes_the_crease_at_a_mirror(renderer):
     scene = scene_from_toml(CREASE)
     for render in (render_reference, renderer.render):
         flat = largest_neighbour_turn(*_nh(render(scene, W, H)))
-        smooth = largest_neighbour_turn(*_nh(render(replace(scene, effects=["smooth_shading"]),
-                                                    W, H)))
+        smooth = largest_neighbour_turn(
+            *_nh(render(replace(scene, effects=["smooth_shading"]), W, H))
+        )
         assert flat > 0.9 * CREASE_ANGLE, flat
         assert smooth < SMOOTH_BOUND, smooth
 
@@ -190,8 +216,14 @@ def twist_forward(p: np.ndarray, k: float, center: np.ndarray) -> np.ndarray:
     around the vertical axis through ``center`` by k × height."""
     r = p - center
     a = k * r[:, 1]
-    rot = np.stack([r[:, 0] * np.cos(a) - r[:, 2] * np.sin(a), r[:, 1],
-                    r[:, 0] * np.sin(a) + r[:, 2] * np.cos(a)], axis=1)
+    rot = np.stack(
+        [
+            r[:, 0] * np.cos(a) - r[:, 2] * np.sin(a),
+            r[:, 1],
+            r[:, 0] * np.sin(a) + r[:, 2] * np.cos(a),
+        ],
+        axis=1,
+    )
     return center + rot
 
 
@@ -233,10 +265,13 @@ def test_twist_without_the_lipschitz_factor_would_overshoot():
 def test_empty_zones_keep_the_bound_and_remove_what_they_cover(seed):
     rng = np.random.default_rng(seed)
     krs = arbitrary_krs(rng, 4)
-    zones = [EmptyZone(tuple(rng.normal(size=3)), float(rng.uniform(0.3, 1.5)))
-             for _ in range(3)]
-    scene = replace(load_scene(resolve("rock")), krs=krs, effects=["empty_zones"],
-                    effect_settings=EffectSettings(empty_zones=zones))
+    zones = [EmptyZone(tuple(rng.normal(size=3)), float(rng.uniform(0.3, 1.5))) for _ in range(3)]
+    scene = replace(
+        load_scene(resolve("rock")),
+        krs=krs,
+        effects=["empty_zones"],
+        effect_settings=EffectSettings(empty_zones=zones),
+    )
     c = compile_krs(krs, ALBEDO)
     dist = Distortion.of(scene)
     samples = clipped_samples(krs, rng, 400)

@@ -1,6 +1,7 @@
 """Camera-path frames and video [issue 18 §3]: each frame is the headless render of its
 camera (computed here from the pose by the fly camera's formula, not by the code under test),
 chunks and resumed runs give the same files, and the video holds the frames."""
+
 from __future__ import annotations
 
 import json
@@ -25,9 +26,11 @@ from .conftest import headless_render
 SIZE = (64, 36)
 FPS = 4.0
 # tree's camera looks along +z with y up; three poses 0.5 s apart, turning and climbing
-POSES = [dict(t=10.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
-         dict(t=10.5, position=[0.5, 2.5, -8.0], yaw=0.3, pitch=0.1),
-         dict(t=11.0, position=[1.0, 2.5, -7.0], yaw=-0.2, pitch=0.1)]
+POSES = [
+    dict(t=10.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
+    dict(t=10.5, position=[0.5, 2.5, -8.0], yaw=0.3, pitch=0.1),
+    dict(t=11.0, position=[1.0, 2.5, -7.0], yaw=-0.2, pitch=0.1),
+]
 
 
 @pytest.fixture
@@ -38,8 +41,13 @@ def path_file(tmp_path):
 
 
 def krsview(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "krsview", *args], capture_output=True,
-                          text=True, timeout=300, env={**os.environ, "DISPLAY": ""})
+    return subprocess.run(
+        [sys.executable, "-m", "krsview", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "DISPLAY": ""},
+    )
 
 
 def read(path: Path) -> np.ndarray:
@@ -66,8 +74,18 @@ def test_poses_interpolate_linearly_and_clamp(path_file):
 
 
 def test_each_frame_is_the_headless_render_of_its_camera(path_file, tmp_path):
-    r = krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
-                "--fps", str(FPS), "-o", str(tmp_path / "frames"))
+    r = krsview(
+        "render",
+        "tree",
+        "--camera-path",
+        str(path_file),
+        "--size",
+        "64x36",
+        "--fps",
+        str(FPS),
+        "-o",
+        str(tmp_path / "frames"),
+    )
     assert r.returncode == 0, r.stderr
     assert "frames 0-4 of 5" in r.stdout and "0 already there, 5 to render" in r.stdout
     scene = load_scene(resolve("tree"))
@@ -93,11 +111,13 @@ def test_chunks_and_an_interrupted_run_give_the_same_files(path_file, tmp_path, 
     def stop_after_two(k):
         if k == 1:
             raise Interrupted
+
     job = FrameJob(scene, path, FPS, SIZE, chunks)
     with pytest.raises(Interrupted):
         render_frames(job, [3, 4, 0, 1, 2], renderer, stop_after_two)  # a chunk, then a crash
-    assert sorted(p.name for p in chunks.iterdir()) == [frame_file(chunks, k).name
-                                                        for k in (0, 1, 3, 4)]   # whole files
+    assert sorted(p.name for p in chunks.iterdir()) == [
+        frame_file(chunks, k).name for k in (0, 1, 3, 4)
+    ]  # whole files
     assert job.missing(range(5)) == [2]
     render_frames(job, job.missing(range(5)), renderer)
     for k in range(5):
@@ -106,12 +126,37 @@ def test_chunks_and_an_interrupted_run_give_the_same_files(path_file, tmp_path, 
 
 def test_a_resumed_run_skips_the_frames_already_written(path_file, tmp_path):
     out = tmp_path / "frames"
-    assert krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
-                   "--fps", "4", "-o", str(out), "--frames", "1-3").returncode == 0
+    assert (
+        krsview(
+            "render",
+            "tree",
+            "--camera-path",
+            str(path_file),
+            "--size",
+            "64x36",
+            "--fps",
+            "4",
+            "-o",
+            str(out),
+            "--frames",
+            "1-3",
+        ).returncode
+        == 0
+    )
     assert sorted(p.name for p in out.iterdir()) == [f"frame_0000{k}.png" for k in (1, 2, 3)]
     stamps = {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)}
-    r = krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
-                "--fps", "4", "-o", str(out))
+    r = krsview(
+        "render",
+        "tree",
+        "--camera-path",
+        str(path_file),
+        "--size",
+        "64x36",
+        "--fps",
+        "4",
+        "-o",
+        str(out),
+    )
     assert "3 already there, 2 to render" in r.stdout
     assert {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)} == stamps
     assert len(list(out.iterdir())) == 5
@@ -119,48 +164,76 @@ def test_a_resumed_run_skips_the_frames_already_written(path_file, tmp_path):
 
 def test_the_video_holds_the_frames(path_file, tmp_path):
     import imageio_ffmpeg
+
     out, video = tmp_path / "frames", tmp_path / "fly.mp4"
-    r = krsview("render", "tree", "--camera-path", str(path_file), "--size", "64x36",
-                "--fps", "4", "-o", str(out), "--video", str(video))
+    r = krsview(
+        "render",
+        "tree",
+        "--camera-path",
+        str(path_file),
+        "--size",
+        "64x36",
+        "--fps",
+        "4",
+        "-o",
+        str(out),
+        "--video",
+        str(video),
+    )
     assert r.returncode == 0, r.stderr
     reader = imageio_ffmpeg.read_frames(str(video))
     meta = next(reader)
     assert tuple(meta["size"]) == SIZE and meta["fps"] == 4.0
-    decoded = [np.frombuffer(f, np.uint8).reshape(SIZE[1], SIZE[0], 3).astype(int)
-               for f in reader]
+    decoded = [np.frombuffer(f, np.uint8).reshape(SIZE[1], SIZE[0], 3).astype(int) for f in reader]
     assert len(decoded) == 5
     for k in range(5):
-        assert np.abs(decoded[k] - read(frame_file(out, k))).mean() < 4, k   # lossy, close
-    assert np.abs(decoded[0] - read(frame_file(out, 4))).mean() > 8           # and in order
+        assert np.abs(decoded[k] - read(frame_file(out, k))).mean() < 4, k  # lossy, close
+    assert np.abs(decoded[0] - read(frame_file(out, 4))).mean() > 8  # and in order
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--frames", "3-9"], "--frames = '3-9': the path has frames 0-4 at this frame rate"),
-    (["--frames", "x"], "--frames = 'x': expected FIRST-LAST or one frame number"),
-    (["--video", "v.avi"], "--video = 'v.avi': the file must end in .mp4"),
-    (["--size", "63x36", "--video", "v.mp4"], "--video needs an even width and height"),
-    (["-o", "f.png"], "-o = 'f.png': with --camera-path, give a folder for the frames"),
-    (["--buffers", "b.npz"], "--buffers = 'b.npz': cannot be combined with --camera-path"),
-    (["--view", "iterations"], "--view = 'iterations': cannot be combined with"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--frames", "3-9"], "--frames = '3-9': the path has frames 0-4 at this frame rate"),
+        (["--frames", "x"], "--frames = 'x': expected FIRST-LAST or one frame number"),
+        (["--video", "v.avi"], "--video = 'v.avi': the file must end in .mp4"),
+        (["--size", "63x36", "--video", "v.mp4"], "--video needs an even width and height"),
+        (["-o", "f.png"], "-o = 'f.png': with --camera-path, give a folder for the frames"),
+        (["--buffers", "b.npz"], "--buffers = 'b.npz': cannot be combined with --camera-path"),
+        (["--view", "iterations"], "--view = 'iterations': cannot be combined with"),
+    ],
+)
 def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, message):
-    r = krsview("render", "tree", "--camera-path", str(path_file), "--fps", "4",
-                *(["-o", str(tmp_path / "f")] if "-o" not in args else []), *args)
-    assert r.returncode == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1, \
-        r.stderr
+    r = krsview(
+        "render",
+        "tree",
+        "--camera-path",
+        str(path_file),
+        "--fps",
+        "4",
+        *(["-o", str(tmp_path / "f")] if "-o" not in args else []),
+        *args,
+    )
+    assert r.returncode == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1, r.stderr
     assert not (tmp_path / "f").exists() or not any((tmp_path / "f").iterdir())
 
 
-@pytest.mark.parametrize("text, message", [
-    ("{", "not JSON"),
-    ('{"poses": []}', "poses = []: a non-empty list"),
-    ('{"poses": [{"t": 0, "position": [1, "x", 0], "yaw": 0, "pitch": 0}]}', "poses[0]"),
-    ('{"poses": [{"t": 0, "position": [1, 2], "yaw": 0, "pitch": 0}]}', "3-vector"),
-    ('{"poses": [{"t": 1, "position": [0, 0, 0], "yaw": 0, "pitch": 0},'
-     ' {"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 0}]}', "poses[1].t = 0.0: times must"),
-    ('{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 2}]}', "−π/2 < pitch"),
-    ('{"poses": [{"t": 0, "position": [0, 0, NaN], "yaw": 0, "pitch": 0}]}', "finite"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("{", "not JSON"),
+        ('{"poses": []}', "poses = []: a non-empty list"),
+        ('{"poses": [{"t": 0, "position": [1, "x", 0], "yaw": 0, "pitch": 0}]}', "poses[0]"),
+        ('{"poses": [{"t": 0, "position": [1, 2], "yaw": 0, "pitch": 0}]}', "3-vector"),
+        (
+            '{"poses": [{"t": 1, "position": [0, 0, 0], "yaw": 0, "pitch": 0},'
+            ' {"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 0}]}',
+            "poses[1].t = 0.0: times must",
+        ),
+        ('{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 2}]}', "−π/2 < pitch"),
+        ('{"poses": [{"t": 0, "position": [0, 0, NaN], "yaw": 0, "pitch": 0}]}', "finite"),
+    ],
+)
 def test_a_damaged_path_file_names_the_file_and_the_pose(tmp_path, text, message):
     f = tmp_path / "bad.path.json"
     f.write_text(text)

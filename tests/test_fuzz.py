@@ -4,6 +4,7 @@ one-line error, never a traceback or a hang.
 
 CI runs a bounded, seeded slice; `KRSVIEW_FUZZ=full pytest -m fuzz` runs the full campaign
 (2000 scene files, 250 command lines) and prints the counts."""
+
 from __future__ import annotations
 
 import io
@@ -31,22 +32,33 @@ COUNTS: dict[str, int] = {}
 
 
 def fuzz_settings(n: int):
-    return settings(max_examples=n, deadline=None, derandomize=not FULL, database=None,
-                    suppress_health_check=list(HealthCheck))
+    return settings(
+        max_examples=n,
+        deadline=None,
+        derandomize=not FULL,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+    )
 
 
 # ----------------------------------------------------------------------- valid scenes
 finite = st.floats(-5.0, 5.0, allow_nan=False)
 point = st.tuples(finite, finite, finite)
 unit = point.filter(lambda v: math.hypot(*v) > 0.1).map(
-    lambda v: tuple(c / math.hypot(*v) for c in v))
+    lambda v: tuple(c / math.hypot(*v) for c in v)
+)
 radius = st.floats(0.01, 2.0)
 kernel = st.one_of(
     st.builds(lambda c, r: {"type": "sphere", "center": list(c), "radius": r}, point, radius),
-    st.builds(lambda a, b, r: {"type": "capsule", "a": list(a), "b": list(b), "radius": r},
-              point, point, radius),
+    st.builds(
+        lambda a, b, r: {"type": "capsule", "a": list(a), "b": list(b), "radius": r},
+        point,
+        point,
+        radius,
+    ),
     st.builds(lambda n, w: {"type": "plane", "normal": list(n), "offset": w}, unit, finite),
-    st.just({"type": "empty"}))
+    st.just({"type": "empty"}),
+)
 
 
 @st.composite
@@ -54,20 +66,33 @@ def valid_scene(draw) -> dict:
     n = draw(st.integers(1, 6))
     levels = [{"kernel": draw(kernel.filter(lambda k: k["type"] != "empty"))}]
     for _ in range(n - 1):
-        levels.append({"kernel": draw(kernel), "mirror": {"normal": list(draw(unit)),
-                                                          "offset": draw(finite)}})
+        levels.append(
+            {"kernel": draw(kernel), "mirror": {"normal": list(draw(unit)), "offset": draw(finite)}}
+        )
     eye = draw(point)
     target = draw(point.filter(lambda t: math.dist(t, eye) > 0.1))
     up = (0.0, 1.0, 0.0)
-    return {"camera": {"position": list(eye), "target": list(target), "up": list(up),
-                       "fov_y": draw(st.floats(10.0, 120.0))},
-            "render": {"tracer": draw(st.sampled_from(["sphere", "binary", "relaxed"])),
-                       "max_iterations": draw(st.integers(1, 200)),
-                       "epsilon_scale": draw(st.floats(0.01, 10.0))},
-            "effects": draw(st.lists(st.sampled_from(["sky", "fog", "tone_mapping",
-                                                      "shadows", "ambient_occlusion"]),
-                                     unique=True, max_size=2)),
-            "krs": {"levels": levels}}
+    return {
+        "camera": {
+            "position": list(eye),
+            "target": list(target),
+            "up": list(up),
+            "fov_y": draw(st.floats(10.0, 120.0)),
+        },
+        "render": {
+            "tracer": draw(st.sampled_from(["sphere", "binary", "relaxed"])),
+            "max_iterations": draw(st.integers(1, 200)),
+            "epsilon_scale": draw(st.floats(0.01, 10.0)),
+        },
+        "effects": draw(
+            st.lists(
+                st.sampled_from(["sky", "fog", "tone_mapping", "shadows", "ambient_occlusion"]),
+                unique=True,
+                max_size=2,
+            )
+        ),
+        "krs": {"levels": levels},
+    }
 
 
 def test_random_valid_scenes_render_finite_within_the_cap(renderer):
@@ -78,29 +103,37 @@ def test_random_valid_scenes_render_finite_within_the_cap(renderer):
     def run(doc):
         try:
             scene = scene_from_toml(dumps(doc))
-        except SceneError:     # e.g. the camera's up along the view: refused, not drawn
+        except SceneError:  # e.g. the camera's up along the view: refused, not drawn
             COUNTS["valid scenes refused"] = COUNTS.get("valid scenes refused", 0) + 1
             return
         b = renderer.render(scene, 12, 8)
         for name in ("color", "depth", "normal"):
             assert np.isfinite(getattr(b, name)).all(), name
-        assert 1 <= b.iterations.min() and b.iterations.max() <= scene.render.max_iterations
+        assert b.iterations.min() >= 1 and b.iterations.max() <= scene.render.max_iterations
         rendered.append(b.hit.mean())
+
     run()
     COUNTS["valid scenes rendered"] = len(rendered)
-    assert len(rendered) >= 0.8 * VALID_SCENES          # not vacuous: most were drawn
-    assert 0 < np.mean([h > 0 for h in rendered]) < 1   # and some show geometry, some not
+    assert len(rendered) >= 0.8 * VALID_SCENES  # not vacuous: most were drawn
+    assert 0 < np.mean([h > 0 for h in rendered]) < 1  # and some show geometry, some not
 
 
 # ----------------------------------------------------------------------- broken files
 PRESET_DOCS = [tomllib.loads(p.read_text()) for p in sorted(PRESET_DIR.glob("*.toml"))]
 junk = st.recursive(
-    st.one_of(st.none(), st.booleans(), st.integers(-10**30, 10**30), st.text(max_size=8),
-              st.floats(allow_nan=True, allow_infinity=True),
-              st.sampled_from([1e308, -1e308, 1e-320, 0.0, -0.0, 1e20, 65, 64, -1])),
-    lambda inner: st.one_of(st.lists(inner, max_size=4),
-                            st.dictionaries(st.text(max_size=6), inner, max_size=3)),
-    max_leaves=6)
+    st.one_of(
+        st.none(),
+        st.booleans(),
+        st.integers(-(10**30), 10**30),
+        st.text(max_size=8),
+        st.floats(allow_nan=True, allow_infinity=True),
+        st.sampled_from([1e308, -1e308, 1e-320, 0.0, -0.0, 1e20, 65, 64, -1]),
+    ),
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=6), inner, max_size=3)
+    ),
+    max_leaves=6,
+)
 
 
 def paths(doc, prefix=()):
@@ -130,7 +163,7 @@ def mutate(doc, path, value, delete: bool):
 def to_toml(doc) -> str | None:
     try:
         return dumps(doc)
-    except Exception:     # a value TOML cannot hold (None, …): write it raw instead
+    except Exception:  # a value TOML cannot hold (None, …): write it raw instead
         return None
 
 
@@ -142,7 +175,7 @@ def broken_file(draw) -> bytes:
         return draw(st.binary(max_size=200))
     text = dumps(doc)
     if kind == "truncate":
-        return text.encode()[:draw(st.integers(0, len(text)))]
+        return text.encode()[: draw(st.integers(0, len(text)))]
     for _ in range(draw(st.integers(1, 3))):
         where = draw(st.sampled_from(list(paths(doc))))
         doc = mutate(doc, where, draw(junk), draw(st.booleans()))
@@ -165,6 +198,7 @@ def test_random_broken_scene_files_give_one_clear_line(tmp_path):
             text = str(e)
             assert text.startswith(f"{path}: ") and "\n" not in text and len(text) < 2000
             outcomes["refused"] += 1
+
     run()
     COUNTS.update({f"scene files {k}": v for k, v in outcomes.items()})
     assert outcomes["refused"] >= 0.5 * SCENE_FILES
@@ -172,8 +206,9 @@ def test_random_broken_scene_files_give_one_clear_line(tmp_path):
 
 # ----------------------------------------------------------------------- command lines
 OPTIONS = {
-    "--size": st.one_of(st.sampled_from(["8x6", "-5x3", "0x10", "x", "9999x9999", "12"]),
-                        st.text(max_size=6)),
+    "--size": st.one_of(
+        st.sampled_from(["8x6", "-5x3", "0x10", "x", "9999x9999", "12"]), st.text(max_size=6)
+    ),
     "--epsilon-scale": st.sampled_from(["-inf", "nan", "0", "1e999", "0.5", "abc", "-1"]),
     "--max-iterations": st.sampled_from(["0", "-3", "1.5", "20", "1e9", ""]),
     "--tracer": st.sampled_from(["sphere", "binary", "relaxed", "bent", ""]),
@@ -209,7 +244,7 @@ def test_random_command_lines_end_in_an_exit_code_not_a_traceback(tmp_path):
     @fuzz_settings(COMMAND_LINES)
     @given(command_line(str(tmp_path)))
     def run(argv):
-        if "--size" in argv:   # keep real renders small: a valid big size is not the point
+        if "--size" in argv:  # keep real renders small: a valid big size is not the point
             i = argv.index("--size") + 1
             if i < len(argv) and argv[i] == "9999x9999":
                 argv[i] = "8x6"
@@ -217,13 +252,14 @@ def test_random_command_lines_end_in_an_exit_code_not_a_traceback(tmp_path):
         with redirect_stdout(io.StringIO()), redirect_stderr(err):
             try:
                 code = main(argv)
-            except SystemExit as e:    # argparse: usage errors exit 2, --help exits 0
+            except SystemExit as e:  # argparse: usage errors exit 2, --help exits 0
                 code = e.code
         assert "Traceback" not in err.getvalue()
         if code:
             last = err.getvalue().strip().splitlines()[-1]
             assert last.startswith(("krsview: error:", "krsview ")) and "error" in last, last
         codes[code] = codes.get(code, 0) + 1
+
     run()
     COUNTS.update({f"command lines exit {k}": v for k, v in sorted(codes.items())})
     assert codes.get(0, 0) > 0 and sum(v for k, v in codes.items() if k) > 0

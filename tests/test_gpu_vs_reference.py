@@ -1,4 +1,5 @@
 """Every preset: the GLSL tracer agrees with the float64 NumPy reference pixel by pixel."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -36,22 +37,31 @@ def test_preset_matches_reference(renderer, path):
     assert a.off_edge_hit == 0 and a.off_edge_depth <= 2.0 * eps and a.hit >= 0.985, a
 
 
-@pytest.mark.parametrize("broken", [
-    # a sphere 1 % too large
-    ("kernels.glsl", "return length(p - kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;",
-     "return length(p - kernel_rec(i, 1).xyz) - 1.01 * kernel_rec(i, 1).w;"),
-    # a fold that leaves points within 0.01 behind a mirror unreflected
-    ("krs.glsl", "p -= 2.0 * max(e, 0.0) * m.xyz;", "p -= 2.0 * (e > 1e-2 ? e : 0.0) * m.xyz;"),
-])
+@pytest.mark.parametrize(
+    "broken",
+    [
+        # a sphere 1 % too large
+        (
+            "kernels.glsl",
+            "return length(p - kernel_rec(i, 1).xyz) - kernel_rec(i, 1).w;",
+            "return length(p - kernel_rec(i, 1).xyz) - 1.01 * kernel_rec(i, 1).w;",
+        ),
+        # a fold that leaves points within 0.01 behind a mirror unreflected
+        ("krs.glsl", "p -= 2.0 * max(e, 0.0) * m.xyz;", "p -= 2.0 * (e > 1e-2 ? e : 0.0) * m.xyz;"),
+    ],
+)
 def test_a_deliberately_broken_shader_fails_the_comparison(tmp_path, broken):
     """Negative control of the pixel comparison [issue 16]: a copy of the shaders with a
     small, deliberate error must fail it, while the intact copy passes; the every-pixel rule
     away from outlines is among what finds them."""
     import shutil
+
     from krsview.gpu.program import SHADER_DIR
     from krsview.gpu.renderer import Renderer
     from krsview.presets import resolve
+
     from .conftest import agreement, failures
+
     shutil.copytree(SHADER_DIR, tmp_path / "shaders")
     scene = load_scene(resolve("sierpinski"))
     ref = render_reference(scene, W, H)

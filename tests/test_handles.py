@@ -1,6 +1,7 @@
 """Editor handles: every handle edits the field it is tied to, as the geometry says it should
 (a fork drag moves the branch end, a normal tip turns the mirror about its fork, a KRS mirror
 stays on its pivot, a compound component moves as a whole)."""
+
 from __future__ import annotations
 
 import math
@@ -34,7 +35,9 @@ def test_a_route_has_a_fork_and_control_per_level_and_a_normal_above_level_0(rou
     assert sum(h.kind == "normal" for h in hs) == n - 1
     assert len(outline(route_scene)) == n
     line = polyline(route_scene)
-    assert np.allclose(line[0], route_scene.route.base) and np.allclose(line[-1], route_scene.route.levels[0].fork)
+    assert np.allclose(line[0], route_scene.route.base) and np.allclose(
+        line[-1], route_scene.route.levels[0].fork
+    )
 
 
 def test_dragging_a_fork_alone_moves_the_branch_end_and_the_childs_start(route_scene):
@@ -44,7 +47,7 @@ def test_dragging_a_fork_alone_moves_the_branch_end_and_the_childs_start(route_s
     krs = s.geometry()
     assert np.allclose(krs.levels[7].kernel.end, p) and np.allclose(krs.levels[6].kernel.start, p)
     assert krs.levels[5] == route_scene.geometry().levels[5]
-    m = krs.levels[7].mirror                        # the fork's mirror follows the fork
+    m = krs.levels[7].mirror  # the fork's mirror follows the fork
     assert abs(np.array(m.normal) @ p - m.offset) < 1e-12
 
 
@@ -55,6 +58,7 @@ def test_a_dragged_fork_carries_its_subtree_rigidly(route_scene):
     from krsview.reference.compiled import compile_krs
     from krsview.reference.krs import distance
     from krsview.scene import KRS
+
     i = 20
     h = by(handles(route_scene), ("route", "levels", i, "fork"))
     delta = np.array([-0.6, 0.1, 0.3])

@@ -1,6 +1,7 @@
 """Hard cases are inputs, not accidents (DESIGN.md): the catalogue in krsview.bench.hard_cases,
 each case with its invariants (finite, within the cap and capped rays counted, continuous,
 GPU = reference or a documented precision limit) and the behaviour written beside it."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -34,8 +35,9 @@ def test_hard_case_keeps_its_invariants(renderer, name):
     assert o.precision == ("double" if case.precision_limit else "float"), o.precision
     # capped rays are expected (and then counted on both sides) or absent
     if case.capped:
-        assert o.capped_reference > 0 and abs(o.capped_gpu - o.capped_reference) <= \
-            0.01 * np.prod(stability.SIZE), o
+        assert o.capped_reference > 0 and abs(o.capped_gpu - o.capped_reference) <= 0.01 * np.prod(
+            stability.SIZE
+        ), o
     else:
         assert o.capped_reference == 0 and o.capped_gpu == 0, o
 
@@ -45,7 +47,7 @@ def test_continuity_measure_sees_a_real_move(renderer):
     scene = CASES["camera-on-mirror"].build()
     a = renderer.render(scene, *stability.SIZE)
     moved = scene
-    for _ in range(1000):   # 1000 nudges of 1/100 pixel
+    for _ in range(1000):  # 1000 nudges of 1/100 pixel
         moved = stability.nudged(moved, stability.SIZE)
     b = renderer.render(moved, *stability.SIZE)
     assert (a.hit != b.hit).mean() > stability.CONTINUITY
@@ -83,10 +85,20 @@ def test_image_changes_little_when_the_camera_crosses_a_mirror(renderer):
     """Continuity: a 1e-6 nudge of the eye across the mirror plane changes few pixels."""
     s = CASES["camera-on-mirror"].build()
     u = np.array(s.geometry().mirrors[-1].normal)
-    a = renderer.render(replace(s, camera=replace(
-        s.camera, position=tuple(np.array(s.camera.position) - 1e-6 * u))), W, H)
-    b = renderer.render(replace(s, camera=replace(
-        s.camera, position=tuple(np.array(s.camera.position) + 1e-6 * u))), W, H)
+    a = renderer.render(
+        replace(
+            s, camera=replace(s.camera, position=tuple(np.array(s.camera.position) - 1e-6 * u))
+        ),
+        W,
+        H,
+    )
+    b = renderer.render(
+        replace(
+            s, camera=replace(s.camera, position=tuple(np.array(s.camera.position) + 1e-6 * u))
+        ),
+        W,
+        H,
+    )
     assert (a.hit != b.hit).mean() < 0.002
     assert (np.abs(a.color - b.color).max(-1) > 4 / 255).mean() < 0.005
 
@@ -112,8 +124,15 @@ def test_deep_zoom_thirty_levels_down_is_stable(renderer):
     assert gpu.hit.mean() > 0.05, "the twig is not in view"
     check_against_reference("hard_deep_zoom", gpu, ref)
     # No jitter: a sub-pixel nudge of the eye (1e-3 twig radii) changes almost nothing.
-    nudged = replace(scene, camera=replace(scene.camera, position=tuple(
-        np.array(scene.camera.position) + 1e-3 * scene.geometry().kernels[0].radius)))
+    nudged = replace(
+        scene,
+        camera=replace(
+            scene.camera,
+            position=tuple(
+                np.array(scene.camera.position) + 1e-3 * scene.geometry().kernels[0].radius
+            ),
+        ),
+    )
     again = renderer.render(nudged, W, H)
     assert (again.hit != gpu.hit).mean() < 0.002
 
@@ -127,7 +146,9 @@ def test_double_precision_follows_the_reference_where_float_cannot(renderer, nam
     assert case.precision_limit
     ref = render_reference(scene, 48, 27)
     assert 0.3 < ref.hit.mean() < 0.95, "the horizon is not in view"
-    double = renderer.render(replace(scene, render=replace(scene.render, precision="double")), 48, 27)
+    double = renderer.render(
+        replace(scene, render=replace(scene.render, precision="double")), 48, 27
+    )
     assert_finite(double, scene.render.max_iterations)
     check_against_reference(f"hard_{name}_double", double, ref)
     single = renderer.render(scene, 48, 27)
@@ -138,14 +159,16 @@ def test_double_precision_follows_the_reference_where_float_cannot(renderer, nam
 def test_double_precision_uploads_the_geometry_in_float64():
     from krsview.gpu.uniforms import krs_block
     from krsview.reference.geometry import compile_geometry
+
     s = hard_cases.preset("tree")
     c = compile_geometry(s.geometry(), s.material.albedo)
     single, double = krs_block(c, "float"), krs_block(c, "double")
     assert len(double) == 2 * len(single)
-    mirrors = np.frombuffer(double, np.float64)[:4 * c.n].reshape(c.n, 4)
-    assert np.array_equal(mirrors, c.mirrors)          # not rounded through float32
-    assert not np.array_equal(np.frombuffer(single, np.float32)[:4 * c.n].reshape(c.n, 4)
-                              .astype(np.float64), c.mirrors)
+    mirrors = np.frombuffer(double, np.float64)[: 4 * c.n].reshape(c.n, 4)
+    assert np.array_equal(mirrors, c.mirrors)  # not rounded through float32
+    assert not np.array_equal(
+        np.frombuffer(single, np.float32)[: 4 * c.n].reshape(c.n, 4).astype(np.float64), c.mirrors
+    )
 
 
 def test_a_twisted_ground_plane_stays_a_plane(monkeypatch):
@@ -155,16 +178,21 @@ def test_a_twisted_ground_plane_stays_a_plane(monkeypatch):
     control: with ε not scaled by the twist's Lipschitz bound, the horizon rises again."""
     from krsview.reference import distortion
     from krsview.scene import KRS, Camera, Level, Plane, Render, Scene
-    plane = Scene(name="ground", camera=Camera((0.0, 2.0, -10.0), (0.0, 1.5, 10.0)),
-                  render=Render(max_distance=100.0),
-                  krs=KRS([Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), None)]))
+
+    plane = Scene(
+        name="ground",
+        camera=Camera((0.0, 2.0, -10.0), (0.0, 1.5, 10.0)),
+        render=Render(max_distance=100.0),
+        krs=KRS([Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), None)]),
+    )
     flat = render_reference(plane, 80, 45)
-    twisted = replace(plane, effects=["twist"],
-                      effect_settings=replace(plane.effect_settings, twist=8.0))
+    twisted = replace(
+        plane, effects=["twist"], effect_settings=replace(plane.effect_settings, twist=8.0)
+    )
     t = render_reference(twisted, 80, 45)
     assert not (t.hit & ~flat.hit).any()
     capped = (t.iterations >= plane.render.max_iterations) & ~t.hit
-    assert (flat.hit & ~t.hit & ~capped).sum() == 0     # every lost ground pixel is counted
+    assert (flat.hit & ~t.hit & ~capped).sum() == 0  # every lost ground pixel is counted
     monkeypatch.setattr(distortion.Distortion, "lod_scale", lambda self, p: np.ones(len(p)))
     rose = render_reference(twisted, 80, 45)
     assert (rose.hit & ~flat.hit).sum() > 100
@@ -172,5 +200,6 @@ def test_a_twisted_ground_plane_stays_a_plane(monkeypatch):
 
 def test_control_on_chord_really_degenerates_to_a_capsule():
     from krsview.reference.compiled import compile_krs
+
     types = compile_krs(CASES["control-on-chord"].build().geometry(), (1.0, 1.0, 1.0)).types
     assert types[-1] == "capsule" and types[-2] == "toroidal_capsule"

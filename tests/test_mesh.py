@@ -1,6 +1,7 @@
 """Mesh export [issue 18 §2]: analytic spheres, a dense marching cubes as the narrow band's
 oracle, vertices certified on the surface by a sign change of the reference, watertightness,
 and the files trimesh writes."""
+
 from __future__ import annotations
 
 import math
@@ -30,26 +31,27 @@ def sphere_scene():
 def test_a_sphere_has_the_analytic_volume_and_area_and_is_closed():
     mesh, st = build_mesh(sphere_scene(), 64)
     assert st.resolution == 64 and mesh.is_watertight and mesh.euler_number == 2
-    assert abs(mesh.volume / (4 / 3 * math.pi * RADIUS ** 3) - 1) < 0.002   # outward faces
-    assert abs(mesh.area / (4 * math.pi * RADIUS ** 2) - 1) < 0.002
+    assert abs(mesh.volume / (4 / 3 * math.pi * RADIUS**3) - 1) < 0.002  # outward faces
+    assert abs(mesh.area / (4 * math.pi * RADIUS**2) - 1) < 0.002
     r = np.linalg.norm(mesh.vertices - CENTER, axis=1)
-    assert np.abs(r - RADIUS).max() < st.voxel * 2.0 ** -REFINE_STEPS
+    assert np.abs(r - RADIUS).max() < st.voxel * 2.0**-REFINE_STEPS
     # negative control: the level set half a voxel out is another sphere
     fat, st = build_mesh(sphere_scene(), 64, lod=0.5)
     expected = 4 / 3 * math.pi * (RADIUS + 0.5 * st.voxel) ** 3
     assert abs(fat.volume / expected - 1) < 0.002
-    assert fat.volume / (4 / 3 * math.pi * RADIUS ** 3) - 1 > 0.02
+    assert fat.volume / (4 / 3 * math.pi * RADIUS**3) - 1 > 0.02
 
 
 def test_mirrored_spheres_are_two_closed_pieces():
     """One reflection doubles the sphere: two components, each closed [KRS17 Alg. 1]."""
-    krs = KRS([Level(Sphere((-1.0, 0.5, 0.0), 0.6)),
-               Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.0))])   # folds x > 0 onto x < 0
+    krs = KRS(
+        [Level(Sphere((-1.0, 0.5, 0.0), 0.6)), Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.0))]
+    )  # folds x > 0 onto x < 0
     mesh, _ = build_mesh(BASE.with_geometry(krs), 64)
     parts = mesh.split(only_watertight=False)
     assert len(parts) == 2 and all(p.is_watertight for p in parts)
     assert sorted(np.sign(p.centroid[0]) for p in parts) == [-1, 1]
-    assert abs(mesh.volume / (2 * 4 / 3 * math.pi * 0.6 ** 3) - 1) < 0.01
+    assert abs(mesh.volume / (2 * 4 / 3 * math.pi * 0.6**3) - 1) < 0.01
 
 
 def tree(levels: int = 12):
@@ -73,11 +75,13 @@ def test_the_narrow_band_finds_what_a_dense_grid_finds(monkeypatch):
     # negative control: an octree test with balls a quarter too small drops bricks that hold
     # surface, and the dense grid sees the loss
     import krsview.share.mesh as module
+
     field = module.surface_field
 
     def shrunk(c, dist):
         value, is_empty = field(c, dist)
         return value, lambda x, r: is_empty(x, 0.75 * r)
+
     monkeypatch.setattr(module, "surface_field", shrunk)
     assert build_mesh(scene, 64)[1].triangles != len(faces)
 
@@ -92,11 +96,11 @@ def test_every_vertex_is_certified_on_the_surface(name, lod):
     mesh, st = build_mesh(scene, 96, lod=lod)
     assert mesh.is_watertight
     f = lambda x: scene_distance(c, x) - lod * st.voxel  # noqa: E731
-    certified, missed = sign_change_near(mesh.vertices, f, st.voxel, 2.0 ** -REFINE_STEPS)
+    certified, missed = sign_change_near(mesh.vertices, f, st.voxel, 2.0**-REFINE_STEPS)
     assert missed.mean() < 0.01 and certified.mean() > 0.99
     # negative control: vertices a third of a voxel off the surface are not certified
     off = mesh.vertices + st.voxel / 3 * mesh.vertex_normals
-    assert sign_change_near(off, f, st.voxel, 2.0 ** -REFINE_STEPS)[0].mean() < 0.1
+    assert sign_change_near(off, f, st.voxel, 2.0**-REFINE_STEPS)[0].mean() < 0.1
 
 
 def sign_change_near(v: np.ndarray, f, h: float, fraction: float):
@@ -117,21 +121,26 @@ def test_a_mobius_scene_meshes_on_its_zero_set():
     c = compile_geometry(scene.geometry(), scene.material.albedo)
     mesh, st = build_mesh(scene, 64)
     assert mesh.is_watertight and st.bricks < (st.resolution // BRICK) ** 3
-    certified, _ = sign_change_near(mesh.vertices, lambda x: distance_estimate(c, x),
-                                    st.voxel, 2.0 ** -REFINE_STEPS)
+    certified, _ = sign_change_near(
+        mesh.vertices, lambda x: distance_estimate(c, x), st.voxel, 2.0**-REFINE_STEPS
+    )
     assert certified.mean() > 0.99
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "krsview", "export", "mesh", *args],
-                          capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "DISPLAY": ""})
+    return subprocess.run(
+        [sys.executable, "-m", "krsview", "export", "mesh", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "DISPLAY": ""},
+    )
 
 
 @pytest.mark.parametrize("suffix", [".glb", ".ply", ".stl", ".obj"])
 def test_each_format_loads_back_with_the_same_triangles(tmp_path, suffix):
     out = tmp_path / f"tree{suffix}"
-    r = run("tree", "-o", str(out), "--resolution", "32")   # bark and leaves
+    r = run("tree", "-o", str(out), "--resolution", "32")  # bark and leaves
     assert r.returncode == 0, r.stderr
     triangles = int(r.stdout.split(" triangles")[0].split()[-1].replace(",", ""))
     mesh = trimesh.load(out, force="mesh")
@@ -141,19 +150,27 @@ def test_each_format_loads_back_with_the_same_triangles(tmp_path, suffix):
         assert len(np.unique(colors, axis=0)) >= 2
 
 
-@pytest.mark.parametrize("args, message", [
-    (["tree", "-o", "t.fbx"], "-o = 't.fbx': the file must end in .glb, .ply, .stl, .obj"),
-    (["grass", "-o", "g.glb"], "geometry = 'grass': is unbounded"),
-    (["tree", "-o", "t.glb", "--box", "1,2,3"], "--box '1,2,3': expected six numbers"),
-    (["tree", "-o", "t.glb", "--box", "0,0,0,1,-1,1"], "each max must exceed its min"),
-    (["tree", "-o", "t.glb", "--resolution", "8"], "--resolution '8': allowed 16 ≤ value"),
-    (["tree", "-o", "t.glb", "--lod", "nan"], "--lod 'nan': allowed 0.0 ≤ value ≤ 4.0"),
-    (["tree", "-o", "t.glb", "--box", "50,50,50,51,51,51"], "no surface inside the region"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["tree", "-o", "t.fbx"], "-o = 't.fbx': the file must end in .glb, .ply, .stl, .obj"),
+        (["grass", "-o", "g.glb"], "geometry = 'grass': is unbounded"),
+        (["tree", "-o", "t.glb", "--box", "1,2,3"], "--box '1,2,3': expected six numbers"),
+        (["tree", "-o", "t.glb", "--box", "0,0,0,1,-1,1"], "each max must exceed its min"),
+        (["tree", "-o", "t.glb", "--resolution", "8"], "--resolution '8': allowed 16 ≤ value"),
+        (["tree", "-o", "t.glb", "--lod", "nan"], "--lod 'nan': allowed 0.0 ≤ value ≤ 4.0"),
+        (["tree", "-o", "t.glb", "--box", "50,50,50,51,51,51"], "no surface inside the region"),
+    ],
+)
 def test_bad_mesh_options_are_one_line_errors(tmp_path, args, message):
-    r = subprocess.run([sys.executable, "-m", "krsview", "export", "mesh", *args],
-                       capture_output=True, text=True, timeout=120, cwd=tmp_path,
-                       env={**os.environ, "DISPLAY": ""})
+    r = subprocess.run(
+        [sys.executable, "-m", "krsview", "export", "mesh", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+        env={**os.environ, "DISPLAY": ""},
+    )
     assert r.returncode == 2 and message in r.stderr, r.stderr
     assert len([line for line in r.stderr.splitlines() if "error" in line]) == 1
     assert "Traceback" not in r.stderr

@@ -4,6 +4,7 @@ Random transformations are products of Table 1's constructors. Tolerances are re
 size of the numbers involved and say why; "near-singular" inputs put points close to a pole,
 where L_H grows like 1/distance and rounding grows with it.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -25,12 +26,15 @@ def unit(rng):
 
 def random_transform(rng: np.random.Generator, steps: int = 4) -> np.ndarray:
     """A product of random translations, rotations, dilations, reflections and inversions."""
-    makers = [lambda: M.translation(rng.normal(size=3)),
-              lambda: M.rotation(unit(rng), rng.uniform(-np.pi, np.pi)),
-              lambda: M.dilation(np.exp(rng.uniform(-1.0, 1.0))),
-              lambda: M.reflection(),
-              lambda: M.compose(M.translation(rng.normal(size=3)), M.inversion(),
-                                M.translation(rng.normal(size=3)))]
+    makers = [
+        lambda: M.translation(rng.normal(size=3)),
+        lambda: M.rotation(unit(rng), rng.uniform(-np.pi, np.pi)),
+        lambda: M.dilation(np.exp(rng.uniform(-1.0, 1.0))),
+        lambda: M.reflection(),
+        lambda: M.compose(
+            M.translation(rng.normal(size=3)), M.inversion(), M.translation(rng.normal(size=3))
+        ),
+    ]
     return M.compose(M.identity(), *[makers[rng.integers(len(makers))]() for _ in range(steps)])
 
 
@@ -42,11 +46,14 @@ def far_from_pole(H, x, margin):
 def test_constructors_act_as_table_1():
     x = np.array([[0.3, -1.2, 2.0]])
     r = Q.from_axis_angle([0, 0, 1], np.pi / 2)
-    cases = {"identity": (M.identity(), x), "dilation": (M.dilation(2.5), 2.5 * x),
-             "translation": (M.translation([1, 2, 3]), x + [1, 2, 3]),
-             "rotation": (M.matrix(r, M.ZERO, M.ZERO, r), [[1.2, 0.3, 2.0]]),
-             "reflection": (M.reflection(), [[-0.3, -1.2, 2.0]]),
-             "inversion": (M.inversion(), -x / (x @ x.T))}
+    cases = {
+        "identity": (M.identity(), x),
+        "dilation": (M.dilation(2.5), 2.5 * x),
+        "translation": (M.translation([1, 2, 3]), x + [1, 2, 3]),
+        "rotation": (M.matrix(r, M.ZERO, M.ZERO, r), [[1.2, 0.3, 2.0]]),
+        "reflection": (M.reflection(), [[-0.3, -1.2, 2.0]]),
+        "inversion": (M.inversion(), -x / (x @ x.T)),
+    }
     for name, (H, want) in cases.items():
         np.testing.assert_allclose(M.apply(H, x), want, atol=1e-14, err_msg=name)
 
@@ -97,9 +104,8 @@ def test_app_a_preimage_maps_onto_the_sphere(seed):
     err = np.abs(np.linalg.norm(image - c[proper], axis=1) - r[proper])
     # App. A recovers ρ'² = |κ'|² − γ'/α', which cancels: its relative error is about
     # 1e-16 (1 + |κ'|²)/ρ'² — the reason the tracer maps balls by two points instead
-    cancel = 1e-15 * (1 + np.sum(c2 * c2, axis=1)) / r2 ** 2
-    assert (err <= 1e-7 * (1 + np.abs(c[proper]).max(1) + r[proper])
-            + cancel * r[proper]).all()
+    cancel = 1e-15 * (1 + np.sum(c2 * c2, axis=1)) / r2**2
+    assert (err <= 1e-7 * (1 + np.abs(c[proper]).max(1) + r[proper]) + cancel * r[proper]).all()
 
 
 @settings(max_examples=60, deadline=None)
@@ -114,7 +120,7 @@ def test_map_ball_equals_app_a(seed):
     good = ok & (a2 > 1e-6)
     c2, r2 = M.sphere_of(a2[good], b2[good], g2[good])
     scale = 1 + np.abs(c2).max(1) + r2
-    cancel = 1e-15 * (1 + np.sum(c2 * c2, axis=1)) / r2 ** 2  # App. A's own error, as above
+    cancel = 1e-15 * (1 + np.sum(c2 * c2, axis=1)) / r2**2  # App. A's own error, as above
     assert (np.abs(c3[good] - c2).max(1) <= 1e-7 * scale).all()
     assert (np.abs(r3[good] - r2) <= 1e-7 * scale + cancel * r2).all()
 
@@ -123,12 +129,18 @@ def test_map_ball_keeps_a_tiny_probe_in_float32_where_app_a_loses_it():
     """Why the tracer maps balls by two points: at |κ| = 10, ρ = 1e-3 App. A's
     ρ² = |κ|² − γ cancels to noise in float32, the two-point form keeps ρ to ~1e-4."""
     f32 = np.float32
-    H = M.compose(M.rotation([0, 1, 0], 0.4), M.translation([3.0, 1.0, -2.0]),
-                  M.dilation(100.0), M.inversion(), M.translation([-20.0, 0, 0])).astype(f32)
+    H = M.compose(
+        M.rotation([0, 1, 0], 0.4),
+        M.translation([3.0, 1.0, -2.0]),
+        M.dilation(100.0),
+        M.inversion(),
+        M.translation([-20.0, 0, 0]),
+    ).astype(f32)
     c, r = np.array([[10.0, 0.5, -0.2]], f32), np.array([1e-3], f32)
     alpha, beta, gamma = (v.astype(f32) for v in M.sphere_coeffs(c, r))
-    a2, b2, g2 = (v.astype(f32) for v in M.transform_sphere(M.inverse(H).astype(f32),
-                                                            alpha, beta, gamma))
+    a2, b2, g2 = (
+        v.astype(f32) for v in M.transform_sphere(M.inverse(H).astype(f32), alpha, beta, gamma)
+    )
     r_app_a = M.sphere_of(a2, b2, g2)[1].astype(f32)
     r_two_point = M.map_ball(H, c, r)[1]
     exact = M.map_ball(H.astype(np.float64), c.astype(np.float64), r.astype(np.float64))[1]
@@ -209,5 +221,7 @@ def test_near_pole_points_stay_finite_and_accurate():
 
 def test_condition_flags_singular():
     assert M.condition(M.identity()) == pytest.approx(1.0)
-    assert M.condition(M.matrix(M.ONE, M.ONE, M.ONE, M.ONE)) == float("inf") or \
-        M.condition(M.matrix(M.ONE, M.ONE, M.ONE, M.ONE)) > 1e15
+    assert (
+        M.condition(M.matrix(M.ONE, M.ONE, M.ONE, M.ONE)) == float("inf")
+        or M.condition(M.matrix(M.ONE, M.ONE, M.ONE, M.ONE)) > 1e15
+    )

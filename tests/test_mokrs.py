@@ -1,6 +1,7 @@
 """MöKRS and binary tracing: the tree written as a MöKRS reproduces the KRS tree, the binary
 tracer agrees with the reference on KRS presets too, the two tracers draw the same tree, and
 bad Möbius input gets clear errors."""
+
 from __future__ import annotations
 
 import tomllib
@@ -9,8 +10,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.presets import resolve
 from krsview.algebra import mobius
+from krsview.presets import resolve
 from krsview.reference import render_reference
 from krsview.reference.camera import primary_rays, view_of
 from krsview.scene import Camera, SceneError, load_scene, scene_from_toml, scene_to_toml
@@ -30,8 +31,13 @@ def binary(scene):
 def on_silhouette(hit: np.ndarray) -> np.ndarray:
     """Pixels whose 3×3 neighbourhood holds both hits and misses."""
     p = np.pad(hit, 1, mode="edge")
-    nb = np.stack([p[1 + dy:1 + dy + hit.shape[0], 1 + dx:1 + dx + hit.shape[1]]
-                   for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
+    nb = np.stack(
+        [
+            p[1 + dy : 1 + dy + hit.shape[0], 1 + dx : 1 + dx + hit.shape[1]]
+            for dy in (-1, 0, 1)
+            for dx in (-1, 0, 1)
+        ]
+    )
     return nb.any(0) & ~nb.all(0)
 
 
@@ -119,17 +125,30 @@ def test_mokrs_needs_binary_tracer():
         scene_from_toml(palm_with(tracer="sphere"))
 
 
-@pytest.mark.parametrize("steps,match", [
-    ([{"type": "scale", "factor": 0.0}], r"palm.toml: mokrs.levels\[0\].transform\[0\].factor = "
-                                         r"0.0: allowed: 1e-06 ≤ value ≤ 1e\+06"),
-    ([{"type": "shear", "factor": 0.9}], r"transform\[0\].type = 'shear': unknown Möbius step "
-                                         r"type; allowed: translate, scale, rotate, invert"),
-    ([{"type": "scale", "factor": float("nan")}], r"factor = nan: NaN and infinity are not"),
-    ([{"type": "rotate", "axis": [0.0, 0.0, 0.0], "degrees": 5.0}],
-     r"axis = \[0.0, 0.0, 0.0\]: a direction must not be the zero vector"),
-    ([{"type": "scale", "factor": 1e-6}] * 3,
-     r"mokrs.levels\[0\].transform = '<condition number .*>': numerically singular"),
-])
+@pytest.mark.parametrize(
+    "steps,match",
+    [
+        (
+            [{"type": "scale", "factor": 0.0}],
+            r"palm.toml: mokrs.levels\[0\].transform\[0\].factor = "
+            r"0.0: allowed: 1e-06 ≤ value ≤ 1e\+06",
+        ),
+        (
+            [{"type": "shear", "factor": 0.9}],
+            r"transform\[0\].type = 'shear': unknown Möbius step "
+            r"type; allowed: translate, scale, rotate, invert",
+        ),
+        ([{"type": "scale", "factor": float("nan")}], r"factor = nan: NaN and infinity are not"),
+        (
+            [{"type": "rotate", "axis": [0.0, 0.0, 0.0], "degrees": 5.0}],
+            r"axis = \[0.0, 0.0, 0.0\]: a direction must not be the zero vector",
+        ),
+        (
+            [{"type": "scale", "factor": 1e-6}] * 3,
+            r"mokrs.levels\[0\].transform = '<condition number .*>': numerically singular",
+        ),
+    ],
+)
 def test_bad_transform_is_named(steps, match):
     with pytest.raises(SceneError, match=match):
         scene_from_toml(palm_with(steps), "palm.toml")
@@ -138,8 +157,11 @@ def test_bad_transform_is_named(steps, match):
 def test_view_at_a_pole_is_rejected():
     s = load_scene(resolve("inversion"))
     text = scene_to_toml(replace(s, camera=replace(s.camera, position=(12.0, 12.0, 12.0))))
-    with pytest.raises(SceneError, match=r"camera.position = \[12.0, 12.0, 12.0\]: level 2\d's "
-                                          r"transform sends this point to infinity"):
+    with pytest.raises(
+        SceneError,
+        match=r"camera.position = \[12.0, 12.0, 12.0\]: level 2\d's "
+        r"transform sends this point to infinity",
+    ):
         scene_from_toml(text)
 
 
@@ -165,15 +187,18 @@ def test_truncating_inversion_keeps_its_sphere_carried_by_the_maps(levels):
     rng = np.random.default_rng(levels)
     d = rng.normal(size=(200, 3))
     pts = np.array(m.levels[0].kernel.center) + m.levels[0].kernel.radius * (
-        d / np.linalg.norm(d, axis=1, keepdims=True))
+        d / np.linalg.norm(d, axis=1, keepdims=True)
+    )
     for i in range(cut):
         pts = mobius.apply(m.levels[i].matrix(), pts)
     r = np.linalg.norm(pts - np.array(k.center), axis=1)
     assert np.allclose(r, k.radius, rtol=1e-9), "the carried sphere is not the image"
     k0 = m.levels[0].kernel
-    if cut >= 3:   # the maps really moved or resized it (inversion's levels map in threes)
-        assert (np.linalg.norm(np.subtract(k.center, k0.center)) > k0.radius
-                or abs(k.radius - k0.radius) > 0.01 * k0.radius)
+    if cut >= 3:  # the maps really moved or resized it (inversion's levels map in threes)
+        assert (
+            np.linalg.norm(np.subtract(k.center, k0.center)) > k0.radius
+            or abs(k.radius - k0.radius) > 0.01 * k0.radius
+        )
     # negative control: a radius off by one part in a million fails the comparison
     assert not np.allclose(r, k.radius * (1 + 1e-6), rtol=1e-9)
     image = render_reference(scene.with_geometry(t), 48, 27)
@@ -182,8 +207,12 @@ def test_truncating_inversion_keeps_its_sphere_carried_by_the_maps(levels):
 
 def test_a_cut_that_cannot_carry_its_kernel_is_refused():
     doc = tomllib.loads(scene_to_toml(load_scene(resolve("inversion"))))
-    doc["mokrs"]["levels"][0]["kernel"] = {"type": "capsule", "a": [0.0, 0.0, 0.0],
-                                           "b": [0.0, 1.0, 0.0], "radius": 0.2}
+    doc["mokrs"]["levels"][0]["kernel"] = {
+        "type": "capsule",
+        "a": [0.0, 0.0, 0.0],
+        "b": [0.0, 1.0, 0.0],
+        "radius": 0.2,
+    }
     m = scene_from_toml(dumps(doc)).mokrs
     with pytest.raises(SceneError, match="level 0's capsule cannot be carried up to level 1"):
         m.truncated(m.depth - 1)
@@ -194,7 +223,7 @@ def expand_spheres(m, upto: int) -> tuple[np.ndarray, np.ndarray]:
     """Brute force: every sphere instance of levels 0..upto in level upto's own space (before
     G_upto), by mapping balls level by level — the MöKRS's set, written out."""
     C, R = np.zeros((0, 3)), np.zeros(0)
-    for i, lv in enumerate(m.levels[:upto + 1]):
+    for i, lv in enumerate(m.levels[: upto + 1]):
         if lv.kernel.kind == "sphere":
             C, R = np.vstack([C, [lv.kernel.center]]), np.append(R, lv.kernel.radius)
         if lv.reflect:
@@ -210,6 +239,7 @@ def test_level_bounds_hold_every_instance_below(preset, levels):
     """Each level's bounding ball (reference/mokrs.py) holds the brute-force expansion of that
     level and all below it, in the level's own space."""
     from krsview.reference.mokrs import level_bounds
+
     m = load_scene(resolve(preset)).mokrs
     m = m.truncated(levels)
     bounds = level_bounds(m)
@@ -219,12 +249,13 @@ def test_level_bounds_hold_every_instance_below(preset, levels):
         assert b[3] > 0 and len(C)
         reach = np.linalg.norm(C - b[:3], axis=1) + R
         assert reach.max() <= b[3] * (1 + 1e-9), f"level {i}: an instance outside its bound"
-        assert reach.max() > 0.5 * b[3]      # and not vacuously huge
+        assert reach.max() > 0.5 * b[3]  # and not vacuously huge
 
 
 def test_arc_bound_holds_the_arc():
     from krsview.reference.mokrs import kernel_ball
     from krsview.scene.model import ToroidalCapsule, arc_of
+
     rng = np.random.default_rng(3)
     for _ in range(200):
         s, c, e = rng.normal(size=(3, 3))
@@ -245,12 +276,13 @@ def test_rays_passing_a_pole_in_empty_space_are_not_stopped(renderer):
     the GPU; the negative control (Alg. 3's rule) still stops some."""
     from krsview.reference.mokrs import compile_mokrs, is_unbounding
     from krsview.reference.trace import binary_trace
+
     scene = load_scene(resolve("inversion"))
     c = compile_mokrs(scene.mokrs, (1.0, 1.0, 1.0))
     pole = mobius.pole(c.inverse[-1])
     C, R = expand_spheres(scene.mokrs, scene.mokrs.depth - 1)
     C, R, _ = mobius.map_ball(scene.mokrs.levels[-1].matrix(), C, R)
-    assert (np.linalg.norm(C - pole, axis=1) - R).min() > 20.0    # empty space
+    assert (np.linalg.norm(C - pole, axis=1) - R).min() > 20.0  # empty space
     view = view_of(scene.camera, 320, 180)
     d = pole - view.origin
     t = np.linalg.norm(d)
@@ -261,8 +293,10 @@ def test_rays_passing_a_pole_in_empty_space_are_not_stopped(renderer):
     off = np.random.default_rng(0).uniform(-3, 3, size=(4000, 2)) * view.footprint * t
     q = pole + off[:, :1] * e1 + off[:, 1:] * e2
     dirs = (q - view.origin) / np.linalg.norm(q - view.origin, axis=1, keepdims=True)
-    trace = lambda rule: binary_trace([rule], view.origin, dirs, view.footprint, 256,  # noqa: E731
-                                      1000.0, 2.0, 0.3).hit
+
+    def trace(rule):
+        return binary_trace([rule], view.origin, dirs, view.footprint, 256, 1000.0, 2.0, 0.3).hit
+
     assert not trace(lambda x, s: is_unbounding(c, x, s)).any()
     assert trace(lambda x, s: is_unbounding(c, x, s, pole_bounds=False)).sum() > 5
     # the GPU: a 1° view centred on the pole, same as the reference

@@ -1,6 +1,7 @@
 """The reliable oracle [RAA09]: its enclosures contain the true distance, cross-checked with
 python-flint's arb balls (an independent arbitrary-precision evaluation of Alg. 1), and it
 certifies the holes and false hits it is built to find."""
+
 from __future__ import annotations
 
 import functools
@@ -62,7 +63,7 @@ def akernel(kind, rec, p):
 
 
 def arb_distance(c, point):
-    if hasattr(c, "parts"):          # a compound: the least over its components
+    if hasattr(c, "parts"):  # a compound: the least over its components
         ds = [arb_distance(part, point) for part in c.parts]
         return functools.reduce(lambda d, k: (d + k - abs(d - k)) / 2, ds)
     x = [arb(float(v)) for v in point]
@@ -80,8 +81,12 @@ def arb_distance(c, point):
 def aqmul(p, q):
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return (pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw)
+    return (
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    )
 
 
 def arb_mokrs(c, point):
@@ -121,9 +126,10 @@ def enclosures_contain_arb(c, origin, starts, dirs, a, b, arithmetic, samples=4,
     pts = origin + starts
     d = value(c, on_segments(pts, dirs, a, b, arithmetic))
     lo, hi = d.range()
-    if narrow:            # negative control: the affine form without its error term
+    if narrow:  # negative control: the affine form without its error term
         lo, hi = d.x0 - np.abs(d.x1), d.x0 + np.abs(d.x1)
     from krsview.reference.mokrs import CompiledMoKRS
+
     exact = arb_mokrs if isinstance(c, CompiledMoKRS) else arb_distance
     outside = 0
     for i in range(len(dirs)):
@@ -151,7 +157,7 @@ def test_mokrs_enclosures_contain_the_arb_value(scene_name, arithmetic):
     c, origin, starts, dirs, a, b = segments(scene_name, 6, 0.05, seed=4)
     with np.errstate(all="ignore"):
         lo, hi = value(c, on_segments(origin + starts, dirs, a, b, arithmetic)).range()
-        assert np.isfinite(lo).all() and np.isfinite(hi).all()   # not vacuously wide
+        assert np.isfinite(lo).all() and np.isfinite(hi).all()  # not vacuously wide
         assert enclosures_contain_arb(c, origin, starts, dirs, a, b, arithmetic, samples=3) == 0
 
 
@@ -182,8 +188,9 @@ def test_a_certified_surface_and_certified_empty_space():
     eye = center + np.array([0.0, 0.0, -5.0])
     dirs = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
     for arithmetic in ("interval", "affine"):
-        cert = surfaces_before(c, eye, dirs, np.array([10.0, 10.0]), 4e-4,
-                               arithmetic, max_segments=4000)
+        cert = surfaces_before(
+            c, eye, dirs, np.array([10.0, 10.0]), 4e-4, arithmetic, max_segments=4000
+        )
         assert list(cert.surface) == [1, 0], arithmetic
 
 
@@ -201,7 +208,9 @@ def test_counts_on_a_traced_image(renderer):
     """Sphere and binary tracing of the sierpinski: no hole, no false hit beyond ε, nothing
     undecided at 24×14. Negative control: an image with its hit mask inverted has both."""
     from dataclasses import replace
+
     from krsview.buffers import Buffers
+
     s = load_scene(resolve("sierpinski"))
     for tracer in ("sphere", "binary"):
         t = replace(s, render=replace(s.render, tracer=tracer))
@@ -222,6 +231,7 @@ def signs_hold(c, origin, starts, dirs, a, b, arithmetic, lod, samples=3, numeri
     (only its sign for a MöKRS, whose balls live in scaled frames) and v ≤ hi."""
     from krsview.oracle.distance import bounds
     from krsview.reference.mokrs import CompiledMoKRS
+
     pts = origin + starts
     with np.errstate(all="ignore"):
         e = bounds(c, on_segments(pts, dirs, a, b, arithmetic), lod)
@@ -231,8 +241,9 @@ def signs_hold(c, origin, starts, dirs, a, b, arithmetic, lod, samples=3, numeri
         for t in np.linspace(a[i], b[i], samples):
             v = exact(c, pts[i] + t * dirs[i])
             low = arb(float(e.lower[i])) if numeric else (arb(0) if e.lower[i] > 0 else None)
-            if (low is not None and np.isfinite(e.lower[i]) and not low <= v) or \
-                    (np.isfinite(e.hi[i]) and not v <= arb(float(e.hi[i]))):
+            if (low is not None and np.isfinite(e.lower[i]) and not low <= v) or (
+                np.isfinite(e.hi[i]) and not v <= arb(float(e.hi[i]))
+            ):
                 broken += 1
     return broken, e
 
@@ -243,21 +254,19 @@ def test_balls_bound_what_the_levels_below_them_hold(scene_name):
     detail) and v ≤ the kernels walked (a subset of the scene), at arb values along segments
     long enough that many walks end at a ball."""
     c, origin, starts, dirs, a, b = segments(scene_name, 16, 0.4, seed=5)
-    starts *= 2.0                              # reach out of the crown too
+    starts *= 2.0  # reach out of the crown too
     broken, e = signs_hold(c, origin, starts, dirs, a, b, "affine", lod=b - a)
     assert broken == 0
-    assert np.isfinite(e.cut).any() and (e.lower > 0).any()   # both kinds of ball were used
+    assert np.isfinite(e.cut).any() and (e.lower > 0).any()  # both kinds of ball were used
 
 
-@pytest.mark.parametrize("scene_name, reach", [("palm", 4), ("inversion", 60),
-                                               ("tree-mokrs", 4)])
+@pytest.mark.parametrize("scene_name, reach", [("palm", 4), ("inversion", 60), ("tree-mokrs", 4)])
 def test_mokrs_balls_keep_the_sign(scene_name, reach):
     """A MöKRS's level bounds, mapped out past each level's pole: where the walk certifies
     a sign, the arb value has it."""
     c, origin, starts, dirs, a, b = segments(scene_name, 10, 0.3, seed=6)
-    starts *= reach                            # out of the geometry too
-    broken, e = signs_hold(c, origin, starts, dirs, a, b, "interval", lod=b - a,
-                           numeric=False)
+    starts *= reach  # out of the geometry too
+    broken, e = signs_hold(c, origin, starts, dirs, a, b, "interval", lod=b - a, numeric=False)
     assert broken == 0 and (e.lower > 0).any()
 
 
@@ -265,12 +274,14 @@ def test_a_ball_too_small_breaks_the_bound():
     """Negative control: the tree's culling balls at half their radius claim clear space
     (or a bound) where the levels below them reach lower."""
     from dataclasses import replace
+
     c, origin, starts, dirs, a, b = segments("tree", 16, 0.4, seed=5)
     starts *= 2.0
     shrunk = c.bounds.copy()
     shrunk[:, 3] = np.where(shrunk[:, 3] >= 0, shrunk[:, 3] / 2, shrunk[:, 3])
-    broken, _ = signs_hold(replace(c, bounds=shrunk), origin, starts, dirs, a, b, "affine",
-                           lod=b - a)
+    broken, _ = signs_hold(
+        replace(c, bounds=shrunk), origin, starts, dirs, a, b, "affine", lod=b - a
+    )
     assert broken > 0
 
 
@@ -279,13 +290,13 @@ def test_the_level_of_detail_decides_a_full_depth_tree(renderer):
     ray undecided; leaving out detail below a quarter pixel decides them, with no hole and
     no false hit beyond ε. Negative control: the image with its hit mask inverted has both."""
     from krsview.buffers import Buffers
+
     s = load_scene(resolve("tree"))
     img = renderer.render(s, 16, 9)
     counts = count_errors(s, img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
     assert counts.undecided <= 0.02 * counts.rays and counts.hits > 20, counts
-    broken = Buffers(img.color, np.where(img.hit, 0.0, 60.0), img.normal, img.iterations,
-                     ~img.hit)
+    broken = Buffers(img.color, np.where(img.hit, 0.0, 60.0), img.normal, img.iterations, ~img.hit)
     counts = count_errors(s, broken, arithmetics=("affine",))
     assert counts.holes > 0 and counts.false_hits > 0, counts
 
@@ -296,11 +307,13 @@ def test_a_ray_through_a_pole_is_decided():
     ray is certified (before: undecided, NaN)."""
     from krsview.bench.hard_cases import CASES
     from krsview.reference.camera import primary_rays, view_of
+
     s = CASES["mobius-pole-in-view"].build()
     c = compile_geometry(s.geometry(), s.material.albedo)
     view = view_of(s.camera, 9, 9)
-    dirs = primary_rays(view)[40:41]                       # the centre ray, at the pole
+    dirs = primary_rays(view)[40:41]  # the centre ray, at the pole
     for arithmetic in ("interval", "affine"):
-        cert = surfaces_before(c, view.origin, dirs, np.array([s.render.max_distance]),
-                               view.footprint, arithmetic)
+        cert = surfaces_before(
+            c, view.origin, dirs, np.array([s.render.max_distance]), view.footprint, arithmetic
+        )
         assert list(cert.surface) == [0], arithmetic

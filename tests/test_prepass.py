@@ -2,6 +2,7 @@
 all free. It never skips a surface — the reliable oracle certifies no hole in its images, on
 presets and hard cases — it changes hit decisions only on grazing rays, and it saves
 iterations. Negative control: a cone without its spread starts rays past surfaces."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -26,9 +27,14 @@ def with_prepass(scene, tile):
     return replace(scene, render=replace(scene.render, prepass=tile))
 
 
-SCENES = preset_names()          # every preset
-HARD = ["camera-on-mirror", "grazing-ground", "inside-crown", "compound-overlap",
-        "mobius-pole-in-view"]
+SCENES = preset_names()  # every preset
+HARD = [
+    "camera-on-mirror",
+    "grazing-ground",
+    "inside-crown",
+    "compound-overlap",
+    "mobius-pole-in-view",
+]
 
 
 def scene_of(name):
@@ -47,8 +53,8 @@ def test_the_prepass_skips_no_surface(renderer, name):
     img = renderer.render(with_prepass(scene, 4), W, H)
     counts = count_errors(with_prepass(scene, 4), img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
-    if counts.undecided > 0.02 * counts.rays:   # as many undecided without the pre-pass?
-        alone = count_errors(scene, plain, arithmetics=("affine",))   # (inversion's poles)
+    if counts.undecided > 0.02 * counts.rays:  # as many undecided without the pre-pass?
+        alone = count_errors(scene, plain, arithmetics=("affine",))  # (inversion's poles)
         assert counts.undecided <= alone.undecided + 0.02 * counts.rays, (counts, alone)
     a = agreement(img, plain, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
     eps_per_t = view_of(scene.camera, W, H).footprint * scene.render.epsilon_scale
@@ -58,8 +64,9 @@ def test_the_prepass_skips_no_surface(renderer, name):
 def test_a_cone_without_its_spread_skips_surfaces(tmp_path):
     """Negative control: a pre-pass that marches the tile's centre ray alone (no spread, no
     ε margin) starts the tile's other rays past twigs the centre ray missed."""
-    shaders = broken_shaders(tmp_path, "prepass.glsl", "return sigma + real(u_eps_per_t);",
-                             "return 0.0;")
+    shaders = broken_shaders(
+        tmp_path, "prepass.glsl", "return sigma + real(u_eps_per_t);", "return 0.0;"
+    )
     scene = with_prepass(load_scene(resolve("tree")), 8)
     img = Renderer(shader_dir=shaders).render(scene, W, H)
     assert count_errors(scene, img, arithmetics=("affine",)).holes > 0
@@ -70,8 +77,7 @@ def passes(scene, tile, levels):
 
 
 @pytest.mark.parametrize("name", ["tree", "grove"])
-def test_coarser_passes_skip_no_surface_and_each_starts_where_the_coarser_stopped(renderer,
-                                                                                   name):
+def test_coarser_passes_skip_no_surface_and_each_starts_where_the_coarser_stopped(renderer, name):
     """Three coarse passes (tiles of 32, 8 and 2 pixels): the oracle still certifies no hole
     and no false hit. Each cone starts at the free distance of the coarser tile around it, so
     no tile's free distance is below that tile's (the coarsest pass alone is a one-pass
@@ -82,12 +88,12 @@ def test_coarser_passes_skip_no_surface_and_each_starts_where_the_coarser_stoppe
     img = renderer.render(deep, W, H)
     counts = count_errors(deep, img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
-    used = len(getattr(scene.geometry(), "parts", [None]))     # components: the rest are 0
+    used = len(getattr(scene.geometry(), "parts", [None]))  # components: the rest are 0
     fine = renderer.free_distances(passes(scene, 8, 2), W, H)[::-1, :, :used]  # rows bottom
     parent = renderer.free_distances(passes(scene, 32, 1), W, H)[::-1, :, :used]  # → top
     below = parent[np.arange(fine.shape[0])[:, None] // 4, np.arange(fine.shape[1]) // 4]
     assert (fine >= below * (1 - 2e-6)).all()
-    assert (fine > below).mean() > 0.5        # the finer cones get further
+    assert (fine > below).mean() > 0.5  # the finer cones get further
     # and they started at the coarser tile's distance: a finer cone marched from the eye (as
     # in a one-pass pre-pass) also gets further, but stops at other points
     one = renderer.free_distances(passes(scene, 8, 1), W, H)[::-1, :, :used]
@@ -98,9 +104,12 @@ def test_a_finer_pass_that_reads_the_wrong_coarse_tile_skips_surfaces(tmp_path):
     """Negative control: a finer cone that starts at the free distance of another coarse
     tile than the one around it (the shader assuming half the renderer's tile ratio) starts
     rays past surfaces."""
-    shaders = broken_shaders(tmp_path, "prepass.frag",
-                             "ivec2(gl_FragCoord.xy) / u_parent_ratio",
-                             "ivec2(gl_FragCoord.xy) / (u_parent_ratio / 2)")
+    shaders = broken_shaders(
+        tmp_path,
+        "prepass.frag",
+        "ivec2(gl_FragCoord.xy) / u_parent_ratio",
+        "ivec2(gl_FragCoord.xy) / (u_parent_ratio / 2)",
+    )
     scene = passes(load_scene(resolve("tree")), 2, 2)
     img = Renderer(shader_dir=shaders).render(scene, W, H)
     assert count_errors(scene, img, arithmetics=("affine",)).holes > 0
@@ -120,7 +129,7 @@ def test_rays_start_at_their_tiles_free_distance(renderer, name):
     assert free.shape[:2] == (-(-90 // 8), -(-160 // 8))
     assert np.isfinite(free).all() and (free >= 0).all() and (free > 0).mean() > 0.9
     assert img.iterations.mean() < 0.6 * plain.iterations.mean()
-    with pytest.raises(ValueError, match="prepass > 0"):    # no pre-pass: nothing to read
+    with pytest.raises(ValueError, match="prepass > 0"):  # no pre-pass: nothing to read
         renderer.free_distances(scene, 160, 90)
 
 
@@ -142,19 +151,39 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
     import csv
     import subprocess
     import sys
+
     out = tmp_path / "paths.csv"
-    r = subprocess.run([sys.executable, "-m", "krsview", "bench", "paths", "sierpinski",
-                        "--size", "32x18", "--rounds", "1", "--csv", str(out)],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "krsview",
+            "bench",
+            "paths",
+            "sierpinski",
+            "--size",
+            "32x18",
+            "--rounds",
+            "1",
+            "--csv",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     rows = list(csv.DictReader(out.open()))
     sizes = ("32x18", "64x36")
     key = ("size", "path", "culling", "prepass", "coarse_passes", "steps")
     assert {tuple(row[k] for k in key) for row in rows} == {
-        (size, "fragment", c, str(t), "2" if t else "0", "0") for size in sizes
-        for c in ("on", "off") for t in (0, 4, 8, 16)} | {
-        (size, "fragment", "on", str(t), "1", "0") for size in sizes for t in (4, 8)} | {
-        (size, "compute", "on", "8", "2", str(s)) for size in sizes for s in (4, 8, 16, 32)}
+        (size, "fragment", c, str(t), "2" if t else "0", "0")
+        for size in sizes
+        for c in ("on", "off")
+        for t in (0, 4, 8, 16)
+    } | {(size, "fragment", "on", str(t), "1", "0") for size in sizes for t in (4, 8)} | {
+        (size, "compute", "on", "8", "2", str(s)) for size in sizes for s in (4, 8, 16, 32)
+    }
     n = len(load_scene(resolve("sierpinski")).geometry().mirrors)
     for row in rows:
         if (row["path"], row["culling"], row["prepass"]) == ("fragment", "off", "0"):
@@ -162,13 +191,21 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
         assert (float(row["coarse_share"]) > 0) == (row["prepass"] != "0")
         # no level of sierpinski has a ball: every step walks all n levels
         assert float(row["levels"]) == pytest.approx(n * float(row["iterations"]))
-    iters = {tuple(row[k] for k in key): float(row["iterations"])
-             for row in rows if row["culling"] == "on"}
-    assert (iters[("64x36", "fragment", "on", "4", "2", "0")]
-            < iters[("64x36", "fragment", "on", "0", "0", "0")])
-    assert (iters[("64x36", "compute", "on", "8", "2", "4")]
-            == iters[("64x36", "fragment", "on", "8", "2", "0")])
-    assert {row["shadow_rays"] for row in rows} == {""}      # sierpinski has no shadows
+    iters = {
+        tuple(row[k] for k in key): float(row["iterations"])
+        for row in rows
+        if row["culling"] == "on"
+    }
+    assert (
+        iters[("64x36", "fragment", "on", "4", "2", "0")]
+        < iters[("64x36", "fragment", "on", "0", "0", "0")]
+    )
+    assert (
+        iters[("64x36", "compute", "on", "8", "2", "4")]
+        == iters[("64x36", "fragment", "on", "8", "2", "0")]
+    )
+    assert {row["shadow_rays"] for row in rows} == {""}  # sierpinski has no shadows
     from krsview.bench.paths import levers
+
     shadowed = {k[4:] for k in levers(load_scene(resolve("tree"))) if k[0] == "compute"}
     assert shadowed == {(s, kind) for s in (4, 8, 16, 32) for kind in ("tasks", "inline")}

@@ -1,6 +1,7 @@
 """Over-relaxed sphere tracing [Keinert et al. 2014]: it never skips a surface (brute force over
 the expanded KRS, with a negative control that drops the fallback), and the GPU draws what
 the reference draws."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -31,7 +32,7 @@ def naive_relaxed(dist, origin, dirs, omega, max_iterations=512):
     t = np.zeros(len(dirs))
     hit = np.zeros(len(dirs), bool)
     for _ in range(max_iterations):
-        with np.errstate(all="ignore"):                # rays that fly off to infinity
+        with np.errstate(all="ignore"):  # rays that fly off to infinity
             d = dist(origin + t[:, None] * dirs)
         hit |= d <= EPS * t
         t = np.where(hit, t, t + omega * d)
@@ -45,9 +46,9 @@ def test_relaxed_tracing_never_skips_a_surface(seed):
     c = compile_krs(krs, (0.5,) * 3)
     dist = lambda x: distance(c, x)  # noqa: E731
     origin = unit(rng) * 12.0
-    targets = clipped_samples(krs, rng, 30)           # points inside the geometry …
+    targets = clipped_samples(krs, rng, 30)  # points inside the geometry …
     targets = targets[rng.choice(len(targets), 120)] + rng.normal(0, 0.05, (120, 3))
-    dirs = targets - origin                            # … and rays that graze or miss them
+    dirs = targets - origin  # … and rays that graze or miss them
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     tr = relaxed_trace(dist, origin, dirs, EPS, 4096, 60.0, 1.9)
     truth = np.array([first_surface(krs, origin, d) for d in dirs])
@@ -76,5 +77,6 @@ def test_relaxed_tracing_is_refused_for_a_compound_and_a_mokrs():
         with pytest.raises(SceneError, match=allowed):
             scene.check_tracer("relaxed")
     with pytest.raises(SceneError, match="render.relaxation"):
-        scene_from_toml("[render]\nrelaxation = 2.5\n[krs]\nlevels = [{ kernel = "
-                        "{ type = 'sphere' } }]\n")
+        scene_from_toml(
+            "[render]\nrelaxation = 2.5\n[krs]\nlevels = [{ kernel = { type = 'sphere' } }]\n"
+        )

@@ -1,5 +1,6 @@
 """The route form of a tree [KRS17 §9.2]: analytic properties of the baked route, exact
 reproduction of the growth tree, and defined behaviour on degenerate input."""
+
 from __future__ import annotations
 
 import math
@@ -12,8 +13,17 @@ import pytest
 from krsview.presets import resolve
 from krsview.reference.compiled import compile_krs
 from krsview.reference.krs import distance
-from krsview.scene import (KRS, Capsule, Level, Route, RouteLevel, SceneError, load_scene,
-                           save_scene, scene_from_toml)
+from krsview.scene import (
+    KRS,
+    Capsule,
+    Level,
+    Route,
+    RouteLevel,
+    SceneError,
+    load_scene,
+    save_scene,
+    scene_from_toml,
+)
 from krsview.scene.edits import apply_edit
 
 ALBEDO = (0.5, 0.5, 0.5)
@@ -34,7 +44,7 @@ def kernel_distance_at(k, points) -> np.ndarray:
 
 
 def test_each_branch_runs_from_its_lower_fork_to_its_fork_through_its_control(route):
-    forks = [route.base] + [lv.fork for lv in route.levels][::-1]   # trunk foot → twig tip
+    forks = [route.base] + [lv.fork for lv in route.levels][::-1]  # trunk foot → twig tip
     krs = route.krs()
     n = len(route.levels)
     for i, lv in enumerate(route.levels):
@@ -74,31 +84,39 @@ def test_baked_route_reproduces_the_growth_trees_krs_exactly_through_a_file(pres
     baked = replace(scene, tree=None, route=scene.tree.route())
     save_scene(baked, tmp_path / "baked.toml")
     again = load_scene(tmp_path / "baked.toml")
-    assert again == baked                              # bit-exact TOML round trip
-    assert again.geometry() == scene.geometry()        # the same KRS, float for float
+    assert again == baked  # bit-exact TOML round trip
+    assert again.geometry() == scene.geometry()  # the same KRS, float for float
     assert "[tree]" not in (tmp_path / "baked.toml").read_text()
 
 
 def test_a_route_compound_component_is_placed_like_a_tree(tmp_path):
     scene = load_scene(resolve("grove"))
     c0 = scene.compound[0]
-    baked = replace(scene, compound=[replace(c0, tree=None, route=c0.tree.route())]
-                    + scene.compound[1:])
+    baked = replace(
+        scene, compound=[replace(c0, tree=None, route=c0.tree.route())] + scene.compound[1:]
+    )
     assert baked.geometry() == scene.geometry()
 
 
 # ----------------------------------------------------------------------------- degenerate
 def small_route() -> Route:
-    return Route(base=(0.0, 0.0, 0.0), levels=[
-        RouteLevel(fork=(-0.5, 2.0, 0.0), control=(-0.3, 1.6, 0.0), radius=0.05),
-        RouteLevel(fork=(0.0, 1.0, 0.0), control=(0.1, 0.5, 0.0), radius=0.1,
-                   normal=(1.0, 0.0, 0.0)),
-    ])
+    return Route(
+        base=(0.0, 0.0, 0.0),
+        levels=[
+            RouteLevel(fork=(-0.5, 2.0, 0.0), control=(-0.3, 1.6, 0.0), radius=0.05),
+            RouteLevel(
+                fork=(0.0, 1.0, 0.0), control=(0.1, 0.5, 0.0), radius=0.1, normal=(1.0, 0.0, 0.0)
+            ),
+        ],
+    )
 
 
 def scene_of(route: Route):
-    return replace(scene_from_toml("[krs]\nlevels = [{ kernel = { type = 'empty' } }]\n"),
-                   krs=None, route=route)
+    return replace(
+        scene_from_toml("[krs]\nlevels = [{ kernel = { type = 'empty' } }]\n"),
+        krs=None,
+        route=route,
+    )
 
 
 def test_control_point_on_the_chord_gives_a_straight_capsule():
@@ -107,21 +125,31 @@ def test_control_point_on_the_chord_gives_a_straight_capsule():
     straight = replace(r, levels=[r.levels[0], replace(r.levels[1], control=tuple((a + b) / 2))])
     k = straight.krs().levels[1].kernel
     pts = np.random.default_rng(1).normal(0.5, 1.0, (500, 3))
-    np.testing.assert_allclose(kernel_distance_at(k, pts),
-                               kernel_distance_at(Capsule(k.start, k.end, k.radius), pts),
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        kernel_distance_at(k, pts),
+        kernel_distance_at(Capsule(k.start, k.end, k.radius), pts),
+        atol=1e-12,
+    )
     # negative control: the bent branch is not that capsule
     bent = r.krs().levels[1].kernel
-    assert np.abs(kernel_distance_at(bent, pts)
-                  - kernel_distance_at(Capsule(bent.start, bent.end, bent.radius), pts)).max() > 1e-3
+    assert (
+        np.abs(
+            kernel_distance_at(bent, pts)
+            - kernel_distance_at(Capsule(bent.start, bent.end, bent.radius), pts)
+        ).max()
+        > 1e-3
+    )
 
 
-@pytest.mark.parametrize("value, allowed", [
-    ([0.0, 0.0, 0.0], "must not be the zero vector"),
-    ([1e-12, 0.0, 0.0], "must not be the zero vector"),
-    ([math.nan, 1.0, 0.0], "NaN and infinity are not allowed"),
-    ([math.inf, 0.0, 0.0], "NaN and infinity are not allowed"),
-])
+@pytest.mark.parametrize(
+    "value, allowed",
+    [
+        ([0.0, 0.0, 0.0], "must not be the zero vector"),
+        ([1e-12, 0.0, 0.0], "must not be the zero vector"),
+        ([math.nan, 1.0, 0.0], "NaN and infinity are not allowed"),
+        ([math.inf, 0.0, 0.0], "NaN and infinity are not allowed"),
+    ],
+)
 def test_a_bad_normal_is_a_clear_error_and_changes_nothing(value, allowed):
     scene = scene_of(small_route())
     with pytest.raises(SceneError) as e:
@@ -138,8 +166,11 @@ def test_zero_radius_and_fork_on_fork_are_clear_errors():
     scene = scene_of(small_route())
     with pytest.raises(SceneError, match=r"route\.levels\[0\]\.radius = 0\.0: allowed: 0 < value"):
         apply_edit(scene, ("route", "levels", 0, "radius"), 0.0)
-    with pytest.raises(SceneError, match=r"route\.levels\[0\]\.fork .*must differ from "
-                                         r"levels\[1\]\.fork"):
+    with pytest.raises(
+        SceneError,
+        match=r"route\.levels\[0\]\.fork .*must differ from "
+        r"levels\[1\]\.fork",
+    ):
         apply_edit(scene, ("route", "levels", 0, "fork"), [0.0, 1.0, 0.0])
     with pytest.raises(SceneError, match=r"route\.levels\[1\]\.fork .*must differ from base"):
         apply_edit(scene, ("route", "levels", 1, "fork"), [0.0, 0.0, 0.0])
@@ -167,10 +198,12 @@ def test_a_child_crossing_its_forks_mirror_is_a_warning_naming_the_level():
 
 def test_the_readme_route_example_loads_without_warnings():
     readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
-    block = readme[readme.index("```toml\n[route]") + 8:]
-    scene = scene_from_toml(block[:block.index("```")], "README.md")
+    block = readme[readme.index("```toml\n[route]") + 8 :]
+    scene = scene_from_toml(block[: block.index("```")], "README.md")
     assert scene.route.warnings() == [] and scene.geometry().instance_count() == 3
     # negative control: turning its mirror puts the twig on the positive side
-    turned = replace(scene.route, levels=[scene.route.levels[0],
-                                          replace(scene.route.levels[1], normal=(-1.0, 0.0, 0.0))])
+    turned = replace(
+        scene.route,
+        levels=[scene.route.levels[0], replace(scene.route.levels[1], normal=(-1.0, 0.0, 0.0))],
+    )
     assert turned.warnings()

@@ -1,5 +1,6 @@
 """Scene files: every user mistake gets a clear error naming file, field, value and what is
 allowed; save → load round-trips exactly; saves are atomic."""
+
 from __future__ import annotations
 
 import math
@@ -8,8 +9,21 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from krsview.scene import (KRS, Empty, Level, Mirror, Scene, SceneError, Sphere, ToroidalCapsule, Tree,
-                           load_scene, save_scene, scene_from_toml, scene_to_toml)
+from krsview.scene import (
+    KRS,
+    Empty,
+    Level,
+    Mirror,
+    Scene,
+    SceneError,
+    Sphere,
+    ToroidalCapsule,
+    Tree,
+    load_scene,
+    save_scene,
+    scene_from_toml,
+    scene_to_toml,
+)
 from krsview.scene.model import MAX_LEVELS
 
 from .conftest import preset_paths
@@ -37,23 +51,62 @@ def test_good_scene_loads():
     assert s.geometry().n == 1 and s.geometry().instance_count() == 2
 
 
-@pytest.mark.parametrize("old, new, path, value, allowed", [
-    ("normal = [1.0, 0.0, 0.0]", "normal = [0.0, 0.0, 0.0]", "krs.levels[1].mirror.normal",
-     "[0.0, 0.0, 0.0]", "zero vector"),
-    ("normal = [1.0, 0.0, 0.0]", "normal = [2.0, 0.0, 0.0]", "krs.levels[1].mirror.normal",
-     "[2.0, 0.0, 0.0]", "unit vector"),
-    ("radius = 0.5", "radius = -0.5", "krs.levels[0].kernel.radius", "-0.5", "0 < value ≤ 1e+09"),
-    ("radius = 0.5", "radius = nan", "krs.levels[0].kernel.radius", "nan", "NaN"),
-    ("offset = 1.0", "offset = inf", "krs.levels[1].mirror.offset", "inf", "NaN and infinity"),
-    ('type = "sphere"', 'type = "cube"', "krs.levels[0].kernel.type", "'cube'",
-     "allowed: empty, sphere"),
-    ("radius = 0.5 }", "radius = 0.5, colour = [1, 0, 0] }", "krs.levels[0].kernel.colour",
-     "[1, 0, 0]", "unknown field; allowed fields: center, color, radius"),
-    ("target = [0.0, 1.0, 0.0]", "target = [0.0, 1.0, -5.0]", "camera.target",
-     "[0.0, 1.0, -5.0]", "must be at least 1e-09 from position (it is 0 away)"),
-    ("radius = 0.5", 'radius = "big"', "krs.levels[0].kernel.radius", "'big'",
-     "expected a number"),
-])
+@pytest.mark.parametrize(
+    "old, new, path, value, allowed",
+    [
+        (
+            "normal = [1.0, 0.0, 0.0]",
+            "normal = [0.0, 0.0, 0.0]",
+            "krs.levels[1].mirror.normal",
+            "[0.0, 0.0, 0.0]",
+            "zero vector",
+        ),
+        (
+            "normal = [1.0, 0.0, 0.0]",
+            "normal = [2.0, 0.0, 0.0]",
+            "krs.levels[1].mirror.normal",
+            "[2.0, 0.0, 0.0]",
+            "unit vector",
+        ),
+        (
+            "radius = 0.5",
+            "radius = -0.5",
+            "krs.levels[0].kernel.radius",
+            "-0.5",
+            "0 < value ≤ 1e+09",
+        ),
+        ("radius = 0.5", "radius = nan", "krs.levels[0].kernel.radius", "nan", "NaN"),
+        ("offset = 1.0", "offset = inf", "krs.levels[1].mirror.offset", "inf", "NaN and infinity"),
+        (
+            'type = "sphere"',
+            'type = "cube"',
+            "krs.levels[0].kernel.type",
+            "'cube'",
+            "allowed: empty, sphere",
+        ),
+        (
+            "radius = 0.5 }",
+            "radius = 0.5, colour = [1, 0, 0] }",
+            "krs.levels[0].kernel.colour",
+            "[1, 0, 0]",
+            "unknown field; allowed fields: center, color, radius",
+        ),
+        (
+            "target = [0.0, 1.0, 0.0]",
+            "target = [0.0, 1.0, -5.0]",
+            "camera.target",
+            "[0.0, 1.0, -5.0]",
+            "must be at least 1e-09 from position (it is 0 away)",
+        ),
+        (
+            "radius = 0.5",
+            'radius = "big"',
+            "krs.levels[0].kernel.radius",
+            "'big'",
+            "expected a number",
+        ),
+    ],
+)
 def test_bad_value_names_file_field_value_and_allowed(old, new, path, value, allowed):
     assert old in GOOD
     e = error_of(GOOD.replace(old, new))
@@ -112,13 +165,23 @@ vec = st.tuples(finite, finite, finite)
 
 
 @settings(max_examples=60, deadline=None)
-@given(center=vec, radius=st.floats(1e-6, 1e6), normal=vec.filter(
-    lambda v: math.hypot(*v) > 1e-3), offset=finite, name=st.text(max_size=20))
+@given(
+    center=vec,
+    radius=st.floats(1e-6, 1e6),
+    normal=vec.filter(lambda v: math.hypot(*v) > 1e-3),
+    offset=finite,
+    name=st.text(max_size=20),
+)
 def test_round_trip_property(center, radius, normal, offset, name):
     n = math.sqrt(sum(c * c for c in normal))
     mirror = Mirror(tuple(c / n for c in normal), offset)
-    s = scene_from_toml(scene_to_toml(Scene(name=name, krs=KRS(
-        [Level(Sphere(center, radius), None), Level(Sphere(), mirror)]))))
+    s = scene_from_toml(
+        scene_to_toml(
+            Scene(
+                name=name, krs=KRS([Level(Sphere(center, radius), None), Level(Sphere(), mirror)])
+            )
+        )
+    )
     assert scene_from_toml(scene_to_toml(s)) == s
     assert s.krs.levels[0].kernel == Sphere(center, radius)
 
@@ -130,6 +193,7 @@ def test_atomic_save_keeps_old_file_when_writing_fails(tmp_path, monkeypatch):
 
     def broken(_scene):
         raise RuntimeError("disk full")
+
     monkeypatch.setattr(mod, "scene_to_toml", broken)
     with pytest.raises(RuntimeError):
         save_scene(scene_from_toml(GOOD), path)
@@ -141,9 +205,9 @@ def test_tree_expands_to_toroidal_capsules_with_fork_mirrors():
     krs = Tree(levels=6).krs()
     assert krs.n == 6 and all(isinstance(k, ToroidalCapsule) for k in krs.kernels)
     for i, m in enumerate(krs.mirrors):
-        fork = krs.kernels[i].start          # R_i passes through the fork where L_i starts
+        fork = krs.kernels[i].start  # R_i passes through the fork where L_i starts
         assert abs(sum(a * b for a, b in zip(m.normal, fork)) - m.offset) < 1e-9
-        parent = krs.kernels[i + 1]          # …and that fork is where K_{i+1} ends
+        parent = krs.kernels[i + 1]  # …and that fork is where K_{i+1} ends
         assert max(abs(a - b) for a, b in zip(parent.end, fork)) < 1e-12
 
 
@@ -151,37 +215,64 @@ def test_truncation_keeps_the_coarsest_levels_and_something_to_draw():
     tree = Tree(levels=8).krs()
     t = tree.truncated(3)
     assert t.kernels[1:] == tree.kernels[-2:] and t.kernels[0] == tree.kernels[-3]
-    ifs = KRS([Level(Sphere(), None)] + [Level(Empty(), Mirror((1.0, 0.0, 0.0), float(i)))
-                                         for i in range(1, 6)])
+    ifs = KRS(
+        [Level(Sphere(), None)]
+        + [Level(Empty(), Mirror((1.0, 0.0, 0.0), float(i))) for i in range(1, 6)]
+    )
     cut = ifs.truncated(2)
     assert cut.kernels[0] == Sphere() and cut.n == 1 and cut.mirrors == ifs.mirrors[-1:]
 
 
-
 SPHERE = 'kernel = { type = "sphere", center = [0.0, 0.0, 0.0], radius = 0.5 }\n'
-PALM_ROTATE = ('[[mokrs.levels]]\n' + SPHERE + '[[mokrs.levels.transform]]\n'
-               'type = "rotate"\naxis = AXIS\ndegrees = 10.0\n')
+PALM_ROTATE = (
+    "[[mokrs.levels]]\n" + SPHERE + "[[mokrs.levels.transform]]\n"
+    'type = "rotate"\naxis = AXIS\ndegrees = 10.0\n'
+)
 
 
-@pytest.mark.parametrize("content, message", [
-    (b"\x89PNG\r\n\x1a\n\x00\x00garbage", "<file> = 'byte 0x89 at offset 0': a scene file is UTF-8 text"),
-    ("[camera]\nfov_y = 40.0\n".encode("utf-16"), "this one is UTF-16: save it as UTF-8"),
-    (('[[krs.levels]]\nkernel = { type = ["sphere"] }\n').encode(),
-     "krs.levels[0].kernel.type = ['sphere']: unknown kernel type"),
-    (PALM_ROTATE.replace("rotate", "['rotate']", 1).replace('"[', '[').replace(']"', ']')
-     .replace("AXIS", "[1.0, 0.0, 0.0]").encode(), "transform[0].type = ['rotate']: unknown Möbius step"),
-    (PALM_ROTATE.replace("AXIS", "[1e308, 0.0, 0.0]").encode(),
-     "transform[0].axis[0] = 1e+308: allowed: -1e+09 ≤ value ≤ 1e+09"),
-    (("[[krs.levels]]\n" + SPHERE.replace("0.5 }", "1e30 }")).encode(),
-     "krs.levels[0].kernel.radius = 1e+30: allowed: 0 < value ≤ 1e+09"),
-    (b"[camera]\nposition = [1e20, 0.0, 0.0]\n", "camera.position[0] = 1e+20: allowed"),
-    (b"[camera]\nposition = [1.0, 2.0, 3.0]\ntarget = [1.0, 2.0, 3.000000000001]\n",
-     "must be at least 1e-09 from position (it is 1e-12 away)"),
-    (("[[compound]]\n[compound.mokrs]\n[[compound.mokrs.levels]]\n" + SPHERE).encode(),
-     "compound[0].mokrs = {a table with levels}: a MöKRS cannot join a compound"),
-    (("[krs]\n" + "[[krs.levels]]\n" * 2000).encode(),
-     "krs.levels = '<a list of 2,000 items>': too long; allowed: at most 1024 items"),
-])
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        (
+            b"\x89PNG\r\n\x1a\n\x00\x00garbage",
+            "<file> = 'byte 0x89 at offset 0': a scene file is UTF-8 text",
+        ),
+        ("[camera]\nfov_y = 40.0\n".encode("utf-16"), "this one is UTF-16: save it as UTF-8"),
+        (
+            (b'[[krs.levels]]\nkernel = { type = ["sphere"] }\n'),
+            "krs.levels[0].kernel.type = ['sphere']: unknown kernel type",
+        ),
+        (
+            PALM_ROTATE.replace("rotate", "['rotate']", 1)
+            .replace('"[', "[")
+            .replace(']"', "]")
+            .replace("AXIS", "[1.0, 0.0, 0.0]")
+            .encode(),
+            "transform[0].type = ['rotate']: unknown Möbius step",
+        ),
+        (
+            PALM_ROTATE.replace("AXIS", "[1e308, 0.0, 0.0]").encode(),
+            "transform[0].axis[0] = 1e+308: allowed: -1e+09 ≤ value ≤ 1e+09",
+        ),
+        (
+            ("[[krs.levels]]\n" + SPHERE.replace("0.5 }", "1e30 }")).encode(),
+            "krs.levels[0].kernel.radius = 1e+30: allowed: 0 < value ≤ 1e+09",
+        ),
+        (b"[camera]\nposition = [1e20, 0.0, 0.0]\n", "camera.position[0] = 1e+20: allowed"),
+        (
+            b"[camera]\nposition = [1.0, 2.0, 3.0]\ntarget = [1.0, 2.0, 3.000000000001]\n",
+            "must be at least 1e-09 from position (it is 1e-12 away)",
+        ),
+        (
+            ("[[compound]]\n[compound.mokrs]\n[[compound.mokrs.levels]]\n" + SPHERE).encode(),
+            "compound[0].mokrs = {a table with levels}: a MöKRS cannot join a compound",
+        ),
+        (
+            ("[krs]\n" + "[[krs.levels]]\n" * 2000).encode(),
+            "krs.levels = '<a list of 2,000 items>': too long; allowed: at most 1024 items",
+        ),
+    ],
+)
 def test_bad_scene_files_get_one_clear_line(tmp_path, content, message):
     """Bad input found by trying the tool as a new user [issue 16]: each used to end in a
     traceback (UnicodeDecodeError, unhashable list, SVD failure) or a flat overflowing image."""
@@ -195,9 +286,10 @@ def test_bad_scene_files_get_one_clear_line(tmp_path, content, message):
 
 def test_an_oversized_scene_file_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
     from krsview.scene import scene as scene_module
+
     path = tmp_path / "huge.toml"
     path.write_text("# " + "x" * 2000 + "\n[camera]\nfov_y = 40.0\n[[krs.levels]]\n" + SPHERE)
-    assert load_scene(path).camera.fov_y == 40.0     # control: the same file under the limit
+    assert load_scene(path).camera.fov_y == 40.0  # control: the same file under the limit
     monkeypatch.setattr(scene_module, "MAX_FILE_BYTES", 1000)
     monkeypatch.setattr(scene_module.tomllib, "loads", lambda _: pytest.fail("parsed"))
     with pytest.raises(SceneError, match="scene files hold at most 1,000 bytes"):

@@ -1,5 +1,6 @@
 """The program builder: #include resolution, errors mapped to .glsl file:line, variants
 specialised by #define and cached."""
+
 from __future__ import annotations
 
 import re
@@ -35,7 +36,7 @@ def test_compile_error_is_mapped_to_file_and_line(renderer, shader_copy):
     text = str(e.value)
     assert f"kernels.glsl:{k + 1}:" in text, text
     assert "| " + target.replace(";", " + undefined_thing;") in text
-    assert not re.search(r"\b0:\d+\(\d+\)", text), text       # no raw Mesa offsets left
+    assert not re.search(r"\b0:\d+\(\d+\)", text), text  # no raw Mesa offsets left
 
 
 def test_include_cycle_and_missing_file_are_named(shader_copy):
@@ -57,23 +58,27 @@ def test_source_map_points_every_line_back():
 
 
 def test_variant_contains_only_the_kernels_the_scene_uses(renderer):
-    sier = load_scene(resolve("sierpinski"))      # spheres only
-    tree = load_scene(resolve("tree"))            # toroidal capsules only
+    sier = load_scene(resolve("sierpinski"))  # spheres only
+    tree = load_scene(resolve("tree"))  # toroidal capsules only
     d_sier = variant_defines(sier, compile_krs(sier.geometry(), (1, 1, 1)))
     d_tree = variant_defines(tree, compile_krs(tree.geometry(), (1, 1, 1)))
     assert "KRS_KERNEL_SPHERE" in d_sier and "KRS_KERNEL_TOROIDAL_CAPSULE" not in d_sier
     assert "KRS_KERNEL_TOROIDAL_CAPSULE" in d_tree and "KRS_KERNEL_SPHERE" not in d_tree
     before = renderer.programs.compiles
     renderer.render(sier, 8, 6)
-    renderer.render(sier, 8, 6)                    # same define set: cached
+    renderer.render(sier, 8, 6)  # same define set: cached
     assert renderer.programs.compiles - before <= 1
 
 
-@pytest.mark.parametrize("defines, emitted", [({"A": None}, "a"), ({"B": None}, "b"),
-                                              ({"A": None, "B": None}, "a"), ({}, "c")])
+@pytest.mark.parametrize(
+    "defines, emitted",
+    [({"A": None}, "a"), ({"B": None}, "b"), ({"A": None, "B": None}, "a"), ({}, "c")],
+)
 def test_elif_emits_the_first_true_branch_only(tmp_path, defines, emitted):
-    (tmp_path / "x.glsl").write_text("#ifdef A\nint a;\n#elif defined(B)\nint b;\n#else\n"
-                                     "int c;\n#endif\n#if defined(B)\nint bb;\n#endif\n")
+    (tmp_path / "x.glsl").write_text(
+        "#ifdef A\nint a;\n#elif defined(B)\nint b;\n#else\n"
+        "int c;\n#endif\n#if defined(B)\nint bb;\n#endif\n"
+    )
     body = Source("x.glsl", defines, tmp_path).text.splitlines()
     decl = [line for line in body if line.startswith("int ") and len(line) == 6]
     assert decl == [f"int {emitted};"]

@@ -4,12 +4,14 @@ sizes), variant switches and hot reloads — keeps GL objects and process memory
 
 CI runs a slice; `KRSVIEW_SOAK=full pytest -m soak -s` runs 3000 frames, 200 variant
 switches and 100 hot reloads and prints the figures."""
+
 from __future__ import annotations
 
 import os
 import shutil
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -22,7 +24,7 @@ pytestmark = pytest.mark.soak
 
 
 def rss_mb() -> float:
-    for line in open("/proc/self/status"):
+    for line in Path("/proc/self/status").read_text().splitlines():
         if line.startswith("VmRSS:"):
             return int(line.split()[1]) / 1024
     raise RuntimeError("no VmRSS")
@@ -47,6 +49,7 @@ def fly(v, frames: int, start: int = 0) -> None:
 @pytest.fixture
 def long_viewer(display, tmp_path):
     from krsview.app.window import Viewer
+
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(160, 120), hud=False)
@@ -57,13 +60,13 @@ def long_viewer(display, tmp_path):
 def test_a_long_session_keeps_gl_objects_and_memory_flat(long_viewer):
     v = long_viewer
     r = v.renderer
-    fly(v, 60)                                  # warm-up: variants and targets exist
+    fly(v, 60)  # warm-up: variants and targets exist
     for on in (True, False):
         v.set_effect("fog", on)
         v.step(0.03)
     base, sizes_seen = rss_mb(), set()
     for k in range(FRAMES):
-        if k % 100 == 0:              # alternate budgets: the image size keeps changing
+        if k % 100 == 0:  # alternate budgets: the image size keeps changing
             v.set_target_fps(240 if (k // 100) % 2 == 0 else 5)
         fly(v, 1, k)
         sizes_seen.add(v.image[1] if v.image else None)
@@ -73,21 +76,26 @@ def test_a_long_session_keeps_gl_objects_and_memory_flat(long_viewer):
         if RELOADS and k % max(1, FRAMES // RELOADS) == 0:
             scene = load_scene(v.path)
             shade = 0.1 + 0.5 * ((k // max(1, FRAMES // RELOADS)) % 2)
-            save_scene(replace(scene, material=replace(scene.material,
-                                                       background=(shade, shade, shade))), v.path)
-            time.sleep(0.6)                     # the reload watches modification times
+            save_scene(
+                replace(scene, material=replace(scene.material, background=(shade, shade, shade))),
+                v.path,
+            )
+            time.sleep(0.6)  # the reload watches modification times
             v.step(0.3)
             v.step(0.3)
     grown = rss_mb() - base
-    print(f"\nsoak: {FRAMES} frames, {len(sizes_seen)} image sizes, {SWITCHES} switches, "
-          f"{RELOADS} reloads: RSS {base:.0f} → {base + grown:.0f} MB, "
-          f"{len(r._targets)} render targets, {len(r.programs._programs)} programs")
-    assert len(sizes_seen) > 8                  # flying really visited many sizes
+    print(
+        f"\nsoak: {FRAMES} frames, {len(sizes_seen)} image sizes, {SWITCHES} switches, "
+        f"{RELOADS} reloads: RSS {base:.0f} → {base + grown:.0f} MB, "
+        f"{len(r._targets)} render targets, {len(r.programs._programs)} programs"
+    )
+    assert len(sizes_seen) > 8  # flying really visited many sizes
     from krsview.gpu.renderer import MAX_TARGETS
+
     assert len(r._targets) <= MAX_TARGETS
-    assert len(r.programs._programs) <= 17      # sphere/binary × fog on/off × moving (no
-                                                # soft shadows) / still, each with its
-                                                # pre-pass, + the display program
+    assert len(r.programs._programs) <= 17  # sphere/binary × fog on/off × moving (no
+    # soft shadows) / still, each with its
+    # pre-pass, + the display program
     assert grown < 60, f"resident memory grew by {grown:.0f} MB"
     assert not v.error
 
@@ -95,8 +103,9 @@ def test_a_long_session_keeps_gl_objects_and_memory_flat(long_viewer):
 def test_without_the_target_limit_flying_leaks_render_targets(long_viewer, monkeypatch):
     """Negative control: with no limit on kept sizes, every size flown through stays."""
     from krsview.gpu import renderer
+
     monkeypatch.setattr(renderer, "MAX_TARGETS", 10**6)
-    for fps in (240, 5, 240, 5):      # make the adaptive resolution walk down and up
+    for fps in (240, 5, 240, 5):  # make the adaptive resolution walk down and up
         long_viewer.set_target_fps(fps)
         fly(long_viewer, 60)
     assert len(long_viewer.renderer._targets) > 8

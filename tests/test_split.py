@@ -1,6 +1,7 @@
 """`krsview bench split` [issue 17]: where a frame's time goes, as differences of variants.
 What can be checked without asserting wall time: the tracing-only variant traces exactly as
 the frame does and shades nothing, and the report has every part, adding up to the frame."""
+
 from __future__ import annotations
 
 import csv
@@ -33,17 +34,43 @@ def test_the_tracing_only_variant_traces_as_the_frame_and_shades_nothing(rendere
 
 def test_bench_split_reports_every_part(tmp_path):
     out = tmp_path / "split.csv"
-    r = subprocess.run([sys.executable, "-m", "krsview", "bench", "split", "tree", "--size",
-                        "32x18", "--rounds", "1", "--prepass", "4", "--csv", str(out)],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "krsview",
+            "bench",
+            "split",
+            "tree",
+            "--size",
+            "32x18",
+            "--rounds",
+            "1",
+            "--prepass",
+            "4",
+            "--csv",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     rows = {row["part"]: float(row["ms"]) for row in csv.DictReader(out.open())}
-    parts = ("coarse passes", "tracing", "nearest kernel and shading",
-             "secondary effects (shadow rays, occlusion)")
+    parts = (
+        "coarse passes",
+        "tracing",
+        "nearest kernel and shading",
+        "secondary effects (shadow rays, occlusion)",
+    )
     assert set(rows) == {*parts, "frame", "moving frame (no secondary effects)"}
     assert sum(rows[p] for p in parts) == pytest.approx(rows["frame"])
     assert rows["coarse passes"] > 0 and "| tracing |" in r.stdout
-    bad = subprocess.run([sys.executable, "-m", "krsview", "bench", "split", "tree",
-                          "--prepass-levels", "9"], capture_output=True, text=True, timeout=60)
+    bad = subprocess.run(
+        [sys.executable, "-m", "krsview", "bench", "split", "tree", "--prepass-levels", "9"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert bad.returncode == 2 and "--prepass-levels" in bad.stderr
     assert "Traceback" not in bad.stderr

@@ -1,4 +1,5 @@
 """The real viewer window under Xvfb, driven through its input layer."""
+
 from __future__ import annotations
 
 import shutil
@@ -20,6 +21,7 @@ SIZE = (160, 120)
 @pytest.fixture
 def viewer(display, tmp_path):
     from krsview.app.window import Viewer
+
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=SIZE, hud=False)
@@ -65,7 +67,7 @@ def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_
 
 def test_adaptive_resolution_drops_when_slow_and_restores_when_still(viewer):
     v = viewer
-    v.adaptive.target_fps = 2000.0           # a budget no llvmpipe frame meets
+    v.adaptive.target_fps = 2000.0  # a budget no llvmpipe frame meets
     scales = []
     for _ in range(8):
         v.input.key("D", True)
@@ -109,8 +111,7 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
     v = viewer
     settle(v)
     scene = load_scene(v.path)
-    save_scene(replace(scene, material=replace(scene.material, background=(1.0, 0.0, 0.0))),
-               v.path)
+    save_scene(replace(scene, material=replace(scene.material, background=(1.0, 0.0, 0.0))), v.path)
     time.sleep(0.6)
     for _ in range(3):
         v.step(0.3)
@@ -127,19 +128,25 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
 def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(display, tmp_path):
     from krsview.app.window import Viewer
     from krsview.gpu.program import SHADER_DIR
+
     shaders = tmp_path / "shaders"
     shutil.copytree(SHADER_DIR, shaders)
     v = Viewer(resolve("sierpinski"), size=SIZE, hud=False, shader_dir=shaders)
     try:
         settle(v)
         shade = shaders / "shade.glsl"
-        shade.write_text(shade.read_text().replace("vec3 color = albedo * light;",
-                                                   "vec3 color = vec3(1.0, 0.0, 1.0);"))
+        shade.write_text(
+            shade.read_text().replace(
+                "vec3 color = albedo * light;", "vec3 color = vec3(1.0, 0.0, 1.0);"
+            )
+        )
         time.sleep(0.6)
         v.step(0.01)
         settle(v)
         magenta = v.read_window()
-        assert not v.error and (np.abs(magenta.astype(int) - (255, 0, 255)).max(-1) < 3).mean() > 0.1
+        assert (
+            not v.error and (np.abs(magenta.astype(int) - (255, 0, 255)).max(-1) < 3).mean() > 0.1
+        )
         lines = shade.read_text().splitlines()
         k = next(i for i, line in enumerate(lines) if "vec3(1.0, 0.0, 1.0)" in line)
         lines[k] = lines[k].replace(";", " +;")
@@ -246,10 +253,10 @@ def test_mokrs_presets_fly_in_the_viewer(viewer):
 def test_adaptive_controller_unit():
     a = AdaptiveResolution((640, 360), target_fps=30)
     for _ in range(20):
-        a.frame_done(0.2)                  # far over budget: shrink to the floor
+        a.frame_done(0.2)  # far over budget: shrink to the floor
     assert a.scale == a.min_scale
     for _ in range(40):
-        a.frame_done(0.001)                # far under budget: grow back to full
+        a.frame_done(0.001)  # far under budget: grow back to full
     assert a.scale == 1.0
     r = Refinement((100, 50))
     tiles = []
@@ -324,40 +331,52 @@ def test_compound_preset_flies_and_the_levels_slider_cuts_every_component(viewer
     assert np.isfinite(v.camera.position).all()
 
 
-def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(viewer, tmp_path,
-                                                                              monkeypatch):
+def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
+    viewer, tmp_path, monkeypatch
+):
     """A constructed report: the panel knows which row the view draws, and its button puts
     the view on the most accurate row that fits the frame budget (scaled by pixels)."""
     from krsview.app import hud, measured
     from krsview.app.measured import apply_row, best_within, load_measured, matches
+
     (tmp_path / "tree").mkdir()
     (tmp_path / "tree" / "accuracy.csv").write_text(
         "knob,value,width,height,ms,mask_error\n"
         "scene,as saved,100,100,50,0.02\nepsilon_scale,0.5,100,100,80,0.01\n"
         "epsilon_scale,4,100,100,20,0.09\nlevels,12,100,100,10,0.2\n"
-        "tracer,binary 2/0.3,100,100,90,0.015\nprecision,double,100,100,70,0.019\n")
+        "tracer,binary 2/0.3,100,100,90,0.015\nprecision,double,100,100,70,0.019\n"
+    )
     monkeypatch.setattr(measured, "REPORT_DIRS", (tmp_path,))
     rows = load_measured("tree")
     v = viewer
-    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)] == ["as saved"]
+    assert [
+        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+    ] == ["as saved"]
     assert best_within(rows, 60.0, 100 * 100)["value"] == "as saved"
     assert best_within(rows, 100.0, 100 * 100)["value"] == "0.5"
-    assert best_within(rows, 200.0, 400 * 400)["value"] == "12"     # 16× the pixels
+    assert best_within(rows, 200.0, 400 * 400)["value"] == "12"  # 16× the pixels
     assert best_within(rows, 1.0, 100 * 100) is None
     v.execute(apply_row(rows[1], v.doc.saved))
     assert v.scene.render.epsilon_scale == 0.5
-    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)] == ["0.5"]
+    assert [
+        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+    ] == ["0.5"]
     v.execute(apply_row(rows[4], v.doc.saved))
-    assert v.scene.render.tracer == "binary" and matches(rows[4], v.scene, v.doc.saved, v.levels, v.geometry.depth)
+    assert v.scene.render.tracer == "binary" and matches(
+        rows[4], v.scene, v.doc.saved, v.levels, v.geometry.depth
+    )
     v.execute(apply_row(rows[5], v.doc.saved))
     assert v.scene.render.precision == "double" and v.scene.render.tracer == "sphere"
-    assert [r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)] == ["double"]
+    assert [
+        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+    ] == ["double"]
     v.execute(apply_row(rows[3], v.doc.saved))
     assert v.levels == 12 and v.scene.render == v.doc.saved.render
     # the panel itself draws inside an ImGui frame and returns commands, not changes
     v.measured = rows
     v.platform.new_frame()
     from imgui_bundle import imgui
+
     imgui.begin("test")
     commands: list = []
     hud._measured(v, commands)
@@ -373,6 +392,7 @@ def test_the_viewer_draws_with_the_prepass_and_can_turn_it_off(viewer):
     goes through Viewer.set_prepass, and off or on, the window shows the same tree (pixels
     change only on outlines, where grazing rays may flip)."""
     from krsview.scene.model import VIEW_PREPASS
+
     v = viewer
     settle(v)
     assert v.prepass == VIEW_PREPASS and v.view_scene().render.prepass == VIEW_PREPASS
@@ -403,13 +423,13 @@ def test_moving_frames_leave_out_shadow_rays_and_the_still_image_has_them(viewer
     `--moving-effects` have them. Each frame is compared with a headless render of the same
     view with and without the shadows (negative control: the other one differs)."""
     v = viewer
-    v.adaptive.target_fps, v.adaptive.scale = 0.5, 1.0   # every frame fits: moving = full size
+    v.adaptive.target_fps, v.adaptive.scale = 0.5, 1.0  # every frame fits: moving = full size
 
     def agree(shot, ref):
         return (np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2).mean()
 
     hold(v, "W", 1)
-    assert not v.refined and v.image[1] == SIZE       # full size, but shadows still to come
+    assert not v.refined and v.image[1] == SIZE  # full size, but shadows still to come
     moving = v.read_window()
     assert "soft_shadows" in v.scene.effects
     assert "soft_shadows" not in v.view_scene(moving=True).effects

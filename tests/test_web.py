@@ -3,6 +3,7 @@ headless, WebGL2 on its SwiftShader rasteriser. Each screenshot is compared with
 render` (EGL, llvmpipe) of the same view; the orbit is checked against cameras computed here
 from the orbit formula, and every preset and hard case compiles as GLSL ES 3.00
 (glslangValidator)."""
+
 from __future__ import annotations
 
 import json
@@ -26,22 +27,39 @@ from krsview.share.web import html_page, shadertoy_source, web_shader
 from .conftest import headless_render
 
 SIZE = (160, 90)
-BROWSER = ["chromium", "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-           "--enable-unsafe-swiftshader", "--hide-scrollbars", "--virtual-time-budget=8000"]
+BROWSER = [
+    "chromium",
+    "--headless=new",
+    "--no-sandbox",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--hide-scrollbars",
+    "--virtual-time-budget=8000",
+]
 # Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
 # main that calls mainImage (iMouse released, iTime 0).
-TOY_PAGE_SHADER = ("#version 300 es\nprecision highp float;\nprecision highp int;\n"
-                   "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\n"
-                   "{body}\nout vec4 toy_out;\n"
-                   "void main() {{ mainImage(toy_out, gl_FragCoord.xy); }}\n")
+TOY_PAGE_SHADER = (
+    "#version 300 es\nprecision highp float;\nprecision highp int;\n"
+    "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\n"
+    "{body}\nout vec4 toy_out;\n"
+    "void main() {{ mainImage(toy_out, gl_FragCoord.xy); }}\n"
+)
 
 
 def screenshot(page: Path, out: Path, fragment: str = "bare") -> np.ndarray:
     """The page at SIZE in headless chromium (software WebGL2), rows top → bottom."""
     assert shutil.which("chromium"), "chromium is missing: `make deps` installs it"
-    r = subprocess.run([*BROWSER, f"--window-size={SIZE[0]},{SIZE[1]}",
-                        f"--screenshot={out}", f"{page.resolve().as_uri()}#{fragment}"],
-                       capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            *BROWSER,
+            f"--window-size={SIZE[0]},{SIZE[1]}",
+            f"--screenshot={out}",
+            f"{page.resolve().as_uri()}#{fragment}",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0 and out.exists(), r.stderr[-2000:]
     return np.asarray(Image.open(out).convert("RGB")).astype(int)
 
@@ -101,8 +119,9 @@ def orbit_camera(scene, yaw: float, pitch: float, zoom: float) -> Camera:
     pitch0 = math.asin(away[1])
     y, p = yaw0 + yaw, pitch0 + pitch
     d = np.linalg.norm(eye - target) * zoom
-    new_eye = target + d * np.array([math.cos(p) * math.sin(y), math.sin(p),
-                                     math.cos(p) * math.cos(y)])
+    new_eye = target + d * np.array(
+        [math.cos(p) * math.sin(y), math.sin(p), math.cos(p) * math.cos(y)]
+    )
     return Camera(tuple(new_eye), cam.target, cam.up, cam.fov_y)
 
 
@@ -131,8 +150,7 @@ canvas.dispatchEvent(new PointerEvent("pointerup", at(50, 60)));
 canvas.dispatchEvent(new WheelEvent("wheel", {deltaY: 223, bubbles: true, cancelable: true}));
 </script>
 </body>"""
-    page.write_text(page.read_text(encoding="utf-8").replace("</body>", events),
-                    encoding="utf-8")
+    page.write_text(page.read_text(encoding="utf-8").replace("</body>", events), encoding="utf-8")
     shot = screenshot(page, tmp_path / "shot.png")
     yaw, pitch, zoom = 0.006 * 50, 0.006 * 20, math.exp(0.001 * 223)
     ref = reference(replace(scene, camera=orbit_camera(scene, yaw, pitch, zoom)), tmp_path, "r")
@@ -154,14 +172,21 @@ def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
     start = text.index("const FRAGMENT = ") + len("const FRAGMENT = ")
     end = text.index(";\nconst canvas")
     toy = page.with_name("toy.html")
-    toy.write_text(text[:start] + json.dumps(TOY_PAGE_SHADER.format(body=body)) + text[end:]
-                   .replace('gl.getUniformLocation(program, "u_orbit")',
-                            'gl.getUniformLocation(program, "iMouse")')
-                   .replace('gl.getUniformLocation(program, "u_canvas")',
-                            'gl.getUniformLocation(program, "iResolution")')
-                   .replace("gl.uniform3fv(uOrbit, orbit);", "gl.uniform4f(uOrbit, 0, 0, 0, 0);")
-                   .replace("gl.uniform2f(uCanvas, w, h);", "gl.uniform3f(uCanvas, w, h, 1);"),
-                   encoding="utf-8")
+    toy.write_text(
+        text[:start]
+        + json.dumps(TOY_PAGE_SHADER.format(body=body))
+        + text[end:]
+        .replace(
+            'gl.getUniformLocation(program, "u_orbit")', 'gl.getUniformLocation(program, "iMouse")'
+        )
+        .replace(
+            'gl.getUniformLocation(program, "u_canvas")',
+            'gl.getUniformLocation(program, "iResolution")',
+        )
+        .replace("gl.uniform3fv(uOrbit, orbit);", "gl.uniform4f(uOrbit, 0, 0, 0, 0);")
+        .replace("gl.uniform2f(uCanvas, w, h);", "gl.uniform3f(uCanvas, w, h, 1);"),
+        encoding="utf-8",
+    )
     shot = screenshot(toy, tmp_path / "toy.png")
     ref = reference(scene, tmp_path, "ref")
     assert agreement(shot, ref, 16) >= 0.97
@@ -170,8 +195,9 @@ def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
 def glsl_es_errors(text: str, tmp_path: Path) -> str:
     f = tmp_path / "stage.frag"
     f.write_text(text, encoding="utf-8")
-    r = subprocess.run(["glslangValidator", "-S", "frag", str(f)], capture_output=True,
-                       text=True, timeout=60)
+    r = subprocess.run(
+        ["glslangValidator", "-S", "frag", str(f)], capture_output=True, text=True, timeout=60
+    )
     return "" if r.returncode == 0 else r.stdout + r.stderr
 
 
@@ -192,14 +218,23 @@ def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
         exported += 1
     assert exported == len(scenes) - refused and exported > len(preset_names())
     # negative control: the validator does reject what GLSL ES forbids
-    assert glsl_es_errors(web_shader(load_scene(resolve("tree"))).replace(
-        "precision highp float;", "") + "\ndouble x;", tmp_path)
+    assert glsl_es_errors(
+        web_shader(load_scene(resolve("tree"))).replace("precision highp float;", "")
+        + "\ndouble x;",
+        tmp_path,
+    )
 
 
 def test_export_on_the_command_line_and_its_refusals(tmp_path):
-    run = lambda *a: subprocess.run([sys.executable, "-m", "krsview", "export", *a],  # noqa
-                                    capture_output=True, text=True, timeout=120,
-                                    env={**os.environ, "DISPLAY": ""})
+    def run(*a):
+        return subprocess.run(
+            [sys.executable, "-m", "krsview", "export", *a],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={**os.environ, "DISPLAY": ""},
+        )
+
     r = run("html", "tree", "-o", str(tmp_path / "t.html"), "--levels", "8")
     assert r.returncode == 0 and "wrote" in r.stdout, r.stderr
     r = run("shadertoy", "palm", "-o", str(tmp_path / "p.glsl"))
@@ -207,8 +242,10 @@ def test_export_on_the_command_line_and_its_refusals(tmp_path):
     bad = run("html", "tree", "-o", str(tmp_path / "t.htm"))
     assert bad.returncode == 2 and "-o = " in bad.stderr and "must end in .html" in bad.stderr
     deep = load_scene(resolve("tree"))
-    save_scene(replace(deep, render=replace(deep.render, precision="double", prepass=8)),
-               tmp_path / "deep.toml")
+    save_scene(
+        replace(deep, render=replace(deep.render, precision="double", prepass=8)),
+        tmp_path / "deep.toml",
+    )
     r = run("html", str(tmp_path / "deep.toml"), "-o", str(tmp_path / "d.html"))
     assert r.returncode == 2 and len(r.stderr.splitlines()) == 1
     assert "render.precision = 'double'" in r.stderr and "no fp64" in r.stderr

@@ -5,6 +5,7 @@ q ∈ H_0 ≅ R³ as L_H(q) = (aq + b)(cq + d)⁻¹ (Eq. 1); composition is the 
 Spheres are (α, β, γ) with α q q̄ + βq + q̄β̄ + γ = 0 (Eq. 2); planes have α = 0.
 Mirrors ``shaders/quaternion.glsl`` and ``shaders/mobius.glsl``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -57,8 +58,12 @@ def compose(*Hs: np.ndarray) -> np.ndarray:
     """compose(G, H) = G·H, the transformation L_G ∘ L_H (H applied first)."""
     out = Hs[0]
     for H in Hs[1:]:
-        out = np.array([[Q.mul(out[r, 0], H[0, k]) + Q.mul(out[r, 1], H[1, k])
-                         for k in range(2)] for r in range(2)])
+        out = np.array(
+            [
+                [Q.mul(out[r, 0], H[0, k]) + Q.mul(out[r, 1], H[1, k]) for k in range(2)]
+                for r in range(2)
+            ]
+        )
     return out
 
 
@@ -78,7 +83,7 @@ def inverse(H: np.ndarray) -> np.ndarray:
     """H⁻¹. The real 8×8 inverse commutes with right multiplication by quaternions, so each
     4×4 block is again a left multiplication; its first column is the quaternion."""
     M = np.linalg.inv(real_matrix(H))
-    return np.array([[M[4 * r:4 * r + 4, 4 * k] for k in range(2)] for r in range(2)])
+    return np.array([[M[4 * r : 4 * r + 4, 4 * k] for k in range(2)] for r in range(2)])
 
 
 def tidy(H: np.ndarray) -> np.ndarray:
@@ -128,8 +133,11 @@ def sphere_coeffs(center: np.ndarray, radius: np.ndarray):
     """(α, β, γ) of spheres (N,): α = 1, β = κ, γ = |κ|² − ρ² [KRS17 §6.3]."""
     center = np.asarray(center, dtype=np.float64)
     radius = np.asarray(radius, dtype=np.float64)
-    return (np.ones(radius.shape), Q.pure(center),
-            np.sum(center * center, axis=-1) - radius * radius)
+    return (
+        np.ones(radius.shape),
+        Q.pure(center),
+        np.sum(center * center, axis=-1) - radius * radius,
+    )
 
 
 def sphere_of(alpha, beta, gamma):
@@ -171,8 +179,9 @@ def map_ball(M: np.ndarray, center: np.ndarray, radius: np.ndarray, exterior: bo
     off = center - p
     dist = np.linalg.norm(off, axis=-1)
     ok = dist > radius
-    u = np.where((dist > 0)[:, None], off / np.where(dist > 0, dist, 1.0)[:, None],
-                 [1.0, 0.0, 0.0])   # a pole at the centre: any diameter passes through it
+    u = np.where(
+        (dist > 0)[:, None], off / np.where(dist > 0, dist, 1.0)[:, None], [1.0, 0.0, 0.0]
+    )  # a pole at the centre: any diameter passes through it
     r = (radius if exterior else np.where(ok, radius, 0.0))[:, None]
     x1, x2 = apply(M, center + r * u), apply(M, center - r * u)
     return 0.5 * (x1 + x2), 0.5 * np.linalg.norm(x1 - x2, axis=-1), ok
@@ -189,7 +198,7 @@ def ray_sphere(alpha, beta, gamma, tau: np.ndarray, omega: np.ndarray) -> np.nda
     NaN where the ray misses (for a plane, the second root is NaN)."""
     t_, w_ = Q.pure(tau), Q.pure(omega)
     A = np.asarray(alpha, dtype=np.float64)
-    B = A * Q.mul(t_, Q.conj(w_))[..., 0] + Q.mul(beta, w_)[..., 0]   # half the linear term
+    B = A * Q.mul(t_, Q.conj(w_))[..., 0] + Q.mul(beta, w_)[..., 0]  # half the linear term
     C = A * Q.norm2(t_) + 2.0 * Q.mul(beta, t_)[..., 0] + gamma
     out = np.full(A.shape + (2,), np.nan)
     plane = A == 0.0

@@ -2,6 +2,7 @@
 
 R³ is embedded as the pure quaternions H_0 (real part 0). Mirrors ``shaders/quaternion.glsl``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -17,10 +18,15 @@ def mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Hamilton product pq (written out by component: the reference's hot loop)."""
     pw, px, py, pz = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
     qw, qx, qy, qz = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return np.stack([pw * qw - px * qx - py * qy - pz * qz,
-                     pw * qx + px * qw + py * qz - pz * qy,
-                     pw * qy - px * qz + py * qw + pz * qx,
-                     pw * qz + px * qy - py * qx + pz * qw], axis=-1)
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        axis=-1,
+    )
 
 
 def conj(q: np.ndarray) -> np.ndarray:

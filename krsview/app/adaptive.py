@@ -1,6 +1,7 @@
 """Adaptive internal resolution: while the view moves, scale the image so a frame fits the
 target frame time; when it is still, refine to full resolution in tiles within a per-turn
 time budget, so input is never blocked by a slow frame."""
+
 from __future__ import annotations
 
 import math
@@ -9,11 +10,11 @@ from dataclasses import dataclass, field
 
 @dataclass
 class AdaptiveResolution:
-    full: tuple[int, int]            # window size in pixels
+    full: tuple[int, int]  # window size in pixels
     target_fps: float = 30.0
     min_scale: float = 0.1
-    scale: float = 0.5               # start near 320×180 for a 640×360 window (DESIGN.md)
-    supersample: int = 1             # still images: 1, or 2 for 2×2 supersampling
+    scale: float = 0.5  # start near 320×180 for a 640×360 window (DESIGN.md)
+    supersample: int = 1  # still images: 1, or 2 for 2×2 supersampling
     history: list[float] = field(default_factory=list)
 
     @property
@@ -39,8 +40,9 @@ class AdaptiveResolution:
 @dataclass
 class Refinement:
     """Full-resolution image traced in horizontal bands, a few per event-loop turn."""
+
     size: tuple[int, int]
-    band: int = 16                  # rows per tile
+    band: int = 16  # rows per tile
     next_row: int = 0
     seconds_per_row: float = 0.0
 
@@ -60,5 +62,6 @@ class Refinement:
 
     def tile_done(self, tile: tuple[int, int, int, int], seconds: float) -> None:
         per_row = seconds / max(tile[3], 1)
-        self.seconds_per_row = per_row if self.seconds_per_row == 0 else (
-            0.5 * self.seconds_per_row + 0.5 * per_row)
+        self.seconds_per_row = (
+            per_row if self.seconds_per_row == 0 else (0.5 * self.seconds_per_row + 0.5 * per_row)
+        )

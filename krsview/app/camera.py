@@ -1,5 +1,6 @@
 """A float64 fly/orbit camera; the renderer receives camera-relative data from it, so deep
 zooms keep their precision (DESIGN.md, Precision)."""
+
 from __future__ import annotations
 
 import math
@@ -16,21 +17,26 @@ MAX_PITCH = math.radians(89.0)
 @dataclass
 class FlyCamera:
     position: np.ndarray
-    yaw: float                 # radians around the world up axis
-    pitch: float               # radians above the horizon
+    yaw: float  # radians around the world up axis
+    pitch: float  # radians above the horizon
     fov_y: float
     world_up: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))
 
     @classmethod
-    def from_camera(cls, cam: Camera) -> "FlyCamera":
+    def from_camera(cls, cam: Camera) -> FlyCamera:
         up = np.array(cam.up, dtype=np.float64)
         f = np.array(cam.target, dtype=np.float64) - np.array(cam.position, dtype=np.float64)
         f /= np.linalg.norm(f)
         east, north = horizontal_axes(up)
         pitch = math.asin(max(-1.0, min(1.0, float(f @ up))))
         yaw = math.atan2(float(f @ east), float(f @ north))
-        return cls(np.array(cam.position, dtype=np.float64), yaw,
-                   max(-MAX_PITCH, min(MAX_PITCH, pitch)), cam.fov_y, up)
+        return cls(
+            np.array(cam.position, dtype=np.float64),
+            yaw,
+            max(-MAX_PITCH, min(MAX_PITCH, pitch)),
+            cam.fov_y,
+            up,
+        )
 
     def forward(self) -> np.ndarray:
         return look_direction(self.yaw, self.pitch, self.world_up)
@@ -42,8 +48,9 @@ class FlyCamera:
     def to_camera(self) -> Camera:
         """The scene camera; the target sits one unit ahead (only its direction matters)."""
         f = lambda v: tuple(float(c) for c in v)  # noqa: E731  plain floats for files
-        return Camera(f(self.position), f(self.position + self.forward()), f(self.world_up),
-                      float(self.fov_y))
+        return Camera(
+            f(self.position), f(self.position + self.forward()), f(self.world_up), float(self.fov_y)
+        )
 
     def fly(self, local: np.ndarray, distance: float) -> None:
         """Move ``distance`` along local (right, up, forward) components."""

@@ -1,28 +1,46 @@
 """Controls as data (action ↦ key, the pygfx habit) and one input layer fed by GLFW callbacks
 or by tests with synthetic events."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 # Held keys move the camera; pressed keys trigger an action once.
 CONTROLS: dict[str, str] = {
-    "forward": "W", "back": "S", "left": "A", "right": "D", "down": "Q", "up": "E",
-    "reset": "R", "orbit": "O", "screenshot": "F12", "hud": "F1",
-    "bookmark": "B", "next_bookmark": "N", "record": "F5", "replay": "F6",
+    "forward": "W",
+    "back": "S",
+    "left": "A",
+    "right": "D",
+    "down": "Q",
+    "up": "E",
+    "reset": "R",
+    "orbit": "O",
+    "screenshot": "F12",
+    "hud": "F1",
+    "bookmark": "B",
+    "next_bookmark": "N",
+    "record": "F5",
+    "replay": "F6",
 }
-MOVES = {"forward": (0, 0, 1), "back": (0, 0, -1), "left": (-1, 0, 0), "right": (1, 0, 0),
-         "down": (0, -1, 0), "up": (0, 1, 0)}
-LOOK_BUTTON = "right"    # hold to look around (fly) …
-ORBIT_BUTTON = "left"    # … or drag to orbit in orbit mode
+MOVES = {
+    "forward": (0, 0, 1),
+    "back": (0, 0, -1),
+    "left": (-1, 0, 0),
+    "right": (1, 0, 0),
+    "down": (0, -1, 0),
+    "up": (0, 1, 0),
+}
+LOOK_BUTTON = "right"  # hold to look around (fly) …
+ORBIT_BUTTON = "left"  # … or drag to orbit in orbit mode
 
 
 @dataclass
 class Input:
     held: set[str] = field(default_factory=set)
-    pressed: list[str] = field(default_factory=list)   # key presses since the last frame
+    pressed: list[str] = field(default_factory=list)  # key presses since the last frame
     buttons: set[str] = field(default_factory=set)
     cursor: tuple[float, float] = (0.0, 0.0)
-    drag: tuple[float, float] = (0.0, 0.0)             # cursor motion while a button is held
+    drag: tuple[float, float] = (0.0, 0.0)  # cursor motion while a button is held
     scroll: float = 0.0
 
     def key(self, name: str, down: bool) -> None:

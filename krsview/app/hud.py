@@ -1,6 +1,7 @@
 """The viewer's ImGui HUD: frame time plot, resolution, accuracy knobs (from the scene schema),
 effects, view mode, presets, bookmarks, screenshot, and any error from a hot reload. It reads
 the viewer and returns commands; it never writes the viewer's fields."""
+
 from __future__ import annotations
 
 from dataclasses import fields
@@ -23,13 +24,24 @@ if TYPE_CHECKING:
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
 # the last one sits beside the pre-pass tile slider
-KNOBS = ("tracer", "epsilon_scale", "max_iterations", *TRACER_KNOBS, "precision", "culling",
-         "path", "steps", "shadow_tasks", "component_tasks", "prepass_levels")
-COMPUTE_KNOBS = ("steps", "shadow_tasks", "component_tasks")   # on the compute path only
+KNOBS = (
+    "tracer",
+    "epsilon_scale",
+    "max_iterations",
+    *TRACER_KNOBS,
+    "precision",
+    "culling",
+    "path",
+    "steps",
+    "shadow_tasks",
+    "component_tasks",
+    "prepass_levels",
+)
+COMPUTE_KNOBS = ("steps", "shadow_tasks", "component_tasks")  # on the compute path only
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
-def draw_hud(v: "Viewer", interactions: Interactions) -> list[Command]:
+def draw_hud(v: Viewer, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
     imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
     imgui.set_next_window_size(imgui.ImVec2(330, 0), imgui.Cond_.first_use_ever)
@@ -52,17 +64,23 @@ def draw_hud(v: "Viewer", interactions: Interactions) -> list[Command]:
     return out
 
 
-def _performance(v: "Viewer", out: list) -> None:
+def _performance(v: Viewer, out: list) -> None:
     times = np.array(v.frame_seconds[-120:] or [0.0], dtype=np.float32) * 1e3
     fps = 1e3 / max(float(np.median(times)), 1e-6)
     w, h = v.adaptive.moving_size()
-    state = "refined" if v.refined else f"refining {v.refinement.next_row}/{v.refinement.size[1]}" \
-        if v.refinement else "moving"
+    state = (
+        "refined"
+        if v.refined
+        else f"refining {v.refinement.next_row}/{v.refinement.size[1]}"
+        if v.refinement
+        else "moving"
+    )
     imgui.text(f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.adaptive.scale:.0%})")
     imgui.text(f"{state}; {v.view} view")
     if implot.begin_plot("##frametime", imgui.ImVec2(-1, 70), implot.Flags_.no_legend):
-        implot.setup_axes_limits(0, 120, 0, max(60.0, float(times.max()) * 1.1),
-                                 implot.Cond_.always)
+        implot.setup_axes_limits(
+            0, 120, 0, max(60.0, float(times.max()) * 1.1), implot.Cond_.always
+        )
         implot.plot_line("frame ms", times)
         budget = np.full(2, 1e3 / v.adaptive.target_fps, dtype=np.float32)
         implot.plot_line("budget", budget, xscale=120)
@@ -77,21 +95,23 @@ def _performance(v: "Viewer", out: list) -> None:
     if changed:
         out.append(Do("set_moving_effects", on))
     if imgui.is_item_hovered():
-        imgui.set_tooltip("off: moving frames skip the effects that trace the geometry again "
-                          "per pixel, for a sharper image at the target FPS; the still image "
-                          "always has them")
+        imgui.set_tooltip(
+            "off: moving frames skip the effects that trace the geometry again "
+            "per pixel, for a sharper image at the target FPS; the still image "
+            "always has them"
+        )
 
 
-def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:
+def _accuracy(v: Viewer, out: list, interactions: Interactions) -> None:
     r = v.scene.render
     for name in KNOBS:
-        if TRACER_KNOBS.get(name, r.tracer) != r.tracer:   # another tracer's knob
+        if TRACER_KNOBS.get(name, r.tracer) != r.tracer:  # another tracer's knob
             continue
         if name in COMPUTE_KNOBS and r.path != "compute":
             continue
         meta = RENDER_META[name]
         if name == "tracer" and v.scene.mokrs is not None:
-            meta = {**meta, "choices": ("binary",)}   # a MöKRS has only unbounding tests
+            meta = {**meta, "choices": ("binary",)}  # a MöKRS has only unbounding tests
         changed, value = field_widget(f"{name}##render", getattr(r, name), meta)
         key = interactions.key(("render", name))
         if changed:
@@ -117,19 +137,22 @@ def _accuracy(v: "Viewer", out: list, interactions: Interactions) -> None:
             imgui.set_tooltip(EFFECTS[name].help)
 
 
-def _scene(v: "Viewer", out: list) -> None:
+def _scene(v: Viewer, out: list) -> None:
     names = preset_names()
     current = names.index(v.path.stem) if v.path.stem in names else -1
     changed, k = imgui.combo("preset", current, names)
     if changed:
         out.append(Do("open_preset", resolve(names[k])))
-    imgui.text(f"speed ×{v.speed_factor:.2f} of the nearest distance "
-               f"({v.nearest_distance():.3g}); scroll to change")
-    for label, action, same_line in (("screenshot (F12)", "screenshot", True),
-                                     ("reset view (R)", "reset", True),
-                                     ("orbit (O)" if v.orbit_pivot is None else "fly (O)",
-                                      "orbit", False),
-                                     ("add bookmark (B)", "bookmark", False)):
+    imgui.text(
+        f"speed ×{v.speed_factor:.2f} of the nearest distance "
+        f"({v.nearest_distance():.3g}); scroll to change"
+    )
+    for label, action, same_line in (
+        ("screenshot (F12)", "screenshot", True),
+        ("reset view (R)", "reset", True),
+        ("orbit (O)" if v.orbit_pivot is None else "fly (O)", "orbit", False),
+        ("add bookmark (B)", "bookmark", False),
+    ):
         if imgui.button(label):
             out.append(Do("act", action))
         if same_line:
@@ -145,16 +168,18 @@ def _scene(v: "Viewer", out: list) -> None:
         out.append(Do("act", "replay"))
 
 
-def _measured(v: "Viewer", out: list) -> None:
+def _measured(v: Viewer, out: list) -> None:
     """Where the current setting sits on the preset's measured time/error curve, and a
     button for the most accurate measured setting that fits the frame budget."""
     rows = v.measured
     if rows is None:
-        imgui.text_wrapped(f"no accuracy report for {v.path.stem}: run `krsview bench "
-                           f"accuracy {v.path.stem}`")
+        imgui.text_wrapped(
+            f"no accuracy report for {v.path.stem}: run `krsview bench accuracy {v.path.stem}`"
+        )
         return
-    now = [r for r in rows
-           if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth, v.prepass)]
+    now = [
+        r for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth, v.prepass)
+    ]
     w, h = v.adaptive.moving_size()
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
         implot.setup_axes("ms (report size)", "hit-mask error %")
@@ -162,13 +187,18 @@ def _measured(v: "Viewer", out: list) -> None:
         err = np.array([100 * r["mask_error"] for r in rows], dtype=np.float32)
         implot.plot_scatter("measured", ms, err)
         if now:
-            implot.plot_scatter("now", np.array([now[0]["ms"]], np.float32),
-                                np.array([100 * now[0]["mask_error"]], np.float32))
+            implot.plot_scatter(
+                "now",
+                np.array([now[0]["ms"]], np.float32),
+                np.array([100 * now[0]["mask_error"]], np.float32),
+            )
         implot.end_plot()
     if now:
         r = now[0]
-        imgui.text(f"now: {r['knob']} {r['value']}: {r['mask_error']:.2%} error, "
-                   f"{r['ms']:.0f} ms at {r['width']:.0f}×{r['height']:.0f}")
+        imgui.text(
+            f"now: {r['knob']} {r['value']}: {r['mask_error']:.2%} error, "
+            f"{r['ms']:.0f} ms at {r['width']:.0f}×{r['height']:.0f}"
+        )
     else:
         imgui.text_disabled("the current setting was not measured (change one knob at a time)")
     budget = 1e3 / v.adaptive.target_fps

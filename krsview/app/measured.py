@@ -1,5 +1,6 @@
 """The viewer's view of a preset's measured accuracy report (`krsview bench accuracy`): which
 measured setting the view uses now, and the most accurate one that fits the frame budget."""
+
 from __future__ import annotations
 
 import csv
@@ -34,15 +35,19 @@ def load_measured(stem: str) -> list[dict] | None:
     return None
 
 
-def matches(row: dict, scene: Scene, saved: Scene, levels: int, depth: int,
-            prepass: int = 0) -> bool:
+def matches(
+    row: dict, scene: Scene, saved: Scene, levels: int, depth: int, prepass: int = 0
+) -> bool:
     """Whether the view draws with the setting this row measured; ``levels`` is the view's
     level count (0: all ``depth`` levels of the geometry, which the caller already has),
     ``prepass`` the viewer's pre-pass tile."""
     r, s = scene.render, saved.render
     drawn_levels = levels or depth
     full = drawn_levels == depth
-    same_but = (lambda **kw: replace(s, **kw) == r and full)
+
+    def same_but(**kw) -> bool:
+        return replace(s, **kw) == r and full
+
     knob, value = row["knob"], row["value"]
     if knob == "scene":
         return r == s and full
@@ -81,12 +86,14 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
     """Commands that put the view on a measured setting (the others as saved)."""
     knob, value = row["knob"], row["value"]
     base = saved.render
-    render = {"epsilon_scale": lambda: replace(base, epsilon_scale=float(value)),
-              "max_iterations": lambda: replace(base, max_iterations=int(value)),
-              "tracer": lambda: replace(base, **_tracer(value)),
-              "precision": lambda: replace(base, precision=value),
-              "culling": lambda: replace(base, culling=value),
-              "path": lambda: replace(base, path=value)}.get(knob, lambda: base)()
+    render = {
+        "epsilon_scale": lambda: replace(base, epsilon_scale=float(value)),
+        "max_iterations": lambda: replace(base, max_iterations=int(value)),
+        "tracer": lambda: replace(base, **_tracer(value)),
+        "precision": lambda: replace(base, precision=value),
+        "culling": lambda: replace(base, culling=value),
+        "path": lambda: replace(base, path=value),
+    }.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
     out = [Edit(("render",), render), Do("set_levels", levels)]
     if knob == "prepass":

@@ -1,13 +1,14 @@
 """The platform layer: a GLFW window with an OpenGL 4.3+ core context, Dear ImGui's GLFW and
 OpenGL3 backends, and the routing of GLFW events to ImGui first, then to the window's own
 input (keys, buttons, cursor, wheel) unless ImGui or a gizmo wants them."""
+
 from __future__ import annotations
 
 import ctypes
 from typing import Protocol
 
-from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
 import glfw  # noqa: E402  (order matters)
+from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
 
 from .controls import CONTROLS, LOOK_BUTTON, Input
 
@@ -21,6 +22,7 @@ class WindowError(RuntimeError):
 
 class Receiver(Protocol):
     """What the events are delivered to (the viewer, the editor)."""
+
     input: Input
     orbit_pivot: object
 
@@ -52,7 +54,7 @@ class Platform:
         def on_key(_w, key, scancode, action, mods):
             b.glfw_key_callback(a, key, scancode, action, mods)
             if imgui.get_io().want_capture_keyboard:
-                return                          # typing in a field
+                return  # typing in a field
             if action == glfw.PRESS and mods & glfw.MOD_CONTROL:
                 to.shortcut(key, bool(mods & glfw.MOD_SHIFT))
             elif action != glfw.REPEAT and key in GLFW_KEYS:
@@ -61,7 +63,7 @@ class Platform:
         def on_button(_w, button, action, mods):
             b.glfw_mouse_button_callback(a, button, action, mods)
             if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or to.mouse_claimed()):
-                return                          # the HUD's or a gizmo's press, not the camera's
+                return  # the HUD's or a gizmo's press, not the camera's
             if button == glfw.MOUSE_BUTTON_LEFT:
                 to.left_button(action == glfw.PRESS)
             if button in GLFW_BUTTONS:
@@ -103,8 +105,10 @@ class Platform:
 def open_window(size: tuple[int, int], title: str, visible: bool):
     glfw.ERROR_REPORTING = "ignore"  # failures are reported below, as a WindowError
     if not glfw.init():
-        raise WindowError("cannot open a window: GLFW found no display (is DISPLAY set? "
-                          "use `krsview render` to render headless)")
+        raise WindowError(
+            "cannot open a window: GLFW found no display (is DISPLAY set? "
+            "use `krsview render` to render headless)"
+        )
     for minor in (5, 3):  # 4.6 fails on llvmpipe (DESIGN.md)
         glfw.default_window_hints()
         glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)

@@ -4,6 +4,7 @@ a range by hand. A widget returns the new value; the document validates it.
 
 Each widget reports its interaction: a slider or drag held down is one interaction, so the
 many values it produces merge into one undo step (DESIGN.md, One seam for edits)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -11,13 +12,14 @@ from typing import Any
 
 from imgui_bundle import imgui
 
-LOG_RATIO = 100.0   # a range spanning more than this factor gets a logarithmic slider
+LOG_RATIO = 100.0  # a range spanning more than this factor gets a logarithmic slider
 
 
 @dataclass
 class Interactions:
     """Numbers each press-and-drag of a widget, so its edits merge into one undo step; keeps
     where each field's widget was drawn (window pixels), for automation and window tests."""
+
     count: int = 0
     rects: dict[tuple, tuple[float, float, float, float]] = field(default_factory=dict)
 
@@ -34,7 +36,8 @@ def _tooltip(meta: dict) -> None:
     text = meta.get("help", "")
     lo, hi, unit = meta.get("lo"), meta.get("hi"), meta.get("unit", "")
     if lo is not None or hi is not None:
-        text += f" [{'' if lo is None else lo} … {'' if hi is None else hi}{' ' + unit if unit else ''}]"
+        lo_text, hi_text = "" if lo is None else lo, "" if hi is None else hi
+        text += f" [{lo_text} … {hi_text}{' ' + unit if unit else ''}]"
     if text and imgui.is_item_hovered():
         imgui.set_tooltip(text + "\n(ctrl+click or double-click to type a value)")
 
@@ -59,14 +62,25 @@ def field_widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
         value = choices[k]
     elif isinstance(value, int):
         changed, value = imgui.drag_int(label, value, 0.2, int(lo or 0), int(hi or 0))
-    elif isinstance(value, float) and lo is not None and hi is not None and lo > 0 \
-            and hi / lo > LOG_RATIO:
-        changed, value = imgui.slider_float(label, value, lo, hi, "%.4g",
-                                            imgui.SliderFlags_.logarithmic)
+    elif (
+        isinstance(value, float)
+        and lo is not None
+        and hi is not None
+        and lo > 0
+        and hi / lo > LOG_RATIO
+    ):
+        changed, value = imgui.slider_float(
+            label, value, lo, hi, "%.4g", imgui.SliderFlags_.logarithmic
+        )
     elif isinstance(value, float):
-        changed, value = imgui.drag_float(label, value, _speed(value, meta),
-                                          lo if lo is not None else 0.0,
-                                          hi if hi is not None else 0.0, "%.5g")
+        changed, value = imgui.drag_float(
+            label,
+            value,
+            _speed(value, meta),
+            lo if lo is not None else 0.0,
+            hi if hi is not None else 0.0,
+            "%.5g",
+        )
     elif isinstance(value, tuple) and len(value) == 3 and lo == 0.0 and hi == 1.0:
         changed, rgb = imgui.color_edit3(label, list(value), imgui.ColorEditFlags_.float)
         value = tuple(rgb)

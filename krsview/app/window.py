@@ -1,50 +1,60 @@
 """`krsview view`: a GLFW window to fly through a scene, with adaptive resolution, an ImGui HUD
 and hot reload of the preset and the shaders."""
+
 from __future__ import annotations
 
 import time
 from dataclasses import replace
 from pathlib import Path
 
+import glfw  # noqa: E402  (order matters)
 import moderngl
 import numpy as np
 from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
-import glfw  # noqa: E402  (order matters)
 
+from ..editor.document import Document
+from ..gpu.context import GL_VERSION
 from ..gpu.display import Display
 from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
-from ..gpu.context import GL_VERSION
 from ..reference.geometry import compile_geometry, free_radius
-from ..editor.document import Document
-from ..scene.effects import EFFECTS, EXCLUSIVE
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
+from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
+from ..scene.effects import EFFECTS, EXCLUSIVE
 from ..scene.model import VIEW_PREPASS
 from ..scene.scene import write_atomic
-from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
 from .adaptive import AdaptiveResolution, Refinement
+from .camera import FlyCamera
 from .commands import Command, Edit
+from .controls import LOOK_BUTTON, ORBIT_BUTTON, Input
 from .hud import draw_hud
 from .measured import load_measured
-from .widgets import Interactions
-from .camera import FlyCamera
-from .controls import LOOK_BUTTON, ORBIT_BUTTON, Input
 from .platform import Platform
+from .widgets import Interactions
 
 LOOK_RADIANS_PER_PIXEL = 0.004
-RELOAD_INTERVAL = 0.5   # seconds between checks of the preset and shader files
+RELOAD_INTERVAL = 0.5  # seconds between checks of the preset and shader files
 
 
 class Viewer:
-    def __init__(self, path: Path, size: tuple[int, int] = (960, 540), hud: bool = True,
-                 target_fps: float = 30.0, visible: bool = True, shader_dir: Path = SHADER_DIR,
-                 prepass: int | None = None, moving_effects: bool = False):
+    def __init__(
+        self,
+        path: Path,
+        size: tuple[int, int] = (960, 540),
+        hud: bool = True,
+        target_fps: float = 30.0,
+        visible: bool = True,
+        shader_dir: Path = SHADER_DIR,
+        prepass: int | None = None,
+        moving_effects: bool = False,
+    ):
         self.shader_dir = Path(shader_dir)
-        self.doc = Document(path)              # a bad file is a SceneError before any window
+        self.doc = Document(path)  # a bad file is a SceneError before any window
         # the pre-pass tile the viewer draws with: given, else the file's, else VIEW_PREPASS
-        self.prepass = prepass if prepass is not None else \
-            self.doc.scene.render.prepass or VIEW_PREPASS
-        self.moving_effects = moving_effects    # False: moving frames skip secondary effects
+        self.prepass = (
+            prepass if prepass is not None else self.doc.scene.render.prepass or VIEW_PREPASS
+        )
+        self.moving_effects = moving_effects  # False: moving frames skip secondary effects
         self.platform = Platform(size, self.window_title(), visible)
         self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
@@ -54,12 +64,12 @@ class Viewer:
         self.interactions = Interactions()
         self.hud = hud
         self.view = "shaded"
-        self.levels = 0                         # 0: all of the scene's levels
-        self.speed_factor = 1.0                 # × distance to the nearest surface, per second
+        self.levels = 0  # 0: all of the scene's levels
+        self.speed_factor = 1.0  # × distance to the nearest surface, per second
         self.orbit_pivot: np.ndarray | None = None
         self.message, self.error = "", ""
         self.recording: list[Pose] | None = None
-        self.camera_path: CameraPath | None = None     # NAME.path.json, recorded or loaded
+        self.camera_path: CameraPath | None = None  # NAME.path.json, recorded or loaded
         self.replay_start: float | None = None
         self.bookmark_index = -1
         self.clock = 0.0
@@ -90,7 +100,7 @@ class Viewer:
         """Follow the document: a new scene version redraws (and recompiles only if its
         variant changed: effects, tracer, geometry family)."""
         self._seen_version = self.doc.version
-        if getattr(self, "_measured_for", None) != self.path.stem:   # per preset, not per edit
+        if getattr(self, "_measured_for", None) != self.path.stem:  # per preset, not per edit
             self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
         self.geometry = scene.geometry()
         self.levels = min(self.levels, self.geometry.depth)
@@ -160,8 +170,12 @@ class Viewer:
         effects = self.scene.effects
         if moving and not self.moving_effects:
             effects = [e for e in effects if not EFFECTS[e].secondary]
-        return replace(self.scene, camera=self.camera.to_camera(), effects=effects,
-                       render=replace(self.scene.render, prepass=self.prepass))
+        return replace(
+            self.scene,
+            camera=self.camera.to_camera(),
+            effects=effects,
+            render=replace(self.scene.render, prepass=self.prepass),
+        )
 
     def nearest_distance(self) -> float:
         """Radius of an empty ball around the eye. Recomputed only after the eye moved a
@@ -197,9 +211,13 @@ class Viewer:
         return bool(glfw.window_should_close(self.window))
 
     def is_idle(self) -> bool:
-        return (not self.dirty and (self.refinement is None or self.refinement.done)
-                and not self.input.held and not self.input.buttons
-                and self.replay_start is None)
+        return (
+            not self.dirty
+            and (self.refinement is None or self.refinement.done)
+            and not self.input.held
+            and not self.input.buttons
+            and self.replay_start is None
+        )
 
     def step(self, dt: float) -> None:
         """One event-loop turn: input, reload, a bounded amount of tracing, present, HUD."""
@@ -268,8 +286,14 @@ class Viewer:
         self.ctx.screen.use()
         self.ctx.clear(*self.scene.material.background)
         if self.image is not None:
-            self.display.show(self.image[0], self.ctx.screen, fb, self.view,
-                              self.scene.render.max_iterations, self._depth_scale())
+            self.display.show(
+                self.image[0],
+                self.ctx.screen,
+                fb,
+                self.view,
+                self.scene.render.max_iterations,
+                self._depth_scale(),
+            )
         if self.hud:
             self.platform.new_frame()
             self.draw_ui(fb)
@@ -289,8 +313,9 @@ class Viewer:
                 getattr(self, c.action)(*c.args)
 
     def _depth_scale(self) -> float:
-        return max(float(np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))),
-                   1e-9)
+        return max(
+            float(np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))), 1e-9
+        )
 
     # ---------------------------------------------------------------------------- input
     def _handle_input(self, dt: float) -> None:
@@ -298,13 +323,14 @@ class Viewer:
             self.act(action)
         scroll = self.input.take_scroll()
         if scroll:
-            self.speed_factor *= 1.25 ** scroll
+            self.speed_factor *= 1.25**scroll
         dx, dy = self.input.take_drag()
         move = np.array(self.input.movement(), dtype=float)
         if self.orbit_pivot is not None:
             if ORBIT_BUTTON in self.input.buttons and (dx or dy):
-                self.camera.orbit(self.orbit_pivot, -dx * LOOK_RADIANS_PER_PIXEL,
-                                  dy * LOOK_RADIANS_PER_PIXEL)
+                self.camera.orbit(
+                    self.orbit_pivot, -dx * LOOK_RADIANS_PER_PIXEL, dy * LOOK_RADIANS_PER_PIXEL
+                )
                 self.dirty = True
             if move[2]:
                 self.camera.dolly(self.orbit_pivot, 0.5 ** (move[2] * dt * self.speed_factor))
@@ -326,8 +352,11 @@ class Viewer:
             self.orbit_pivot, self.dirty = None, True
         elif action == "orbit":
             self.orbit_pivot = None if self.orbit_pivot is not None else self.pick_center()
-            self.message = "orbit mode: left-drag turns, W/S dolly" if self.orbit_pivot is not None \
+            self.message = (
+                "orbit mode: left-drag turns, W/S dolly"
+                if self.orbit_pivot is not None
                 else "fly mode"
+            )
         elif action == "screenshot":
             self.screenshot()
         elif action == "hud":
@@ -386,8 +415,10 @@ class Viewer:
         poses = list(self.camera_path.poses)
         try:
             write_atomic(self.path_file(), camera_path_json(poses))
-            self.message = (f"recorded {len(poses)} poses to {self.path_file().name} "
-                            "(F6 replays; `krsview render --camera-path` renders its frames)")
+            self.message = (
+                f"recorded {len(poses)} poses to {self.path_file().name} "
+                "(F6 replays; `krsview render --camera-path` renders its frames)"
+            )
         except OSError as e:
             self.error = f"{self.path_file()}: cannot save the camera path: {e.strerror}"
 
@@ -415,8 +446,14 @@ class Viewer:
 
     def _replay(self) -> None:
         if self.recording is not None:
-            self.recording.append(Pose(self.clock, tuple(float(c) for c in self.camera.position),
-                                       self.camera.yaw, self.camera.pitch))
+            self.recording.append(
+                Pose(
+                    self.clock,
+                    tuple(float(c) for c in self.camera.position),
+                    self.camera.yaw,
+                    self.camera.pitch,
+                )
+            )
         if self.replay_start is None:
             return
         path = self.camera_path
@@ -435,6 +472,7 @@ class Viewer:
                 return p.stat().st_mtime
             except OSError:
                 return 0.0
+
         shaders = sorted(self.shader_dir.iterdir())
         return (mtime(self.path), tuple(mtime(p) for p in shaders))
 
@@ -460,7 +498,7 @@ class Viewer:
             self.doc.reload()
             self.error, self.message = "", f"reloaded {self.path.name}"
         except SceneError as e:
-            self.error = str(e)             # keep the last good scene and image
+            self.error = str(e)  # keep the last good scene and image
 
     def reload_shaders(self) -> None:
         """Compile the current variant from the edited files; on failure keep the old ones."""
@@ -484,10 +522,12 @@ class Viewer:
         prog = self.renderer.prepare(self.view_scene(), *size, self.krs)
         fbo = self.renderer.draw(prog, *size)
         target = self.ctx.simple_framebuffer(size, components=4)
-        self.display.show(fbo, target, size, self.view, self.scene.render.max_iterations,
-                          self._depth_scale())
+        self.display.show(
+            fbo, target, size, self.view, self.scene.render.max_iterations, self._depth_scale()
+        )
         rgb = np.frombuffer(target.read(components=3), np.uint8).reshape(size[1], size[0], 3)
         from PIL import Image
+
         Image.fromarray(rgb[::-1]).save(out)
         target.release()
         self.message = f"screenshot: {out.resolve()}"
@@ -502,7 +542,7 @@ class Viewer:
             return
         b = Bookmark(f"view {len(on_disk.bookmarks) + 1}", self.camera.to_camera())
         save_scene(replace(on_disk, bookmarks=on_disk.bookmarks + [b]), self.path)
-        self._stamps = self._file_stamps()      # our own save is not an outside edit
+        self._stamps = self._file_stamps()  # our own save is not an outside edit
         self.edit(("bookmarks",), on_disk.bookmarks + [b])
         self.doc.mark_saved(replace(on_disk, bookmarks=on_disk.bookmarks + [b]))
         self.message = f"saved bookmark {b.name!r} in {self.path.name}"

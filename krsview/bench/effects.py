@@ -13,6 +13,7 @@ The paper reports soft shadows at quarter resolution ≈ 25 % of the primary cos
 occlusion ≈ one extra level and a compound of eight ≈ a single KRS of similar kernel count;
 we trace shadows at full resolution.
 """
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -55,37 +56,62 @@ def runs_of(scene: Scene) -> dict[str, tuple[Scene, bool]]:
     return runs
 
 
-def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5,
-                  csv: str | None = None) -> list[dict]:
+def bench_effects(
+    scene: Scene, size: tuple[int, int], rounds: int = 5, csv: str | None = None
+) -> list[dict]:
     w, h = size
     runs = runs_of(scene)
-    med = median_times(Renderer(), {name: Variant(s, all_effects=uber)
-                                    for name, (s, uber) in runs.items()},
-                       size, rounds, f"bench effects {scene.name}")
-    rows = [dict(variant=name, effects="+".join(s.effects) or "none",
-                 all_effects_compiled=uber, ms=med[name] * 1e3,
-                 ratio_to_plain=med[name] / med["plain"],
-                 incremental=med[name] / med["plain"] - 1.0)
-            for name, (s, uber) in runs.items()]
+    med = median_times(
+        Renderer(),
+        {name: Variant(s, all_effects=uber) for name, (s, uber) in runs.items()},
+        size,
+        rounds,
+        f"bench effects {scene.name}",
+    )
+    rows = [
+        dict(
+            variant=name,
+            effects="+".join(s.effects) or "none",
+            all_effects_compiled=uber,
+            ms=med[name] * 1e3,
+            ratio_to_plain=med[name] / med["plain"],
+            incremental=med[name] / med["plain"] - 1.0,
+        )
+        for name, (s, uber) in runs.items()
+    ]
     alone = [med[name] for name in runs if name.startswith("component ")]
     if alone:
-        rows.append(dict(variant="components alone, summed", effects="none",
-                         all_effects_compiled=False, ms=sum(alone) * 1e3,
-                         ratio_to_plain=sum(alone) / med["plain"],
-                         incremental=sum(alone) / med["plain"] - 1.0))
-    print(f"\nEffect costs — {scene.name}, {w}×{h}, {scene.render.tracer} tracing, median of "
-          f"{rounds} interleaved rounds (ratios to plain = no effect, specialised)\n")
+        rows.append(
+            dict(
+                variant="components alone, summed",
+                effects="none",
+                all_effects_compiled=False,
+                ms=sum(alone) * 1e3,
+                ratio_to_plain=sum(alone) / med["plain"],
+                incremental=sum(alone) / med["plain"] - 1.0,
+            )
+        )
+    print(
+        f"\nEffect costs — {scene.name}, {w}×{h}, {scene.render.tracer} tracing, median of "
+        f"{rounds} interleaved rounds (ratios to plain = no effect, specialised)\n"
+    )
     print("| variant | effects | ms/frame | × plain | incremental cost |")
     print("|---|---|---:|---:|---:|")
     for row in rows:
-        print(f"| {row['variant']} | {row['effects']} | {row['ms']:.1f} | "
-              f"{row['ratio_to_plain']:.2f} | {row['incremental']:+.0%} |")
+        print(
+            f"| {row['variant']} | {row['effects']} | {row['ms']:.1f} | "
+            f"{row['ratio_to_plain']:.2f} | {row['incremental']:+.0%} |"
+        )
     if scene.effects:
-        print(f"\nspecialised vs all effects compiled, scene's effects on: "
-              f"{med['scene, all compiled'] / med['scene, specialised']:.2f}× slower "
-              f"when not specialised")
-    print(f"all effects compiled, none on, vs plain: "
-          f"{med['none on, all compiled'] / med['plain']:.2f}×")
+        print(
+            f"\nspecialised vs all effects compiled, scene's effects on: "
+            f"{med['scene, all compiled'] / med['scene, specialised']:.2f}× slower "
+            f"when not specialised"
+        )
+    print(
+        f"all effects compiled, none on, vs plain: "
+        f"{med['none on, all compiled'] / med['plain']:.2f}×"
+    )
     if csv:
         write_csv(rows, csv)
     return rows

@@ -2,11 +2,12 @@
 beside it (DESIGN.md: hard cases are inputs, not accidents). The tests and ``krsview check
 --stability hard`` run the invariants of :mod:`krsview.bench.stability` over every case;
 docs/stability.md reports the outcomes."""
+
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Callable
 
 import numpy as np
 
@@ -14,17 +15,29 @@ from ..presets import resolve
 from ..reference.camera import pixel_ray, view_of
 from ..reference.geometry import compile_geometry, component_distances, nearest, scene_distance
 from ..reference.trace import sphere_trace
-from ..scene import (KRS, Camera, Capsule, Component, Empty, Level, Mirror, Plane, Render,
-                     Scene, Sphere, load_scene)
+from ..scene import (
+    KRS,
+    Camera,
+    Capsule,
+    Component,
+    Empty,
+    Level,
+    Mirror,
+    Plane,
+    Render,
+    Scene,
+    Sphere,
+    load_scene,
+)
 
 
 @dataclass(frozen=True)
 class HardCase:
     name: str
     build: Callable[[], Scene]
-    expect: str                 # what must hold, in words
-    precision_limit: str = ""   # where float32 on the GPU cannot follow, and the mitigation
-    capped: bool = False        # rays are expected to reach the iteration cap (counted)
+    expect: str  # what must hold, in words
+    precision_limit: str = ""  # where float32 on the GPU cannot follow, and the mitigation
+    capped: bool = False  # rays are expected to reach the iteration cap (counted)
 
 
 # ------------------------------------------------------------------------------ helpers
@@ -33,13 +46,15 @@ def preset(name: str) -> Scene:
 
 
 def look(scene: Scene, position, target, fov_y: float | None = None) -> Scene:
-    cam = replace(scene.camera, position=tuple(map(float, position)),
-                  target=tuple(map(float, target)))
+    cam = replace(
+        scene.camera, position=tuple(map(float, position)), target=tuple(map(float, target))
+    )
     return replace(scene, camera=cam if fov_y is None else replace(cam, fov_y=fov_y))
 
 
-def surface_point(scene: Scene, x: float, y: float, width: int = 64, height: int = 36
-                  ) -> tuple[np.ndarray, np.ndarray]:
+def surface_point(
+    scene: Scene, x: float, y: float, width: int = 64, height: int = 36
+) -> tuple[np.ndarray, np.ndarray]:
     """The surface point seen through window point (x, y) of the scene's camera, and its
     world normal: the reference traces the ray (at the view's own level of detail), then
     Newton steps p ← p − d(p)·n(p) put p on the surface to float64 rounding (the traced hit
@@ -91,31 +106,45 @@ def camera_on_mirror() -> Scene:
 def points_on_planes() -> Scene:
     """Kernel centres and the eye's line of sight exactly on the mirror planes: every fold
     meets e = u·x − w = 0 exactly (a sphere centred on each of three mirrors)."""
-    return krs_scene("points-on-planes", [
-        Level(Sphere((0.0, 0.5, 0.0), 0.3), None),
-        Level(Sphere((0.0, 1.2, 0.0), 0.2), Mirror((1.0, 0.0, 0.0), 0.0)),
-        Level(Sphere((0.0, 0.5, 0.0), 0.15), Mirror((0.0, 0.0, 1.0), 0.0)),
-        Level(Empty(), Mirror((0.0, 1.0, 0.0), 0.5))],
-        Camera((0.0, 0.5, -4.0), (0.0, 0.5, 0.0)))
+    return krs_scene(
+        "points-on-planes",
+        [
+            Level(Sphere((0.0, 0.5, 0.0), 0.3), None),
+            Level(Sphere((0.0, 1.2, 0.0), 0.2), Mirror((1.0, 0.0, 0.0), 0.0)),
+            Level(Sphere((0.0, 0.5, 0.0), 0.15), Mirror((0.0, 0.0, 1.0), 0.0)),
+            Level(Empty(), Mirror((0.0, 1.0, 0.0), 0.5)),
+        ],
+        Camera((0.0, 0.5, -4.0), (0.0, 0.5, 0.0)),
+    )
 
 
 def grazing_ground() -> Scene:
     """Rays skimming a ground plane and sphere silhouettes; a low cap of 48 is reached."""
-    return krs_scene("grazing-ground", [
-        Level(Sphere((0.0, 0.3, 0.0), 0.3), None),
-        Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.8)),
-        Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), Mirror((0.0, 0.0, 1.0), 1.5))],
-        Camera((0.0, 0.02, -4.0), (0.0, 0.0, 10.0)), max_iterations=48, max_distance=60.0)
+    return krs_scene(
+        "grazing-ground",
+        [
+            Level(Sphere((0.0, 0.3, 0.0), 0.3), None),
+            Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.8)),
+            Level(Plane((0.0, 1.0, 0.0), 0.0, (0.4, 0.5, 0.3)), Mirror((0.0, 0.0, 1.0), 1.5)),
+        ],
+        Camera((0.0, 0.02, -4.0), (0.0, 0.0, 10.0)),
+        max_iterations=48,
+        max_distance=60.0,
+    )
 
 
 def grazing_kernel() -> Scene:
     """The line of sight runs along a capsule's surface, tangent to it, and along its mirror
     copy: steps shrink to the distance to the surface for the whole length."""
     r = 0.2
-    return krs_scene("grazing-kernel", [
-        Level(Capsule((0.0, 0.0, 0.0), (0.0, 0.0, 6.0), r), None),
-        Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.5))],
-        Camera((0.0, r, -2.0), (0.0, r, 6.0)))
+    return krs_scene(
+        "grazing-kernel",
+        [
+            Level(Capsule((0.0, 0.0, 0.0), (0.0, 0.0, 6.0), r), None),
+            Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.5)),
+        ],
+        Camera((0.0, r, -2.0), (0.0, r, 6.0)),
+    )
 
 
 def inside_kernel() -> Scene:
@@ -131,29 +160,40 @@ def inside_crown() -> Scene:
 
 def tiny_radii() -> Scene:
     """A KRS of radius-1e-6 spheres 1e-5 apart, seen from 1e-5: all lengths tiny."""
-    return krs_scene("tiny-radii", [
-        Level(Sphere((0.0, 0.0, 0.0), 1e-6), None),
-        Level(Empty(), Mirror((1.0, 0.0, 0.0), 2e-6)),
-        Level(Empty(), Mirror((0.0, 1.0, 0.0), 2e-6))],
-        Camera((0.0, 2e-6, -2e-5), (2e-6, 2e-6, 0.0)), max_distance=1e-3)
+    return krs_scene(
+        "tiny-radii",
+        [
+            Level(Sphere((0.0, 0.0, 0.0), 1e-6), None),
+            Level(Empty(), Mirror((1.0, 0.0, 0.0), 2e-6)),
+            Level(Empty(), Mirror((0.0, 1.0, 0.0), 2e-6)),
+        ],
+        Camera((0.0, 2e-6, -2e-5), (2e-6, 2e-6, 0.0)),
+        max_distance=1e-3,
+    )
 
 
 def huge_radii() -> Scene:
     """Spheres of radius 1e8 (scene coordinates near the validated 1e9), seen from 5e8."""
-    return krs_scene("huge-radii", [
-        Level(Sphere((0.0, 0.0, 0.0), 1e8), None),
-        Level(Empty(), Mirror((1.0, 0.0, 0.0), 1.5e8))],
-        Camera((1.5e8, 5e7, -5e8), (1.5e8, 0.0, 0.0)), max_distance=1e9)
+    return krs_scene(
+        "huge-radii",
+        [Level(Sphere((0.0, 0.0, 0.0), 1e8), None), Level(Empty(), Mirror((1.0, 0.0, 0.0), 1.5e8))],
+        Camera((1.5e8, 5e7, -5e8), (1.5e8, 0.0, 0.0)),
+        max_distance=1e9,
+    )
 
 
 def parallel_mirrors() -> Scene:
     """Two mirrors 1e-6 rad apart: their images pile up along a thin wedge."""
     a = 1e-6
-    return krs_scene("parallel-mirrors", [
-        Level(Sphere((-0.6, 0.5, 0.0), 0.3), None),
-        Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.0)),
-        Level(Empty(), Mirror((math.cos(a), math.sin(a), 0.0), 0.0))],
-        Camera((0.0, 1.5, -4.0), (0.0, 0.5, 0.0)))
+    return krs_scene(
+        "parallel-mirrors",
+        [
+            Level(Sphere((-0.6, 0.5, 0.0), 0.3), None),
+            Level(Empty(), Mirror((1.0, 0.0, 0.0), 0.0)),
+            Level(Empty(), Mirror((math.cos(a), math.sin(a), 0.0), 0.0)),
+        ],
+        Camera((0.0, 1.5, -4.0), (0.0, 0.5, 0.0)),
+    )
 
 
 def compound_overlap() -> Scene:
@@ -161,8 +201,14 @@ def compound_overlap() -> Scene:
     s = preset("tree")
     t = replace(s.tree, levels=12, ground=None)
     comps = [Component(tree=t), Component(tree=t, position=(0.8, 0.0, 0.3), angle=70.0)]
-    return replace(s, name="compound-overlap", tree=None, compound=comps, effects=[],
-                   camera=replace(s.camera, position=(0.5, 3.0, -9.0), target=(0.4, 3.0, 0.0)))
+    return replace(
+        s,
+        name="compound-overlap",
+        tree=None,
+        compound=comps,
+        effects=[],
+        camera=replace(s.camera, position=(0.5, 3.0, -9.0), target=(0.4, 3.0, 0.0)),
+    )
 
 
 def twist_ground() -> Scene:
@@ -196,10 +242,18 @@ def mobius_gamma_zero() -> Scene:
 
 def _inversion_of_sphere(name: str, center, radius: float) -> Scene:
     from ..scene import Invert, MobiusLevel, MoKRS
-    lv = MobiusLevel(kernel=Sphere(tuple(center), radius), reflect=False,
-                     transform=[Invert((0.0, 0.0, 0.0), 1.0)])
-    return Scene(name=name, camera=Camera((0.3, 0.4, 3.0), (0.0, 0.0, 0.0)),
-                 render=Render(tracer="binary", max_distance=200.0), mokrs=MoKRS([lv]))
+
+    lv = MobiusLevel(
+        kernel=Sphere(tuple(center), radius),
+        reflect=False,
+        transform=[Invert((0.0, 0.0, 0.0), 1.0)],
+    )
+    return Scene(
+        name=name,
+        camera=Camera((0.3, 0.4, 3.0), (0.0, 0.0, 0.0)),
+        render=Render(tracer="binary", max_distance=200.0),
+        mokrs=MoKRS([lv]),
+    )
 
 
 def mobius_sixty_levels() -> Scene:
@@ -215,59 +269,111 @@ def control_on_chord() -> Scene:
     lv = r.levels[-1]
     a = np.array(r.base)
     b = np.array(lv.fork)
-    return replace(s, name="control-on-chord", route=replace(r, levels=r.levels[:-1] + [
-        replace(lv, control=tuple(a + 0.4 * (b - a)))]))
+    return replace(
+        s,
+        name="control-on-chord",
+        route=replace(r, levels=r.levels[:-1] + [replace(lv, control=tuple(a + 0.4 * (b - a)))]),
+    )
 
 
 # The tree's twig at window point (27.5, 0.5) of a 64×36 view: level 0, behind all 22 folds.
 TWIG = (27.5, 0.5)
 
-CASES: dict[str, HardCase] = {c.name: c for c in [
-    HardCase("camera-on-mirror", camera_on_mirror,
-             "the eye on a mirror plane: both half-images drawn, no seam, GPU = reference"),
-    HardCase("points-on-planes", points_on_planes,
-             "folds at exactly e = 0 keep each sphere whole: GPU = reference"),
-    HardCase("grazing-ground", grazing_ground,
-             "rays skimming the ground reach the cap of 48; those are counted as capped",
-             capped=True),
-    HardCase("grazing-kernel", grazing_kernel,
-             "a line of sight tangent to a capsule for its whole length: finite, bounded"),
-    HardCase("inside-kernel", inside_kernel,
-             "the eye inside the trunk: every ray hits at t = 0 in one iteration"),
-    HardCase("inside-crown", inside_crown,
-             "the eye among the branches of the crown: GPU = reference"),
-    HardCase("levels-30", lambda: tree_levels(30), "a billion twigs: finite, GPU = reference"),
-    HardCase("levels-40", lambda: tree_levels(40), "2^41 instances: finite, GPU = reference"),
-    HardCase("levels-63", lambda: tree_levels(63),
-             "the most levels a tree may have: finite, GPU = reference"),
-    HardCase("deep-zoom-1e-6", lambda: zoomed(preset("tree"), *TWIG, 1e-6),
-             "a twig seen from 1e-6 scene units: depths and normals as the reference's",
-             "float32 kernel records and folds are off by ~1e-7 × scene size, a tenth of "
-             "this view: precision = \"double\" follows the reference (depth to 1e-7)"),
-    HardCase("deep-zoom-1e-9", lambda: zoomed(preset("tree"), *TWIG, 1e-9),
-             "a twig seen from 1e-9 scene units: depths and normals as the reference's",
-             "float32 is off by 100× the view; precision = \"double\" follows the reference",
-             capped=True),   # a few rays graze the horizon at a 1e-9 scale: counted
-    HardCase("tiny-radii", tiny_radii, "lengths of 1e-6 throughout: GPU = reference"),
-    HardCase("huge-radii", huge_radii, "lengths of 1e8 throughout: GPU = reference"),
-    HardCase("parallel-mirrors", parallel_mirrors,
-             "mirrors 1e-6 rad apart: finite, GPU = reference"),
-    HardCase("compound-overlap", compound_overlap,
-             "interpenetrating components: the nearer surface wins, GPU = reference"),
-    HardCase("twist-ground", twist_ground,
-             "twisted forest on its ground: the ground never rises above its plane (ε shrinks "
-             "with the twist's Lipschitz bound, so rays converge only at the surface), GPU = "
-             "reference (a bare twisted plane, tested apart, has capped far rays: counted)"),
-    HardCase("mobius-pole-in-view", mobius_pole_in_view,
-             "rays through and near the pole pass (the level bound lies outside the probe's "
-             "exterior image): nothing drawn there, GPU = reference"),
-    HardCase("mobius-alpha-zero", mobius_alpha_zero,
-             "a sphere mapped to radius ~1e4: finite, GPU = reference"),
-    HardCase("mobius-gamma-zero", mobius_gamma_zero,
-             "a sphere mapped through 1e-7 of the origin: finite, GPU = reference"),
-    HardCase("mobius-60-levels", mobius_sixty_levels,
-             "60 composed quaternion maps: no drift beyond the agreement tolerances"),
-    HardCase("control-on-chord", control_on_chord,
-             "a branch with its control point on the chord is a straight capsule: "
-             "GPU = reference"),
-]}
+CASES: dict[str, HardCase] = {
+    c.name: c
+    for c in [
+        HardCase(
+            "camera-on-mirror",
+            camera_on_mirror,
+            "the eye on a mirror plane: both half-images drawn, no seam, GPU = reference",
+        ),
+        HardCase(
+            "points-on-planes",
+            points_on_planes,
+            "folds at exactly e = 0 keep each sphere whole: GPU = reference",
+        ),
+        HardCase(
+            "grazing-ground",
+            grazing_ground,
+            "rays skimming the ground reach the cap of 48; those are counted as capped",
+            capped=True,
+        ),
+        HardCase(
+            "grazing-kernel",
+            grazing_kernel,
+            "a line of sight tangent to a capsule for its whole length: finite, bounded",
+        ),
+        HardCase(
+            "inside-kernel",
+            inside_kernel,
+            "the eye inside the trunk: every ray hits at t = 0 in one iteration",
+        ),
+        HardCase(
+            "inside-crown", inside_crown, "the eye among the branches of the crown: GPU = reference"
+        ),
+        HardCase("levels-30", lambda: tree_levels(30), "a billion twigs: finite, GPU = reference"),
+        HardCase("levels-40", lambda: tree_levels(40), "2^41 instances: finite, GPU = reference"),
+        HardCase(
+            "levels-63",
+            lambda: tree_levels(63),
+            "the most levels a tree may have: finite, GPU = reference",
+        ),
+        HardCase(
+            "deep-zoom-1e-6",
+            lambda: zoomed(preset("tree"), *TWIG, 1e-6),
+            "a twig seen from 1e-6 scene units: depths and normals as the reference's",
+            "float32 kernel records and folds are off by ~1e-7 × scene size, a tenth of "
+            'this view: precision = "double" follows the reference (depth to 1e-7)',
+        ),
+        HardCase(
+            "deep-zoom-1e-9",
+            lambda: zoomed(preset("tree"), *TWIG, 1e-9),
+            "a twig seen from 1e-9 scene units: depths and normals as the reference's",
+            'float32 is off by 100× the view; precision = "double" follows the reference',
+            capped=True,
+        ),  # a few rays graze the horizon at a 1e-9 scale: counted
+        HardCase("tiny-radii", tiny_radii, "lengths of 1e-6 throughout: GPU = reference"),
+        HardCase("huge-radii", huge_radii, "lengths of 1e8 throughout: GPU = reference"),
+        HardCase(
+            "parallel-mirrors", parallel_mirrors, "mirrors 1e-6 rad apart: finite, GPU = reference"
+        ),
+        HardCase(
+            "compound-overlap",
+            compound_overlap,
+            "interpenetrating components: the nearer surface wins, GPU = reference",
+        ),
+        HardCase(
+            "twist-ground",
+            twist_ground,
+            "twisted forest on its ground: the ground never rises above its plane (ε shrinks "
+            "with the twist's Lipschitz bound, so rays converge only at the surface), GPU = "
+            "reference (a bare twisted plane, tested apart, has capped far rays: counted)",
+        ),
+        HardCase(
+            "mobius-pole-in-view",
+            mobius_pole_in_view,
+            "rays through and near the pole pass (the level bound lies outside the probe's "
+            "exterior image): nothing drawn there, GPU = reference",
+        ),
+        HardCase(
+            "mobius-alpha-zero",
+            mobius_alpha_zero,
+            "a sphere mapped to radius ~1e4: finite, GPU = reference",
+        ),
+        HardCase(
+            "mobius-gamma-zero",
+            mobius_gamma_zero,
+            "a sphere mapped through 1e-7 of the origin: finite, GPU = reference",
+        ),
+        HardCase(
+            "mobius-60-levels",
+            mobius_sixty_levels,
+            "60 composed quaternion maps: no drift beyond the agreement tolerances",
+        ),
+        HardCase(
+            "control-on-chord",
+            control_on_chord,
+            "a branch with its control point on the chord is a straight capsule: GPU = reference",
+        ),
+    ]
+}

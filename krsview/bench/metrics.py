@@ -6,6 +6,7 @@ threshold explains it. Depth error is measured in units of the LOD threshold ε(
 footprint × t [KRS17 §4], so "within 1" means "as close as the tracer was asked to stop".
 The GPU-vs-reference pixel tests use :func:`agreement` from here too.
 """
+
 from __future__ import annotations
 
 import math
@@ -15,8 +16,8 @@ import numpy as np
 
 from ..buffers import Buffers
 
-SSIM_WINDOW = 7           # pixels on a side of SSIM's local window
-SSIM_C1, SSIM_C2 = 0.01 ** 2, 0.03 ** 2   # Wang et al. 2004's constants for a range of 1
+SSIM_WINDOW = 7  # pixels on a side of SSIM's local window
+SSIM_C1, SSIM_C2 = 0.01**2, 0.03**2  # Wang et al. 2004's constants for a range of 1
 
 
 def silhouette(hit: np.ndarray) -> np.ndarray:
@@ -47,8 +48,9 @@ def ssim(a: np.ndarray, b: np.ndarray, k: int = SSIM_WINDOW) -> float:
     va = _box_mean(a * a, k) - ma * ma
     vb = _box_mean(b * b, k) - mb * mb
     cov = _box_mean(a * b, k) - ma * mb
-    s = ((2 * ma * mb + SSIM_C1) * (2 * cov + SSIM_C2)) / \
-        ((ma * ma + mb * mb + SSIM_C1) * (va + vb + SSIM_C2))
+    s = ((2 * ma * mb + SSIM_C1) * (2 * cov + SSIM_C2)) / (
+        (ma * ma + mb * mb + SSIM_C1) * (va + vb + SSIM_C2)
+    )
     return float(s.mean())
 
 
@@ -60,18 +62,18 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class Errors:
-    holes: float               # fraction of pixels: truth hits, image misses
-    false_hits: float          # fraction of pixels: image hits, truth misses
+    holes: float  # fraction of pixels: truth hits, image misses
+    false_hits: float  # fraction of pixels: image hits, truth misses
     holes_off_silhouette: float
     false_hits_off_silhouette: float
-    depth_eps_median: float    # |t − t_truth| / ε(t_truth) on common hits
+    depth_eps_median: float  # |t − t_truth| / ε(t_truth) on common hits
     depth_eps_p99: float
-    normal_deg_median: float   # angle between normals on common hits
+    normal_deg_median: float  # angle between normals on common hits
     normal_deg_p99: float
-    psnr: float                # colour, dB
+    psnr: float  # colour, dB
     ssim: float
-    iterations: float          # mean per pixel
-    capped: float              # fraction of pixels whose ray spent the cap without a verdict
+    iterations: float  # mean per pixel
+    capped: float  # fraction of pixels whose ray spent the cap without a verdict
 
     @property
     def mask_error(self) -> float:
@@ -90,17 +92,25 @@ def compare(image: Buffers, truth: Buffers, eps_per_t: float, cap: int) -> Error
     dt = np.abs(image.depth[both] - t) / np.maximum(eps_per_t * t, 1e-300)
     cos = np.clip((image.normal * truth.normal).sum(-1)[both], -1.0, 1.0)
     ang = np.degrees(np.arccos(cos))
-    q = (lambda x, p: float(np.percentile(x, p)) if x.size else 0.0)
+
+    def q(x: np.ndarray, p: float) -> float:
+        return float(np.percentile(x, p)) if x.size else 0.0
+
     n = holes.size
     return Errors(
-        holes=holes.sum() / n, false_hits=false.sum() / n,
+        holes=holes.sum() / n,
+        false_hits=false.sum() / n,
         holes_off_silhouette=(holes & off).sum() / n,
         false_hits_off_silhouette=(false & off).sum() / n,
-        depth_eps_median=q(dt, 50), depth_eps_p99=q(dt, 99),
-        normal_deg_median=q(ang, 50), normal_deg_p99=q(ang, 99),
-        psnr=psnr(image.color, truth.color), ssim=ssim(image.color, truth.color),
+        depth_eps_median=q(dt, 50),
+        depth_eps_p99=q(dt, 99),
+        normal_deg_median=q(ang, 50),
+        normal_deg_p99=q(ang, 99),
+        psnr=psnr(image.color, truth.color),
+        ssim=ssim(image.color, truth.color),
         iterations=float(image.iterations.mean()),
-        capped=float(((image.iterations >= cap) & ~image.hit).mean()))
+        capped=float(((image.iterations >= cap) & ~image.hit).mean()),
+    )
 
 
 def error_image(image: Buffers, truth: Buffers) -> np.ndarray:
@@ -111,7 +121,7 @@ def error_image(image: Buffers, truth: Buffers) -> np.ndarray:
     return out
 
 
-EDGE_DEPTH_JUMP = 0.01    # a 4-neighbour 1 % nearer or farther marks an occlusion edge
+EDGE_DEPTH_JUMP = 0.01  # a 4-neighbour 1 % nearer or farther marks an occlusion edge
 
 
 def edges(b: Buffers) -> np.ndarray:
@@ -131,18 +141,20 @@ def edges(b: Buffers) -> np.ndarray:
 @dataclass(frozen=True)
 class Agreement:
     """How closely two renders of one scene agree (the GPU-vs-reference pixel tests)."""
-    hit: float           # fraction of pixels with equal hit mask
-    depth_close: float   # fraction of common hits with relative depth error ≤ depth_rel
+
+    hit: float  # fraction of pixels with equal hit mask
+    depth_close: float  # fraction of common hits with relative depth error ≤ depth_rel
     normal_close: float  # fraction of common hits with normal angle ≤ normal_deg
-    color: float         # fraction of pixels with every channel within color_tol
+    color: float  # fraction of pixels with every channel within color_tol
     # away from every occlusion edge (of either image), the worst pixel:
-    off_edge_hit: int = 0              # pixels with different hit state
-    off_edge_depth: float = 0.0        # largest relative depth error of a common hit
-    off_edge_color: float = 0.0        # largest channel error
+    off_edge_hit: int = 0  # pixels with different hit state
+    off_edge_depth: float = 0.0  # largest relative depth error of a common hit
+    off_edge_color: float = 0.0  # largest channel error
 
 
-def agreement(a: Buffers, b: Buffers, depth_rel: float, normal_deg: float,
-              color_tol: float) -> Agreement:
+def agreement(
+    a: Buffers, b: Buffers, depth_rel: float, normal_deg: float, color_tol: float
+) -> Agreement:
     both = a.hit & b.hit
     t = b.depth[both]
     dt = np.abs(a.depth[both] - t)
@@ -157,19 +169,22 @@ def agreement(a: Buffers, b: Buffers, depth_rel: float, normal_deg: float,
         off_edge_depth=float(rel[both_off].max()) if both_off.any() else 0.0,
         off_edge_color=float(np.abs(a.color - b.color).max(-1)[off].max()) if off.any() else 0.0,
         hit=float((a.hit == b.hit).mean()),
-        depth_close=float((dt <= depth_rel * np.maximum(t, 1e-12)).sum() / n) if both.any() else 1.0,
+        depth_close=float((dt <= depth_rel * np.maximum(t, 1e-12)).sum() / n)
+        if both.any()
+        else 1.0,
         normal_close=float((angle <= normal_deg).sum() / n) if both.any() else 1.0,
-        color=float((np.abs(a.color - b.color).max(-1) <= color_tol).mean()))
+        color=float((np.abs(a.color - b.color).max(-1) <= color_tol).mean()),
+    )
 
 
 # Tolerances of the GPU (float32) against the reference (float64), and why; the pixel tests
 # and the stability invariants use these. The fractions hold for the whole image; away from
 # occlusion edges (:func:`edges`) every pixel must also meet OFF_EDGE_* below:
-HIT_AGREEMENT = 0.995    # a ray whose last distance lands within float32 rounding of ε flips
-DEPTH_REL = 1e-3         # same stopping step ⇒ depths agree to float32 accumulation over ~100 steps
-NORMAL_DEG = 2.0         # same winning kernel ⇒ same analytic gradient up to float32 rounding
-CLOSE_FRACTION = 0.995   # …except where one side stopped a step later (|Δt| ≈ ε(t)) or slipped
-                         # past an outline onto a surface behind
+HIT_AGREEMENT = 0.995  # a ray whose last distance lands within float32 rounding of ε flips
+DEPTH_REL = 1e-3  # same stopping step ⇒ depths agree to float32 accumulation over ~100 steps
+NORMAL_DEG = 2.0  # same winning kernel ⇒ same analytic gradient up to float32 rounding
+CLOSE_FRACTION = 0.995  # …except where one side stopped a step later (|Δt| ≈ ε(t)) or slipped
+# past an outline onto a surface behind
 COLOR_TOL = 2.0 / 255.0  # one rounding of each channel plus float32 shading error
 COLOR_FRACTION = 0.99
 # Away from occlusion edges, the worst pixel: equal hit state, and at most one tracer step
@@ -187,9 +202,11 @@ def tolerance_failures(a: Agreement) -> list[str]:
     """What falls short of the GPU-vs-reference tolerances; empty when all hold."""
     out = []
     if a.off_edge_hit or a.off_edge_depth > OFF_EDGE_DEPTH or a.off_edge_color > OFF_EDGE_COLOR:
-        out.append(f"away from outlines every pixel must agree: {a.off_edge_hit} hit "
-                   f"mismatches, depth error up to {a.off_edge_depth:.2g} (≤ {OFF_EDGE_DEPTH}), "
-                   f"colour error up to {a.off_edge_color:.3f} (≤ {OFF_EDGE_COLOR})")
+        out.append(
+            f"away from outlines every pixel must agree: {a.off_edge_hit} hit "
+            f"mismatches, depth error up to {a.off_edge_depth:.2g} (≤ {OFF_EDGE_DEPTH}), "
+            f"colour error up to {a.off_edge_color:.3f} (≤ {OFF_EDGE_COLOR})"
+        )
     if a.hit < HIT_AGREEMENT:
         out.append(f"hit masks agree on {a.hit:.4%} < {HIT_AGREEMENT:.1%}")
     if a.depth_close < CLOSE_FRACTION:

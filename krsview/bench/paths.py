@@ -6,6 +6,7 @@ shadows), at two resolutions; frame-time ratios against the plain frame (fragmen
 culling, no pre-pass), iterations and levels of Alg. 1 walked per pixel in the full pass (a
 KRS), and the coarse passes' share of the frame. Variants are interleaved round by round
 (bench/harness.py)."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -15,18 +16,34 @@ from ..scene import Scene
 from .harness import Variant, median_times
 from .report import write_csv
 
-TILES = (0, 4, 8, 16)        # pre-pass tile sizes compared (0: off)
-ONE_PASS_TILES = (4, 8)      # also timed with a single coarse pass (prepass_levels = 1)
-STEPS = (4, 8, 16, 32)       # compute path: iterations per ray per round
-COMPUTE_TILE = 8             # the compute path is timed with culling and this pre-pass
+TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
+ONE_PASS_TILES = (4, 8)  # also timed with a single coarse pass (prepass_levels = 1)
+STEPS = (4, 8, 16, 32)  # compute path: iterations per ray per round
+COMPUTE_TILE = 8  # the compute path is timed with culling and this pre-pass
 
 
-def lever(scene: Scene, path: str, culling: str, tile: int, steps: int,
-          shadow_tasks: str = "on", passes: int | None = None) -> Scene:
+def lever(
+    scene: Scene,
+    path: str,
+    culling: str,
+    tile: int,
+    steps: int,
+    shadow_tasks: str = "on",
+    passes: int | None = None,
+) -> Scene:
     r = scene.render
-    return replace(scene, render=replace(r, path=path, culling=culling, prepass=tile,
-                                         steps=steps, shadow_tasks=shadow_tasks,
-                                         prepass_levels=passes or r.prepass_levels))
+    return replace(
+        scene,
+        render=replace(
+            r,
+            path=path,
+            culling=culling,
+            prepass=tile,
+            steps=steps,
+            shadow_tasks=shadow_tasks,
+            prepass_levels=passes or r.prepass_levels,
+        ),
+    )
 
 
 def levers(scene: Scene) -> dict[tuple, Scene]:
@@ -35,57 +52,108 @@ def levers(scene: Scene) -> dict[tuple, Scene]:
     "inline" on the compute path of a scene with shadows, else ""."""
     shadowed = bool({"shadows", "soft_shadows"} & set(scene.effects))
     passes = scene.render.prepass_levels
-    out = {("fragment", c, t, passes if t else 0, 0, ""):
-           lever(scene, "fragment", c, t, scene.render.steps) for c in ("off", "on") for t in TILES}
-    out.update({("fragment", "on", t, 1, 0, ""): lever(scene, "fragment", "on", t,
-                                                       scene.render.steps, passes=1)
-                for t in ONE_PASS_TILES if passes != 1})
-    out.update({("compute", "on", COMPUTE_TILE, passes, s, "tasks" if shadowed else ""):
-                lever(scene, "compute", "on", COMPUTE_TILE, s) for s in STEPS})
+    out = {
+        ("fragment", c, t, passes if t else 0, 0, ""): lever(
+            scene, "fragment", c, t, scene.render.steps
+        )
+        for c in ("off", "on")
+        for t in TILES
+    }
+    out.update(
+        {
+            ("fragment", "on", t, 1, 0, ""): lever(
+                scene, "fragment", "on", t, scene.render.steps, passes=1
+            )
+            for t in ONE_PASS_TILES
+            if passes != 1
+        }
+    )
+    out.update(
+        {
+            ("compute", "on", COMPUTE_TILE, passes, s, "tasks" if shadowed else ""): lever(
+                scene, "compute", "on", COMPUTE_TILE, s
+            )
+            for s in STEPS
+        }
+    )
     if shadowed:
-        out.update({("compute", "on", COMPUTE_TILE, passes, s, "inline"):
-                    lever(scene, "compute", "on", COMPUTE_TILE, s, "off") for s in STEPS})
+        out.update(
+            {
+                ("compute", "on", COMPUTE_TILE, passes, s, "inline"): lever(
+                    scene, "compute", "on", COMPUTE_TILE, s, "off"
+                )
+                for s in STEPS
+            }
+        )
     return out
 
 
-def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5,
-                csv: str | None = None) -> list[dict]:
+def bench_paths(
+    scene: Scene, size: tuple[int, int], rounds: int = 5, csv: str | None = None
+) -> list[dict]:
     r = Renderer()
     sizes = [size, (2 * size[0], 2 * size[1])]
     rows = []
     for w, h in sizes:
         variants = levers(scene)
-        names = {k: f"{k[0]}, culling {k[1]}, pre-pass {k[2] or 'off'}"
-                 + (f" × {k[3]}" if k[3] else "")
-                 + (f", {k[4]} per round" if k[4] else "")
-                 + (f", shadow rays {k[5]}" if k[5] else "") for k in variants}
-        med = median_times(r, {names[k]: Variant(s) for k, s in variants.items()}, (w, h),
-                           rounds, f"bench paths {scene.name}")
+        names = {
+            k: f"{k[0]}, culling {k[1]}, pre-pass {k[2] or 'off'}"
+            + (f" × {k[3]}" if k[3] else "")
+            + (f", {k[4]} per round" if k[4] else "")
+            + (f", shadow rays {k[5]}" if k[5] else "")
+            for k in variants
+        }
+        med = median_times(
+            r,
+            {names[k]: Variant(s) for k, s in variants.items()},
+            (w, h),
+            rounds,
+            f"bench paths {scene.name}",
+        )
         tiles = {k[1:4]: s for k, s in variants.items() if k[2]}
-        coarse = {k: median_times(r, {"pre-pass": Variant(s, prepass_only=True)}, (w, h),
-                                  rounds, "pre-pass alone")["pre-pass"]
-                  for k, s in tiles.items()}
+        coarse = {
+            k: median_times(
+                r, {"pre-pass": Variant(s, prepass_only=True)}, (w, h), rounds, "pre-pass alone"
+            )["pre-pass"]
+            for k, s in tiles.items()
+        }
         base = med[names[("fragment", "off", 0, 0, 0, "")]]
         for k, s in variants.items():
             t = med[names[k]]
-            rows.append(dict(size=f"{w}x{h}", path=k[0], culling=k[1], prepass=k[2],
-                             coarse_passes=k[3], steps=k[4], shadow_rays=k[5], ms=t * 1e3,
-                             speedup=base / t,
-                             iterations=float(r.render(s, w, h).iterations.mean()),
-                             levels=float(r.levels(s, w, h).mean()) if not scene.mokrs
-                             else 0.0, coarse_share=coarse.get(k[1:4], 0.0) / t))
-    print(f"\nSpeed levers — {scene.name}, median of {rounds} interleaved rounds; speed-up "
-          "against the fragment path without culling or pre-pass at the same size\n")
-    print("| size | path | culling | pre-pass tile | coarse passes | iterations per round | "
-          "shadow rays | ms/frame | speed-up | iterations/px (full pass) | levels walked/px | "
-          "coarse pass share |")
+            rows.append(
+                dict(
+                    size=f"{w}x{h}",
+                    path=k[0],
+                    culling=k[1],
+                    prepass=k[2],
+                    coarse_passes=k[3],
+                    steps=k[4],
+                    shadow_rays=k[5],
+                    ms=t * 1e3,
+                    speedup=base / t,
+                    iterations=float(r.render(s, w, h).iterations.mean()),
+                    levels=float(r.levels(s, w, h).mean()) if not scene.mokrs else 0.0,
+                    coarse_share=coarse.get(k[1:4], 0.0) / t,
+                )
+            )
+    print(
+        f"\nSpeed levers — {scene.name}, median of {rounds} interleaved rounds; speed-up "
+        "against the fragment path without culling or pre-pass at the same size\n"
+    )
+    print(
+        "| size | path | culling | pre-pass tile | coarse passes | iterations per round | "
+        "shadow rays | ms/frame | speed-up | iterations/px (full pass) | levels walked/px | "
+        "coarse pass share |"
+    )
     print("|---|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|")
     for row in rows:
-        levels = f"{row['levels']:.1f}" if row["levels"] else "—"      # not counted in a MöKRS
-        print(f"| {row['size']} | {row['path']} | {row['culling']} | {row['prepass'] or 'off'} "
-              f"| {row['coarse_passes'] or '—'} | {row['steps'] or '—'} | "
-              f"{row['shadow_rays'] or '—'} | {row['ms']:.1f} | {row['speedup']:.2f}× | "
-              f"{row['iterations']:.1f} | {levels} | {row['coarse_share']:.0%} |")
+        levels = f"{row['levels']:.1f}" if row["levels"] else "—"  # not counted in a MöKRS
+        print(
+            f"| {row['size']} | {row['path']} | {row['culling']} | {row['prepass'] or 'off'} "
+            f"| {row['coarse_passes'] or '—'} | {row['steps'] or '—'} | "
+            f"{row['shadow_rays'] or '—'} | {row['ms']:.1f} | {row['speedup']:.2f}× | "
+            f"{row['iterations']:.1f} | {levels} | {row['coarse_share']:.0%} |"
+        )
     if csv:
         write_csv(rows, csv)
     return rows

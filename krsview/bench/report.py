@@ -1,4 +1,5 @@
 """Shared output of the benchmarks: Markdown tables on stdout, CSV files."""
+
 from __future__ import annotations
 
 import csv

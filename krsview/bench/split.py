@@ -5,6 +5,7 @@ is the difference of two variants timed side by side, interleaved (bench/harness
 to the GPU's finish. GPU timer queries would split one frame instead, but llvmpipe's time
 only its command thread (a 138 ms draw read 29 ms), so each part is a variant of its own.
 Drawn on the fragment path, as the viewer draws."""
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -20,28 +21,37 @@ def split_variants(scene: Scene) -> dict[str, Variant]:
     effects (a moving frame), the tracing alone, and the coarse passes alone."""
     scene = replace(scene, render=replace(scene.render, path="fragment"))
     moving = replace(scene, effects=tuple(e for e in scene.effects if not EFFECTS[e].secondary))
-    out = {"frame": Variant(scene), "moving": Variant(moving),
-           "trace": Variant(moving, probes=("KRS_TRACE_ONLY",))}
+    out = {
+        "frame": Variant(scene),
+        "moving": Variant(moving),
+        "trace": Variant(moving, probes=("KRS_TRACE_ONLY",)),
+    }
     if scene.render.prepass:
         out["coarse"] = Variant(scene, prepass_only=True)
     return out
 
 
-def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5,
-                csv: str | None = None) -> list[dict]:
-    med = median_times(Renderer(), split_variants(scene), size, rounds,
-                       f"bench split {scene.name}")
+def bench_split(
+    scene: Scene, size: tuple[int, int], rounds: int = 5, csv: str | None = None
+) -> list[dict]:
+    med = median_times(Renderer(), split_variants(scene), size, rounds, f"bench split {scene.name}")
     coarse = med.get("coarse", 0.0)
-    parts = [("coarse passes", coarse), ("tracing", med["trace"] - coarse),
-             ("nearest kernel and shading", med["moving"] - med["trace"]),
-             ("secondary effects (shadow rays, occlusion)", med["frame"] - med["moving"]),
-             ("frame", med["frame"]), ("moving frame (no secondary effects)", med["moving"])]
+    parts = [
+        ("coarse passes", coarse),
+        ("tracing", med["trace"] - coarse),
+        ("nearest kernel and shading", med["moving"] - med["trace"]),
+        ("secondary effects (shadow rays, occlusion)", med["frame"] - med["moving"]),
+        ("frame", med["frame"]),
+        ("moving frame (no secondary effects)", med["moving"]),
+    ]
     rows = [dict(part=name, ms=t * 1e3, share=t / med["frame"]) for name, t in parts]
     r = scene.render
-    print(f"\nWhere the time goes — {scene.name} at {size[0]}×{size[1]}, pre-pass "
-          f"{f'{r.prepass} × {r.prepass_levels}' if r.prepass else 'off'}, culling "
-          f"{r.culling}; median of {rounds} interleaved rounds, each part the difference of "
-          "two variants\n")
+    print(
+        f"\nWhere the time goes — {scene.name} at {size[0]}×{size[1]}, pre-pass "
+        f"{f'{r.prepass} × {r.prepass_levels}' if r.prepass else 'off'}, culling "
+        f"{r.culling}; median of {rounds} interleaved rounds, each part the difference of "
+        "two variants\n"
+    )
     print("| part | ms | share of the frame |\n|---|---:|---:|")
     for row in rows:
         print(f"| {row['part']} | {row['ms']:.1f} | {row['share']:.0%} |")

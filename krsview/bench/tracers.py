@@ -5,6 +5,7 @@ unexplored (§12). On one KRS scene and view, in one run: sphere tracing, binary
 the paper's (2.0, 0.3), and a small ξ sweep; frames interleaved round by round, medians and
 ratios to sphere tracing. "Hit agreement" compares each hit mask with sphere tracing's.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -26,25 +27,36 @@ def variants(scene: Scene, sweep: bool) -> dict[str, Scene]:
     out = {}
     if scene.mokrs is None:
         out["sphere"] = replace(scene, render=replace(scene.render, tracer="sphere"))
-    pairs = [(2.0, 0.3)] + ([p for p in itertools.product(BONUS, PENALTY) if p != (2.0, 0.3)]
-                            if sweep else [])
+    pairs = [(2.0, 0.3)] + (
+        [p for p in itertools.product(BONUS, PENALTY) if p != (2.0, 0.3)] if sweep else []
+    )
     for b, p in pairs:
-        out[f"binary {b:g}/{p:g}"] = replace(scene, render=replace(
-            scene.render, tracer="binary", xi_bonus=b, xi_penalty=p))
+        out[f"binary {b:g}/{p:g}"] = replace(
+            scene, render=replace(scene.render, tracer="binary", xi_bonus=b, xi_penalty=p)
+        )
     return out
 
 
-def bench_tracers(scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: bool = True,
-                  csv: str | None = None) -> list[dict]:
+def bench_tracers(
+    scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: bool = True, csv: str | None = None
+) -> list[dict]:
     if scene.mokrs is not None and not sweep:
-        raise SceneError("--no-sweep", True, "a MöKRS has only the binary tracer; keep the ξ "
-                         "sweep to have something to compare")
+        raise SceneError(
+            "--no-sweep",
+            True,
+            "a MöKRS has only the binary tracer; keep the ξ sweep to have something to compare",
+        )
     w, h = size
     runs = variants(scene, sweep)
     r = Renderer()
     buffers = {name: r.render(s, w, h) for name, s in runs.items()}
-    med = median_times(r, {name: Variant(s) for name, s in runs.items()}, size, rounds,
-                       f"bench tracers {scene.name}")
+    med = median_times(
+        r,
+        {name: Variant(s) for name, s in runs.items()},
+        size,
+        rounds,
+        f"bench tracers {scene.name}",
+    )
     base = next(iter(runs))
     t0 = med[base]
     it0 = float(np.mean(buffers[base].iterations))
@@ -52,31 +64,46 @@ def bench_tracers(scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: b
     for name, s in runs.items():
         b, t = buffers[name], med[name]
         binary = s.render.tracer == "binary"
-        rows.append(dict(tracer=s.render.tracer, xi_bonus=s.render.xi_bonus if binary else "",
-                         xi_penalty=s.render.xi_penalty if binary else "",
-                         median_iterations=float(np.median(b.iterations)),
-                         mean_iterations=float(np.mean(b.iterations)),
-                         iteration_ratio=float(np.mean(b.iterations)) / it0, ms=t * 1e3,
-                         time_ratio=t / t0, hit_fraction=float(b.hit.mean()),
-                         hit_agreement=float((b.hit == buffers[base].hit).mean())))
-    print(f"\nSphere vs binary tracing — {scene.name}, {w}×{h}, ε-scale "
-          f"{scene.render.epsilon_scale}, median of {rounds} interleaved rounds "
-          f"(ratios to {base})\n")
-    print("| tracer | ξ_bonus | ξ_penalty | median it/px | mean it/px | iteration ratio | "
-          "ms/frame | time ratio | hit agreement |")
+        rows.append(
+            dict(
+                tracer=s.render.tracer,
+                xi_bonus=s.render.xi_bonus if binary else "",
+                xi_penalty=s.render.xi_penalty if binary else "",
+                median_iterations=float(np.median(b.iterations)),
+                mean_iterations=float(np.mean(b.iterations)),
+                iteration_ratio=float(np.mean(b.iterations)) / it0,
+                ms=t * 1e3,
+                time_ratio=t / t0,
+                hit_fraction=float(b.hit.mean()),
+                hit_agreement=float((b.hit == buffers[base].hit).mean()),
+            )
+        )
+    print(
+        f"\nSphere vs binary tracing — {scene.name}, {w}×{h}, ε-scale "
+        f"{scene.render.epsilon_scale}, median of {rounds} interleaved rounds "
+        f"(ratios to {base})\n"
+    )
+    print(
+        "| tracer | ξ_bonus | ξ_penalty | median it/px | mean it/px | iteration ratio | "
+        "ms/frame | time ratio | hit agreement |"
+    )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for row in rows:
-        print(f"| {row['tracer']} | {row['xi_bonus']} | {row['xi_penalty']} | "
-              f"{row['median_iterations']:.0f} | {row['mean_iterations']:.1f} | "
-              f"{row['iteration_ratio']:.2f} | {row['ms']:.1f} | {row['time_ratio']:.2f} | "
-              f"{row['hit_agreement']:.2%} |")
+        print(
+            f"| {row['tracer']} | {row['xi_bonus']} | {row['xi_penalty']} | "
+            f"{row['median_iterations']:.0f} | {row['mean_iterations']:.1f} | "
+            f"{row['iteration_ratio']:.2f} | {row['ms']:.1f} | {row['time_ratio']:.2f} | "
+            f"{row['hit_agreement']:.2%} |"
+        )
     binaries = [row for row in rows if row["tracer"] == "binary"]
     if len(binaries) > 1:
         fast = min(binaries, key=lambda row: row["ms"])
         few = min(binaries, key=lambda row: row["mean_iterations"])
-        print(f"\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
-              f"({fast['time_ratio']:.2f}× {base}); fewest iterations: "
-              f"{few['xi_bonus']}/{few['xi_penalty']} ({few['mean_iterations']:.1f} it/px)")
+        print(
+            f"\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
+            f"({fast['time_ratio']:.2f}× {base}); fewest iterations: "
+            f"{few['xi_bonus']}/{few['xi_penalty']} ({few['mean_iterations']:.1f} it/px)"
+        )
     if csv:
         write_csv(rows, csv)
     return rows

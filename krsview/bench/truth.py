@@ -1,6 +1,7 @@
 """Ground truth for the accuracy benchmark: the float64 NumPy reference with a tight LOD
 threshold (ε at 1/8 of the pixel footprint) and a generous iteration cap, computed once per
 scene, view and size and cached on disk under a key made from the scene's content."""
+
 from __future__ import annotations
 
 import hashlib
@@ -15,15 +16,19 @@ from ..buffers import Buffers
 from ..reference import render_reference
 from ..scene import Scene, scene_to_toml
 
-TRUTH_EPSILON_SCALE = 0.125   # × the pixel footprint
+TRUTH_EPSILON_SCALE = 0.125  # × the pixel footprint
 TRUTH_ITERATIONS = 4096
 
 
 def truth_scene(scene: Scene) -> Scene:
     """The scene at ground-truth accuracy: tight ε, generous cap, its own tracer (a MöKRS
     keeps binary tracing: it has no distance)."""
-    return replace(scene, render=replace(scene.render, epsilon_scale=TRUTH_EPSILON_SCALE,
-                                         max_iterations=TRUTH_ITERATIONS))
+    return replace(
+        scene,
+        render=replace(
+            scene.render, epsilon_scale=TRUTH_EPSILON_SCALE, max_iterations=TRUTH_ITERATIONS
+        ),
+    )
 
 
 def default_cache() -> Path:

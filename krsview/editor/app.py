@@ -5,6 +5,7 @@ Ctrl+S saves atomically, and unsaved work is autosaved beside the scene.
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
+
 from __future__ import annotations
 
 import math
@@ -12,9 +13,9 @@ import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+import glfw  # noqa: E402  (after imgui, as the viewer)
 import numpy as np
 from imgui_bundle import imgui, imguizmo
-import glfw  # noqa: E402  (after imgui, as the viewer)
 
 from ..app.window import Viewer
 from ..gpu.overlay import FAR, NEAR, Overlay, Shapes, camera_matrices
@@ -26,10 +27,14 @@ from .handles import Handle, handles, polyline
 from .panels import edit_panel
 
 gizmo = imguizmo.im_guizmo
-PICK_PIXELS = 12.0          # a click this close to a handle grabs it
-CLICK_PIXELS = 4.0          # a press and release closer than this is a click, not a drag
-FORK, CONTROL, NORMAL, SELECTED = ((1.0, 0.6, 0.15, 1.0), (0.3, 0.85, 1.0, 1.0),
-                                   (1.0, 0.3, 0.8, 1.0), (1.0, 1.0, 0.3, 1.0))
+PICK_PIXELS = 12.0  # a click this close to a handle grabs it
+CLICK_PIXELS = 4.0  # a press and release closer than this is a click, not a drag
+FORK, CONTROL, NORMAL, SELECTED = (
+    (1.0, 0.6, 0.15, 1.0),
+    (0.3, 0.85, 1.0, 1.0),
+    (1.0, 0.3, 0.8, 1.0),
+    (1.0, 1.0, 0.3, 1.0),
+)
 ROUTE = (1.0, 0.9, 0.5, 0.9)
 DISC = (0.5, 0.8, 1.0, 0.25)
 
@@ -37,8 +42,8 @@ DISC = (0.5, 0.8, 1.0, 0.25)
 @dataclass
 class Snap:
     on: bool = False
-    grid: float = 0.05       # units, for a translate drag
-    angle: float = 5.0       # degrees (a normal's arrow tip snaps to the grid on its circle)
+    grid: float = 0.05  # units, for a translate drag
+    angle: float = 5.0  # degrees (a normal's arrow tip snaps to the grid on its circle)
 
 
 class Editor(Viewer):
@@ -49,10 +54,10 @@ class Editor(Viewer):
         super().__init__(path, **kw)
         self.overlay = Overlay(self.ctx, self.renderer.programs)
         self.snap = Snap()
-        self.carry = True                     # a fork drag takes its subtree along
+        self.carry = True  # a fork drag takes its subtree along
         self.save_as_text = str(self.path)
-        self.asking: tuple[str, Path | None] | None = None   # unsaved edits: close / open?
-        self.recovered = self.doc.recovery()                  # offered in a modal
+        self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
+        self.recovered = self.doc.recovery()  # offered in a modal
         self.conflict = False
         self.scroll_outline = False
         self._gizmo_drag = 0
@@ -69,8 +74,8 @@ class Editor(Viewer):
     def _set_scene(self, scene, reset_camera: bool = False) -> None:
         super()._set_scene(scene, reset_camera)
         self.handles = handles(scene)
-        self.warnings = scene.route.warnings() if scene.route else []   # per edit, not frame
-        if self.selected is not None:      # keep the selection across edits, undo, reload
+        self.warnings = scene.route.warnings() if scene.route else []  # per edit, not frame
+        if self.selected is not None:  # keep the selection across edits, undo, reload
             self.selected = next((h for h in self.handles if h.same(self.selected)), None)
 
     def _update_title(self) -> None:
@@ -130,7 +135,9 @@ class Editor(Viewer):
     def bake(self) -> None:
         """Grown tree → route (one undo step): every fork becomes a handle."""
         t = self.scene.tree
-        self.doc.commit(replace(self.scene, tree=None, route=t.route()), "bake the tree into a route")
+        self.doc.commit(
+            replace(self.scene, tree=None, route=t.route()), "bake the tree into a route"
+        )
         self._sync()
         self.message = "baked: drag forks, control points and mirror normals"
 
@@ -274,8 +281,9 @@ class Editor(Viewer):
     def draw_ui(self, fb: tuple[int, int]) -> None:
         v = self.window_view()
         if self.image is not None:
-            self.overlay.draw(self._shapes(v), self.image[0], self.ctx.screen, fb,
-                              self._matrix(v), v.origin)
+            self.overlay.draw(
+                self._shapes(v), self.image[0], self.ctx.screen, fb, self._matrix(v), v.origin
+            )
         gizmo.begin_frame()
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)  # the view stays free
         super().draw_ui(fb)
@@ -324,16 +332,22 @@ class Editor(Viewer):
         near = 1e-3 * max(float(np.linalg.norm(h.position - v.origin)), 1e-12)
         view, proj = camera_matrices(v, near, 1e6 * near)
         obj = np.eye(4)
-        obj[:3, 3] = h.position - v.origin            # camera-relative: float32 stays precise
+        obj[:3, 3] = h.position - v.origin  # camera-relative: float32 stays precise
         m = gizmo.Matrix16(list(obj.T.flatten()))
         snap = self.snap.on or bool(io.key_shift)
         step = gizmo.Matrix3([self.snap.grid] * 3) if snap and h.kind == "point" else None
-        changed = gizmo.manipulate(gizmo.Matrix16(list(view.T.flatten())),
-                                   gizmo.Matrix16(list(proj.T.flatten())),
-                                   gizmo.OPERATION.translate, gizmo.MODE.world, m, None, step)
+        changed = gizmo.manipulate(
+            gizmo.Matrix16(list(view.T.flatten())),
+            gizmo.Matrix16(list(proj.T.flatten())),
+            gizmo.OPERATION.translate,
+            gizmo.MODE.world,
+            m,
+            None,
+            step,
+        )
         using = gizmo.is_using()
         if using and not self._was_using:
-            self._gizmo_drag += 1                     # a new drag: a new undo step
+            self._gizmo_drag += 1  # a new drag: a new undo step
         self._was_using = using
         if changed and using:
             p = np.array(m.values[12:15], dtype=np.float64) + v.origin
@@ -350,5 +364,6 @@ def _snap_direction(d: np.ndarray, degrees: float) -> np.ndarray:
     step = math.radians(degrees)
     theta = round(math.acos(max(-1.0, min(1.0, d[1] / r))) / step) * step
     phi = round(math.atan2(d[2], d[0]) / step) * step
-    return r * np.array([math.sin(theta) * math.cos(phi), math.cos(theta),
-                         math.sin(theta) * math.sin(phi)])
+    return r * np.array(
+        [math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi)]
+    )

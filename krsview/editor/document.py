@@ -7,19 +7,22 @@ recorded for undo. Saves are atomic; while there are unsaved edits a recovery fi
 scene is rewritten every few seconds, and a file changed on disk is never overwritten
 silently.
 """
+
 from __future__ import annotations
 
 import os
+from collections.abc import Hashable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Hashable
+from typing import Any
 
 from ..scene import Scene, SceneError, load_scene, scene_to_toml
-from ..scene.edits import Path as EditPath, apply_edit, path_text, validated
+from ..scene.edits import Path as EditPath
+from ..scene.edits import apply_edit, path_text, validated
 from ..scene.scene import write_atomic
 from .history import History, Step
 
-AUTOSAVE_SECONDS = 3.0    # a crash loses at most this much work
+AUTOSAVE_SECONDS = 3.0  # a crash loses at most this much work
 RECOVERY_SUFFIX = ".recovery"
 
 
@@ -30,11 +33,12 @@ class ConflictError(RuntimeError):
 @dataclass(frozen=True)
 class Stamp:
     """What a file looked like when we last read or wrote it."""
+
     mtime_ns: int
     size: int
 
     @staticmethod
-    def of(path: Path) -> "Stamp | None":
+    def of(path: Path) -> Stamp | None:
         try:
             st = path.stat()
         except OSError:
@@ -45,12 +49,12 @@ class Stamp:
 class Document:
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
-        self._scene = load_scene(self.path)       # a bad file is a SceneError, nothing opened
-        self.saved = self._scene                   # the version on disk
+        self._scene = load_scene(self.path)  # a bad file is a SceneError, nothing opened
+        self.saved = self._scene  # the version on disk
         self.saved_text = scene_to_toml(self._scene)
         self.stamp = Stamp.of(self.path)
         self.history = History()
-        self.version = 0                           # bumps on every change: views redraw
+        self.version = 0  # bumps on every change: views redraw
         self._autosaved: Scene | None = None
         self._autosave_clock: float | None = None
 
@@ -73,8 +77,13 @@ class Document:
         self.version += 1
 
     # ----------------------------------------------------------------------------- edits
-    def apply(self, path: EditPath, value: Any, interaction: Hashable | None = None,
-              label: str | None = None) -> None:
+    def apply(
+        self,
+        path: EditPath,
+        value: Any,
+        interaction: Hashable | None = None,
+        label: str | None = None,
+    ) -> None:
         """Set the field at ``path``; one undo step (merged with the previous one when both
         come from the same ``interaction``). A SceneError leaves everything unchanged."""
         scene = apply_edit(self._scene, path, value)
@@ -126,8 +135,10 @@ class Document:
         overwrite a file changed on disk since we read it, unless ``overwrite``."""
         target = Path(path) if path is not None else self.path
         if target == self.path and not overwrite and self.changed_on_disk():
-            raise ConflictError(f"{self.path} changed on disk since it was opened here; "
-                                "reload it (your edits stay undoable) or overwrite it")
+            raise ConflictError(
+                f"{self.path} changed on disk since it was opened here; "
+                "reload it (your edits stay undoable) or overwrite it"
+            )
         try:
             write_atomic(target, scene_to_toml(self._scene))
         except OSError as e:
@@ -161,13 +172,13 @@ class Document:
             self._autosave_clock = None
             return False
         if self._autosave_clock is None:
-            self._autosave_clock = now           # first unsaved edit: start the interval
+            self._autosave_clock = now  # first unsaved edit: start the interval
         if self._scene == self._autosaved or now - self._autosave_clock < AUTOSAVE_SECONDS:
             return False
         try:
             write_atomic(self.recovery_path, scene_to_toml(self._scene))
         except OSError:
-            return False                          # a read-only folder: editing goes on
+            return False  # a read-only folder: editing goes on
         self._autosaved, self._autosave_clock = self._scene, now
         return True
 

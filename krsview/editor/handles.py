@@ -3,6 +3,7 @@ edits. A route shows its base, forks, control points and fork mirror normals [KR
 a plain KRS its kernels' points and its mirrors (a point on the plane and a normal arrow);
 a compound its components' placements. Pure NumPy: the window draws and drags them.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -18,13 +19,13 @@ ARROW = 0.6  # a normal arrow's length, × its level's branch length (route) or 
 
 @dataclass(frozen=True)
 class Handle:
-    path: Path               # the field it edits
-    kind: str                # "point": moves to where it is dragged; "normal": its arrow
-    position: np.ndarray     # where it is drawn and grabbed (world, float64)
-    level: int               # the outline entry (level or component) it belongs to
+    path: Path  # the field it edits
+    kind: str  # "point": moves to where it is dragged; "normal": its arrow
+    position: np.ndarray  # where it is drawn and grabbed (world, float64)
+    level: int  # the outline entry (level or component) it belongs to
     label: str
-    owner: Path              # the table the selection panel shows (a level, a component)
-    pivot: np.ndarray | None = None   # "normal": the arrow's foot (a fork, a point on a mirror)
+    owner: Path  # the table the selection panel shows (a level, a component)
+    pivot: np.ndarray | None = None  # "normal": the arrow's foot (a fork, a point on a mirror)
 
     def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
         """The edit (field path, new value) that puts the handle at ``p``. With ``carry``, a
@@ -32,8 +33,12 @@ class Handle:
         it, the branch's own control by half, so its bend stays) and the trunk's foot the
         whole tree: the mirrors at the moved forks move with them, so nothing that grew
         on the negative side of a mirror crosses it (a bone chain, as people expect)."""
-        if carry and self.kind == "point" and self.path[0] == "route" and \
-                self.path[-1] in ("fork", "base"):
+        if (
+            carry
+            and self.kind == "point"
+            and self.path[0] == "route"
+            and self.path[-1] in ("fork", "base")
+        ):
             return self._carry(scene, p)
         return self.path, self.value_at(scene, p)
 
@@ -44,28 +49,34 @@ class Handle:
 
         def moved(v: tuple, f: float = 1.0) -> tuple:
             return tuple(float(c) for c in np.array(v) + f * delta)
-        levels = [replace(lv, fork=moved(lv.fork), control=moved(lv.control)) if j < i else
-                  replace(lv, fork=moved(lv.fork), control=moved(lv.control, 0.5)) if j == i else lv
-                  for j, lv in enumerate(route.levels)]
+
+        levels = [
+            replace(lv, fork=moved(lv.fork), control=moved(lv.control))
+            if j < i
+            else replace(lv, fork=moved(lv.fork), control=moved(lv.control, 0.5))
+            if j == i
+            else lv
+            for j, lv in enumerate(route.levels)
+        ]
         if self.path[-1] == "base":
             return ("route",), replace(route, base=moved(route.base), levels=levels)
         return ("route", "levels"), levels
 
     def value_at(self, scene: Scene, p: np.ndarray) -> Any:
         """The field's new value when the handle is dragged to ``p``."""
-        if self.kind == "point" and self.path[-1] == "mirror":   # a point on a KRS mirror
+        if self.kind == "point" and self.path[-1] == "mirror":  # a point on a KRS mirror
             m = get_at(scene, self.path)
             return Mirror(m.normal, float(np.array(m.normal) @ p))
         if self.kind == "point":
             return tuple(float(c) for c in p)
         d = p - self.pivot
         n = float(np.linalg.norm(d))
-        u = tuple(float(c) for c in (d / n if n > 0 else d))   # zero: the schema says why
-        if self.path[-1] == "mirror":                         # keep the plane on the pivot
+        u = tuple(float(c) for c in (d / n if n > 0 else d))  # zero: the schema says why
+        if self.path[-1] == "mirror":  # keep the plane on the pivot
             return Mirror(u, float(np.array(u) @ self.pivot)) if n > 0 else Mirror(u, 0.0)
         return u
 
-    def same(self, other: "Handle | None") -> bool:
+    def same(self, other: Handle | None) -> bool:
         return other is not None and (self.path, self.kind) == (other.path, other.kind)
 
 
@@ -74,24 +85,44 @@ def handles(scene: Scene) -> list[Handle]:
         return route_handles(scene.route, ("route",))
     if scene.krs is not None:
         return krs_handles(scene.krs, ("krs",))
-    return [Handle(("compound", k, "position"), "point", np.array(c.position), k,
-                   f"component {k}", ("compound", k)) for k, c in enumerate(scene.compound)]
+    return [
+        Handle(
+            ("compound", k, "position"),
+            "point",
+            np.array(c.position),
+            k,
+            f"component {k}",
+            ("compound", k),
+        )
+        for k, c in enumerate(scene.compound)
+    ]
 
 
 def route_handles(route: Route, at: Path) -> list[Handle]:
-    out = [Handle((*at, "base"), "point", np.array(route.base), len(route.levels) - 1,
-                  "trunk foot", at)]
+    out = [
+        Handle(
+            (*at, "base"), "point", np.array(route.base), len(route.levels) - 1, "trunk foot", at
+        )
+    ]
     starts = route.starts()
     for i, lv in enumerate(route.levels):
         fork = np.array(lv.fork)
         lev = (*at, "levels", i)
         out.append(Handle((*lev, "fork"), "point", fork, i, f"fork P{i}", lev))
-        out.append(Handle((*lev, "control"), "point", np.array(lv.control), i, f"control {i}",
-                          lev))
+        out.append(Handle((*lev, "control"), "point", np.array(lv.control), i, f"control {i}", lev))
         if lv.normal is not None:
             length = ARROW * float(np.linalg.norm(fork - np.array(starts[i])))
-            out.append(Handle((*lev, "normal"), "normal", fork + length * np.array(lv.normal), i,
-                              f"mirror normal R{i - 1}", lev, pivot=fork))
+            out.append(
+                Handle(
+                    (*lev, "normal"),
+                    "normal",
+                    fork + length * np.array(lv.normal),
+                    i,
+                    f"mirror normal R{i - 1}",
+                    lev,
+                    pivot=fork,
+                )
+            )
     return out
 
 
@@ -100,8 +131,11 @@ def krs_handles(krs: KRS, at: Path) -> list[Handle]:
     for i, lv in enumerate(krs.levels):
         k = lv.kernel
         kp = (*at, "levels", i, "kernel")
-        names = {Sphere: ("center",), Capsule: ("a", "b"),
-                 ToroidalCapsule: ("start", "control", "end")}.get(type(k), ())
+        names = {
+            Sphere: ("center",),
+            Capsule: ("a", "b"),
+            ToroidalCapsule: ("start", "control", "end"),
+        }.get(type(k), ())
         pts = [np.array(getattr(k, f)) for f in names]
         lev = (*at, "levels", i)
         out += [Handle((*kp, f), "point", p, i, f"K{i} {f}", lev) for f, p in zip(names, pts)]
@@ -109,13 +143,19 @@ def krs_handles(krs: KRS, at: Path) -> list[Handle]:
             continue
         u, w = np.array(lv.mirror.normal), lv.mirror.offset
         centre = np.mean(pts, axis=0) if pts else w * u
-        foot = centre - (u @ centre - w) * u          # the kernel's centre, projected
-        size = max(float(getattr(k, "radius", 0.0)) * 4.0,
-                   float(np.ptp(np.array(pts), axis=0).max()) if len(pts) > 1 else 0.0, 0.25)
+        foot = centre - (u @ centre - w) * u  # the kernel's centre, projected
+        size = max(
+            float(getattr(k, "radius", 0.0)) * 4.0,
+            float(np.ptp(np.array(pts), axis=0).max()) if len(pts) > 1 else 0.0,
+            0.25,
+        )
         mp = (*at, "levels", i, "mirror")
         out.append(Handle(mp, "point", foot, i, f"mirror R{i - 1} position", lev))
-        out.append(Handle(mp, "normal", foot + ARROW * size * u, i, f"mirror R{i - 1} normal",
-                          lev, pivot=foot))
+        out.append(
+            Handle(
+                mp, "normal", foot + ARROW * size * u, i, f"mirror R{i - 1} normal", lev, pivot=foot
+            )
+        )
     return out
 
 
@@ -123,12 +163,15 @@ def outline(scene: Scene) -> list[str]:
     """One line per selectable entry, in handle ``level`` order."""
     if scene.route is not None:
         n = len(scene.route.levels)
-        return [f"L{i} " + ("trunk" if i == n - 1 else "twig" if i == 0 else "branch")
-                for i in range(n)]
+        return [
+            f"L{i} " + ("trunk" if i == n - 1 else "twig" if i == 0 else "branch") for i in range(n)
+        ]
     if scene.krs is not None:
         return [f"L{i} {lv.kernel.kind}" for i, lv in enumerate(scene.krs.levels)]
-    return [f"component {k}: {'tree' if c.tree else 'route' if c.route else 'KRS'}"
-            for k, c in enumerate(scene.compound)]
+    return [
+        f"component {k}: {'tree' if c.tree else 'route' if c.route else 'KRS'}"
+        for k, c in enumerate(scene.compound)
+    ]
 
 
 def polyline(scene: Scene) -> np.ndarray:

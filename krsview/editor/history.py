@@ -4,10 +4,11 @@ A step keeps the scene before and after it; scenes are frozen dataclasses that s
 unchanged part, so a step costs little. Consecutive steps of one interaction (a gizmo drag, a
 slider drag) merge into one step: the merge is keyed on the interaction, never on a timer.
 """
+
 from __future__ import annotations
 
+from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import Hashable
 
 from ..scene import Scene
 
@@ -28,9 +29,13 @@ class History:
         self.index = 0  # steps[:index] are done, steps[index:] can be redone
 
     def push(self, step: Step) -> None:
-        del self.steps[self.index:]
+        del self.steps[self.index :]
         last = self.steps[-1] if self.steps else None
-        if last is not None and step.interaction is not None and last.interaction == step.interaction:
+        if (
+            last is not None
+            and step.interaction is not None
+            and last.interaction == step.interaction
+        ):
             step = Step(last.label, last.before, step.after, step.interaction)
             self.steps[-1] = step
         else:
@@ -61,5 +66,7 @@ class History:
 
     def labels(self) -> tuple[list[str], list[str]]:
         """(done, undone) step labels, oldest first: for the history panel."""
-        return ([s.label for s in self.steps[:self.index]],
-                [s.label for s in self.steps[self.index:]])
+        return (
+            [s.label for s in self.steps[: self.index]],
+            [s.label for s in self.steps[self.index :]],
+        )

@@ -1,6 +1,7 @@
 """The editor's ImGui panels. A panel reads the editor's state and returns commands; it never
 writes the editor or the scene itself (the editor applies the commands through the document),
 so the arrows run one way: editor app → panels."""
+
 from __future__ import annotations
 
 from dataclasses import fields
@@ -16,27 +17,32 @@ from .handles import outline
 if TYPE_CHECKING:
     from .app import Editor
 
-GEOMETRY_TABLES = ("krs", "route")   # a component's own geometry: too big for a panel
+GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 
 
-def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
+def edit_panel(e: Editor, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
     imgui.set_next_window_pos(imgui.ImVec2(e.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever)
-    imgui.set_next_window_size(imgui.ImVec2(340, e.adaptive.full[1] - 16), imgui.Cond_.first_use_ever)
+    imgui.set_next_window_size(
+        imgui.ImVec2(340, e.adaptive.full[1] - 16), imgui.Cond_.first_use_ever
+    )
     imgui.set_next_window_bg_alpha(0.8)
     imgui.begin("edit")
     _file(e, out)
     scene = e.scene
     if scene.tree is not None:
-        imgui.text_wrapped("This tree is grown from ratios. Bake it into a route to drag its "
-                           "forks, control points and mirror normals [KRS17 §9.2].")
+        imgui.text_wrapped(
+            "This tree is grown from ratios. Bake it into a route to drag its "
+            "forks, control points and mirror normals [KRS17 §9.2]."
+        )
         if imgui.button("bake into a route"):
             out.append(Do("bake"))
     elif scene.mokrs is not None:
-        imgui.text_wrapped("A MöKRS has no handles yet; edit its file (it reloads) or the "
-                           "fields below.")
+        imgui.text_wrapped(
+            "A MöKRS has no handles yet; edit its file (it reloads) or the fields below."
+        )
     else:
         for w in e.warnings:
             imgui.push_style_color(imgui.Col_.text, YELLOW)
@@ -48,16 +54,19 @@ def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
     if imgui.collapsing_header("material"):
         _fields(scene.material, ("material",), out, interactions)
     if imgui.collapsing_header("effect settings"):
-        imgui.text_disabled("effects: " + (", ".join(scene.effects) or "none") +
-                            " (switched in the krsview window)")
+        imgui.text_disabled(
+            "effects: " + (", ".join(scene.effects) or "none") + " (switched in the krsview window)"
+        )
         _fields(scene.effect_settings, ("effect_settings",), out, interactions)
     if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
         changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
         if changed:
             out.append(Do("set_carry", on))
         if imgui.is_item_hovered():
-            imgui.set_tooltip("on: the finer forks, control points and mirrors move with a "
-                              "dragged fork, so the crown stays attached; off: only the fork")
+            imgui.set_tooltip(
+                "on: the finer forks, control points and mirrors move with a "
+                "dragged fork, so the crown stays attached; off: only the fork"
+            )
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
             out.append(Do("set_snap", on))
@@ -67,7 +76,7 @@ def edit_panel(e: "Editor", interactions: Interactions) -> list[Command]:
     return out
 
 
-def _file(e: "Editor", out: list) -> None:
+def _file(e: Editor, out: list) -> None:
     doc = e.doc
     imgui.text(("* unsaved: " if doc.dirty else "saved: ") + str(doc.path.name))
     if imgui.button("save (Ctrl+S)"):
@@ -101,11 +110,11 @@ def _file(e: "Editor", out: list) -> None:
             out.append(Do("keep_mine"))
 
 
-def _outline(e: "Editor", out: list) -> None:
+def _outline(e: Editor, out: list) -> None:
     entries = outline(e.scene)
     imgui.text("outline (click an entry, a handle or the geometry)")
     if imgui.begin_child("outline", imgui.ImVec2(-1, 120), imgui.ChildFlags_.borders):
-        for k in range(len(entries) - 1, -1, -1):          # trunk first, as it grows
+        for k in range(len(entries) - 1, -1, -1):  # trunk first, as it grows
             selected = e.selected is not None and e.selected.level == k
             clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
             if clicked:
@@ -116,7 +125,7 @@ def _outline(e: "Editor", out: list) -> None:
     imgui.end_child()
 
 
-def _selection(e: "Editor", out: list, interactions: Interactions) -> None:
+def _selection(e: Editor, out: list, interactions: Interactions) -> None:
     h = e.selected
     if h is None:
         imgui.text_disabled("nothing selected")
@@ -138,24 +147,30 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
         if value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
             continue
         if hasattr(value, "__dataclass_fields__"):
-            imgui.separator_text(f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else ""))
+            imgui.separator_text(
+                f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else "")
+            )
             _fields(value, path, out, interactions)
             continue
-        changed, new = field_widget(f"{f.name}##{'.'.join(map(str, path))}", value,
-                                    dict(f.metadata))
+        changed, new = field_widget(
+            f"{f.name}##{'.'.join(map(str, path))}", value, dict(f.metadata)
+        )
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))
 
 
-def _modals(e: "Editor", out: list) -> None:
+def _modals(e: Editor, out: list) -> None:
     if e.asking is not None and not imgui.is_popup_open("unsaved changes"):
         imgui.open_popup("unsaved changes")
     if imgui.begin_popup_modal("unsaved changes", None, imgui.WindowFlags_.always_auto_resize)[0]:
         what = "closing" if e.asking == ("close", None) else "opening another scene"
         imgui.text(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
-        for label, action in (("save", "answer_save"), ("discard", "answer_discard"),
-                              ("cancel", "answer_cancel")):
+        for label, action in (
+            ("save", "answer_save"),
+            ("discard", "answer_discard"),
+            ("cancel", "answer_cancel"),
+        ):
             if imgui.button(label):
                 out.append(Do(action))
                 imgui.close_current_popup()
@@ -164,8 +179,10 @@ def _modals(e: "Editor", out: list) -> None:
     if e.recovered is not None and not imgui.is_popup_open("recover"):
         imgui.open_popup("recover")
     if imgui.begin_popup_modal("recover", None, imgui.WindowFlags_.always_auto_resize)[0]:
-        imgui.text(f"{e.doc.recovery_path.name} holds unsaved edits from a session that "
-                   "did not end cleanly.")
+        imgui.text(
+            f"{e.doc.recovery_path.name} holds unsaved edits from a session that "
+            "did not end cleanly."
+        )
         if imgui.button("restore them"):
             out.append(Do("restore"))
             imgui.close_current_popup()

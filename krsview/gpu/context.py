@@ -1,4 +1,5 @@
 """OpenGL contexts: headless through EGL (tests, CI, `krsview render`)."""
+
 from __future__ import annotations
 
 import moderngl
@@ -16,12 +17,14 @@ def headless_context() -> moderngl.Context:
     current makes a later glXMakeCurrent fail with BadAccess, which kills the process."""
     try:
         # Versioned names: the runtime packages (libgl1, libegl1) ship only these.
-        ctx = moderngl.create_standalone_context(backend="egl", require=GL_VERSION,
-                                                 libgl="libGL.so.1", libegl="libEGL.so.1")
+        ctx = moderngl.create_standalone_context(
+            backend="egl", require=GL_VERSION, libgl="libGL.so.1", libegl="libEGL.so.1"
+        )
     except Exception as e:  # moderngl raises plain Exception subclasses from glcontext
         raise ContextError(
             f"cannot create a headless OpenGL {GL_VERSION // 100}.{GL_VERSION % 100 // 10} "
             f"context through EGL ({e}). On Debian install libegl1 libegl-mesa0 libgl1 "
-            "libgl1-mesa-dri (`make deps` does it).") from None
+            "libgl1-mesa-dri (`make deps` does it)."
+        ) from None
     ctx.__exit__(None, None, None)  # release it: nothing is current on this thread now
     return ctx

@@ -1,5 +1,6 @@
 """Draws a traced image (the renderer's float buffers) into the current framebuffer, scaled to
 it, in one of the view modes of ``display.frag``."""
+
 from __future__ import annotations
 
 import moderngl
@@ -17,8 +18,15 @@ class Display:
         for unit, name in enumerate(("u_color", "u_normal", "u_iterations")):
             self.prog[name].value = unit
 
-    def show(self, source: moderngl.Framebuffer, target: moderngl.Framebuffer,
-             size: tuple[int, int], view: str, iteration_cap: int, depth_scale: float) -> None:
+    def show(
+        self,
+        source: moderngl.Framebuffer,
+        target: moderngl.Framebuffer,
+        size: tuple[int, int],
+        view: str,
+        iteration_cap: int,
+        depth_scale: float,
+    ) -> None:
         for unit, tex in enumerate(source.color_attachments):
             tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
             tex.use(location=unit)

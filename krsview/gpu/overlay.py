@@ -1,5 +1,6 @@
 """Draws editor overlays (lines, round points, translucent triangles) over the displayed
 image, composited with the traced depth so that what is behind a surface shows faint."""
+
 from __future__ import annotations
 
 import math
@@ -11,19 +12,21 @@ import numpy as np
 from ..reference.camera import View
 from .program import ProgramCache
 
-HIDDEN_ALPHA = 0.22   # strength of overlay fragments behind traced geometry
+HIDDEN_ALPHA = 0.22  # strength of overlay fragments behind traced geometry
 NEAR, FAR = 1e-5, 1e7  # clip planes of the overlay's projection (no depth buffer is used)
 
 
 @dataclass
 class Shapes:
     """Overlay geometry in world coordinates (float64), with RGBA colours."""
+
     lines: list[tuple[np.ndarray, np.ndarray, tuple]] = field(default_factory=list)
     points: list[tuple[np.ndarray, tuple, float]] = field(default_factory=list)
     triangles: list[tuple[np.ndarray, tuple]] = field(default_factory=list)  # (3, 3) corners
 
-    def disc(self, centre: np.ndarray, normal: np.ndarray, radius: float, rgba: tuple,
-             segments: int = 48) -> None:
+    def disc(
+        self, centre: np.ndarray, normal: np.ndarray, radius: float, rgba: tuple, segments: int = 48
+    ) -> None:
         a = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
         a /= np.linalg.norm(a)
         b = np.cross(normal, a)
@@ -39,9 +42,14 @@ def camera_matrices(v: View, near: float, far: float) -> tuple[np.ndarray, np.nd
     view = np.eye(4)
     view[0, :3], view[1, :3], view[2, :3] = v.right, v.up, -v.forward
     f = 1.0 / v.tan_half
-    proj = np.array([[f / v.aspect, 0, 0, 0], [0, f, 0, 0],
-                     [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)],
-                     [0, 0, -1, 0]])
+    proj = np.array(
+        [
+            [f / v.aspect, 0, 0, 0],
+            [0, f, 0, 0],
+            [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)],
+            [0, 0, -1, 0],
+        ]
+    )
     return view, proj
 
 
@@ -53,10 +61,18 @@ class Overlay:
         self.prog["u_normal"].value = 1
         self.prog["u_hidden_alpha"].value = HIDDEN_ALPHA
 
-    def draw(self, shapes: Shapes, source: moderngl.Framebuffer, target: moderngl.Framebuffer,
-             size: tuple[int, int], matrix: np.ndarray, eye: np.ndarray) -> None:
+    def draw(
+        self,
+        shapes: Shapes,
+        source: moderngl.Framebuffer,
+        target: moderngl.Framebuffer,
+        size: tuple[int, int],
+        matrix: np.ndarray,
+        eye: np.ndarray,
+    ) -> None:
         """Draw ``shapes`` into ``target``; ``source`` holds the traced colour and depth,
-        ``matrix`` is projection × view (:func:`camera_matrices`), ``eye`` the camera position (float64)."""
+        ``matrix`` is projection × view (:func:`camera_matrices`), ``eye`` the camera position
+        (float64)."""
         batches = [
             (moderngl.TRIANGLES, [(p, c, 1.0) for tri, c in shapes.triangles for p in tri]),
             (moderngl.LINES, [(p, c, 1.0) for a, b, c in shapes.lines for p in (a, b)]),
@@ -75,8 +91,9 @@ class Overlay:
                 continue
             data = np.array([[*(np.asarray(p) - eye), *c, s] for p, c, s in verts], dtype="f4")
             vbo = self.ctx.buffer(data.tobytes())
-            vao = self.ctx.vertex_array(self.prog, [(vbo, "3f 4f 1f", "in_position", "in_color",
-                                                     "in_size")])
+            vao = self.ctx.vertex_array(
+                self.prog, [(vbo, "3f 4f 1f", "in_position", "in_color", "in_size")]
+            )
             self.prog["u_points"].value = mode == moderngl.POINTS
             vao.render(mode)
             vao.release()

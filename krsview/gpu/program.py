@@ -1,6 +1,7 @@
 """Shader program builder: ``#include`` resolution with ``#line`` mapping, one ``#define``
 per enabled feature, a variant cache keyed by the define set, and compile errors mapped back
 to ``file.glsl:line`` (the moderngl-window habit, DESIGN.md)."""
+
 from __future__ import annotations
 
 import re
@@ -24,7 +25,9 @@ class ShaderError(RuntimeError):
     """A shader failed to build; ``str()`` names the .glsl file, line and the offending text."""
 
 
-_DIRECTIVE = re.compile(r"^\s*#\s*(ifdef|ifndef|if|elif|else|endif|define|undef)\b\s*(.*?)\s*(//.*)?$")
+_DIRECTIVE = re.compile(
+    r"^\s*#\s*(ifdef|ifndef|if|elif|else|endif|define|undef)\b\s*(.*?)\s*(//.*)?$"
+)
 _DEFINED = re.compile(r"defined\s*\(?\s*(\w+)\s*\)?")
 
 
@@ -36,12 +39,18 @@ class Source:
     block, and any file it includes, never reaches the driver, so a scene without an effect
     compiles none of that effect's code (DESIGN.md, Specialise, don't branch)."""
 
-    def __init__(self, entry: str, defines: dict[str, str | int | float | None],
-                 shader_dir: Path = SHADER_DIR, header: tuple[str, ...] = CORE_HEADER):
+    def __init__(
+        self,
+        entry: str,
+        defines: dict[str, str | int | float | None],
+        shader_dir: Path = SHADER_DIR,
+        header: tuple[str, ...] = CORE_HEADER,
+    ):
         self.shader_dir = shader_dir
         head = list(header)
-        head += [f"#define {k}" + ("" if v is None else f" {v}") for k, v in
-                 sorted(defines.items())]
+        head += [
+            f"#define {k}" + ("" if v is None else f" {v}") for k, v in sorted(defines.items())
+        ]
         self.origin: list[tuple[str, int]] = [("<defines>", k) for k in range(1, len(head) + 1)]
         self.defined = set(defines)
         self.included: set[str] = set()
@@ -84,17 +93,23 @@ class Source:
             raise ShaderError(f"{name}: #if without #endif")
         return out
 
-    def _conditional(self, kind: str, arg: str, active: list[list[bool]], name: str,
-                     k: int) -> None:
+    def _conditional(
+        self, kind: str, arg: str, active: list[list[bool]], name: str, k: int
+    ) -> None:
         if kind in ("ifdef", "ifndef", "if"):
-            on = (arg in self.defined if kind == "ifdef" else arg not in self.defined
-                  if kind == "ifndef" else self._evaluate(arg, name, k))
+            on = (
+                arg in self.defined
+                if kind == "ifdef"
+                else arg not in self.defined
+                if kind == "ifndef"
+                else self._evaluate(arg, name, k)
+            )
             active.append([on, on])
         elif len(active) == 1:
             raise ShaderError(f"{name}:{k}: #{kind} without #if")
         elif kind == "endif":
             active.pop()
-        else:                                   # elif / else: the first true branch only
+        else:  # elif / else: the first true branch only
             taken = active[-1][1]
             on = not taken and (kind == "else" or self._evaluate(arg, name, k))
             active[-1] = [on, taken or on]
@@ -104,8 +119,9 @@ class Source:
         py = _DEFINED.sub(lambda m: str(m.group(1) in self.defined), expr)
         py = py.replace("&&", " and ").replace("||", " or ").replace("!", " not ")
         if re.fullmatch(r"[\s()]*((True|False|and|or|not)[\s()]*)*", py) is None:
-            raise ShaderError(f"{name}:{k}: #if {expr}: only defined(), !, && and || are "
-                              "supported by the builder")
+            raise ShaderError(
+                f"{name}:{k}: #if {expr}: only defined(), !, && and || are supported by the builder"
+            )
         return bool(eval(py))  # noqa: S307 - the expression holds only booleans and operators
 
     def map_log(self, log: str) -> str:
@@ -119,30 +135,42 @@ class Source:
                 if 0 < n <= len(self.origin):
                     file, line = self.origin[n - 1]
                     col = f":{m.group(2)}" if m.group(2) else ""
-                    out.append(raw[:m.start()] + f"{file}:{line}{col}" + raw[m.end():]
-                               + f"\n    | {lines[n - 1].strip()}")
+                    out.append(
+                        raw[: m.start()]
+                        + f"{file}:{line}{col}"
+                        + raw[m.end() :]
+                        + f"\n    | {lines[n - 1].strip()}"
+                    )
                     continue
             if raw.strip():
                 out.append(raw)
         return "\n".join(out)
 
 
-def build_program(ctx: moderngl.Context, vertex: str, fragment: str,
-                  defines: dict[str, str | int | float | None],
-                  shader_dir: Path = SHADER_DIR) -> moderngl.Program:
+def build_program(
+    ctx: moderngl.Context,
+    vertex: str,
+    fragment: str,
+    defines: dict[str, str | int | float | None],
+    shader_dir: Path = SHADER_DIR,
+) -> moderngl.Program:
     vs, fs = Source(vertex, defines, shader_dir), Source(fragment, defines, shader_dir)
     try:
         return ctx.program(vertex_shader=vs.text, fragment_shader=fs.text)
     except moderngl.Error as e:
         msg = str(e)
         stage = vs if "vertex_shader" in msg and "fragment_shader" not in msg else fs
-        raise ShaderError(f"{vertex} + {fragment} failed to compile:\n"
-                          + stage.map_log(msg)) from None
+        raise ShaderError(
+            f"{vertex} + {fragment} failed to compile:\n" + stage.map_log(msg)
+        ) from None
 
 
-def build_compute(ctx: moderngl.Context, entry: str,
-                  defines: dict[str, str | int | float | None],
-                  shader_dir: Path = SHADER_DIR) -> moderngl.ComputeShader:
+def build_compute(
+    ctx: moderngl.Context,
+    entry: str,
+    defines: dict[str, str | int | float | None],
+    shader_dir: Path = SHADER_DIR,
+) -> moderngl.ComputeShader:
     cs = Source(entry, defines, shader_dir)
     try:
         return ctx.compute_shader(cs.text)
@@ -158,17 +186,20 @@ class ProgramCache:
         self._programs: dict[tuple, moderngl.Program] = {}
         self.compiles = 0
 
-    def get(self, vertex: str, fragment: str,
-            defines: dict[str, str | int | float | None]) -> moderngl.Program:
+    def get(
+        self, vertex: str, fragment: str, defines: dict[str, str | int | float | None]
+    ) -> moderngl.Program:
         key = (vertex, fragment, tuple(sorted(defines.items())))
         if key not in self._programs:
-            self._programs[key] = build_program(self.ctx, vertex, fragment, defines,
-                                                self.shader_dir)
+            self._programs[key] = build_program(
+                self.ctx, vertex, fragment, defines, self.shader_dir
+            )
             self.compiles += 1
         return self._programs[key]
 
-    def compute(self, entry: str,
-                defines: dict[str, str | int | float | None]) -> moderngl.ComputeShader:
+    def compute(
+        self, entry: str, defines: dict[str, str | int | float | None]
+    ) -> moderngl.ComputeShader:
         key = (entry, None, tuple(sorted(defines.items())))
         if key not in self._programs:
             self._programs[key] = build_compute(self.ctx, entry, defines, self.shader_dir)

@@ -2,13 +2,14 @@
 float32 render targets, read back as :class:`Buffers` in image order (rows top → bottom).
 With ``[render] prepass`` a coarse pass over tiles first writes each tile's free distances
 (prepass.glsl), which the full pass starts its rays from."""
+
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 from collections.abc import Callable, Iterator
-from pathlib import Path
 from contextlib import contextmanager
+from dataclasses import replace
+from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -16,16 +17,16 @@ import numpy as np
 from ..buffers import Buffers
 from ..reference.camera import view_of
 from ..reference.geometry import Compiled, compile_geometry
-from ..scene.scene import MAX_LIGHTS
-from ..scene.model import PREPASS_RATIO
 from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
+from ..scene.model import PREPASS_RATIO
+from ..scene.scene import MAX_LIGHTS
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
 
-PROGRESS_BANDS = 16   # bands of rows of a first frame drawn with progress
-MAX_TARGETS = 8       # render-target sizes kept (least recently used released)
-COMPUTE_GROUP = 64    # compute.comp's local size
+PROGRESS_BANDS = 16  # bands of rows of a first frame drawn with progress
+MAX_TARGETS = 8  # render-target sizes kept (least recently used released)
+COMPUTE_GROUP = 64  # compute.comp's local size
 
 
 class Renderer:
@@ -35,9 +36,9 @@ class Renderer:
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
         self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int, int]] = {}  # pre-pass
-        self._blank: moderngl.Texture | None = None   # bound where the coarsest pass's parent is
-        self._compute: dict[moderngl.Program, tuple] = {}   # deferred → compute, its sizes
-        self._rays: dict[int, moderngl.Buffer] = {}   # the compute path's buffers, by binding
+        self._blank: moderngl.Texture | None = None  # bound where the coarsest pass's parent is
+        self._compute: dict[moderngl.Program, tuple] = {}  # deferred → compute, its sizes
+        self._rays: dict[int, moderngl.Buffer] = {}  # the compute path's buffers, by binding
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
@@ -62,7 +63,7 @@ class Renderer:
         (a pre-pass's: 2)."""
         key = (width, height, layers)
         if key in self._targets:
-            self._targets[key] = self._targets.pop(key)       # most recent last
+            self._targets[key] = self._targets.pop(key)  # most recent last
         else:
             while len(self._targets) >= MAX_TARGETS:
                 old = self._targets.pop(next(iter(self._targets)))
@@ -73,8 +74,15 @@ class Renderer:
             self._targets[key] = self.ctx.framebuffer(color_attachments=tex)
         return self._targets[key]
 
-    def prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                all_effects: bool = False, probes: tuple[str, ...] = ()) -> moderngl.Program:
+    def prepare(
+        self,
+        scene: Scene,
+        width: int,
+        height: int,
+        geometry: Geometry | None = None,
+        all_effects: bool = False,
+        probes: tuple[str, ...] = (),
+    ) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms,
         ``probes`` the defines of a measuring variant, drawn on the fragment path:
@@ -83,36 +91,55 @@ class Renderer:
         with self.current():
             return self._prepare(scene, width, height, geometry, all_effects, probes)
 
-    def _prepare(self, scene: Scene, width: int, height: int, geometry: Geometry | None,
-                 all_effects: bool, probes: tuple[str, ...] = ()) -> moderngl.Program:
+    def _prepare(
+        self,
+        scene: Scene,
+        width: int,
+        height: int,
+        geometry: Geometry | None,
+        all_effects: bool,
+        probes: tuple[str, ...] = (),
+    ) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
-        c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
+        c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(
+            view.origin
+        )
         block = krs_block(c, scene.render.precision)
         storage = scene.render.precision == "double"  # scene_block.glsl: a storage buffer
-        limit = self.ctx.info["GL_MAX_SHADER_STORAGE_BLOCK_SIZE" if storage
-                              else "GL_MAX_UNIFORM_BLOCK_SIZE"]
+        limit = self.ctx.info[
+            "GL_MAX_SHADER_STORAGE_BLOCK_SIZE" if storage else "GL_MAX_UNIFORM_BLOCK_SIZE"
+        ]
         if len(block) > limit:
-            raise SceneError("compound", f"<a uniform block of {len(block)} bytes>",
-                             f"this GPU's uniform blocks hold at most {limit} bytes, too few "
-                             "for a compound's 8 × 64 level slots: render its components as "
-                             "separate scenes")
+            raise SceneError(
+                "compound",
+                f"<a uniform block of {len(block)} bytes>",
+                f"this GPU's uniform blocks hold at most {limit} bytes, too few "
+                "for a compound's 8 × 64 level slots: render its components as "
+                "separate scenes",
+            )
         defines = variant_defines(scene, c, all_effects)
         if probes:
             defines.update(dict.fromkeys(probes))
             scene = replace(scene, render=replace(scene.render, path="fragment"))
-        if scene.render.path == "compute":        # trace in rounds, then a shading pass
+        if scene.render.path == "compute":  # trace in rounds, then a shading pass
             prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
             comp = self.programs.compute("compute.comp", defines)
             components = MAX_COMPONENTS if "KRS_COMPOUND" in defines else 1
             real = 8 if scene.render.precision == "double" else 4
-            ray_bytes = (2 * components + 4) * real + 8      # trace.glsl's Ray in std430
-            shadow_bytes = 0                                 # shadows.glsl's Shadow
+            ray_bytes = (2 * components + 4) * real + 8  # trace.glsl's Ray in std430
+            shadow_bytes = 0  # shadows.glsl's Shadow
             if "KRS_SHADOW_TASKS" in defines:
                 align = max(4 * real, 16)
                 shadow_bytes = -(-(4 * real + 16 + (components + 1) * real + 12) // align) * align
             per_pixel = components if "KRS_COMPONENT_TASKS" in defines else 0
-            self._compute[prog] = (comp, scene.render.steps, scene.render.max_iterations,
-                                   ray_bytes, shadow_bytes, per_pixel)
+            self._compute[prog] = (
+                comp,
+                scene.render.steps,
+                scene.render.max_iterations,
+                ray_bytes,
+                shadow_bytes,
+                per_pixel,
+            )
             progs = [prog, comp]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
@@ -121,9 +148,9 @@ class Renderer:
             coarse = self.programs.get("fullscreen.vert", "prepass.frag", defines)
             self._coarse[prog] = (coarse, scene.render.prepass, scene.render.prepass_levels)
             progs.append(coarse)
-            for p in progs:    # the finest coarse pass's output, and the coarser one's before it
+            for p in progs:  # the finest coarse pass's output, and the coarser one's before it
                 for unit, name in enumerate(("u_free0", "u_free1", "u_parent0", "u_parent1")):
-                    if name in p:                                    # unused: compiled away
+                    if name in p:  # unused: compiled away
                         p[name].value = unit
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
@@ -145,13 +172,21 @@ class Renderer:
     def _world(self, geometry: Geometry, albedo: tuple) -> Compiled:
         """The geometry compiled in world coordinates, redone only when it or the albedo
         changes (a moving camera only translates it: per-frame work stays per-frame)."""
-        if (self._compiled is None or self._compiled[0] is not geometry
-                or self._compiled[1] != albedo):
+        if (
+            self._compiled is None
+            or self._compiled[0] is not geometry
+            or self._compiled[1] != albedo
+        ):
             self._compiled = (geometry, albedo, compile_geometry(geometry, albedo))
         return self._compiled[2]
 
-    def draw(self, prog: moderngl.Program, width: int, height: int,
-             tile: tuple[int, int, int, int] | None = None) -> moderngl.Framebuffer:
+    def draw(
+        self,
+        prog: moderngl.Program,
+        width: int,
+        height: int,
+        tile: tuple[int, int, int, int] | None = None,
+    ) -> moderngl.Framebuffer:
         """Trace the whole image, or only ``tile`` = (x, y, w, h) in GL pixel coordinates, so a
         slow full-resolution frame can be spread over several event-loop turns."""
         with self.current():
@@ -167,18 +202,23 @@ class Renderer:
             self.ctx.scissor = None
             return fbo
 
-    def _prepass(self, prog: moderngl.Program, width: int, height: int,
-                 tile: tuple[int, int, int, int] | None) -> None:
+    def _prepass(
+        self,
+        prog: moderngl.Program,
+        width: int,
+        height: int,
+        tile: tuple[int, int, int, int] | None,
+    ) -> None:
         """The coarse passes of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
         coarsest first, each reading the one before's free distances from texture units 2
         and 3; the finest's are left bound to units 0 and 1 for the full pass."""
         coarse, size, levels = self._coarse[prog]
-        passes: list[tuple[int, int, int]] = []      # (tile size, columns, rows), finest first
+        passes: list[tuple[int, int, int]] = []  # (tile size, columns, rows), finest first
         for k in range(levels):
-            t = size * PREPASS_RATIO ** k
+            t = size * PREPASS_RATIO**k
             grid = (t, -(-width // t), -(-height // t))
             if passes and passes[-1][1:] == grid[1:]:
-                break                                # as coarse as the image allows
+                break  # as coarse as the image allows
             passes.append(grid)
         parent = None
         for t, cw, ch in reversed(passes):
@@ -189,8 +229,9 @@ class Renderer:
             coarse["u_parent_ratio"].value = PREPASS_RATIO if parent else 0
             # the coarsest pass reads no parent: its samplers get a texture no pass draws
             # into, so no target is ever bound for sampling while it is drawn into
-            for unit, tex in enumerate(parent.color_attachments if parent else
-                                       (self._blank_texture(),) * 2):
+            for unit, tex in enumerate(
+                parent.color_attachments if parent else (self._blank_texture(),) * 2
+            ):
                 tex.use(2 + unit)
             if tile is not None:
                 x, y, w, h = tile
@@ -212,8 +253,14 @@ class Renderer:
             self._vaos[prog] = self.ctx.vertex_array(prog, [])
         return self._vaos[prog]
 
-    def render(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-               progress: Callable[[int, int], None] | None = None) -> Buffers:
+    def render(
+        self,
+        scene: Scene,
+        width: int,
+        height: int,
+        geometry: Geometry | None = None,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> Buffers:
         """The image; with ``progress`` it is drawn in PROGRESS_BANDS bands of rows, each
         finished before progress(done, total) is called (the same pixels either way)."""
         with self.current():
@@ -228,8 +275,13 @@ class Renderer:
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
 
-    def _trace_rays(self, prog: moderngl.Program, width: int, height: int,
-                    tile: tuple[int, int, int, int] | None) -> None:
+    def _trace_rays(
+        self,
+        prog: moderngl.Program,
+        width: int,
+        height: int,
+        tile: tuple[int, int, int, int] | None,
+    ) -> None:
         """The compute path (compute.comp): start the rays of ``tile`` (or all), run rounds
         of at most ``steps`` iterations, each sized by the GPU from the rays still live, and
         leave the ray buffer bound for the shading pass (deferred.frag). Rounds enough for
@@ -239,7 +291,7 @@ class Renderer:
         comp, steps, cap, ray_bytes, shadow_bytes, per_pixel = self._compute[prog]
         x, y, w, h = tile or (0, 0, width, height)
         area = w * h
-        traced = area * max(per_pixel, 1)                      # rays traced in rounds
+        traced = area * max(per_pixel, 1)  # rays traced in rounds
         queue = max(traced, area * MAX_LIGHTS if shadow_bytes else area)  # the longest queue
         sizes = {1: area * ray_bytes, 2: 2 * queue * 4, 3: 5 * 4}
         if shadow_bytes:
@@ -253,27 +305,33 @@ class Renderer:
                 self._rays[binding] = self.ctx.buffer(reserve=max(size, 16))
             self._rays[binding].bind_to_storage_buffer(binding)
         groups = -(-area // COMPUTE_GROUP)
-        self._rays[3].write(np.array([traced, 0, -(-traced // COMPUTE_GROUP), 1, 1],
-                                     dtype=np.uint32))
+        self._rays[3].write(
+            np.array([traced, 0, -(-traced // COMPUTE_GROUP), 1, 1], dtype=np.uint32)
+        )
         prog["u_tile_rect"].value = (x, y, w, h)
-        for name, value in (("u_tile_rect", (x, y, w, h)), ("u_area", area),
-                            ("u_queue", queue), ("u_tasks", traced), ("u_steps", steps),
-                            ("u_phase", 0)):
+        for name, value in (
+            ("u_tile_rect", (x, y, w, h)),
+            ("u_area", area),
+            ("u_queue", queue),
+            ("u_tasks", traced),
+            ("u_steps", steps),
+            ("u_phase", 0),
+        ):
             if name in comp:
                 comp[name].value = value
         comp.run(-(-traced // COMPUTE_GROUP))
         self._rounds(comp, 1, -(-cap // steps) + 1)
-        if per_pixel:               # each pixel's ray: the nearest of its components' hits
+        if per_pixel:  # each pixel's ray: the nearest of its components' hits
             self.ctx.memory_barrier()
             comp["u_phase"].value = 5
             comp.run(groups)
-        if shadow_bytes:            # shadow rays as tasks of their own, through the same queues
+        if shadow_bytes:  # shadow rays as tasks of their own, through the same queues
             self.ctx.memory_barrier()
             self._rays[3].write(np.array([0, 0, 0, 1, 1], dtype=np.uint32))
             comp["u_phase"].value = 3
             comp.run(groups)
             self.ctx.memory_barrier()
-            comp["u_parity"].value, comp["u_phase"].value = 1, 2   # size round 0 from queue 0
+            comp["u_parity"].value, comp["u_phase"].value = 1, 2  # size round 0 from queue 0
             comp.run(1)
             self._rounds(comp, 4, -(-cap // steps) + 1)
         self.ctx.memory_barrier()
@@ -310,18 +368,30 @@ class Renderer:
             self._prepass(prog, width, height, None)
             cw, ch = -(-width // size), -(-height // size)
             fbo = self._framebuffer(cw, ch, layers=2)
-            return np.concatenate([read_plane(fbo, k, cw, ch) for k in range(2)],
-                                  axis=-1).astype(np.float64)
+            return np.concatenate([read_plane(fbo, k, cw, ch) for k in range(2)], axis=-1).astype(
+                np.float64
+            )
 
-    def time_frame(self, scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                   repeats: int = 1, all_effects: bool = False, prepass_only: bool = False,
-                   probes: tuple[str, ...] = ()) -> list[float]:
+    def time_frame(
+        self,
+        scene: Scene,
+        width: int,
+        height: int,
+        geometry: Geometry | None = None,
+        repeats: int = 1,
+        all_effects: bool = False,
+        prepass_only: bool = False,
+        probes: tuple[str, ...] = (),
+    ) -> list[float]:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up;
         ``prepass_only``: of the pre-pass's coarse passes alone; ``probes``: see prepare."""
         with self.current():
             prog = self.prepare(scene, width, height, geometry, all_effects, probes)
-            draw = (lambda: self._prepass(prog, width, height, None)) if prepass_only else \
-                (lambda: self.draw(prog, width, height))
+            draw = (
+                (lambda: self._prepass(prog, width, height, None))
+                if prepass_only
+                else (lambda: self.draw(prog, width, height))
+            )
             draw()
             self.ctx.finish()
             times = []
@@ -342,5 +412,10 @@ def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np
 def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Buffers:
     c, nd, it = (read_plane(fbo, k, width, height) for k in range(3))
     hit = c[..., 3] > 0.5
-    return Buffers(c[..., :3].astype(np.float64), nd[..., 3].astype(np.float64),
-                   nd[..., :3].astype(np.float64), it[..., 0].astype(np.int64), hit)
+    return Buffers(
+        c[..., :3].astype(np.float64),
+        nd[..., 3].astype(np.float64),
+        nd[..., :3].astype(np.float64),
+        it[..., 0].astype(np.int64),
+        hit,
+    )

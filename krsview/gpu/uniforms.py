@@ -1,5 +1,6 @@
 """Scene → GPU: the variant's defines and the uniform values, camera-relative, in float32 or
 (the geometry of a double-precision variant) float64."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -10,20 +11,24 @@ from ..reference.geometry import Compiled
 from ..reference.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS
-from ..scene.scene import MAX_LIGHTS
 from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
+from ..scene.scene import MAX_LIGHTS
 
 MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record, its bound
 
 
-def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
-                    ) -> dict[str, str | int | None]:
+def variant_defines(
+    scene: Scene, c: Compiled, all_effects: bool = False
+) -> dict[str, str | int | None]:
     """One define per kernel type present, per enabled effect, for the tracer, culling, the
     pre-pass, the Möbius geometry family and a compound: nothing else is compiled. ``all_effects``
     compiles every effect the geometry allows, each switched by its bit of ``u_effects``
     (the benchmark's baseline)."""
-    defines: dict[str, str | int | None] = {"KRS_SLOTS": slots(c), "KRS_RECORD": RECORD_VEC4,
-                                            "LIGHT_SLOTS": MAX_LIGHTS}
+    defines: dict[str, str | int | None] = {
+        "KRS_SLOTS": slots(c),
+        "KRS_RECORD": RECORD_VEC4,
+        "LIGHT_SLOTS": MAX_LIGHTS,
+    }
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
     if not isinstance(c, CompiledMoKRS):
@@ -42,21 +47,32 @@ def variant_defines(scene: Scene, c: Compiled, all_effects: bool = False
         defines[f"KRS_TRACER_{scene.render.tracer.upper()}"] = None
     if scene.render.precision == "double":
         defines["KRS_DOUBLE"] = None
-    if scene.render.culling == "on" and any((part.bounds[:, 3] >= 0).any()
-                                            for part, _ in component_slots(c)
-                                            if not isinstance(part, CompiledMoKRS)):
-        defines["KRS_CULLING"] = None     # only where some level has a ball to test
+    if scene.render.culling == "on" and any(
+        (part.bounds[:, 3] >= 0).any()
+        for part, _ in component_slots(c)
+        if not isinstance(part, CompiledMoKRS)
+    ):
+        defines["KRS_CULLING"] = None  # only where some level has a ball to test
     if scene.render.prepass:
         defines["KRS_PREPASS"] = None
-    if (scene.render.path == "compute" and scene.render.shadow_tasks == "on"
-            and {"shadows", "soft_shadows"} & set(scene.effects)):
-        defines["KRS_SHADOW_TASKS"] = None   # shadow rays traced in rounds (compute.comp)
-    if (scene.render.path == "compute" and scene.render.component_tasks == "on"
-            and isinstance(c, CompiledCompound)):
+    if (
+        scene.render.path == "compute"
+        and scene.render.shadow_tasks == "on"
+        and {"shadows", "soft_shadows"} & set(scene.effects)
+    ):
+        defines["KRS_SHADOW_TASKS"] = None  # shadow rays traced in rounds (compute.comp)
+    if (
+        scene.render.path == "compute"
+        and scene.render.component_tasks == "on"
+        and isinstance(c, CompiledCompound)
+    ):
         defines["KRS_COMPONENT_TASKS"] = None  # a task per pixel and component (compute.comp)
-    if (not isinstance(c, CompiledMoKRS) and "KRS_TWIST" not in defines
-            and any(ball[3] >= 0 for ball in component_balls(c))):
-        defines["KRS_BALL_EXIT"] = None    # rays leave the components' balls (trace.glsl)
+    if (
+        not isinstance(c, CompiledMoKRS)
+        and "KRS_TWIST" not in defines
+        and any(ball[3] >= 0 for ball in component_balls(c))
+    ):
+        defines["KRS_BALL_EXIT"] = None  # rays leave the components' balls (trace.glsl)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
         defines["MOBIUS_RECORD"] = MOBIUS_RECORD
@@ -92,18 +108,18 @@ def block_arrays(c: Compiled, precision: str, n: int) -> dict[str, np.ndarray]:
     ``len(c.records)``, the slots in use; unused slots stay zero, balls −1: none)."""
     dtype = np.float64 if precision == "double" else np.float32
     kernels = np.zeros((n, RECORD_VEC4, 4), dtype=dtype)
-    kernels[:len(c.records)] = c.records
+    kernels[: len(c.records)] = c.records
     if isinstance(c, CompiledMoKRS):
         head = np.zeros((n, MOBIUS_RECORD, 4), dtype=dtype)
-        head[:c.n, :4] = c.inverse.reshape(c.n, 4, 4)
-        head[:c.n, 4] = c.poles
-        head[:c.n, 5] = c.bounds
+        head[: c.n, :4] = c.inverse.reshape(c.n, 4, 4)
+        head[: c.n, 4] = c.poles
+        head[: c.n, 5] = c.bounds
         return {"u_mobius": head.reshape(-1, 4), "u_kernels": kernels.reshape(-1, 4)}
     mirrors, bounds = np.zeros((n, 4), dtype=dtype), np.zeros((n, 4), dtype=dtype)
     bounds[:, 3] = -1.0
     for part, first in component_slots(c):
-        mirrors[first:first + part.n] = part.mirrors
-        bounds[first:first + part.n] = part.bounds
+        mirrors[first : first + part.n] = part.mirrors
+        bounds[first : first + part.n] = part.bounds
     return {"u_mirrors": mirrors, "u_bounds": bounds, "u_kernels": kernels.reshape(-1, 4)}
 
 
@@ -120,16 +136,21 @@ def component_balls(c: Compiled) -> list[tuple[float, ...]]:
     if isinstance(c, CompiledMoKRS):
         return [tuple(UNBOUNDED)]
     balls = [tuple(float(v) for v in part.ball) for part, _ in component_slots(c)]
-    return balls + [tuple(UNBOUNDED)] * (MAX_COMPONENTS - len(balls)) \
-        if isinstance(c, CompiledCompound) else balls
+    return (
+        balls + [tuple(UNBOUNDED)] * (MAX_COMPONENTS - len(balls))
+        if isinstance(c, CompiledCompound)
+        else balls
+    )
 
 
 def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     """Per-frame values; positions are camera-relative (the eye is the origin)."""
     lights = scene.lights
     fx = scene.effect_settings
-    zones = [tuple(float(v) for v in (*(np.array(z.center) - view.origin), z.radius))
-             for z in fx.empty_zones]
+    zones = [
+        tuple(float(v) for v in (*(np.array(z.center) - view.origin), z.radius))
+        for z in fx.empty_zones
+    ]
     parts = [(int(first), part.n) for part, first in component_slots(c)]
     return {
         "u_n": getattr(c, "n", 0),
@@ -137,7 +158,9 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_component": parts + [(0, 0)] * (MAX_COMPONENTS - len(parts)),
         "u_footprint": view.footprint,
         "u_eye": tuple(view.origin),
-        "u_forward": tuple(view.forward), "u_right": tuple(view.right), "u_up": tuple(view.up),
+        "u_forward": tuple(view.forward),
+        "u_right": tuple(view.right),
+        "u_up": tuple(view.up),
         "u_resolution": (float(view.width), float(view.height)),
         "u_tan_half": view.tan_half,
         "u_eps_per_t": view.footprint * scene.render.epsilon_scale,
@@ -149,16 +172,17 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_tile": scene.render.prepass,
         "u_light_count": len(lights),
         "u_light_dir": [lt.direction for lt in lights]
-                       + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
+        + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
         "u_light_color": [tuple(c * lt.intensity for c in lt.color) for lt in lights]
-                         + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
+        + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
         "u_ambient": scene.material.ambient,
         "u_background": scene.material.background,
         "u_effects": sum(EFFECTS[e].bit for e in scene.effects),
         "u_smooth_width": fx.smooth_width,
         "u_shadow_softness": fx.shadow_softness,
-        "u_bounding_ball": (component_balls(c) if isinstance(c, CompiledCompound)
-                             else component_balls(c)[0]),     # an array only in a compound
+        "u_bounding_ball": (
+            component_balls(c) if isinstance(c, CompiledCompound) else component_balls(c)[0]
+        ),  # an array only in a compound
         "u_ao_step": fx.ao_step,
         "u_ao_strength": fx.ao_strength,
         "u_texture_scale": fx.texture_scale,

@@ -19,6 +19,7 @@ walk (culling), and a ball no larger than LOD_BALL × the segment stands for its
 long segment costs a few levels and only short ones near the geometry walk deep — the
 level-of-detail oracle that decides trees at full depth.
 """
+
 from __future__ import annotations
 
 import time
@@ -32,13 +33,13 @@ from ..reference.geometry import compile_geometry
 from ..scene import Scene
 from .distance import Bounds, bounds, in_box, on_segments
 
-DELTA_PIXELS = 0.25        # a crossing is certified within a quarter pixel footprint
-REFINE = 1024              # a segment δ/REFINE long that touches 0 without a crossing: undecided
-MAX_SEGMENTS = 500         # per ray: past this the ray is undecided
-BOX_DEPTH = 3              # octree subdivisions of an ε-box (up to 8³ boxes)
-LOD_BALL = 1.0             # a segment walks no level whose ball is ≤ this × its length
-SURFACE, NONE, UNDECIDED, BELOW_LOD = 1, 0, -1, 2   # per-ray outcomes
-DECIDED = np.array([0, 2, 3, 1])   # at outcome + 1: undecided < below LOD < none < surface
+DELTA_PIXELS = 0.25  # a crossing is certified within a quarter pixel footprint
+REFINE = 1024  # a segment δ/REFINE long that touches 0 without a crossing: undecided
+MAX_SEGMENTS = 500  # per ray: past this the ray is undecided
+BOX_DEPTH = 3  # octree subdivisions of an ε-box (up to 8³ boxes)
+LOD_BALL = 1.0  # a segment walks no level whose ball is ≤ this × its length
+SURFACE, NONE, UNDECIDED, BELOW_LOD = 1, 0, -1, 2  # per-ray outcomes
+DECIDED = np.array([0, 2, 3, 1])  # at outcome + 1: undecided < below LOD < none < surface
 ARITHMETICS = ("affine", "interval")
 
 
@@ -46,8 +47,9 @@ ARITHMETICS = ("affine", "interval")
 class Certified:
     """Per ray: SURFACE certified on [0, T], NONE certified there, BELOW_LOD (none but
     perhaps sub-pixel detail), UNDECIDED; and the work it took."""
+
     surface: np.ndarray
-    segments: int = 0        # enclosures evaluated (subdivisions + 1 per ray)
+    segments: int = 0  # enclosures evaluated (subdivisions + 1 per ray)
     seconds: float = 0.0
 
 
@@ -55,13 +57,21 @@ def enclosure(c, origin, dirs, a, b, arithmetic: str, lod: bool = False) -> Boun
     """Bounds of the value over the segments (with ``lod``, detail below LOD_BALL × their
     length left out); NaN (∞ · 0 near a pole) means unknown."""
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        return bounds(c, on_segments(origin, dirs, a, b, arithmetic),
-                      LOD_BALL * (b - a) if lod else None)
+        return bounds(
+            c, on_segments(origin, dirs, a, b, arithmetic), LOD_BALL * (b - a) if lod else None
+        )
 
 
-def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, footprint: float,
-                    arithmetic: str, max_segments: int = MAX_SEGMENTS,
-                    lod: bool = True) -> Certified:
+def surfaces_before(
+    c,
+    origin: np.ndarray,
+    dirs: np.ndarray,
+    T: np.ndarray,
+    footprint: float,
+    arithmetic: str,
+    max_segments: int = MAX_SEGMENTS,
+    lod: bool = True,
+) -> Certified:
     """For each ray (dirs (N, 3)), whether a surface is certified on [0, T]. ``footprint``
     is a pixel's angle: a segment ending at t is small at δ = DELTA_PIXELS × footprint × t,
     where a crossing is looked for and left-out detail is accepted as below the level of
@@ -78,10 +88,10 @@ def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, foot
         e = enclosure(c, origin, dirs[ray], a, b, arithmetic, lod)
         total += ray.size
         np.subtract.at(budget, ray, 1)
-        live = ~(e.lower > 0) & (surface[ray] == NONE)   # may hold a surface (NaN: unknown)
-        delta = DELTA_PIXELS * footprint * b     # a quarter pixel where the segment ends
+        live = ~(e.lower > 0) & (surface[ray] == NONE)  # may hold a surface (NaN: unknown)
+        delta = DELTA_PIXELS * footprint * b  # a quarter pixel where the segment ends
         small = live & (b - a <= delta)
-        detail = small & (e.lo > 0)          # only a left-out ball reaches 0: sub-pixel detail
+        detail = small & (e.lo > 0)  # only a left-out ball reaches 0: sub-pixel detail
         below_lod[ray[detail]] = True
         small &= ~detail
         live &= ~detail
@@ -89,9 +99,9 @@ def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, foot
             r, sa, sb = ray[small], a[small], b[small]
             pa = enclosure(c, origin, dirs[r], sa, sa, "interval")
             pb = enclosure(c, origin, dirs[r], sb, sb, "interval")
-            crossing = ((pa.lower > 0) & (pb.hi < 0)) | (pa.hi < 0)   # or already inside
+            crossing = ((pa.lower > 0) & (pb.hi < 0)) | (pa.hi < 0)  # or already inside
             surface[r[crossing]] = SURFACE
-            tiny = ~crossing & (sb - sa <= delta[small] / REFINE)       # touches 0: give up
+            tiny = ~crossing & (sb - sa <= delta[small] / REFINE)  # touches 0: give up
             surface[r[tiny]] = np.where(surface[r[tiny]] == NONE, UNDECIDED, surface[r[tiny]])
         split = live & (surface[ray] == NONE)
         out = budget[ray] <= 0
@@ -103,8 +113,9 @@ def surfaces_before(c, origin: np.ndarray, dirs: np.ndarray, T: np.ndarray, foot
     surface[(surface == NONE) & below_lod] = BELOW_LOD
     again = np.nonzero(surface == BELOW_LOD)[0]
     if lod and again.size:
-        exact = surfaces_before(c, origin, dirs[again], T[again], footprint, arithmetic,
-                                max_segments, lod=False)
+        exact = surfaces_before(
+            c, origin, dirs[again], T[again], footprint, arithmetic, max_segments, lod=False
+        )
         surface[again] = np.where(exact.surface == UNDECIDED, BELOW_LOD, exact.surface)
         total += exact.segments
     return Certified(surface, total, time.perf_counter() - t0)
@@ -119,7 +130,7 @@ def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
     for depth in range(BOX_DEPTH + 1):
         with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
             lower = bounds(c, in_box(ctr, h)).lower
-        open_ = ~(lower > 0)                           # NaN (through a pole): unknown
+        open_ = ~(lower > 0)  # NaN (through a pole): unknown
         if depth == BOX_DEPTH:
             free[idx[open_]] = False
             break
@@ -148,16 +159,16 @@ class Counts:
     false_hits: int
     below_lod: int
     undecided: int
-    work: dict = field(default_factory=dict)    # arithmetic → (segments, seconds)
+    work: dict = field(default_factory=dict)  # arithmetic → (segments, seconds)
 
 
-def count_errors(scene: Scene, image: Buffers, arithmetics=ARITHMETICS,
-                 max_segments: int = MAX_SEGMENTS) -> Counts:
+def count_errors(
+    scene: Scene, image: Buffers, arithmetics=ARITHMETICS, max_segments: int = MAX_SEGMENTS
+) -> Counts:
     """Certified holes and false hits of a traced image (GPU or reference) of ``scene``: a
     KRS, compound or MöKRS (the twist and empty zones are not in the oracle)."""
     if {"twist", "empty_zones"} & set(scene.effects):
-        raise ValueError(f"{scene.name}: the oracle covers scenes without twist or empty "
-                         "zones")
+        raise ValueError(f"{scene.name}: the oracle covers scenes without twist or empty zones")
     h, w = image.hit.shape
     view = view_of(scene.camera, w, h)
     c = compile_geometry(scene.geometry(), scene.material.albedo)
@@ -168,13 +179,24 @@ def count_errors(scene: Scene, image: Buffers, arithmetics=ARITHMETICS,
     T = np.where(hit, t - eps, scene.render.max_distance)
     check = ~capped & (T > 0)
     work, surface = {}, None
-    for arithmetic in arithmetics:   # both are sound: the more decided answer counts
-        cert = surfaces_before(c, view.origin, dirs[check], T[check], view.footprint, arithmetic,
-                               max_segments)
+    for arithmetic in arithmetics:  # both are sound: the more decided answer counts
+        cert = surfaces_before(
+            c, view.origin, dirs[check], T[check], view.footprint, arithmetic, max_segments
+        )
         work[arithmetic] = (cert.segments, cert.seconds)
-        surface = cert.surface if surface is None else np.where(
-            DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
+        surface = (
+            cert.surface
+            if surface is None
+            else np.where(DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
+        )
     centres = view.origin + t[hit, None] * dirs[hit]
     false_hits = int(free_boxes(c, centres, HIT_REACH[scene.render.tracer] * eps[hit]).sum())
-    return Counts(len(hit), int(hit.sum()), int((surface == SURFACE).sum()), false_hits,
-                  int((surface == BELOW_LOD).sum()), int((surface == UNDECIDED).sum()), work)
+    return Counts(
+        len(hit),
+        int(hit.sum()),
+        int((surface == SURFACE).sum()),
+        false_hits,
+        int((surface == BELOW_LOD).sum()),
+        int((surface == UNDECIDED).sum()),
+        work,
+    )

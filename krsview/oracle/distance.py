@@ -4,6 +4,7 @@ they share). A fold is x − 2·max(0, u·x − w)·u, its conditional turned in
 writes them; the toroidal capsule's wedge test takes the hull of both branches where the
 range cannot decide it. The result encloses the real-number value of the distance the tracer
 approximates, on the compiled scene's exact float64 constants."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -52,7 +53,7 @@ def kernel(kind: str, rec, p: Vec) -> Number | None:
     if kind == "capsule":
         ab = B - A
         h = dot(ab, minus(p, A)) * (1.0 / max(float(ab @ ab), 1e-300))
-        h = h.relu() - (h - 1.0).relu()                       # clamp to [0, 1]
+        h = h.relu() - (h - 1.0).relu()  # clamp to [0, 1]
         return norm(tuple(p[k] - float(A[k]) - h * float(ab[k]) for k in range(3))) - r
     # toroidal capsule: torus formula inside the wedge, else the nearer cap
     q = minus(p, rec[3, :3])
@@ -87,8 +88,12 @@ def qmul(p, q):
     """Quaternion product; each side four Numbers or four floats (real, i, j, k)."""
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return (pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw)
+    return (
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    )
 
 
 def mobius_apply(H, x: Vec) -> Vec:
@@ -122,15 +127,20 @@ def steps(c: CompiledKRS | CompiledMoKRS):
     yield None, np.inf, lambda x: x, c.types[c.n], c.records[c.n]
     for i in range(c.n - 1, -1, -1):
         ball = c.bounds[i] if c.bounds[i, 3] >= 0 else None
-        yield ball, np.inf if ball is None else ball[3], lambda x, m=c.mirrors[i]: fold(m, x), \
-            c.types[i], c.records[i]
+        yield (
+            ball,
+            np.inf if ball is None else ball[3],
+            lambda x, m=c.mirrors[i]: fold(m, x),
+            c.types[i],
+            c.records[i],
+        )
 
 
 def inwards(H, reflect: bool, x: Vec) -> Vec:
     """One MöKRS level inwards: x ← H(x), then −|x| where the level reflects."""
     x = mobius_apply(H, x)
     if reflect:
-        x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])     # x ← −|x|
+        x = (-(x[0].relu() + (-x[0]).relu()), x[1], x[2])  # x ← −|x|
     return x
 
 
@@ -139,10 +149,12 @@ def value(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:
     the point followed inwards as Alg. 3 tests it — not a distance (the maps scale lengths)
     but continuous where the maps are defined (+∞ towards a pole), so its sign certifies
     surfaces and empty space alike. A compound takes the least over its components."""
+
     def terms(part, x):
         for _, _, move, kind, rec in steps(part):
             x = move(x)
             yield kernel(kind, rec, x)
+
     parts = c.parts if isinstance(c, CompiledCompound) else (c,)
     return least(k for part in parts for k in terms(part, x))
 
@@ -153,6 +165,7 @@ class Bounds:
     used): ``lo`` ≤ v from the kernels walked and the balls found clear; ``hi`` ≥ v from the
     kernels walked (a subset of the scene); ``cut`` ≤ v from the balls of levels left out
     at the level of detail (+∞ where none), so v ≥ min(lo, cut)."""
+
     lo: np.ndarray
     hi: np.ndarray
     cut: np.ndarray
@@ -162,8 +175,9 @@ class Bounds:
         return np.minimum(self.lo, self.cut)
 
 
-def bounds(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec,
-           lod: np.ndarray | None = None) -> Bounds:
+def bounds(
+    c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec, lod: np.ndarray | None = None
+) -> Bounds:
     """Bounds of the value over the batch ``x`` walked with the levels' balls: where a
     point's ball lies clear (its enclosure > 0) the levels below cannot reach 0 and its
     walk ends (culling, which for a MöKRS also steps around the poles); with ``lod`` (a
@@ -177,7 +191,7 @@ def bounds(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec,
         for ball, size, move, kind, rec in steps(part):
             if ball is not None:
                 blo = (norm(minus(y, ball[:3])) - float(ball[3])).range()[0]
-                clear = blo > 0                          # NaN: not clear
+                clear = blo > 0  # NaN: not clear
                 cut = ~clear & (size <= lod[rows]) if lod is not None else np.zeros_like(clear)
                 out.lo[rows[clear]] = np.minimum(out.lo[rows[clear]], blo[clear])
                 out.cut[rows[cut]] = np.minimum(out.cut[rows[cut]], blo[cut])
@@ -203,8 +217,7 @@ def on_segments(origin, dirs, a, b, arithmetic: str) -> Vec:
         t = Interval(a, b)
         return tuple(t * dirs[:, k] + o[..., k] for k in range(3))
     mid, half = 0.5 * (a + b), 0.5 * (b - a)
-    return tuple(Affine.rounded(o[..., k] + dirs[:, k] * mid, dirs[:, k] * half)
-                 for k in range(3))
+    return tuple(Affine.rounded(o[..., k] + dirs[:, k] * mid, dirs[:, k] * half) for k in range(3))
 
 
 def in_box(center, half) -> Vec:

@@ -12,11 +12,12 @@ approximations: f(x) ≈ αx + ζ ± δ over the argument's range [a, b], with f
 bounded by hand on [a, b] [RAA09 §3.4, dS97]. Conditionals whose outcome the range cannot
 decide take the hull of both branches, as RAA09 does.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-ROUNDING = 2.0 ** -49   # relative error added per affine operation (≥ a few ulps of float64)
+ROUNDING = 2.0**-49  # relative error added per affine operation (≥ a few ulps of float64)
 
 
 def _down(x):
@@ -29,6 +30,7 @@ def _up(x):
 
 class Interval:
     """[lo, hi] per element; constants (float arrays) are exact degenerate intervals."""
+
     __slots__ = ("lo", "hi")
 
     def __init__(self, lo, hi=None):
@@ -36,12 +38,12 @@ class Interval:
         self.hi = self.lo if hi is None else np.asarray(hi, dtype=np.float64)
 
     @staticmethod
-    def outward(lo, hi) -> "Interval":
+    def outward(lo, hi) -> Interval:
         """[lo, hi] widened by an ulp each way (for bounds computed in float64)."""
         return Interval(_down(lo), _up(hi))
 
     @staticmethod
-    def lift(x) -> "Interval":
+    def lift(x) -> Interval:
         return x if isinstance(x, Interval) else Interval(x)
 
     def range(self) -> tuple[np.ndarray, np.ndarray]:
@@ -51,7 +53,7 @@ class Interval:
     def size(self) -> int:
         return np.broadcast(self.lo, self.hi).size
 
-    def take(self, keep: np.ndarray) -> "Interval":
+    def take(self, keep: np.ndarray) -> Interval:
         """The elements where ``keep``."""
         return Interval(self.lo[keep], self.hi[keep])
 
@@ -84,8 +86,10 @@ class Interval:
         return Interval(np.maximum(_down(lo), 0.0), _up(np.maximum(a, b) ** 2))
 
     def sqrt(self):
-        return Interval(np.maximum(_down(np.sqrt(np.maximum(self.lo, 0.0))), 0.0),
-                        _up(np.sqrt(np.maximum(self.hi, 0.0))))
+        return Interval(
+            np.maximum(_down(np.sqrt(np.maximum(self.lo, 0.0))), 0.0),
+            _up(np.sqrt(np.maximum(self.hi, 0.0))),
+        )
 
     def relu(self):
         return Interval(np.maximum(self.lo, 0.0), np.maximum(self.hi, 0.0))
@@ -104,15 +108,18 @@ class Interval:
     def hull(self, o):
         return Interval(np.minimum(self.lo, o.lo), np.maximum(self.hi, o.hi))
 
-    def select(self, yes: np.ndarray, no: np.ndarray, other: "Interval") -> "Interval":
+    def select(self, yes: np.ndarray, no: np.ndarray, other: Interval) -> Interval:
         """Where ``yes``: self; where ``no``: other; elsewhere the hull of both."""
         h = self.hull(other)
-        return Interval(np.where(yes, self.lo, np.where(no, other.lo, h.lo)),
-                        np.where(yes, self.hi, np.where(no, other.hi, h.hi)))
+        return Interval(
+            np.where(yes, self.lo, np.where(no, other.lo, h.lo)),
+            np.where(yes, self.hi, np.where(no, other.hi, h.hi)),
+        )
 
 
 class Affine:
     """x0 + x1·ε1 ± e per element (revised affine form with one noise symbol)."""
+
     __slots__ = ("x0", "x1", "e")
 
     def __init__(self, x0, x1=0.0, e=0.0):
@@ -121,11 +128,11 @@ class Affine:
         self.e = np.broadcast_to(np.asarray(e, dtype=np.float64), self.x0.shape)
 
     @staticmethod
-    def lift(x) -> "Affine":
+    def lift(x) -> Affine:
         return x if isinstance(x, Affine) else Affine(x)
 
     @staticmethod
-    def rounded(x0, x1, e=0.0) -> "Affine":
+    def rounded(x0, x1, e=0.0) -> Affine:
         """The form with e grown by the rounding of the float64 computation of its parts."""
         return Affine(x0, x1, e + ROUNDING * (np.abs(x0) + np.abs(x1) + e))
 
@@ -138,7 +145,7 @@ class Affine:
     def size(self) -> int:
         return self.x0.size
 
-    def take(self, keep: np.ndarray) -> "Affine":
+    def take(self, keep: np.ndarray) -> Affine:
         """The elements where ``keep``."""
         return Affine(self.x0[keep], self.x1[keep], self.e[keep])
 
@@ -146,7 +153,7 @@ class Affine:
         return Interval(*self.range())
 
     @staticmethod
-    def of_interval(i: Interval) -> "Affine":
+    def of_interval(i: Interval) -> Affine:
         mid = 0.5 * (i.lo + i.hi)
         return Affine.rounded(mid, 0.0, np.maximum(i.hi - mid, mid - i.lo))
 
@@ -166,12 +173,15 @@ class Affine:
         return Affine.lift(o) + (-self)
 
     def __mul__(self, o):
-        if not isinstance(o, Affine):   # by a constant: exact up to rounding
+        if not isinstance(o, Affine):  # by a constant: exact up to rounding
             c = np.asarray(o, dtype=np.float64)
             return Affine.rounded(c * self.x0, c * self.x1, np.abs(c) * self.e)
         # (x0 + x1ε + η)(y0 + y1ε + θ): the ε² term x1·y1·ε² lies in ±|x1·y1|
-        e = (np.abs(self.x0) * o.e + np.abs(o.x0) * self.e
-             + (np.abs(self.x1) + self.e) * (np.abs(o.x1) + o.e))
+        e = (
+            np.abs(self.x0) * o.e
+            + np.abs(o.x0) * self.e
+            + (np.abs(self.x1) + self.e) * (np.abs(o.x1) + o.e)
+        )
         return Affine.rounded(self.x0 * o.x0, self.x0 * o.x1 + self.x1 * o.x0, e)
 
     __rmul__ = __mul__
@@ -182,10 +192,11 @@ class Affine:
         e = h + 2.0 * (np.abs(self.x0) + np.abs(self.x1)) * self.e + self.e * self.e
         return Affine.rounded(self.x0 * self.x0 + h, 2.0 * self.x0 * self.x1, e)
 
-    def _linearised(self, alpha, zeta, delta) -> "Affine":
+    def _linearised(self, alpha, zeta, delta) -> Affine:
         """f(x) ≈ αx + ζ ± δ applied to this form."""
-        return Affine.rounded(alpha * self.x0 + zeta, alpha * self.x1,
-                             np.abs(alpha) * self.e + delta)
+        return Affine.rounded(
+            alpha * self.x0 + zeta, alpha * self.x1, np.abs(alpha) * self.e + delta
+        )
 
     def sqrt(self):
         """Min-range: α = f'(b); f − αx increases on [a, b], so it spans [g(a), g(b)]."""
@@ -202,14 +213,15 @@ class Affine:
         is least, so 1/x − αx is monotone on [a, b]; unbounded where the range holds 0."""
         a, b = self.range()
         safe = (a > 0) | (b < 0)
-        far = np.where(safe, np.where(a > 0, b, a), 1.0)     # the end with the smaller |f'|
+        far = np.where(safe, np.where(a > 0, b, a), 1.0)  # the end with the smaller |f'|
         near = np.where(safe, np.where(a > 0, a, b), 1.0)
         alpha = -1.0 / (far * far)
         g_far, g_near = 1.0 / far - alpha * far, 1.0 / near - alpha * near
         lo, hi = np.minimum(g_far, g_near), np.maximum(g_far, g_near)
         out = self._linearised(alpha, 0.5 * (lo + hi), 0.5 * (hi - lo))
-        return Affine(np.where(safe, out.x0, 0.0), np.where(safe, out.x1, 0.0),
-                      np.where(safe, out.e, np.inf))
+        return Affine(
+            np.where(safe, out.x0, 0.0), np.where(safe, out.x1, 0.0), np.where(safe, out.e, np.inf)
+        )
 
     def relu(self):
         """Chebyshev: on a < 0 < b, max(0, x) − αx with α = b/(b − a) spans [0, −ab/(b − a)]."""
@@ -225,12 +237,14 @@ class Affine:
         o = Affine.lift(o)
         return self - (self - o).relu()
 
-    def select(self, yes: np.ndarray, no: np.ndarray, other: "Affine") -> "Affine":
+    def select(self, yes: np.ndarray, no: np.ndarray, other: Affine) -> Affine:
         """Where ``yes``: self; where ``no``: other; elsewhere the hull of both (as an
         interval, turned back into a form)."""
         h = Affine.of_interval(self.interval().hull(other.interval()))
-        pick = lambda f: np.where(yes, getattr(self, f), np.where(no, getattr(other, f),  # noqa: E731
-                                                                   getattr(h, f)))
+
+        def pick(f: str) -> np.ndarray:
+            return np.where(yes, getattr(self, f), np.where(no, getattr(other, f), getattr(h, f)))
+
         return Affine(pick("x0"), pick("x1"), pick("e"))
 
 

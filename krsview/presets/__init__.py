@@ -1,5 +1,6 @@
 """Find scene files: a path, or the name of a preset shipped in this package (the .toml
 files beside this module, so an installed wheel has them too)."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -18,16 +19,22 @@ def resolve(name_or_path: str) -> Path:
     p = Path(name_or_path)
     if p.suffix == ".toml" or p.exists():
         if p.is_dir():
-            raise SceneError("PRESET", name_or_path, "is a folder; give a scene file (.toml) "
-                             "or a preset: " + ", ".join(preset_names()))
+            raise SceneError(
+                "PRESET",
+                name_or_path,
+                "is a folder; give a scene file (.toml) or a preset: " + ", ".join(preset_names()),
+            )
         if not p.is_file():
-            hint = (f"; the preset of that name is `{p.stem}` (no .toml)"
-                    if (PRESET_DIR / p.name).is_file() else
-                    "; presets: " + ", ".join(preset_names()))
+            hint = (
+                f"; the preset of that name is `{p.stem}` (no .toml)"
+                if (PRESET_DIR / p.name).is_file()
+                else "; presets: " + ", ".join(preset_names())
+            )
             raise SceneError("PRESET", name_or_path, "no such scene file" + hint)
         return p
     candidate = PRESET_DIR / f"{name_or_path}.toml"
     if candidate.is_file():
         return candidate
-    raise SceneError("PRESET", name_or_path,
-                     "not a file and not a preset; presets: " + ", ".join(preset_names()))
+    raise SceneError(
+        "PRESET", name_or_path, "not a file and not a preset; presets: " + ", ".join(preset_names())
+    )

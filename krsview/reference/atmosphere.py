@@ -1,4 +1,5 @@
 """Sky, fog and tone mapping; twin of ``shaders/atmosphere.glsl``."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -1,4 +1,5 @@
 """Pinhole view: basis, primary rays and the pixel footprint used for LOD [KRS17 §4]."""
+
 from __future__ import annotations
 
 import math
@@ -11,11 +12,11 @@ from ..scene import Camera
 
 @dataclass(frozen=True)
 class View:
-    origin: np.ndarray    # eye position, float64 world
+    origin: np.ndarray  # eye position, float64 world
     forward: np.ndarray
     right: np.ndarray
     up: np.ndarray
-    tan_half: float       # tan(fov_y / 2)
+    tan_half: float  # tan(fov_y / 2)
     width: int
     height: int
 
@@ -43,7 +44,7 @@ def primary_rays(v: View) -> np.ndarray:
     """Unit directions (H·W, 3) through pixel centres, rows top → bottom (as the shader's
     gl_FragCoord, flipped)."""
     cols = np.arange(v.width) + 0.5
-    rows = v.height - (np.arange(v.height) + 0.5)      # gl_FragCoord.y of each image row
+    rows = v.height - (np.arange(v.height) + 0.5)  # gl_FragCoord.y of each image row
     fx, fy = np.meshgrid(cols, rows)
     nx = (2.0 * fx / v.width - 1.0) * v.tan_half * v.aspect
     ny = (2.0 * fy / v.height - 1.0) * v.tan_half

@@ -5,6 +5,7 @@ Each kernel becomes a record of ``RECORD_VEC4`` vec4s (layout below, mirrored in
 the origin to the camera each frame, so the GPU works in camera-relative float32 while the CPU
 keeps the camera in float64 (DESIGN.md, Precision).
 """
+
 from __future__ import annotations
 
 import math
@@ -26,13 +27,13 @@ RECORD_VEC4 = 6
 # record[5] = arc (e2: unit, in-plane ⟂ e1, sin phi)
 
 
-CULL_MARGIN = 1e-6   # relative growth of the culling balls, against rounding
+CULL_MARGIN = 1e-6  # relative growth of the culling balls, against rounding
 
 # Record slots holding a position (xyz), per kernel type: what moves when the origin moves.
 POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1, 2, 3)}
 
 
-UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])   # a bound record for "no bounding ball"
+UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])  # a bound record for "no bounding ball"
 
 
 def kernel_ball(k: Kernel) -> np.ndarray | None:
@@ -102,8 +103,9 @@ def grown(ball: np.ndarray | None) -> np.ndarray:
     UNBOUNDED for None."""
     if ball is None:
         return UNBOUNDED.copy()
-    return np.array([*ball[:3], ball[3] * (1 + CULL_MARGIN)
-                     + CULL_MARGIN * float(np.abs(ball[:3]).max())])
+    return np.array(
+        [*ball[:3], ball[3] * (1 + CULL_MARGIN) + CULL_MARGIN * float(np.abs(ball[:3]).max())]
+    )
 
 
 def krs_bounds(krs: KRS) -> np.ndarray:
@@ -125,17 +127,17 @@ def krs_bounds(krs: KRS) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CompiledKRS:
-    mirrors: np.ndarray   # (n, 4): u.xyz, w  (the plane u·x = w)
-    bounds: np.ndarray    # (n, 4): krs_bounds, the culling ball before fold i (r < 0: none)
-    records: np.ndarray   # (n+1, RECORD_VEC4, 4) float64
+    mirrors: np.ndarray  # (n, 4): u.xyz, w  (the plane u·x = w)
+    bounds: np.ndarray  # (n, 4): krs_bounds, the culling ball before fold i (r < 0: none)
+    records: np.ndarray  # (n+1, RECORD_VEC4, 4) float64
     types: tuple[str, ...]  # kernel type per level (after arc → capsule degeneration)
-    ball: np.ndarray      # (4,): grown(krs_ball), everything drawn (r < 0: unbounded)
+    ball: np.ndarray  # (4,): grown(krs_ball), everything drawn (r < 0: unbounded)
 
     @property
     def n(self) -> int:
         return len(self.mirrors)
 
-    def relative_to(self, origin: np.ndarray | tuple) -> "CompiledKRS":
+    def relative_to(self, origin: np.ndarray | tuple) -> CompiledKRS:
         """The same KRS with every position taken relative to ``origin`` (float64): the
         per-frame step of camera-relative rendering; the rest is compiled once per scene."""
         o = np.asarray(origin, dtype=np.float64)
@@ -155,14 +157,16 @@ class CompiledKRS:
 
 def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
     """Flatten ``krs`` in world coordinates (float64); see :meth:`CompiledKRS.relative_to`."""
-    mirrors = np.array([[*m.normal, m.offset] for m in krs.mirrors],
-                       dtype=np.float64).reshape(-1, 4)
+    mirrors = np.array([[*m.normal, m.offset] for m in krs.mirrors], dtype=np.float64).reshape(
+        -1, 4
+    )
     records, types = kernel_records(krs.kernels, albedo)
     return CompiledKRS(mirrors, krs_bounds(krs), records, types, grown(krs_ball(krs)))
 
 
-def kernel_records(kernels: list, albedo: tuple[float, float, float]
-                   ) -> tuple[np.ndarray, tuple[str, ...]]:
+def kernel_records(
+    kernels: list, albedo: tuple[float, float, float]
+) -> tuple[np.ndarray, tuple[str, ...]]:
     """One record per kernel (layout above) and each kernel's drawn type."""
     records = np.zeros((len(kernels), RECORD_VEC4, 4))
     types = []
@@ -199,6 +203,7 @@ class CompiledCompound:
     """A compound's components [KRS17 §5.1], each a CompiledKRS. Their levels share one row of
     slots, as in the GPU's uniform block: level i of component c is slot ``bases[c] + i``, so
     a slot names a kernel record across the whole compound (shading looks colours up by it)."""
+
     parts: tuple[CompiledKRS, ...]
 
     @cached_property
@@ -223,5 +228,5 @@ class CompiledCompound:
             out = union_ball(out, p.ball)
         return out
 
-    def relative_to(self, origin: np.ndarray | tuple) -> "CompiledCompound":
+    def relative_to(self, origin: np.ndarray | tuple) -> CompiledCompound:
         return CompiledCompound(tuple(p.relative_to(origin) for p in self.parts))

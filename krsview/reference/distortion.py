@@ -7,6 +7,7 @@ Its inverse g has Jacobian ‖Dg‖ ≤ 1 + |k|ρ at axis distance ρ (a shear o
 KRS distance D at g(p) becomes a safe step δ at p by solving δ(1 + |k|(ρ + δ)) = D: every
 point of the ball of radius δ around p maps into the free ball of radius D around g(p).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -18,12 +19,12 @@ from ..scene import Scene
 
 @dataclass(frozen=True)
 class Distortion:
-    twist: float            # radians per unit height; 0 when the effect is off
-    center: np.ndarray      # a point on the twist axis (world)
-    zones: np.ndarray       # (Z, 4) empty zones: centre, radius (world)
+    twist: float  # radians per unit height; 0 when the effect is off
+    center: np.ndarray  # a point on the twist axis (world)
+    zones: np.ndarray  # (Z, 4) empty zones: centre, radius (world)
 
     @staticmethod
-    def of(scene: Scene) -> "Distortion | None":
+    def of(scene: Scene) -> Distortion | None:
         """The scene's distortion, or None when it lists neither twist nor empty_zones."""
         fx = scene.effect_settings
         twist = "twist" in scene.effects
@@ -31,16 +32,20 @@ class Distortion:
         if not (twist or zones):
             return None
         z = np.array([[*e.center, e.radius] for e in fx.empty_zones]) if zones else ()
-        return Distortion(np.radians(fx.twist) if twist else 0.0,
-                          np.array(fx.twist_center, dtype=float), np.reshape(z, (-1, 4)))
+        return Distortion(
+            np.radians(fx.twist) if twist else 0.0,
+            np.array(fx.twist_center, dtype=float),
+            np.reshape(z, (-1, 4)),
+        )
 
     def untwist(self, p: np.ndarray) -> np.ndarray:
         """g = f⁻¹: where the undistorted KRS is looked up for world points p (N, 3)."""
         r = p - self.center
         a = -self.twist * r[:, 1]
         cos, sin = np.cos(a), np.sin(a)
-        return self.center + np.stack([r[:, 0] * cos - r[:, 2] * sin, r[:, 1],
-                                       r[:, 0] * sin + r[:, 2] * cos], axis=1)
+        return self.center + np.stack(
+            [r[:, 0] * cos - r[:, 2] * sin, r[:, 1], r[:, 0] * sin + r[:, 2] * cos], axis=1
+        )
 
     def twist_step(self, p: np.ndarray, D: np.ndarray) -> np.ndarray:
         """The safe step at p from the undistorted distance D at g(p) (module docstring)."""
@@ -53,7 +58,7 @@ class Distortion:
         """World normal Dgᵀ g from the gradient g at q = g(p); only Dg's y column (a tangent
         of length |k|ρ) is not a rotation."""
         r, s = p - self.center, q - self.center
-        a = self.twist * r[:, 1]           # Rᵀ = rotation by −(−k·h)
+        a = self.twist * r[:, 1]  # Rᵀ = rotation by −(−k·h)
         cos, sin = np.cos(a), np.sin(a)
         gy = g[:, 1] - self.twist * (-s[:, 2] * g[:, 0] + s[:, 0] * g[:, 2])
         w = np.stack([g[:, 0] * cos - g[:, 2] * sin, gy, g[:, 0] * sin + g[:, 2] * cos], axis=1)

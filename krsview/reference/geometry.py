@@ -1,9 +1,10 @@
 """One interface over the geometry families, so tracers and renderers need not know which:
 compile, give each component's distance or unbounding test to the tracer, find the nearest
 kernel and its world normal. A single KRS or MöKRS is the compound of one [KRS17 §5.1]."""
+
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -28,16 +29,18 @@ def components(c: CompiledKRS | CompiledCompound) -> tuple[CompiledKRS, ...]:
     return c.parts if isinstance(c, CompiledCompound) else (c,)
 
 
-def component_distance(part: CompiledKRS, x: np.ndarray, dist: Distortion | None = None
-                       ) -> np.ndarray:
+def component_distance(
+    part: CompiledKRS, x: np.ndarray, dist: Distortion | None = None
+) -> np.ndarray:
     """The distance bound of one KRS: Alg. 1, through the scene's distortion."""
     if dist is None:
         return krs.distance(part, x)
     return dist.distance(x, krs.distance(part, dist.undistort(x)))
 
 
-def scene_distance(c: CompiledKRS | CompiledCompound, x: np.ndarray,
-                   dist: Distortion | None = None) -> np.ndarray:
+def scene_distance(
+    c: CompiledKRS | CompiledCompound, x: np.ndarray, dist: Distortion | None = None
+) -> np.ndarray:
     """The distance bound of everything drawn: the least over the components (a distortion
     is monotone in the distance, so it may be applied once, after the minimum)."""
     q = x if dist is None else dist.undistort(x)
@@ -45,8 +48,9 @@ def scene_distance(c: CompiledKRS | CompiledCompound, x: np.ndarray,
     return D if dist is None else dist.distance(x, D)
 
 
-def component_distances(c: CompiledKRS | CompiledCompound, dist: Distortion | None
-                        ) -> list[Distance]:
+def component_distances(
+    c: CompiledKRS | CompiledCompound, dist: Distortion | None
+) -> list[Distance]:
     """One distance bound per component, for the sphere tracer's free distances."""
     return [lambda x, p=p: component_distance(p, x, dist) for p in components(c)]
 
@@ -58,8 +62,9 @@ def component_tests(c: Compiled, dist: Distortion | None) -> list[Test]:
     return [lambda x, s, p=p: component_distance(p, x, dist) >= s for p in components(c)]
 
 
-def nearest(c: Compiled, x: np.ndarray, width: np.ndarray | None = None,
-            dist: Distortion | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def nearest(
+    c: Compiled, x: np.ndarray, width: np.ndarray | None = None, dist: Distortion | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(level slot, unit world normal, kernel-space point) of the kernel nearest to each
     point; ``width`` is the smooth-shading band per point (None: no smoothing). In a compound
     the component nearest to the point is asked (ties: the first), and its level is offset
@@ -72,11 +77,17 @@ def nearest(c: Compiled, x: np.ndarray, width: np.ndarray | None = None,
         D, level, g, xk = krs.nearest(c, q, width)
     else:
         win = np.argmin([krs.distance(p, q) for p in c.parts], axis=0)
-        D, level, g, xk = np.empty(len(q)), np.empty(len(q), int), np.empty_like(q), np.empty_like(q)
+        D, level, g, xk = (
+            np.empty(len(q)),
+            np.empty(len(q), int),
+            np.empty_like(q),
+            np.empty_like(q),
+        )
         for k, (part, base) in enumerate(zip(c.parts, c.bases)):
             sel = win == k
             D[sel], level[sel], g[sel], xk[sel] = krs.nearest(
-                part, q[sel], None if width is None else width[sel])
+                part, q[sel], None if width is None else width[sel]
+            )
             level[sel] += base
     if dist is not None:
         g = dist.normal(x, q, D, g)
@@ -105,14 +116,14 @@ def scene_ball(c: Compiled) -> np.ndarray | None:
     return c.ball.copy() if c.ball[3] >= 0 else None
 
 
-def surface_field(c: Compiled, dist: Distortion | None = None
-                  ) -> tuple[Callable[[np.ndarray], np.ndarray],
-                             Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+def surface_field(
+    c: Compiled, dist: Distortion | None = None
+) -> tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray, np.ndarray], np.ndarray]]:
     """(value, is_empty) for sampling the surface: value(x) is negative inside and zero on
     the surface (a KRS's distance bound; for a MöKRS, which has no distance function, the
     first-order world distance to the nearest kernel, mokrs.distance_estimate); is_empty(x, r)
     certifies balls free of the surface (the distance bound, or Alg. 3)."""
-    if isinstance(c, mokrs.CompiledMoKRS):      # Alg. 3 certifies free balls only
+    if isinstance(c, mokrs.CompiledMoKRS):  # Alg. 3 certifies free balls only
         return lambda x: mokrs.distance_estimate(c, x), lambda x, r: mokrs.is_unbounding(c, x, r)
 
     def is_empty(x: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -120,4 +131,5 @@ def surface_field(c: Compiled, dist: Distortion | None = None
         and reflections are isometries); a distortion certifies only the free side."""
         d = scene_distance(c, x, dist)
         return (d >= r) | ((d <= -r) & (dist is None))
+
     return lambda x: scene_distance(c, x, dist), is_empty

@@ -4,9 +4,11 @@ Sphere, capsule and toroidal capsule are a point, segment or circular arc swept 
 k(p) = |p − core(p)| − r is exact outside and the gradient is the unit vector from core(p)
 (the hg_sdf discipline: distances never overshoot). Mirrors ``shaders/kernels.glsl``.
 """
+
 from __future__ import annotations
 
 import numpy as np
+
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
@@ -41,7 +43,9 @@ def core_point(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     # toroidal capsule: inside the wedge the arc point at p's angle, else the nearer end
     q, x, y = _arc_frame(rec, p)
     rho = np.hypot(x, y)
-    radial = (x[:, None] * rec[4, :3] + y[:, None] * rec[5, :3]) / np.where(rho > 0, rho, 1)[:, None]
+    radial = (x[:, None] * rec[4, :3] + y[:, None] * rec[5, :3]) / np.where(rho > 0, rho, 1)[
+        :, None
+    ]
     on_arc = rec[3, :3] + rec[3, 3] * np.where((rho > 0)[:, None], radial, rec[4, :3])
     end = np.where((_dot(p - A, p - A) <= _dot(p - B, p - B))[:, None], A, B)
     return np.where(in_wedge(rec, x, y)[:, None], on_arc, end)
@@ -58,9 +62,11 @@ def kernel_distance(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
         z = _dot(q, np.cross(rec[4, :3], rec[5, :3]))
         R, cos_phi, sin_phi = rec[3, 3], rec[4, 3], rec[5, 3]
         ring = (np.hypot(x, y) - R) ** 2
-        cap = np.minimum((x - R) ** 2 + y ** 2, (x - R * cos_phi) ** 2 + (y - R * sin_phi) ** 2)
+        cap = np.minimum((x - R) ** 2 + y**2, (x - R * cos_phi) ** 2 + (y - R * sin_phi) ** 2)
         return np.sqrt(np.where(in_wedge(rec, x, y), ring, cap) + z * z) - rec[1, 3]
     return np.linalg.norm(p - core_point(kind, rec, p), axis=1) - rec[1, 3]
+
+
 def kernel_gradient(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Unit gradient of k_i at p (the outward surface normal)."""
     if kind == "plane":
@@ -72,8 +78,13 @@ def kernel_gradient(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.where(n > 0.0, g / np.where(n > 0.0, n, 1.0), np.array([0.0, 0.0, 1.0]))
 
 
-def world_normal(types: tuple[str, ...], records: np.ndarray, level: np.ndarray,
-                 xk: np.ndarray, to_world: np.ndarray) -> np.ndarray:
+def world_normal(
+    types: tuple[str, ...],
+    records: np.ndarray,
+    level: np.ndarray,
+    xk: np.ndarray,
+    to_world: np.ndarray,
+) -> np.ndarray:
     """Unit world normals to_world[n] · ∇k_j(x_j) of each point's winning kernel j = level[n]
     at its kernel-space point xk[n]; the kernel gradient itself where the map degenerates."""
     g = np.zeros((len(xk), 3))

@@ -4,6 +4,7 @@ Folding x into the negative half-space of each mirror clips every level to that 
 [KRS14 Fig. 2], so DISTANCE is a lower bound of the distance to the clipped expansion, and
 exact when kernels are separated. Mirrors ``shaders/krs.glsl``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -44,8 +45,9 @@ def mirror_weight(e: np.ndarray, width: np.ndarray | None) -> np.ndarray:
     return np.clip(e / width + 0.5, 0.0, 1.0)
 
 
-def nearest(c: CompiledKRS, xw: np.ndarray, width: np.ndarray | None = None
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def nearest(
+    c: CompiledKRS, xw: np.ndarray, width: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Alg. 1 that also keeps the winning level j, its kernel-space point x_j and the world
     normal M ∇k_j(x_j), where M = A_{n−1} ⋯ A_j with A_i = I − 2 w_i u_i u_iᵀ accumulates while
     walking down (w_i from :func:`mirror_weight`) [KRS14 §6.1]. Ties go to the coarser level

@@ -8,15 +8,16 @@ merely pass near a pole in empty space. Here it is free when everything level i 
 levels below it hold — inside the level's bounding ball, computed once per scene — lies
 inside that ball.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..algebra import mobius
 from ..scene import MoKRS
 from ..scene.model import Empty
-from ..algebra import mobius
 from .compiled import CULL_MARGIN, UNBOUNDED, kernel_ball, kernel_records, union_ball
 from .kernels import kernel_distance, world_normal
 
@@ -35,7 +36,7 @@ def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     unbounded or where the bound holds G_i's pole (its image is no ball). Third, each mapped
     ball's radius in world lengths: scaled by the maps above it while they are similarities,
     ∞ below a map with a pole (its scale varies) or where unbounded."""
-    out, outer, below = [], [], None    # below: bound of L_{i−1} in level i's space
+    out, outer, below = [], [], None  # below: bound of L_{i−1} in level i's space
     unbounded = False
     for lv in m.levels:
         if not unbounded:
@@ -50,10 +51,13 @@ def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             unbounded = not ok[0] or not np.isfinite(r[0]) or not np.isfinite(c).all()
             below = np.array([*c[0], r[0]])
         margin = CULL_MARGIN * float(np.abs(below[:3]).max()) if below is not None else 0.0
-        outer.append(UNBOUNDED if unbounded or ball is None else
-                     np.array([*below[:3], below[3] * (1 + CULL_MARGIN) + margin]))
+        outer.append(
+            UNBOUNDED
+            if unbounded or ball is None
+            else np.array([*below[:3], below[3] * (1 + CULL_MARGIN) + margin])
+        )
     outer = np.array(outer)
-    size, scale = np.full(len(outer), np.inf), 1.0   # world length per unit of level i+1
+    size, scale = np.full(len(outer), np.inf), 1.0  # world length per unit of level i+1
     for i in range(len(outer) - 1, -1, -1):
         if outer[i, 3] >= 0:
             size[i] = outer[i, 3] * scale
@@ -64,30 +68,38 @@ def bounds_in_and_out(m: MoKRS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class CompiledMoKRS:
-    inverse: np.ndarray      # (n, 2, 2, 4): H_i = G_i⁻¹, level i+1's space → level i's
-    reflect: np.ndarray      # (n,) bool
-    records: np.ndarray      # (n, RECORD_VEC4, 4), in each level's own space
+    inverse: np.ndarray  # (n, 2, 2, 4): H_i = G_i⁻¹, level i+1's space → level i's
+    reflect: np.ndarray  # (n,) bool
+    records: np.ndarray  # (n, RECORD_VEC4, 4), in each level's own space
     types: tuple[str, ...]
-    poles: np.ndarray        # (n, 4): (pole.xyz | (|a|/|d|, 0, 0), has_pole + 2·reflects)
-    bounds: np.ndarray       # (n, 4): level_bounds, in each level's own space
-    outer: np.ndarray        # (n, 4): each mapped out by G_i (bounds_in_and_out)
-    outer_size: np.ndarray   # (n,): their radii in world lengths (∞: the scale varies)
+    poles: np.ndarray  # (n, 4): (pole.xyz | (|a|/|d|, 0, 0), has_pole + 2·reflects)
+    bounds: np.ndarray  # (n, 4): level_bounds, in each level's own space
+    outer: np.ndarray  # (n, 4): each mapped out by G_i (bounds_in_and_out)
+    outer_size: np.ndarray  # (n,): their radii in world lengths (∞: the scale varies)
 
     @property
     def n(self) -> int:
         return len(self.reflect)
 
-    def relative_to(self, origin) -> "CompiledMoKRS":
+    def relative_to(self, origin) -> CompiledMoKRS:
         """World positions taken relative to ``origin``: only the outermost H changes,
         H_{n−1} ← H_{n−1} · T(origin) (the world point is origin + the relative point)."""
         inverse, poles = self.inverse.copy(), self.poles.copy()
         inverse[-1] = mobius.tidy(mobius.compose(inverse[-1], mobius.translation(origin)))
         poles[-1] = pole_record(inverse[-1], self.reflect[-1])
-        outer = self.outer.copy()         # the outermost lives in the world
+        outer = self.outer.copy()  # the outermost lives in the world
         if outer[-1, 3] >= 0:
             outer[-1, :3] -= np.asarray(origin, dtype=np.float64)
-        return CompiledMoKRS(inverse, self.reflect, self.records, self.types, poles,
-                             self.bounds, outer, self.outer_size)   # level spaces stay
+        return CompiledMoKRS(
+            inverse,
+            self.reflect,
+            self.records,
+            self.types,
+            poles,
+            self.bounds,
+            outer,
+            self.outer_size,
+        )  # level spaces stay
 
 
 def pole_record(H: np.ndarray, reflect: bool) -> np.ndarray:
@@ -106,15 +118,16 @@ def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS
     return CompiledMoKRS(inverse, reflect, records, types, poles, *bounds_in_and_out(m))
 
 
-def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray,
-                  pole_bounds: bool = True) -> np.ndarray:
+def is_unbounding(
+    c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray, pole_bounds: bool = True
+) -> np.ndarray:
     """ISUNBOUNDING(κ_w, ρ_w) [KRS17 Alg. 3] for balls (N, 3), (N,): whether each ball is free
     of the MöKRS. A ball that holds a level's pole maps to a ball's exterior: it is free when
     the level's bound lies inside that ball, else blocked (``pole_bounds=False``: always
     blocked, Alg. 3's inside-out rule). The mirror decision is taken on the ball's centre, as
     in the paper."""
     free = np.ones(len(center), dtype=bool)
-    live = np.arange(len(center))          # balls not yet decided (the shader returns early)
+    live = np.arange(len(center))  # balls not yet decided (the shader returns early)
     kappa, rho = center, radius
     with np.errstate(all="ignore"):
         for i in range(c.n - 1, -1, -1):
@@ -124,7 +137,7 @@ def is_unbounding(c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray,
                 inside = (b[3] >= 0) & (np.linalg.norm(kappa - b[:3], axis=1) + b[3] < rho)
                 outside = ~ok
                 free[live[outside & ~(inside & pole_bounds)]] = False
-                live, kappa, rho = live[ok], kappa[ok], rho[ok]   # decided: leave the walk
+                live, kappa, rho = live[ok], kappa[ok], rho[ok]  # decided: leave the walk
             if c.reflect[i]:
                 kappa = kappa * np.where(kappa[:, :1] > 0.0, [-1.0, 1.0, 1.0], 1.0)
             if c.types[i] != "empty":

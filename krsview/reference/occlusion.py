@@ -7,8 +7,8 @@ distance travelled (Fig. 11): sphere-traced distances for a KRS, free probe radi
 In a compound the shadow ray keeps one free distance per component, as the primary ray does
 [KRS17 §5.1], so a step costs one component's distance, not all of them.
 """
-from __future__ import annotations
 
+from __future__ import annotations
 
 import numpy as np
 
@@ -19,9 +19,15 @@ SHADOW_OFFSET = 2.0
 AO_SAMPLES = 5
 
 
-def shadow_by_distance(distances: list[Distance], o: np.ndarray, l: np.ndarray,
-                       eps: np.ndarray, r: Render, k: float | None,
-                       lod_scale: Scale | None = None) -> np.ndarray:
+def shadow_by_distance(
+    distances: list[Distance],
+    o: np.ndarray,
+    l: np.ndarray,
+    eps: np.ndarray,
+    r: Render,
+    k: float | None,
+    lod_scale: Scale | None = None,
+) -> np.ndarray:
     """Visibility of direction l from points o, sphere tracing each component's distance
     (the least free distance steps, as in :func:`trace.sphere_trace`); k None: hard shadows.
     The ray is blocked when any step converges; soft visibility is the least k·d/t met."""
@@ -44,8 +50,9 @@ def shadow_by_distance(distances: list[Distance], o: np.ndarray, l: np.ndarray,
     return vis
 
 
-def shadow_by_probes(is_free: Test, o: np.ndarray,
-                     l: np.ndarray, eps: np.ndarray, r: Render, k: float | None) -> np.ndarray:
+def shadow_by_probes(
+    is_free: Test, o: np.ndarray, l: np.ndarray, eps: np.ndarray, r: Render, k: float | None
+) -> np.ndarray:
     """Visibility of direction l from points o by binary probing [KRS17 Alg. 2]."""
     N = len(o)
     vis, t, s = np.ones(N), np.zeros(N), np.full(N, INITIAL_PROBE)
@@ -65,8 +72,9 @@ def shadow_by_probes(is_free: Test, o: np.ndarray,
     return vis
 
 
-def ambient_occlusion(distance: Distance, p: np.ndarray,
-                      n: np.ndarray, step: float, strength: float) -> np.ndarray:
+def ambient_occlusion(
+    distance: Distance, p: np.ndarray, n: np.ndarray, step: float, strength: float
+) -> np.ndarray:
     """1 − strength·Σ 2^−k·clamp((h_k − d(p + h_k n))/h_k) over h_k = k·step, k = 1..5."""
     occlusion = np.zeros(len(p))
     weight = 0.5

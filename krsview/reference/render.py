@@ -1,4 +1,5 @@
 """Whole-image reference render: the same outputs as the GPU, in float64."""
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -10,16 +11,20 @@ from ..scene import Geometry, Scene
 from .atmosphere import background
 from .camera import View, primary_rays, view_of
 from .distortion import Distortion
-from .geometry import component_distances, component_tests, compile_geometry, nearest
+from .geometry import compile_geometry, component_distances, component_tests, nearest
 from .shade import Hits, encode, shade
 from .trace import binary_trace, relaxed_trace, sphere_trace
 
+PROGRESS_CHUNK = 8192  # rays per chunk when progress is reported
 
-PROGRESS_CHUNK = 8192   # rays per chunk when progress is reported
 
-
-def render_reference(scene: Scene, width: int, height: int, geometry: Geometry | None = None,
-                     progress: Callable[[int, int], None] | None = None) -> Buffers:
+def render_reference(
+    scene: Scene,
+    width: int,
+    height: int,
+    geometry: Geometry | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Buffers:
     """The image in float64. With ``progress``, rays go in chunks and progress(done, total)
     is called after each (every ray is independent: the image is the same)."""
     view = view_of(scene.camera, width, height)
@@ -30,39 +35,65 @@ def render_reference(scene: Scene, width: int, height: int, geometry: Geometry |
     step = PROGRESS_CHUNK if progress else N
     parts = []
     for k in range(0, N, step):
-        parts.append(_trace_and_shade(scene, c, dist, view, dirs[k:k + step]))
+        parts.append(_trace_and_shade(scene, c, dist, view, dirs[k : k + step]))
         if progress:
             progress(min(k + step, N), N)
     color, depth, normal, iterations, hit = (np.concatenate(a) for a in zip(*parts))
     H, W = height, width
-    return Buffers(color.reshape(H, W, 3), depth.reshape(H, W), normal.reshape(H, W, 3),
-                   iterations.reshape(H, W), hit.reshape(H, W))
+    return Buffers(
+        color.reshape(H, W, 3),
+        depth.reshape(H, W),
+        normal.reshape(H, W, 3),
+        iterations.reshape(H, W),
+        hit.reshape(H, W),
+    )
 
 
-def _trace_and_shade(scene: Scene, c, dist: Distortion | None, view: View, dirs: np.ndarray
-                     ) -> tuple[np.ndarray, ...]:
+def _trace_and_shade(
+    scene: Scene, c, dist: Distortion | None, view: View, dirs: np.ndarray
+) -> tuple[np.ndarray, ...]:
     """Colour, depth (0 on a miss), normal, iterations and hit of the rays ``dirs``."""
     r = scene.render
     eps = view.footprint * r.epsilon_scale
     scale = dist.lod_scale if dist is not None else None
     if r.tracer == "binary":
-        tr = binary_trace(component_tests(c, dist), view.origin, dirs, eps,
-                          r.max_iterations, r.max_distance, r.xi_bonus, r.xi_penalty, scale)
+        tr = binary_trace(
+            component_tests(c, dist),
+            view.origin,
+            dirs,
+            eps,
+            r.max_iterations,
+            r.max_distance,
+            r.xi_bonus,
+            r.xi_penalty,
+            scale,
+        )
     elif r.tracer == "relaxed":
-        (d,) = component_distances(c, dist)   # a single KRS (Scene.check_tracer)
-        tr = relaxed_trace(d, view.origin, dirs, eps, r.max_iterations, r.max_distance,
-                           r.relaxation, scale)
+        (d,) = component_distances(c, dist)  # a single KRS (Scene.check_tracer)
+        tr = relaxed_trace(
+            d, view.origin, dirs, eps, r.max_iterations, r.max_distance, r.relaxation, scale
+        )
     else:
-        tr = sphere_trace(component_distances(c, dist), view.origin, dirs, eps,  # type: ignore[arg-type]
-                          r.max_iterations, r.max_distance, scale)
+        tr = sphere_trace(
+            component_distances(c, dist),
+            view.origin,
+            dirs,
+            eps,  # type: ignore[arg-type]
+            r.max_iterations,
+            r.max_distance,
+            scale,
+        )
     N = len(dirs)
     normal = np.zeros((N, 3))
     color = encode(scene, background(scene, dirs))
     h = np.flatnonzero(tr.hit)
     if h.size:
         p = view.origin + tr.t[h, None] * dirs[h]
-        width_ = (np.maximum(scene.effect_settings.smooth_width, 2.0 * view.footprint * tr.t[h])
-                  if "smooth_shading" in scene.effects else None)
+        width_ = (
+            np.maximum(scene.effect_settings.smooth_width, 2.0 * view.footprint * tr.t[h])
+            if "smooth_shading" in scene.effects
+            else None
+        )
         level, g, xk = nearest(c, p, width_, dist)
         normal[h] = g
         hits = Hits(p, dirs[h], tr.t[h], level, g, xk)

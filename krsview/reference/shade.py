@@ -1,5 +1,6 @@
 """Shading of hits [KRS17 §8]: Lambert + ambient with the scene's effects (texture, shadows,
 ambient occlusion, fog), then tone mapping and gamma. Twin of ``shaders/shade.glsl``."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -25,6 +26,7 @@ def encode(scene: Scene, linear: np.ndarray) -> np.ndarray:
 class Hits:
     """What shading needs of each hit: world point, ray direction and distance, the nearest
     kernel level, world normal and kernel-space point."""
+
     p: np.ndarray
     dirs: np.ndarray
     t: np.ndarray
@@ -44,14 +46,16 @@ def albedo(scene: Scene, c: Compiled, h: Hits, footprint: np.ndarray) -> np.ndar
         pattern = np.zeros(len(h.p))
         for j in np.unique(h.level):
             sel = h.level == j
-            pattern[sel] = texture.kernel_texture(c.types[j], c.records[j], h.xk[sel],
-                                                  footprint[sel], fx.texture_scale)
+            pattern[sel] = texture.kernel_texture(
+                c.types[j], c.records[j], h.xk[sel], footprint[sel], fx.texture_scale
+            )
         a = a * texture.modulation(pattern, fx.texture_strength)[:, None]
     return a
 
 
-def shade(scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint: float,
-          eps_per_t: float) -> np.ndarray:
+def shade(
+    scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint: float, eps_per_t: float
+) -> np.ndarray:
     """Linear radiance of each hit: albedo × (ambient·AO + Σ visibility·cos·light), fogged."""
     fx = scene.effect_settings
     fp = footprint * h.t
@@ -75,12 +79,19 @@ def shade(scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint
             o = h.p[lit] + occlusion.SHADOW_OFFSET * eps[lit, None] * h.normal[lit]
             k = fx.shadow_softness if soft else None
             if isinstance(c, CompiledMoKRS):
-                vis = occlusion.shadow_by_probes(lambda x, s: mokrs.is_unbounding(c, x, s), o, l,
-                                                 eps[lit], scene.render, k)
+                vis = occlusion.shadow_by_probes(
+                    lambda x, s: mokrs.is_unbounding(c, x, s), o, l, eps[lit], scene.render, k
+                )
             else:
-                vis = occlusion.shadow_by_distance(component_distances(c, dist), o, l,  # type: ignore[arg-type]
-                                                   eps[lit], scene.render, k,
-                                                   dist.lod_scale if dist is not None else None)
+                vis = occlusion.shadow_by_distance(
+                    component_distances(c, dist),
+                    o,
+                    l,  # type: ignore[arg-type]
+                    eps[lit],
+                    scene.render,
+                    k,
+                    dist.lod_scale if dist is not None else None,
+                )
             cos[lit] *= vis
         light = light + lt.intensity * cos[:, None] * np.array(lt.color)
     color = albedo(scene, c, h, fp) * light

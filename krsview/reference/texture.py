@@ -3,6 +3,7 @@ octaves faded out as they approach the pixel footprint (LOD filtering); triplana
 [Gei07] and kernel-space coordinates along / around each kernel. Twin of
 ``shaders/texture.glsl``: the hash is exact uint32 arithmetic in both, so only the float
 interpolation differs."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -11,7 +12,7 @@ from ..scene.tree import perpendicular
 
 OCTAVES = 5
 OCTAVE_SHIFT = np.array([17.0, 31.0])  # decorrelates the octaves
-BARK_STRETCH = np.array([0.25, 2.0])   # kernel texture: long streaks along a branch
+BARK_STRETCH = np.array([0.25, 2.0])  # kernel texture: long streaks along a branch
 
 
 def lattice(cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
@@ -61,8 +62,11 @@ def triplanar(p: np.ndarray, n: np.ndarray, footprint: np.ndarray, scale: float)
     w = np.abs(n) ** 4
     w /= w.sum(axis=1, keepdims=True)
     x, f = p / scale, footprint / scale
-    return (w[:, 0] * fbm(x[:, [1, 2]], f) + w[:, 1] * fbm(x[:, [2, 0]], f)
-            + w[:, 2] * fbm(x[:, [0, 1]], f))
+    return (
+        w[:, 0] * fbm(x[:, [1, 2]], f)
+        + w[:, 1] * fbm(x[:, [2, 0]], f)
+        + w[:, 2] * fbm(x[:, [0, 1]], f)
+    )
 
 
 def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
@@ -94,7 +98,8 @@ def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
     return np.stack([xk @ e1, xk @ np.cross(u, e1)], axis=1)
 
 
-def kernel_texture(kind: str, rec: np.ndarray, xk: np.ndarray, footprint: np.ndarray,
-                   scale: float) -> np.ndarray:
+def kernel_texture(
+    kind: str, rec: np.ndarray, xk: np.ndarray, footprint: np.ndarray, scale: float
+) -> np.ndarray:
     x = BARK_STRETCH * kernel_uv(kind, rec, xk) / scale
     return fbm(x, BARK_STRETCH[1] * footprint / scale)

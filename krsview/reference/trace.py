@@ -4,6 +4,7 @@
 Mirrors ``shaders/trace.glsl`` step for step; a ray that passes max_distance or spends the
 iteration cap is a miss.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -19,8 +20,8 @@ MIN_PROBE = 1e-30
 
 @dataclass
 class Trace:
-    hit: np.ndarray         # bool (N,)
-    t: np.ndarray           # ray distance where the ray converged (N,); meaningless on a miss
+    hit: np.ndarray  # bool (N,)
+    t: np.ndarray  # ray distance where the ray converged (N,); meaningless on a miss
     iterations: np.ndarray  # distance evaluations (N,)
 
 
@@ -47,8 +48,9 @@ def by_component(fns: list, c: np.ndarray, *args: np.ndarray) -> np.ndarray:
     return out
 
 
-def front(tc: np.ndarray, rays: np.ndarray, max_distance: float
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def front(
+    tc: np.ndarray, rays: np.ndarray, max_distance: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """On each of ``rays``, the component with the least free distance in ``tc`` (N, C)
     (ties: the first, as front() in trace.glsl) and that distance; a ray whose least free
     distance is past max_distance has left every component and is dropped.
@@ -64,9 +66,15 @@ def lod(scale: Scale | None, points: np.ndarray) -> np.ndarray | float:
     return 1.0 if scale is None else scale(points)
 
 
-def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray,
-                 eps_per_t: float, max_iterations: int, max_distance: float,
-                 lod_scale: Scale | None = None) -> Trace:
+def sphere_trace(
+    distances: list[Distance],
+    origin: np.ndarray,
+    dirs: np.ndarray,
+    eps_per_t: float,
+    max_iterations: int,
+    max_distance: float,
+    lod_scale: Scale | None = None,
+) -> Trace:
     """Sphere tracing of the components' distance bounds (points (N, 3) → (N,)), each with
     its own free distance t_c along the ray [KRS17 §5.1]: the component with the least t_c
     (ties: the first) takes the step, and the ray converges when that step does. So it
@@ -93,9 +101,16 @@ def sphere_trace(distances: list[Distance], origin: np.ndarray, dirs: np.ndarray
     return Trace(hit, t, iters)
 
 
-def relaxed_trace(distance: Distance, origin: np.ndarray, dirs: np.ndarray, eps_per_t: float,
-                  max_iterations: int, max_distance: float, omega: float,
-                  lod_scale: Scale | None = None) -> Trace:
+def relaxed_trace(
+    distance: Distance,
+    origin: np.ndarray,
+    dirs: np.ndarray,
+    eps_per_t: float,
+    max_iterations: int,
+    max_distance: float,
+    omega: float,
+    lod_scale: Scale | None = None,
+) -> Trace:
     """Over-relaxed sphere tracing [Keinert et al. 2014] of one distance bound: from the last
     verified point t_s (free ball of radius d_s) step ω·d; at the new point t, if the two free
     balls no longer cover [t_s, t] (d_s + d < t − t_s) a surface may lie between, so go back
@@ -105,7 +120,7 @@ def relaxed_trace(distance: Distance, origin: np.ndarray, dirs: np.ndarray, eps_
     the test is skipped (rounding of t_s + d_s − t_s must not send a ray back forever)."""
     N = len(dirs)
     t = np.zeros(N)
-    ts, ds = np.zeros(N), np.zeros(N)          # last verified point and its free radius
+    ts, ds = np.zeros(N), np.zeros(N)  # last verified point and its free radius
     w = np.full(N, omega)
     hit = np.zeros(N, dtype=bool)
     iters = np.zeros(N, dtype=np.int64)
@@ -131,9 +146,17 @@ def relaxed_trace(distance: Distance, origin: np.ndarray, dirs: np.ndarray, eps_
     return Trace(hit, t, iters)
 
 
-def binary_trace(tests: list[Test], origin: np.ndarray, dirs: np.ndarray, eps_per_t: float,
-                 max_iterations: int, max_distance: float, xi_bonus: float,
-                 xi_penalty: float, lod_scale: Scale | None = None) -> Trace:
+def binary_trace(
+    tests: list[Test],
+    origin: np.ndarray,
+    dirs: np.ndarray,
+    eps_per_t: float,
+    max_iterations: int,
+    max_distance: float,
+    xi_bonus: float,
+    xi_penalty: float,
+    lod_scale: Scale | None = None,
+) -> Trace:
     """BINARYTRACE [KRS17 Alg. 2]: probe the ball of radius s that touches the free point t;
     if it is unbounding, advance by its diameter 2s and grow s by ξ_bonus, else shrink s by
     ξ_penalty. Iterations count probes. Two departures from the paper's listing: we advance

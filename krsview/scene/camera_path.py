@@ -3,6 +3,7 @@ as ``NAME.path.json``, and what ``krsview render --camera-path`` and ``krsview b
 into frames. A pose is a time, an eye position and the fly camera's yaw and pitch; between
 poses the camera moves linearly, so frame k of a path at F frames per second is one camera,
 whoever renders it."""
+
 from __future__ import annotations
 
 import json
@@ -20,10 +21,10 @@ FORMAT = '{"poses": [{"t": seconds, "position": [x, y, z], "yaw": radians, "pitc
 
 @dataclass(frozen=True)
 class Pose:
-    t: float                             # seconds since the recording began
+    t: float  # seconds since the recording began
     position: tuple[float, float, float]
-    yaw: float                           # radians around the world up axis
-    pitch: float                         # radians above the horizon
+    yaw: float  # radians around the world up axis
+    pitch: float  # radians above the horizon
 
 
 def horizontal_axes(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -44,7 +45,7 @@ def look_direction(yaw: float, pitch: float, up: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CameraPath:
-    poses: tuple[Pose, ...]              # at least one, times non-decreasing
+    poses: tuple[Pose, ...]  # at least one, times non-decreasing
 
     @property
     def duration(self) -> float:
@@ -87,37 +88,61 @@ def load_camera_path(path: str | Path) -> CameraPath:
     except OSError as e:
         raise SceneError("<file>", str(f), f"cannot read: {e.strerror}", str(f)) from None
     except json.JSONDecodeError as e:
-        raise SceneError("<file>", f"line {e.lineno} column {e.colno}", f"not JSON ({e.msg}); "
-                         f"expected {FORMAT}", str(f)) from None
+        raise SceneError(
+            "<file>",
+            f"line {e.lineno} column {e.colno}",
+            f"not JSON ({e.msg}); expected {FORMAT}",
+            str(f),
+        ) from None
     except UnicodeDecodeError as e:
-        raise SceneError("<file>", f"byte 0x{e.object[e.start]:02x} at offset {e.start}",
-                         "not UTF-8 text", str(f)) from None
+        raise SceneError(
+            "<file>",
+            f"byte 0x{e.object[e.start]:02x} at offset {e.start}",
+            "not UTF-8 text",
+            str(f),
+        ) from None
     poses = data.get("poses") if isinstance(data, dict) else None
     if not isinstance(poses, list) or not poses:
         raise SceneError("poses", poses, f"a non-empty list; expected {FORMAT}", str(f))
     out = []
     for i, p in enumerate(poses):
         try:
-            pose = Pose(float(p["t"]), tuple(float(c) for c in p["position"]),
-                        float(p["yaw"]), float(p["pitch"]))
+            pose = Pose(
+                float(p["t"]),
+                tuple(float(c) for c in p["position"]),
+                float(p["yaw"]),
+                float(p["pitch"]),
+            )
         except (KeyError, TypeError, ValueError) as e:
-            raise SceneError(f"poses[{i}]", p, f"needs t, position [x, y, z], yaw and pitch "
-                             f"as numbers ({e!r})", str(f)) from None
+            raise SceneError(
+                f"poses[{i}]",
+                p,
+                f"needs t, position [x, y, z], yaw and pitch as numbers ({e!r})",
+                str(f),
+            ) from None
         values = (pose.t, *pose.position, pose.yaw, pose.pitch)
         if len(pose.position) != 3 or not all(math.isfinite(v) for v in values):
             raise SceneError(f"poses[{i}]", p, "finite numbers and a 3-vector position", str(f))
         if out and pose.t < out[-1].t:
-            raise SceneError(f"poses[{i}].t", pose.t,
-                             f"times must not decrease (the pose before is at {out[-1].t})",
-                             str(f))
+            raise SceneError(
+                f"poses[{i}].t",
+                pose.t,
+                f"times must not decrease (the pose before is at {out[-1].t})",
+                str(f),
+            )
         if abs(pose.pitch) >= math.pi / 2:
-            raise SceneError(f"poses[{i}].pitch", pose.pitch, "allowed −π/2 < pitch < π/2",
-                             str(f))
+            raise SceneError(f"poses[{i}].pitch", pose.pitch, "allowed −π/2 < pitch < π/2", str(f))
         out.append(pose)
     return CameraPath(tuple(out))
 
 
 def camera_path_json(poses: list[Pose]) -> str:
     """The file text of a path (written atomically by the caller)."""
-    return json.dumps({"poses": [dict(t=p.t, position=list(p.position), yaw=p.yaw,
-                                      pitch=p.pitch) for p in poses]}, indent=1)
+    return json.dumps(
+        {
+            "poses": [
+                dict(t=p.t, position=list(p.position), yaw=p.yaw, pitch=p.pitch) for p in poses
+            ]
+        },
+        indent=1,
+    )

@@ -5,6 +5,7 @@ different KRSs side by side hide it. Each component is an explicit KRS or a tree
 rotation, a uniform scale and a translation; the move is applied to its kernels and mirrors
 once, so the tracer sees plain KRSs in world space and keeps one free distance per component.
 """
+
 from __future__ import annotations
 
 import math
@@ -14,10 +15,20 @@ from typing import ClassVar
 
 import numpy as np
 
-from .model import KRS, MAX_LEVELS, Capsule, Empty, Kernel, Level, Mirror, Plane, Sphere, \
-    ToroidalCapsule
-from .schema import SceneError, Vec3, param
+from .model import (
+    KRS,
+    MAX_LEVELS,
+    Capsule,
+    Empty,
+    Kernel,
+    Level,
+    Mirror,
+    Plane,
+    Sphere,
+    ToroidalCapsule,
+)
 from .route import Route
+from .schema import SceneError, Vec3, param
 from .tree import Tree, as_vec3
 
 MAX_COMPONENTS = 8  # [KRS17 §8.3]: "compound of eight KRSs"
@@ -28,6 +39,7 @@ COMPOUND_SLOTS = MAX_COMPONENTS * MAX_LEVELS  # kernel slots of the compound uni
 class Placement:
     """x ↦ scale · R(axis, angle) x + position: a similarity, so distances scale by ``scale``
     and a distance bound stays a bound."""
+
     position: Vec3
     axis: Vec3
     angle: float  # degrees
@@ -47,7 +59,9 @@ class Placement:
     def plane(self, u: Vec3, w: float) -> tuple[Vec3, float]:
         """The plane u·x = w moved: normal R u (still unit), offset scale·w + R u · position."""
         ru = self.linear @ np.array(u) / self.scale
-        return as_vec3(ru / np.linalg.norm(ru)), float(self.scale * w + ru @ np.array(self.position))
+        return as_vec3(ru / np.linalg.norm(ru)), float(
+            self.scale * w + ru @ np.array(self.position)
+        )
 
     def kernel(self, k: Kernel) -> Kernel:
         s = self.scale
@@ -56,8 +70,13 @@ class Placement:
         if isinstance(k, Capsule):
             return replace(k, a=self.point(k.a), b=self.point(k.b), radius=s * k.radius)
         if isinstance(k, ToroidalCapsule):
-            return replace(k, start=self.point(k.start), control=self.point(k.control),
-                           end=self.point(k.end), radius=s * k.radius)
+            return replace(
+                k,
+                start=self.point(k.start),
+                control=self.point(k.control),
+                end=self.point(k.end),
+                radius=s * k.radius,
+            )
         if isinstance(k, Plane):
             u, w = self.plane(k.normal, k.offset)
             return replace(k, normal=u, offset=w)
@@ -65,35 +84,51 @@ class Placement:
         return k
 
     def krs(self, krs: KRS) -> KRS:
-        return KRS([Level(self.kernel(lv.kernel),
-                          None if lv.mirror is None else Mirror(*self.plane(lv.mirror.normal,
-                                                                            lv.mirror.offset)))
-                    for lv in krs.levels])
+        return KRS(
+            [
+                Level(
+                    self.kernel(lv.kernel),
+                    None
+                    if lv.mirror is None
+                    else Mirror(*self.plane(lv.mirror.normal, lv.mirror.offset)),
+                )
+                for lv in krs.levels
+            ]
+        )
 
 
 @dataclass(frozen=True)
 class Component:
     """One member of a ``[[compound]]`` list: a KRS or a tree, rotated by ``angle`` about
     ``axis``, scaled, then moved to ``position``."""
+
     UNKNOWN_FIELDS: ClassVar[dict[str, str]] = {
         "mokrs": "a MöKRS cannot join a compound: it has no distance function, and the "
-                 "compound's tracer steps by each component's distance [KRS17 §5.1]"}
+        "compound's tracer steps by each component's distance [KRS17 §5.1]"
+    }
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
     route: Route | None = param(None, help="a tree given by its route (instead of krs)")
     position: Vec3 = param((0.0, 0.0, 0.0), help="where the component's origin goes")
     axis: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="rotation axis")
-    angle: float = param(0.0, lo=-360.0, hi=360.0, unit="degrees",
-                         help="rotation about axis, applied before the move")
+    angle: float = param(
+        0.0,
+        lo=-360.0,
+        hi=360.0,
+        unit="degrees",
+        help="rotation about axis, applied before the move",
+    )
     scale: float = param(1.0, lo=1e-3, hi=1e3, help="uniform scale, applied before the move")
 
     def validate(self, path: str) -> None:
         given = [k for k in ("krs", "tree", "route") if getattr(self, k) is not None]
         if len(given) != 1:
-            raise SceneError(f"{path}.krs / {path}.tree / {path}.route",
-                             "<" + (" and ".join(given) or "none") + ">",
-                             "a compound component has exactly one geometry: a krs, tree or "
-                             "route table (a MöKRS cannot join a compound: it has no distance)")
+            raise SceneError(
+                f"{path}.krs / {path}.tree / {path}.route",
+                "<" + (" and ".join(given) or "none") + ">",
+                "a compound component has exactly one geometry: a krs, tree or "
+                "route table (a MöKRS cannot join a compound: it has no distance)",
+            )
 
     def placed(self) -> KRS:
         """The component's KRS in world space."""
@@ -105,14 +140,18 @@ class Component:
 
 def check_compound(components: list[Component], path: str = "compound") -> None:
     if len(components) > MAX_COMPONENTS:
-        raise SceneError(path, f"<{len(components)} components>",
-                         f"allowed: at most {MAX_COMPONENTS} components [KRS17 §5.1]")
+        raise SceneError(
+            path,
+            f"<{len(components)} components>",
+            f"allowed: at most {MAX_COMPONENTS} components [KRS17 §5.1]",
+        )
 
 
 @dataclass(frozen=True)
 class Compound:
     """The drawn geometry of a compound scene: its components' KRSs in world space. Offers
     what a KRS offers to the viewer, the CLI and the benchmarks."""
+
     parts: tuple[KRS, ...]
 
     @property
@@ -127,7 +166,6 @@ class Compound:
     def instance_count(self) -> int:
         return sum(p.instance_count() for p in self.parts)
 
-    def truncated(self, levels: int) -> "Compound":
+    def truncated(self, levels: int) -> Compound:
         """Each component keeps its coarsest ``levels`` levels (all, if it has fewer)."""
         return Compound(tuple(p.truncated(min(levels, p.depth)) for p in self.parts))
-

@@ -5,6 +5,7 @@ editor is held to exactly the rules of a scene file (DESIGN.md, One seam for edi
 A path is a tuple of field names and list indices, e.g. ``("route", "levels", 3, "fork")``;
 it prints as ``route.levels[3].fork``, the form scene-file errors use.
 """
+
 from __future__ import annotations
 
 from dataclasses import fields, is_dataclass, replace
@@ -63,7 +64,7 @@ def field_meta(scene: Scene, path: Path) -> dict:
     names = [k for k in path if isinstance(k, str)]
     if not names:
         return {}
-    owner = get_at(scene, path[:max(i for i, k in enumerate(path) if isinstance(k, str))])
+    owner = get_at(scene, path[: max(i for i, k in enumerate(path) if isinstance(k, str))])
     for f in fields(owner) if is_dataclass(owner) else ():
         if f.name == names[-1]:
             return dict(f.metadata)

@@ -5,6 +5,7 @@ Each effect becomes one ``#define KRS_<NAME>`` in the scene's shader variant, so
 only for what it lists (DESIGN.md, Specialise, don't branch). Some effects need the KRS
 distance function or its mirror planes, which a MöKRS does not have [KRS17 §7].
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -17,27 +18,49 @@ class Effect:
     name: str
     help: str
     needs_distance: bool = False  # a KRS distance function and mirror planes (not a MöKRS)
-    bit: int = 0                  # its bit in u_effects when all effects are compiled in
-    secondary: bool = False       # evaluates the geometry again per hit pixel (a shadow ray,
-                                  # occlusion samples): the viewer drops it while moving
+    bit: int = 0  # its bit in u_effects when all effects are compiled in
+    secondary: bool = False  # evaluates the geometry again per hit pixel (a shadow ray,
+    # occlusion samples): the viewer drops it while moving
 
 
 _LIST = [
-    Effect("smooth_shading", "blend normals across mirror planes so no crease shows "
-           "[KRS14 Alg. 2, KRS17 §8.1]", needs_distance=True),
-    Effect("triplanar_texture", "procedural texture projected along the three world axes, "
-           "filtered by the pixel footprint [KRS17 §8.2]"),
-    Effect("kernel_texture", "procedural bark-like texture in each kernel's own coordinates "
-           "(along / around a capsule) [KRS17 §8.2]", needs_distance=True),
+    Effect(
+        "smooth_shading",
+        "blend normals across mirror planes so no crease shows [KRS14 Alg. 2, KRS17 §8.1]",
+        needs_distance=True,
+    ),
+    Effect(
+        "triplanar_texture",
+        "procedural texture projected along the three world axes, "
+        "filtered by the pixel footprint [KRS17 §8.2]",
+    ),
+    Effect(
+        "kernel_texture",
+        "procedural bark-like texture in each kernel's own coordinates "
+        "(along / around a capsule) [KRS17 §8.2]",
+        needs_distance=True,
+    ),
     Effect("shadows", "hard shadows: one shadow ray per light [KRS17 §8.5]", secondary=True),
-    Effect("soft_shadows", "soft shadows from the closest free distance along the shadow ray "
-           "[KRS17 §8.5]", secondary=True),
-    Effect("ambient_occlusion", "darken creases by sampling the distance along the normal "
-           "[KRS17 §8.5]", needs_distance=True, secondary=True),
-    Effect("twist", "twist the geometry around a vertical axis, steps kept safe by the "
-           "twist's Lipschitz bound [KRS17 §5.2]", needs_distance=True),
-    Effect("empty_zones", "remove the geometry inside given spheres [KRS17 §8.4]",
-           needs_distance=True),
+    Effect(
+        "soft_shadows",
+        "soft shadows from the closest free distance along the shadow ray [KRS17 §8.5]",
+        secondary=True,
+    ),
+    Effect(
+        "ambient_occlusion",
+        "darken creases by sampling the distance along the normal [KRS17 §8.5]",
+        needs_distance=True,
+        secondary=True,
+    ),
+    Effect(
+        "twist",
+        "twist the geometry around a vertical axis, steps kept safe by the "
+        "twist's Lipschitz bound [KRS17 §5.2]",
+        needs_distance=True,
+    ),
+    Effect(
+        "empty_zones", "remove the geometry inside given spheres [KRS17 §8.4]", needs_distance=True
+    ),
     Effect("sky", "sky gradient and sun instead of a flat background"),
     Effect("fog", "exponential distance fog towards the sky colour"),
     Effect("tone_mapping", "exposure and filmic (ACES) tone curve before gamma"),
@@ -52,6 +75,7 @@ _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 @dataclass(frozen=True)
 class EmptyZone:
     """A ball whose inside is skipped by the tracer: geometry there is removed [KRS17 §8.4]."""
+
     center: Vec3 = param((0.0, 0.0, 0.0), help="centre")
     radius: float = param(1.0, lo=0.0, lo_open=True, help="radius")
 
@@ -59,33 +83,70 @@ class EmptyZone:
 @dataclass(frozen=True)
 class EffectSettings:
     """Tuning of the effects; a setting of an effect the scene does not list is ignored."""
-    smooth_width: float = param(0.05, lo=0.0, hi=1e6, help="smooth_shading: width of the "
-                                "blend band across a mirror plane, scene units (never less "
-                                "than 2 pixel footprints)")
-    shadow_softness: float = param(12.0, lo=1.0, hi=1000.0, help="soft_shadows: penumbra "
-                                   "sharpness k in visibility = min k·free/t (larger: harder)")
-    ao_step: float = param(0.06, lo=0.0, lo_open=True, hi=1e6,
-                           help="ambient_occlusion: spacing of the 5 samples along the normal")
+
+    smooth_width: float = param(
+        0.05,
+        lo=0.0,
+        hi=1e6,
+        help="smooth_shading: width of the "
+        "blend band across a mirror plane, scene units (never less "
+        "than 2 pixel footprints)",
+    )
+    shadow_softness: float = param(
+        12.0,
+        lo=1.0,
+        hi=1000.0,
+        help="soft_shadows: penumbra sharpness k in visibility = min k·free/t (larger: harder)",
+    )
+    ao_step: float = param(
+        0.06,
+        lo=0.0,
+        lo_open=True,
+        hi=1e6,
+        help="ambient_occlusion: spacing of the 5 samples along the normal",
+    )
     ao_strength: float = param(1.0, lo=0.0, hi=4.0, help="ambient_occlusion: darkening scale")
-    texture_scale: float = param(0.5, lo=0.0, lo_open=True, hi=1e6,
-                                 help="textures: size of one noise cell, scene units")
-    texture_strength: float = param(0.5, lo=0.0, hi=1.0,
-                                    help="textures: 0 = plain albedo, 1 = full contrast")
-    twist: float = param(0.0, lo=-720.0, hi=720.0, unit="degrees per unit height",
-                         help="twist: turn around the vertical axis per unit of height")
-    twist_center: Vec3 = param((0.0, 0.0, 0.0), help="twist: a point on the vertical axis "
-                               "(no turn at its height)")
+    texture_scale: float = param(
+        0.5, lo=0.0, lo_open=True, hi=1e6, help="textures: size of one noise cell, scene units"
+    )
+    texture_strength: float = param(
+        0.5, lo=0.0, hi=1.0, help="textures: 0 = plain albedo, 1 = full contrast"
+    )
+    twist: float = param(
+        0.0,
+        lo=-720.0,
+        hi=720.0,
+        unit="degrees per unit height",
+        help="twist: turn around the vertical axis per unit of height",
+    )
+    twist_center: Vec3 = param(
+        (0.0, 0.0, 0.0), help="twist: a point on the vertical axis (no turn at its height)"
+    )
     empty_zones: list[EmptyZone] = param([], help=f"empty_zones: at most {MAX_EMPTY_ZONES} balls")
     sky_zenith: Vec3 = param((0.22, 0.42, 0.82), **_COLOR)
-    fog_density: float = param(0.03, lo=0.0, hi=100.0, unit="per scene unit",
-                               help="fog: fraction of light lost is 1 − exp(−density·t)")
-    exposure: float = param(0.6, lo=0.0, lo_open=True, hi=64.0,
-                            help="tone_mapping: scale of linear radiance before the curve (0.6 maps mid-grey near where plain gamma puts it)")
+    fog_density: float = param(
+        0.03,
+        lo=0.0,
+        hi=100.0,
+        unit="per scene unit",
+        help="fog: fraction of light lost is 1 − exp(−density·t)",
+    )
+    exposure: float = param(
+        0.6,
+        lo=0.0,
+        lo_open=True,
+        hi=64.0,
+        help="tone_mapping: scale of linear radiance before the curve "
+        "(0.6 maps mid-grey near where plain gamma puts it)",
+    )
 
     def validate(self, path: str) -> None:
         if len(self.empty_zones) > MAX_EMPTY_ZONES:
-            raise SceneError(f"{path}.empty_zones", f"<{len(self.empty_zones)} zones>",
-                             f"allowed: at most {MAX_EMPTY_ZONES}")
+            raise SceneError(
+                f"{path}.empty_zones",
+                f"<{len(self.empty_zones)} zones>",
+                f"allowed: at most {MAX_EMPTY_ZONES}",
+            )
 
 
 def allowed_effects(mokrs: bool) -> list[str]:
@@ -99,9 +160,13 @@ def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> Non
         if e not in EFFECTS:
             raise SceneError(f"{path}[{i}]", e, "unknown effect; allowed: " + ", ".join(EFFECTS))
         if e not in allowed_effects(mokrs):
-            raise SceneError(f"{path}[{i}]", e, "needs a KRS distance function and mirror "
-                             "planes, which a MöKRS does not have; allowed on a MöKRS: "
-                             + ", ".join(allowed_effects(True)))
+            raise SceneError(
+                f"{path}[{i}]",
+                e,
+                "needs a KRS distance function and mirror "
+                "planes, which a MöKRS does not have; allowed on a MöKRS: "
+                + ", ".join(allowed_effects(True)),
+            )
     if len(set(effects)) != len(effects):
         raise SceneError(path, effects, "each effect at most once")
     for a, b in EXCLUSIVE:

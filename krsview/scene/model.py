@@ -3,6 +3,7 @@
 Names follow [KRS17 §3]: a KRS is (K_0..K_n; R_0..R_{n-1}); level i ≥ 1 holds mirror R_{i-1}
 (unit normal u, offset w: the plane u·x = w) and kernel K_i; level 0 holds K_0 only.
 """
+
 from __future__ import annotations
 
 import math
@@ -18,8 +19,8 @@ TRACERS = ("sphere", "binary", "relaxed")
 PRECISIONS = ("float", "double")
 SWITCH = ("on", "off")
 PATHS = ("fragment", "compute")
-PREPASS_RATIO = 4   # pre-pass: a coarse pass's tiles are this many times as wide as the next's
-VIEW_PREPASS = 4    # the viewer's pre-pass tile where the file has none (docs/speed.md)
+PREPASS_RATIO = 4  # pre-pass: a coarse pass's tiles are this many times as wide as the next's
+VIEW_PREPASS = 4  # the viewer's pre-pass tile where the file has none (docs/speed.md)
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -36,19 +37,21 @@ def _norm(a: Vec3) -> float:
 class Kernel(Tagged):
     """Base of all kernel shapes; ``type`` in the file picks the subclass."""
 
-    registry: ClassVar[dict[str, type["Kernel"]]] = {}
+    registry: ClassVar[dict[str, type[Kernel]]] = {}
     noun: ClassVar[str] = "kernel"
 
 
 @dataclass(frozen=True)
 class Empty(Kernel):
     """No geometry: a level that only reflects (e.g. the forest construction [KRS17 §9.2])."""
+
     kind: ClassVar[str] = "empty"
 
 
 @dataclass(frozen=True)
 class Sphere(Kernel):
     """Ball of ``radius`` around ``center``."""
+
     kind: ClassVar[str] = "sphere"
     center: Vec3 = param((0.0, 0.0, 0.0), help="centre")
     radius: float = param(1.0, lo=0.0, lo_open=True, help="radius")
@@ -58,6 +61,7 @@ class Sphere(Kernel):
 @dataclass(frozen=True)
 class Capsule(Kernel):
     """Segment a–b swept by a ball of ``radius``."""
+
     kind: ClassVar[str] = "capsule"
     a: Vec3 = param((0.0, 0.0, 0.0), help="first end")
     b: Vec3 = param((0.0, 1.0, 0.0), help="second end")
@@ -69,6 +73,7 @@ class Capsule(Kernel):
 class ToroidalCapsule(Kernel):
     """Circular arc start → control → end swept by a ball: a torus segment with two capping
     spheres [KRS17 §9.2]. Nearly collinear points give a straight capsule."""
+
     kind: ClassVar[str] = "toroidal_capsule"
     start: Vec3 = param((0.0, 0.0, 0.0), help="fork point where the branch starts")
     control: Vec3 = param((0.1, 0.5, 0.0), help="point the arc passes through (sets curvature)")
@@ -84,6 +89,7 @@ class ToroidalCapsule(Kernel):
 @dataclass(frozen=True)
 class Plane(Kernel):
     """Half-space u·x ≤ offset (solid below the plane)."""
+
     kind: ClassVar[str] = "plane"
     normal: Vec3 = param((0.0, 1.0, 0.0), unit_vector="require", help="outward unit normal")
     offset: float = param(0.0, help="plane offset w in u·x = w")
@@ -94,6 +100,7 @@ class Plane(Kernel):
 @dataclass(frozen=True)
 class Mirror:
     """Reflection plane u·x = w; points with u·x − w > 0 are folded [KRS17 Alg. 1]."""
+
     normal: Vec3 = param((1.0, 0.0, 0.0), unit_vector="require", help="unit normal u")
     offset: float = param(0.0, lo=-1e9, hi=1e9, help="offset w")
 
@@ -101,6 +108,7 @@ class Mirror:
 @dataclass(frozen=True)
 class Level:
     """Expansion level i: L_i = K_i ∪ L_{i-1} ∪ R_{i-1} L_{i-1}; level 0 has no mirror."""
+
     kernel: Kernel = param(Empty(), help="kernel K_i added at this level")
     mirror: Mirror | None = param(None, help="mirror R_{i-1} that doubles the level below")
 
@@ -110,12 +118,14 @@ def check_level_count(levels: list, path: str, empty: str) -> None:
     if not levels:
         raise SceneError(path, [], empty)
     if len(levels) > MAX_LEVELS:
-        raise SceneError(path, f"<{len(levels)} levels>",
-                         f"too many levels; allowed: at most {MAX_LEVELS}")
+        raise SceneError(
+            path, f"<{len(levels)} levels>", f"too many levels; allowed: at most {MAX_LEVELS}"
+        )
 
 
-def check_mirror_per_level(levels: list, path: str, name: str, none_at_0: str,
-                           needed_above: str) -> None:
+def check_mirror_per_level(
+    levels: list, path: str, name: str, none_at_0: str, needed_above: str
+) -> None:
     """A KRS's shape [KRS17 §3]: level 0 has no mirror, every level above has one (field
     ``name`` of each level)."""
     if getattr(levels[0], name) is not None:
@@ -128,14 +138,19 @@ def check_mirror_per_level(levels: list, path: str, name: str, none_at_0: str,
 @dataclass(frozen=True)
 class KRS:
     """A kernel–reflection sequence (K_0..K_n; R_0..R_{n-1}) [KRS17 §3]."""
+
     levels: list[Level] = param([], help="level 0 first (finest), level n last (coarsest)")
 
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
         check_level_count(self.levels, p, "a KRS needs at least one level (level 0: a kernel)")
-        check_mirror_per_level(self.levels, p, "mirror",
-                               "level 0 has no mirror (it holds only kernel K_0)",
-                               "every level above 0 needs a mirror {normal, offset}")
+        check_mirror_per_level(
+            self.levels,
+            p,
+            "mirror",
+            "level 0 has no mirror (it holds only kernel K_0)",
+            "every level above 0 needs a mirror {normal, offset}",
+        )
 
     @property
     def depth(self) -> int:
@@ -158,27 +173,35 @@ class KRS:
     def instance_count(self) -> int:
         """Kernel instances in the expansion: K_i is doubled by R_i..R_{n-1}, so it appears
         2^(n−i) times (empty kernels excluded)."""
-        return sum(2 ** (self.n - i) for i, k in enumerate(self.kernels)
-                   if not isinstance(k, Empty))
+        return sum(
+            2 ** (self.n - i) for i, k in enumerate(self.kernels) if not isinstance(k, Empty)
+        )
 
-    def truncated(self, levels: int) -> "KRS":
+    def truncated(self, levels: int) -> KRS:
         """Keep the coarsest ``levels`` levels (K_{n-levels+1}..K_n), dropping the finest.
         If the kernel at the cut is empty (an IFS-like KRS whose only shape is K_0), the
         nearest non-empty kernel below the cut becomes the new K_0, so something is drawn."""
         cut = len(self.levels) - levels
         keep = self.levels[cut:]
-        k0 = next((lv.kernel for lv in reversed(self.levels[:cut + 1])
-                   if not isinstance(lv.kernel, Empty)), keep[0].kernel)
+        k0 = next(
+            (
+                lv.kernel
+                for lv in reversed(self.levels[: cut + 1])
+                if not isinstance(lv.kernel, Empty)
+            ),
+            keep[0].kernel,
+        )
         return KRS([Level(k0, None)] + list(keep[1:]))
 
 
 # ------------------------------------------------------------------------ view and render
-TARGET_DISTANCE = 1e-9   # below this the view direction is lost to rounding
+TARGET_DISTANCE = 1e-9  # below this the view direction is lost to rounding
 
 
 @dataclass(frozen=True)
 class Camera:
     """Pinhole camera; the renderer keeps it in float64 and gives the GPU camera-relative data."""
+
     position: Vec3 = param((0.0, 1.0, -5.0), help="eye position")
     target: Vec3 = param((0.0, 1.0, 0.0), help="point looked at")
     up: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="up direction")
@@ -187,9 +210,12 @@ class Camera:
     def validate(self, path: str) -> None:
         fwd = _sub(self.target, self.position)
         if _norm(fwd) < TARGET_DISTANCE:
-            raise SceneError(f"{path}.target", list(self.target),
-                             f"must be at least {TARGET_DISTANCE:g} from position (it is "
-                             f"{_norm(fwd):.3g} away): the view direction comes from the two")
+            raise SceneError(
+                f"{path}.target",
+                list(self.target),
+                f"must be at least {TARGET_DISTANCE:g} from position (it is "
+                f"{_norm(fwd):.3g} away): the view direction comes from the two",
+            )
         f = tuple(c / _norm(fwd) for c in fwd)
         cos = abs(sum(a * b for a, b in zip(f, self.up)))
         if cos > 1 - 1e-9:
@@ -199,7 +225,12 @@ class Camera:
 @dataclass(frozen=True)
 class Light:
     """Directional light arriving from ``direction`` (pointing towards the light)."""
-    direction: Vec3 = param((0.35777087639996635, 0.8944271909999159, -0.2683281572999748), unit_vector="normalise", help="towards the light")
+
+    direction: Vec3 = param(
+        (0.35777087639996635, 0.8944271909999159, -0.2683281572999748),
+        unit_vector="normalise",
+        help="towards the light",
+    )
     color: Vec3 = param((1.0, 1.0, 1.0), lo=0.0, hi=100.0, help="linear RGB radiance")
     intensity: float = param(1.0, lo=0.0, hi=100.0, help="scale of color")
 
@@ -207,6 +238,7 @@ class Light:
 @dataclass(frozen=True)
 class Material:
     """Lambert + ambient shading [KRS14 Alg. 2 without smoothing]."""
+
     albedo: Vec3 = param((0.7, 0.7, 0.7), **_COLOR)
     ambient: Vec3 = param((0.15, 0.17, 0.2), lo=0.0, hi=10.0, help="ambient light, linear RGB")
     background: Vec3 = param((0.55, 0.7, 0.9), **_COLOR)
@@ -215,66 +247,109 @@ class Material:
 @dataclass(frozen=True)
 class Render:
     """Accuracy knobs; each is swept by the benchmark against time."""
-    tracer: str = param("sphere", choices=TRACERS,
-                        help="sphere: sphere tracing [Har96]; binary: binary sphere tracing "
-                             "with unbounding probes [KRS17 Alg. 2] (required by a MöKRS); "
-                             "relaxed: over-relaxed sphere tracing, steps of ω·d with a "
-                             "fallback [Keinert et al. 2014] (a single KRS)")
-    epsilon_scale: float = param(1.0, lo=1e-4, hi=100.0, unit="pixels",
-                                 help="stop when distance < footprint × depth × scale")
+
+    tracer: str = param(
+        "sphere",
+        choices=TRACERS,
+        help="sphere: sphere tracing [Har96]; binary: binary sphere tracing "
+        "with unbounding probes [KRS17 Alg. 2] (required by a MöKRS); "
+        "relaxed: over-relaxed sphere tracing, steps of ω·d with a "
+        "fallback [Keinert et al. 2014] (a single KRS)",
+    )
+    epsilon_scale: float = param(
+        1.0, lo=1e-4, hi=100.0, unit="pixels", help="stop when distance < footprint × depth × scale"
+    )
     max_iterations: int = param(256, lo=1, hi=10000, help="iteration cap per ray")
     max_distance: float = param(100.0, lo=0.0, lo_open=True, hi=1e9, help="far limit of rays")
-    xi_bonus: float = param(2.0, lo=1.0, lo_open=True, hi=16.0,
-                            help="binary tracing: probe growth after a free probe [KRS17 §6.1]")
-    xi_penalty: float = param(0.3, lo=0.01, hi=0.95,
-                              help="binary tracing: probe shrink after a blocked probe")
-    relaxation: float = param(1.6, lo=1.0, hi=1.99,
-                              help="relaxed tracing: step ω·d; a step whose sphere does not "
-                                   "meet the last one is taken back and ω drops to 1")
-    precision: str = param("float", choices=PRECISIONS,
-                           help="float: the GPU's float32; double: distances, folds, Möbius "
-                                "maps and ray positions in float64 (GL 4 fp64), for deep "
-                                "zooms, at a cost in time")
-    culling: str = param("on", choices=SWITCH,
-                         help="exact level culling: Alg. 1 stops at the first level whose "
-                              "bounding ball is no nearer than the distance found (the same "
-                              "value, fewer levels walked)")
-    path: str = param("fragment", choices=PATHS,
-                      help="fragment: one full-screen pass traces and shades each pixel; "
-                           "compute: rays in a storage buffer traced in rounds of "
-                           "--steps iterations, finished rays leaving the queue, then "
-                           "shaded in a deferred pass (the same image)")
-    steps: int = param(16, lo=1, hi=1024,
-                       help="compute path: iterations per ray per round (dispatch)")
-    shadow_tasks: str = param("on", choices=SWITCH,
-                              help="compute path: shadow rays as tasks of their own, traced "
-                                   "in rounds like the primary rays (on), or inline while "
-                                   "shading (off); the same image")
-    component_tasks: str = param("off", choices=SWITCH,
-                                 help="compute path, compound: a task per pixel and "
-                                      "component, each traced to its own hit, the nearest "
-                                      "kept [KRS17 §5.1] (on); or one ray stepping its nearest "
-                                      "component (off). The same hits except where a ray "
-                                      "reaches the iteration cap, which counts per task")
-    prepass: int = param(0, lo=0, hi=64, unit="pixels",
-                         help="tile size of the low-resolution pre-pass: one cone per tile "
-                              "finds how far all its rays are free, and each ray starts there "
-                              "(0: off)")
-    prepass_levels: int = param(2, lo=1, hi=4,
-                                help=f"pre-pass: coarse passes, coarsest first, each with "
-                                     f"tiles {PREPASS_RATIO}× as wide as the next; a cone "
-                                     "starts where the coarser cone around it stopped (1: "
-                                     "one coarse pass)")
+    xi_bonus: float = param(
+        2.0,
+        lo=1.0,
+        lo_open=True,
+        hi=16.0,
+        help="binary tracing: probe growth after a free probe [KRS17 §6.1]",
+    )
+    xi_penalty: float = param(
+        0.3, lo=0.01, hi=0.95, help="binary tracing: probe shrink after a blocked probe"
+    )
+    relaxation: float = param(
+        1.6,
+        lo=1.0,
+        hi=1.99,
+        help="relaxed tracing: step ω·d; a step whose sphere does not "
+        "meet the last one is taken back and ω drops to 1",
+    )
+    precision: str = param(
+        "float",
+        choices=PRECISIONS,
+        help="float: the GPU's float32; double: distances, folds, Möbius "
+        "maps and ray positions in float64 (GL 4 fp64), for deep "
+        "zooms, at a cost in time",
+    )
+    culling: str = param(
+        "on",
+        choices=SWITCH,
+        help="exact level culling: Alg. 1 stops at the first level whose "
+        "bounding ball is no nearer than the distance found (the same "
+        "value, fewer levels walked)",
+    )
+    path: str = param(
+        "fragment",
+        choices=PATHS,
+        help="fragment: one full-screen pass traces and shades each pixel; "
+        "compute: rays in a storage buffer traced in rounds of "
+        "--steps iterations, finished rays leaving the queue, then "
+        "shaded in a deferred pass (the same image)",
+    )
+    steps: int = param(
+        16, lo=1, hi=1024, help="compute path: iterations per ray per round (dispatch)"
+    )
+    shadow_tasks: str = param(
+        "on",
+        choices=SWITCH,
+        help="compute path: shadow rays as tasks of their own, traced "
+        "in rounds like the primary rays (on), or inline while "
+        "shading (off); the same image",
+    )
+    component_tasks: str = param(
+        "off",
+        choices=SWITCH,
+        help="compute path, compound: a task per pixel and "
+        "component, each traced to its own hit, the nearest "
+        "kept [KRS17 §5.1] (on); or one ray stepping its nearest "
+        "component (off). The same hits except where a ray "
+        "reaches the iteration cap, which counts per task",
+    )
+    prepass: int = param(
+        0,
+        lo=0,
+        hi=64,
+        unit="pixels",
+        help="tile size of the low-resolution pre-pass: one cone per tile "
+        "finds how far all its rays are free, and each ray starts there "
+        "(0: off)",
+    )
+    prepass_levels: int = param(
+        2,
+        lo=1,
+        hi=4,
+        help=f"pre-pass: coarse passes, coarsest first, each with "
+        f"tiles {PREPASS_RATIO}× as wide as the next; a cone "
+        "starts where the coarser cone around it stopped (1: "
+        "one coarse pass)",
+    )
 
 
 # ------------------------------------------------------------------------------ arc geometry
-STRAIGHT_RATIO = 200.0  # arcs with radius > 200 × chord are drawn as capsules (sagitta < chord/1600)
+STRAIGHT_RATIO = (
+    200.0  # arcs with radius > 200 × chord are drawn as capsules (sagitta < chord/1600)
+)
 
 
 @dataclass(frozen=True)
 class Arc:
     """Circular arc of a toroidal capsule: centre O, in-plane unit axes e1 (towards start) and e2,
     radius R, arc angle phi from start to end (counter-clockwise around e1 × e2)."""
+
     center: Vec3
     e1: Vec3
     e2: Vec3
@@ -293,7 +368,7 @@ def arc_of(k: ToroidalCapsule) -> Arc | None:
         return None
     O = C + np.cross(a @ a * b - b @ b * a, axb) / denom
     R = float(np.linalg.norm(A - O))
-    if not np.isfinite(R) or R > STRAIGHT_RATIO * chord:
+    if not np.isfinite(R) or STRAIGHT_RATIO * chord < R:
         return None
     N = np.cross(C - A, B - C)
     N /= np.linalg.norm(N)

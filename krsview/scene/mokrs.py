@@ -13,6 +13,7 @@ exactly would cost a second kernel test per level; a kernel that is its own mirr
 across x = 0 is drawn the same either way. Kernels are written in
 their level's space; G_i maps that space into level i+1's (the last level's G into the world).
 """
+
 from __future__ import annotations
 
 import math
@@ -31,7 +32,7 @@ SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is r
 class MobiusStep(Tagged):
     """One elementary transformation; ``type`` picks it. Steps apply in the order listed."""
 
-    registry: ClassVar[dict[str, type["MobiusStep"]]] = {}
+    registry: ClassVar[dict[str, type[MobiusStep]]] = {}
     noun: ClassVar[str] = "Möbius step"
 
     def matrix(self):
@@ -41,6 +42,7 @@ class MobiusStep(Tagged):
 @dataclass(frozen=True)
 class Translate(MobiusStep):
     """q ↦ q + by."""
+
     kind: ClassVar[str] = "translate"
     by: Vec3 = param((0.0, 0.0, 0.0), help="translation vector")
 
@@ -51,6 +53,7 @@ class Translate(MobiusStep):
 @dataclass(frozen=True)
 class Scale(MobiusStep):
     """Dilation q ↦ s q about the origin."""
+
     kind: ClassVar[str] = "scale"
     factor: float = param(1.0, lo=1e-6, hi=1e6, help="dilation factor s")
 
@@ -61,6 +64,7 @@ class Scale(MobiusStep):
 @dataclass(frozen=True)
 class Rotate(MobiusStep):
     """Rotation q ↦ r q r⁻¹ about an axis through the origin."""
+
     kind: ClassVar[str] = "rotate"
     axis: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="rotation axis")
     degrees: float = param(0.0, lo=-360.0, hi=360.0, unit="degrees", help="angle (right hand)")
@@ -73,6 +77,7 @@ class Rotate(MobiusStep):
 class Invert(MobiusStep):
     """q ↦ c + r²(q − c)⁻¹: inversion in the sphere (c, r) composed with the point reflection
     through c (Table 1's q ↦ q⁻¹, moved and scaled). c itself goes to infinity."""
+
     kind: ClassVar[str] = "invert"
     center: Vec3 = param((0.0, 0.0, 0.0), help="centre c (mapped to infinity)")
     radius: float = param(1.0, lo=1e-6, hi=1e6, help="radius r of the fixed sphere")
@@ -80,18 +85,26 @@ class Invert(MobiusStep):
     def matrix(self):
         M = mobius
         neg = tuple(-v for v in self.center)
-        return M.compose(M.translation(self.center), M.dilation(self.radius),
-                         M.inversion(), M.dilation(1.0 / self.radius), M.translation(neg))
+        return M.compose(
+            M.translation(self.center),
+            M.dilation(self.radius),
+            M.inversion(),
+            M.dilation(1.0 / self.radius),
+            M.translation(neg),
+        )
 
 
 @dataclass(frozen=True)
 class MobiusLevel:
     """Level i: kernel K_i in this level's space, transform G_i out of it, reflection R."""
+
     kernel: Kernel = param(Empty(), help="kernel K_i, in this level's space")
-    transform: list[MobiusStep] = param([], help="G_i: steps applied in order, into the "
-                                                 "next level's space (world for the last)")
-    reflect: bool = param(True, help="double this level's kernel and the levels below by "
-                                         "the reflection across x = 0")
+    transform: list[MobiusStep] = param(
+        [], help="G_i: steps applied in order, into the next level's space (world for the last)"
+    )
+    reflect: bool = param(
+        True, help="double this level's kernel and the levels below by the reflection across x = 0"
+    )
 
     def matrix(self):
         """G_i as a quaternion matrix: the last step applied last (leftmost)."""
@@ -105,6 +118,7 @@ class MobiusLevel:
 @dataclass(frozen=True)
 class MoKRS:
     """A Möbius kernel–reflection sequence [KRS17 §7]; traced by binary sphere tracing."""
+
     levels: list[MobiusLevel] = param([], help="level 0 first (finest), last level coarsest")
 
     def validate(self, path: str) -> None:
@@ -113,9 +127,12 @@ class MoKRS:
         for i, lv in enumerate(self.levels):
             cond = mobius.condition(lv.matrix())
             if not cond <= SINGULAR_CONDITION:
-                raise SceneError(f"{p}[{i}].transform", f"<condition number {cond:.3g}>",
-                                 f"numerically singular; allowed: condition ≤ "
-                                 f"{SINGULAR_CONDITION:g} (avoid extreme scale factors)")
+                raise SceneError(
+                    f"{p}[{i}].transform",
+                    f"<condition number {cond:.3g}>",
+                    f"numerically singular; allowed: condition ≤ "
+                    f"{SINGULAR_CONDITION:g} (avoid extreme scale factors)",
+                )
 
     @property
     def depth(self) -> int:
@@ -140,7 +157,7 @@ class MoKRS:
                 total += copies
         return total
 
-    def truncated(self, levels: int) -> "MoKRS":
+    def truncated(self, levels: int) -> MoKRS:
         """Keep the coarsest ``levels`` levels, dropping the finest. If none of them has a
         kernel (an IFS-like MöKRS whose only shape is K_0, as ``inversion``), the nearest
         kernel below the cut is carried into the new finest level's space by G_j … G_{cut−1},
@@ -153,20 +170,29 @@ class MoKRS:
             j = below[-1]
             k = self.levels[j].kernel
             if not isinstance(k, Sphere):
-                raise SceneError("levels", levels, f"the kept levels have no kernel, and "
-                                 f"level {j}'s {k.kind} cannot be carried up to level {cut} "
-                                 f"(only a sphere stays a sphere under Möbius maps); allowed: "
-                                 f"more than {len(self.levels) - 1 - j} levels")
+                raise SceneError(
+                    "levels",
+                    levels,
+                    f"the kept levels have no kernel, and "
+                    f"level {j}'s {k.kind} cannot be carried up to level {cut} "
+                    f"(only a sphere stays a sphere under Möbius maps); allowed: "
+                    f"more than {len(self.levels) - 1 - j} levels",
+                )
             c, r = np.array([k.center], dtype=np.float64), np.array([k.radius])
             for i in range(j, cut):
                 c, r, ok = mobius.map_ball(self.levels[i].matrix(), c, r)
                 if not ok[0]:
-                    raise SceneError("levels", levels, f"level {j}'s sphere holds the pole "
-                                     f"of level {i}'s transformation, so its image is not a "
-                                     f"ball; allowed: more than {len(self.levels) - 1 - i} "
-                                     "levels")
-            keep[0] = replace(keep[0], kernel=Sphere(tuple(float(v) for v in c[0]),
-                                                     float(r[0]), k.color))
+                    raise SceneError(
+                        "levels",
+                        levels,
+                        f"level {j}'s sphere holds the pole "
+                        f"of level {i}'s transformation, so its image is not a "
+                        f"ball; allowed: more than {len(self.levels) - 1 - i} "
+                        "levels",
+                    )
+            keep[0] = replace(
+                keep[0], kernel=Sphere(tuple(float(v) for v in c[0]), float(r[0]), k.color)
+            )
         return MoKRS(keep)
 
 
@@ -183,9 +209,12 @@ def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
         if p is not None:
             scale = max(1.0, float(np.linalg.norm(x)))
             if np.linalg.norm(x[0] - p) <= POLE_DISTANCE * scale:
-                raise SceneError(path, list(position),
-                                 f"level {i}'s transform sends this point to infinity (its "
-                                 f"pole); move the viewpoint or the transform's centre")
+                raise SceneError(
+                    path,
+                    list(position),
+                    f"level {i}'s transform sends this point to infinity (its "
+                    f"pole); move the viewpoint or the transform's centre",
+                )
         x = mobius.apply(H, x)
         if mokrs.levels[i].reflect and x[0, 0] > 0.0:
             x[0, 0] = -x[0, 0]
@@ -211,8 +240,11 @@ def mokrs_of(krs) -> MoKRS:
         turn = lambda v: tuple(float(c) for c in mobius.apply(R, np.array([v]))[0])  # noqa: E731
         if isinstance(k, Plane):
             return replace(k, normal=turn(k.normal), offset=k.offset - float(np.dot(k.normal, o)))
-        change = {f.name: turn(np.asarray(getattr(k, f.name)) - o) for f in fields(k)
-                  if f.name in ("center", "a", "b", "start", "control", "end")}
+        change = {
+            f.name: turn(np.asarray(getattr(k, f.name)) - o)
+            for f in fields(k)
+            if f.name in ("center", "a", "b", "start", "control", "end")
+        }
         return replace(k, **change)
 
     frames = []  # (axis, degrees, origin w·u) of each mirror's frame

@@ -12,64 +12,98 @@ from the fork it must pass through (w = u·P_i), so L_{i−1} and its mirror ima
 from P_i. A growth ``[tree]`` bakes into a route (:meth:`Tree.route`) that expands into
 exactly the same KRS.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from .model import (KRS, MAX_LEVELS, Empty, Kernel, Level, Mirror, ToroidalCapsule, _COLOR,
-                    arc_of, check_mirror_per_level)
+from .model import (
+    _COLOR,
+    KRS,
+    MAX_LEVELS,
+    Empty,
+    Kernel,
+    Level,
+    Mirror,
+    ToroidalCapsule,
+    arc_of,
+    check_mirror_per_level,
+)
 from .schema import SceneError, Vec3, param
 
-FORK_SEPARATION = 1e-9   # forks closer than this × the route's size are "on top of each other"
-CLIP_TOLERANCE = 0.5     # × a child's radius: a shallower crossing stays inside the fork joint
-ARC_SAMPLES = 17         # points along a branch checked against its fork's mirror
+FORK_SEPARATION = 1e-9  # forks closer than this × the route's size are "on top of each other"
+CLIP_TOLERANCE = 0.5  # × a child's radius: a shallower crossing stays inside the fork joint
+ARC_SAMPLES = 17  # points along a branch checked against its fork's mirror
 
 
 @dataclass(frozen=True)
 class RouteLevel:
     """One fork of the route and the branch that ends there."""
-    fork: Vec3 = param((0.0, 1.0, 0.0), help="fork point P_i where this branch ends "
-                       "(the twig tip for level 0)")
-    control: Vec3 = param((0.0, 0.5, 0.0), help="point the branch's arc passes through "
-                          "(on the chord: a straight branch)")
+
+    fork: Vec3 = param(
+        (0.0, 1.0, 0.0), help="fork point P_i where this branch ends (the twig tip for level 0)"
+    )
+    control: Vec3 = param(
+        (0.0, 0.5, 0.0),
+        help="point the branch's arc passes through (on the chord: a straight branch)",
+    )
     radius: float = param(0.05, lo=0.0, lo_open=True, hi=1e6, help="branch section radius")
     color: Vec3 | None = param(None, **_COLOR)
-    normal: Vec3 | None = param(None, unit_vector="normalise",
-                                help="normal of the mirror through this fork (not on level 0)")
+    normal: Vec3 | None = param(
+        None,
+        unit_vector="normalise",
+        help="normal of the mirror through this fork (not on level 0)",
+    )
 
 
 @dataclass(frozen=True)
 class Route:
     """Fork points, control points, widths and fork mirrors from twig to trunk."""
+
     base: Vec3 = param((0.0, 0.0, 0.0), help="foot of the trunk (where the last level starts)")
     levels: list[RouteLevel] = param([], help="level 0 (the twig) first, the trunk last")
-    forest: list[Mirror] = param([], help="extra reflections above the trunk, with empty "
-                                 "kernels: 2^k trees from one [KRS17 §9.2]")
-    ground: Kernel | None = param(None, help="kernel of the last forest level: a ground plane, "
-                                  "say")
+    forest: list[Mirror] = param(
+        [],
+        help="extra reflections above the trunk, with empty "
+        "kernels: 2^k trees from one [KRS17 §9.2]",
+    )
+    ground: Kernel | None = param(None, help="kernel of the last forest level: a ground plane, say")
 
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
         if not self.levels:
             raise SceneError(p, [], "a route needs at least one level (the trunk)")
         if len(self.levels) + len(self.forest) > MAX_LEVELS:
-            raise SceneError(p, f"<{len(self.levels)} levels, {len(self.forest)} forest>",
-                             f"levels + forest mirrors must be ≤ {MAX_LEVELS}")
-        check_mirror_per_level(self.levels, p, "normal",
-                               "level 0 is the twig: no mirror forks there; remove the normal",
-                               "every level above 0 needs the normal of its fork's mirror")
+            raise SceneError(
+                p,
+                f"<{len(self.levels)} levels, {len(self.forest)} forest>",
+                f"levels + forest mirrors must be ≤ {MAX_LEVELS}",
+            )
+        check_mirror_per_level(
+            self.levels,
+            p,
+            "normal",
+            "level 0 is the twig: no mirror forks there; remove the normal",
+            "every level above 0 needs the normal of its fork's mirror",
+        )
         forks = np.array([self.base] + [lv.fork for lv in self.levels])
         size = max(float(np.ptp(forks, axis=0).max()), 1.0)
         for i, (start, lv) in enumerate(zip(self.starts(), self.levels)):
             if np.linalg.norm(np.subtract(lv.fork, start)) <= FORK_SEPARATION * size:
                 below = "base" if i == len(self.levels) - 1 else f"levels[{i + 1}].fork"
-                raise SceneError(f"{p}[{i}].fork", list(lv.fork),
-                                 f"must differ from {below} (a branch needs a length)")
+                raise SceneError(
+                    f"{p}[{i}].fork",
+                    list(lv.fork),
+                    f"must differ from {below} (a branch needs a length)",
+                )
         if self.ground is not None and not self.forest:
-            raise SceneError(f"{path}.ground", "<kernel>", "the ground is the kernel of the "
-                             "last forest level: add at least one forest mirror")
+            raise SceneError(
+                f"{path}.ground",
+                "<kernel>",
+                "the ground is the kernel of the last forest level: add at least one forest mirror",
+            )
 
     def starts(self) -> list[Vec3]:
         """Where each level's branch starts: the fork of the level above, the base for the trunk."""
@@ -105,9 +139,11 @@ class Route:
             e = arc_points(child) @ np.array(m.normal) - m.offset
             worst = float(e.max())
             if worst > CLIP_TOLERANCE * child.radius:
-                out.append(f"levels[{i - 1}]: the branch crosses the mirror at its fork "
-                           f"(levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — "
-                           "turn the normal or move the branch to the mirror's negative side")
+                out.append(
+                    f"levels[{i - 1}]: the branch crosses the mirror at its fork "
+                    f"(levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — "
+                    "turn the normal or move the branch to the mirror's negative side"
+                )
         return out
 
 

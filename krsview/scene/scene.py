@@ -1,5 +1,6 @@
 """The scene: geometry (an explicit KRS or a tree), camera, lights, material, render settings
 and the effect set; loaded from and saved to TOML."""
+
 from __future__ import annotations
 
 import os
@@ -12,11 +13,10 @@ from .compound import Component, Compound, check_compound
 from .effects import EffectSettings, check_effects
 from .model import KRS, Camera, Light, Material, Render
 from .mokrs import MoKRS, check_view
+from .route import Route
 from .schema import SceneError, from_dict, param, to_dict
 from .toml_writer import dumps
-from .route import Route
 from .tree import Tree
-
 
 Geometry = KRS | MoKRS | Compound
 GEOMETRY_KEYS = ("krs", "tree", "route", "mokrs", "compound")  # a scene has exactly one
@@ -25,11 +25,12 @@ GEOMETRY_KEYS = ("krs", "tree", "route", "mokrs", "compound")  # a scene has exa
 @dataclass(frozen=True)
 class Bookmark:
     """A named camera saved in the scene file by the viewer."""
+
     name: str = param("view", help="shown in the viewer's bookmark list")
     camera: Camera = param(Camera())
 
 
-MAX_LIGHTS = 4   # the shaders' light slots (LIGHT_SLOTS)
+MAX_LIGHTS = 4  # the shaders' light slots (LIGHT_SLOTS)
 
 
 @dataclass(frozen=True)
@@ -40,29 +41,39 @@ class Scene:
     lights: list[Light] = param([Light()], help=f"directional lights (at most {MAX_LIGHTS})")
     material: Material = param(Material())
     render: Render = param(Render())
-    effects: list[str] = param([], help="effects compiled into this scene's shader; "
-                               "allowed: see krsview.scene.effects.EFFECTS (README, Effects)")
+    effects: list[str] = param(
+        [],
+        help="effects compiled into this scene's shader; "
+        "allowed: see krsview.scene.effects.EFFECTS (README, Effects)",
+    )
     effect_settings: EffectSettings = param(EffectSettings())
     krs: KRS | None = param(None, help="explicit kernel–reflection sequence")
     tree: Tree | None = param(None, help="tree growth parameters (instead of krs)")
-    route: Route | None = param(None, help="a tree given by its route: forks, control "
-                                "points, widths, fork mirrors (the editor's form of a tree)")
+    route: Route | None = param(
+        None,
+        help="a tree given by its route: forks, control "
+        "points, widths, fork mirrors (the editor's form of a tree)",
+    )
     mokrs: MoKRS | None = param(None, help="Möbius kernel–reflection sequence (instead of krs)")
-    compound: list[Component] = param([], help="up to 8 placed KRSs or trees, drawn as one "
-                                      "scene (instead of krs) [KRS17 §5.1]")
+    compound: list[Component] = param(
+        [], help="up to 8 placed KRSs or trees, drawn as one scene (instead of krs) [KRS17 §5.1]"
+    )
     bookmarks: list[Bookmark] = param([], help="saved cameras")
 
     def validate(self, path: str) -> None:
         given = [k for k in GEOMETRY_KEYS if getattr(self, k)]
         if len(given) != 1:
-            raise SceneError(" / ".join(GEOMETRY_KEYS),
-                             "<" + (" and ".join(given) or "none") + ">",
-                             "a scene has exactly one geometry: a [krs], [tree], [route] or "
-                             "[mokrs] table, or a [[compound]] list")
+            raise SceneError(
+                " / ".join(GEOMETRY_KEYS),
+                "<" + (" and ".join(given) or "none") + ">",
+                "a scene has exactly one geometry: a [krs], [tree], [route] or "
+                "[mokrs] table, or a [[compound]] list",
+            )
         check_compound(self.compound)
         if len(self.lights) > MAX_LIGHTS:
-            raise SceneError("lights", f"<{len(self.lights)} lights>",
-                             f"allowed: at most {MAX_LIGHTS}")
+            raise SceneError(
+                "lights", f"<{len(self.lights)} lights>", f"allowed: at most {MAX_LIGHTS}"
+            )
         check_effects(self.effects, self.mokrs is not None)
         self.check_tracer(self.render.tracer)
         if self.mokrs is not None:
@@ -75,13 +86,21 @@ class Scene:
         binary tracing; over-relaxed tracing is for a single KRS (a compound's per-component
         free distances must be verified ones)."""
         if self.mokrs is not None and tracer != "binary":
-            raise SceneError(path, tracer, "this scene is a MöKRS, which has no distance "
-                             "function, only unbounding tests: it needs binary tracing; "
-                             "allowed: 'binary'")
+            raise SceneError(
+                path,
+                tracer,
+                "this scene is a MöKRS, which has no distance "
+                "function, only unbounding tests: it needs binary tracing; "
+                "allowed: 'binary'",
+            )
         if self.compound and tracer == "relaxed":
-            raise SceneError(path, tracer, "over-relaxed tracing steps past what is verified "
-                             "free, which a compound's nearest-component rule cannot allow; "
-                             "allowed here: 'sphere', 'binary'")
+            raise SceneError(
+                path,
+                tracer,
+                "over-relaxed tracing steps past what is verified "
+                "free, which a compound's nearest-component rule cannot allow; "
+                "allowed here: 'sphere', 'binary'",
+            )
 
     def geometry(self) -> Geometry:
         """What is drawn: the explicit KRS or MöKRS, the tree expanded [KRS17 §9.2], or the
@@ -94,7 +113,7 @@ class Scene:
             return Compound(tuple(c.placed() for c in self.compound))
         return self.krs if self.krs is not None else self.mokrs  # type: ignore[return-value]
 
-    def with_geometry(self, geometry: Geometry) -> "Scene":
+    def with_geometry(self, geometry: Geometry) -> Scene:
         none = dict(krs=None, tree=None, route=None, mokrs=None, compound=[])
         if isinstance(geometry, MoKRS):
             return replace(self, **{**none, "mokrs": geometry})
@@ -122,10 +141,15 @@ def load_scene(path: str | os.PathLike) -> Scene:
     p = Path(path)
     try:
         size = p.stat().st_size
-        if size > MAX_FILE_BYTES:   # refuse before parsing: 500,000 levels took 100 s and 900 MB
-            raise SceneError("<file>", f"{size:,} bytes", f"scene files hold at most "
-                             f"{MAX_FILE_BYTES:,} bytes (a compound of 8 × 64 levels is far "
-                             "smaller)", str(p))
+        if size > MAX_FILE_BYTES:  # refuse before parsing: 500,000 levels took 100 s and 900 MB
+            raise SceneError(
+                "<file>",
+                f"{size:,} bytes",
+                f"scene files hold at most "
+                f"{MAX_FILE_BYTES:,} bytes (a compound of 8 × 64 levels is far "
+                "smaller)",
+                str(p),
+            )
         raw = p.read_bytes()
     except OSError as e:
         raise SceneError("<file>", str(p), f"cannot read: {e.strerror}", str(p)) from None
@@ -133,10 +157,13 @@ def load_scene(path: str | os.PathLike) -> Scene:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
         bom = raw[:2] in (b"\xff\xfe", b"\xfe\xff")
-        raise SceneError("<file>", f"byte 0x{raw[e.start]:02x} at offset {e.start}",
-                         "a scene file is UTF-8 text (TOML)" +
-                         ("; this one is UTF-16: save it as UTF-8" if bom else ""),
-                         str(p)) from None
+        raise SceneError(
+            "<file>",
+            f"byte 0x{raw[e.start]:02x} at offset {e.start}",
+            "a scene file is UTF-8 text (TOML)"
+            + ("; this one is UTF-16: save it as UTF-8" if bom else ""),
+            str(p),
+        ) from None
     return scene_from_toml(text, str(p))
 
 

@@ -4,6 +4,7 @@ A field is declared with :func:`param`; :func:`from_dict` builds and validates a
 tree from TOML data and :func:`to_dict` writes it back, so validation, files and (later) GUI
 panels read the same metadata (the Fragmentarium habit, see DESIGN.md).
 """
+
 from __future__ import annotations
 
 import math
@@ -19,10 +20,13 @@ UNIT_TOLERANCE = 1e-6  # how far a plane normal's length may be from 1 before it
 def _brief(value: Any, limit: int = 60) -> str:
     """A value as it is shown in an error: one short line (a table is not printed whole)."""
     if isinstance(value, dict):
-        return "{a table with " + (", ".join(map(str, value)) or "no fields") + "}" \
-            if len(repr(value)) > limit else repr(value)
+        return (
+            "{a table with " + (", ".join(map(str, value)) or "no fields") + "}"
+            if len(repr(value)) > limit
+            else repr(value)
+        )
     text = repr(value)
-    return text if len(text) <= limit else text[:limit - 1] + "…"
+    return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
 class SceneError(ValueError):
@@ -36,25 +40,40 @@ class SceneError(ValueError):
         where = f"{self.file}: " if self.file else ""
         return f"{where}{self.path} = {_brief(self.value)}: {self.allowed}"
 
-    def in_file(self, file: str) -> "SceneError":
+    def in_file(self, file: str) -> SceneError:
         return SceneError(self.path, self.value, self.allowed, file)
 
 
-def param(default: Any = MISSING, *, lo: float | None = None, hi: float | None = None,
-          lo_open: bool = False, unit: str = "", help: str = "", choices: tuple | None = None,
-          unit_vector: str | None = None) -> Any:
+def param(
+    default: Any = MISSING,
+    *,
+    lo: float | None = None,
+    hi: float | None = None,
+    lo_open: bool = False,
+    unit: str = "",
+    help: str = "",
+    choices: tuple | None = None,
+    unit_vector: str | None = None,
+) -> Any:
     """A scene field with its allowed range (closed unless ``lo_open``), unit and help text.
 
     ``unit_vector``: "normalise" scales a direction to length 1; "require" rejects a normal
     whose length is not 1 (a plane's offset is measured in units of its normal)."""
-    meta = dict(lo=lo, hi=hi, lo_open=lo_open, unit=unit, help=help, choices=choices,
-                unit_vector=unit_vector)
+    meta = dict(
+        lo=lo,
+        hi=hi,
+        lo_open=lo_open,
+        unit=unit,
+        help=help,
+        choices=choices,
+        unit_vector=unit_vector,
+    )
     if isinstance(default, (list, dict)):
         return field(default_factory=lambda d=default: type(d)(d), metadata=meta)
     return field(default=default, metadata=meta)
 
 
-MAX_ITEMS = 1024   # any list in a scene file (the fields' own limits are far lower)
+MAX_ITEMS = 1024  # any list in a scene file (the fields' own limits are far lower)
 
 # Scene lengths and coordinates without a range of their own: the GPU squares them in
 # float32 (max 3.4e38), so beyond 1e9 a distance overflows to infinity and the image is flat.
@@ -71,6 +90,7 @@ def _bounds(meta: dict, kind: type = float) -> tuple[float | None, float | None]
 
 class _Short(float):
     """A bound as people write it: 1e+09, not 1000000000.0; 89, not 89.0."""
+
     def __str__(self) -> str:
         return f"{float(self):g}"
 
@@ -107,14 +127,18 @@ def _check_vec3(x: Any, path: str, meta: dict) -> Vec3:
     v = tuple(_check_number(c, f"{path}[{i}]", meta, float) for i, c in enumerate(x))
     mode = meta.get("unit_vector")
     if mode:
-        n = math.hypot(*v)   # no overflow for huge components
+        n = math.hypot(*v)  # no overflow for huge components
         if n < 1e-9:
             raise SceneError(path, list(x), "a direction must not be the zero vector")
         if mode == "require" and abs(n - 1.0) > UNIT_TOLERANCE:
             hint = ", ".join(f"{c / n:.9g}" for c in v)
-            raise SceneError(path, list(x), f"must be a unit vector (length {n:.6g}, allowed "
-                             f"1 ± {UNIT_TOLERANCE:g}, because the offset is measured in its "
-                             f"units); normalised it is [{hint}]")
+            raise SceneError(
+                path,
+                list(x),
+                f"must be a unit vector (length {n:.6g}, allowed "
+                f"1 ± {UNIT_TOLERANCE:g}, because the offset is measured in its "
+                f"units); normalised it is [{hint}]",
+            )
         if abs(n - 1.0) > 1e-12:
             v = tuple(c / n for c in v)  # normalise once; already-unit input is kept bit-exact
     return v  # type: ignore[return-value]
@@ -150,10 +174,13 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
     if origin is list:
         if not isinstance(x, list):
             raise SceneError(path, x, "expected a list")
-        if len(x) > MAX_ITEMS:   # before converting: 500,000 levels took 100 s and 900 MB
-            raise SceneError(path, f"<a list of {len(x):,} items>",
-                             f"too long; allowed: at most {MAX_ITEMS} items (64 levels, 8 "
-                             "components, 4 lights, … are the real limits)")
+        if len(x) > MAX_ITEMS:  # before converting: 500,000 levels took 100 s and 900 MB
+            raise SceneError(
+                path,
+                f"<a list of {len(x):,} items>",
+                f"too long; allowed: at most {MAX_ITEMS} items (64 levels, 8 "
+                "components, 4 lights, … are the real limits)",
+            )
         (inner,) = args
         return [check_value(inner, v, f"{path}[{i}]", meta) for i, v in enumerate(x)]
     if is_dataclass(hint):
@@ -172,15 +199,17 @@ def from_dict(cls: type, data: Any, path: str = "") -> Any:
     for key in data:
         if key not in known:
             why = getattr(cls, "UNKNOWN_FIELDS", {}).get(key, "unknown field")
-            raise SceneError(_join(path, key), data[key],
-                             f"{why}; allowed fields: {', '.join(sorted(known))}")
+            raise SceneError(
+                _join(path, key), data[key], f"{why}; allowed fields: {', '.join(sorted(known))}"
+            )
     kwargs = {}
     for f in fields(cls):
         if not f.init:
             continue
         if f.name in data:
-            kwargs[f.name] = check_value(hints[f.name], data[f.name], _join(path, f.name),
-                                         dict(f.metadata))
+            kwargs[f.name] = check_value(
+                hints[f.name], data[f.name], _join(path, f.name), dict(f.metadata)
+            )
         elif f.default is MISSING and f.default_factory is MISSING:
             raise SceneError(_join(path, f.name), "<missing>", "this field is required")
     obj = cls(**kwargs)
@@ -225,8 +254,9 @@ class Tagged:
     def from_toml(cls, data: Any, path: str) -> Any:
         allowed = ", ".join(cls.registry)
         if not isinstance(data, dict) or "type" not in data:
-            raise SceneError(path, data, f"expected a {cls.noun} table with a 'type'; "
-                             f"allowed types: {allowed}")
+            raise SceneError(
+                path, data, f"expected a {cls.noun} table with a 'type'; allowed types: {allowed}"
+            )
         kind = data["type"]
         if not isinstance(kind, str) or kind not in cls.registry:
             raise SceneError(f"{path}.type", kind, f"unknown {cls.noun} type; allowed: {allowed}")

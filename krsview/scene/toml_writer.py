@@ -2,6 +2,7 @@
 
 Floats are written with ``repr`` (shortest round-trip form), so save → load is bit-exact.
 """
+
 from __future__ import annotations
 
 import json
@@ -39,8 +40,11 @@ def _is_table_list(v: Any) -> bool:
 
 
 def _emit(table: dict, name: str, out: list[str], header: str | None) -> None:
-    plain = {k: v for k, v in table.items()
-             if not (isinstance(v, dict) and header != "[[") and not _is_table_list(v)}
+    plain = {
+        k: v
+        for k, v in table.items()
+        if not (isinstance(v, dict) and header != "[[") and not _is_table_list(v)
+    }
     if header is not None:
         out.append(f"\n{header}{name}{']]' if header == '[[' else ']'}")
     out += [f"{_key(k)} = {_value(v)}" for k, v in plain.items()]

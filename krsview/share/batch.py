@@ -11,6 +11,7 @@ if its actor died; the result is the same set of files a local `krsview render
 Ray starts a local cluster unless given the address of an existing one (``ray://…`` or
 ``auto``). The accuracy bench of many presets runs the same way, one task per preset
 (`krsview bench accuracy P1 P2 … --workers N`)."""
+
 from __future__ import annotations
 
 import contextlib
@@ -20,9 +21,9 @@ import re
 import socket
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 from ..scene import Scene, SceneError
 from .frames import FrameJob, frame_png, write_frame
@@ -30,12 +31,12 @@ from .frames import FrameJob, frame_png, write_frame
 
 @dataclass
 class BatchReport:
-    frames: int = 0              # rendered by this run
-    skipped: int = 0             # already in the folder
-    retried: list[list[int]] = field(default_factory=list)   # chunks that failed once or more
-    failed: list[list[int]] = field(default_factory=list)    # chunks that ran out of retries
-    startup: float = 0.0         # seconds to start Ray and the actors (context + compile)
-    seconds: float = 0.0         # seconds rendering, after start-up
+    frames: int = 0  # rendered by this run
+    skipped: int = 0  # already in the folder
+    retried: list[list[int]] = field(default_factory=list)  # chunks that failed once or more
+    failed: list[list[int]] = field(default_factory=list)  # chunks that ran out of retries
+    startup: float = 0.0  # seconds to start Ray and the actors (context + compile)
+    seconds: float = 0.0  # seconds rendering, after start-up
 
     @property
     def fps(self) -> float:
@@ -47,9 +48,10 @@ class FrameWorker:
 
     def __init__(self, job: FrameJob):
         from ..gpu.renderer import Renderer
+
         self.job = job
         self.renderer = Renderer()
-        self.renderer.prepare(job.frame_scene(0), *job.size)   # compile before timing starts
+        self.renderer.prepare(job.frame_scene(0), *job.size)  # compile before timing starts
 
     def ready(self) -> int:
         return os.getpid()
@@ -69,43 +71,60 @@ def check_address(address: str | None, flag: str = "--address") -> None:
         return
     m = re.fullmatch(r"(ray://)?([^:/\s]+):(\d{1,5})", address)
     if m is None:
-        raise SceneError(flag, address, "expected ray://HOST:PORT (the Ray client), "
-                                        "HOST:PORT (a head node's GCS) or auto")
+        raise SceneError(
+            flag,
+            address,
+            "expected ray://HOST:PORT (the Ray client), HOST:PORT (a head node's GCS) or auto",
+        )
     try:
         socket.create_connection((m.group(2), int(m.group(3))), timeout=5).close()
     except OSError as e:
-        raise SceneError(flag, address, f"cannot reach {m.group(2)}:{m.group(3)}: "
-                                        f"{e.strerror or e}") from None
+        raise SceneError(
+            flag, address, f"cannot reach {m.group(2)}:{m.group(3)}: {e.strerror or e}"
+        ) from None
 
 
 def start_ray(workers: int, address: str | None) -> None:
     """Join ``address``, or start a local cluster with one CPU per worker; each worker's
     llvmpipe gets its share of the cores (on a GPU machine the variable is ignored)."""
     import ray
+
     if ray.is_initialized():
         return
     threads = max(1, (os.cpu_count() or 1) // workers)
     try:
-        ray.init(address=address, num_cpus=None if address else workers,
-                 include_dashboard=False, log_to_driver=False, configure_logging=False,
-                 runtime_env={"env_vars": {"LP_NUM_THREADS": str(threads), "DISPLAY": ""}})
+        ray.init(
+            address=address,
+            num_cpus=None if address else workers,
+            include_dashboard=False,
+            log_to_driver=False,
+            configure_logging=False,
+            runtime_env={"env_vars": {"LP_NUM_THREADS": str(threads), "DISPLAY": ""}},
+        )
     except (ConnectionError, TimeoutError, RuntimeError, ValueError) as e:
         where = address or "a local cluster"
         raise ClusterError(f"Ray at {where}: {str(e).strip().splitlines()[-1]}") from None
 
 
 def chunks_of(frames: list[int], size: int) -> list[list[int]]:
-    return [frames[k:k + size] for k in range(0, len(frames), size)]
+    return [frames[k : k + size] for k in range(0, len(frames), size)]
 
 
-def run_batch(job: FrameJob, frames: range, workers: int = 2, chunk: int = 8,
-              address: str | None = None, retries: int = 2,
-              done: Callable[[int], None] | None = None,
-              worker: type = FrameWorker) -> BatchReport:
+def run_batch(
+    job: FrameJob,
+    frames: range,
+    workers: int = 2,
+    chunk: int = 8,
+    address: str | None = None,
+    retries: int = 2,
+    done: Callable[[int], None] | None = None,
+    worker: type = FrameWorker,
+) -> BatchReport:
     """Render the frames of ``frames`` not yet in ``job.folder`` on ``workers`` Ray actors in
     chunks of ``chunk``; ``done(k)`` after each frame written. ``worker`` is the actor class
     (tests pass one that fails on purpose)."""
     import ray
+
     report = BatchReport()
     todo = job.missing(frames)
     report.skipped = len(frames) - len(todo)
@@ -115,7 +134,7 @@ def run_batch(job: FrameJob, frames: range, workers: int = 2, chunk: int = 8,
     start_ray(workers, address)
     actor = ray.remote(num_cpus=1, max_restarts=0)(worker)
     pool = [actor.remote(job) for _ in range(workers)]
-    actors = list(pool)                                   # every actor started, to stop them
+    actors = list(pool)  # every actor started, to stop them
     ray.get([a.ready.remote() for a in pool])
     report.startup = time.perf_counter() - t0
     t1 = time.perf_counter()
@@ -135,12 +154,12 @@ def run_batch(job: FrameJob, frames: range, workers: int = 2, chunk: int = 8,
                 if done is not None:
                     done(k)
             idle.append(a)
-        except ray.exceptions.RayActorError:          # the actor died: start another
+        except ray.exceptions.RayActorError:  # the actor died: start another
             report.retried.append(frames_)
             actors.append(actor.remote(job))
             idle.append(actors[-1])
             _requeue(queue, report, frames_, attempt, retries)
-        except ray.exceptions.RayTaskError:           # the task raised: the actor lives on
+        except ray.exceptions.RayTaskError:  # the task raised: the actor lives on
             report.retried.append(frames_)
             idle.append(a)
             _requeue(queue, report, frames_, attempt, retries)
@@ -150,37 +169,46 @@ def run_batch(job: FrameJob, frames: range, workers: int = 2, chunk: int = 8,
     return report
 
 
-def _requeue(queue: list, report: BatchReport, frames: list[int], attempt: int,
-             retries: int) -> None:
+def _requeue(
+    queue: list, report: BatchReport, frames: list[int], attempt: int, retries: int
+) -> None:
     if attempt < retries:
         queue.append((frames, attempt + 1))
     else:
         report.failed.append(frames)
 
 
-def accuracy_report(scene: Scene, size: tuple[int, int], rounds: int,
-                    cache: Path | None = None) -> tuple[dict[str, bytes], list[str]]:
+def accuracy_report(
+    scene: Scene, size: tuple[int, int], rounds: int, cache: Path | None = None
+) -> tuple[dict[str, bytes], list[str]]:
     """One preset's `bench accuracy` (bench/accuracy.py) in a scratch folder: its files as
     bytes, so the driver writes them wherever it likes, and the report's verdict. ``cache``:
     the ground-truth cache on the worker's machine (None: its default)."""
     from ..bench.accuracy import bench_accuracy, verdict
+
     with tempfile.TemporaryDirectory() as d:
-        with contextlib.redirect_stdout(io.StringIO()):     # the report is in the files
+        with contextlib.redirect_stdout(io.StringIO()):  # the report is in the files
             rows = bench_accuracy(scene, size, Path(d), rounds, cache)
-        files = {str(p.relative_to(d)): p.read_bytes() for p in Path(d).rglob("*")
-                 if p.is_file()}
+        files = {str(p.relative_to(d)): p.read_bytes() for p in Path(d).rglob("*") if p.is_file()}
     return files, verdict(rows)
 
 
-def run_accuracy_sweep(scenes: dict[str, Scene], size: tuple[int, int], rounds: int,
-                       outs: dict[str, Path], workers: int, address: str | None,
-                       done: Callable[[str, list[str] | None, str], None],
-                       cache: Path | None = None) -> list[str]:
+def run_accuracy_sweep(
+    scenes: dict[str, Scene],
+    size: tuple[int, int],
+    rounds: int,
+    outs: dict[str, Path],
+    workers: int,
+    address: str | None,
+    done: Callable[[str, list[str] | None, str], None],
+    cache: Path | None = None,
+) -> list[str]:
     """The accuracy bench of every scene as one Ray task each (retried if its worker dies);
     each report is written to ``outs[name]`` as it arrives and ``done(name, verdict, error)``
     called. Returns the names that failed. Time ratios are measured within each task, side
     by side; tasks sharing one machine's cores inflate absolute times, not the ratios' sense."""
     import ray
+
     start_ray(workers, address)
     task = ray.remote(num_cpus=1, max_retries=2)(accuracy_report)
     running = {task.remote(scene, size, rounds, cache): name for name, scene in scenes.items()}

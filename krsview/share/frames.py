@@ -2,13 +2,14 @@
 each worker of ``krsview batch`` do. Frame k is ``frame_00042.png`` in the output folder,
 written atomically, so a folder holds only whole frames; a run skips the frames already
 there, which makes an interrupted run resumable and lets chunks be rendered anywhere."""
+
 from __future__ import annotations
 
 import io
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
 
 from PIL import Image
 
@@ -27,6 +28,7 @@ def frame_file(folder: Path, k: int) -> Path:
 class FrameJob:
     """Everything a renderer needs for frames of one path: plain data, so it can be sent
     to another process or machine (``krsview batch``)."""
+
     scene: Scene
     path: CameraPath
     fps: float
@@ -53,15 +55,22 @@ def parse_frames(text: str | None, count: int, flag: str = "--frames") -> range:
         a, _, b = text.partition("-")
         lo, hi = int(a), int(b) if b else int(a)
     except ValueError:
-        raise SceneError(flag, text, "expected FIRST-LAST or one frame number, e.g. 0-119")
+        raise SceneError(
+            flag, text, "expected FIRST-LAST or one frame number, e.g. 0-119"
+        ) from None
     if not 0 <= lo <= hi < count:
-        raise SceneError(flag, text, f"the path has frames 0-{count - 1} at this frame rate; "
-                                     "allowed 0 ≤ FIRST ≤ LAST ≤ " + str(count - 1))
+        raise SceneError(
+            flag,
+            text,
+            f"the path has frames 0-{count - 1} at this frame rate; "
+            "allowed 0 ≤ FIRST ≤ LAST ≤ " + str(count - 1),
+        )
     return range(lo, hi + 1)
 
 
-def render_frames(job: FrameJob, frames: list[int], renderer,
-                  done: Callable[[int], None] | None = None) -> None:
+def render_frames(
+    job: FrameJob, frames: list[int], renderer, done: Callable[[int], None] | None = None
+) -> None:
     """Render ``frames`` of ``job`` with ``renderer`` (a gpu Renderer) into its folder;
     ``done(k)`` after each."""
     for k in frames:
@@ -84,18 +93,26 @@ def write_frame(folder: Path, k: int, png: bytes) -> None:
     write_atomic(frame_file(folder, k), png)
 
 
-def write_video(folder: Path, frames: range, fps: float, video: Path,
-                done: Callable[[int], None] | None = None) -> None:
+def write_video(
+    folder: Path, frames: range, fps: float, video: Path, done: Callable[[int], None] | None = None
+) -> None:
     """An H.264 MP4 of the frames' PNGs (imageio-ffmpeg ships its own ffmpeg), written to a
     temporary file first so a failed run leaves no half video."""
     import imageio.v3 as iio
     import imageio_ffmpeg
+
     first = iio.imread(frame_file(folder, frames[0]))
     h, w = first.shape[:2]
     tmp = video.with_name(f".{video.name}.tmp{video.suffix}")
-    writer = imageio_ffmpeg.write_frames(str(tmp), (w, h), fps=fps, codec="libx264",
-                                         pix_fmt_out="yuv420p", macro_block_size=1,
-                                         quality=8)
+    writer = imageio_ffmpeg.write_frames(
+        str(tmp),
+        (w, h),
+        fps=fps,
+        codec="libx264",
+        pix_fmt_out="yuv420p",
+        macro_block_size=1,
+        quality=8,
+    )
     writer.send(None)
     try:
         for k in frames:

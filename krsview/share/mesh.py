@@ -5,12 +5,13 @@ ball the reference certifies free of the surface (outside, or inside one kernel 
 down to bricks of BRICK³ voxels; each remaining brick's corners are sampled densely and
 marching cubes (scikit-image) extracts its piece. Pieces meet on shared brick faces with the
 same corner values, so merging their vertices closes the mesh. trimesh writes the file."""
+
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -18,19 +19,19 @@ from ..reference.distortion import Distortion
 from ..reference.geometry import compile_geometry, nearest, scene_ball, surface_field
 from ..scene import Scene, SceneError
 
-BRICK = 16                  # voxels per brick side: one marching-cubes call each
-FORMATS = (".glb", ".ply", ".stl", ".obj")   # what trimesh writes
-BATCH = 1 << 18             # points per reference call (memory stays flat)
-REFINE_STEPS = 8            # bisections per vertex along its grid edge: within h / 256
+BRICK = 16  # voxels per brick side: one marching-cubes call each
+FORMATS = (".glb", ".ply", ".stl", ".obj")  # what trimesh writes
+BATCH = 1 << 18  # points per reference call (memory stays flat)
+REFINE_STEPS = 8  # bisections per vertex along its grid edge: within h / 256
 
 
 @dataclass
 class MeshStats:
-    resolution: int         # voxels along the box's side
-    lod: float              # the level set meshed, in voxels (0: the surface)
-    voxel: float            # their size, scene units
-    bricks: int             # bricks sampled (of resolution³ / BRICK³)
-    samples: int            # reference evaluations, octree tests included
+    resolution: int  # voxels along the box's side
+    lod: float  # the level set meshed, in voxels (0: the surface)
+    voxel: float  # their size, scene units
+    bricks: int  # bricks sampled (of resolution³ / BRICK³)
+    samples: int  # reference evaluations, octree tests included
     triangles: int
     seconds: float
     watertight: bool
@@ -45,15 +46,24 @@ def box_of(scene: Scene, c, box: tuple[float, ...] | None) -> tuple[np.ndarray, 
         return (lo + hi) / 2 - side / 2, side
     ball = scene_ball(c)
     if ball is None:
-        raise SceneError("geometry", scene.name, "is unbounded (a ground plane, or a MöKRS "
-                         "whose outer bound is not a ball): give the region to mesh with "
-                         "--box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX")
-    pad = 1.02 * ball[3]    # a margin, so the surface never touches the cube's faces
+        raise SceneError(
+            "geometry",
+            scene.name,
+            "is unbounded (a ground plane, or a MöKRS "
+            "whose outer bound is not a ball): give the region to mesh with "
+            "--box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
+        )
+    pad = 1.02 * ball[3]  # a margin, so the surface never touches the cube's faces
     return ball[:3] - pad, 2 * pad
 
 
-def build_mesh(scene: Scene, resolution: int, box: tuple[float, ...] | None = None,
-               lod: float = 0.0, progress: Callable[[int, int], None] | None = None):
+def build_mesh(
+    scene: Scene,
+    resolution: int,
+    box: tuple[float, ...] | None = None,
+    lod: float = 0.0,
+    progress: Callable[[int, int], None] | None = None,
+):
     """The mesh (a trimesh.Trimesh with vertex colours from the nearest kernel's albedo) and
     its MeshStats. ``resolution`` voxels along the sampled cube's side, rounded up to a
     multiple of BRICK. ``lod`` > 0 meshes the level set at lod voxels instead of the surface
@@ -61,6 +71,7 @@ def build_mesh(scene: Scene, resolution: int, box: tuple[float, ...] | None = No
     about one instead of vanishing between samples)."""
     import trimesh
     from skimage.measure import marching_cubes
+
     t0 = time.perf_counter()
     geometry = scene.geometry()
     c = compile_geometry(geometry, scene.material.albedo)
@@ -73,7 +84,7 @@ def build_mesh(scene: Scene, resolution: int, box: tuple[float, ...] | None = No
     iso = lod * h
     samples = 0
     # octree: keep boxes whose ball may hold surface, split them, down to bricks
-    boxes, size = np.zeros((1, 3), dtype=np.int64), bricks_per_side   # in bricks
+    boxes, size = np.zeros((1, 3), dtype=np.int64), bricks_per_side  # in bricks
     while True:
         centers = lo + (boxes + size / 2) * BRICK * h
         radius = np.full(len(boxes), math.sqrt(3) / 2 * size * BRICK * h + h + iso)
@@ -89,16 +100,17 @@ def build_mesh(scene: Scene, resolution: int, box: tuple[float, ...] | None = No
     grid = np.stack(np.meshgrid(*[np.arange(BRICK + 1)] * 3, indexing="ij"), -1).reshape(-1, 3)
     per_call = max(1, BATCH // len(grid))
     for k0 in range(0, len(boxes), per_call):
-        chunk = boxes[k0:k0 + per_call]
+        chunk = boxes[k0 : k0 + per_call]
         corners = (chunk[:, None, :] * BRICK + grid[None]).reshape(-1, 3)
         field = value(lo + corners * h).reshape(len(chunk), BRICK + 1, BRICK + 1, BRICK + 1) - iso
         samples += len(corners)
         for b, vol in zip(chunk, field):
             if not (vol.min() < 0.0 < vol.max()):
                 continue
-            v, f, _, _ = marching_cubes(vol, 0.0, gradient_direction="descent",
-                                        allow_degenerate=False)
-            verts.append(b * BRICK + v)        # grid units: shared faces agree exactly
+            v, f, _, _ = marching_cubes(
+                vol, 0.0, gradient_direction="descent", allow_degenerate=False
+            )
+            verts.append(b * BRICK + v)  # grid units: shared faces agree exactly
             faces.append(f + count)
             count += len(v)
         if progress is not None:
@@ -107,24 +119,33 @@ def build_mesh(scene: Scene, resolution: int, box: tuple[float, ...] | None = No
         raise SceneError("geometry", scene.name, "no surface inside the region sampled")
     grid_verts, index = np.unique(np.concatenate(verts), axis=0, return_inverse=True)
     faces = index.reshape(-1)[np.concatenate(faces)]
-    faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
-                  & (faces[:, 2] != faces[:, 0])]
+    faces = faces[
+        (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])
+    ]
     positions = lo + refine(grid_verts, lambda g: value(lo + g * h) - iso) * h
     samples += REFINE_STEPS * len(grid_verts)
     mesh = trimesh.Trimesh(positions, faces, process=False)
     level, _, _ = nearest(c, np.asarray(mesh.vertices), None, dist)
     albedo = np.clip(c.records[level, 0, :3], 0.0, 1.0) ** (1 / 2.2)
     mesh.visual.vertex_colors = np.concatenate(
-        [np.round(albedo * 255), np.full((len(albedo), 1), 255)], axis=1).astype(np.uint8)
-    stats = MeshStats(n, lod, h, len(boxes), samples, len(mesh.faces),
-                      time.perf_counter() - t0, bool(mesh.is_watertight))
+        [np.round(albedo * 255), np.full((len(albedo), 1), 255)], axis=1
+    ).astype(np.uint8)
+    stats = MeshStats(
+        n,
+        lod,
+        h,
+        len(boxes),
+        samples,
+        len(mesh.faces),
+        time.perf_counter() - t0,
+        bool(mesh.is_watertight),
+    )
     return mesh, stats
 
 
 def _batched(f: Callable, *xs: np.ndarray) -> np.ndarray:
     """f over the rows of ``xs`` (at least one) in slices of BATCH rows: memory stays flat."""
-    return np.concatenate([f(*(x[k:k + BATCH] for x in xs))
-                           for k in range(0, len(xs[0]), BATCH)])
+    return np.concatenate([f(*(x[k : k + BATCH] for x in xs)) for k in range(0, len(xs[0]), BATCH)])
 
 
 def refine(g: np.ndarray, f: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
@@ -149,7 +170,7 @@ def refine(g: np.ndarray, f: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     for _ in range(REFINE_STEPS):
         m = (a + b) / 2
         fm = _batched(f, m)
-        same = (fm < 0) == (fa < 0)           # the sign change lies in [m, b]
+        same = (fm < 0) == (fa < 0)  # the sign change lies in [m, b]
         a = np.where(same[:, None], m, a)
         fa = np.where(same, fm, fa)
         b = np.where(same[:, None], b, m)

@@ -9,6 +9,7 @@ Shadertoy file is one ``mainImage``.
 What cannot be exported: double precision (GLSL ES has no fp64). The compute path and the
 pre-pass are speed-ups of the desktop renderer (a storage buffer, float render targets): the
 page traces every pixel in one fragment pass, the same surfaces."""
+
 from __future__ import annotations
 
 import html
@@ -28,9 +29,16 @@ from ..scene import Scene, SceneError
 from ..scene.camera_path import horizontal_axes
 
 # Set per pixel by orbit_camera (web.frag): declared as plain globals.
-CAMERA = ("u_eye_shift", "u_forward", "u_right", "u_up", "u_resolution", "u_footprint",
-          "u_eps_per_t")
-PAGE = ("u_orbit", "u_canvas")   # the page's own uniforms (Shadertoy has iMouse instead)
+CAMERA = (
+    "u_eye_shift",
+    "u_forward",
+    "u_right",
+    "u_up",
+    "u_resolution",
+    "u_footprint",
+    "u_eps_per_t",
+)
+PAGE = ("u_orbit", "u_canvas")  # the page's own uniforms (Shadertoy has iMouse instead)
 _UNIFORM = re.compile(r"^\s*uniform\s+(\w+)\s+(\w+)\s*(\[\s*(\w+)\s*\])?\s*;.*$", re.M)
 _BLOCK = re.compile(r"layout\(std140\) uniform KRSBlock \{.*?\};", re.S)
 _REAL = {"real": "float", "vec2r": "vec2", "vec3r": "vec3", "vec4r": "vec4", "mat3r": "mat3"}
@@ -41,16 +49,24 @@ def export_notes(scene: Scene) -> list[str]:
     is a SceneError naming the field."""
     r = scene.render
     if r.precision == "double":
-        raise SceneError("render.precision", "double", 'a web page or Shadertoy cannot draw '
-                         'it: GLSL ES 3.00 (WebGL2) has no fp64; export with precision = '
-                         '"float"')
+        raise SceneError(
+            "render.precision",
+            "double",
+            "a web page or Shadertoy cannot draw "
+            "it: GLSL ES 3.00 (WebGL2) has no fp64; export with precision = "
+            '"float"',
+        )
     notes = []
     if r.path == "compute":
-        notes.append("render.path = \"compute\": the page traces in one fragment pass "
-                     "(WebGL2 has no compute shaders; the same image)")
+        notes.append(
+            'render.path = "compute": the page traces in one fragment pass '
+            "(WebGL2 has no compute shaders; the same image)"
+        )
     if r.prepass:
-        notes.append(f"render.prepass = {r.prepass}: the page traces without the pre-pass "
-                     "(the same surfaces, a slower frame)")
+        notes.append(
+            f"render.prepass = {r.prepass}: the page traces without the pre-pass "
+            "(the same surfaces, a slower frame)"
+        )
     return notes
 
 
@@ -59,18 +75,22 @@ def web_shader(scene: Scene, shadertoy: bool = False) -> str:
     adds the version, precision and its uniforms)."""
     export_notes(scene)
     scene = replace(scene, render=replace(scene.render, prepass=0, path="fragment"))
-    view = view_of(scene.camera, 640, 360)   # only its eye O matters: the rest is live
+    view = view_of(scene.camera, 640, 360)  # only its eye O matters: the rest is live
     c = compile_geometry(scene.geometry(), scene.material.albedo).relative_to(view.origin)
     defines = variant_defines(scene, c)
-    defines["KRS_SLOTS"] = len(c.records)                  # the slots in use, no more
+    defines["KRS_SLOTS"] = len(c.records)  # the slots in use, no more
     if shadertoy:
         defines["KRS_SHADERTOY"] = None
     text = Source("web.frag", defines, header=() if shadertoy else ES_HEADER).text
-    values = {**view_uniforms(scene, view, c), **orbit_uniforms(scene, view.origin),
-              "u_epsilon_scale": scene.render.epsilon_scale}
+    values = {
+        **view_uniforms(scene, view, c),
+        **orbit_uniforms(scene, view.origin),
+        "u_epsilon_scale": scene.render.epsilon_scale,
+    }
     blocks = block_arrays(c, "float", len(c.records))
-    text = _BLOCK.sub(lambda m: "\n".join(const_array("vec4", k, v) for k, v in blocks.items()),
-                      text)
+    text = _BLOCK.sub(
+        lambda m: "\n".join(const_array("vec4", k, v) for k, v in blocks.items()), text
+    )
     return _UNIFORM.sub(lambda m: _bake(m, values, shadertoy), text)
 
 
@@ -83,11 +103,17 @@ def orbit_uniforms(scene: Scene, origin: np.ndarray) -> dict[str, object]:
     east, north = horizontal_axes(up)
     target = np.array(cam.target, dtype=np.float64) - origin
     away = -target / np.linalg.norm(target)
-    return {"u_orbit_target": tuple(target), "u_orbit_east": tuple(east),
-            "u_orbit_north": tuple(north), "u_orbit_up": tuple(up),
-            "u_orbit_start": (math.atan2(away @ east, away @ north),
-                              math.asin(max(-1.0, min(1.0, away @ up))),
-                              float(np.linalg.norm(target)))}
+    return {
+        "u_orbit_target": tuple(target),
+        "u_orbit_east": tuple(east),
+        "u_orbit_north": tuple(north),
+        "u_orbit_up": tuple(up),
+        "u_orbit_start": (
+            math.atan2(away @ east, away @ north),
+            math.asin(max(-1.0, min(1.0, away @ up))),
+            float(np.linalg.norm(target)),
+        ),
+    }
 
 
 def _bake(m: re.Match, values: dict, shadertoy: bool) -> str:
@@ -135,19 +161,22 @@ def html_page(scene: Scene) -> str:
     """One self-contained page: canvas, the two shaders, and a few lines of WebGL2."""
     template = resources.files("krsview.share").joinpath("page.html").read_text("utf-8")
     notes = export_notes(scene)
-    return (template
-            .replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
-            .replace("{{NOTES}}", html.escape(" · ".join(notes)))
-            .replace("{{VERTEX}}", json.dumps(vertex_shader()))
-            .replace("{{FRAGMENT}}", json.dumps(web_shader(scene))))
+    return (
+        template.replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
+        .replace("{{NOTES}}", html.escape(" · ".join(notes)))
+        .replace("{{VERTEX}}", json.dumps(vertex_shader()))
+        .replace("{{FRAGMENT}}", json.dumps(web_shader(scene)))
+    )
 
 
 def shadertoy_source(scene: Scene) -> str:
     """The scene as one Shadertoy ``mainImage``: drag the mouse to orbit (x: around, y: up
     and down), and the view turns slowly with time."""
-    head = (f"// krsview — {scene.name}: a Kernel–Reflection Sequence scene exported by "
-            "`krsview export shadertoy` [KRS17].\n// Drag to orbit; the view turns slowly "
-            "with time.\n")
+    head = (
+        f"// krsview — {scene.name}: a Kernel–Reflection Sequence scene exported by "
+        "`krsview export shadertoy` [KRS17].\n// Drag to orbit; the view turns slowly "
+        "with time.\n"
+    )
     notes = "".join(f"// note: {n}\n" for n in export_notes(scene))
     body = web_shader(scene, shadertoy=True)
     return head + notes + body + SHADERTOY_MAIN
