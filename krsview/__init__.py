@@ -1,3 +1,5 @@
 """krsview: real-time viewer, editor and benchmark for Kernel–Reflection Sequences [KRS17]."""
 
-__version__ = "0.1.0"
+from .version import __version__
+
+__all__ = ["__version__"]

@@ -16,7 +16,7 @@ import pytest
 from krsview.bench import metrics
 from krsview.bench.metrics import Agreement
 from krsview.buffers import Buffers
-from krsview.presets import PRESET_DIR
+from krsview.scene.presets import PRESET_DIR
 
 TEST_OUTPUT = Path(__file__).resolve().parent.parent / "test-output"
 

@@ -14,10 +14,10 @@ import pytest
 from krsview.bench.accuracy import pareto, settings
 from krsview.bench.metrics import compare
 from krsview.bench.truth import cache_key, ground_truth
-from krsview.presets import resolve
+from krsview.compile.camera import view_of
 from krsview.reference import render_reference
-from krsview.reference.camera import view_of
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
 
 W, H = 48, 27
 

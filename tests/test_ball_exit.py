@@ -14,12 +14,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from krsview.compile.geometry import compile_geometry
+from krsview.compile.krs import compile_krs
 from krsview.gpu.renderer import Renderer
 from krsview.gpu.uniforms import variant_defines
-from krsview.presets import resolve
-from krsview.reference.compiled import compile_krs
-from krsview.reference.geometry import compile_geometry
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
 
 from .conftest import broken_shaders
 from .test_distance_bound import ALBEDO, arbitrary_krs, brute_force_distance

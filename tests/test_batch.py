@@ -15,9 +15,9 @@ import pytest
 import ray
 from PIL import Image
 
-from krsview.presets import resolve
 from krsview.scene import load_scene
 from krsview.scene.camera_path import load_camera_path
+from krsview.scene.presets import resolve
 from krsview.share.batch import FrameWorker, run_batch
 from krsview.share.frames import FrameJob, frame_file, render_frames
 

@@ -232,9 +232,9 @@ def test_every_complete_scene_in_the_readme_renders_something(renderer):
 def test_progress_reporting_does_not_change_the_image(renderer, monkeypatch):
     """Slow renders show progress: the reference in chunks of rays, the GPU's first frame in
     bands of rows; the pixels are the same as in one piece, and progress reaches the end."""
-    from krsview.presets import resolve
     from krsview.reference import render as reference_render
     from krsview.scene import load_scene
+    from krsview.scene.presets import resolve
 
     scene = load_scene(resolve("sierpinski"))
     monkeypatch.setattr(reference_render, "PROGRESS_CHUNK", 100)

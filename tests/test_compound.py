@@ -13,10 +13,11 @@ from hypothesis import strategies as st
 
 from krsview.bench.metrics import HIT_AGREEMENT
 from krsview.buffers import Buffers
+from krsview.compile.geometry import compile_geometry
+from krsview.compile.krs import compile_krs
 from krsview.gpu.program import Source
 from krsview.gpu.uniforms import variant_defines
-from krsview.reference import compile_krs, distance, render_reference
-from krsview.reference.geometry import compile_geometry
+from krsview.reference import distance, render_reference
 from krsview.scene import (
     Compound,
     EffectSettings,

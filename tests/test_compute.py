@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from krsview.gpu.renderer import Renderer
-from krsview.presets import preset_names, resolve
 from krsview.scene import load_scene
 from krsview.scene.model import VIEW_PREPASS
+from krsview.scene.presets import preset_names, resolve
 
 from .conftest import broken_shaders
 
@@ -115,8 +115,8 @@ def test_shadow_rays_traced_as_tasks_shade_the_same_image(renderer, name, effect
         "fragment",
         tracer=tracer,
     )
+    from krsview.compile.geometry import compile_geometry
     from krsview.gpu.uniforms import variant_defines
-    from krsview.reference.geometry import compile_geometry
 
     c = compile_geometry(scene.geometry(), scene.material.albedo)
     assert "KRS_SHADOW_TASKS" in variant_defines(on_path(scene, "compute"), c)
@@ -150,8 +150,8 @@ def test_a_task_per_component_keeps_every_hit(renderer, tracer, prepass):
     same point whether or not the others are interleaved with it, so colour, depth, normal
     and hits equal the fragment path's; the tasks do more work (the others run on past the
     nearest hit), and the iterations are their sum."""
+    from krsview.compile.geometry import compile_geometry
     from krsview.gpu.uniforms import variant_defines
-    from krsview.reference.geometry import compile_geometry
 
     scene = on_path(load_scene(resolve("grove")), "fragment", tracer=tracer, prepass=prepass)
     tasks = on_path(scene, "compute", steps=4, component_tasks="on")

@@ -8,10 +8,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.presets import resolve
+from krsview.compile.krs import compile_krs, krs_bounds
 from krsview.reference import krs
-from krsview.reference.compiled import compile_krs, krs_bounds
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
 
 
 def points(scene, n=3000, seed=0):
@@ -33,7 +33,7 @@ def test_every_culling_ball_holds_what_it_claims():
     """C_i holds the expansion of levels ≤ i: brute force over every copy of every kernel's
     bounding ball (kernel_ball, tested against sampled arcs in test_mokrs) under the
     reflection products R_i^b_i ⋯ R_j^b_j, on a 12-level tree and the rock."""
-    from krsview.reference.compiled import kernel_ball
+    from krsview.compile.krs import kernel_ball
 
     for name, levels in (("tree", 12), ("rock", None)):
         g = load_scene(resolve(name)).geometry()

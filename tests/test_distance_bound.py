@@ -17,7 +17,8 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from krsview.reference import compile_krs, distance
+from krsview.compile.krs import compile_krs
+from krsview.reference import distance
 from krsview.reference.kernels import kernel_distance
 from krsview.scene import KRS, Capsule, Empty, Level, Mirror, Plane, Sphere, ToroidalCapsule
 

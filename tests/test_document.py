@@ -11,10 +11,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from krsview.editor.document import AUTOSAVE_SECONDS, ConflictError, Document
-from krsview.presets import resolve
+from krsview.document.document import AUTOSAVE_SECONDS, ConflictError, Document
 from krsview.scene import SceneError, load_scene, save_scene
 from krsview.scene.edits import get_at, path_text
+from krsview.scene.presets import resolve
 
 
 @pytest.fixture

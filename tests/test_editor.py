@@ -16,9 +16,9 @@ import time
 import numpy as np
 import pytest
 
-from krsview.app.commands import Do, Edit
-from krsview.presets import resolve
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
+from krsview.viewer.commands import Do, Edit
 
 from .conftest import headless_render
 
@@ -28,7 +28,7 @@ LEVEL = 19  # a fork near the top of the shipped tree, clear of the panels
 
 @pytest.fixture
 def editor(display, tmp_path):
-    from krsview.editor.app import Editor
+    from krsview.editor.window import Editor
 
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
@@ -62,7 +62,7 @@ def xdo(*args) -> None:
 def screen_of(e, world) -> tuple[float, float]:
     import glfw
 
-    from krsview.reference.camera import project
+    from krsview.compile.camera import project
 
     x, y, z = project(e.window_view(), np.asarray(world))
     assert z > 0
@@ -221,7 +221,7 @@ def test_killed_mid_edit_the_reopened_editor_offers_the_recovery(display, tmp_pa
     assert r.returncode == -signal.SIGKILL, r.stderr
     assert load_scene(path).tree is not None, "the killed editor saved the scene"
     assert path.with_name(path.name + ".recovery").exists(), "no autosave before the kill"
-    from krsview.editor.app import Editor
+    from krsview.editor.window import Editor
 
     e = Editor(path, size=(320, 200))
     try:
@@ -311,8 +311,8 @@ def test_opening_another_scene_with_unsaved_edits_asks_first(editor):
 def test_the_editor_opens_every_kind_of_scene(display, tmp_path, preset, entries):
     """A KRS shows its levels, a compound its components, a MöKRS no handles (and says so);
     the panels draw without an error."""
-    from krsview.editor.app import Editor
     from krsview.editor.handles import outline
+    from krsview.editor.window import Editor
 
     path = tmp_path / f"{preset}.toml"
     shutil.copy(resolve(preset), path)

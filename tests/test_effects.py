@@ -10,13 +10,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from krsview.compile.geometry import compile_geometry
+from krsview.compile.krs import compile_krs
 from krsview.gpu.program import SHADER_DIR, Source
 from krsview.gpu.renderer import read_buffers
 from krsview.gpu.uniforms import variant_defines
-from krsview.presets import resolve
-from krsview.reference import compile_krs, distance, render_reference
+from krsview.reference import distance, render_reference
 from krsview.reference.distortion import Distortion
-from krsview.reference.geometry import compile_geometry, scene_distance
+from krsview.reference.geometry import scene_distance
 from krsview.scene import (
     EFFECTS,
     KRS,
@@ -27,6 +28,7 @@ from krsview.scene import (
     load_scene,
     scene_from_toml,
 )
+from krsview.scene.presets import resolve
 
 from .conftest import assert_finite, check_against_reference
 from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from krsview.presets import resolve
 from krsview.scene import Camera, SceneError, load_scene
 from krsview.scene.camera_path import CameraPath, Pose, load_camera_path
+from krsview.scene.presets import resolve
 from krsview.share.frames import FrameJob, frame_file, parse_frames, render_frames
 
 from .conftest import headless_render

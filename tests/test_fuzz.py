@@ -19,8 +19,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from krsview.cli import main
-from krsview.presets import PRESET_DIR
 from krsview.scene import SceneError, load_scene, scene_from_toml
+from krsview.scene.presets import PRESET_DIR
 from krsview.scene.toml_writer import dumps
 
 FULL = os.environ.get("KRSVIEW_FUZZ") == "full"

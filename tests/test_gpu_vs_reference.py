@@ -7,8 +7,8 @@ from dataclasses import replace
 import pytest
 
 from krsview.bench.metrics import gpu_reference_agreement
+from krsview.compile.camera import view_of
 from krsview.reference import render_reference
-from krsview.reference.camera import view_of
 from krsview.scene import load_scene
 
 from .conftest import assert_finite, check_against_reference, preset_paths
@@ -58,7 +58,7 @@ def test_a_deliberately_broken_shader_fails_the_comparison(tmp_path, broken):
 
     from krsview.gpu.program import SHADER_DIR
     from krsview.gpu.renderer import Renderer
-    from krsview.presets import resolve
+    from krsview.scene.presets import resolve
 
     from .conftest import agreement, failures
 

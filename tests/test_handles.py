@@ -10,11 +10,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.editor.app import _snap_direction
 from krsview.editor.handles import handles, outline, polyline
-from krsview.presets import resolve
+from krsview.editor.window import _snap_direction
 from krsview.scene import SceneError, load_scene
 from krsview.scene.edits import apply_edit
+from krsview.scene.presets import resolve
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +55,7 @@ def test_a_dragged_fork_carries_its_subtree_rigidly(route_scene):
     """Every finer kernel moves by the drag, every finer mirror keeps its normal and passes
     through its moved fork: the subtree is the same geometry, translated (checked on the
     expanded KRS with the reference distance), and the crown stays attached."""
-    from krsview.reference.compiled import compile_krs
+    from krsview.compile.krs import compile_krs
     from krsview.reference.krs import distance
     from krsview.scene import KRS
 

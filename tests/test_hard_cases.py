@@ -157,8 +157,8 @@ def test_double_precision_follows_the_reference_where_float_cannot(renderer, nam
 
 
 def test_double_precision_uploads_the_geometry_in_float64():
+    from krsview.compile.geometry import compile_geometry
     from krsview.gpu.uniforms import krs_block
-    from krsview.reference.geometry import compile_geometry
 
     s = hard_cases.preset("tree")
     c = compile_geometry(s.geometry(), s.material.albedo)
@@ -199,7 +199,7 @@ def test_a_twisted_ground_plane_stays_a_plane(monkeypatch):
 
 
 def test_control_on_chord_really_degenerates_to_a_capsule():
-    from krsview.reference.compiled import compile_krs
+    from krsview.compile.krs import compile_krs
 
     types = compile_krs(CASES["control-on-chord"].build().geometry(), (1.0, 1.0, 1.0)).types
     assert types[-1] == "capsule" and types[-2] == "toroidal_capsule"

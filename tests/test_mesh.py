@@ -14,10 +14,11 @@ import pytest
 import trimesh
 from skimage.measure import marching_cubes
 
-from krsview.presets import resolve
-from krsview.reference.geometry import compile_geometry, scene_distance
+from krsview.compile.geometry import compile_geometry
+from krsview.reference.geometry import scene_distance
 from krsview.reference.mokrs import distance_estimate
 from krsview.scene import KRS, Empty, Level, Mirror, Sphere, load_scene
+from krsview.scene.presets import resolve
 from krsview.share.mesh import BRICK, REFINE_STEPS, box_of, build_mesh
 
 BASE = load_scene(resolve("tree"))

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from krsview.algebra import mobius
-from krsview.presets import resolve
+from krsview.compile.camera import primary_rays, view_of
 from krsview.reference import render_reference
-from krsview.reference.camera import primary_rays, view_of
 from krsview.scene import Camera, SceneError, load_scene, scene_from_toml, scene_to_toml
 from krsview.scene.mokrs import mokrs_of
+from krsview.scene.presets import resolve
 from krsview.scene.toml_writer import dumps
 
 from .conftest import assert_finite, check_against_reference
@@ -238,7 +238,7 @@ def expand_spheres(m, upto: int) -> tuple[np.ndarray, np.ndarray]:
 def test_level_bounds_hold_every_instance_below(preset, levels):
     """Each level's bounding ball (reference/mokrs.py) holds the brute-force expansion of that
     level and all below it, in the level's own space."""
-    from krsview.reference.mokrs import level_bounds
+    from krsview.compile.mokrs import level_bounds
 
     m = load_scene(resolve(preset)).mokrs
     m = m.truncated(levels)
@@ -253,7 +253,7 @@ def test_level_bounds_hold_every_instance_below(preset, levels):
 
 
 def test_arc_bound_holds_the_arc():
-    from krsview.reference.mokrs import kernel_ball
+    from krsview.compile.krs import kernel_ball
     from krsview.scene.model import ToroidalCapsule, arc_of
 
     rng = np.random.default_rng(3)
@@ -274,7 +274,8 @@ def test_rays_passing_a_pole_in_empty_space_are_not_stopped(renderer):
     so rays within a fraction of ε of `inversion`'s pole (24.8 units from every sphere, by
     brute force) stopped in empty space. With the level bounds they pass, on the reference and
     the GPU; the negative control (Alg. 3's rule) still stops some."""
-    from krsview.reference.mokrs import compile_mokrs, is_unbounding
+    from krsview.compile.mokrs import compile_mokrs
+    from krsview.reference.mokrs import is_unbounding
     from krsview.reference.trace import binary_trace
 
     scene = load_scene(resolve("inversion"))

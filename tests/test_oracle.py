@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from flint import arb, ctx
 
+from krsview.compile.geometry import compile_geometry
 from krsview.oracle.certify import count_errors, free_boxes, surfaces_before
 from krsview.oracle.distance import on_segments, value
-from krsview.presets import resolve
-from krsview.reference.geometry import compile_geometry
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
 
 ctx.prec = 200
 
@@ -128,7 +128,7 @@ def enclosures_contain_arb(c, origin, starts, dirs, a, b, arithmetic, samples=4,
     lo, hi = d.range()
     if narrow:  # negative control: the affine form without its error term
         lo, hi = d.x0 - np.abs(d.x1), d.x0 + np.abs(d.x1)
-    from krsview.reference.mokrs import CompiledMoKRS
+    from krsview.compile.mokrs import CompiledMoKRS
 
     exact = arb_mokrs if isinstance(c, CompiledMoKRS) else arb_distance
     outside = 0
@@ -229,8 +229,8 @@ def test_counts_on_a_traced_image(renderer):
 def signs_hold(c, origin, starts, dirs, a, b, arithmetic, lod, samples=3, numeric=True):
     """Count samples whose arb value breaks what the walk with balls certifies: v ≥ lower
     (only its sign for a MöKRS, whose balls live in scaled frames) and v ≤ hi."""
+    from krsview.compile.mokrs import CompiledMoKRS
     from krsview.oracle.distance import bounds
-    from krsview.reference.mokrs import CompiledMoKRS
 
     pts = origin + starts
     with np.errstate(all="ignore"):
@@ -306,7 +306,7 @@ def test_a_ray_through_a_pole_is_decided():
     unbounded there, but the level's bound mapped out by H⁻¹ lies clear of the pole, so the
     ray is certified (before: undecided, NaN)."""
     from krsview.bench.hard_cases import CASES
-    from krsview.reference.camera import primary_rays, view_of
+    from krsview.compile.camera import primary_rays, view_of
 
     s = CASES["mobius-pole-in-view"].build()
     c = compile_geometry(s.geometry(), s.material.albedo)

@@ -12,11 +12,11 @@ import pytest
 
 from krsview.bench.hard_cases import CASES
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
+from krsview.compile.camera import view_of
 from krsview.gpu.renderer import Renderer
 from krsview.oracle.certify import count_errors
-from krsview.presets import preset_names, resolve
-from krsview.reference.camera import view_of
 from krsview.scene import load_scene
+from krsview.scene.presets import preset_names, resolve
 
 from .conftest import broken_shaders
 

@@ -9,10 +9,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.presets import resolve
-from krsview.reference import compile_krs, distance, render_reference
+from krsview.compile.krs import compile_krs
+from krsview.reference import distance, render_reference
 from krsview.reference.trace import relaxed_trace
 from krsview.scene import SceneError, load_scene, scene_from_toml
+from krsview.scene.presets import resolve
 
 from .conftest import check_against_reference
 from .test_distance_bound import brute_force_distance, clipped_samples, separated_krs, unit

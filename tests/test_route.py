@@ -10,8 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from krsview.presets import resolve
-from krsview.reference.compiled import compile_krs
+from krsview.compile.krs import compile_krs
 from krsview.reference.krs import distance
 from krsview.scene import (
     KRS,
@@ -25,6 +24,7 @@ from krsview.scene import (
     scene_from_toml,
 )
 from krsview.scene.edits import apply_edit
+from krsview.scene.presets import resolve
 
 ALBEDO = (0.5, 0.5, 0.5)
 

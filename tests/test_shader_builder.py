@@ -8,11 +8,11 @@ import shutil
 
 import pytest
 
+from krsview.compile.krs import compile_krs
 from krsview.gpu.program import SHADER_DIR, ShaderError, Source, build_program
 from krsview.gpu.uniforms import variant_defines
-from krsview.presets import resolve
-from krsview.reference import compile_krs
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
 
 DEFINES = {"KRS_SLOTS": 64, "KRS_RECORD": 6, "KRS_KERNEL_TOROIDAL_CAPSULE": None}
 

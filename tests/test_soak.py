@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from krsview.presets import resolve
 from krsview.scene import load_scene, save_scene
+from krsview.scene.presets import resolve
 
 FULL = os.environ.get("KRSVIEW_SOAK") == "full"
 FRAMES, SWITCHES, RELOADS = (3000, 200, 100) if FULL else (300, 12, 2)
@@ -48,7 +48,7 @@ def fly(v, frames: int, start: int = 0) -> None:
 
 @pytest.fixture
 def long_viewer(display, tmp_path):
-    from krsview.app.window import Viewer
+    from krsview.viewer.window import Viewer
 
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)

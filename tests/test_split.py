@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from krsview.gpu.renderer import read_buffers
-from krsview.presets import resolve
 from krsview.scene import load_scene
+from krsview.scene.presets import resolve
 
 
 def test_the_tracing_only_variant_traces_as_the_frame_and_shades_nothing(renderer):

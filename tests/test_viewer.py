@@ -9,9 +9,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.app.adaptive import AdaptiveResolution, Refinement
-from krsview.presets import resolve
 from krsview.scene import load_scene, save_scene
+from krsview.scene.presets import resolve
+from krsview.viewer.adaptive import AdaptiveResolution, Refinement
 
 from .conftest import headless_render
 
@@ -20,7 +20,7 @@ SIZE = (160, 120)
 
 @pytest.fixture
 def viewer(display, tmp_path):
-    from krsview.app.window import Viewer
+    from krsview.viewer.window import Viewer
 
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
@@ -126,8 +126,8 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
 
 
 def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(display, tmp_path):
-    from krsview.app.window import Viewer
     from krsview.gpu.program import SHADER_DIR
+    from krsview.viewer.window import Viewer
 
     shaders = tmp_path / "shaders"
     shutil.copytree(SHADER_DIR, shaders)
@@ -336,8 +336,8 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
 ):
     """A constructed report: the panel knows which row the view draws, and its button puts
     the view on the most accurate row that fits the frame budget (scaled by pixels)."""
-    from krsview.app import hud, measured
-    from krsview.app.measured import apply_row, best_within, load_measured, matches
+    from krsview.viewer import hud, measured
+    from krsview.viewer.measured import apply_row, best_within, load_measured, matches
 
     (tmp_path / "tree").mkdir()
     (tmp_path / "tree" / "accuracy.csv").write_text(

@@ -20,8 +20,8 @@ import pytest
 from PIL import Image
 
 from krsview.bench.hard_cases import CASES
-from krsview.presets import preset_names, resolve
 from krsview.scene import Camera, SceneError, load_scene, save_scene
+from krsview.scene.presets import preset_names, resolve
 from krsview.share.web import html_page, shadertoy_source, web_shader
 
 from .conftest import headless_render

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compile.camera import view_of
 from ..gpu.renderer import Renderer
-from ..reference.camera import view_of
 from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PRECISIONS
 from .harness import Variant, median_times

@@ -11,9 +11,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..presets import resolve
-from ..reference.camera import pixel_ray, view_of
-from ..reference.geometry import compile_geometry, component_distances, nearest, scene_distance
+from ..compile.camera import pixel_ray, view_of
+from ..compile.geometry import compile_geometry
+from ..reference.geometry import component_distances, nearest, scene_distance
 from ..reference.trace import sphere_trace
 from ..scene import (
     KRS,
@@ -29,6 +29,7 @@ from ..scene import (
     Sphere,
     load_scene,
 )
+from ..scene.presets import resolve
 
 
 @dataclass(frozen=True)

@@ -15,8 +15,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..buffers import Buffers
+from ..compile.camera import view_of
 from ..gpu.renderer import Renderer
-from ..reference.camera import view_of
 from ..reference.render import render_reference
 from ..scene import Scene
 from .metrics import gpu_reference_agreement, tolerance_failures

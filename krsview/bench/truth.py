@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
 from ..buffers import Buffers
 from ..reference import render_reference
 from ..scene import Scene, scene_to_toml
+from ..version import __version__
 
 TRUTH_EPSILON_SCALE = 0.125  # × the pixel footprint
 TRUTH_ITERATIONS = 4096

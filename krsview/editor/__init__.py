@@ -1,2 +1,2 @@
-"""The tree editor: a document that owns the scene, its file, the undo history and the saved
-version (``document``, ``history``), and the editor window on top of the viewer (``app``)."""
+"""The tree editor: handles (what can be grabbed, and the edit a drag makes), panels, and the
+editor window (``window``) built on the viewer; its document lives in ``krsview.document``."""

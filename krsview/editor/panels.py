@@ -9,13 +9,13 @@ from typing import TYPE_CHECKING, Any
 
 from imgui_bundle import imgui
 
-from ..app.commands import Command, Do, Edit
-from ..app.widgets import Interactions, field_widget
 from ..scene.edits import get_at
+from ..viewer.commands import Command, Do, Edit
+from ..viewer.widgets import Interactions, field_widget
 from .handles import outline
 
 if TYPE_CHECKING:
-    from .app import Editor
+    from .window import Editor
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import moderngl
 import numpy as np
 
-from ..reference.camera import View
+from ..compile.camera import View
 from .program import ProgramCache
 
 HIDDEN_ALPHA = 0.22  # strength of overlay fragments behind traced geometry

@@ -15,8 +15,8 @@ import moderngl
 import numpy as np
 
 from ..buffers import Buffers
-from ..reference.camera import view_of
-from ..reference.geometry import Compiled, compile_geometry
+from ..compile.camera import view_of
+from ..compile.geometry import Compiled, compile_geometry
 from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
 from ..scene.model import PREPASS_RATIO
 from ..scene.scene import MAX_LIGHTS

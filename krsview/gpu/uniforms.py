@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..reference.camera import View
-from ..reference.compiled import KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound
-from ..reference.geometry import Compiled
-from ..reference.mokrs import CompiledMoKRS
+from ..compile.camera import View
+from ..compile.geometry import Compiled
+from ..compile.krs import KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound
+from ..compile.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS
 from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects

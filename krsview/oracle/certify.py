@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..buffers import Buffers
-from ..reference.camera import primary_rays, view_of
-from ..reference.geometry import compile_geometry
+from ..compile.camera import primary_rays, view_of
+from ..compile.geometry import compile_geometry
 from ..scene import Scene
 from .distance import Bounds, bounds, in_box, on_segments
 

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..reference.compiled import CompiledCompound, CompiledKRS
-from ..reference.mokrs import CompiledMoKRS
+from ..compile.krs import CompiledCompound, CompiledKRS
+from ..compile.mokrs import CompiledMoKRS
 from .numbers import Affine, Interval, Number
 
 Vec = tuple  # three Numbers

@@ -1,5 +1,5 @@
-"""One interface over the geometry families, so tracers and renderers need not know which:
-compile, give each component's distance or unbounding test to the tracer, find the nearest
+"""One interface over the compiled geometry families, so tracers and renderers need not
+know which: give each component's distance or unbounding test to the tracer, find the nearest
 kernel and its world normal. A single KRS or MöKRS is the compound of one [KRS17 §5.1]."""
 
 from __future__ import annotations
@@ -8,25 +8,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..scene import Compound, Geometry, MoKRS
+from ..compile.geometry import Compiled, components
+from ..compile.krs import CompiledCompound, CompiledKRS
 from . import krs, mokrs
-from .compiled import CompiledCompound, CompiledKRS, compile_krs
 from .distortion import Distortion
 from .trace import Distance, Test
-
-Compiled = CompiledKRS | CompiledCompound | mokrs.CompiledMoKRS
-
-
-def compile_geometry(g: Geometry, albedo: tuple[float, float, float]) -> Compiled:
-    if isinstance(g, MoKRS):
-        return mokrs.compile_mokrs(g, albedo)
-    if isinstance(g, Compound):
-        return CompiledCompound(tuple(compile_krs(p, albedo) for p in g.parts))
-    return compile_krs(g, albedo)
-
-
-def components(c: CompiledKRS | CompiledCompound) -> tuple[CompiledKRS, ...]:
-    return c.parts if isinstance(c, CompiledCompound) else (c,)
 
 
 def component_distance(
@@ -105,15 +91,6 @@ def free_radius(c: Compiled, x: np.ndarray) -> float:
         return abs(float(scene_distance(c, x[None])[0]))
     free = mokrs.is_unbounding(c, np.broadcast_to(x, (len(FREE_RADII), 3)), FREE_RADII)
     return float(FREE_RADII[free].max()) if free.any() else 0.0
-
-
-def scene_ball(c: Compiled) -> np.ndarray | None:
-    """A world ball (centre, radius) holding everything ``c`` draws; None when it is unbounded
-    (a plane kernel, or a MöKRS whose outermost bound is not a ball)."""
-    if isinstance(c, mokrs.CompiledMoKRS):
-        top = c.outer[-1]
-        return top.copy() if top[3] >= 0 and np.isfinite(top).all() else None
-    return c.ball.copy() if c.ball[3] >= 0 else None
 
 
 def surface_field(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import CompiledKRS
+from ..compile.krs import CompiledKRS
 from .kernels import kernel_distance, world_normal
 
 

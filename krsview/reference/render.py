@@ -7,11 +7,12 @@ from collections.abc import Callable
 import numpy as np
 
 from ..buffers import Buffers
+from ..compile.camera import View, primary_rays, view_of
+from ..compile.geometry import compile_geometry
 from ..scene import Geometry, Scene
 from .atmosphere import background
-from .camera import View, primary_rays, view_of
 from .distortion import Distortion
-from .geometry import compile_geometry, component_distances, component_tests, nearest
+from .geometry import component_distances, component_tests, nearest
 from .shade import Hits, encode, shade
 from .trace import binary_trace, relaxed_trace, sphere_trace
 

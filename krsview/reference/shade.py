@@ -7,11 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.geometry import Compiled
+from ..compile.mokrs import CompiledMoKRS
 from ..scene import Scene
 from . import atmosphere, mokrs, occlusion, texture
 from .distortion import Distortion
-from .geometry import Compiled, component_distances, scene_distance
-from .mokrs import CompiledMoKRS
+from .geometry import component_distances, scene_distance
 
 GAMMA = 2.2
 

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.geometry import compile_geometry, scene_ball
 from ..reference.distortion import Distortion
-from ..reference.geometry import compile_geometry, nearest, scene_ball, surface_field
+from ..reference.geometry import nearest, surface_field
 from ..scene import Scene, SceneError
 
 BRICK = 16  # voxels per brick side: one marching-cubes call each

@@ -21,10 +21,10 @@ from importlib import resources
 
 import numpy as np
 
+from ..compile.camera import view_of
+from ..compile.geometry import compile_geometry
 from ..gpu.program import ES_HEADER, Source
 from ..gpu.uniforms import block_arrays, variant_defines, view_uniforms
-from ..reference.camera import view_of
-from ..reference.geometry import compile_geometry
 from ..scene import Scene, SceneError
 from ..scene.camera_path import horizontal_axes
 

@@ -12,12 +12,13 @@ import moderngl
 import numpy as np
 from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
 
-from ..editor.document import Document
+from ..compile.geometry import compile_geometry
+from ..document.document import Document
 from ..gpu.context import GL_VERSION
 from ..gpu.display import Display
 from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
-from ..reference.geometry import compile_geometry, free_radius
+from ..reference.geometry import free_radius
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
 from ..scene.effects import EFFECTS, EXCLUSIVE

@@ -13,17 +13,17 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .oracle.certify import MAX_SEGMENTS
-from .presets import DEFAULT_PRESET, preset_names, resolve
-from .progress import Progress
-from .scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
-from .scene.effects import check_effects
-from .scene.model import VIEW_PREPASS
-from .scene.schema import check_value, describe_range
-from .share.frames import DEFAULT_FPS
-from .share.mesh import BRICK as MESH_BRICK
-from .share.mesh import FORMATS as MESH_FORMATS
+from ..oracle.certify import MAX_SEGMENTS
+from ..progress import Progress
+from ..scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError, load_scene
+from ..scene.effects import check_effects
+from ..scene.model import VIEW_PREPASS
+from ..scene.presets import DEFAULT_PRESET, preset_names, resolve
+from ..scene.schema import check_value, describe_range
+from ..share.frames import DEFAULT_FPS
+from ..share.mesh import BRICK as MESH_BRICK
+from ..share.mesh import FORMATS as MESH_FORMATS
+from ..version import __version__
 
 EXIT_USAGE, EXIT_SCENE, EXIT_GL = 2, 2, 3
 
@@ -171,13 +171,13 @@ def cmd_render(args: argparse.Namespace) -> int:
     )
     t0 = time.perf_counter()
     if args.reference:
-        from .reference import render_reference
+        from ..reference import render_reference
 
         buffers = render_reference(scene, w, h, progress=Progress(1, "  rays", SILENT_SECONDS))
         frame = time.perf_counter() - t0
         print(f"  traced in {frame * 1e3:.0f} ms (float64 reference)")
     else:
-        from .gpu.renderer import Renderer
+        from ..gpu.renderer import Renderer
 
         r = Renderer()
         print("  compiling shader variant …", flush=True)
@@ -197,7 +197,7 @@ def cmd_render(args: argparse.Namespace) -> int:
             f"{buffers.hit.mean() * 100:.0f}% of pixels hit"
         )
     if args.view == "iterations":
-        from .heatmap import save_heatmap
+        from ..heatmap import save_heatmap
 
         it = buffers.iterations
         vmax = save_heatmap(
@@ -219,8 +219,8 @@ def cmd_render(args: argparse.Namespace) -> int:
 def frame_job(args: argparse.Namespace, scene: Scene):
     """The frames ``--camera-path``, ``--frames``, ``--fps``, ``--size`` and ``-o`` ask for,
     checked before any frame is drawn."""
-    from .scene.camera_path import load_camera_path
-    from .share.frames import FrameJob, parse_frames
+    from ..scene.camera_path import load_camera_path
+    from ..share.frames import FrameJob, parse_frames
 
     path = load_camera_path(args.camera_path)
     folder = Path(args.output or "out/frames")
@@ -232,7 +232,7 @@ def frame_job(args: argparse.Namespace, scene: Scene):
 
 
 def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
-    from .share.frames import render_frames, write_video
+    from ..share.frames import render_frames, write_video
 
     job, frames = frame_job(args, scene)
     video = check_video(args.video, job.size)
@@ -245,7 +245,7 @@ def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
         flush=True,
     )
     if todo:
-        from .gpu.renderer import Renderer
+        from ..gpu.renderer import Renderer
 
         bar = Progress(len(todo), "  frames")
         render_frames(job, todo, Renderer(), lambda k: bar.step(f"frame {k}"))
@@ -257,8 +257,8 @@ def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
 
 
 def cmd_export_web(args: argparse.Namespace) -> int:
-    from .scene.scene import write_atomic
-    from .share.web import export_notes, html_page, shadertoy_source
+    from ..scene.scene import write_atomic
+    from ..share.web import export_notes, html_page, shadertoy_source
 
     scene = _load(args)
     out = check_output_file(args.output, "-o", args.suffix)
@@ -274,7 +274,7 @@ def cmd_export_web(args: argparse.Namespace) -> int:
 def cmd_export_mesh(args: argparse.Namespace) -> int:
     import resource
 
-    from .share.mesh import build_mesh
+    from ..share.mesh import build_mesh
 
     require("skimage", "trimesh", extra="mesh", what="export mesh")
     scene = _load(args)
@@ -321,8 +321,8 @@ class MissingExtra(RuntimeError):
 
 def cmd_batch(args: argparse.Namespace) -> int:
     require("ray", extra="cluster", what="batch")
-    from .share.batch import check_address, run_batch
-    from .share.frames import write_video
+    from ..share.batch import check_address, run_batch
+    from ..share.frames import write_video
 
     check_address(args.address)
     scene = _load(args)
@@ -380,9 +380,9 @@ def check_video(text: str | None, size: tuple[int, int]) -> Path | None:
 
 
 def cmd_view(args: argparse.Namespace) -> int:
-    from .app.window import Viewer
+    from .. import app
 
-    viewer = Viewer(
+    app.view(
         resolve(args.preset),
         size=args.size,
         hud=not args.no_hud,
@@ -390,24 +390,13 @@ def cmd_view(args: argparse.Namespace) -> int:
         prepass=args.prepass,
         moving_effects=args.moving_effects,
     )
-    print(
-        f"krsview: viewing {viewer.path} — WASD/QE fly, right-drag look, scroll speed, "
-        "O orbit, R reset, B bookmark, F5/F6 record/replay, F12 screenshot, F1 HUD"
-    )
-    viewer.run()
     return 0
 
 
 def cmd_edit(args: argparse.Namespace) -> int:
-    from .editor.app import Editor
+    from .. import app
 
-    editor = Editor(resolve(args.preset), size=args.size, target_fps=args.fps)
-    print(
-        f"krsview: editing {editor.path} — click a handle, an outline entry or the tree to "
-        "select; drag the gizmo; Ctrl+Z/Ctrl+Shift+Z undo/redo, Ctrl+S save; right-drag "
-        "looks, WASD/QE fly"
-    )
-    editor.run()
+    app.edit(resolve(args.preset), size=args.size, target_fps=args.fps)
     return 0
 
 
@@ -465,9 +454,9 @@ def check_bench_csv(args: argparse.Namespace) -> None:
 def check_stability(name: str, size: tuple[int, int]) -> int:
     """The invariants of bench/stability.py on a scene, a hard case (hard:NAME) or the whole
     catalogue (hard); exit status 1 when one fails."""
-    from .bench import stability
-    from .bench.hard_cases import CASES, HardCase
-    from .gpu.renderer import Renderer
+    from ..bench import stability
+    from ..bench.hard_cases import CASES, HardCase
+    from ..gpu.renderer import Renderer
 
     if name == "hard":
         cases = list(CASES.values())
@@ -491,9 +480,9 @@ def check_stability(name: str, size: tuple[int, int]) -> int:
 def check_oracle(name: str, size: tuple[int, int], segments: int) -> int:
     """Certified holes and false hits of the tracers on a scene (or a hard case, hard:NAME),
     with the oracle's work in interval and affine arithmetic."""
-    from .bench.hard_cases import CASES
-    from .gpu.renderer import Renderer
-    from .oracle.certify import count_errors
+    from ..bench.hard_cases import CASES
+    from ..gpu.renderer import Renderer
+    from ..oracle.certify import count_errors
 
     if name.startswith("hard:"):
         if name[5:] not in CASES:
@@ -527,7 +516,7 @@ def check_oracle(name: str, size: tuple[int, int], segments: int) -> int:
 
 
 def cmd_bench_levels(args: argparse.Namespace) -> int:
-    from .bench.levels import bench_levels
+    from ..bench.levels import bench_levels
 
     scene = _load(args)
     check_bench_csv(args)
@@ -536,7 +525,7 @@ def cmd_bench_levels(args: argparse.Namespace) -> int:
 
 
 def cmd_bench_paths(args: argparse.Namespace) -> int:
-    from .bench.paths import bench_paths
+    from ..bench.paths import bench_paths
 
     scene = _load(args)
     check_bench_csv(args)
@@ -545,7 +534,7 @@ def cmd_bench_paths(args: argparse.Namespace) -> int:
 
 
 def cmd_bench_split(args: argparse.Namespace) -> int:
-    from .bench.split import bench_split
+    from ..bench.split import bench_split
 
     scene = _load(args)
     check_bench_csv(args)
@@ -554,7 +543,7 @@ def cmd_bench_split(args: argparse.Namespace) -> int:
 
 
 def cmd_bench_tracers(args: argparse.Namespace) -> int:
-    from .bench.tracers import bench_tracers
+    from ..bench.tracers import bench_tracers
 
     scene = _load(args)
     check_bench_csv(args)
@@ -563,7 +552,7 @@ def cmd_bench_tracers(args: argparse.Namespace) -> int:
 
 
 def cmd_bench_effects(args: argparse.Namespace) -> int:
-    from .bench.effects import bench_effects
+    from ..bench.effects import bench_effects
 
     scene = _load(args)
     check_bench_csv(args)
@@ -572,7 +561,7 @@ def cmd_bench_effects(args: argparse.Namespace) -> int:
 
 
 def cmd_bench_accuracy(args: argparse.Namespace) -> int:
-    from .bench.accuracy import bench_accuracy
+    from ..bench.accuracy import bench_accuracy
 
     names = args.preset or [DEFAULT_PRESET]
     scenes = {n: _load(argparse.Namespace(**{**vars(args), "preset": n})) for n in names}
@@ -601,7 +590,7 @@ def cmd_bench_accuracy(args: argparse.Namespace) -> int:
             )
         return 0
     require("ray", extra="cluster", what="bench accuracy --workers/--address")
-    from .share.batch import check_address, run_accuracy_sweep
+    from ..share.batch import check_address, run_accuracy_sweep
 
     check_address(args.address)
     print(

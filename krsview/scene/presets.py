@@ -1,13 +1,15 @@
-"""Find scene files: a path, or the name of a preset shipped in this package (the .toml
-files beside this module, so an installed wheel has them too)."""
+"""Find scene files: a path, or the name of a preset shipped with krsview. The presets are
+data in the top-level ``presets/`` folder, installed as the package ``krsview.presets`` (so a
+wheel has them too); this module is the code that finds them."""
 
 from __future__ import annotations
 
+from importlib.resources import files
 from pathlib import Path
 
-from ..scene import SceneError
+from .schema import SceneError
 
-PRESET_DIR = Path(__file__).resolve().parent
+PRESET_DIR = Path(str(files("krsview.presets")))
 DEFAULT_PRESET = "tree"
 
 

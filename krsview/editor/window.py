@@ -17,12 +17,12 @@ import glfw  # noqa: E402  (after imgui, as the viewer)
 import numpy as np
 from imgui_bundle import imgui, imguizmo
 
-from ..app.window import Viewer
+from ..compile.camera import View, pixel_ray, project, view_of
+from ..document.document import ConflictError
 from ..gpu.overlay import FAR, NEAR, Overlay, Shapes, camera_matrices
-from ..reference.camera import View, pixel_ray, project, view_of
 from ..reference.geometry import nearest
 from ..scene import Bookmark, SceneError
-from .document import ConflictError
+from ..viewer.window import Viewer
 from .handles import Handle, handles, polyline
 from .panels import edit_panel
 

@@ -11,9 +11,9 @@ import numpy as np
 from imgui_bundle import imgui, implot
 
 from ..gpu.display import VIEW_MODES
-from ..presets import preset_names, resolve
 from ..scene import EFFECTS, Render
 from ..scene.effects import allowed_effects
+from ..scene.presets import preset_names, resolve
 from .commands import Command, Do, Edit
 from .measured import apply_row, best_within, matches
 from .widgets import Interactions, field_widget

@@ -1,0 +1,1 @@
+"""The shipped scene files (data only; krsview.scene.presets finds them)."""
