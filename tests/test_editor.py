@@ -197,7 +197,7 @@ def test_overlay_is_composited_by_traced_depth(editor):
 RECOVERY_SCRIPT = """
 import os, signal, sys, time
 from pathlib import Path
-from krsview.editor.app import Editor
+from krsview.editor.window import Editor
 e = Editor(Path(sys.argv[1]), size=(320, 200))
 e.bake()
 e.edit(("route", "levels", 5, "radius"), 0.123, ("gizmo", 1))

@@ -12,7 +12,7 @@ real fold(int i, inout vec3r p) {
 
 // The KRS whose kernels K_0..K_n and mirrors R_0..R_{n−1} sit in slots first..first + n.
 // Exact level culling [issue 17]: once d ≤ dist(x, C_i), the ball of everything levels i..0
-// would still test (reference/compiled.py, krs_bounds; r < 0: none), the walk stops with the
+// would still test (compile/krs.py, krs_bounds; r < 0: none), the walk stops with the
 // same value. Most rays far from the finer levels pay for a few levels instead of n.
 #ifdef KRS_COUNT_LEVELS
 int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)

@@ -1,4 +1,4 @@
-// Scene data: the compiled KRS (reference/compiled.py holds the same layout) and view.
+// Scene data: the compiled KRS (compile/krs.py holds the same layout) and view.
 // Positions are camera-relative: the eye sits at the origin.
 #define KERNEL_EMPTY 0
 #define KERNEL_SPHERE 1
