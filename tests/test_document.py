@@ -61,7 +61,7 @@ def test_one_drag_is_one_undo_step_and_two_drags_are_two(route_file):
 
 
 def test_history_forgets_the_oldest_steps_beyond_its_limit(route_file, monkeypatch):
-    monkeypatch.setattr("krsview.editor.history.MAX_STEPS", 30)
+    monkeypatch.setattr("krsview.document.history.MAX_STEPS", 30)
     doc = Document(route_file)
     for k in range(40):
         doc.apply(("render", "max_iterations"), 100 + k)
