@@ -15,7 +15,7 @@ import pytest
 
 from krsview.bench import metrics
 from krsview.bench.metrics import Agreement
-from krsview.buffers import Buffers
+from krsview.frame import Frame
 from krsview.scene.presets import PRESET_DIR
 
 TEST_OUTPUT = Path(__file__).resolve().parent.parent / "test-output"
@@ -38,7 +38,7 @@ failures = metrics.tolerance_failures
 agreement = metrics.gpu_reference_agreement
 
 
-def assert_finite(b: Buffers, max_iterations: int, prepass: bool = False) -> None:
+def assert_finite(b: Frame, max_iterations: int, prepass: bool = False) -> None:
     """Finite pixels, and every ray traced within the cap: at least one step, or none where
     the pre-pass found its whole tile free up to the far limit."""
     for name in ("color", "depth", "normal"):
@@ -47,7 +47,7 @@ def assert_finite(b: Buffers, max_iterations: int, prepass: bool = False) -> Non
     assert b.iterations.min() >= (0 if prepass else 1)
 
 
-def save_diff(name: str, gpu: Buffers, ref: Buffers) -> Path:
+def save_diff(name: str, gpu: Frame, ref: Frame) -> Path:
     """GPU | reference | amplified difference, side by side, for a failing pixel test."""
     from PIL import Image
 
@@ -60,7 +60,7 @@ def save_diff(name: str, gpu: Buffers, ref: Buffers) -> Path:
     return path
 
 
-def check_against_reference(name: str, gpu: Buffers, ref: Buffers) -> Agreement:
+def check_against_reference(name: str, gpu: Frame, ref: Frame) -> Agreement:
     a = agreement(gpu, ref)
     problems = failures(a)
     if problems:

@@ -13,11 +13,11 @@ PACKAGE = Path(__file__).resolve().parent.parent / "krsview"
 # states its arrows. Arrows run one way: cli → app → editor → viewer → document → scene;
 # viewer/editor → gpu → compile → scene → algebra; reference, oracle → compile;
 # bench/share → gpu, reference; the public API (krsview/__init__.py) sits under the CLI.
-BASE = {"algebra", "buffers", "progress", "heatmap", "version"}
+BASE = {"algebra", "frame", "progress", "heatmap", "version"}
 ALLOWED = {
     "algebra": set(),
     "version": set(),
-    "buffers": set(),
+    "frame": set(),
     "progress": set(),
     "heatmap": set(),
     "scene": {"algebra"},
@@ -31,8 +31,12 @@ ALLOWED = {
     "viewer": {"document", "gpu", "reference", "compile", "scene"} | BASE,
     "editor": {"viewer", "document", "gpu", "reference", "compile", "scene"} | BASE,
     "app": {"viewer", "editor", "scene"},
-    "": {"share", "bench", "oracle", "gpu", "reference", "compile", "document", "scene"} | BASE,
-    "cli": {"", "app", "share", "bench", "oracle", "gpu", "reference", "compile", "scene"} | BASE,
+    "api": {"share", "bench", "oracle", "gpu", "reference", "compile", "scene"} | BASE,
+    "export": {"api", "share", "scene"} | BASE,
+    "": {"api", "export", "scene"} | BASE,
+    "cli": {"", "api", "export", "app", "share", "bench", "oracle", "gpu", "reference"}
+    | {"compile", "scene"}
+    | BASE,
     "__main__": {"cli"},
 }
 

@@ -12,9 +12,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from krsview.bench.metrics import HIT_AGREEMENT
-from krsview.buffers import Buffers
 from krsview.compile.geometry import compile_geometry
 from krsview.compile.krs import compile_krs
+from krsview.frame import Frame
 from krsview.gpu.program import Source
 from krsview.gpu.uniforms import variant_defines
 from krsview.reference import distance, render_reference
@@ -65,7 +65,7 @@ def compound_scene(tracer: str = "sphere"):
     return replace(s, render=replace(s.render, tracer=tracer))
 
 
-def nearest_of(parts: list[Buffers]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def nearest_of(parts: list[Frame]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per pixel: any component hit, the nearest one's index, and its depth."""
     hit = np.stack([p.hit for p in parts])
     depth = np.where(hit, np.stack([p.depth for p in parts]), np.inf)

@@ -7,17 +7,17 @@ import math
 import numpy as np
 
 from krsview.bench.metrics import compare, error_image, psnr, silhouette, ssim
-from krsview.buffers import Buffers
+from krsview.frame import Frame
 
 H, W = 40, 60
 
 
-def disc(cx: float, cy: float, r: float, depth: float = 5.0) -> Buffers:
+def disc(cx: float, cy: float, r: float, depth: float = 5.0) -> Frame:
     y, x = np.mgrid[0:H, 0:W] + 0.5
     hit = (x - cx) ** 2 + (y - cy) ** 2 <= r * r
     color = np.where(hit[..., None], [0.8, 0.4, 0.2], [0.2, 0.3, 0.9])
     normal = np.where(hit[..., None], [0.0, 0.0, -1.0], 0.0)
-    return Buffers(
+    return Frame(
         color.astype(float),
         np.where(hit, depth, 0.0),
         normal.astype(float),

@@ -209,7 +209,7 @@ def test_counts_on_a_traced_image(renderer):
     undecided at 24×14. Negative control: an image with its hit mask inverted has both."""
     from dataclasses import replace
 
-    from krsview.buffers import Buffers
+    from krsview.frame import Frame
 
     s = load_scene(resolve("sierpinski"))
     for tracer in ("sphere", "binary"):
@@ -220,7 +220,7 @@ def test_counts_on_a_traced_image(renderer):
         assert counts.hits > 20
     img = renderer.render(s, 24, 14)
     fake_t = np.where(img.hit, 0.0, 60.0)
-    broken = Buffers(img.color, fake_t, img.normal, img.iterations, ~img.hit)
+    broken = Frame(img.color, fake_t, img.normal, img.iterations, ~img.hit)
     counts = count_errors(s, broken)
     assert counts.holes > 0 and counts.false_hits > 0
 
@@ -289,14 +289,14 @@ def test_the_level_of_detail_decides_a_full_depth_tree(renderer):
     """At full depth (22 levels, twigs a thousandth of a pixel) the exact walk leaves every
     ray undecided; leaving out detail below a quarter pixel decides them, with no hole and
     no false hit beyond ε. Negative control: the image with its hit mask inverted has both."""
-    from krsview.buffers import Buffers
+    from krsview.frame import Frame
 
     s = load_scene(resolve("tree"))
     img = renderer.render(s, 16, 9)
     counts = count_errors(s, img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
     assert counts.undecided <= 0.02 * counts.rays and counts.hits > 20, counts
-    broken = Buffers(img.color, np.where(img.hit, 0.0, 60.0), img.normal, img.iterations, ~img.hit)
+    broken = Frame(img.color, np.where(img.hit, 0.0, 60.0), img.normal, img.iterations, ~img.hit)
     counts = count_errors(s, broken, arithmetics=("affine",))
     assert counts.holes > 0 and counts.false_hits > 0, counts
 

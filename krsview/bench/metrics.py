@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..buffers import Buffers
+from ..frame import Frame
 
 SSIM_WINDOW = 7  # pixels on a side of SSIM's local window
 SSIM_C1, SSIM_C2 = 0.01**2, 0.03**2  # Wang et al. 2004's constants for a range of 1
@@ -81,7 +81,7 @@ class Errors:
         return self.holes + self.false_hits
 
 
-def compare(image: Buffers, truth: Buffers, eps_per_t: float, cap: int) -> Errors:
+def compare(image: Frame, truth: Frame, eps_per_t: float, cap: int) -> Errors:
     """Errors of ``image`` against ``truth``; ``eps_per_t`` is the footprint per unit ray
     distance (the unit of depth error), ``cap`` the image's iteration cap."""
     holes = truth.hit & ~image.hit
@@ -113,7 +113,7 @@ def compare(image: Buffers, truth: Buffers, eps_per_t: float, cap: int) -> Error
     )
 
 
-def error_image(image: Buffers, truth: Buffers) -> np.ndarray:
+def error_image(image: Frame, truth: Frame) -> np.ndarray:
     """RGB8 picture of the hit-mask errors over the dimmed truth: holes red, false hits blue."""
     out = (truth.rgb8().astype(np.float64) * 0.35 + 40).astype(np.uint8)
     out[truth.hit & ~image.hit] = (255, 40, 40)
@@ -124,7 +124,7 @@ def error_image(image: Buffers, truth: Buffers) -> np.ndarray:
 EDGE_DEPTH_JUMP = 0.01  # a 4-neighbour 1 % nearer or farther marks an occlusion edge
 
 
-def edges(b: Buffers) -> np.ndarray:
+def edges(b: Frame) -> np.ndarray:
     """Occlusion edges: the silhouette, and pixels with a 4-neighbour at a depth more than
     EDGE_DEPTH_JUMP apart (an outline in front of another surface). Only there may two
     correct tracers legitimately differ: a ray one step later slips past the outline."""
@@ -153,7 +153,7 @@ class Agreement:
 
 
 def agreement(
-    a: Buffers, b: Buffers, depth_rel: float, normal_deg: float, color_tol: float
+    a: Frame, b: Frame, depth_rel: float, normal_deg: float, color_tol: float
 ) -> Agreement:
     both = a.hit & b.hit
     t = b.depth[both]
@@ -194,7 +194,7 @@ OFF_EDGE_DEPTH = 0.02
 OFF_EDGE_COLOR = 5.0 / 255.0
 
 
-def gpu_reference_agreement(gpu: Buffers, ref: Buffers) -> Agreement:
+def gpu_reference_agreement(gpu: Frame, ref: Frame) -> Agreement:
     return agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
 
 

@@ -14,8 +14,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..buffers import Buffers
 from ..compile.camera import view_of
+from ..frame import Frame
 from ..gpu.renderer import Renderer
 from ..reference.render import render_reference
 from ..scene import Scene
@@ -48,11 +48,11 @@ class Outcome:
         )
 
 
-def capped(b: Buffers, cap: int) -> int:
+def capped(b: Frame, cap: int) -> int:
     return int(((b.iterations >= cap) & ~b.hit).sum())
 
 
-def disagreement(gpu: Buffers, ref: Buffers) -> str:
+def disagreement(gpu: Frame, ref: Frame) -> str:
     return "; ".join(tolerance_failures(gpu_reference_agreement(gpu, ref))) or "ok"
 
 

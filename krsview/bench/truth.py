@@ -9,9 +9,7 @@ import os
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
-from ..buffers import Buffers
+from ..frame import Frame
 from ..reference import render_reference
 from ..scene import Scene, scene_to_toml
 from ..version import __version__
@@ -46,15 +44,14 @@ def cache_key(scene: Scene, size: tuple[int, int]) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-def ground_truth(scene: Scene, size: tuple[int, int], cache: Path | None = None) -> Buffers:
+def ground_truth(scene: Scene, size: tuple[int, int], cache: Path | None = None) -> Frame:
     """The reference image at ground-truth accuracy, from the cache when it holds one."""
     path = (cache or default_cache()) / f"{cache_key(scene, size)}.npz"
     if path.exists():
-        with np.load(path) as f:
-            return Buffers(f["color"], f["depth"], f["normal"], f["iterations"], f["hit"])
+        return Frame.load(path)
     b = render_reference(truth_scene(scene), *size)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp.npz")
-    b.save_npz(tmp)
+    b.save(tmp)
     tmp.replace(path)
     return b

@@ -208,10 +208,10 @@ def cmd_render(args: argparse.Namespace) -> int:
             f"max {it.max()} (colour scale 0..{vmax})"
         )
     else:
-        buffers.save_png(out)
+        buffers.save(out)
     print(f"  wrote {out.resolve()}")
     if args.buffers:
-        buffers.save_npz(args.buffers)
+        buffers.save(args.buffers)
         print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")
     return 0
 

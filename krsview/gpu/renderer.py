@@ -1,5 +1,5 @@
 """Fragment-shader path: one full-screen pass writes colour, normal+depth and iterations to
-float32 render targets, read back as :class:`Buffers` in image order (rows top → bottom).
+float32 render targets, read back as :class:`Frame` in image order (rows top → bottom).
 With ``[render] prepass`` a coarse pass over tiles first writes each tile's free distances
 (prepass.glsl), which the full pass starts its rays from."""
 
@@ -14,9 +14,9 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from ..buffers import Buffers
 from ..compile.camera import view_of
 from ..compile.geometry import Compiled, compile_geometry
+from ..frame import Frame
 from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
 from ..scene.model import PREPASS_RATIO
 from ..scene.scene import MAX_LIGHTS
@@ -260,7 +260,7 @@ class Renderer:
         height: int,
         geometry: Geometry | None = None,
         progress: Callable[[int, int], None] | None = None,
-    ) -> Buffers:
+    ) -> Frame:
         """The image; with ``progress`` it is drawn in PROGRESS_BANDS bands of rows, each
         finished before progress(done, total) is called (the same pixels either way)."""
         with self.current():
@@ -409,10 +409,10 @@ def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np
     return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)[::-1]
 
 
-def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Buffers:
+def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Frame:
     c, nd, it = (read_plane(fbo, k, width, height) for k in range(3))
     hit = c[..., 3] > 0.5
-    return Buffers(
+    return Frame(
         c[..., :3].astype(np.float64),
         nd[..., 3].astype(np.float64),
         nd[..., :3].astype(np.float64),

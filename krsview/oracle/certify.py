@@ -27,9 +27,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..buffers import Buffers
 from ..compile.camera import primary_rays, view_of
 from ..compile.geometry import compile_geometry
+from ..frame import Frame
 from ..scene import Scene
 from .distance import Bounds, bounds, in_box, on_segments
 
@@ -163,7 +163,7 @@ class Counts:
 
 
 def count_errors(
-    scene: Scene, image: Buffers, arithmetics=ARITHMETICS, max_segments: int = MAX_SEGMENTS
+    scene: Scene, image: Frame, arithmetics=ARITHMETICS, max_segments: int = MAX_SEGMENTS
 ) -> Counts:
     """Certified holes and false hits of a traced image (GPU or reference) of ``scene``: a
     KRS, compound or MöKRS (the twist and empty zones are not in the oracle)."""

@@ -6,9 +6,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..buffers import Buffers
 from ..compile.camera import View, primary_rays, view_of
 from ..compile.geometry import compile_geometry
+from ..frame import Frame
 from ..scene import Geometry, Scene
 from .atmosphere import background
 from .distortion import Distortion
@@ -25,7 +25,7 @@ def render_reference(
     height: int,
     geometry: Geometry | None = None,
     progress: Callable[[int, int], None] | None = None,
-) -> Buffers:
+) -> Frame:
     """The image in float64. With ``progress``, rays go in chunks and progress(done, total)
     is called after each (every ray is independent: the image is the same)."""
     view = view_of(scene.camera, width, height)
@@ -41,7 +41,7 @@ def render_reference(
             progress(min(k + step, N), N)
     color, depth, normal, iterations, hit = (np.concatenate(a) for a in zip(*parts))
     H, W = height, width
-    return Buffers(
+    return Frame(
         color.reshape(H, W, 3),
         depth.reshape(H, W),
         normal.reshape(H, W, 3),

@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
-from .scene import Scene
 from .schema import SceneError, from_dict, to_dict
 
 Path = tuple[str | int, ...]
@@ -44,13 +43,26 @@ def replace_at(obj: Any, path: Path, value: Any) -> Any:
     return replace(obj, **{key: replace_at(getattr(obj, key), rest, value)})
 
 
-def validated(scene: Scene) -> Scene:
+def validated(scene: Any) -> Any:
     """The scene as a file holding it would load: every field checked and normalised (unit
     vectors), or a SceneError naming the field. Values already valid come back bit-exact."""
-    return from_dict(Scene, to_dict(scene))
+    return from_dict(type(scene), to_dict(scene))
 
 
-def apply_edit(scene: Scene, path: Path, value: Any) -> Scene:
+def parse_path(text: str | Path) -> Path:
+    """``"route.levels[3].fork"`` → ``("route", "levels", 3, "fork")`` (a tuple passes)."""
+    if not isinstance(text, str):
+        return tuple(text)
+    out: list[str | int] = []
+    for part in text.split("."):
+        name, *indices = part.replace("]", "").split("[")
+        if not name or not all(i.isdigit() for i in indices):
+            raise SceneError(text, "<path>", "expected names and [indices], e.g. render.tracer")
+        out += [name, *(int(i) for i in indices)]
+    return tuple(out)
+
+
+def apply_edit(scene: Any, path: Path, value: Any) -> Any:
     """Replace the value at ``path`` and validate the result; a SceneError leaves nothing
     changed (the caller keeps its last valid scene)."""
     try:
@@ -59,7 +71,7 @@ def apply_edit(scene: Scene, path: Path, value: Any) -> Scene:
         raise SceneError(path_text(path), value, f"not a field of this scene ({e})") from None
 
 
-def field_meta(scene: Scene, path: Path) -> dict:
+def field_meta(scene: Any, path: Path) -> dict:
     """The schema metadata (range, unit, help) of the field at ``path`` (the last name on it)."""
     names = [k for k in path if isinstance(k, str)]
     if not names:

@@ -10,6 +10,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .compound import Component, Compound, check_compound
+from .edits import apply_edit, parse_path
 from .effects import EffectSettings, check_effects
 from .model import KRS, Camera, Light, Material, Render
 from .mokrs import MoKRS, check_view
@@ -112,6 +113,29 @@ class Scene:
         if self.compound:
             return Compound(tuple(c.placed() for c in self.compound))
         return self.krs if self.krs is not None else self.mokrs  # type: ignore[return-value]
+
+    def edit(self, path: str | tuple, value: object) -> Scene:
+        """A new scene with the value at ``path`` replaced, validated by the schema that
+        reads files (a SceneError names the field and what is allowed; this scene is left as
+        it is). ``path``: ``"render.tracer"``, ``"route.levels[3].fork"`` or a tuple.
+
+        >>> from krsview import load
+        >>> load("tree").edit("render.epsilon_scale", 0.5).render.epsilon_scale
+        0.5
+        """
+        return apply_edit(self, parse_path(path), value)
+
+    def with_levels(self, levels: int, path: str = "levels") -> Scene:
+        """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation)."""
+        g = self.geometry()
+        if not (isinstance(levels, int) and 1 <= levels <= g.depth):
+            raise SceneError(path, levels, f"this scene has {g.depth} levels; allowed 1..{g.depth}")
+        return self.with_geometry(g.truncated(levels))
+
+    def with_effects(self, effects: list[str], path: str = "effects") -> Scene:
+        """The scene with this effect set compiled in (checked against what it allows)."""
+        check_effects(list(effects), self.mokrs is not None, path)
+        return replace(self, effects=list(effects))
 
     def with_geometry(self, geometry: Geometry) -> Scene:
         none = dict(krs=None, tree=None, route=None, mokrs=None, compound=[])

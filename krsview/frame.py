@@ -1,0 +1,75 @@
+"""A traced frame: the per-pixel outputs of the GPU renderer and of the NumPy reference alike
+(rows top → bottom), as NumPy arrays, with ways to save and show them."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass
+class Frame:
+    """``color`` (H, W, 3) display colour in [0, 1] (gamma-encoded); ``depth`` (H, W) ray
+    distance t to the hit, 0 where missed; ``normal`` (H, W, 3) unit world normal, 0 where
+    missed; ``iterations`` (H, W) distance evaluations spent by the tracer; ``hit`` (H, W)
+    bool."""
+
+    color: np.ndarray
+    depth: np.ndarray
+    normal: np.ndarray
+    iterations: np.ndarray
+    hit: np.ndarray
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return self.hit.shape[1], self.hit.shape[0]
+
+    def rgb8(self) -> np.ndarray:
+        """The colour as (H, W, 3) uint8."""
+        return np.round(np.clip(self.color, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+    def image(self):
+        """The colour as a PIL image."""
+        from PIL import Image
+
+        return Image.fromarray(self.rgb8(), "RGB")
+
+    def save(self, path: str | Path) -> Path:
+        """Write the colour (``.png``, or any format Pillow knows by the suffix) or every
+        array (``.npz``); returns the path."""
+        path = Path(path)
+        if path.suffix.lower() == ".npz":
+            np.savez_compressed(
+                path,
+                color=self.color,
+                depth=self.depth,
+                normal=self.normal,
+                iterations=self.iterations,
+                hit=self.hit,
+            )
+        else:
+            self.image().save(path)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> Frame:
+        """A frame written by :meth:`save` as ``.npz``."""
+        with np.load(path) as data:
+            return cls(**{name: data[name] for name in cls.__dataclass_fields__})
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter shows a frame as its image."""
+        out = io.BytesIO()
+        self.image().save(out, format="PNG")
+        return out.getvalue()
+
+    def __repr__(self) -> str:
+        w, h = self.size
+        return (
+            f"Frame({w}×{h}, {self.hit.mean():.0%} hit, "
+            f"{self.iterations.mean():.1f} iterations/pixel)"
+        )

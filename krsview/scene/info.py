@@ -1,0 +1,63 @@
+"""What a scene is, in numbers: its geometry, levels, kernel instances, kernels, effects and
+render settings (`krsview check`, :func:`krsview.check`)."""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+
+from .scene import Scene
+
+
+@dataclass(frozen=True)
+class SceneInfo:
+    name: str
+    description: str
+    geometry: str  # "explicit KRS", "tree (grown)", "tree (route)", "compound", "MöKRS"
+    levels: int  # kernels K_0..K_{levels-1}
+    mirrors: int
+    instances: int  # kernel instances drawn (up to 2^levels - 1 per KRS)
+    kernels: dict[str, int]  # kernel kind → how many levels carry one
+    effects: tuple[str, ...]
+    warnings: tuple[str, ...]  # e.g. a route's branch clipped by its fork's mirror
+    parts: tuple[str, ...]  # a compound's components, one line each
+    reflecting: int  # a MöKRS's reflecting levels
+    tracer: str
+    epsilon_scale: float
+    max_iterations: int
+    max_distance: float
+    xi: tuple[float, float] | None  # binary tracing's (ξ_bonus, ξ_penalty)
+
+
+def describe(scene: Scene) -> SceneInfo:
+    """The statistics of a (validated) scene."""
+    g = scene.geometry()
+    if scene.mokrs is not None:
+        kind = "MöKRS"
+    elif scene.compound:
+        kind = "compound"
+    else:
+        kind = "tree (grown)" if scene.tree else "tree (route)" if scene.route else "explicit KRS"
+    parts = tuple(
+        f"{'tree' if c.tree else 'route' if c.route else 'KRS'} of {p.depth} levels"
+        for c, p in zip(scene.compound, getattr(g, "parts", ()))
+    )
+    r = scene.render
+    return SceneInfo(
+        name=scene.name,
+        description=scene.description,
+        geometry=kind,
+        levels=g.depth,
+        mirrors=g.n if kind != "compound" else sum(p.n for p in g.parts),
+        instances=g.instance_count(),
+        kernels=dict(sorted(Counter(k.kind for k in g.kernels).items())),
+        effects=tuple(scene.effects),
+        warnings=tuple(f"route.{w}" for w in (scene.route.warnings() if scene.route else ())),
+        parts=parts,
+        reflecting=sum(lv.reflect for lv in scene.mokrs.levels) if scene.mokrs else 0,
+        tracer=r.tracer,
+        epsilon_scale=r.epsilon_scale,
+        max_iterations=r.max_iterations,
+        max_distance=r.max_distance,
+        xi=(r.xi_bonus, r.xi_penalty) if r.tracer == "binary" else None,
+    )
