@@ -194,7 +194,7 @@ def check(scene: Scene | str | Path) -> SceneInfo:
     name or path is loaded and validated first.
 
     >>> check("forest").instances
-    67108863
+    4194273
     """
     return describe(scene if isinstance(scene, Scene) else load(scene))
 

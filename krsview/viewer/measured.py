@@ -8,17 +8,23 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..scene import Scene
+from ..scene.presets import PRESET_DIR
 from .commands import Command, Do, Edit
 
-# Reports made here, then the ones committed in a clone (an installed wheel has none).
-REPORT_DIRS = (Path("out") / "accuracy", Path(__file__).resolve().parents[2] / "docs" / "accuracy")
+# A report made here by `krsview bench accuracy` (OUT/PRESET/accuracy.csv) wins over the
+# measurements shipped beside the presets (PRESET.accuracy.csv, in the wheel too).
+REPORT_DIRS = (Path("out") / "accuracy",)
+
+
+def report_files(stem: str) -> list[Path]:
+    """Where the measurements of the preset ``stem`` may be, in order."""
+    return [d / stem / "accuracy.csv" for d in REPORT_DIRS] + [PRESET_DIR / f"{stem}.accuracy.csv"]
 
 
 def load_measured(stem: str) -> list[dict] | None:
     """The rows of ``accuracy.csv`` for the preset ``stem``, numbers as floats; None if no
     report exists or it cannot be read."""
-    for d in REPORT_DIRS:
-        f = d / stem / "accuracy.csv"
+    for f in report_files(stem):
         try:
             with f.open() as fh:
                 rows = list(csv.DictReader(fh))
