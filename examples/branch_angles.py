@@ -19,8 +19,7 @@ covered = np.array([f.hit.mean() for f in frames])
 for a, c in zip(angles[::8], covered[::8]):
     print(f"branch angle {a:5.1f}°: {c:6.1%} of the pixels hit")
 
-sheet = np.concatenate(
-    [np.concatenate([f.rgb8() for f in frames[r::5]], axis=1) for r in range(5)], axis=0
-)
+rows = [np.concatenate([f.rgb8() for f in frames[r : r + 8]], axis=1) for r in range(0, 40, 8)]
+sheet = np.concatenate(rows, axis=0)  # 5 rows of 8, the angle growing along each row
 Image.fromarray(sheet).save("branch-angles.png")
 print(f"wrote branch-angles.png ({sheet.shape[1]}×{sheet.shape[0]})")
