@@ -54,7 +54,7 @@ BENCHES = {
         "(tiles 4 and 8 also with one coarse pass) on the fragment path, and the compute "
         "path at 4, 8, 16, 32 iterations per round, at --size and twice it, interleaved: "
         "frame time and speed-up against the plain frame, iterations per pixel, the coarse "
-        "pass's share.",
+        "pass's share. Example: krsview bench paths forest --size 160x90 --csv paths.csv",
         knobs=("tracer",),
     ),
     "split": Bench(
@@ -71,7 +71,8 @@ BENCHES = {
         "On one scene and view: sphere tracing, binary tracing at the paper's "
         "ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over ξ_bonus ∈ {1.5, 2, 3} × ξ_penalty ∈ "
         "{0.2, 0.3, 0.5}; iterations per pixel, frame time and hit agreement, as ratios to "
-        "sphere tracing (to binary 2.0/0.3 for a MöKRS).",
+        "sphere tracing (to binary 2.0/0.3 for a MöKRS). Example: krsview bench tracers "
+        "palm --epsilon-scale 0.5",
         scene_options=True,
         own=(
             (
@@ -87,7 +88,7 @@ BENCHES = {
         "every effect and switches them by uniforms; frame times as ratios to the plain "
         "render. An idle twist (0°) or an empty zone list gets a stand-in so its cost "
         "shows. A KRS is also drawn as a compound of one; a compound against its "
-        "components drawn alone, and their sum.",
+        "components drawn alone, and their sum. Example: krsview bench effects grove",
         scene_options=True,
     ),
 }
