@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 
 from .. import app
 from ..scene import Render
@@ -32,7 +32,7 @@ class ViewerSettings:
         default=None,
         metadata={
             **RENDER_PREPASS,
-            "help": "tile size of the low-resolution pre-pass while viewing (0: off)",
+            "help": "tile size of the low-resolution pre-pass while viewing; 0: off",
         },
     )
     hud: bool = param(True, help="the HUD shown at start")
@@ -58,8 +58,8 @@ def settings_options(sp: argparse.ArgumentParser, names, **defaults) -> None:
             ViewerSettings,
             name,
             FLAGS.get(name),
-            **({"default": defaults[name]} if name in defaults else {}),
-            note=NOTES.get(name),
+            defaults.get(name, MISSING),
+            NOTES.get(name),
         )
 
 
