@@ -1,40 +1,41 @@
-"""A one-line progress bar on stderr for long work (sweeps, slow renders)."""
+"""Progress of long work (sweeps, slow renders, frames) on stderr, drawn by tqdm: a bar that
+redraws in place on a terminal, and nothing at all when stderr is a file or a pipe, so logs
+hold no carriage-return redraws."""
 
 from __future__ import annotations
 
 import sys
-import time
+
+from tqdm import tqdm
 
 
 class Progress:
-    """``step()`` once per unit of work. With ``delay`` seconds the bar stays silent until
-    the work has taken that long, so quick work prints nothing (tqdm's habit)."""
+    """``step()`` once per unit of work, or call it as a renderer's ``progress(done, total)``.
+    With ``delay`` seconds the bar stays silent until the work has taken that long, so quick
+    work prints nothing."""
 
     def __init__(self, total: int, label: str, delay: float = 0.0):
-        self.total, self.label, self.done, self.delay = total, label, 0, delay
-        self.start, self.shown = time.perf_counter(), False
+        self.bar = tqdm(
+            total=total,
+            desc=label,
+            delay=delay,
+            file=sys.stderr,
+            disable=None,  # off unless stderr is a terminal
+            bar_format="{desc} [{bar:24}] {n_fmt}/{total_fmt}{postfix}",
+            ascii="·█",
+        )
 
     def step(self, note: str = "") -> None:
-        self.done += 1
-        self.show(self.done, note)
+        self.show(self.bar.n + 1, note)
 
     def show(self, done: int, note: str = "") -> None:
-        self.done = done
-        if not self.shown and time.perf_counter() - self.start < self.delay:
-            return
-        self.shown = True
-        width = 24
-        filled = width * self.done // self.total
-        bar = "█" * filled + "·" * (width - filled)
-        end = "\n" if self.done == self.total else ""
-        print(
-            f"\r{self.label} [{bar}] {self.done}/{self.total} {note:<24}",
-            end=end,
-            file=sys.stderr,
-            flush=True,
-        )
+        if note:
+            self.bar.set_postfix_str(note, refresh=False)
+        self.bar.update(done - self.bar.n)
+        if self.bar.total is not None and done >= self.bar.total:
+            self.bar.close()
 
     def __call__(self, done: int, total: int) -> None:
         """As a ``progress(done, total)`` callback of the renderers."""
-        self.total = total
+        self.bar.total = total
         self.show(done)

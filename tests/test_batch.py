@@ -155,7 +155,7 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     differ; errors are a function of the images and the ground truth)."""
     import csv
 
-    from krsview.bench.accuracy import bench_accuracy
+    from krsview.bench.accuracy import bench_accuracy, write_report
     from krsview.share.batch import run_accuracy_sweep
 
     names = ("sierpinski", "rock")
@@ -170,7 +170,7 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     for n in names:
         assert (outs[n] / "README.md").exists() and (outs[n] / "pareto.png").exists()
         local = tmp_path / "local" / n
-        bench_accuracy(scenes[n], (32, 18), local, rounds=1)
+        write_report(bench_accuracy(scenes[n], (32, 18), rounds=1), local)
         rows = [[list(csv.DictReader((d / "accuracy.csv").open()))] for d in (outs[n], local)]
         ray_rows, local_rows = rows[0][0], rows[1][0]
         assert [[r[c] for c in columns] for r in ray_rows] == [

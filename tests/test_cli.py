@@ -288,3 +288,65 @@ def test_check_oracle_prints_certified_counts(capsys):
     assert int(row[7]) > 0  # the undecided column
     assert main(["check", "--oracle", "hard:twist-ground"]) == 2
     assert "the oracle covers scenes without twist or empty zones" in capsys.readouterr().err
+
+
+def test_every_render_option_takes_its_range_and_help_from_the_schema(capsys):
+    """Each [render] knob `render` offers accepts its field's bounds and refuses a value just
+    beyond them with the schema's own words; its help is the field's help (DESIGN.md, one
+    schema). Negative control: an option's value outside the range exits 2."""
+    from dataclasses import fields
+
+    from krsview.cli import build_parser
+    from krsview.cli.render import KNOBS
+    from krsview.scene import Render
+    from krsview.scene.schema import describe_range
+
+    parser = build_parser()
+    for f in fields(Render):
+        meta, flag = f.metadata, "--" + f.name.replace("_", "-")
+        if f.name not in KNOBS:
+            continue
+        if meta["choices"]:
+            for choice in meta["choices"]:
+                assert getattr(parser.parse_args(["render", flag, choice]), f.name) == choice
+            continue
+        kind = type(f.default)
+        for bound in (meta["lo"], meta["hi"]):
+            assert getattr(parser.parse_args(["render", flag, str(kind(bound))]), f.name) == bound
+        with pytest.raises(SystemExit):
+            parser.parse_args(["render", f"{flag}={kind(meta['hi']) + 1}"])
+        assert describe_range(dict(meta), kind) in capsys.readouterr().err
+    help_text = " ".join(
+        parser._subparsers._group_actions[0].choices["render"].format_help().split()
+    )
+    assert all(
+        " ".join(f.metadata["help"].split()) in help_text for f in fields(Render) if f.name in KNOBS
+    )
+
+
+def test_view_options_come_from_the_settings_fields(capsys):
+    from dataclasses import fields
+
+    from krsview.cli import build_parser
+    from krsview.scene import Render
+    from krsview.scene.schema import describe_range
+
+    parser = build_parser()
+    view = parser.parse_args(["view"])
+    assert (view.size, view.target_fps, view.prepass, view.hud, view.moving_effects) == (
+        (960, 540),
+        30.0,
+        None,
+        True,
+        False,
+    )
+    assert parser.parse_args(["edit"]).size == (1280, 720)
+    v = parser.parse_args(["view", "--no-hud", "--moving-effects", "--fps", "60", "--prepass", "8"])
+    assert (v.hud, v.moving_effects, v.target_fps, v.prepass) == (False, True, 60.0, 8)
+    prepass = next(f for f in fields(Render) if f.name == "prepass")
+    with pytest.raises(SystemExit):  # the pre-pass tile's range is the scene schema's
+        parser.parse_args(["view", "--prepass", str(prepass.metadata["hi"] + 1)])
+    assert describe_range(dict(prepass.metadata), int) in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        parser.parse_args(["view", "--fps", "0.5"])
+    assert "--fps = 0.5: allowed: 1 ≤ value ≤ 240" in capsys.readouterr().err

@@ -24,7 +24,7 @@ from ..scene.model import PRECISIONS
 from .harness import Variant, median_times
 from .metrics import compare, error_image
 from .paths import TILES as PREPASS_TILES
-from .report import write_csv
+from .report import Measured, write_csv
 from .truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS, ground_truth
 
 EPSILON_SCALES = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
@@ -106,16 +106,22 @@ def settings(scene: Scene) -> list[Setting]:
     return out
 
 
+@dataclass(frozen=True)
+class Accuracy:
+    """The accuracy bench's result: one row per setting (the CSV's columns: knob, value,
+    size, time, every error of :class:`krsview.bench.metrics.Errors`) and the error images
+    of the notable settings (file name → RGB array)."""
+
+    measured: Measured
+    errors: dict[str, np.ndarray]
+
+
 def bench_accuracy(
-    scene: Scene, size: tuple[int, int], out: Path, rounds: int = 3, cache: Path | None = None
-) -> list[dict]:
+    scene: Scene, size: tuple[int, int], rounds: int = 3, cache: Path | None = None
+) -> Accuracy:
+    """Every setting of :func:`settings` timed on the GPU and compared with the ground truth
+    (computed once, then read from ``cache``)."""
     w, h = size
-    out.mkdir(parents=True, exist_ok=True)
-    print(
-        f"ground truth: float64 reference, ε-scale {TRUTH_EPSILON_SCALE}, cap "
-        f"{TRUTH_ITERATIONS} (cached) …",
-        flush=True,
-    )
     truth = ground_truth(scene, size, cache)
     footprint = view_of(scene.camera, w, h).footprint
     runs = settings(scene)
@@ -144,20 +150,27 @@ def bench_accuracy(
                 **asdict(e),
             )
         )
-    write_csv(rows, str(out / "accuracy.csv"))
-    notable = _notable(rows)
-    for row in notable:
-        from PIL import Image
+    errors = {
+        _image_name(row): error_image(images[f"{row['knob']} {row['value']}"], truth)
+        for row in _notable(rows)
+    }
+    return Accuracy(Measured(scene, size, rounds, rows), errors)
 
-        Image.fromarray(error_image(images[f"{row['knob']} {row['value']}"], truth)).save(
-            out / _image_name(row)
-        )
-    _plots(rows, out, scene.name)
-    report = _markdown(scene, size, rounds, rows, notable)
+
+def write_report(acc: Accuracy, out: Path) -> str:
+    """The report in folder ``out``: accuracy.csv, README.md (returned), plots of time
+    against error and the Pareto front, and the error images."""
+    from PIL import Image
+
+    m = acc.measured
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv(m.rows, out / "accuracy.csv")
+    for name, image in acc.errors.items():
+        Image.fromarray(image).save(out / name)
+    _plots(m.rows, out, m.scene.name)
+    report = _markdown(m.scene, m.size, m.rounds, m.rows, _notable(m.rows))
     (out / "README.md").write_text(report)
-    print(report)
-    print(f"wrote {out.resolve()}/ (README.md, accuracy.csv, plots, error images)")
-    return rows
+    return report
 
 
 def _image_name(row: dict) -> str:

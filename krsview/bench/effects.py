@@ -22,7 +22,7 @@ from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
 from .harness import Variant, median_times
-from .report import write_csv
+from .report import Measured, markdown
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
 
@@ -56,10 +56,9 @@ def runs_of(scene: Scene) -> dict[str, tuple[Scene, bool]]:
     return runs
 
 
-def bench_effects(
-    scene: Scene, size: tuple[int, int], rounds: int = 5, csv: str | None = None
-) -> list[dict]:
-    w, h = size
+def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
+    """One row per variant (:func:`runs_of`, then the components' sum for a compound): its
+    effects, ms per frame, ratio to the plain render and incremental cost."""
     runs = runs_of(scene)
     med = median_times(
         Renderer(),
@@ -91,27 +90,37 @@ def bench_effects(
                 incremental=sum(alone) / med["plain"] - 1.0,
             )
         )
-    print(
-        f"\nEffect costs — {scene.name}, {w}×{h}, {scene.render.tracer} tracing, median of "
-        f"{rounds} interleaved rounds (ratios to plain = no effect, specialised)\n"
+    return Measured(scene, size, rounds, rows)
+
+
+def table(m: Measured) -> str:
+    ms = {row["variant"]: row["ms"] for row in m.rows}
+    text = (
+        f"\nEffect costs — {m.scene.name}, {m.size[0]}×{m.size[1]}, {m.scene.render.tracer} "
+        f"tracing, median of {m.rounds} interleaved rounds (ratios to plain = no effect, "
+        "specialised)\n\n"
     )
-    print("| variant | effects | ms/frame | × plain | incremental cost |")
-    print("|---|---|---:|---:|---:|")
-    for row in rows:
-        print(
-            f"| {row['variant']} | {row['effects']} | {row['ms']:.1f} | "
-            f"{row['ratio_to_plain']:.2f} | {row['incremental']:+.0%} |"
-        )
-    if scene.effects:
-        print(
-            f"\nspecialised vs all effects compiled, scene's effects on: "
-            f"{med['scene, all compiled'] / med['scene, specialised']:.2f}× slower "
+    text += markdown(
+        ("variant", "effects", "ms/frame", "× plain", "incremental cost"),
+        "llrrr",
+        (
+            (
+                r["variant"],
+                r["effects"],
+                f"{r['ms']:.1f}",
+                f"{r['ratio_to_plain']:.2f}",
+                f"{r['incremental']:+.0%}",
+            )
+            for r in m.rows
+        ),
+    )
+    if "scene, specialised" in ms:
+        text += (
+            f"\n\nspecialised vs all effects compiled, scene's effects on: "
+            f"{ms['scene, all compiled'] / ms['scene, specialised']:.2f}× slower "
             f"when not specialised"
         )
-    print(
-        f"all effects compiled, none on, vs plain: "
-        f"{med['none on, all compiled'] / med['plain']:.2f}×"
+    return text + (
+        f"\nall effects compiled, none on, vs plain: "
+        f"{ms['none on, all compiled'] / ms['plain']:.2f}×"
     )
-    if csv:
-        write_csv(rows, csv)
-    return rows

@@ -12,7 +12,7 @@ import numpy as np
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from .harness import Variant, median_times
-from .report import write_csv
+from .report import Measured, markdown
 
 
 def level_counts(total: int, step: int) -> list[int]:
@@ -22,9 +22,9 @@ def level_counts(total: int, step: int) -> list[int]:
     return counts
 
 
-def bench_levels(
-    scene: Scene, size: tuple[int, int], step: int = 4, rounds: int = 5, csv: str | None = None
-) -> list[dict]:
+def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int = 5) -> Measured:
+    """One row per level count (every ``step`` levels, and all): kernel instances, ms per
+    frame, time ratio to the fewest levels, iterations per pixel, time per iteration ratio."""
     w, h = size
     krs = scene.geometry()
     counts = level_counts(krs.depth, step)
@@ -53,32 +53,51 @@ def bench_levels(
                 ratio_per_iteration=(t / iters[m]) / (t_base / iters[base]),
             )
         )
-    print(
-        f"\nFrame time against levels — {scene.name}, {w}×{h}, median of {rounds} "
-        f"interleaved rounds (ratios to {base} levels)\n"
+    return Measured(scene, size, rounds, rows)
+
+
+def linear_fit(m: Measured) -> tuple[float, float, float]:
+    """Frame time against levels as a line: (intercept ms, slope ms/level, R²)."""
+    n = np.array(m.column("levels"), float)
+    t = np.array(m.column("ms"))
+    slope, icpt = np.polyfit(n, t, 1)
+    resid = t - (slope * n + icpt)
+    return icpt, slope, 1 - (resid @ resid) / max(((t - t.mean()) ** 2).sum(), 1e-30)
+
+
+def table(m: Measured) -> str:
+    rows = m.rows
+    text = (
+        f"\nFrame time against levels — {m.scene.name}, {m.size[0]}×{m.size[1]}, median of "
+        f"{m.rounds} interleaved rounds (ratios to {rows[0]['levels']} levels)\n\n"
     )
-    print(
-        "| levels | kernel instances | ms/frame | time ratio | iterations/px | "
-        "time/iteration ratio |"
+    text += markdown(
+        (
+            "levels",
+            "kernel instances",
+            "ms/frame",
+            "time ratio",
+            "iterations/px",
+            "time/iteration ratio",
+        ),
+        "rrrrrr",
+        (
+            (
+                r["levels"],
+                f"{r['instances']:,}",
+                f"{r['ms']:.2f}",
+                f"{r['time_ratio']:.2f}",
+                f"{r['iterations']:.1f}",
+                f"{r['ratio_per_iteration']:.2f}",
+            )
+            for r in rows
+        ),
     )
-    print("|---:|---:|---:|---:|---:|---:|")
-    for row in rows:
-        print(
-            f"| {row['levels']} | {row['instances']:,} | {row['ms']:.2f} | "
-            f"{row['time_ratio']:.2f} | {row['iterations']:.1f} | "
-            f"{row['ratio_per_iteration']:.2f} |"
-        )
     if len(rows) >= 3:
-        n = np.array([row["levels"] for row in rows], float)
-        t = np.array([row["ms"] for row in rows])
-        slope, icpt = np.polyfit(n, t, 1)
-        resid = t - (slope * n + icpt)
-        r2 = 1 - (resid @ resid) / max(((t - t.mean()) ** 2).sum(), 1e-30)
+        icpt, slope, r2 = linear_fit(m)
         grow = rows[-1]["instances"] / max(rows[0]["instances"], 1)
-        print(
-            f"\nlinear fit: {icpt:.2f} ms + {slope:.3f} ms/level (R² = {r2:.3f}); geometry grew "
-            f"{grow:,.0f}× while time grew {rows[-1]['time_ratio']:.2f}×"
+        text += (
+            f"\n\nlinear fit: {icpt:.2f} ms + {slope:.3f} ms/level (R² = {r2:.3f}); geometry "
+            f"grew {grow:,.0f}× while time grew {rows[-1]['time_ratio']:.2f}×"
         )
-    if csv:
-        write_csv(rows, csv)
-    return rows
+    return text

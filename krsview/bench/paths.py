@@ -14,7 +14,7 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from .harness import Variant, median_times
-from .report import write_csv
+from .report import Measured, markdown
 
 TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
 ONE_PASS_TILES = (4, 8)  # also timed with a single coarse pass (prepass_levels = 1)
@@ -88,24 +88,26 @@ def levers(scene: Scene) -> dict[tuple, Scene]:
     return out
 
 
-def bench_paths(
-    scene: Scene, size: tuple[int, int], rounds: int = 5, csv: str | None = None
-) -> list[dict]:
+def lever_name(k: tuple) -> str:
+    """A lever's key as words: "compute, culling on, pre-pass 8 × 2, 16 per round"."""
+    return (
+        f"{k[0]}, culling {k[1]}, pre-pass {k[2] or 'off'}"
+        + (f" × {k[3]}" if k[3] else "")
+        + (f", {k[4]} per round" if k[4] else "")
+        + (f", shadow rays {k[5]}" if k[5] else "")
+    )
+
+
+def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
+    """One row per lever (:func:`levers`) at ``size`` and twice it: ms per frame, speed-up
+    against the plain frame, iterations and levels walked per pixel, coarse passes' share."""
     r = Renderer()
-    sizes = [size, (2 * size[0], 2 * size[1])]
     rows = []
-    for w, h in sizes:
+    for w, h in (size, (2 * size[0], 2 * size[1])):
         variants = levers(scene)
-        names = {
-            k: f"{k[0]}, culling {k[1]}, pre-pass {k[2] or 'off'}"
-            + (f" × {k[3]}" if k[3] else "")
-            + (f", {k[4]} per round" if k[4] else "")
-            + (f", shadow rays {k[5]}" if k[5] else "")
-            for k in variants
-        }
         med = median_times(
             r,
-            {names[k]: Variant(s) for k, s in variants.items()},
+            {lever_name(k): Variant(s) for k, s in variants.items()},
             (w, h),
             rounds,
             f"bench paths {scene.name}",
@@ -117,9 +119,9 @@ def bench_paths(
             )["pre-pass"]
             for k, s in tiles.items()
         }
-        base = med[names[("fragment", "off", 0, 0, 0, "")]]
+        base = med[lever_name(("fragment", "off", 0, 0, 0, ""))]
         for k, s in variants.items():
-            t = med[names[k]]
+            t = med[lever_name(k)]
             rows.append(
                 dict(
                     size=f"{w}x{h}",
@@ -136,24 +138,45 @@ def bench_paths(
                     coarse_share=coarse.get(k[1:4], 0.0) / t,
                 )
             )
-    print(
-        f"\nSpeed levers — {scene.name}, median of {rounds} interleaved rounds; speed-up "
-        "against the fragment path without culling or pre-pass at the same size\n"
+    return Measured(scene, size, rounds, rows)
+
+
+def table(m: Measured) -> str:
+    caption = (
+        f"\nSpeed levers — {m.scene.name}, median of {m.rounds} interleaved rounds; speed-up "
+        "against the fragment path without culling or pre-pass at the same size\n\n"
     )
-    print(
-        "| size | path | culling | pre-pass tile | coarse passes | iterations per round | "
-        "shadow rays | ms/frame | speed-up | iterations/px (full pass) | levels walked/px | "
-        "coarse pass share |"
+    return caption + markdown(
+        (
+            "size",
+            "path",
+            "culling",
+            "pre-pass tile",
+            "coarse passes",
+            "iterations per round",
+            "shadow rays",
+            "ms/frame",
+            "speed-up",
+            "iterations/px (full pass)",
+            "levels walked/px",
+            "coarse pass share",
+        ),
+        "lllrrrlrrrrr",
+        (
+            (
+                r["size"],
+                r["path"],
+                r["culling"],
+                r["prepass"] or "off",
+                r["coarse_passes"] or "—",
+                r["steps"] or "—",
+                r["shadow_rays"] or "—",
+                f"{r['ms']:.1f}",
+                f"{r['speedup']:.2f}×",
+                f"{r['iterations']:.1f}",
+                f"{r['levels']:.1f}" if r["levels"] else "—",  # not counted in a MöKRS
+                f"{r['coarse_share']:.0%}",
+            )
+            for r in m.rows
+        ),
     )
-    print("|---|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|")
-    for row in rows:
-        levels = f"{row['levels']:.1f}" if row["levels"] else "—"  # not counted in a MöKRS
-        print(
-            f"| {row['size']} | {row['path']} | {row['culling']} | {row['prepass'] or 'off'} "
-            f"| {row['coarse_passes'] or '—'} | {row['steps'] or '—'} | "
-            f"{row['shadow_rays'] or '—'} | {row['ms']:.1f} | {row['speedup']:.2f}× | "
-            f"{row['iterations']:.1f} | {levels} | {row['coarse_share']:.0%} |"
-        )
-    if csv:
-        write_csv(rows, csv)
-    return rows

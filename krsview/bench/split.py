@@ -13,7 +13,7 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import EFFECTS, Scene
 from .harness import Variant, median_times
-from .report import write_csv
+from .report import Measured, markdown
 
 
 def split_variants(scene: Scene) -> dict[str, Variant]:
@@ -31,9 +31,9 @@ def split_variants(scene: Scene) -> dict[str, Variant]:
     return out
 
 
-def bench_split(
-    scene: Scene, size: tuple[int, int], rounds: int = 5, csv: str | None = None
-) -> list[dict]:
+def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
+    """One row per part of the frame (coarse passes, tracing, nearest kernel and shading,
+    secondary effects) and the frame and the moving frame whole: ms and share of the frame."""
     med = median_times(Renderer(), split_variants(scene), size, rounds, f"bench split {scene.name}")
     coarse = med.get("coarse", 0.0)
     parts = [
@@ -45,16 +45,18 @@ def bench_split(
         ("moving frame (no secondary effects)", med["moving"]),
     ]
     rows = [dict(part=name, ms=t * 1e3, share=t / med["frame"]) for name, t in parts]
-    r = scene.render
-    print(
-        f"\nWhere the time goes — {scene.name} at {size[0]}×{size[1]}, pre-pass "
+    return Measured(scene, size, rounds, rows)
+
+
+def table(m: Measured) -> str:
+    r = m.scene.render
+    return (
+        f"\nWhere the time goes — {m.scene.name} at {m.size[0]}×{m.size[1]}, pre-pass "
         f"{f'{r.prepass} × {r.prepass_levels}' if r.prepass else 'off'}, culling "
-        f"{r.culling}; median of {rounds} interleaved rounds, each part the difference of "
-        "two variants\n"
+        f"{r.culling}; median of {m.rounds} interleaved rounds, each part the difference of "
+        "two variants\n\n"
+    ) + markdown(
+        ("part", "ms", "share of the frame"),
+        "lrr",
+        ((row["part"], f"{row['ms']:.1f}", f"{row['share']:.0%}") for row in m.rows),
     )
-    print("| part | ms | share of the frame |\n|---|---:|---:|")
-    for row in rows:
-        print(f"| {row['part']} | {row['ms']:.1f} | {row['share']:.0%} |")
-    if csv:
-        write_csv(rows, csv)
-    return rows

@@ -16,7 +16,7 @@ import numpy as np
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
 from .harness import Variant, median_times
-from .report import write_csv
+from .report import Measured, markdown
 
 BONUS = (1.5, 2.0, 3.0)
 PENALTY = (0.2, 0.3, 0.5)
@@ -38,8 +38,10 @@ def variants(scene: Scene, sweep: bool) -> dict[str, Scene]:
 
 
 def bench_tracers(
-    scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: bool = True, csv: str | None = None
-) -> list[dict]:
+    scene: Scene, size: tuple[int, int], rounds: int = 5, sweep: bool = True
+) -> Measured:
+    """One row per tracer setting: iterations per pixel (median, mean, ratio to the first),
+    ms per frame, time ratio, hit fraction and agreement with the first's hit mask."""
     if scene.mokrs is not None and not sweep:
         raise SceneError(
             "--no-sweep",
@@ -78,32 +80,56 @@ def bench_tracers(
                 hit_agreement=float((b.hit == buffers[base].hit).mean()),
             )
         )
-    print(
-        f"\nSphere vs binary tracing — {scene.name}, {w}×{h}, ε-scale "
-        f"{scene.render.epsilon_scale}, median of {rounds} interleaved rounds "
-        f"(ratios to {base})\n"
+    return Measured(scene, size, rounds, rows)
+
+
+def table(m: Measured) -> str:
+    first = m.rows[0]
+    base = (
+        "sphere"
+        if first["tracer"] == "sphere"
+        else f"binary {first['xi_bonus']:g}/{first['xi_penalty']:g}"
     )
-    print(
-        "| tracer | ξ_bonus | ξ_penalty | median it/px | mean it/px | iteration ratio | "
-        "ms/frame | time ratio | hit agreement |"
+    text = (
+        f"\nSphere vs binary tracing — {m.scene.name}, {m.size[0]}×{m.size[1]}, ε-scale "
+        f"{m.scene.render.epsilon_scale}, median of {m.rounds} interleaved rounds "
+        f"(ratios to {base})\n\n"
     )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for row in rows:
-        print(
-            f"| {row['tracer']} | {row['xi_bonus']} | {row['xi_penalty']} | "
-            f"{row['median_iterations']:.0f} | {row['mean_iterations']:.1f} | "
-            f"{row['iteration_ratio']:.2f} | {row['ms']:.1f} | {row['time_ratio']:.2f} | "
-            f"{row['hit_agreement']:.2%} |"
-        )
-    binaries = [row for row in rows if row["tracer"] == "binary"]
+    text += markdown(
+        (
+            "tracer",
+            "ξ_bonus",
+            "ξ_penalty",
+            "median it/px",
+            "mean it/px",
+            "iteration ratio",
+            "ms/frame",
+            "time ratio",
+            "hit agreement",
+        ),
+        "lrrrrrrrr",
+        (
+            (
+                r["tracer"],
+                r["xi_bonus"],
+                r["xi_penalty"],
+                f"{r['median_iterations']:.0f}",
+                f"{r['mean_iterations']:.1f}",
+                f"{r['iteration_ratio']:.2f}",
+                f"{r['ms']:.1f}",
+                f"{r['time_ratio']:.2f}",
+                f"{r['hit_agreement']:.2%}",
+            )
+            for r in m.rows
+        ),
+    )
+    binaries = [row for row in m.rows if row["tracer"] == "binary"]
     if len(binaries) > 1:
         fast = min(binaries, key=lambda row: row["ms"])
         few = min(binaries, key=lambda row: row["mean_iterations"])
-        print(
-            f"\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
+        text += (
+            f"\n\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
             f"({fast['time_ratio']:.2f}× {base}); fewest iterations: "
             f"{few['xi_bonus']}/{few['xi_penalty']} ({few['mean_iterations']:.1f} it/px)"
         )
-    if csv:
-        write_csv(rows, csv)
-    return rows
+    return text

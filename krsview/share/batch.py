@@ -14,8 +14,6 @@ Ray starts a local cluster unless given the address of an existing one (``ray://
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import re
 import socket
@@ -184,13 +182,13 @@ def accuracy_report(
     """One preset's `bench accuracy` (bench/accuracy.py) in a scratch folder: its files as
     bytes, so the driver writes them wherever it likes, and the report's verdict. ``cache``:
     the ground-truth cache on the worker's machine (None: its default)."""
-    from ..bench.accuracy import bench_accuracy, verdict
+    from ..bench.accuracy import bench_accuracy, verdict, write_report
 
+    acc = bench_accuracy(scene, size, rounds, cache)
     with tempfile.TemporaryDirectory() as d:
-        with contextlib.redirect_stdout(io.StringIO()):  # the report is in the files
-            rows = bench_accuracy(scene, size, Path(d), rounds, cache)
+        write_report(acc, Path(d))
         files = {str(p.relative_to(d)): p.read_bytes() for p in Path(d).rglob("*") if p.is_file()}
-    return files, verdict(rows)
+    return files, verdict(acc.measured.rows)
 
 
 def run_accuracy_sweep(

@@ -83,20 +83,7 @@ def build_mesh(
     n = bricks_per_side * BRICK
     h = side / n
     iso = lod * h
-    samples = 0
-    # octree: keep boxes whose ball may hold surface, split them, down to bricks
-    boxes, size = np.zeros((1, 3), dtype=np.int64), bricks_per_side  # in bricks
-    while True:
-        centers = lo + (boxes + size / 2) * BRICK * h
-        radius = np.full(len(boxes), math.sqrt(3) / 2 * size * BRICK * h + h + iso)
-        keep = ~_batched(is_empty, centers, radius)
-        samples += len(boxes)
-        boxes = boxes[keep]
-        if size == 1 or len(boxes) == 0:
-            break
-        size //= 2
-        offsets = np.array([(i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1)]) * size
-        boxes = (boxes[:, None, :] + offsets[None]).reshape(-1, 3)
+    boxes, samples = occupied_bricks(is_empty, lo, h, iso, bricks_per_side)
     verts, faces, count = [], [], 0
     grid = np.stack(np.meshgrid(*[np.arange(BRICK + 1)] * 3, indexing="ij"), -1).reshape(-1, 3)
     per_call = max(1, BATCH // len(grid))
@@ -142,6 +129,27 @@ def build_mesh(
         bool(mesh.is_watertight),
     )
     return mesh, stats
+
+
+def occupied_bricks(
+    is_empty: Callable, lo: np.ndarray, h: float, iso: float, bricks_per_side: int
+) -> tuple[np.ndarray, int]:
+    """The bricks (integer corners, in bricks) that may hold surface, by an octree: boxes
+    whose ball is certified empty are dropped, the rest split, down to single bricks; and
+    the tests it took."""
+    samples = 0
+    boxes, size = np.zeros((1, 3), dtype=np.int64), bricks_per_side
+    while True:
+        centers = lo + (boxes + size / 2) * BRICK * h
+        radius = np.full(len(boxes), math.sqrt(3) / 2 * size * BRICK * h + h + iso)
+        keep = ~_batched(is_empty, centers, radius)
+        samples += len(boxes)
+        boxes = boxes[keep]
+        if size == 1 or len(boxes) == 0:
+            return boxes, samples
+        size //= 2
+        offsets = np.array([(i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1)]) * size
+        boxes = (boxes[:, None, :] + offsets[None]).reshape(-1, 3)
 
 
 def _batched(f: Callable, *xs: np.ndarray) -> np.ndarray:

@@ -1,0 +1,244 @@
+"""`krsview bench NAME`: one table of benchmarks, each a function of :mod:`krsview.bench`
+returning its rows and a ``table`` making them Markdown; this module only parses, calls and
+prints (and writes ``--csv``). `bench accuracy` writes a report folder per preset."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..bench.report import write_csv
+from ..scene import MAX_LEVELS, SceneError
+from ..scene.model import VIEW_PREPASS
+from ..scene.presets import DEFAULT_PRESET, resolve
+from . import options
+from .options import check_output_dir, check_output_file, render_option
+
+
+@dataclass(frozen=True)
+class Bench:
+    """A bench of ``krsview.bench.NAME``: ``bench_NAME(scene, size, rounds=, **own)`` →
+    :class:`krsview.bench.report.Measured`, printed by its ``table``."""
+
+    help: str
+    description: str
+    knobs: tuple[str, ...] = ()  # [render] fields it takes as options
+    scene_options: bool = False  # --epsilon-scale, --max-iterations, --levels, --effects
+    own: tuple[tuple[str, dict], ...] = field(default=())  # its own options: flag, argparse
+
+
+BENCHES = {
+    "levels": Bench(
+        "frame time against level count (O(n) vs 2^n)",
+        "Render the same view with the coarsest 4, 8, … levels, interleaved, median of "
+        "several frames; print time relative to the smallest level count beside the kernel "
+        "instances. Example: krsview bench levels tree --step 4",
+        knobs=("epsilon_scale", "max_iterations"),
+        own=(
+            (
+                "--step",
+                dict(
+                    type=options.number_in("--step", 1, MAX_LEVELS),
+                    default=4,
+                    help="level increment (default 4)",
+                ),
+            ),
+        ),
+    ),
+    "paths": Bench(
+        "what culling, the pre-pass and the compute path buy",
+        "Exact level culling off/on × the low-resolution pre-pass off and at tiles 4, 8, 16 "
+        "(tiles 4 and 8 also with one coarse pass) on the fragment path, and the compute "
+        "path at 4, 8, 16, 32 iterations per round, at --size and twice it, interleaved: "
+        "frame time and speed-up against the plain frame, iterations per pixel, the coarse "
+        "pass's share. Example: krsview bench paths forest --size 160x90 --csv paths.csv",
+        knobs=("tracer",),
+    ),
+    "split": Bench(
+        "where a frame's time goes: coarse passes, tracing, shading, shadow rays",
+        "On one scene and view, the fragment path: the frame, the frame without secondary "
+        "effects (shadow rays, occlusion; what the viewer's moving frames leave out), the "
+        "tracing alone and the coarse passes alone, interleaved; each part of the frame is "
+        "the difference of two of them. Example: krsview bench split tree "
+        f"--prepass {VIEW_PREPASS} (the viewer's pre-pass).",
+        knobs=("culling", "prepass", "prepass_levels"),
+    ),
+    "tracers": Bench(
+        "sphere vs binary sphere tracing, and a ξ sweep",
+        "On one scene and view: sphere tracing, binary tracing at the paper's "
+        "ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over ξ_bonus ∈ {1.5, 2, 3} × ξ_penalty ∈ "
+        "{0.2, 0.3, 0.5}; iterations per pixel, frame time and hit agreement, as ratios to "
+        "sphere tracing (to binary 2.0/0.3 for a MöKRS). Example: krsview bench tracers "
+        "palm --epsilon-scale 0.5",
+        scene_options=True,
+        own=(
+            (
+                "--no-sweep",
+                dict(dest="sweep", action="store_false", help="only sphere vs binary 2.0/0.3"),
+            ),
+        ),
+    ),
+    "effects": Bench(
+        "cost of each effect; specialised vs all compiled",
+        "On one scene and view: the plain render (no effect), each effect alone, and the "
+        "scene's effect set both specialised (#define) and in the variant that compiles "
+        "every effect and switches them by uniforms; frame times as ratios to the plain "
+        "render. An idle twist (0°) or an empty zone list gets a stand-in so its cost "
+        "shows. A KRS is also drawn as a compound of one; a compound against its "
+        "components drawn alone, and their sum. Example: krsview bench effects grove",
+        scene_options=True,
+    ),
+}
+
+
+def add(sub) -> None:
+    b = sub.add_parser(
+        "bench",
+        help="benchmarks (levels, tracers, effects, accuracy)",
+        description="Benchmarks that report ratios measured side by side. "
+        "Example: krsview bench tracers tree --csv out/tracers.csv",
+    )
+    bsub = b.add_subparsers(dest="bench", required=True, metavar="BENCH")
+    for name, bench in BENCHES.items():
+        sp = bsub.add_parser(name, help=bench.help, description=bench.description)
+        options.preset(sp)
+        sp.add_argument("--size", type=options.size, default=(320, 180), help="default 320x180")
+        sp.add_argument(
+            "--rounds",
+            type=options.number_in("--rounds", 1, 100),
+            default=5,
+            help="interleaved rounds; medians are reported (default 5)",
+        )
+        sp.add_argument(
+            "--csv", metavar="PATH", help="also write the table to this file, ending in .csv"
+        )
+        own = [sp.add_argument(flag, **spec).dest for flag, spec in bench.own]
+        for knob in bench.knobs:
+            render_option(sp, knob)
+        if bench.scene_options:
+            options.scene_options(sp)
+        sp.set_defaults(func=run, own=own)
+    add_accuracy(bsub)
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = options.scene_of(args)
+    if args.csv:
+        check_output_file(args.csv, "--csv", ".csv")
+    module = importlib.import_module(f"krsview.bench.{args.bench}")
+    own = {dest: getattr(args, dest) for dest in args.own}
+    measured = getattr(module, f"bench_{args.bench}")(scene, args.size, rounds=args.rounds, **own)
+    print(module.table(measured))
+    if args.csv:
+        print(f"wrote {write_csv(measured.rows, args.csv)}")
+    return 0
+
+
+def add_accuracy(bsub) -> None:
+    ba = bsub.add_parser(
+        "accuracy",
+        help="what accuracy costs: every knob against time and ground truth, as a report "
+        "with plots",
+        description="On one view: sweep ε-scale, the iteration cap, the tracer (sphere, "
+        "over-relaxed with ω, binary with ξ pairs) and the level count; time each setting "
+        "on the GPU (interleaved rounds, medians) and compare its image with the ground "
+        "truth (the float64 reference at ε/8, computed once and cached): holes, false "
+        "hits, depth error in ε, normal error, PSNR, SSIM, iterations, capped rays. Writes "
+        "OUT/README.md, OUT/accuracy.csv, plots (time vs error per knob, the Pareto front) "
+        "and error images. Example: krsview bench accuracy tree rock --out out/accuracy",
+    )
+    ba.add_argument(
+        "preset",
+        nargs="*",
+        metavar="PRESET",
+        help="one or more presets (default tree); several write OUT/PRESET each",
+    )
+    ba.add_argument("--size", type=options.size, default=(320, 180), help="default 320x180")
+    ba.add_argument(
+        "--workers",
+        type=options.number_in("--workers", 1, 1024),
+        default=1,
+        help="run the presets as tasks on this many Ray workers (default 1: "
+        "here, one after the other); needs 'krsview[cluster]'",
+    )
+    ba.add_argument(
+        "--address",
+        metavar="ADDRESS",
+        help="run them on an existing Ray cluster (ray://HOST:10001 or 'auto')",
+    )
+    ba.add_argument(
+        "--rounds",
+        type=options.number_in("--rounds", 1, 100),
+        default=3,
+        help="interleaved rounds; medians are reported (default 3)",
+    )
+    ba.add_argument(
+        "--out",
+        metavar="DIR",
+        help="report folder (default out/accuracy/PRESET; with several presets, DIR/PRESET)",
+    )
+    ba.add_argument(
+        "--cache", metavar="DIR", help="ground-truth cache (default ~/.cache/krsview/truth)"
+    )
+    ba.set_defaults(func=run_accuracy)
+
+
+def report_folder(out: str | None, name: str, several: bool) -> Path:
+    """Where a preset's accuracy report goes: --out, --out/PRESET, or out/accuracy/PRESET."""
+    if out is None:
+        return Path("out") / "accuracy" / resolve(name).stem
+    return Path(out) / resolve(name).stem if several else Path(out)
+
+
+def run_accuracy(args: argparse.Namespace) -> int:
+    from ..bench.accuracy import bench_accuracy, write_report
+    from ..bench.truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS
+
+    names = args.preset or [DEFAULT_PRESET]
+    scenes = {n: options.scene_of(args, n) for n in names}
+    if len(set(names)) != len(names):
+        raise SceneError("PRESET", " ".join(names), "each preset once")
+    outs = {n: report_folder(args.out, n, len(names) > 1) for n in names}
+    for out in outs.values():
+        check_output_dir(out, "--out")
+    cache = Path(args.cache) if args.cache else None
+    if args.workers > 1 or args.address is not None:
+        return run_accuracy_on_ray(args, scenes, outs, cache)
+    for n in names:  # here, one after the other
+        print(
+            f"ground truth: float64 reference, ε-scale {TRUTH_EPSILON_SCALE}, cap "
+            f"{TRUTH_ITERATIONS} (cached) …",
+            flush=True,
+        )
+        print(write_report(bench_accuracy(scenes[n], args.size, args.rounds, cache), outs[n]))
+        print(f"wrote {outs[n].resolve()}/ (README.md, accuracy.csv, plots, error images)")
+    return 0
+
+
+def run_accuracy_on_ray(args: argparse.Namespace, scenes: dict, outs: dict, cache) -> int:
+    """The presets' reports as Ray tasks, each printed as its task ends."""
+    options.require("ray", extra="cluster", what="bench accuracy --workers/--address")
+    from ..share.batch import check_address, run_accuracy_sweep
+
+    check_address(args.address)
+    print(
+        f"krsview: accuracy of {len(scenes)} preset(s) on {args.workers} Ray worker(s) of "
+        f"{args.address or 'a local cluster'}; each report when its task ends",
+        flush=True,
+    )
+
+    def done(name: str, lines: list[str] | None, error: str) -> None:
+        if lines is None:
+            print(f"krsview: error: {name}: {error}", file=sys.stderr)
+            return
+        print(f"{name}: wrote {outs[name].resolve()}/")
+        for line in lines:
+            print(f"  {line}")
+
+    failed = run_accuracy_sweep(
+        scenes, args.size, args.rounds, outs, args.workers, args.address, done, cache
+    )
+    return 1 if failed else 0

@@ -1,0 +1,218 @@
+"""The options the commands share: value parsers, options generated from a schema dataclass's
+field metadata (range, default and help in one place, DESIGN.md), the scene a command's
+arguments ask for, and the checks of output paths made before any work."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import math
+import types
+import typing
+from dataclasses import MISSING, fields
+from pathlib import Path
+from typing import Any
+
+from .. import api
+from ..scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError
+from ..scene.presets import DEFAULT_PRESET
+from ..scene.schema import check_value, describe_range
+
+MAX_SIDE = 8192  # pixels, as krsview.Renderer allows
+SILENT_SECONDS = 1.0  # work quicker than this shows no progress bar
+
+
+def size(text: str) -> tuple[int, int]:
+    """``WIDTHxHEIGHT`` → (width, height)."""
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--size {text!r}: expected WIDTHxHEIGHT, e.g. 640x360"
+        ) from None
+    if not (1 <= w <= MAX_SIDE and 1 <= h <= MAX_SIDE):
+        raise argparse.ArgumentTypeError(f"--size {text!r}: each side must be 1..{MAX_SIDE} pixels")
+    return w, h
+
+
+def number_in(flag: str, lo: float, hi: float, kind: type = int):
+    """A parser of a whole (``kind=int``) or real number in lo..hi for the CLI's own
+    options (rounds, workers, …: settings of a run, not of a scene)."""
+
+    def parse(text: str):
+        try:
+            v = kind(text)
+        except ValueError:
+            if kind is int:
+                raise argparse.ArgumentTypeError(
+                    f"{flag} {text!r}: expected a whole number"
+                ) from None
+            v = math.nan
+        if not (lo <= v <= hi):
+            raise argparse.ArgumentTypeError(f"{flag} {text!r}: allowed {lo} ≤ value ≤ {hi}")
+        return v
+
+    return parse
+
+
+def box(text: str) -> tuple[float, ...]:
+    """``XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX`` → six finite numbers, each max above its min."""
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 6 or not all(map(math.isfinite, values)):
+        raise argparse.ArgumentTypeError(
+            f"--box {text!r}: expected six numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX"
+        )
+    if not all(values[k + 3] > values[k] for k in range(3)):
+        raise argparse.ArgumentTypeError(f"--box {text!r}: each max must exceed its min")
+    return values
+
+
+def field_option(
+    sp: argparse.ArgumentParser,
+    cls: type,
+    name: str,
+    flag: str | None = None,
+    default: Any = MISSING,
+    note: str | None = None,
+) -> None:
+    """``--NAME`` for field NAME of a schema dataclass (``scene.schema.param``): its type,
+    range, default and help come from the field, and a value is checked by the schema's own
+    rule. ``default``: the option's default when not the field's (None: not given);
+    ``note``: what the help says instead of the default. A bool field is a switch
+    (``--no-NAME`` when it is on by default); a (width, height) field takes WIDTHxHEIGHT."""
+    f = {f.name: f for f in fields(cls)}[name]
+    meta, hint = dict(f.metadata), typing.get_type_hints(cls)[name]
+    default = f.default if default is MISSING else default
+    flag = flag or "--" + name.replace("_", "-")
+    if hint is bool:
+        on = not default
+        sp.add_argument(
+            flag if on else "--no-" + flag[2:],
+            dest=name,
+            action="store_true" if on else "store_false",
+            help=meta["help"] if on else f"{meta['help']}: off (default on)",
+        )
+        return
+    if typing.get_origin(hint) is tuple:
+        shown = "x".join(map(str, default))
+        sp.add_argument(
+            flag, dest=name, type=size, default=default, help=f"{meta['help']} (default {shown})"
+        )
+        return
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        (hint,) = [a for a in typing.get_args(hint) if a is not type(None)]
+
+    def parse(text: str):
+        try:
+            value = hint(text) if hint in (int, float) else text
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{flag} {text!r}: expected a {'whole ' if hint is int else ''}number"
+            ) from None
+        try:
+            return check_value(hint, value, flag, meta)
+        except SceneError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+
+    allowed = (
+        "one of " + ", ".join(meta["choices"])
+        if meta.get("choices")
+        else describe_range(meta, hint)
+    )
+    sp.add_argument(
+        flag,
+        dest=name,
+        type=parse,
+        default=default,
+        metavar=name.split("_")[-1].upper(),
+        help=f"{meta['help']} ({allowed}; {note or f'default {default:g}'})",
+    )
+
+
+def render_option(sp: argparse.ArgumentParser, name: str) -> None:
+    """``--NAME`` overriding the scene's ``[render] NAME`` (:class:`krsview.scene.Render`)."""
+    field_option(sp, Render, name, default=None, note="overrides the scene's [render]")
+
+
+def scene_options(sp: argparse.ArgumentParser) -> None:
+    """The accuracy options every scene-drawing command takes: ε-scale, iteration cap,
+    level count and effect set."""
+    render_option(sp, "epsilon_scale")
+    render_option(sp, "max_iterations")
+    sp.add_argument(
+        "--levels",
+        type=number_in("--levels", 1, MAX_LEVELS),
+        help=f"keep only the coarsest N levels (drops the finest detail; at most the "
+        f"scene's own, and ≤ {MAX_LEVELS})",
+    )
+    sp.add_argument(
+        "--effects",
+        metavar="LIST",
+        help="comma-separated effects replacing the scene's, or 'none'; one of: "
+        + ", ".join(EFFECTS),
+    )
+
+
+def preset(sp: argparse.ArgumentParser) -> None:
+    """The optional PRESET argument (a scene file or a shipped preset's name)."""
+    sp.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET")
+
+
+def scene_of(args: argparse.Namespace, name: str | None = None) -> Scene:
+    """The scene PRESET (or ``name``) names, with the render options, ``--effects`` and
+    ``--levels`` given applied; errors name the option."""
+    scene = api.load(name or args.preset)
+    knobs = {k: v for k in api.RENDER_KNOBS if (v := getattr(args, k, None)) is not None}
+    if "tracer" in knobs:
+        scene.check_tracer(knobs["tracer"], "--tracer")
+    scene = api.configure(scene, **knobs)
+    effects = getattr(args, "effects", None)
+    if effects is not None:
+        names = [] if effects.strip() == "none" else [e.strip() for e in effects.split(",")]
+        scene = scene.with_effects(names, "--effects")
+    levels = getattr(args, "levels", None)
+    return scene if levels is None else scene.with_levels(levels, "--levels")
+
+
+def check_output_file(path: str, flag: str, suffix: str) -> Path:
+    """Before any work: the file has the format's extension, is not a folder, and its folder
+    exists or can be made and is writable (a render must not fail after it ran)."""
+    p = Path(path)
+    if p.suffix.lower() != suffix:
+        raise SceneError(
+            flag, path, f"the file must end in {suffix} (it is written as {suffix[1:].upper()})"
+        )
+    if p.is_dir():
+        raise SceneError(flag, path, "is a folder; give a file name ending in " + suffix)
+    _probe(p.parent, f".{p.name}.write-test", flag, path)
+    return p
+
+
+def check_output_dir(path: Path, flag: str) -> None:
+    """Before any work: the folder exists or can be made, and is writable."""
+    if path.exists() and not path.is_dir():
+        raise SceneError(flag, str(path), "is a file; give a folder for the report")
+    _probe(path, ".write-test", flag, str(path))
+
+
+def _probe(folder: Path, name: str, flag: str, given: str) -> None:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / name).write_text("")
+        (folder / name).unlink()
+    except OSError as e:
+        raise SceneError(flag, given, f"cannot write there: {e.strerror}") from None
+
+
+class MissingExtra(RuntimeError):
+    """An optional dependency is not installed (exit status 3, as for GL problems)."""
+
+
+def require(*modules: str, extra: str, what: str) -> None:
+    """An optional extra's packages are there, or one line says how to get them."""
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    if missing:
+        raise MissingExtra(f"{what} needs {', '.join(missing)}: pip install 'krsview[{extra}]'")

@@ -1,0 +1,264 @@
+"""`krsview render`: one frame headless to PNG (and its arrays), or a camera path's frames and
+their video, through :class:`krsview.Renderer` and :mod:`krsview.export`."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .. import api, export
+from ..frame import Frame
+from ..progress import Progress
+from ..scene import Scene, SceneError
+from ..share.frames import DEFAULT_FPS
+from . import options
+from .options import SILENT_SECONDS, check_output_dir, check_output_file, render_option
+
+KNOBS = (
+    "tracer",
+    "relaxation",
+    "precision",
+    "culling",
+    "prepass",
+    "prepass_levels",
+    "path",
+    "steps",
+    "shadow_tasks",
+    "component_tasks",
+)  # the [render] fields `render` overrides, beside the scene options
+
+
+def add(sub) -> None:
+    r = sub.add_parser(
+        "render",
+        help="render a scene headless to PNG (and raw buffers)",
+        description="Render PRESET headless through EGL and write a PNG; prints the measured "
+        "frame time. Example: krsview render tree -o tree.png --size 640x360 --prepass 8",
+    )
+    options.preset(r)
+    r.add_argument(
+        "-o",
+        "--output",
+        help="PNG file to write, ending in .png (default out/render.png); with "
+        "--camera-path, the folder for the frames (default out/frames)",
+    )
+    r.add_argument(
+        "--size", type=options.size, default=(640, 360), help="WIDTHxHEIGHT (default 640x360)"
+    )
+    r.add_argument(
+        "--buffers",
+        metavar="NPZ",
+        help="also write color, depth, normal, iterations and hit arrays to this "
+        "NumPy file, ending in .npz",
+    )
+    r.add_argument(
+        "--reference",
+        action="store_true",
+        help="render with the float64 NumPy reference instead of the GPU (slow)",
+    )
+    r.add_argument(
+        "--repeats",
+        type=options.number_in("--repeats", 1, 1000),
+        default=5,
+        help="frames timed; the median is printed (default 5)",
+    )
+    r.add_argument(
+        "--view",
+        choices=("shaded", "iterations"),
+        default="shaded",
+        help="shaded image, or the per-pixel iteration count as a heat map with a "
+        "legend (black = 0, white = the maximum) [KRS17 Fig. 13]",
+    )
+    r.add_argument(
+        "--legend-max",
+        type=options.number_in("--legend-max", 1, 100000),
+        metavar="N",
+        help="iterations shown as white in --view iterations (default: the image's "
+        "maximum); fix it to compare tracers on one scale",
+    )
+    for name in KNOBS:
+        render_option(r, name)
+    options.scene_options(r)
+    cp = r.add_argument_group(
+        "camera paths",
+        "Render the frames of a path recorded in the viewer (F5; saved as "
+        "NAME.path.json beside the preset) to frame_00000.png, … in the -o folder. Frames "
+        "already there are skipped, so an interrupted run resumes where it stopped.",
+    )
+    camera_path_options(cp, required=False)
+    r.set_defaults(func=run)
+
+
+def camera_path_options(sp, required: bool) -> None:
+    """--camera-path, --frames, --fps and --video (`render` and `batch`)."""
+    sp.add_argument(
+        "--camera-path",
+        required=required,
+        metavar="FILE",
+        help="a NAME.path.json camera path (recorded in the viewer with F5)",
+    )
+    sp.add_argument(
+        "--frames", metavar="A-B", help="only frames A to B, inclusive (default: all the path's)"
+    )
+    sp.add_argument(
+        "--fps",
+        type=options.number_in("--fps", 1.0, 240.0, float),
+        default=DEFAULT_FPS,
+        help=f"frames per second of path time (default {DEFAULT_FPS:g})",
+    )
+    sp.add_argument(
+        "--video",
+        metavar="MP4",
+        help="also write the frames as an H.264 "
+        "video, ending in .mp4 (needs an even width and height)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = options.scene_of(args)
+    if args.camera_path is not None:
+        for flag, given in (
+            ("--buffers", args.buffers),
+            ("--reference", args.reference),
+            ("--view", args.view != "shaded"),
+        ):
+            if given:
+                raise SceneError(
+                    flag,
+                    getattr(args, flag[2:]),
+                    "cannot be combined with --camera-path (it writes shaded frames)",
+                )
+        return render_camera_path(args, scene)
+    for flag in ("frames", "video"):
+        if getattr(args, flag) is not None:
+            raise SceneError(f"--{flag}", getattr(args, flag), "needs --camera-path FILE")
+    out = check_output_file(args.output or "out/render.png", "-o", ".png")
+    if args.buffers:
+        check_output_file(args.buffers, "--buffers", ".npz")
+    info = api.check(scene)
+    print(
+        f"krsview: {scene.name}: {info.levels} levels, {info.instances:,} kernel "
+        f"instances, {args.size[0]}×{args.size[1]}, "
+        f"{'NumPy reference' if args.reference else 'GPU'}",
+        flush=True,
+    )
+    if args.reference:
+        frame = reference_frame(scene, args.size)
+    else:
+        frame = timed_frame(scene, args.size, args.repeats)
+    if args.view == "iterations":
+        from ..heatmap import save_heatmap
+
+        it = frame.iterations
+        vmax = save_heatmap(
+            it, out, args.legend_max, f"{scene.render.tracer} tracing: iterations per pixel"
+        )
+        print(
+            f"  iterations per pixel: median {np.median(it):.0f}, mean {it.mean():.1f}, "
+            f"max {it.max()} (colour scale 0..{vmax})"
+        )
+    else:
+        frame.save(out)
+    print(f"  wrote {out.resolve()}")
+    if args.buffers:
+        frame.save(args.buffers)
+        print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")
+    return 0
+
+
+def reference_frame(scene: Scene, size: tuple[int, int]) -> Frame:
+    """The float64 reference's frame, its time printed."""
+    t0 = time.perf_counter()
+    frame = api.Renderer(*size).render(
+        scene, reference=True, progress=Progress(1, "  rays", SILENT_SECONDS)
+    )
+    print(f"  traced in {(time.perf_counter() - t0) * 1e3:.0f} ms (float64 reference)")
+    return frame
+
+
+def timed_frame(scene: Scene, size: tuple[int, int], repeats: int) -> Frame:
+    """The GPU's frame, and the median of ``repeats`` more frames' times, printed."""
+    r = api.Renderer(*size)
+    t0 = time.perf_counter()
+    print("  compiling shader variant …", flush=True)
+    frame = r.render(scene, progress=Progress(1, "  first frame, rows", SILENT_SECONDS))
+    print(f"  first frame {(time.perf_counter() - t0) * 1e3:.0f} ms (with compiling)", flush=True)
+    bar = Progress(repeats, "  timing frames", SILENT_SECONDS)
+    times = []
+    for _ in range(repeats):
+        times += r.time(scene, repeats=1)
+        bar.step()
+    print(
+        f"  frame time {sorted(times)[len(times) // 2] * 1e3:.1f} ms (median of {repeats}), "
+        f"{frame.iterations.mean():.1f} iterations/pixel, "
+        f"{frame.hit.mean() * 100:.0f}% of pixels hit"
+    )
+    return frame
+
+
+def frame_job(args: argparse.Namespace, scene: Scene):
+    """The frames ``--camera-path``, ``--frames``, ``--fps``, ``--size`` and ``-o`` ask for,
+    checked before any frame is drawn: the job and the range of frames."""
+    from ..scene.camera_path import load_camera_path
+    from ..share.frames import FrameJob, parse_frames
+
+    path = load_camera_path(args.camera_path)
+    folder = Path(args.output or "out/frames")
+    if folder.suffix.lower() == ".png":
+        raise SceneError("-o", str(folder), "with --camera-path, give a folder for the frames")
+    check_output_dir(folder, "-o")
+    job = FrameJob(scene, path, args.fps, args.size, folder)
+    return job, parse_frames(args.frames, job.count)
+
+
+def check_video(text: str | None, size: tuple[int, int]) -> Path | None:
+    """``--video``: an .mp4 that can be written, of a size H.264 4:2:0 takes."""
+    if text is None:
+        return None
+    video = check_output_file(text, "--video", ".mp4")
+    if size[0] % 2 or size[1] % 2:
+        raise SceneError(
+            "--size",
+            f"{size[0]}x{size[1]}",
+            "--video needs an even width and height (H.264, 4:2:0 colour)",
+        )
+    return video
+
+
+def write_video(job, frames: range, video: Path) -> None:
+    """The frames as an MP4, with a progress bar."""
+    from ..share.frames import write_video
+
+    bar = Progress(len(frames), "  video")
+    write_video(job.folder, frames, job.fps, video, lambda k: bar.step())
+    print(f"  wrote {video.resolve()}")
+
+
+def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
+    job, frames = frame_job(args, scene)
+    video = check_video(args.video, job.size)
+    todo = job.missing(frames)
+    print(
+        f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of "
+        f"{job.count} ({job.path.duration:.2f} s at {job.fps:g} fps), "
+        f"{job.size[0]}×{job.size[1]} → {job.folder}/; "
+        f"{len(frames) - len(todo)} already there, {len(todo)} to render",
+        flush=True,
+    )
+    if todo:
+        bar = Progress(len(todo), "  frames")
+        export.frames(
+            scene,
+            job.path,
+            job.folder,
+            job.size,
+            job.fps,
+            args.frames,
+            lambda k: bar.step(f"frame {k}"),
+        )
+    if video is not None:
+        write_video(job, frames, video)
+    return 0

@@ -1,0 +1,108 @@
+"""`krsview view` and `krsview edit`: open a window (:func:`krsview.app.view`,
+:func:`krsview.app.edit`); their options are generated from the viewer's settings fields."""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import MISSING, dataclass, field, fields
+
+from .. import app
+from ..scene import Render
+from ..scene.model import VIEW_PREPASS
+from ..scene.presets import resolve
+from ..scene.schema import param
+from . import options
+
+RENDER_PREPASS = next(f for f in fields(Render) if f.name == "prepass").metadata
+
+
+@dataclass(frozen=True)
+class ViewerSettings:
+    """What a viewer window starts with (the fields of krsview.scene.settings.ViewerSettings,
+    which replaces this class once it is in the scene package)."""
+
+    size: tuple[int, int] = param((960, 540), help="window size")
+    target_fps: float = param(
+        30.0,
+        lo=1.0,
+        hi=240.0,
+        help="frame rate held while moving or dragging, by lowering the internal resolution",
+    )
+    prepass: int | None = field(
+        default=None,
+        metadata={
+            **RENDER_PREPASS,
+            "help": "tile size of the low-resolution pre-pass while viewing; 0: off",
+        },
+    )
+    hud: bool = param(True, help="the HUD shown at start")
+    moving_effects: bool = param(
+        False,
+        help="keep shadows and ambient occlusion in moving frames too (default: "
+        "they appear when the view stops, so moving frames stay sharp)",
+    )
+
+
+FLAGS = {"target_fps": "--fps"}  # fields whose flag is not --FIELD-NAME
+NOTES = {"prepass": f"default: the scene's [render] prepass, else {VIEW_PREPASS}"}
+EDITOR = ("size", "target_fps")  # the settings the editor takes
+EDITOR_SIZE = (1280, 720)
+
+
+def settings_options(sp: argparse.ArgumentParser, names, **defaults) -> None:
+    """PRESET and one option per settings field in ``names`` (``defaults``: per command)."""
+    options.preset(sp)
+    for name in names:
+        options.field_option(
+            sp,
+            ViewerSettings,
+            name,
+            FLAGS.get(name),
+            defaults.get(name, MISSING),
+            NOTES.get(name),
+        )
+
+
+def add(sub) -> None:
+    v = sub.add_parser(
+        "view",
+        help="fly through a scene in a window",
+        description="Open PRESET in a window. WASD/QE fly (speed follows the "
+        "distance to the nearest surface; scroll scales it), right-drag "
+        "looks, O orbits the point at the centre, R resets, B saves a "
+        "bookmark in the preset, N cycles bookmarks, F5 records and F6 "
+        "replays a camera path, F12 saves a screenshot, F1 hides the "
+        "HUD. Editing the preset or a shader reloads it. "
+        "Example: krsview view forest --fps 60 --prepass 8",
+    )
+    settings_options(v, [f.name for f in fields(ViewerSettings)])
+    v.set_defaults(func=run_view)
+
+    e = sub.add_parser(
+        "edit",
+        help="shape a tree: drag forks, control points and mirror normals; undo, save",
+        description="Open PRESET in the editor. Click a handle (forks orange, "
+        "control points cyan, mirror normals pink), an outline entry "
+        "or the geometry to select; drag the gizmo to move it (Shift "
+        "snaps). A grown [tree] is baked into an editable route with "
+        "one click. Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo, "
+        "Ctrl+S saves atomically, Ctrl+Shift+S saves as; unsaved "
+        "edits are autosaved to PRESET.recovery and offered back "
+        "after a crash. The viewer's keys fly the camera. Example: krsview edit tree",
+    )
+    settings_options(e, EDITOR, size=EDITOR_SIZE)
+    e.set_defaults(func=run_edit)
+
+
+def chosen(args: argparse.Namespace, names) -> dict:
+    return {name: getattr(args, name) for name in names}
+
+
+def run_view(args: argparse.Namespace) -> int:
+    app.view(resolve(args.preset), **chosen(args, [f.name for f in fields(ViewerSettings)]))
+    return 0
+
+
+def run_edit(args: argparse.Namespace) -> int:
+    app.edit(resolve(args.preset), **chosen(args, EDITOR))
+    return 0

@@ -1,0 +1,132 @@
+"""The benchmarks return data (issue 26): each bench function gives its rows, with the CSV's
+columns, and its ``table`` prints those rows; what the rows must hold is checked against
+what the bench was asked to measure (no wall time is asserted)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import krsview
+from krsview.bench import accuracy, effects, levels, paths, split, tracers
+from krsview.bench.report import Measured, markdown, write_csv
+from krsview.scene import SceneError
+from krsview.scene.effects import allowed_effects
+
+SIZE = (16, 9)
+
+
+def data_rows(table: str) -> list[str]:
+    """The body rows of the Markdown table in ``table``."""
+    lines = table.splitlines()
+    head = next(k for k, line in enumerate(lines) if line.startswith("|---"))
+    return [line for line in lines[head + 1 :] if line.startswith("| ")]
+
+
+def test_levels_returns_a_row_per_level_count():
+    scene = krsview.load("sierpinski")
+    m = levels.bench_levels(scene, SIZE, step=8, rounds=1)
+    assert isinstance(m, Measured) and m.size == SIZE and m.rounds == 1
+    assert m.column("levels") == [8, 16, 22]
+    assert list(m.rows[0]) == [
+        "levels",
+        "instances",
+        "ms",
+        "time_ratio",
+        "iterations",
+        "ratio_per_iteration",
+    ]
+    assert m.rows[0]["time_ratio"] == 1.0 and m.rows[0]["ratio_per_iteration"] == 1.0
+    assert m.column("instances") == [
+        scene.geometry().truncated(n).instance_count() for n in (8, 16, 22)
+    ]
+    assert len(data_rows(levels.table(m))) == 3 and "linear fit" in levels.table(m)
+    # negative control: two level counts make no fit
+    two = Measured(m.scene, m.size, 1, m.rows[:2])
+    assert "linear fit" not in levels.table(two) and len(data_rows(levels.table(two))) == 2
+
+
+def test_tracers_returns_sphere_and_binary_against_sphere():
+    m = tracers.bench_tracers(krsview.load("sierpinski"), SIZE, rounds=1, sweep=False)
+    assert m.column("tracer") == ["sphere", "binary"]
+    first = m.rows[0]
+    assert first["iteration_ratio"] == 1.0 and first["hit_agreement"] == 1.0
+    assert m.rows[1]["xi_bonus"] == 2.0 and m.rows[1]["xi_penalty"] == 0.3
+    assert 0 < m.rows[1]["hit_fraction"] < 1
+    assert "fastest ξ pair" not in tracers.table(m)  # one binary setting: no pair to pick
+    with pytest.raises(SceneError, match="--no-sweep"):  # a MöKRS has nothing to compare
+        tracers.bench_tracers(krsview.load("palm"), SIZE, rounds=1, sweep=False)
+
+
+def test_effects_returns_plain_each_effect_and_the_compiled_variants():
+    scene = krsview.load("sierpinski")
+    m = effects.bench_effects(scene, SIZE, rounds=1)
+    names = m.column("variant")
+    assert names[0] == "plain" and m.rows[0]["ratio_to_plain"] == 1.0
+    assert set(allowed_effects(False)) <= set(names)
+    assert "none on, all compiled" in names and "compound of 1" in names
+    for row in m.rows:
+        assert row["incremental"] == pytest.approx(row["ratio_to_plain"] - 1.0)
+    assert len(data_rows(effects.table(m))) == len(m.rows)
+    # negative control: a scene without effects has no specialised-vs-compiled pair
+    assert ("scene, specialised" in names) == bool(scene.effects)
+
+
+def test_split_parts_add_up_to_the_frame_and_no_prepass_has_no_coarse_part():
+    tree = krsview.load("tree")
+    with_prepass = split.bench_split(tree.edit("render.prepass", 4), SIZE, rounds=1)
+    ms = dict(zip(with_prepass.column("part"), with_prepass.column("ms")))
+    parts = [p for p in ms if not p.startswith(("frame", "moving"))]
+    assert len(parts) == 4 and sum(ms[p] for p in parts) == pytest.approx(ms["frame"])
+    assert ms["coarse passes"] > 0
+    without = split.bench_split(tree.edit("render.prepass", 0), SIZE, rounds=1)
+    assert dict(zip(without.column("part"), without.column("ms")))["coarse passes"] == 0.0
+
+
+def test_paths_returns_every_lever_at_two_sizes():
+    scene = krsview.load("sierpinski")
+    m = paths.bench_paths(scene, (8, 6), rounds=1)
+    assert len(m.rows) == 2 * len(paths.levers(scene))
+    assert {row["size"] for row in m.rows} == {"8x6", "16x12"}
+    plain = [r for r in m.rows if (r["path"], r["culling"], r["prepass"]) == ("fragment", "off", 0)]
+    assert [r["speedup"] for r in plain] == [1.0, 1.0]
+    assert all((r["coarse_share"] > 0) == (r["prepass"] > 0) for r in m.rows)
+
+
+def test_accuracy_returns_a_row_per_setting_and_error_images(tmp_path):
+    scene = krsview.load("sierpinski")
+    acc = accuracy.bench_accuracy(scene, SIZE, rounds=1, cache=tmp_path / "cache")
+    m = acc.measured
+    assert [(r["knob"], r["value"]) for r in m.rows] == [
+        (s.knob, s.value) for s in accuracy.settings(scene)
+    ]
+    assert m.rows[0]["time_ratio"] == 1.0
+    assert all(r["mask_error"] == r["holes"] + r["false_hits"] for r in m.rows)
+    assert acc.errors and all(
+        name.endswith(".png") and img.shape == (SIZE[1], SIZE[0], 3) and img.dtype == np.uint8
+        for name, img in acc.errors.items()
+    )
+    # the loosest ε loses pixels the truth has; the scene's own setting far fewer
+    eps = {r["value"]: r["mask_error"] for r in m.rows if r["knob"] == "epsilon_scale"}
+    assert eps["8"] > eps["0.125"]
+    text = accuracy.write_report(acc, tmp_path / "report")
+    assert text == (tmp_path / "report" / "README.md").read_text()
+    assert {name for name in acc.errors} <= {p.name for p in (tmp_path / "report").iterdir()}
+
+
+def test_markdown_and_csv_hold_the_rows(tmp_path):
+    rows = [dict(part="shadow rays, occlusion", ms=1.5), dict(part="frame", ms=3.0)]
+    assert markdown(("part", "ms"), "lr", [(r["part"], r["ms"]) for r in rows]) == (
+        "| part | ms |\n|---|---:|\n| shadow rays, occlusion | 1.5 |\n| frame | 3.0 |"
+    )
+    path = write_csv(rows, tmp_path / "sub" / "x.csv")
+    assert path.read_text() == 'part,ms\n"shadow rays, occlusion",1.5\nframe,3.0\n'
+
+
+def test_split_table_names_the_prepass_it_measured():
+    tree = krsview.load("tree")
+    m = Measured(replace(tree, render=replace(tree.render, prepass=8)), SIZE, 1, [])
+    assert "pre-pass 8 × 2" in split.table(m)
+    assert "pre-pass off" in split.table(Measured(tree, SIZE, 1, []))
