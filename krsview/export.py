@@ -98,14 +98,19 @@ def frames(
 
 
 def video(
-    folder: str | Path, video_path: str | Path, fps: float = DEFAULT_FPS, which: range | None = None
+    folder: str | Path,
+    video_path: str | Path,
+    fps: float = DEFAULT_FPS,
+    which: range | None = None,
+    done: Callable[[int], None] | None = None,
 ) -> Path:
-    """An H.264 MP4 of the frames in ``folder`` (all, or the range ``which``)."""
+    """An H.264 MP4 of the frames in ``folder`` (all, or the range ``which``), written whole
+    or not at all; ``done(k)`` after each frame."""
     folder = Path(folder)
     if which is None:
         count = 0
         while frame_file(folder, count).exists():
             count += 1
         which = range(count)
-    write_video(folder, which, fps, Path(video_path))
+    write_video(folder, which, fps, Path(video_path), done)
     return Path(video_path)

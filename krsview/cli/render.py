@@ -230,10 +230,8 @@ def check_video(text: str | None, size: tuple[int, int]) -> Path | None:
 
 def write_video(job, frames: range, video: Path) -> None:
     """The frames as an MP4, with a progress bar."""
-    from ..share.frames import write_video
-
     bar = Progress(len(frames), "  video")
-    write_video(job.folder, frames, job.fps, video, lambda k: bar.step())
+    export.video(job.folder, video, job.fps, frames, lambda k: bar.step())
     print(f"  wrote {video.resolve()}")
 
 
