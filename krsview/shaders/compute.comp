@@ -166,5 +166,5 @@ void main() {
     else if (u_phase == PHASE_SHADOW_START) start_shadows(k);
     else if (u_phase == PHASE_SHADOW_ROUND) shadow_round(k);
 #endif
-    else ray_round(k);
+    else if (u_phase == PHASE_ROUND) ray_round(k);
 }
