@@ -86,7 +86,7 @@ def test_rounds_that_drop_live_rays_lose_them(tmp_path, renderer):
     shaders = broken_shaders(
         tmp_path,
         "compute.comp",
-        "queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = ray;",
+        "if (r.state == RAY_LIVE) requeue(ray);",
         "",
     )
     scene = on_path(load_scene(resolve("tree")), "compute", steps=2)
@@ -134,7 +134,7 @@ def test_shadow_rounds_that_drop_live_tasks_lose_the_shadows(tmp_path, renderer)
     shaders = broken_shaders(
         tmp_path,
         "compute.comp",
-        "queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = slot;",
+        "if (sh.state == SHADOW_LIVE) requeue(slot);",
         "",
     )
     scene = on_path(replace(load_scene(resolve("palm")), effects=["shadows"]), "compute", steps=2)

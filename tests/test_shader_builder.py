@@ -14,7 +14,7 @@ from krsview.gpu.uniforms import variant_defines
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
 
-DEFINES = {"KRS_SLOTS": 64, "KRS_RECORD": 6, "KRS_KERNEL_TOROIDAL_CAPSULE": None}
+DEFINES = {"KRS_SLOTS": 64, "KRS_KERNEL_TOROIDAL_CAPSULE": None}
 
 
 @pytest.fixture

@@ -1,6 +1,7 @@
-"""Shader program builder: ``#include`` resolution with ``#line`` mapping, one ``#define``
-per enabled feature, a variant cache keyed by the define set, and compile errors mapped back
-to ``file.glsl:line`` (the moderngl-window habit, DESIGN.md)."""
+"""Shader program builder: ``#include`` resolution with ``#line`` mapping, the constants shared
+with Python (compile/constants.py) and one ``#define`` per enabled feature, a variant cache
+keyed by the define set, and compile errors mapped back to ``file.glsl:line`` (the
+moderngl-window habit, DESIGN.md)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import moderngl
 
+from ..compile.constants import glsl_defines
 from .context import GL_VERSION
 
 SHADER_DIR = Path(str(resources.files("krsview") / "shaders"))
@@ -19,6 +21,7 @@ ES_HEADER = ("#version 300 es", "precision highp float;", "precision highp int;"
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 # Mesa: "0:12(5): error"; NVIDIA: "0(12) : error". The line is in the assembled source.
 _LOCATION = re.compile(r"\b\d+(?::(\d+)\((\d+)\)|\((\d+)\))")
+SHARED = glsl_defines()  # every program's first defines: the constants shared with Python
 
 
 class ShaderError(RuntimeError):
@@ -47,12 +50,15 @@ class Source:
         header: tuple[str, ...] = CORE_HEADER,
     ):
         self.shader_dir = shader_dir
-        head = list(header)
+        clash = sorted(set(defines) & set(SHARED))
+        if clash:
+            raise ShaderError(f"{entry}: {', '.join(clash)} shared with Python, not a variant's")
+        head = list(header) + [f"#define {k} {v}" for k, v in SHARED.items()]
         head += [
             f"#define {k}" + ("" if v is None else f" {v}") for k, v in sorted(defines.items())
         ]
         self.origin: list[tuple[str, int]] = [("<defines>", k) for k in range(1, len(head) + 1)]
-        self.defined = set(defines)
+        self.defined = set(defines) | set(SHARED)
         self.included: set[str] = set()
         lines = head + self._expand(entry, [])
         self.text = "\n".join(lines) + "\n"
@@ -80,7 +86,13 @@ class Source:
             if not all(on for on, _ in active):
                 continue
             if d and d.group(1) == "define":
-                self.defined.add(d.group(2).split("(")[0].split()[0])
+                defined = d.group(2).split("(")[0].split()[0]
+                if defined in SHARED:
+                    raise ShaderError(
+                        f"{name}:{k}: #define {defined}: shared with Python, so defined once "
+                        "in compile/constants.py and given to every program"
+                    )
+                self.defined.add(defined)
             elif d and d.group(1) == "undef":
                 self.defined.discard(d.group(2))
             m = _INCLUDE.match(line)

@@ -15,18 +15,18 @@ import moderngl
 import numpy as np
 
 from ..compile.camera import view_of
+from ..compile.constants import BINDING_KRS_BLOCK, PREPASS_TARGETS
 from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
-from ..scene import MAX_COMPONENTS, Geometry, Scene, SceneError
+from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PREPASS_RATIO
-from ..scene.scene import MAX_LIGHTS
+from .compute import ComputePath, Rounds
 from .context import headless_context
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
 
 PROGRESS_BANDS = 16  # bands of rows of a first frame drawn with progress
 MAX_TARGETS = 8  # render-target sizes kept (least recently used released)
-COMPUTE_GROUP = 64  # compute.comp's local size
 
 
 class Renderer:
@@ -37,8 +37,8 @@ class Renderer:
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
         self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int, int]] = {}  # pre-pass
         self._blank: moderngl.Texture | None = None  # bound where the coarsest pass's parent is
-        self._compute: dict[moderngl.Program, tuple] = {}  # deferred → compute, its sizes
-        self._rays: dict[int, moderngl.Buffer] = {}  # the compute path's buffers, by binding
+        self._compute: dict[moderngl.Program, Rounds] = {}  # deferred → its compute pass
+        self._rays = ComputePath(self.ctx)  # the compute path's buffers
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
@@ -60,7 +60,7 @@ class Renderer:
     def _framebuffer(self, width: int, height: int, layers: int = 3) -> moderngl.Framebuffer:
         """Render targets per size, the most recently used MAX_TARGETS kept: the viewer's
         adaptive resolution and window resizes visit many sizes, and each holds 3 textures
-        (a pre-pass's: 2)."""
+        (a pre-pass's: PREPASS_TARGETS)."""
         key = (width, height, layers)
         if key in self._targets:
             self._targets[key] = self._targets.pop(key)  # most recent last
@@ -124,22 +124,7 @@ class Renderer:
         if scene.render.path == "compute":  # trace in rounds, then a shading pass
             prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
             comp = self.programs.compute("compute.comp", defines)
-            components = MAX_COMPONENTS if "KRS_COMPOUND" in defines else 1
-            real = 8 if scene.render.precision == "double" else 4
-            ray_bytes = (2 * components + 4) * real + 8  # trace.glsl's Ray in std430
-            shadow_bytes = 0  # shadows.glsl's Shadow
-            if "KRS_SHADOW_TASKS" in defines:
-                align = max(4 * real, 16)
-                shadow_bytes = -(-(4 * real + 16 + (components + 1) * real + 12) // align) * align
-            per_pixel = components if "KRS_COMPONENT_TASKS" in defines else 0
-            self._compute[prog] = (
-                comp,
-                scene.render.steps,
-                scene.render.max_iterations,
-                ray_bytes,
-                shadow_bytes,
-                per_pixel,
-            )
+            self._compute[prog] = Rounds.of(comp, scene.render, defines)
             progs = [prog, comp]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
@@ -149,21 +134,22 @@ class Renderer:
             self._coarse[prog] = (coarse, scene.render.prepass, scene.render.prepass_levels)
             progs.append(coarse)
             for p in progs:  # the finest coarse pass's output, and the coarser one's before it
-                for unit, name in enumerate(("u_free0", "u_free1", "u_parent0", "u_parent1")):
-                    if name in p:  # unused: compiled away
-                        p[name].value = unit
+                for k, name in enumerate(("u_free", "u_parent")):
+                    if name in p:  # unused: compiled away; only its first elements used
+                        units = range(k * PREPASS_TARGETS, (k + 1) * PREPASS_TARGETS)
+                        p[name].write(np.array(units[: p[name].array_length], "i4").tobytes())
         if self._ubo is None or self._ubo.size != len(block):
             self._ubo = self.ctx.buffer(block)
         else:
             self._ubo.write(block)
         if storage:
-            self._ubo.bind_to_storage_buffer(0)
+            self._ubo.bind_to_storage_buffer(BINDING_KRS_BLOCK)
         else:
-            self._ubo.bind_to_uniform_block(0)
+            self._ubo.bind_to_uniform_block(BINDING_KRS_BLOCK)
         uniforms = view_uniforms(scene, view, c)
         for p in progs:
             if not storage and "KRSBlock" in p:
-                p["KRSBlock"].binding = 0
+                p["KRSBlock"].binding = BINDING_KRS_BLOCK
             for name, value in uniforms.items():
                 if name in p:
                     p[name].value = value
@@ -193,7 +179,7 @@ class Renderer:
             if prog in self._coarse:
                 self._prepass(prog, width, height, tile)
             if prog in self._compute:
-                self._trace_rays(prog, width, height, tile)
+                self._rays.trace(self._compute[prog], prog, width, height, tile)
             fbo = self._framebuffer(width, height)
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
@@ -210,8 +196,9 @@ class Renderer:
         tile: tuple[int, int, int, int] | None,
     ) -> None:
         """The coarse passes of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
-        coarsest first, each reading the one before's free distances from texture units 2
-        and 3; the finest's are left bound to units 0 and 1 for the full pass."""
+        coarsest first, each reading the one before's free distances from the texture units
+        after the first PREPASS_TARGETS; the finest's are left bound to those for the full
+        pass."""
         coarse, size, levels = self._coarse[prog]
         passes: list[tuple[int, int, int]] = []  # (tile size, columns, rows), finest first
         for k in range(levels):
@@ -222,7 +209,7 @@ class Renderer:
             passes.append(grid)
         parent = None
         for t, cw, ch in reversed(passes):
-            fbo = self._framebuffer(cw, ch, layers=2)
+            fbo = self._framebuffer(cw, ch, layers=PREPASS_TARGETS)
             fbo.use()
             self.ctx.viewport = (0, 0, cw, ch)
             coarse["u_tile"].value = t
@@ -230,9 +217,9 @@ class Renderer:
             # the coarsest pass reads no parent: its samplers get a texture no pass draws
             # into, so no target is ever bound for sampling while it is drawn into
             for unit, tex in enumerate(
-                parent.color_attachments if parent else (self._blank_texture(),) * 2
+                parent.color_attachments if parent else (self._blank_texture(),) * PREPASS_TARGETS
             ):
-                tex.use(2 + unit)
+                tex.use(PREPASS_TARGETS + unit)
             if tile is not None:
                 x, y, w, h = tile
                 x0, y0 = x // t, y // t
@@ -275,78 +262,6 @@ class Renderer:
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
 
-    def _trace_rays(
-        self,
-        prog: moderngl.Program,
-        width: int,
-        height: int,
-        tile: tuple[int, int, int, int] | None,
-    ) -> None:
-        """The compute path (compute.comp): start the rays of ``tile`` (or all), run rounds
-        of at most ``steps`` iterations, each sized by the GPU from the rays still live, and
-        leave the ray buffer bound for the shading pass (deferred.frag). Rounds enough for
-        the iteration cap are issued without reading anything back. With a task per pixel
-        and component (``per_pixel`` of them), those are traced instead, and a last pass
-        keeps each pixel's nearest hit in its ray."""
-        comp, steps, cap, ray_bytes, shadow_bytes, per_pixel = self._compute[prog]
-        x, y, w, h = tile or (0, 0, width, height)
-        area = w * h
-        traced = area * max(per_pixel, 1)  # rays traced in rounds
-        queue = max(traced, area * MAX_LIGHTS if shadow_bytes else area)  # the longest queue
-        sizes = {1: area * ray_bytes, 2: 2 * queue * 4, 3: 5 * 4}
-        if shadow_bytes:
-            sizes[4] = area * MAX_LIGHTS * shadow_bytes
-        if per_pixel:
-            sizes[5] = traced * ray_bytes
-        for binding, size in sizes.items():
-            if binding not in self._rays or self._rays[binding].size < size:
-                if binding in self._rays:
-                    self._rays[binding].release()
-                self._rays[binding] = self.ctx.buffer(reserve=max(size, 16))
-            self._rays[binding].bind_to_storage_buffer(binding)
-        groups = -(-area // COMPUTE_GROUP)
-        self._rays[3].write(
-            np.array([traced, 0, -(-traced // COMPUTE_GROUP), 1, 1], dtype=np.uint32)
-        )
-        prog["u_tile_rect"].value = (x, y, w, h)
-        for name, value in (
-            ("u_tile_rect", (x, y, w, h)),
-            ("u_area", area),
-            ("u_queue", queue),
-            ("u_tasks", traced),
-            ("u_steps", steps),
-            ("u_phase", 0),
-        ):
-            if name in comp:
-                comp[name].value = value
-        comp.run(-(-traced // COMPUTE_GROUP))
-        self._rounds(comp, 1, -(-cap // steps) + 1)
-        if per_pixel:  # each pixel's ray: the nearest of its components' hits
-            self.ctx.memory_barrier()
-            comp["u_phase"].value = 5
-            comp.run(groups)
-        if shadow_bytes:  # shadow rays as tasks of their own, through the same queues
-            self.ctx.memory_barrier()
-            self._rays[3].write(np.array([0, 0, 0, 1, 1], dtype=np.uint32))
-            comp["u_phase"].value = 3
-            comp.run(groups)
-            self.ctx.memory_barrier()
-            comp["u_parity"].value, comp["u_phase"].value = 1, 2  # size round 0 from queue 0
-            comp.run(1)
-            self._rounds(comp, 4, -(-cap // steps) + 1)
-        self.ctx.memory_barrier()
-
-    def _rounds(self, comp: moderngl.ComputeShader, phase: int, rounds: int) -> None:
-        """``rounds`` rounds of ``phase`` (1: rays, 4: shadow tasks), each sized by the GPU
-        from what the last one left live, with no read-back."""
-        for k in range(rounds):
-            self.ctx.memory_barrier()
-            comp["u_parity"].value, comp["u_phase"].value = k % 2, phase
-            comp.run_indirect(self._rays[3], offset=8)
-            self.ctx.memory_barrier()
-            comp["u_phase"].value = 2
-            comp.run(1)
-
     def levels(self, scene: Scene, width: int, height: int) -> np.ndarray:
         """Per pixel (rows top → bottom), the levels Alg. 1 walked while tracing the ray (not
         shading it), summed over its steps: with culling, fewer than steps × n. Counted by
@@ -358,8 +273,8 @@ class Renderer:
 
     def free_distances(self, scene: Scene, width: int, height: int) -> np.ndarray:
         """The pre-pass's free distance per tile and component, (rows top → bottom, columns,
-        8), for a scene with ``[render] prepass`` > 0: what each of the tile's rays starts
-        from."""
+        MAX_COMPONENTS), for a scene with ``[render] prepass`` > 0: what each of the tile's
+        rays starts from."""
         if not scene.render.prepass:
             raise ValueError(f"{scene.name}: free distances need [render] prepass > 0")
         with self.current():
@@ -367,10 +282,9 @@ class Renderer:
             size = self._coarse[prog][1]
             self._prepass(prog, width, height, None)
             cw, ch = -(-width // size), -(-height // size)
-            fbo = self._framebuffer(cw, ch, layers=2)
-            return np.concatenate([read_plane(fbo, k, cw, ch) for k in range(2)], axis=-1).astype(
-                np.float64
-            )
+            fbo = self._framebuffer(cw, ch, layers=PREPASS_TARGETS)
+            planes = [read_plane(fbo, k, cw, ch) for k in range(PREPASS_TARGETS)]
+            return np.concatenate(planes, axis=-1).astype(np.float64)
 
     def time_frame(
         self,

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..compile.camera import View
+from ..compile.constants import MOBIUS_RECORD
 from ..compile.geometry import Compiled
 from ..compile.krs import KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound
 from ..compile.mokrs import CompiledMoKRS
@@ -14,8 +15,6 @@ from ..scene.compound import COMPOUND_SLOTS
 from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
 from ..scene.scene import MAX_LIGHTS
 
-MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record, its bound
-
 
 def variant_defines(
     scene: Scene, c: Compiled, all_effects: bool = False
@@ -23,12 +22,8 @@ def variant_defines(
     """One define per kernel type present, per enabled effect, for the tracer, culling, the
     pre-pass, the Möbius geometry family and a compound: nothing else is compiled. ``all_effects``
     compiles every effect the geometry allows, each switched by its bit of ``u_effects``
-    (the benchmark's baseline)."""
-    defines: dict[str, str | int | None] = {
-        "KRS_SLOTS": slots(c),
-        "KRS_RECORD": RECORD_VEC4,
-        "LIGHT_SLOTS": MAX_LIGHTS,
-    }
+    (the benchmark's baseline). The constants every variant shares are the builder's."""
+    defines: dict[str, str | int | None] = {"KRS_SLOTS": slots(c)}
     for kind in set(c.types) - {"empty"}:
         defines[f"KRS_KERNEL_{kind.upper()}"] = None
     if not isinstance(c, CompiledMoKRS):
@@ -75,10 +70,8 @@ def variant_defines(
         defines["KRS_BALL_EXIT"] = None  # rays leave the components' balls (trace.glsl)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
-        defines["MOBIUS_RECORD"] = MOBIUS_RECORD
     if isinstance(c, CompiledCompound):
         defines["KRS_COMPOUND"] = None
-        defines["KRS_MAX_COMPONENTS"] = MAX_COMPONENTS
     return defines
 
 

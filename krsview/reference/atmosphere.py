@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compile.constants import SUN_SHARPNESS
 from ..scene import Scene
-
-SUN_SHARPNESS = 600.0
 
 
 def sky(scene: Scene, dirs: np.ndarray) -> np.ndarray:

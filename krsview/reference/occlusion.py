@@ -12,11 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compile.constants import AO_SAMPLES, INITIAL_PROBE, MIN_PROBE
 from ..scene import Render
-from .trace import INITIAL_PROBE, MIN_PROBE, Distance, Scale, Test, by_component, front, lod
-
-SHADOW_OFFSET = 2.0
-AO_SAMPLES = 5
+from .trace import Distance, Scale, Test, by_component, front, lod
 
 
 def shadow_by_distance(

@@ -7,14 +7,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.constants import GAMMA, SHADOW_OFFSET
 from ..compile.geometry import Compiled
 from ..compile.mokrs import CompiledMoKRS
 from ..scene import Scene
 from . import atmosphere, mokrs, occlusion, texture
 from .distortion import Distortion
 from .geometry import component_distances, scene_distance
-
-GAMMA = 2.2
 
 
 def encode(scene: Scene, linear: np.ndarray) -> np.ndarray:
@@ -77,7 +76,7 @@ def shade(
         cos = np.maximum(h.normal @ l, 0.0)
         if shadows:
             lit = np.flatnonzero(cos > 0.0)
-            o = h.p[lit] + occlusion.SHADOW_OFFSET * eps[lit, None] * h.normal[lit]
+            o = h.p[lit] + SHADOW_OFFSET * eps[lit, None] * h.normal[lit]
             k = fx.shadow_softness if soft else None
             if isinstance(c, CompiledMoKRS):
                 vis = occlusion.shadow_by_probes(

@@ -8,11 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compile.constants import BARK_STRETCH, TEXTURE_OCTAVE_SHIFT, TEXTURE_OCTAVES
 from ..scene.tree import perpendicular
-
-OCTAVES = 5
-OCTAVE_SHIFT = np.array([17.0, 31.0])  # decorrelates the octaves
-BARK_STRETCH = np.array([0.25, 2.0])  # kernel texture: long streaks along a branch
 
 
 def lattice(cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
@@ -42,10 +39,10 @@ def fbm(x: np.ndarray, footprint: np.ndarray) -> np.ndarray:
     """Octaves of 1, 2, 4, … cells per unit of x; an octave is kept fully while its cell is
     ≥ 4 footprints wide and replaced by its mean 0.5 once it is ≤ 2 footprints."""
     total = np.zeros(len(x))
-    norm, amp, freq = 0.0, 1.0, 1.0
-    for o in range(OCTAVES):
+    norm, amp, freq, shift = 0.0, 1.0, 1.0, np.array(TEXTURE_OCTAVE_SHIFT)
+    for o in range(TEXTURE_OCTAVES):
         keep = np.clip(2.0 - 4.0 * footprint * freq, 0.0, 1.0)
-        total += amp * (0.5 + (value_noise(freq * x + o * OCTAVE_SHIFT) - 0.5) * keep)
+        total += amp * (0.5 + (value_noise(freq * x + o * shift) - 0.5) * keep)
         norm += amp
         amp *= 0.5
         freq *= 2.0
@@ -101,5 +98,5 @@ def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
 def kernel_texture(
     kind: str, rec: np.ndarray, xk: np.ndarray, footprint: np.ndarray, scale: float
 ) -> np.ndarray:
-    x = BARK_STRETCH * kernel_uv(kind, rec, xk) / scale
+    x = np.array(BARK_STRETCH) * kernel_uv(kind, rec, xk) / scale
     return fbm(x, BARK_STRETCH[1] * footprint / scale)

@@ -12,10 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 Alg. 2 line 2]
-# A blocked probe this small has converged even where ε(t) = 0 (an eye inside a solid): in
-# exact arithmetic it would shrink forever; in float32 it underflowed to 0 within 100 probes.
-MIN_PROBE = 1e-30
+from ..compile.constants import INITIAL_PROBE, MIN_PROBE
 
 
 @dataclass

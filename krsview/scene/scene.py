@@ -31,7 +31,7 @@ class Bookmark:
     camera: Camera = param(Camera())
 
 
-MAX_LIGHTS = 4  # the shaders' light slots (LIGHT_SLOTS)
+MAX_LIGHTS = 4  # the shaders' light slots (given to them by compile/constants.py)
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,6 @@
 // Sky, fog and tone mapping: what makes a preset look like a scene; twin of
-// reference/effects.py. Each part is its own effect.
+// reference/atmosphere.py. Each part is its own effect.
 #ifdef KRS_SKY
-#define SUN_SHARPNESS 600.0   // cosine power of the sun's glow
 uniform vec3 u_sky_zenith;
 
 // Horizon (the material's background) to zenith above, darkening below; a glow towards

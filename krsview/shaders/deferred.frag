@@ -8,14 +8,14 @@
 #include "pixel.glsl"
 
 #ifdef KRS_SHADOW_TASKS
-layout(std430, binding = 4) readonly buffer Shadows { Shadow shadows[]; };
+layout(std430, binding = BINDING_SHADOWS) readonly buffer Shadows { Shadow shadows[]; };
 #endif
 
 void main() {
     int index = ray_index(ivec2(gl_FragCoord.xy));
     Ray r = rays[index];
 #ifdef KRS_SHADOW_TASKS
-    for (int j = 0; j < LIGHT_SLOTS; ++j) g_shadow[j] = shadows[index * LIGHT_SLOTS + j].vis;
+    for (int j = 0; j < MAX_LIGHTS; ++j) g_shadow[j] = shadows[index * MAX_LIGHTS + j].vis;
 #endif
     write_pixel(pixel_ray(gl_FragCoord.xy), r.state == RAY_HIT, r.t, r.iterations);
 }

@@ -1,10 +1,7 @@
 // Shows the tracer's buffers in the window, upscaled from the internal resolution:
 // shaded colour, an iteration heat map, depth or normals. A display choice, not a scene
-// effect: a uniform of this cheap pass, so switching never recompiles the tracer.
-#define VIEW_SHADED 0
-#define VIEW_ITERATIONS 1
-#define VIEW_DEPTH 2
-#define VIEW_NORMALS 3
+// effect: a uniform of this cheap pass, so switching never recompiles the tracer. u_view is
+// one of VIEW_SHADED, VIEW_ITERATIONS, VIEW_DEPTH, VIEW_NORMALS (compile/constants.py).
 
 uniform sampler2D u_color;       // rgb, hit
 uniform sampler2D u_normal;      // xyz, depth t
@@ -16,7 +13,8 @@ uniform vec2 u_window;           // size of the target in pixels
 
 out vec4 frag_color;
 
-// Black → purple → orange → white heat ramp for iteration counts [KRS17 Fig. 13].
+// Black → purple → orange → white heat ramp for iteration counts [KRS17 Fig. 13]; twin of
+// heatmap.py's heat.
 vec3 heat(float x) {
     x = clamp(x, 0.0, 1.0);
     return clamp(vec3(1.6 * x, 1.15 * x * x - 0.15, 0.9 * sin(3.14159265 * x) + x * x * x),

@@ -1,5 +1,5 @@
 // What is drawn, for the KRS family: the distance bound with the scene's distortions and the
-// nearest kernel with its world normal; twin of reference/geometry.py and distortion.py.
+// nearest kernel with its world normal; twin of reference/geometry.py and reference/distortion.py.
 // Without twist and empty zones this is Alg. 1 itself [KRS17 Alg. 1]; in a compound, each
 // component is a KRS of its own [KRS17 §5.1].
 #include "krs.glsl"
@@ -20,7 +20,7 @@ vec3r undistort(vec3r p) {
 
 // The factor of the LOD threshold ε(t) at p: the twist's safe step is D / (1 + |k|ρ) to
 // first order, so ε shrinks by the same factor and rays converge where the undistorted
-// distance is within ε(t), not high above a twisted ground (distortion.py, lod_scale).
+// distance is within ε(t), not high above a twisted ground (reference/distortion.py, lod_scale).
 real lod_scale(vec3r p) {
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT))

@@ -1,7 +1,6 @@
 // Empty zones: balls whose inside the tracer skips, removing the geometry there [KRS17 §8.4];
 // twin of reference/distortion.py. max(D, r − |p − c|) still never overshoots: the remaining
 // geometry is farther than D and lies outside every ball.
-#define MAX_EMPTY_ZONES 8
 uniform int u_empty_zone_count;
 uniform vec4 u_empty_zones[MAX_EMPTY_ZONES];  // camera-relative centre, radius
 

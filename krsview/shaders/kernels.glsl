@@ -1,7 +1,7 @@
 // Kernel distances k_i and gradients [KRS17 §3, §9.2]; twin of reference/kernels.py.
 // Sphere, capsule, toroidal capsule = point, segment, arc swept by a ball of radius r:
 // k(p) = |p - core(p)| - r never overshoots. Only the types a scene uses are compiled in.
-vec4r kernel_rec(int i, int k) { return u_kernels[i * KRS_RECORD + k]; }
+vec4r kernel_rec(int i, int k) { return u_kernels[i * RECORD_VEC4 + k]; }
 vec4 kernel_rec_float(int i, int k) { return vec4(kernel_rec(i, k)); }  // for shading
 
 #ifdef KRS_KERNEL_CAPSULE
@@ -57,7 +57,7 @@ vec3r toroidal_capsule_core(int i, vec3r p) {
 // every branch's code whether any pixel takes it or not (docs/speed.md): Alg. 1's level
 // loop, which meets only the branches' kinds, no longer pays for the trunk's kind.
 #define KERNEL_BIT(type) (1 << (type))
-#ifndef KRS_TOP_KERNELS           // the kinds of each component's top kernel K_n (uniforms.py)
+#ifndef KRS_TOP_KERNELS           // the kinds of each component's top kernel K_n (gpu/uniforms.py)
 #define KRS_TOP_KERNELS (~0)
 #endif
 #ifndef KRS_LEVEL_KERNELS         // the kinds of the kernels below it, K_0..K_{n-1}

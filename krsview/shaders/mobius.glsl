@@ -2,7 +2,7 @@
 // algebra/mobius.py (apply, map_ball, gradient). Record per level: a, b, c, d, then
 // (pole.xyz, flags) with a pole, or (|a|/|d|, 0, 0, flags) for a similarity (c = 0);
 // flags = has_pole + 2 · reflects; then the level's bounding ball (centre, radius; radius < 0:
-// unbounded), in the level's own space (reference/mokrs.py, level_bounds).
+// unbounded), in the level's own space (compile/mokrs.py, level_bounds).
 #include "quaternion.glsl"
 
 vec4r mobius_rec(int i, int k) { return u_mobius[i * MOBIUS_RECORD + k]; }

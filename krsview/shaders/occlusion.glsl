@@ -1,7 +1,6 @@
 // Ambient occlusion from AO_SAMPLES distance samples along the normal [KRS17 §8.5]: a sample
 // at height h that finds the geometry nearer than h is occluded by (h − d)/h, weighted 2^−k;
-// twin of reference/effects.py. It costs AO_SAMPLES distance evaluations per pixel.
-#define AO_SAMPLES 5
+// twin of reference/occlusion.py. It costs AO_SAMPLES distance evaluations per pixel.
 uniform float u_ao_step;
 uniform float u_ao_strength;
 

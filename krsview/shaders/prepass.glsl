@@ -15,7 +15,7 @@ uniform int u_tile;
 
 #ifdef KRS_PREPASS_COARSE
 real cone_free(int c, vec3r dir, real sigma, real t0) {
-    real t = t0, s = 1.0;
+    real t = t0, s = INITIAL_PROBE;
     for (int i = 0; i < u_max_iterations; ++i) {
         if (t > u_max_distance) break;
         if (is_unbounding(c, (t + s) * dir, s + (t + 2.0 * s) * sigma)) {
@@ -41,13 +41,15 @@ real cone_spread(vec2 corner, vec3r centre) {
 #endif
 
 #ifdef KRS_PREPASS
-uniform sampler2D u_free0;   // free distance per component: 0..3
-uniform sampler2D u_free1;   // 4..7
+// Free distance per component: components 4k..4k + 3 in target k (compile/constants.py:
+// PREPASS_TARGETS × 4 = MAX_COMPONENTS).
+uniform sampler2D u_free[PREPASS_TARGETS];
 
 // Where the ray of `pixel` starts, per component: its tile's free distance.
 void ray_start(ivec2 pixel, out real start[COMPONENT_SLOTS]) {
     ivec2 tile = pixel / u_tile;
-    vec4 t[2] = vec4[2](texelFetch(u_free0, tile, 0), texelFetch(u_free1, tile, 0));
+    vec4 t[PREPASS_TARGETS];
+    for (int k = 0; k < PREPASS_TARGETS; ++k) t[k] = texelFetch(u_free[k], tile, 0);
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = real(t[c / 4][c % 4]);
 }
 #else

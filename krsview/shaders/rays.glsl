@@ -1,6 +1,6 @@
 // The compute path's rays (trace.glsl's Ray, one per pixel of the traced rectangle, row by
 // row): written by compute.comp round after round, read by deferred.frag to shade.
-layout(std430, binding = 1) buffer Rays { Ray rays[]; };
+layout(std430, binding = BINDING_RAYS) buffer Rays { Ray rays[]; };
 uniform ivec4 u_tile_rect;   // x, y, width, height of the pixels traced
 
 int ray_index(ivec2 pixel) {

@@ -1,10 +1,6 @@
 // Scene data: the compiled KRS (compile/krs.py holds the same layout) and view.
-// Positions are camera-relative: the eye sits at the origin.
-#define KERNEL_EMPTY 0
-#define KERNEL_SPHERE 1
-#define KERNEL_CAPSULE 2
-#define KERNEL_TOROIDAL_CAPSULE 3
-#define KERNEL_PLANE 4
+// Positions are camera-relative: the eye sits at the origin. The KERNEL_<KIND> codes,
+// RECORD_VEC4, MAX_COMPONENTS and MAX_LIGHTS come from compile/constants.py.
 #define FAR_AWAY 1e30
 
 // Precision of the geometry (render.precision): `real` and its vectors are what distances,
@@ -29,7 +25,7 @@
 // In double precision a compound's slots outgrow a 64 KiB uniform block: a storage buffer
 // holds them (same layout: a dvec4 array has a 32-byte stride in std140 and std430).
 #ifdef KRS_DOUBLE
-layout(std430, binding = 0) readonly buffer KRSBlock {
+layout(std430, binding = BINDING_KRS_BLOCK) readonly buffer KRSBlock {
 #else
 layout(std140) uniform KRSBlock {
 #endif
@@ -39,7 +35,7 @@ layout(std140) uniform KRSBlock {
     vec4r u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
     vec4r u_bounds[KRS_SLOTS];                   // culling ball before fold i (krs.glsl)
 #endif
-    vec4r u_kernels[KRS_SLOTS * KRS_RECORD];     // per level: KRS_RECORD vec4s
+    vec4r u_kernels[KRS_SLOTS * RECORD_VEC4];    // per level: RECORD_VEC4 vec4s
 };
 uniform int u_n;            // KRS: number of mirrors, kernels K_0..K_n; MöKRS: levels
 
@@ -47,9 +43,9 @@ uniform int u_n;            // KRS: number of mirrors, kernels K_0..K_n; MöKRS:
 // MöKRS is the compound of one, and then all of this folds to constants.
 #ifdef KRS_COMPOUND
 uniform int u_components;
-uniform ivec2 u_component[KRS_MAX_COMPONENTS];  // per component: first slot, mirror count n
+uniform ivec2 u_component[MAX_COMPONENTS];  // per component: first slot, mirror count n
 #define COMPONENTS u_components
-#define COMPONENT_SLOTS KRS_MAX_COMPONENTS
+#define COMPONENT_SLOTS MAX_COMPONENTS
 #else
 #define COMPONENTS 1
 #define COMPONENT_SLOTS 1
@@ -77,8 +73,8 @@ vec3r pixel_ray(vec2 frag) {
                      + real(ndc.y * u_tan_half) * u_up);
 }
 
-uniform int u_light_count;  // lights in the first of LIGHT_SLOTS (scene.MAX_LIGHTS) slots
-uniform vec3 u_light_dir[LIGHT_SLOTS];
-uniform vec3 u_light_color[LIGHT_SLOTS];  // colour × intensity
+uniform int u_light_count;  // lights in the first of MAX_LIGHTS slots
+uniform vec3 u_light_dir[MAX_LIGHTS];
+uniform vec3 u_light_color[MAX_LIGHTS];   // colour × intensity
 uniform vec3 u_ambient;
 uniform vec3 u_background;

@@ -10,7 +10,6 @@
 #ifdef KRS_AMBIENT_OCCLUSION
 #include "occlusion.glsl"
 #endif
-#define GAMMA 2.2
 
 vec3 encode(vec3 linear) {
 #ifdef KRS_TONE_MAPPING

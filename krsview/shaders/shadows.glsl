@@ -4,7 +4,6 @@
 // (a compound with one free distance per component), a MöKRS probed with unbounding balls
 // (its free distances are the free probe radii).
 uniform float u_shadow_softness;  // k
-#define SHADOW_OFFSET 2.0         // the ray starts this many ε off the surface, along the normal
 
 bool soft_shadows_on() {
 #ifdef KRS_SOFT_SHADOWS
@@ -23,7 +22,8 @@ bool shadows_on() {
 
 // A shadow ray between steps: what shadow_visibility keeps in registers and the compute
 // path's shadow tasks keep in a storage buffer between rounds (compute.comp), so both take
-// the same steps and reach the same visibility.
+// the same steps and reach the same visibility. Declared for Python in compile/std430.py
+// (SHADOW).
 #define SHADOW_LIVE 0
 #define SHADOW_DONE 1
 struct Shadow {
@@ -96,7 +96,7 @@ float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
 }
 
 #ifdef KRS_SHADOW_TASKS
-float g_shadow[LIGHT_SLOTS];   // the compute path: each light's visibility, traced as tasks
+float g_shadow[MAX_LIGHTS];    // the compute path: each light's visibility, traced as tasks
                                // (compute.comp) and loaded by deferred.frag before shading
 #endif
 

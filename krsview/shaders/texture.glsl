@@ -2,7 +2,6 @@
 // in float32 and float64, so the reference matches), filtered by the LOD: an octave fades
 // out as its cells approach the pixel footprint, and its mean takes its place.
 // Twin of reference/texture.py.
-#define TEXTURE_OCTAVES 5
 uniform float u_texture_scale;     // scene units per noise cell
 uniform float u_texture_strength;  // 0: plain albedo, 1: full contrast
 uniform vec3 u_eye;                // camera position in world space: textures stay put
@@ -28,7 +27,7 @@ float texture_fbm(vec2 x, float footprint) {
     float sum = 0.0, norm = 0.0, amp = 1.0, freq = 1.0;
     for (int o = 0; o < TEXTURE_OCTAVES; ++o) {
         float keep = clamp(2.0 - 4.0 * footprint * freq, 0.0, 1.0);
-        sum += amp * (0.5 + (value_noise(freq * x + float(o) * vec2(17.0, 31.0)) - 0.5) * keep);
+        sum += amp * (0.5 + (value_noise(freq * x + float(o) * TEXTURE_OCTAVE_SHIFT) - 0.5) * keep);
         norm += amp;
         amp *= 0.5;
         freq *= 2.0;
@@ -51,8 +50,6 @@ float triplanar(vec3 p_world, vec3 n, float footprint) {
 #endif
 
 #ifdef KRS_KERNEL_TEXTURE
-#define BARK_STRETCH vec2(0.25, 2.0)  // streaks along a branch: long along, fine around
-
 vec3 perpendicular(vec3 d) {
     vec3 a = abs(d.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 0.0, 1.0);
     return normalize(a - dot(a, d) * d);

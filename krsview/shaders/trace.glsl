@@ -19,7 +19,8 @@ int front(real tc[COMPONENT_SLOTS]) {
 
 // A ray between steps: what the fragment path keeps in registers and the compute path
 // saves in a storage buffer between dispatches (compute.comp). One step is one iteration;
-// trace_ray takes steps until the ray is done, so both paths take the same steps.
+// trace_ray takes steps until the ray is done, so both paths take the same steps. Its
+// fields are declared for Python in compile/std430.py (RAY), which sizes the buffer.
 #define RAY_LIVE 0
 #define RAY_HIT 1
 #define RAY_MISS 2
@@ -31,9 +32,6 @@ struct Ray {
     int iterations;
     int state;                  // RAY_LIVE, RAY_HIT or RAY_MISS
 };
-
-#define INITIAL_PROBE 1.0 // binary tracing's first probe radius (reference/trace.py)
-#define MIN_PROBE 1e-30   // converged even where ε(t) = 0 (reference/trace.py)
 
 Ray ray_begin(real start[COMPONENT_SLOTS]) {
     Ray r;

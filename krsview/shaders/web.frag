@@ -17,7 +17,7 @@ uniform vec3 u_orbit_start;   // yaw, pitch and distance of O seen from the targ
 uniform float u_epsilon_scale;
 
 // The camera for `orbit` = (yaw turned, pitch turned, distance factor) from the exported
-// view (0, 0, 1), with the basis of reference/camera.py's view_of.
+// view (0, 0, 1), with the basis of compile/camera.py's view_of.
 void orbit_camera(vec2 resolution, vec3 orbit) {
     float yaw = u_orbit_start.x + orbit.x;
     float pitch = clamp(u_orbit_start.y + orbit.y, -1.55, 1.55);
