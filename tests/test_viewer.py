@@ -93,7 +93,7 @@ def test_orbit_keeps_distance_to_the_picked_point(viewer):
     v = viewer
     settle(v)
     v.execute([ToggleOrbit()])
-    pivot = v.orbit_pivot
+    pivot = v.nav.orbit_pivot
     r0 = np.linalg.norm(v.camera.position - pivot)
     v.input.button("left", True)
     v.input.move_cursor(0, 0)

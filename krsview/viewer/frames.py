@@ -5,9 +5,13 @@ is never blocked by a slow frame."""
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import moderngl
+import numpy as np
 
+from ..gpu.display import Display
+from ..gpu.program import ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.scene import Geometry
@@ -19,6 +23,7 @@ KEPT_FRAME_TIMES = 240  # for the HUD's frame-time plot
 class Frames:
     def __init__(self, ctx: moderngl.Context, renderer: Renderer, adaptive: AdaptiveResolution):
         self.ctx, self.renderer, self.adaptive = ctx, renderer, adaptive
+        self.display = Display(ctx, renderer.programs)
         self.dirty = True  # the view changed: trace a moving frame next
         self.image: tuple[moderngl.Framebuffer, tuple[int, int]] | None = None
         self.refinement: Refinement | None = None
@@ -69,3 +74,42 @@ class Frames:
             spent += seconds
         if r.done:
             self.image = (fbo, r.size)
+
+    def show(
+        self,
+        target: moderngl.Framebuffer,
+        size: tuple[int, int],
+        mode: str,
+        scene: Scene,
+        depth: float,
+    ) -> None:
+        """The last image into ``target`` of ``size`` pixels (scaled to it), in view ``mode``;
+        ``depth`` scales the depth view."""
+        if self.image is not None:
+            self.display.show(self.image[0], target, size, mode, scene.render.max_iterations, depth)
+
+    def still(self, scene: Scene, krs: Geometry, mode: str, depth: float) -> np.ndarray:
+        """The full-resolution image of ``scene`` traced at once, in view ``mode``: (H, W, 3)
+        bytes, rows top → bottom."""
+        size = self.adaptive.still_size()
+        prog = self.renderer.prepare(scene, *size, krs)
+        fbo = self.renderer.draw(prog, *size)
+        target = self.ctx.simple_framebuffer(size, components=4)
+        self.display.show(fbo, target, size, mode, scene.render.max_iterations, depth)
+        rgb = np.frombuffer(target.read(components=3), np.uint8).reshape(size[1], size[0], 3)
+        target.release()
+        return rgb[::-1]
+
+    def reload_programs(self, shader_dir: Path, scene: Scene, krs: Geometry) -> None:
+        """Compile the variant of ``scene`` and the display from the files in ``shader_dir``
+        again, then redraw; a ShaderError keeps the old programs."""
+        programs = ProgramCache(self.ctx, shader_dir)
+        old = self.renderer.programs
+        try:
+            self.renderer.programs = programs
+            self.renderer.prepare(scene, 1, 1, krs)
+            display = Display(self.ctx, programs)
+        except ShaderError:
+            self.renderer.programs = old
+            raise
+        self.display, self.dirty = display, True

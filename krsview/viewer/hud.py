@@ -22,6 +22,7 @@ from . import commands as c
 from .adaptive import AdaptiveResolution
 from .frames import Frames
 from .measured import apply_row, best_within, matches
+from .navigation import Navigation
 from .recording import Recorder
 from .widgets import Interactions, field_widget
 
@@ -54,8 +55,7 @@ class Viewed(Protocol):
     geometry: Geometry
     view: str
     levels: int
-    speed_factor: float
-    orbit_pivot: object
+    nav: Navigation
     moving_effects: bool
     measured: list[dict] | None
     message: str
@@ -173,13 +173,13 @@ def _scene(v: Viewed, out: list) -> None:
     if changed:
         out.append(c.OpenPreset(resolve(names[k])))
     imgui.text(
-        f"speed ×{v.speed_factor:.2f} of the nearest distance "
+        f"speed ×{v.nav.speed_factor:.2f} of the nearest distance "
         f"({v.nearest_distance():.3g}); scroll to change"
     )
     for label, command, same_line in (
         ("screenshot (F12)", c.Screenshot(), True),
         ("reset view (R)", c.ResetView(), True),
-        ("orbit (O)" if v.orbit_pivot is None else "fly (O)", c.ToggleOrbit(), False),
+        ("orbit (O)" if v.nav.orbit_pivot is None else "fly (O)", c.ToggleOrbit(), False),
         ("add bookmark (B)", c.AddBookmark(), False),
     ):
         if imgui.button(label):

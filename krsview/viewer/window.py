@@ -18,10 +18,8 @@ from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, s
 from ..compile.geometry import compile_geometry
 from ..document.document import Document
 from ..gpu.context import GL_VERSION
-from ..gpu.display import Display
-from ..gpu.program import SHADER_DIR, ProgramCache, ShaderError
+from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
-from ..reference.geometry import free_radius
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
 from ..scene.effects import EFFECTS, EXCLUSIVE
 from ..scene.model import VIEW_PREPASS
@@ -29,18 +27,17 @@ from ..scene.settings import ViewerSettings, make_settings
 from . import commands as c
 from .adaptive import AdaptiveResolution
 from .camera import FlyCamera
-from .controls import LOOK_BUTTON, ORBIT_BUTTON, Input
+from .controls import Input
 from .frames import Frames
 from .hud import draw_hud
 from .loop import run
 from .measured import load_measured
+from .navigation import Navigation
 from .picking import pick_center
 from .platform import Platform
 from .recording import Recorder, path_file
 from .watch import FileWatcher
 from .widgets import Interactions
-
-LOOK_RADIANS_PER_PIXEL = 0.004
 
 
 class Viewer:
@@ -63,16 +60,13 @@ class Viewer:
         self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
         self.renderer = Renderer(self.ctx, self.shader_dir)
-        self.display = Display(self.ctx, self.renderer.programs)
         self.input = Input()
         self.interactions = Interactions()
         self.hud = self.settings.hud
         self.view = "shaded"
         self.levels = 0  # 0: all of the scene's levels
-        self.speed_factor = 1.0  # × distance to the nearest surface, per second
-        self.orbit_pivot: np.ndarray | None = None
+        self.nav = Navigation(self.input, self.scene.camera)
         self.message, self.error = "", ""
-        self.bookmark_index = -1
         self.clock = 0.0
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
@@ -90,6 +84,10 @@ class Viewer:
     @property
     def path(self) -> Path:
         return self.doc.path
+
+    @property
+    def camera(self) -> FlyCamera:
+        return self.nav.camera
 
     @property
     def prepass(self) -> int:
@@ -118,7 +116,7 @@ class Viewer:
         self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()
         if reset_camera:
-            self.camera = FlyCamera.from_camera(scene.camera)
+            self.nav.reset(scene.camera)
 
     def sync(self) -> None:
         """Redraw when the document changed (an edit, undo, redo, reload)."""
@@ -128,7 +126,6 @@ class Viewer:
     def _apply_levels(self) -> None:
         self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
         self.world = compile_geometry(self.krs, self.scene.material.albedo)  # speed, picking
-        self._free: tuple[np.ndarray, float] | None = None  # cached nearest_distance
         self.dirty = True
 
     def _report(self, part: Any) -> None:
@@ -174,18 +171,8 @@ class Viewer:
         )
 
     def nearest_distance(self) -> float:
-        """Radius of an empty ball around the eye. Recomputed only after the eye moved a
-        quarter of it (a MöKRS needs a batch of Alg. 3 tests, ~10 ms in NumPy); in between,
-        r₀ − moved is still empty (the ball around the new eye lies inside the old one)."""
-        p = self.camera.position
-        if self._free is not None:
-            p0, r0 = self._free
-            moved = float(np.linalg.norm(p - p0))
-            if moved < 0.25 * r0:
-                return r0 - moved
-        r = free_radius(self.world, p)
-        self._free = (p.copy(), r)
-        return r
+        """Radius of an empty ball around the eye (the flying speed follows it)."""
+        return self.nav.free_distance(self.world)
 
     # ------------------------------------------------------------------------ the changes
     def execute(self, commands: list[c.Command]) -> None:
@@ -262,27 +249,21 @@ class Viewer:
         self._opened()
 
     def reset_view(self) -> None:
-        self.camera = FlyCamera.from_camera(self.scene.camera)
-        self.orbit_pivot, self.dirty = None, True
-        self.input.look_hides_cursor = True
+        self.nav.reset(self.scene.camera)
+        self.dirty = True
 
     def toggle_orbit(self) -> None:
-        if self.orbit_pivot is None:
-            self.orbit_pivot = pick_center(self.camera, self.image, self.nearest_distance())
-            self.message = "orbit mode: left-drag turns, W/S dolly"
-        else:
-            self.orbit_pivot, self.message = None, "fly mode"
-        self.input.look_hides_cursor = self.orbit_pivot is None
+        def centre():
+            return pick_center(self.camera, self.image, self.nearest_distance())
+
+        self.message = self.nav.toggle_orbit(centre)
 
     def go_to_bookmark(self, index: int) -> None:
-        self.bookmark_index = index
-        b = self.scene.bookmarks[index]
-        self.camera, self.dirty = FlyCamera.from_camera(b.camera), True
-        self.message = f"bookmark {b.name!r}"
+        self.message, self.dirty = self.nav.go_to(self.scene.bookmarks, index), True
 
     def next_bookmark(self) -> None:
         if self.scene.bookmarks:
-            self.go_to_bookmark((self.bookmark_index + 1) % len(self.scene.bookmarks))
+            self.go_to_bookmark((self.nav.bookmark_index + 1) % len(self.scene.bookmarks))
 
     def add_bookmark(self) -> None:
         """Append the current camera to the preset file's bookmarks (atomic save)."""
@@ -326,17 +307,12 @@ class Viewer:
 
     def reload_shaders(self) -> None:
         """Compile the current variant from the edited files; on failure keep the old ones."""
-        programs = ProgramCache(self.ctx, self.shader_dir)
-        old = self.renderer.programs
         try:
-            self.renderer.programs = programs
-            self.renderer.prepare(self.view_scene(), 1, 1, self.krs)
-            display = Display(self.ctx, programs)
+            self.frames.reload_programs(self.shader_dir, self.view_scene(), self.krs)
         except ShaderError as e:
-            self.renderer.programs, self.error = old, str(e)
+            self.error = str(e)
             return
-        self.display, self.error, self.message = display, "", "shaders reloaded"
-        self.dirty = True
+        self.error, self.message = "", "shaders reloaded"
 
     # --------------------------------------------------------------------------- the loop
     def run(self) -> None:
@@ -377,32 +353,9 @@ class Viewer:
             self.window = None
 
     def move(self, dt: float) -> None:
-        """Move the camera: held keys fly (or dolly in orbit mode), drags look (or orbit),
-        the wheel scales the speed; a recording takes the pose, a replay sets it."""
-        scroll = self.input.take_scroll()
-        if scroll:
-            self.speed_factor *= 1.25**scroll
-        dx, dy = self.input.take_drag()
-        move = np.array(self.input.movement(), dtype=float)
-        if self.orbit_pivot is not None:
-            if ORBIT_BUTTON in self.input.buttons and (dx or dy):
-                self.camera.orbit(
-                    self.orbit_pivot, -dx * LOOK_RADIANS_PER_PIXEL, dy * LOOK_RADIANS_PER_PIXEL
-                )
-                self.dirty = True
-            if move[2]:
-                self.camera.dolly(self.orbit_pivot, 0.5 ** (move[2] * dt * self.speed_factor))
-                self.dirty = True
-        else:
-            if LOOK_BUTTON in self.input.buttons and (dx or dy):
-                self.camera.look(-dx * LOOK_RADIANS_PER_PIXEL, -dy * LOOK_RADIANS_PER_PIXEL)
-                self.dirty = True
-            if move.any():
-                # Speed ∝ distance to the nearest surface: fly from a forest into a twig many
-                # levels deep without overshooting.
-                speed = self.speed_factor * max(self.nearest_distance(), 1e-12)
-                self.camera.fly(move, speed * dt)
-                self.dirty = True
+        """Move the camera by the input; a recording takes the pose, a replay sets it."""
+        if self.nav.move(dt, self.nearest_distance):
+            self.dirty = True
         if self.recorder.tick(self.clock, self.camera):
             self.dirty = True
         self._report(self.recorder)
@@ -418,15 +371,7 @@ class Viewer:
         self.frames.resize(fb)
         self.ctx.screen.use()
         self.ctx.clear(*self.scene.material.background)
-        if self.image is not None:
-            self.display.show(
-                self.image[0],
-                self.ctx.screen,
-                fb,
-                self.view,
-                self.scene.render.max_iterations,
-                self._depth_scale(),
-            )
+        self.frames.show(self.ctx.screen, fb, self.view, self.scene, self._depth_scale())
 
     def _depth_scale(self) -> float:
         return max(
@@ -436,20 +381,12 @@ class Viewer:
     # -------------------------------------------------------------------------- output
     def screenshot(self, path: Path | None = None) -> Path:
         """A full-resolution PNG of the current view and view mode."""
-        size = self.adaptive.still_size()
         out = path or Path("screenshots") / f"{self.path.stem}-{time.strftime('%Y%m%d-%H%M%S')}.png"
         out.parent.mkdir(parents=True, exist_ok=True)
-        prog = self.renderer.prepare(self.view_scene(), *size, self.krs)
-        fbo = self.renderer.draw(prog, *size)
-        target = self.ctx.simple_framebuffer(size, components=4)
-        self.display.show(
-            fbo, target, size, self.view, self.scene.render.max_iterations, self._depth_scale()
-        )
-        rgb = np.frombuffer(target.read(components=3), np.uint8).reshape(size[1], size[0], 3)
+        rgb = self.frames.still(self.view_scene(), self.krs, self.view, self._depth_scale())
         from PIL import Image
 
-        Image.fromarray(rgb[::-1]).save(out)
-        target.release()
+        Image.fromarray(rgb).save(out)
         self.message = f"screenshot: {out.resolve()}"
         return out
 
