@@ -19,7 +19,7 @@ import pytest
 from krsview.editor.commands import Bake
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
-from krsview.viewer.commands import Edit
+from krsview.viewer.commands import Edit, SetPrepass
 
 from .conftest import headless_render
 
@@ -366,3 +366,23 @@ def test_picking_the_geometry_with_fewer_levels_drawn_selects_the_right_level(ed
     e.select(None)
     click(e, screen_of(e, (0.0, 0.4, -0.2)))
     assert e.selected is not None and e.selected.level == depth - 1
+
+
+def test_the_hud_prepass_knob_is_an_edit_saved_with_the_scene_and_undone_by_ctrl_z(editor):
+    """The HUD's pre-pass knob goes through the document in the editor too: the title says
+    unsaved, Ctrl+Z (a real key) takes it back, and Ctrl+S writes it to the file."""
+    e = editor
+    pump(e)
+    assert load_scene(e.path).render.prepass == 0
+    e.execute([SetPrepass(8)])
+    pump(e)
+    assert e.scene.render.prepass == 8 == e.viewer.prepass and e._title.startswith(
+        "krsview edit — *"
+    )
+    xdo("key", "ctrl+z")
+    pump(e)
+    assert e.scene.render.prepass == 0 and not e.doc.dirty and "*" not in e._title
+    xdo("key", "ctrl+shift+z")
+    xdo("key", "ctrl+s")
+    pump(e)
+    assert load_scene(e.path).render.prepass == 8 and not e.doc.dirty
