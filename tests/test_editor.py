@@ -50,7 +50,7 @@ def pump(e, turns: int = 3) -> None:
 def settle(e, limit: int = 400) -> None:
     for _ in range(limit):
         pump(e, 1)
-        if e.viewer.refined:
+        if e.viewer.frames.refined:
             return
     raise AssertionError("the view never refined")
 
@@ -146,7 +146,7 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     assert e.selected is not None and e.selected.level == len(saved.route.levels) - 1
     # the window (HUD and overlays hidden) against a headless render of the saved file
     e.viewer.hud = False
-    e.viewer.dirty = True
+    e.viewer.frames.dirty = True
     settle(e)
     shot = e.viewer.read_window()
     same_prepass = ("--prepass", str(e.viewer.prepass))  # the window's pre-pass tile

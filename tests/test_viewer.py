@@ -42,7 +42,7 @@ def viewer(display, tmp_path):
 def settle(v, limit: int = 400) -> None:
     for _ in range(limit):
         v.step(0.02)
-        if v.refined:
+        if v.frames.refined:
             return
     raise AssertionError("the view never refined to full resolution")
 
@@ -77,16 +77,16 @@ def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_
 
 def test_adaptive_resolution_drops_when_slow_and_restores_when_still(viewer):
     v = viewer
-    v.adaptive.target_fps = 2000.0  # a budget no llvmpipe frame meets
+    v.frames.adaptive.target_fps = 2000.0  # a budget no llvmpipe frame meets
     scales = []
     for _ in range(8):
         v.input.key("D", True)
         v.step(0.05)
-        scales.append(v.adaptive.scale)
+        scales.append(v.frames.adaptive.scale)
     v.input.key("D", False)
-    assert scales[-1] < scales[0] and v.adaptive.moving_size()[0] < SIZE[0] / 3
+    assert scales[-1] < scales[0] and v.frames.adaptive.moving_size()[0] < SIZE[0] / 3
     settle(v)
-    assert v.image[1] == SIZE, "the still image is not back at full resolution"
+    assert v.frames.image[1] == SIZE, "the still image is not back at full resolution"
 
 
 def test_orbit_keeps_distance_to_the_picked_point(viewer):
@@ -132,7 +132,7 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
         v.step(0.3)
     assert "tree.levels = -4" in v.error
     assert v.scene.material.background == (1.0, 0.0, 0.0)  # last good scene kept
-    assert v.image is not None
+    assert v.frames.image is not None
 
 
 def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(display, tmp_path):
@@ -445,13 +445,18 @@ def test_moving_frames_leave_out_shadow_rays_and_the_still_image_has_them(viewer
     `--moving-effects` have them. Each frame is compared with a headless render of the same
     view with and without the shadows (negative control: the other one differs)."""
     v = viewer
-    v.adaptive.target_fps, v.adaptive.scale = 0.5, 1.0  # every frame fits: moving = full size
+    v.frames.adaptive.target_fps, v.frames.adaptive.scale = (
+        0.5,
+        1.0,
+    )  # every frame fits: moving = full size
 
     def agree(shot, ref):
         return (np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2).mean()
 
     hold(v, "W", 1)
-    assert not v.refined and v.image[1] == SIZE  # full size, but shadows still to come
+    assert (
+        not v.frames.refined and v.frames.image[1] == SIZE
+    )  # full size, but shadows still to come
     moving = v.read_window()
     assert "soft_shadows" in v.scene.effects
     assert "soft_shadows" not in v.view_scene(moving=True).effects

@@ -50,10 +50,10 @@ class Edited(Protocol):
 def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
     imgui.set_next_window_pos(
-        imgui.ImVec2(e.viewer.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever
+        imgui.ImVec2(e.viewer.frames.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever
     )
     imgui.set_next_window_size(
-        imgui.ImVec2(340, e.viewer.adaptive.full[1] - 16), imgui.Cond_.first_use_ever
+        imgui.ImVec2(340, e.viewer.frames.adaptive.full[1] - 16), imgui.Cond_.first_use_ever
     )
     imgui.set_next_window_bg_alpha(0.8)
     imgui.begin("edit")

@@ -290,9 +290,9 @@ class Editor:
         return best
 
     def _pick_surface(self, v: View, x: float, y: float) -> Handle | None:
-        if self.viewer.image is None:
+        if self.viewer.frames.image is None:
             return None
-        fbo, (w, h) = self.viewer.image
+        fbo, (w, h) = self.viewer.frames.image
         px = min(max(int(x / v.width * w), 0), w - 1)
         py = min(max(int((v.height - y) / v.height * h), 0), h - 1)
         t = depth_at(fbo, px, py)
@@ -318,11 +318,13 @@ class Editor:
         at first: the view stays free), the edit panel and the gizmo."""
         v = self.viewer
         view = self.window_view()
-        if v.image is not None:
+        if v.frames.image is not None:
             fb = glfw.get_framebuffer_size(v.window)
             view_matrix, proj = camera_matrices(view, NEAR, FAR)
             matrix = proj @ view_matrix
-            self.overlay.draw(self._shapes(), v.image[0], v.ctx.screen, fb, matrix, view.origin)
+            self.overlay.draw(
+                self._shapes(), v.frames.image[0], v.ctx.screen, fb, matrix, view.origin
+            )
         self.gizmo.begin_frame()
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
         self.execute(draw_hud(v, v.interactions))

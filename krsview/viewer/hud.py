@@ -19,7 +19,6 @@ from ..scene.presets import preset_names, resolve
 from ..scene.scene import Geometry
 from ..scene.settings import settings_meta
 from . import commands as c
-from .adaptive import AdaptiveResolution
 from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
@@ -67,8 +66,6 @@ class Viewed(Protocol):
     def path(self) -> Path: ...
     @property
     def prepass(self) -> int: ...
-    @property
-    def adaptive(self) -> AdaptiveResolution: ...
     def nearest_distance(self) -> float: ...
 
 
@@ -99,7 +96,7 @@ def _performance(v: Viewed, out: list) -> None:
     f = v.frames
     times = np.array(f.frame_seconds[-120:] or [0.0], dtype=np.float32) * 1e3
     fps = 1e3 / max(float(np.median(times)), 1e-6)
-    w, h = v.adaptive.moving_size()
+    w, h = v.frames.adaptive.moving_size()
     state = (
         "refined"
         if f.refined
@@ -107,22 +104,24 @@ def _performance(v: Viewed, out: list) -> None:
         if f.refinement
         else "moving"
     )
-    imgui.text(f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.adaptive.scale:.0%})")
+    imgui.text(
+        f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.frames.adaptive.scale:.0%})"
+    )
     imgui.text(f"{state}; {v.view} view")
     if implot.begin_plot("##frametime", imgui.ImVec2(-1, 70), implot.Flags_.no_legend):
         implot.setup_axes_limits(
             0, 120, 0, max(60.0, float(times.max()) * 1.1), implot.Cond_.always
         )
         implot.plot_line("frame ms", times)
-        budget = np.full(2, 1e3 / v.adaptive.target_fps, dtype=np.float32)
+        budget = np.full(2, 1e3 / v.frames.adaptive.target_fps, dtype=np.float32)
         implot.plot_line("budget", budget, xscale=120)
         implot.end_plot()
     changed, fps_target = field_widget(
-        "target FPS", v.adaptive.target_fps, settings_meta("target_fps")
+        "target FPS", v.frames.adaptive.target_fps, settings_meta("target_fps")
     )
     if changed:
         out.append(c.SetTargetFps(fps_target))
-    changed, ss = imgui.checkbox("supersample still images 2×2", v.adaptive.supersample == 2)
+    changed, ss = imgui.checkbox("supersample still images 2×2", v.frames.adaptive.supersample == 2)
     if changed:
         out.append(c.SetSupersample(2 if ss else 1))
     changed, on = field_widget(
@@ -210,7 +209,7 @@ def _measured(v: Viewed, out: list) -> None:
     now = [
         r for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth, v.prepass)
     ]
-    w, h = v.adaptive.moving_size()
+    w, h = v.frames.adaptive.moving_size()
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
         implot.setup_axes("ms (report size)", "hit-mask error %")
         ms = np.array([r["ms"] for r in rows], dtype=np.float32)
@@ -231,7 +230,7 @@ def _measured(v: Viewed, out: list) -> None:
         )
     else:
         imgui.text_disabled("the current setting was not measured (change one knob at a time)")
-    budget = 1e3 / v.adaptive.target_fps
+    budget = 1e3 / v.frames.adaptive.target_fps
     best = best_within(rows, budget, w * h)
     if best is None:
         imgui.text_disabled(f"no measured setting fits {budget:.0f} ms at {w}×{h}")

@@ -126,7 +126,7 @@ class Viewer:
     def _apply_levels(self) -> None:
         self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
         self.world = compile_geometry(self.krs, self.scene.material.albedo)  # speed, picking
-        self.dirty = True
+        self.frames.dirty = True
 
     def _report(self, part: Any) -> None:
         """Show what a part (the camera-path recorder) has to say, once."""
@@ -134,27 +134,6 @@ class Viewer:
             self.message, part.message = part.message, ""
         if part.error:
             self.error, part.error = part.error, ""
-
-    @property
-    def dirty(self) -> bool:
-        """The view changed: the next turn traces a moving frame."""
-        return self.frames.dirty
-
-    @dirty.setter
-    def dirty(self, value: bool) -> None:
-        self.frames.dirty = value
-
-    @property
-    def refined(self) -> bool:
-        return self.frames.refined
-
-    @property
-    def adaptive(self) -> AdaptiveResolution:
-        return self.frames.adaptive
-
-    @property
-    def image(self) -> tuple[moderngl.Framebuffer, tuple[int, int]] | None:
-        return self.frames.image
 
     def view_scene(self, moving: bool = False) -> Scene:
         """The scene as drawn now: the viewer's camera and settings. A moving frame leaves out
@@ -214,7 +193,7 @@ class Viewer:
         """The scene's pre-pass tile, an edit like the other knobs (undoable, saved by the
         editor); from then on the view draws with the scene's."""
         if self.edit(("render", "prepass"), tile, interaction):
-            self._view_prepass, self.dirty = None, True
+            self._view_prepass, self.frames.dirty = None, True
 
     def set_levels(self, levels: int) -> None:
         """Draw only the coarsest ``levels`` levels (0 or all: the whole scene)."""
@@ -222,13 +201,13 @@ class Viewer:
         self._apply_levels()
 
     def set_target_fps(self, fps: float) -> None:
-        self.adaptive.target_fps = fps
+        self.frames.adaptive.target_fps = fps
 
     def set_supersample(self, factor: int) -> None:
-        self.adaptive.supersample, self.dirty = factor, True
+        self.frames.adaptive.supersample, self.frames.dirty = factor, True
 
     def set_moving_effects(self, on: bool) -> None:
-        self.moving_effects, self.dirty = on, True
+        self.moving_effects, self.frames.dirty = on, True
 
     def undo(self) -> None:
         if self.doc.undo():
@@ -250,16 +229,16 @@ class Viewer:
 
     def reset_view(self) -> None:
         self.nav.reset(self.scene.camera)
-        self.dirty = True
+        self.frames.dirty = True
 
     def toggle_orbit(self) -> None:
         def centre():
-            return pick_center(self.camera, self.image, self.nearest_distance())
+            return pick_center(self.camera, self.frames.image, self.nearest_distance())
 
         self.message = self.nav.toggle_orbit(centre)
 
     def go_to_bookmark(self, index: int) -> None:
-        self.message, self.dirty = self.nav.go_to(self.scene.bookmarks, index), True
+        self.message, self.frames.dirty = self.nav.go_to(self.scene.bookmarks, index), True
 
     def next_bookmark(self) -> None:
         if self.scene.bookmarks:
@@ -323,7 +302,7 @@ class Viewer:
 
     def is_idle(self) -> bool:
         return (
-            self.refined
+            self.frames.refined
             and not self.input.held
             and not self.input.buttons
             and self.recorder.replay_start is None
@@ -355,9 +334,9 @@ class Viewer:
     def move(self, dt: float) -> None:
         """Move the camera by the input; a recording takes the pose, a replay sets it."""
         if self.nav.move(dt, self.nearest_distance):
-            self.dirty = True
+            self.frames.dirty = True
         if self.recorder.tick(self.clock, self.camera):
-            self.dirty = True
+            self.frames.dirty = True
         self._report(self.recorder)
 
     def draw_image(self) -> None:
