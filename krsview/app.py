@@ -7,19 +7,22 @@ from pathlib import Path
 
 
 def view(path: Path, **options) -> None:
-    """Fly through the scene file at ``path`` (options: :class:`krsview.viewer.window.Viewer`)."""
+    """Fly through the scene file at ``path``; ``options``: fields of
+    :class:`krsview.scene.settings.ViewerSettings` (a bad one is a SceneError)."""
     from .viewer.window import Viewer
 
     viewer = Viewer(path, **options)
     print(
         f"krsview: viewing {viewer.path} — WASD/QE fly, right-drag look, scroll speed, "
-        "O orbit, R reset, B bookmark, F5/F6 record/replay, F12 screenshot, F1 HUD"
+        "O orbit, R reset, B bookmark, F5/F6 record/replay, F12 screenshot, F1 HUD, "
+        "Ctrl+Z/Ctrl+Shift+Z undo/redo"
     )
     viewer.run()
 
 
 def edit(path: Path, **options) -> None:
-    """Shape the scene file at ``path`` (options: :class:`krsview.editor.window.Editor`)."""
+    """Shape the scene file at ``path``; ``options``: fields of
+    :class:`krsview.scene.settings.ViewerSettings` (defaults: EDITOR_SETTINGS)."""
     from .editor.window import Editor
 
     editor = Editor(path, **options)

@@ -16,9 +16,10 @@ import time
 import numpy as np
 import pytest
 
+from krsview.editor.commands import Bake
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
-from krsview.viewer.commands import Do, Edit
+from krsview.viewer.commands import Edit, SetPrepass
 
 from .conftest import headless_render
 
@@ -49,7 +50,7 @@ def pump(e, turns: int = 3) -> None:
 def settle(e, limit: int = 400) -> None:
     for _ in range(limit):
         pump(e, 1)
-        if e.refined:
+        if e.viewer.frames.refined:
             return
     raise AssertionError("the view never refined")
 
@@ -66,7 +67,7 @@ def screen_of(e, world) -> tuple[float, float]:
 
     x, y, z = project(e.window_view(), np.asarray(world))
     assert z > 0
-    wx, wy = glfw.get_window_pos(e.window)
+    wx, wy = glfw.get_window_pos(e.viewer.window)
     return wx + x, wy + y
 
 
@@ -97,9 +98,9 @@ def handle(e, path):
 def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor, tmp_path):
     e = editor
     settle(e)
-    e.execute([Do("bake")])
+    e.execute([Bake()])
     settle(e)
-    compiles = e.renderer.programs.compiles
+    compiles = e.viewer.renderer.programs.compiles
     fork_path = ("route", "levels", LEVEL, "fork")
     # select by clicking the handle, then drag the gizmo's centre 40 px to the right
     h = handle(e, fork_path)
@@ -126,7 +127,7 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     n1 = np.array(e.scene.route.levels[LEVEL].normal)
     turned = math.degrees(math.acos(np.clip(n0 @ n1, -1, 1)))
     assert turned > 5.0 and math.isclose(np.linalg.norm(n1), 1.0, rel_tol=1e-12), turned
-    assert e.renderer.programs.compiles == compiles, "a drag recompiled the shader"
+    assert e.viewer.renderer.programs.compiles == compiles, "a drag recompiled the shader"
     # keyboard undo / redo in the window
     xdo("key", "ctrl+z")
     pump(e)
@@ -144,11 +145,11 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     click(e, screen_of(e, (0.0, 0.4, -0.2)))
     assert e.selected is not None and e.selected.level == len(saved.route.levels) - 1
     # the window (HUD and overlays hidden) against a headless render of the saved file
-    e.hud = False
-    e.dirty = True
+    e.viewer.hud = False
+    e.viewer.frames.dirty = True
     settle(e)
-    shot = e.read_window()
-    same_prepass = ("--prepass", str(e.prepass))  # the window's pre-pass tile
+    shot = e.viewer.read_window()
+    same_prepass = ("--prepass", str(e.viewer.prepass))  # the window's pre-pass tile
     ref = headless_render(load_scene(e.path), tmp_path / "saved", SIZE, *same_prepass)
     close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
@@ -167,18 +168,18 @@ def test_overlay_is_composited_by_traced_depth(editor):
     import glfw
 
     e = editor
-    e.execute([Do("bake")])
+    e.execute([Bake()])
     e.select_level(LEVEL)
-    e.hud = False
+    e.viewer.hud = False
     settle(e)
-    plain = e.read_window().astype(int)
-    e.hud = True
+    plain = e.viewer.read_window().astype(int)
+    e.viewer.hud = True
 
     def overlay_change(hidden_alpha: float, world) -> float:
         e.overlay.prog["u_hidden_alpha"].value = hidden_alpha
         pump(e, 2)
-        shot = e.read_window().astype(int)
-        wx, wy = glfw.get_window_pos(e.window)
+        shot = e.viewer.read_window().astype(int)
+        wx, wy = glfw.get_window_pos(e.viewer.window)
         x, y = screen_of(e, world)
         px, py = round(x - wx), round(y - wy)
         return float(
@@ -239,12 +240,12 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
 
     e = editor
     assert e.edit(("render", "epsilon_scale"), 2.0)
-    glfw.set_window_should_close(e.window, True)
+    glfw.set_window_should_close(e.viewer.window, True)
     assert not e.should_close() and e.asking == ("close", None)
     pump(e)
     e.answer_cancel()
     assert not e.should_close() and e.doc.dirty
-    glfw.set_window_should_close(e.window, True)
+    glfw.set_window_should_close(e.viewer.window, True)
     e.should_close()
     e.answer_discard()
     assert e.should_close()
@@ -265,29 +266,29 @@ def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor
     time.sleep(0.6)
     pump(e)
     assert e.conflict and e.scene.render.epsilon_scale == 2.0
-    assert not e.save() and "changed on disk" in e.error
+    assert not e.save() and "changed on disk" in e.viewer.error
     assert load_scene(e.path).name == "changed elsewhere"
     e.take_file()
     assert e.scene.name == "changed elsewhere" and not e.doc.dirty
-    e.undo()
+    e.viewer.undo()
     assert e.scene.render.epsilon_scale == 2.0, "the edits were lost on reload"
 
 
 def test_a_bad_panel_value_keeps_the_last_valid_scene(editor):
     e = editor
-    e.execute([Do("bake")])
+    e.execute([Bake()])
     before = e.scene
     e.execute([Edit(("route", "levels", 3, "normal"), (0.0, 0.0, 0.0))])
-    assert e.scene == before and "route.levels[3].normal" in e.error
+    assert e.scene == before and "route.levels[3].normal" in e.viewer.error
     e.execute([Edit(("route", "levels", 3, "radius"), float("nan"))])
-    assert e.scene == before and "NaN" in e.error
+    assert e.scene == before and "NaN" in e.viewer.error
     pump(e)  # the error shows; nothing breaks
 
 
 def test_save_as_a_bad_name_is_a_clear_error(editor, tmp_path):
     e = editor
     e.save_as(str(tmp_path / "x.png"))
-    assert "ends in .toml" in e.error or "ending in .toml" in e.error
+    assert "ends in .toml" in e.viewer.error or "ending in .toml" in e.viewer.error
     e.save_as(str(tmp_path / "copy.toml"))
     assert e.path == tmp_path / "copy.toml" and load_scene(tmp_path / "copy.toml") == e.scene
 
@@ -319,11 +320,11 @@ def test_the_editor_opens_every_kind_of_scene(display, tmp_path, preset, entries
     e = Editor(path, size=(400, 300))
     try:
         pump(e, 3)
-        assert len(outline(e.scene)) == entries and not e.error
+        assert len(outline(e.scene)) == entries and not e.viewer.error
         if entries:
             e.select_level(entries - 1)
             pump(e, 2)
-            assert e.selected is not None and not e.error
+            assert e.selected is not None and not e.viewer.error
     finally:
         e.close()
 
@@ -331,23 +332,23 @@ def test_the_editor_opens_every_kind_of_scene(display, tmp_path, preset, entries
 def test_a_panel_drag_is_one_undo_step_and_a_second_drag_another(editor):
     """Drag the selected branch's radius field in the panel with the real pointer."""
     e = editor
-    e.execute([Do("bake")])
+    e.execute([Bake()])
     e.select_level(LEVEL)
     pump(e, 3)
     path = ("route", "levels", LEVEL, "radius")
-    x0, y0, x1, y1 = e.interactions.rects[path]
+    x0, y0, x1, y1 = e.viewer.interactions.rects[path]
     r0, steps0 = e.scene.route.levels[LEVEL].radius, len(e.doc.history.steps)
     import glfw
 
-    wx, wy = glfw.get_window_pos(e.window)
+    wx, wy = glfw.get_window_pos(e.viewer.window)
     drag(e, (wx + (x0 + x1) / 2, wy + (y0 + y1) / 2), (40, 0))
     r1 = e.scene.route.levels[LEVEL].radius
     assert r1 > r0 and len(e.doc.history.steps) == steps0 + 1, (r0, r1, e.doc.history.labels())
     drag(e, (wx + (x0 + x1) / 2, wy + (y0 + y1) / 2), (-20, 0))
     assert e.scene.route.levels[LEVEL].radius < r1 and len(e.doc.history.steps) == steps0 + 2
-    e.undo()
+    e.viewer.undo()
     assert e.scene.route.levels[LEVEL].radius == r1
-    e.undo()
+    e.viewer.undo()
     assert e.scene.route.levels[LEVEL].radius == r0
 
 
@@ -355,13 +356,33 @@ def test_picking_the_geometry_with_fewer_levels_drawn_selects_the_right_level(ed
     """The levels slider keeps the coarsest levels: a picked kernel slot is offset by the
     finest levels cut away (the trunk stays the trunk)."""
     e = editor
-    e.execute([Do("bake")])
+    e.execute([Bake()])
     settle(e)
-    depth = e.geometry.depth
+    depth = e.viewer.geometry.depth
     click(e, screen_of(e, (0.0, 0.4, -0.2)))
     assert e.selected.level == depth - 1
-    e.set_levels(6)
+    e.viewer.set_levels(6)
     settle(e)
     e.select(None)
     click(e, screen_of(e, (0.0, 0.4, -0.2)))
     assert e.selected is not None and e.selected.level == depth - 1
+
+
+def test_the_hud_prepass_knob_is_an_edit_saved_with_the_scene_and_undone_by_ctrl_z(editor):
+    """The HUD's pre-pass knob goes through the document in the editor too: the title says
+    unsaved, Ctrl+Z (a real key) takes it back, and Ctrl+S writes it to the file."""
+    e = editor
+    pump(e)
+    assert load_scene(e.path).render.prepass == 0
+    e.execute([SetPrepass(8)])
+    pump(e)
+    assert e.scene.render.prepass == 8 == e.viewer.prepass and e._title.startswith(
+        "krsview edit — *"
+    )
+    xdo("key", "ctrl+z")
+    pump(e)
+    assert e.scene.render.prepass == 0 and not e.doc.dirty and "*" not in e._title
+    xdo("key", "ctrl+shift+z")
+    xdo("key", "ctrl+s")
+    pump(e)
+    assert load_scene(e.path).render.prepass == 8 and not e.doc.dirty

@@ -10,8 +10,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from krsview.editor.gizmo import snap_direction
 from krsview.editor.handles import handles, outline, polyline
-from krsview.editor.window import _snap_direction
 from krsview.scene import SceneError, load_scene
 from krsview.scene.edits import apply_edit
 from krsview.scene.presets import resolve
@@ -132,7 +132,7 @@ def test_a_compound_component_handle_moves_the_whole_component():
 def test_snapped_directions_lie_on_the_angle_grid():
     rng = np.random.default_rng(3)
     for d in rng.normal(size=(50, 3)):
-        s = _snap_direction(d, 5.0)
+        s = snap_direction(d, 5.0)
         assert math.isclose(np.linalg.norm(s), np.linalg.norm(d), rel_tol=1e-12)
         theta = math.degrees(math.acos(s[1] / np.linalg.norm(s)))
         assert abs(theta / 5.0 - round(theta / 5.0)) < 1e-9

@@ -69,7 +69,7 @@ def test_a_long_session_keeps_gl_objects_and_memory_flat(long_viewer):
         if k % 100 == 0:  # alternate budgets: the image size keeps changing
             v.set_target_fps(240 if (k // 100) % 2 == 0 else 5)
         fly(v, 1, k)
-        sizes_seen.add(v.image[1] if v.image else None)
+        sizes_seen.add(v.frames.image[1] if v.frames.image else None)
         if k % max(1, FRAMES // SWITCHES) == 0:
             v.set_effect("fog", (k // max(1, FRAMES // SWITCHES)) % 2 == 0)
             v.set_render(tracer="binary" if k % 2 else "sphere")

@@ -12,6 +12,16 @@ import pytest
 from krsview.scene import load_scene, save_scene
 from krsview.scene.presets import resolve
 from krsview.viewer.adaptive import AdaptiveResolution, Refinement
+from krsview.viewer.commands import (
+    NextBookmark,
+    Redo,
+    Replay,
+    ResetView,
+    SetPrepass,
+    ToggleOrbit,
+    ToggleRecording,
+    Undo,
+)
 
 from .conftest import headless_render
 
@@ -32,7 +42,7 @@ def viewer(display, tmp_path):
 def settle(v, limit: int = 400) -> None:
     for _ in range(limit):
         v.step(0.02)
-        if v.refined:
+        if v.frames.refined:
             return
     raise AssertionError("the view never refined to full resolution")
 
@@ -67,23 +77,23 @@ def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_
 
 def test_adaptive_resolution_drops_when_slow_and_restores_when_still(viewer):
     v = viewer
-    v.adaptive.target_fps = 2000.0  # a budget no llvmpipe frame meets
+    v.frames.adaptive.target_fps = 2000.0  # a budget no llvmpipe frame meets
     scales = []
     for _ in range(8):
         v.input.key("D", True)
         v.step(0.05)
-        scales.append(v.adaptive.scale)
+        scales.append(v.frames.adaptive.scale)
     v.input.key("D", False)
-    assert scales[-1] < scales[0] and v.adaptive.moving_size()[0] < SIZE[0] / 3
+    assert scales[-1] < scales[0] and v.frames.adaptive.moving_size()[0] < SIZE[0] / 3
     settle(v)
-    assert v.image[1] == SIZE, "the still image is not back at full resolution"
+    assert v.frames.image[1] == SIZE, "the still image is not back at full resolution"
 
 
 def test_orbit_keeps_distance_to_the_picked_point(viewer):
     v = viewer
     settle(v)
-    v.act("orbit")
-    pivot = v.orbit_pivot
+    v.execute([ToggleOrbit()])
+    pivot = v.nav.orbit_pivot
     r0 = np.linalg.norm(v.camera.position - pivot)
     v.input.button("left", True)
     v.input.move_cursor(0, 0)
@@ -101,9 +111,9 @@ def test_bookmark_is_saved_in_the_preset_and_reset_restores(viewer):
     hold(v, "B", 1, 0.01)
     saved = load_scene(v.path)
     assert saved.bookmarks and saved.bookmarks[-1].camera == moved
-    v.act("reset")
+    v.execute([ResetView()])
     assert v.camera.to_camera().position == saved.camera.position
-    v.act("next_bookmark")
+    v.execute([NextBookmark()])
     assert np.allclose(v.camera.position, moved.position)
 
 
@@ -122,7 +132,7 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
         v.step(0.3)
     assert "tree.levels = -4" in v.error
     assert v.scene.material.background == (1.0, 0.0, 0.0)  # last good scene kept
-    assert v.image is not None
+    assert v.frames.image is not None
 
 
 def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(display, tmp_path):
@@ -162,34 +172,34 @@ def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(displ
 
 def test_record_and_replay_a_camera_path(viewer):
     v = viewer
-    v.act("record")
+    v.execute([ToggleRecording()])
     hold(v, "E", 5)
-    v.act("record")
+    v.execute([ToggleRecording()])
     end = v.camera.position.copy()
-    v.act("reset")
-    v.act("replay")
+    v.execute([ResetView()])
+    v.execute([Replay()])
     for _ in range(20):
         v.step(0.05)
-    assert v.replay_start is None and np.allclose(v.camera.position, end)
+    assert v.recorder.replay_start is None and np.allclose(v.camera.position, end)
 
 
 def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
     v = viewer
-    v.act("record")
+    v.execute([ToggleRecording()])
     hold(v, "W", 4)
-    v.act("record")
-    end, recorded = v.camera.position.copy(), len(v.camera_path.poses)
-    assert v.path_file().exists() and v.path_file().name == "tree.path.json"
-    v.camera_path = None
+    v.execute([ToggleRecording()])
+    end, recorded = v.camera.position.copy(), len(v.recorder.path.poses)
+    assert v.recorder.file.exists() and v.recorder.file.name == "tree.path.json"
+    v.recorder.path = None
     v.open_preset(v.path)  # as a new session would: the path comes from the file
-    assert len(v.camera_path.poses) == recorded > 0
-    v.act("replay")
+    assert len(v.recorder.path.poses) == recorded > 0
+    v.execute([Replay()])
     for _ in range(20):
         v.step(0.05)
     assert np.allclose(v.camera.position, end)
-    v.path_file().write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
+    v.recorder.file.write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
     v.open_preset(v.path)
-    assert v.camera_path is None and "tree.path.json: poses[0]" in v.error
+    assert v.recorder.path is None and "tree.path.json: poses[0]" in v.error
 
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
@@ -387,21 +397,33 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     assert load_measured("tree") is None
 
 
-def test_the_viewer_draws_with_the_prepass_and_can_turn_it_off(viewer):
-    """The viewer flies with the pre-pass (tile 8) unless told otherwise; the HUD's slider
-    goes through Viewer.set_prepass, and off or on, the window shows the same tree (pixels
-    change only on outlines, where grazing rays may flip)."""
+def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(viewer):
+    """The viewer flies with the pre-pass (tile VIEW_PREPASS) where the file has none; the
+    HUD's knob sets the scene's render.prepass through the document (validated by the
+    schema's range, one undo step), and the view then draws with it. Off or on, the window
+    shows the same tree (pixels change only on outlines, where grazing rays may flip)."""
     from krsview.scene.model import VIEW_PREPASS
 
     v = viewer
     settle(v)
+    assert v.scene.render.prepass == 0, "the shipped tree has no pre-pass of its own"
     assert v.prepass == VIEW_PREPASS and v.view_scene().render.prepass == VIEW_PREPASS
     with_prepass = v.read_window().astype(int)
-    v.set_prepass(0)
+    steps = len(v.doc.history.steps)
+    v.execute([SetPrepass(65)])  # beyond the schema's range: refused, nothing changes
+    assert "render.prepass = 65" in v.error and "≤ 64" in v.error
+    assert v.prepass == VIEW_PREPASS and len(v.doc.history.steps) == steps
+    v.execute([SetPrepass(8)])
+    assert v.scene.render.prepass == 8 and v.view_scene().render.prepass == 8 and v.doc.dirty
+    assert len(v.doc.history.steps) == steps + 1 and not v.error
+    v.execute([Undo()])  # back to the file's: no pre-pass
+    assert v.scene.render.prepass == 0 and v.view_scene().render.prepass == 0
+    assert not v.doc.dirty
     settle(v)
-    assert v.view_scene().render.prepass == 0
     changed = (np.abs(v.read_window().astype(int) - with_prepass).max(-1) > 40).mean()
     assert 0 < changed < 0.02
+    v.execute([Redo()])
+    assert v.view_scene().render.prepass == 8
 
 
 def test_the_compute_path_draws_the_same_window(viewer):
@@ -423,13 +445,18 @@ def test_moving_frames_leave_out_shadow_rays_and_the_still_image_has_them(viewer
     `--moving-effects` have them. Each frame is compared with a headless render of the same
     view with and without the shadows (negative control: the other one differs)."""
     v = viewer
-    v.adaptive.target_fps, v.adaptive.scale = 0.5, 1.0  # every frame fits: moving = full size
+    v.frames.adaptive.target_fps, v.frames.adaptive.scale = (
+        0.5,
+        1.0,
+    )  # every frame fits: moving = full size
 
     def agree(shot, ref):
         return (np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2).mean()
 
     hold(v, "W", 1)
-    assert not v.refined and v.image[1] == SIZE  # full size, but shadows still to come
+    assert (
+        not v.frames.refined and v.frames.image[1] == SIZE
+    )  # full size, but shadows still to come
     moving = v.read_window()
     assert "soft_shadows" in v.scene.effects
     assert "soft_shadows" not in v.view_scene(moving=True).effects

@@ -1,32 +1,59 @@
 """The editor's ImGui panels. A panel reads the editor's state and returns commands; it never
 writes the editor or the scene itself (the editor applies the commands through the document),
-so the arrows run one way: editor app → panels."""
+so the arrows run one way: editor window → panels."""
 
 from __future__ import annotations
 
 from dataclasses import fields
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import Any, Protocol
 
 from imgui_bundle import imgui
 
+from ..document.document import Document
+from ..scene import Scene
 from ..scene.edits import get_at
-from ..viewer.commands import Command, Do, Edit
+from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.widgets import Interactions, field_widget
-from .handles import outline
-
-if TYPE_CHECKING:
-    from .window import Editor
+from ..viewer.window import Viewer
+from . import commands as ec
+from .gizmo import Snap
+from .handles import Handle, outline
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 
 
-def edit_panel(e: Editor, interactions: Interactions) -> list[Command]:
+class Edited(Protocol):
+    """What the panels read of the editor (they write nothing: they return commands)."""
+
+    viewer: Viewer
+    selected: Handle | None
+    warnings: list[str]
+    snap: Snap
+    carry: bool
+    save_as_text: str
+    conflict: bool
+    scroll_outline: bool
+    asking: tuple[str, Path | None] | None
+    recovered: Scene | None
+
+    @property
+    def doc(self) -> Document: ...
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def handles(self) -> list[Handle]: ...
+
+
+def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
-    imgui.set_next_window_pos(imgui.ImVec2(e.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever)
+    imgui.set_next_window_pos(
+        imgui.ImVec2(e.viewer.frames.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever
+    )
     imgui.set_next_window_size(
-        imgui.ImVec2(340, e.adaptive.full[1] - 16), imgui.Cond_.first_use_ever
+        imgui.ImVec2(340, e.viewer.frames.adaptive.full[1] - 16), imgui.Cond_.first_use_ever
     )
     imgui.set_next_window_bg_alpha(0.8)
     imgui.begin("edit")
@@ -38,7 +65,7 @@ def edit_panel(e: Editor, interactions: Interactions) -> list[Command]:
             "forks, control points and mirror normals [KRS17 §9.2]."
         )
         if imgui.button("bake into a route"):
-            out.append(Do("bake"))
+            out.append(ec.Bake())
     elif scene.mokrs is not None:
         imgui.text_wrapped(
             "A MöKRS has no handles yet; edit its file (it reloads) or the fields below."
@@ -61,7 +88,7 @@ def edit_panel(e: Editor, interactions: Interactions) -> list[Command]:
     if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
         changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
         if changed:
-            out.append(Do("set_carry", on))
+            out.append(ec.SetCarry(on))
         if imgui.is_item_hovered():
             imgui.set_tooltip(
                 "on: the finer forks, control points and mirrors move with a "
@@ -69,48 +96,50 @@ def edit_panel(e: Editor, interactions: Interactions) -> list[Command]:
             )
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
-            out.append(Do("set_snap", on))
+            out.append(ec.SetSnap(on))
         imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
     imgui.end()
     _modals(e, out)
     return out
 
 
-def _file(e: Editor, out: list) -> None:
+def _file(e: Edited, out: list) -> None:
     doc = e.doc
     imgui.text(("* unsaved: " if doc.dirty else "saved: ") + str(doc.path.name))
     if imgui.button("save (Ctrl+S)"):
-        out.append(Do("save"))
+        out.append(ec.Save())
     imgui.same_line()
     imgui.set_next_item_width(150)
-    _, e.save_as_text = imgui.input_text("##saveas", e.save_as_text)
+    changed, text = imgui.input_text("##saveas", e.save_as_text)
+    if changed:
+        out.append(ec.SetSaveAsText(text))
     imgui.same_line()
     if imgui.button("save as"):
-        out.append(Do("save_as", e.save_as_text))
+        out.append(ec.SaveAs())
     done, undone = doc.history.labels()
     imgui.begin_disabled(not done)
     if imgui.button("undo (Ctrl+Z)"):
-        out.append(Do("undo"))
+        out.append(Undo())
     imgui.end_disabled()
     if done and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
         imgui.set_tooltip("undo: " + done[-1])
     imgui.same_line()
     imgui.begin_disabled(not undone)
     if imgui.button("redo (Ctrl+Shift+Z)"):
-        out.append(Do("redo"))
+        out.append(Redo())
     imgui.end_disabled()
     if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
         imgui.set_tooltip("redo: " + undone[0])
     if e.conflict:
         imgui.text_colored(RED, f"{doc.path.name} changed on disk, and you have unsaved edits.")
         if imgui.button("take the file (your edits stay undoable)"):
-            out.append(Do("take_file"))
+            out.append(ec.TakeFile())
         imgui.same_line()
         if imgui.button("keep mine"):
-            out.append(Do("keep_mine"))
+            out.append(ec.KeepMine())
 
 
-def _outline(e: Editor, out: list) -> None:
+def _outline(e: Edited, out: list) -> None:
     entries = outline(e.scene)
     imgui.text("outline (click an entry, a handle or the geometry)")
     if imgui.begin_child("outline", imgui.ImVec2(-1, 120), imgui.ChildFlags_.borders):
@@ -118,14 +147,14 @@ def _outline(e: Editor, out: list) -> None:
             selected = e.selected is not None and e.selected.level == k
             clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
             if clicked:
-                out.append(Do("select_level", k))
+                out.append(ec.SelectLevel(k))
             if selected and e.scroll_outline:
                 imgui.set_scroll_here_y()
-                e.scroll_outline = False
+                out.append(ec.OutlineScrolled())
     imgui.end_child()
 
 
-def _selection(e: Editor, out: list, interactions: Interactions) -> None:
+def _selection(e: Edited, out: list, interactions: Interactions) -> None:
     h = e.selected
     if h is None:
         imgui.text_disabled("nothing selected")
@@ -133,7 +162,7 @@ def _selection(e: Editor, out: list, interactions: Interactions) -> None:
     same_level = [k for k in e.handles if k.level == h.level]
     for k, other in enumerate(same_level):
         if imgui.radio_button(f"{other.label}##h{k}", other.same(h)):
-            out.append(Do("select", other))
+            out.append(ec.Select(other))
         if k % 2 == 0 and k + 1 < len(same_level):
             imgui.same_line()
     _fields(get_at(e.scene, h.owner), h.owner, out, interactions)
@@ -160,19 +189,19 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
             out.append(Edit(path, new, key))
 
 
-def _modals(e: Editor, out: list) -> None:
+def _modals(e: Edited, out: list) -> None:
     if e.asking is not None and not imgui.is_popup_open("unsaved changes"):
         imgui.open_popup("unsaved changes")
     if imgui.begin_popup_modal("unsaved changes", None, imgui.WindowFlags_.always_auto_resize)[0]:
         what = "closing" if e.asking == ("close", None) else "opening another scene"
         imgui.text(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
-        for label, action in (
-            ("save", "answer_save"),
-            ("discard", "answer_discard"),
-            ("cancel", "answer_cancel"),
+        for label, command in (
+            ("save", ec.AnswerSave()),
+            ("discard", ec.AnswerDiscard()),
+            ("cancel", ec.AnswerCancel()),
         ):
             if imgui.button(label):
-                out.append(Do(action))
+                out.append(command)
                 imgui.close_current_popup()
             imgui.same_line()
         imgui.end_popup()
@@ -184,10 +213,10 @@ def _modals(e: Editor, out: list) -> None:
             "did not end cleanly."
         )
         if imgui.button("restore them"):
-            out.append(Do("restore"))
+            out.append(ec.Restore())
             imgui.close_current_popup()
         imgui.same_line()
         if imgui.button("discard them"):
-            out.append(Do("discard_recovery"))
+            out.append(ec.DiscardRecovery())
             imgui.close_current_popup()
         imgui.end_popup()

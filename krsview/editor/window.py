@@ -1,7 +1,12 @@
-"""`krsview edit`: the viewer plus direct manipulation. Click a handle, an outline entry or the
+"""`krsview edit`: a viewer plus direct manipulation. Click a handle, an outline entry or the
 geometry to select; drag with the ImGuizmo translate gizmo (a normal by its arrow tip); every
 change is an edit through the document, so Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo it,
 Ctrl+S saves atomically, and unsaved work is autosaved beside the scene.
+
+The editor composes a :class:`Viewer`: it turns the event loop itself, calling the viewer's
+parts (keys, camera, file watching, tracing, HUD) and adding its overlay, panels and gizmo.
+Commands of its own go to EDITOR_HANDLERS, and those the editor decides differently
+(bookmark, open, a file changed on disk); the rest to the viewer's.
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
@@ -10,25 +15,33 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import glfw  # noqa: E402  (after imgui, as the viewer)
 import numpy as np
-from imgui_bundle import imgui, imguizmo
+from imgui_bundle import imgui
 
 from ..compile.camera import View, pixel_ray, project, view_of
-from ..document.document import ConflictError
+from ..document.document import ConflictError, Document
 from ..gpu.overlay import FAR, NEAR, Overlay, Shapes, camera_matrices
 from ..reference.geometry import nearest
-from ..scene import Bookmark, SceneError
+from ..scene import Bookmark, Scene, SceneError
+from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
+from ..viewer import commands as vc
+from ..viewer.controls import VIEWER_KEYS
+from ..viewer.hud import draw_hud
+from ..viewer.loop import run
+from ..viewer.picking import depth_at
 from ..viewer.window import Viewer
+from . import commands as ec
+from .gizmo import Gizmo
 from .handles import Handle, handles, polyline
 from .panels import edit_panel
 
-gizmo = imguizmo.im_guizmo
 PICK_PIXELS = 12.0  # a click this close to a handle grabs it
-CLICK_PIXELS = 4.0  # a press and release closer than this is a click, not a drag
 FORK, CONTROL, NORMAL, SELECTED = (
     (1.0, 0.6, 0.15, 1.0),
     (0.3, 0.85, 1.0, 1.0),
@@ -37,98 +50,158 @@ FORK, CONTROL, NORMAL, SELECTED = (
 )
 ROUTE = (1.0, 0.9, 0.5, 0.9)
 DISC = (0.5, 0.8, 1.0, 0.25)
+EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs()}
 
 
-@dataclass
-class Snap:
-    on: bool = False
-    grid: float = 0.05  # units, for a translate drag
-    angle: float = 5.0  # degrees (a normal's arrow tip snaps to the grid on its circle)
-
-
-class Editor(Viewer):
-    def __init__(self, path: Path, **kw):
-        self.selected: Handle | None = None
-        self.handles: list[Handle] = []
-        self.warnings: list[str] = []
-        super().__init__(path, **kw)
-        self.overlay = Overlay(self.ctx, self.renderer.programs)
-        self.snap = Snap()
+class Editor:
+    def __init__(self, path: Path, settings: ViewerSettings | None = None, **options: Any):
+        """``options``: ``visible``, ``shader_dir``, or fields of ViewerSettings."""
+        window = {k: options.pop(k) for k in ("visible", "shader_dir") if k in options}
+        settings = make_settings(settings or EDITOR_SETTINGS, **options)
+        self.viewer = Viewer(path, settings, **window)
+        self.viewer.input.keymap = dict(EDITOR_KEYS)
+        self.overlay = Overlay(self.viewer.ctx, self.viewer.renderer.programs)
+        self.gizmo = Gizmo()
+        self.snap = self.gizmo.snap
         self.carry = True  # a fork drag takes its subtree along
+        self.selected: Handle | None = None
+        self._handles_of: Scene | None = None  # the scene the handles were made for
+        self._handles: list[Handle] = []
+        self.warnings: list[str] = []
         self.save_as_text = str(self.path)
         self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
         self.recovered = self.doc.recovery()  # offered in a modal
         self.conflict = False
         self.scroll_outline = False
-        self._gizmo_drag = 0
-        self._was_using = False
-        self._press: tuple[float, float] | None = None
         self._quit = False
         self._title = ""
         self._update_title()
 
-    # -------------------------------------------------------------------- document hooks
-    def window_title(self) -> str:
-        return f"krsview edit — {self.doc.title}"
+    # ------------------------------------------------------------------------- the scene
+    @property
+    def doc(self) -> Document:
+        return self.viewer.doc
 
-    def _set_scene(self, scene, reset_camera: bool = False) -> None:
-        super()._set_scene(scene, reset_camera)
-        self.handles = handles(scene)
-        self.warnings = scene.route.warnings() if scene.route else []  # per edit, not frame
-        if self.selected is not None:  # keep the selection across edits, undo, reload
-            self.selected = next((h for h in self.handles if h.same(self.selected)), None)
+    @property
+    def scene(self) -> Scene:
+        return self.viewer.scene
+
+    @property
+    def path(self) -> Path:
+        return self.viewer.path
+
+    @property
+    def handles(self) -> list[Handle]:
+        """The scene's handles, made again when the scene changed (an edit, undo, reload);
+        the selection and the route's warnings follow."""
+        self._follow()
+        return self._handles
+
+    def _follow(self) -> None:
+        if self._handles_of is not self.scene:
+            self._handles_of = self.scene
+            self._handles = handles(self.scene)
+            route = self.scene.route
+            self.warnings = route.warnings() if route else []
+            if self.selected is not None:  # keep the selection across edits, undo, reload
+                self.selected = next((h for h in self._handles if h.same(self.selected)), None)
+
+    def edit(self, path: tuple, value, interaction=None) -> bool:
+        return self.viewer.edit(path, value, interaction)
 
     def _update_title(self) -> None:
-        title = self.window_title()
+        title = f"krsview edit — {self.doc.title}"
         if title != self._title:
-            glfw.set_window_title(self.window, title)
+            glfw.set_window_title(self.viewer.window, title)
             self._title = title
 
+    # ------------------------------------------------------------------------ the loop
+    def run(self) -> None:
+        run(self)
+
+    def is_idle(self) -> bool:
+        return self.viewer.is_idle()
+
+    def close(self) -> None:
+        self.viewer.close()
+
     def step(self, dt: float) -> None:
-        super().step(dt)
+        """The viewer's turn with the editor's parts: picking by a click, the overlay, the
+        panels and the gizmo; then the autosave."""
+        v = self.viewer
+        v.begin_step(dt)
+        self.execute(v.input.commands())
+        click = v.input.take_click()
+        if click is not None and v.hud:
+            self.pick(*click)
+        v.move(dt)
+        self.execute(v.watcher.poll())
+        v.draw_image()
+        self._follow()
+        if v.hud:
+            v.platform.new_frame()
+            self._draw_ui()
+            v.platform.render()
+        v.input.claimed = v.hud and self.gizmo.claims_mouse()
+        glfw.swap_buffers(v.window)
         self.doc.autosave(time.monotonic())
         self._update_title()
 
+    def should_close(self) -> bool:
+        if self._quit:
+            return True
+        if glfw.window_should_close(self.viewer.window):
+            glfw.set_window_should_close(self.viewer.window, False)
+            if not self.doc.dirty:
+                return True
+            self.asking, self.viewer.hud = ("close", None), True
+        return False
+
+    def execute(self, commands: list[vc.Command]) -> None:
+        """Apply commands: the editor's own and those it decides itself here, the rest by
+        the viewer."""
+        for command in commands:
+            handler = EDITOR_HANDLERS.get(type(command))
+            if handler is None:
+                self.viewer.execute([command])
+            else:
+                handler(self, command)
+
+    # --------------------------------------------------------------------------- actions
     def add_bookmark(self) -> None:
         """In the editor a bookmark is an edit like any other (saved with the scene)."""
-        b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.camera.to_camera())
+        b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.viewer.camera.to_camera())
         if self.edit(("bookmarks",), self.scene.bookmarks + [b]):
-            self.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
+            self.viewer.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
 
-    def file_changed(self) -> None:
+    def reload_scene(self) -> None:
         """Unsaved edits are never overwritten by the file's new contents: ask first."""
+        if not self.doc.changed_on_disk():
+            return
         if self.doc.dirty:
             self.conflict = True
         else:
-            super().file_changed()
-
-    # --------------------------------------------------------------------------- actions
-    def undo(self) -> None:
-        if self.doc.undo():
-            self._sync()
-
-    def redo(self) -> None:
-        if self.doc.redo():
-            self._sync()
+            self.viewer.take_file()
 
     def save(self, path: str | None = None, overwrite: bool = False) -> bool:
+        v = self.viewer
         try:
             saved = self.doc.save(path or None, overwrite=overwrite)
         except ConflictError as e:
-            self.error, self.conflict = str(e), True
+            v.error, self.conflict = str(e), True
             return False
         except SceneError as e:
-            self.error = str(e)
+            v.error = str(e)
             return False
-        self._stamps = self._file_stamps()
-        self.error, self.message, self.conflict = "", f"saved {saved.resolve()}", False
+        v.follow_file()
+        v.error, v.message, self.conflict = "", f"saved {saved.resolve()}", False
         self.save_as_text = str(saved)
         return True
 
     def save_as(self, text: str) -> None:
         target = Path(text.strip()).expanduser()
         if target.suffix != ".toml" or target.is_dir():
-            self.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
+            self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
             return
         self.save(str(target))
 
@@ -138,8 +211,8 @@ class Editor(Viewer):
         self.doc.commit(
             replace(self.scene, tree=None, route=t.route()), "bake the tree into a route"
         )
-        self._sync()
-        self.message = "baked: drag forks, control points and mirror normals"
+        self.viewer.sync()
+        self.viewer.message = "baked: drag forks, control points and mirror normals"
 
     def select(self, h: Handle | None) -> None:
         self.selected = h
@@ -148,24 +221,19 @@ class Editor(Viewer):
     def select_level(self, level: int) -> None:
         self.select(next((h for h in self.handles if h.level == level), None))
 
-    def set_snap(self, on: bool) -> None:
-        self.snap.on = on
-
-    def set_carry(self, on: bool) -> None:
-        self.carry = on
-
     def take_file(self) -> None:
         self.conflict = False
-        super().file_changed()
+        self.viewer.take_file()
 
     def keep_mine(self) -> None:
-        self.conflict, self.message = False, "kept your edits; saving will ask to overwrite"
+        self.conflict = False
+        self.viewer.message = "kept your edits; saving will ask to overwrite"
 
     def restore(self) -> None:
         self.doc.restore_recovery()
         self.recovered = None
-        self._sync()
-        self.message = "restored the unsaved edits (Ctrl+Z undoes the restore)"
+        self.viewer.sync()
+        self.viewer.message = "restored the unsaved edits (Ctrl+Z undoes the restore)"
 
     def discard_recovery(self) -> None:
         self.doc.discard_recovery()
@@ -190,53 +258,21 @@ class Editor(Viewer):
         elif what == "open" and path is not None:
             self._open(path)
 
-    def shortcut(self, key: int, shift: bool) -> None:
-        if key == glfw.KEY_Z:
-            self.redo() if shift else self.undo()
-        elif key == glfw.KEY_Y:
-            self.redo()
-        elif key == glfw.KEY_S:
-            self.save_as(self.save_as_text) if shift else self.save()
-
-    # ---------------------------------------------------------------- closing and opening
-    def should_close(self) -> bool:
-        if self._quit:
-            return True
-        if glfw.window_should_close(self.window):
-            glfw.set_window_should_close(self.window, False)
-            if not self.doc.dirty:
-                return True
-            self.asking, self.hud = ("close", None), True
-        return False
-
     def open_preset(self, path: Path) -> None:
         if self.doc.dirty:
-            self.asking, self.hud = ("open", Path(path)), True
+            self.asking, self.viewer.hud = ("open", Path(path)), True
         else:
             self._open(path)
 
     def _open(self, path: Path) -> None:
-        super().open_preset(path)
+        self.viewer.open_preset(path)
         self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
         self.save_as_text = str(self.path)
 
     # ------------------------------------------------------------------- mouse and picking
     def window_view(self) -> View:
-        w, h = glfw.get_window_size(self.window)
-        return view_of(self.camera.to_camera(), max(w, 1), max(h, 1))
-
-    def mouse_claimed(self) -> bool:
-        return self.hud and (gizmo.is_over() or gizmo.is_using())
-
-    def left_button(self, down: bool) -> None:
-        x, y = self.input.cursor
-        if down:
-            self._press = (x, y)
-        elif self._press is not None:
-            moved = math.hypot(x - self._press[0], y - self._press[1])
-            self._press = None
-            if moved <= CLICK_PIXELS and self.hud:
-                self.pick(x, y)
+        w, h = glfw.get_window_size(self.viewer.window)
+        return view_of(self.viewer.camera.to_camera(), max(w, 1), max(h, 1))
 
     def pick(self, x: float, y: float) -> Handle | None:
         """Select what is under window point (x, y): the nearest handle within PICK_PIXELS,
@@ -254,17 +290,16 @@ class Editor(Viewer):
         return best
 
     def _pick_surface(self, v: View, x: float, y: float) -> Handle | None:
-        if self.image is None:
+        if self.viewer.frames.image is None:
             return None
-        fbo, (w, h) = self.image
+        fbo, (w, h) = self.viewer.frames.image
         px = min(max(int(x / v.width * w), 0), w - 1)
         py = min(max(int((v.height - y) / v.height * h), 0), h - 1)
-        raw = fbo.read(viewport=(px, py, 1, 1), attachment=1, components=4, dtype="f4")
-        t = float(np.frombuffer(raw, np.float32)[3])
+        t = depth_at(fbo, px, py)
         if not t > 0:
             return None
         point = v.origin + t * pixel_ray(v, x, y)
-        slot = int(nearest(self.world, point[None])[0][0])
+        slot = int(nearest(self.viewer.world, point[None])[0][0])
         level = self._entry_of_slot(slot)
         return next((h for h in self.handles if h.level == level), None)
 
@@ -273,28 +308,34 @@ class Editor(Viewer):
         levels the levels slider cut away), or a compound's component (slots are numbered
         component after component)."""
         if not self.scene.compound:
-            return slot + self.geometry.depth - self.krs.depth
-        bases = list(getattr(self.world, "bases", (0,)))
+            return slot + self.viewer.geometry.depth - self.viewer.krs.depth
+        bases = list(getattr(self.viewer.world, "bases", (0,)))
         return max(k for k, b in enumerate(bases) if b <= slot)
 
     # ----------------------------------------------------------------------- drawing
-    def draw_ui(self, fb: tuple[int, int]) -> None:
-        v = self.window_view()
-        if self.image is not None:
+    def _draw_ui(self) -> None:
+        """Inside the ImGui frame: the overlay over the image, the viewer's HUD (collapsed
+        at first: the view stays free), the edit panel and the gizmo."""
+        v = self.viewer
+        view = self.window_view()
+        if v.frames.image is not None:
+            fb = glfw.get_framebuffer_size(v.window)
+            view_matrix, proj = camera_matrices(view, NEAR, FAR)
+            matrix = proj @ view_matrix
             self.overlay.draw(
-                self._shapes(v), self.image[0], self.ctx.screen, fb, self._matrix(v), v.origin
+                self._shapes(), v.frames.image[0], v.ctx.screen, fb, matrix, view.origin
             )
-        gizmo.begin_frame()
-        imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)  # the view stays free
-        super().draw_ui(fb)
-        self.execute(edit_panel(self, self.interactions))
-        self._gizmo(v)
+        self.gizmo.begin_frame()
+        imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
+        self.execute(draw_hud(v, v.interactions))
+        self.execute(edit_panel(self, v.interactions))
+        if self.selected is not None:
+            moved = self.gizmo.manipulate(self.selected, view)
+            if moved is not None:
+                p, drag = moved
+                self.edit(*self.selected.edit_to(self.scene, p, self.carry), drag)
 
-    def _matrix(self, v: View) -> np.ndarray:
-        view, proj = camera_matrices(v, NEAR, FAR)
-        return proj @ view
-
-    def _shapes(self, v: View) -> Shapes:
+    def _shapes(self) -> Shapes:
         s = Shapes()
         route = polyline(self.scene)
         for a, b in zip(route[:-1], route[1:]):
@@ -322,48 +363,27 @@ class Editor(Viewer):
         if r > 0:
             s.disc(arrow.pivot, d / r, 1.6 * r, DISC)
 
-    def _gizmo(self, v: View) -> None:
-        h = self.selected
-        if h is None:
-            return
-        io = imgui.get_io()
-        gizmo.set_drawlist(imgui.get_background_draw_list())
-        gizmo.set_rect(0.0, 0.0, io.display_size.x, io.display_size.y)
-        near = 1e-3 * max(float(np.linalg.norm(h.position - v.origin)), 1e-12)
-        view, proj = camera_matrices(v, near, 1e6 * near)
-        obj = np.eye(4)
-        obj[:3, 3] = h.position - v.origin  # camera-relative: float32 stays precise
-        m = gizmo.Matrix16(list(obj.T.flatten()))
-        snap = self.snap.on or bool(io.key_shift)
-        step = gizmo.Matrix3([self.snap.grid] * 3) if snap and h.kind == "point" else None
-        changed = gizmo.manipulate(
-            gizmo.Matrix16(list(view.T.flatten())),
-            gizmo.Matrix16(list(proj.T.flatten())),
-            gizmo.OPERATION.translate,
-            gizmo.MODE.world,
-            m,
-            None,
-            step,
-        )
-        using = gizmo.is_using()
-        if using and not self._was_using:
-            self._gizmo_drag += 1  # a new drag: a new undo step
-        self._was_using = using
-        if changed and using:
-            p = np.array(m.values[12:15], dtype=np.float64) + v.origin
-            if snap and h.kind == "normal":
-                p = h.pivot + _snap_direction(p - h.pivot, self.snap.angle)
-            self.edit(*h.edit_to(self.scene, p, self.carry), ("gizmo", self._gizmo_drag))
 
-
-def _snap_direction(d: np.ndarray, degrees: float) -> np.ndarray:
-    """d with its polar angles (from +y, around y) rounded to multiples of ``degrees``."""
-    r = float(np.linalg.norm(d))
-    if r == 0:
-        return d
-    step = math.radians(degrees)
-    theta = round(math.acos(max(-1.0, min(1.0, d[1] / r))) / step) * step
-    phi = round(math.atan2(d[2], d[0]) / step) * step
-    return r * np.array(
-        [math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi)]
-    )
+# The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
+# edit, opening or reloading asks about unsaved edits); tests/test_commands.py checks them.
+EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
+    ec.Bake: lambda e, c: e.bake(),
+    ec.Select: lambda e, c: e.select(c.handle),
+    ec.SelectLevel: lambda e, c: e.select_level(c.level),
+    ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),
+    ec.SetSnap: lambda e, c: setattr(e.snap, "on", c.on),
+    ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),
+    ec.Save: lambda e, c: e.save(),
+    ec.SaveAs: lambda e, c: e.save_as(e.save_as_text),
+    ec.SetSaveAsText: lambda e, c: setattr(e, "save_as_text", c.text),
+    ec.TakeFile: lambda e, c: e.take_file(),
+    ec.KeepMine: lambda e, c: e.keep_mine(),
+    ec.Restore: lambda e, c: e.restore(),
+    ec.DiscardRecovery: lambda e, c: e.discard_recovery(),
+    ec.AnswerSave: lambda e, c: e.answer_save(),
+    ec.AnswerDiscard: lambda e, c: e.answer_discard(),
+    ec.AnswerCancel: lambda e, c: e.answer_cancel(),
+    vc.AddBookmark: lambda e, c: e.add_bookmark(),
+    vc.OpenPreset: lambda e, c: e.open_preset(c.path),
+    vc.ReloadScene: lambda e, c: e.reload_scene(),
+}

@@ -1,49 +1,71 @@
-"""Controls as data (action ↦ key, the pygfx habit) and one input layer fed by GLFW callbacks
-or by tests with synthetic events."""
+"""Controls as data (key ↦ movement or command, the pygfx habit) and one input layer fed by
+GLFW callbacks or by tests with synthetic events."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
-# Held keys move the camera; pressed keys trigger an action once.
-CONTROLS: dict[str, str] = {
-    "forward": "W",
-    "back": "S",
-    "left": "A",
-    "right": "D",
-    "down": "Q",
-    "up": "E",
-    "reset": "R",
-    "orbit": "O",
-    "screenshot": "F12",
-    "hud": "F1",
-    "bookmark": "B",
-    "next_bookmark": "N",
-    "record": "F5",
-    "replay": "F6",
+from .commands import (
+    AddBookmark,
+    Command,
+    NextBookmark,
+    Redo,
+    Replay,
+    ResetView,
+    Screenshot,
+    ToggleHud,
+    ToggleOrbit,
+    ToggleRecording,
+    Undo,
+)
+
+# Held keys move the camera: (right, up, forward) components.
+MOVES: dict[str, tuple[int, int, int]] = {
+    "W": (0, 0, 1),
+    "S": (0, 0, -1),
+    "A": (-1, 0, 0),
+    "D": (1, 0, 0),
+    "Q": (0, -1, 0),
+    "E": (0, 1, 0),
 }
-MOVES = {
-    "forward": (0, 0, 1),
-    "back": (0, 0, -1),
-    "left": (-1, 0, 0),
-    "right": (1, 0, 0),
-    "down": (0, -1, 0),
-    "up": (0, 1, 0),
+# Pressed keys (Ctrl+key as "ctrl+KEY", "ctrl+shift+KEY") give a command once.
+VIEWER_KEYS: dict[str, Command] = {
+    "R": ResetView(),
+    "O": ToggleOrbit(),
+    "F12": Screenshot(),
+    "F1": ToggleHud(),
+    "B": AddBookmark(),
+    "N": NextBookmark(),
+    "F5": ToggleRecording(),
+    "F6": Replay(),
+    "ctrl+Z": Undo(),
+    "ctrl+shift+Z": Redo(),
+    "ctrl+Y": Redo(),
 }
 LOOK_BUTTON = "right"  # hold to look around (fly) …
 ORBIT_BUTTON = "left"  # … or drag to orbit in orbit mode
+CLICK_PIXELS = 4.0  # a left press and release closer than this is a click, not a drag
 
 
 @dataclass
 class Input:
+    keymap: dict[str, Command] = field(default_factory=lambda: dict(VIEWER_KEYS))
     held: set[str] = field(default_factory=set)
     pressed: list[str] = field(default_factory=list)  # key presses since the last frame
     buttons: set[str] = field(default_factory=set)
     cursor: tuple[float, float] = (0.0, 0.0)
     drag: tuple[float, float] = (0.0, 0.0)  # cursor motion while a button is held
     scroll: float = 0.0
+    press: tuple[float, float] | None = None  # where the left button went down
+    click: tuple[float, float] | None = None  # the last left click not yet taken
+    claimed: bool = False  # a press now is not the camera's (a gizmo is under the cursor)
+    look_hides_cursor: bool = True  # flying: the look button captures the cursor
 
     def key(self, name: str, down: bool) -> None:
+        """A key named as in MOVES and the keymap went down or up (others are ignored)."""
+        if name not in MOVES and name not in self.keymap:
+            return
         if down:
             if name not in self.held:
                 self.pressed.append(name)
@@ -51,8 +73,22 @@ class Input:
         else:
             self.held.discard(name)
 
+    def chord(self, name: str) -> None:
+        """A Ctrl+key press, named "ctrl+KEY" or "ctrl+shift+KEY"."""
+        if name in self.keymap:
+            self.pressed.append(name)
+
     def button(self, name: str, down: bool) -> None:
         (self.buttons.add if down else self.buttons.discard)(name)
+        if name != "left":
+            return
+        if down:
+            self.press = self.cursor
+        elif self.press is not None:
+            moved = math.dist(self.cursor, self.press)
+            self.press = None
+            if moved <= CLICK_PIXELS:
+                self.click = self.cursor
 
     def move_cursor(self, x: float, y: float) -> None:
         if self.buttons:
@@ -62,17 +98,16 @@ class Input:
     def wheel(self, dy: float) -> None:
         self.scroll += dy
 
-    def actions(self) -> list[str]:
-        """Actions pressed since the last call."""
-        by_key = {k: a for a, k in CONTROLS.items()}
-        out = [by_key[k] for k in self.pressed if k in by_key]
+    def commands(self) -> list[Command]:
+        """The commands of the keys pressed since the last call."""
+        out = [self.keymap[k] for k in self.pressed if k in self.keymap]
         self.pressed.clear()
         return out
 
     def movement(self) -> tuple[float, float, float]:
         v = [0.0, 0.0, 0.0]
-        for action, d in MOVES.items():
-            if CONTROLS[action] in self.held:
+        for key, d in MOVES.items():
+            if key in self.held:
                 v = [a + b for a, b in zip(v, d)]
         return (v[0], v[1], v[2])
 
@@ -83,3 +118,7 @@ class Input:
     def take_scroll(self) -> float:
         s, self.scroll = self.scroll, 0.0
         return s
+
+    def take_click(self) -> tuple[float, float] | None:
+        c, self.click = self.click, None
+        return c

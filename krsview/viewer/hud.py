@@ -5,21 +5,25 @@ the viewer and returns commands; it never writes the viewer's fields."""
 from __future__ import annotations
 
 from dataclasses import fields
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 from imgui_bundle import imgui, implot
 
+from ..document.document import Document
 from ..gpu.display import VIEW_MODES
-from ..scene import EFFECTS, Render
+from ..scene import EFFECTS, Render, Scene
 from ..scene.effects import allowed_effects
 from ..scene.presets import preset_names, resolve
-from .commands import Command, Do, Edit
+from ..scene.scene import Geometry
+from ..scene.settings import settings_meta
+from . import commands as c
+from .frames import Frames
 from .measured import apply_row, best_within, matches
+from .navigation import Navigation
+from .recording import Recorder
 from .widgets import Interactions, field_widget
-
-if TYPE_CHECKING:
-    from .window import Viewer
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
@@ -41,8 +45,32 @@ COMPUTE_KNOBS = ("steps", "shadow_tasks", "component_tasks")  # on the compute p
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
-def draw_hud(v: Viewer, interactions: Interactions) -> list[Command]:
-    out: list[Command] = []
+class Viewed(Protocol):
+    """What the HUD reads of the viewer (it writes nothing: it returns commands)."""
+
+    doc: Document
+    frames: Frames
+    recorder: Recorder
+    geometry: Geometry
+    view: str
+    levels: int
+    nav: Navigation
+    moving_effects: bool
+    measured: list[dict] | None
+    message: str
+    error: str
+
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def path(self) -> Path: ...
+    @property
+    def prepass(self) -> int: ...
+    def nearest_distance(self) -> float: ...
+
+
+def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
+    out: list[c.Command] = []
     imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
     imgui.set_next_window_size(imgui.ImVec2(330, 0), imgui.Cond_.first_use_ever)
     imgui.set_next_window_bg_alpha(0.75)
@@ -64,45 +92,46 @@ def draw_hud(v: Viewer, interactions: Interactions) -> list[Command]:
     return out
 
 
-def _performance(v: Viewer, out: list) -> None:
-    times = np.array(v.frame_seconds[-120:] or [0.0], dtype=np.float32) * 1e3
+def _performance(v: Viewed, out: list) -> None:
+    f = v.frames
+    times = np.array(f.frame_seconds[-120:] or [0.0], dtype=np.float32) * 1e3
     fps = 1e3 / max(float(np.median(times)), 1e-6)
-    w, h = v.adaptive.moving_size()
+    w, h = v.frames.adaptive.moving_size()
     state = (
         "refined"
-        if v.refined
-        else f"refining {v.refinement.next_row}/{v.refinement.size[1]}"
-        if v.refinement
+        if f.refined
+        else f"refining {f.refinement.next_row}/{f.refinement.size[1]}"
+        if f.refinement
         else "moving"
     )
-    imgui.text(f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.adaptive.scale:.0%})")
+    imgui.text(
+        f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.frames.adaptive.scale:.0%})"
+    )
     imgui.text(f"{state}; {v.view} view")
     if implot.begin_plot("##frametime", imgui.ImVec2(-1, 70), implot.Flags_.no_legend):
         implot.setup_axes_limits(
             0, 120, 0, max(60.0, float(times.max()) * 1.1), implot.Cond_.always
         )
         implot.plot_line("frame ms", times)
-        budget = np.full(2, 1e3 / v.adaptive.target_fps, dtype=np.float32)
+        budget = np.full(2, 1e3 / v.frames.adaptive.target_fps, dtype=np.float32)
         implot.plot_line("budget", budget, xscale=120)
         implot.end_plot()
-    changed, fps_target = imgui.slider_float("target FPS", v.adaptive.target_fps, 5, 120, "%.0f")
+    changed, fps_target = field_widget(
+        "target FPS", v.frames.adaptive.target_fps, settings_meta("target_fps")
+    )
     if changed:
-        out.append(Do("set_target_fps", fps_target))
-    changed, ss = imgui.checkbox("supersample still images 2×2", v.adaptive.supersample == 2)
+        out.append(c.SetTargetFps(fps_target))
+    changed, ss = imgui.checkbox("supersample still images 2×2", v.frames.adaptive.supersample == 2)
     if changed:
-        out.append(Do("set_supersample", 2 if ss else 1))
-    changed, on = imgui.checkbox("shadows and occlusion while moving", v.moving_effects)
+        out.append(c.SetSupersample(2 if ss else 1))
+    changed, on = field_widget(
+        "shadows and occlusion while moving", v.moving_effects, settings_meta("moving_effects")
+    )
     if changed:
-        out.append(Do("set_moving_effects", on))
-    if imgui.is_item_hovered():
-        imgui.set_tooltip(
-            "off: moving frames skip the effects that trace the geometry again "
-            "per pixel, for a sharper image at the target FPS; the still image "
-            "always has them"
-        )
+        out.append(c.SetMovingEffects(on))
 
 
-def _accuracy(v: Viewer, out: list, interactions: Interactions) -> None:
+def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
     r = v.scene.render
     for name in KNOBS:
         if TRACER_KNOBS.get(name, r.tracer) != r.tracer:  # another tracer's knob
@@ -115,60 +144,60 @@ def _accuracy(v: Viewer, out: list, interactions: Interactions) -> None:
         changed, value = field_widget(f"{name}##render", getattr(r, name), meta)
         key = interactions.key(("render", name))
         if changed:
-            out.append(Edit(("render", name), value, key))
-    changed, tile = imgui.slider_int("pre-pass tile", v.prepass, 0, 32)
+            out.append(c.Edit(("render", name), value, key))
+    changed, tile = field_widget("prepass##render", v.prepass, RENDER_META["prepass"])
+    key = interactions.key(("render", "prepass"))
     if changed:
-        out.append(Do("set_prepass", tile))
-    if imgui.is_item_hovered():
-        imgui.set_tooltip(RENDER_META["prepass"]["help"])
+        out.append(c.SetPrepass(tile, key))
     total = v.geometry.depth
     changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
     if changed:
-        out.append(Do("set_levels", levels))
+        out.append(c.SetLevels(levels))
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))
     if changed:
-        out.append(Do("set_view_mode", VIEW_MODES[k]))
+        out.append(c.SetViewMode(VIEW_MODES[k]))
     imgui.text("effects (each compiles its own shader variant, cached)")
     for name in allowed_effects(v.scene.mokrs is not None):
         changed, on = imgui.checkbox(name, name in v.scene.effects)
         if changed:
-            out.append(Do("set_effect", name, on))
+            out.append(c.SetEffect(name, on))
         if imgui.is_item_hovered():
             imgui.set_tooltip(EFFECTS[name].help)
 
 
-def _scene(v: Viewer, out: list) -> None:
+def _scene(v: Viewed, out: list) -> None:
     names = preset_names()
     current = names.index(v.path.stem) if v.path.stem in names else -1
     changed, k = imgui.combo("preset", current, names)
     if changed:
-        out.append(Do("open_preset", resolve(names[k])))
+        out.append(c.OpenPreset(resolve(names[k])))
     imgui.text(
-        f"speed ×{v.speed_factor:.2f} of the nearest distance "
+        f"speed ×{v.nav.speed_factor:.2f} of the nearest distance "
         f"({v.nearest_distance():.3g}); scroll to change"
     )
-    for label, action, same_line in (
-        ("screenshot (F12)", "screenshot", True),
-        ("reset view (R)", "reset", True),
-        ("orbit (O)" if v.orbit_pivot is None else "fly (O)", "orbit", False),
-        ("add bookmark (B)", "bookmark", False),
+    for label, command, same_line in (
+        ("screenshot (F12)", c.Screenshot(), True),
+        ("reset view (R)", c.ResetView(), True),
+        ("orbit (O)" if v.nav.orbit_pivot is None else "fly (O)", c.ToggleOrbit(), False),
+        ("add bookmark (B)", c.AddBookmark(), False),
     ):
         if imgui.button(label):
-            out.append(Do("act", action))
+            out.append(command)
         if same_line:
             imgui.same_line()
     for i, b in enumerate(v.scene.bookmarks):
         imgui.same_line()
         if imgui.button(f"{b.name}##{i}"):
-            out.append(Do("go_to_bookmark", i))
-    if imgui.button("stop recording (F5)" if v.recording is not None else "record path (F5)"):
-        out.append(Do("act", "record"))
+            out.append(c.GoToBookmark(i))
+    recording = v.recorder.recording is not None
+    if imgui.button("stop recording (F5)" if recording else "record path (F5)"):
+        out.append(c.ToggleRecording())
     imgui.same_line()
     if imgui.button("replay path (F6)"):
-        out.append(Do("act", "replay"))
+        out.append(c.Replay())
 
 
-def _measured(v: Viewer, out: list) -> None:
+def _measured(v: Viewed, out: list) -> None:
     """Where the current setting sits on the preset's measured time/error curve, and a
     button for the most accurate measured setting that fits the frame budget."""
     rows = v.measured
@@ -180,7 +209,7 @@ def _measured(v: Viewer, out: list) -> None:
     now = [
         r for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth, v.prepass)
     ]
-    w, h = v.adaptive.moving_size()
+    w, h = v.frames.adaptive.moving_size()
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
         implot.setup_axes("ms (report size)", "hit-mask error %")
         ms = np.array([r["ms"] for r in rows], dtype=np.float32)
@@ -201,7 +230,7 @@ def _measured(v: Viewer, out: list) -> None:
         )
     else:
         imgui.text_disabled("the current setting was not measured (change one knob at a time)")
-    budget = 1e3 / v.adaptive.target_fps
+    budget = 1e3 / v.frames.adaptive.target_fps
     best = best_within(rows, budget, w * h)
     if best is None:
         imgui.text_disabled(f"no measured setting fits {budget:.0f} ms at {w}×{h}")

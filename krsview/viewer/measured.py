@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..scene import Scene
 from ..scene.presets import PRESET_DIR
-from .commands import Command, Do, Edit
+from .commands import Command, Edit, SetLevels, SetPrepass
 
 # A report made here by `krsview bench accuracy` (OUT/PRESET/accuracy.csv) wins over the
 # measurements shipped beside the presets (PRESET.accuracy.csv, in the wheel too).
@@ -65,8 +65,8 @@ def matches(
         return same_but(**_tracer(value))
     if knob in ("precision", "culling", "path"):
         return same_but(**{knob: value})
-    if knob == "prepass":
-        return r == s and full and prepass == int(value)
+    if knob == "prepass":  # the scene's own pre-pass may differ: the view draws ``prepass``
+        return replace(s, prepass=r.prepass) == r and full and prepass == int(value)
     if knob == "levels":
         return r == s and drawn_levels == int(value)
     return False
@@ -101,7 +101,7 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
         "path": lambda: replace(base, path=value),
     }.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
-    out = [Edit(("render",), render), Do("set_levels", levels)]
+    out: list[Command] = [Edit(("render",), render), SetLevels(levels)]
     if knob == "prepass":
-        out.append(Do("set_prepass", int(value)))
+        out.append(SetPrepass(int(value)))
     return out

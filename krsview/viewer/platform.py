@@ -5,30 +5,21 @@ input (keys, buttons, cursor, wheel) unless ImGui or a gizmo wants them."""
 from __future__ import annotations
 
 import ctypes
-from typing import Protocol
+import string
 
 import glfw  # noqa: E402  (order matters)
 from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
 
-from .controls import CONTROLS, LOOK_BUTTON, Input
+from .controls import LOOK_BUTTON, Input
 
-GLFW_KEYS = {getattr(glfw, f"KEY_{k}"): k for k in set(CONTROLS.values())}
+GLFW_KEYS = {getattr(glfw, f"KEY_{c}"): c for c in string.ascii_uppercase} | {
+    getattr(glfw, f"KEY_F{i}"): f"F{i}" for i in range(1, 13)
+}
 GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
 
 
 class WindowError(RuntimeError):
     """No window could be opened (no display, or no OpenGL 4.3+ there)."""
-
-
-class Receiver(Protocol):
-    """What the events are delivered to (the viewer, the editor)."""
-
-    input: Input
-    orbit_pivot: object
-
-    def shortcut(self, key: int, shift: bool) -> None: ...
-    def mouse_claimed(self) -> bool: ...
-    def left_button(self, down: bool) -> None: ...
 
 
 class Platform:
@@ -48,39 +39,41 @@ class Platform:
         imgui.destroy_context()
         glfw.destroy_window(self.window)
 
-    def route_events(self, to: Receiver) -> None:
+    def route_events(self, to: Input) -> None:
+        """GLFW events go to ImGui first, then to ``to`` unless ImGui or a gizmo takes them."""
         b, a, window = imgui.backends, self.addr, self.window
 
         def on_key(_w, key, scancode, action, mods):
             b.glfw_key_callback(a, key, scancode, action, mods)
             if imgui.get_io().want_capture_keyboard:
                 return  # typing in a field
+            if key not in GLFW_KEYS:
+                return
             if action == glfw.PRESS and mods & glfw.MOD_CONTROL:
-                to.shortcut(key, bool(mods & glfw.MOD_SHIFT))
-            elif action != glfw.REPEAT and key in GLFW_KEYS:
-                to.input.key(GLFW_KEYS[key], action == glfw.PRESS)
+                shift = "shift+" if mods & glfw.MOD_SHIFT else ""
+                to.chord(f"ctrl+{shift}{GLFW_KEYS[key]}")
+            elif action != glfw.REPEAT:
+                to.key(GLFW_KEYS[key], action == glfw.PRESS)
 
         def on_button(_w, button, action, mods):
             b.glfw_mouse_button_callback(a, button, action, mods)
-            if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or to.mouse_claimed()):
+            if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or to.claimed):
                 return  # the HUD's or a gizmo's press, not the camera's
-            if button == glfw.MOUSE_BUTTON_LEFT:
-                to.left_button(action == glfw.PRESS)
             if button in GLFW_BUTTONS:
-                to.input.button(GLFW_BUTTONS[button], action == glfw.PRESS)
+                to.button(GLFW_BUTTONS[button], action == glfw.PRESS)
                 look = GLFW_BUTTONS[button] == LOOK_BUTTON
-                if look and to.orbit_pivot is None:
+                if look and to.look_hides_cursor:
                     mode = glfw.CURSOR_DISABLED if action == glfw.PRESS else glfw.CURSOR_NORMAL
                     glfw.set_input_mode(window, glfw.CURSOR, mode)
 
         def on_cursor(_w, x, y):
             b.glfw_cursor_pos_callback(a, x, y)
-            to.input.move_cursor(x, y)
+            to.move_cursor(x, y)
 
         def on_scroll(_w, dx, dy):
             b.glfw_scroll_callback(a, dx, dy)
             if not imgui.get_io().want_capture_mouse:
-                to.input.wheel(dy)
+                to.wheel(dy)
 
         def on_char(_w, c):
             b.glfw_char_callback(a, c)

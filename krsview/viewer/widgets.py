@@ -32,14 +32,16 @@ class Interactions:
         return ("panel", path, self.count)
 
 
-def _tooltip(meta: dict) -> None:
+def _tooltip(meta: dict, typed: bool) -> None:
     text = meta.get("help", "")
     lo, hi, unit = meta.get("lo"), meta.get("hi"), meta.get("unit", "")
     if lo is not None or hi is not None:
         lo_text, hi_text = "" if lo is None else lo, "" if hi is None else hi
         text += f" [{lo_text} … {hi_text}{' ' + unit if unit else ''}]"
     if text and imgui.is_item_hovered():
-        imgui.set_tooltip(text + "\n(ctrl+click or double-click to type a value)")
+        imgui.set_tooltip(
+            text + ("\n(ctrl+click or double-click to type a value)" if typed else "")
+        )
 
 
 def _speed(value: float, meta: dict) -> float:
@@ -52,7 +54,8 @@ def _speed(value: float, meta: dict) -> float:
 
 
 def field_widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
-    """One widget for one scene field; (changed, new value)."""
+    """One widget for one field (of the scene, or of the viewer's settings); (changed, new
+    value)."""
     lo, hi = meta.get("lo"), meta.get("hi")
     if isinstance(value, bool):
         changed, value = imgui.checkbox(label, value)
@@ -91,5 +94,5 @@ def field_widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
     else:
         imgui.text_disabled(f"{label}: {value!r}")
         return False, value
-    _tooltip(meta)
+    _tooltip(meta, typed=not isinstance(value, (bool, str)))
     return changed, value

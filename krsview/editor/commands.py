@@ -1,0 +1,93 @@
+"""The editor's own commands (the viewer's are in krsview.viewer.commands): what its panels,
+keys and modals return; the editor applies them through its EDITOR_HANDLERS."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..viewer.commands import Command
+from .handles import Handle
+
+
+@dataclass(frozen=True)
+class Bake(Command):
+    """Grown tree → route (one undo step): every fork becomes a handle."""
+
+
+@dataclass(frozen=True)
+class Select(Command):
+    handle: Handle | None
+
+
+@dataclass(frozen=True)
+class SelectLevel(Command):
+    """Select the first handle of an outline entry."""
+
+    level: int
+
+
+@dataclass(frozen=True)
+class OutlineScrolled(Command):
+    """The outline has scrolled to the selection."""
+
+
+@dataclass(frozen=True)
+class SetSnap(Command):
+    on: bool
+
+
+@dataclass(frozen=True)
+class SetCarry(Command):
+    """A dragged fork takes its subtree along (on) or moves alone (off)."""
+
+    on: bool
+
+
+@dataclass(frozen=True)
+class Save(Command):
+    """Ctrl+S: write the scene to its file (atomic)."""
+
+
+@dataclass(frozen=True)
+class SaveAs(Command):
+    """Ctrl+Shift+S: save under the name typed in the save-as field."""
+
+
+@dataclass(frozen=True)
+class SetSaveAsText(Command):
+    text: str
+
+
+@dataclass(frozen=True)
+class TakeFile(Command):
+    """A conflict: take the file's new contents (the edits stay undoable)."""
+
+
+@dataclass(frozen=True)
+class KeepMine(Command):
+    """A conflict: keep the edits; saving will ask to overwrite."""
+
+
+@dataclass(frozen=True)
+class Restore(Command):
+    """Restore the unsaved edits a crashed session left (an undoable step)."""
+
+
+@dataclass(frozen=True)
+class DiscardRecovery(Command):
+    pass
+
+
+@dataclass(frozen=True)
+class AnswerSave(Command):
+    """Unsaved edits before closing or opening another scene: save them, then go on."""
+
+
+@dataclass(frozen=True)
+class AnswerDiscard(Command):
+    """Unsaved edits: drop them and go on."""
+
+
+@dataclass(frozen=True)
+class AnswerCancel(Command):
+    """Unsaved edits: stay."""
