@@ -28,6 +28,7 @@ from .scene import Render, Scene, SceneError, load_scene
 from .scene.info import SceneInfo, describe
 from .scene.presets import preset_names, resolve
 from .scene.schema import from_dict
+from .scene.settings import MAX_SIDE
 
 DEFAULT_SIZE = (320, 180)
 RENDER_KNOBS = tuple(f.name for f in fields(Render))  # render(**knobs): the [render] fields
@@ -108,8 +109,8 @@ class Renderer:
 
     def __init__(self, width: int = DEFAULT_SIZE[0], height: int = DEFAULT_SIZE[1]):
         for axis, v in (("width", width), ("height", height)):
-            if not (isinstance(v, int) and 1 <= v <= 8192):
-                raise SceneError(axis, v, "allowed: a whole number of pixels, 1..8192")
+            if not (isinstance(v, int) and 1 <= v <= MAX_SIDE):
+                raise SceneError(axis, v, f"allowed: a whole number of pixels, 1..{MAX_SIDE}")
         self.width, self.height = width, height
         self._gpu = None
 

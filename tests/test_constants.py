@@ -104,11 +104,6 @@ def test_python_declares_each_shared_constant_once():
     for path in PACKAGE.rglob("*.py"):
         for name in module_constants(path) & names:
             where.setdefault(name, []).append(path.relative_to(PACKAGE).as_posix())
-    # gpu/display.py still types the view modes itself; they must equal the shared ones
-    from krsview.gpu.display import VIEW_MODES
-
-    assert VIEW_MODES == constants.VIEW_MODES
-    where["VIEW_MODES"] = [p for p in where["VIEW_MODES"] if p != "gpu/display.py"]
     homes = {name: [HOMES.get(name, "compile/constants.py")] for name in where}
     assert where == homes
     assert module_constants(Path(constants.__file__)) >= {"AO_SAMPLES", "MIN_PROBE"}  # control

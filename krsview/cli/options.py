@@ -17,8 +17,8 @@ from .. import api
 from ..scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError
 from ..scene.presets import DEFAULT_PRESET
 from ..scene.schema import check_value, describe_range
+from ..scene.settings import MAX_SIDE
 
-MAX_SIDE = 8192  # pixels, as krsview.Renderer allows
 SILENT_SECONDS = 1.0  # work quicker than this shows no progress bar
 
 

@@ -4,49 +4,16 @@
 from __future__ import annotations
 
 import argparse
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, fields
 
 from .. import app
-from ..scene import Render
-from ..scene.model import VIEW_PREPASS
 from ..scene.presets import resolve
-from ..scene.schema import param
+from ..scene.settings import EDITOR_SETTINGS, ViewerSettings
 from . import options
 
-RENDER_PREPASS = next(f for f in fields(Render) if f.name == "prepass").metadata
-
-
-@dataclass(frozen=True)
-class ViewerSettings:
-    """What a viewer window starts with (the fields of krsview.scene.settings.ViewerSettings,
-    which replaces this class once it is in the scene package)."""
-
-    size: tuple[int, int] = param((960, 540), help="window size")
-    target_fps: float = param(
-        30.0,
-        lo=1.0,
-        hi=240.0,
-        help="frame rate held while moving or dragging, by lowering the internal resolution",
-    )
-    prepass: int | None = field(
-        default=None,
-        metadata={
-            **RENDER_PREPASS,
-            "help": "tile size of the low-resolution pre-pass while viewing; 0: off",
-        },
-    )
-    hud: bool = param(True, help="the HUD shown at start")
-    moving_effects: bool = param(
-        False,
-        help="keep shadows and ambient occlusion in moving frames too (default: "
-        "they appear when the view stops, so moving frames stay sharp)",
-    )
-
-
 FLAGS = {"target_fps": "--fps"}  # fields whose flag is not --FIELD-NAME
-NOTES = {"prepass": f"default: the scene's [render] prepass, else {VIEW_PREPASS}"}
+NOTES = {"prepass": "default: unset"}
 EDITOR = ("size", "target_fps")  # the settings the editor takes
-EDITOR_SIZE = (1280, 720)
 
 
 def settings_options(sp: argparse.ArgumentParser, names, **defaults) -> None:
@@ -72,7 +39,8 @@ def add(sub) -> None:
         "looks, O orbits the point at the centre, R resets, B saves a "
         "bookmark in the preset, N cycles bookmarks, F5 records and F6 "
         "replays a camera path, F12 saves a screenshot, F1 hides the "
-        "HUD. Editing the preset or a shader reloads it. "
+        "HUD; Ctrl+Z / Ctrl+Shift+Z undo and redo the HUD's changes. Editing the preset or "
+        "a shader reloads it. "
         "Example: krsview view forest --fps 60 --prepass 8",
     )
     settings_options(v, [f.name for f in fields(ViewerSettings)])
@@ -90,7 +58,7 @@ def add(sub) -> None:
         "edits are autosaved to PRESET.recovery and offered back "
         "after a crash. The viewer's keys fly the camera. Example: krsview edit tree",
     )
-    settings_options(e, EDITOR, size=EDITOR_SIZE)
+    settings_options(e, EDITOR, size=EDITOR_SETTINGS.size)
     e.set_defaults(func=run_edit)
 
 

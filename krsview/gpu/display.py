@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import moderngl
 
+from ..compile.constants import VIEW_MODES
 from .program import ProgramCache
-
-VIEW_MODES = ("shaded", "iterations", "depth", "normals")
 
 
 class Display:

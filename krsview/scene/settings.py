@@ -33,8 +33,8 @@ class ViewerSettings:
         lo=0,
         hi=64,
         unit="pixels",
-        help="tile size of the low-resolution pre-pass while viewing (default: the scene's "
-        f"[render] prepass, else {VIEW_PREPASS}; 0: off); the HUD's knob sets the scene's",
+        help="tile size of the low-resolution pre-pass while viewing (0: off; unset: the "
+        f"scene's [render] prepass, else {VIEW_PREPASS}); the HUD's knob sets the scene's",
     )
     hud: bool = param(True, help="show the HUD (F1 hides and shows it)")
     moving_effects: bool = param(

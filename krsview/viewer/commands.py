@@ -67,7 +67,7 @@ class SetLevels(Command):
 
 @dataclass(frozen=True)
 class SetViewMode(Command):
-    mode: str  # one of gpu.display.VIEW_MODES
+    mode: str  # one of compile.constants.VIEW_MODES
 
 
 @dataclass(frozen=True)

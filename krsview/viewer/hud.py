@@ -11,8 +11,8 @@ from typing import Protocol
 import numpy as np
 from imgui_bundle import imgui, implot
 
+from ..compile.constants import VIEW_MODES
 from ..document.document import Document
-from ..gpu.display import VIEW_MODES
 from ..scene import EFFECTS, Render, Scene
 from ..scene.effects import allowed_effects
 from ..scene.presets import preset_names, resolve
