@@ -8,7 +8,6 @@ import argparse
 
 from .. import api
 from ..bench.report import oracle_header, oracle_row, scene_text
-from ..bench.stability import table as stability_table
 from ..oracle.certify import MAX_SEGMENTS
 from ..progress import Progress
 from ..scene import Scene, SceneError
@@ -93,7 +92,9 @@ def stability(scenes: list[Scene], size: tuple[int, int]) -> int:
     for scene in scenes:
         outcomes.append(api.stability(scene, size))
         bar.step(scene.name)
-    print(stability_table(outcomes))
+    from ..bench.stability import table
+
+    print(table(outcomes))
     return 0 if all(o.ok for o in outcomes) else 1
 
 
