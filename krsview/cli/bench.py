@@ -91,13 +91,40 @@ BENCHES = {
         "components drawn alone, and their sum. Example: krsview bench effects grove",
         scene_options=True,
     ),
+    "zoom": Bench(
+        "a flight into the finest twig: frame time and work at each stop",
+        "From the scene's eye straight into its finest kernel (the tip of a tree's twig, "
+        "20 and more levels down), at distances shrinking geometrically: frame time "
+        "(interleaved rounds), iterations per pixel and levels walked per iteration at each "
+        "stop, and the slowest frame against the fastest. Example: krsview bench zoom tree "
+        "--stops 12 --plot out/zoom.png",
+        knobs=("prepass", "culling"),
+        own=(
+            (
+                "--stops",
+                dict(
+                    dest="stops_count",
+                    type=options.number_in("--stops", 2, 100),
+                    default=12,
+                    help="cameras along the flight (default 12)",
+                ),
+            ),
+            (
+                "--plot",
+                dict(
+                    type=lambda text: check_output_file(text, "--plot", ".png"),
+                    help="also draw time and work along the flight into this PNG",
+                ),
+            ),
+        ),
+    ),
 }
 
 
 def add(sub) -> None:
     b = sub.add_parser(
         "bench",
-        help="benchmarks (levels, tracers, effects, accuracy)",
+        help="benchmarks (levels, paths, split, tracers, effects, zoom, accuracy)",
         description="Benchmarks that report ratios measured side by side. "
         "Example: krsview bench tracers tree --csv out/tracers.csv",
     )

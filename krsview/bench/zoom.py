@@ -1,0 +1,145 @@
+"""`krsview bench zoom`: a straight flight from the scene's view into the tip of its finest
+kernel, twenty and more levels down a tree, with the frame time and the work per frame at
+each stop [issue 27 §2; SVO12 flies a 10^11 zoom at a constant frame rate]. Detail below the
+pixel should cost nothing; this bench shows where it still does (iterations per pixel and
+levels walked per iteration, both deterministic), with the slowest frame against the
+fastest."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..compile.krs import kernel_ball
+from ..gpu.renderer import Renderer
+from ..scene import KRS, Scene, SceneError
+from .harness import Variant, median_times
+from .report import Measured, markdown
+
+END_RADII = 3.0  # the last stop is this many of the finest kernel's ball radii from its centre
+
+
+def finest_kernel_ball(scene: Scene) -> np.ndarray:
+    """(centre, radius) of the finest non-empty kernel K_i as the KRS holds it (one of its
+    2^n instances: the branch every fold leaves in place), in world coordinates."""
+    g = scene.geometry()
+    if not isinstance(g, KRS) or scene.compound:
+        raise SceneError(
+            "PRESET",
+            scene.name,
+            "bench zoom flies into one KRS's finest kernel: a [krs], "
+            "[tree] or [route] scene (not a compound or a MöKRS)",
+        )
+    for kernel in g.kernels:
+        ball = kernel_ball(kernel)
+        if ball is not None:
+            return ball
+    raise SceneError("PRESET", scene.name, "no bounded kernel to fly into")
+
+
+def stops(scene: Scene, count: int) -> list[Scene]:
+    """``count`` cameras on the line from the scene's eye to the finest kernel, looking at
+    it, at distances in geometric progression (a constant zoom rate) down to END_RADII of
+    its radius."""
+    ball = finest_kernel_ball(scene)
+    centre, radius = ball[:3], ball[3]
+    eye = np.array(scene.camera.position, dtype=np.float64)
+    far = float(np.linalg.norm(eye - centre))
+    near = min(END_RADII * radius, far)
+    out = []
+    for d in np.geomspace(far, near, count):
+        position = centre + (eye - centre) * (d / far)
+        camera = replace(
+            scene.camera, position=tuple(map(float, position)), target=tuple(map(float, centre))
+        )
+        out.append(replace(scene, camera=camera))
+    return out
+
+
+def bench_zoom(
+    scene: Scene, size: tuple[int, int], rounds: int = 5, stops_count: int = 12, plot=None
+) -> Measured:
+    """One row per stop: distance to the kernel, median ms per frame (interleaved rounds),
+    iterations per pixel, levels walked per iteration, hit fraction; ``plot``: a PNG path
+    for the plot of time and work along the flight."""
+    w, h = size
+    views = stops(scene, stops_count)
+    r = Renderer()
+    centre = finest_kernel_ball(scene)[:3]
+    names = [f"stop {k}" for k in range(len(views))]
+    med = median_times(
+        r, dict(zip(names, (Variant(v) for v in views))), size, rounds, f"bench zoom {scene.name}"
+    )
+    rows = []
+    for name, v in zip(names, views):
+        frame = r.render(v, w, h)
+        walked = r.levels(v, w, h)
+        iterations = float(frame.iterations.mean())
+        rows.append(
+            dict(
+                stop=name,
+                distance=float(np.linalg.norm(np.array(v.camera.position) - centre)),
+                ms=med[name] * 1e3,
+                iterations=iterations,
+                levels_per_iteration=float(walked.sum() / max(frame.iterations.sum(), 1)),
+                hit=float(frame.hit.mean()),
+            )
+        )
+    m = Measured(scene, size, rounds, rows)
+    if plot is not None:
+        write_plot(m, plot)
+    return m
+
+
+def spread(m: Measured) -> float:
+    """The slowest frame's time over the fastest's along the flight."""
+    return max(m.column("ms")) / min(m.column("ms"))
+
+
+def table(m: Measured) -> str:
+    text = (
+        f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, median of "
+        f"{m.rounds} interleaved rounds\n\n"
+    )
+    text += markdown(
+        ("stop", "distance", "ms/frame", "iterations/px", "levels/iteration", "hit"),
+        "lrrrrr",
+        (
+            (
+                r["stop"],
+                f"{r['distance']:.4g}",
+                f"{r['ms']:.1f}",
+                f"{r['iterations']:.1f}",
+                f"{r['levels_per_iteration']:.1f}",
+                f"{r['hit']:.0%}",
+            )
+            for r in m.rows
+        ),
+    )
+    return text + f"\n\nslowest frame / fastest: {spread(m):.2f}×"
+
+
+def write_plot(m: Measured, path) -> None:
+    """Frame time, and iterations per pixel × levels per iteration, against the distance."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    d = m.column("distance")
+    fig, (a, b) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    a.plot(d, m.column("ms"), "o-", color="C0")
+    a.set_ylabel("ms per frame")
+    a.set_title(f"{m.scene.name}: zoom into the finest kernel, {m.size[0]}×{m.size[1]}")
+    b.plot(d, m.column("iterations"), "o-", color="C1", label="iterations per pixel")
+    b.plot(d, m.column("levels_per_iteration"), "s-", color="C2", label="levels per iteration")
+    b.set_xscale("log")
+    b.invert_xaxis()
+    b.set_xlabel("distance to the kernel (scene units; the flight goes right)")
+    b.legend()
+    for ax in (a, b):
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
