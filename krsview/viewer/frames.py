@@ -5,6 +5,7 @@ is never blocked by a slow frame."""
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import moderngl
@@ -20,6 +21,29 @@ from .adaptive import AdaptiveResolution, Refinement
 KEPT_FRAME_TIMES = 240  # for the HUD's frame-time plot
 
 
+@dataclass(frozen=True)
+class FrameState:
+    """The image on screen, as the HUD reports it: ``state`` is "moving" (adaptive resolution),
+    "refining" (the still image is being traced in tiles; this image stays until it is done)
+    or "still" (final); ``seconds`` is the time its tracing took (all tiles for a still one)."""
+
+    state: str
+    size: tuple[int, int]  # internal resolution of the image on screen
+    window: tuple[int, int]  # the window's framebuffer
+    seconds: float
+    rows: tuple[int, int] = (0, 0)  # refining: rows of the still image done, of all
+
+    def text(self) -> str:
+        w, h = self.size
+        share = w / max(self.window[0], 1)
+        state = (
+            f"refining {self.rows[0]}/{self.rows[1]} rows"
+            if self.state == "refining"
+            else self.state
+        )
+        return f"{state}: {w}×{h} ({share:.0%} of the window)"
+
+
 class Frames:
     def __init__(self, ctx: moderngl.Context, renderer: Renderer, adaptive: AdaptiveResolution):
         self.ctx, self.renderer, self.adaptive = ctx, renderer, adaptive
@@ -27,12 +51,28 @@ class Frames:
         self.dirty = True  # the view changed: trace a moving frame next
         self.image: tuple[moderngl.Framebuffer, tuple[int, int]] | None = None
         self.refinement: Refinement | None = None
-        self.frame_seconds: list[float] = []
+        self.frame_seconds: list[float] = []  # moving frames
+        self.shown = FrameState("moving", (0, 0), adaptive.full, 0.0)  # no image yet
+        self._tile_seconds = 0.0  # the refinement's tiles so far
 
     @property
     def refined(self) -> bool:
         """The window shows the full-resolution image of the current view."""
         return not self.dirty and (self.refinement is None or self.refinement.done)
+
+    def frame_state(self) -> FrameState:
+        """The image on screen: its state, internal resolution and tracing time; a moving
+        frame stays "moving" until the first tile of the still image is traced."""
+        r = self.refinement
+        if self.shown.state == "moving" and r is not None and r.next_row > 0:
+            return FrameState(
+                "refining",
+                self.shown.size,
+                self.adaptive.full,
+                self.shown.seconds,
+                (min(r.next_row, r.size[1]), r.size[1]),
+            )
+        return self.shown
 
     def resize(self, fb: tuple[int, int]) -> None:
         """The window's framebuffer is ``fb`` pixels: a new size redraws."""
@@ -57,6 +97,8 @@ class Frames:
             full = self.adaptive.still_size()
             final = full == size and moving.effects == still.effects
             self.refinement = None if final else Refinement(full)
+            self.shown = FrameState("still" if final else "moving", size, full, seconds)
+            self._tile_seconds = 0.0
         elif self.refinement is not None and not self.refinement.done:
             self._refine(still, krs)
 
@@ -72,8 +114,10 @@ class Frames:
             seconds = time.perf_counter() - t0
             r.tile_done(tile, seconds)
             spent += seconds
+        self._tile_seconds += spent
         if r.done:
             self.image = (fbo, r.size)
+            self.shown = FrameState("still", r.size, self.adaptive.full, self._tile_seconds)
 
     def show(
         self,

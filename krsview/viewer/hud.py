@@ -25,6 +25,9 @@ from .navigation import Navigation
 from .recording import Recorder
 from .widgets import Interactions, field_widget
 
+HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
+PLOT_HEIGHT = 130  # the frame-time plot, tall enough for readable axis labels
+PLOTTED = 120  # moving frames in the plot
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
 # the last one sits beside the pre-pass tile slider
@@ -72,9 +75,12 @@ class Viewed(Protocol):
 def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
     out: list[c.Command] = []
     imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
-    imgui.set_next_window_size(imgui.ImVec2(330, 0), imgui.Cond_.first_use_ever)
+    tallest = imgui.get_io().display_size.y - 16
+    imgui.set_next_window_size_constraints(
+        imgui.ImVec2(HUD_WIDTH, 0), imgui.ImVec2(HUD_WIDTH, max(tallest, 100))
+    )
     imgui.set_next_window_bg_alpha(0.75)
-    imgui.begin("krsview (F1 hides)")
+    imgui.begin("krsview (F1 hides)", None, imgui.WindowFlags_.always_auto_resize)
     _performance(v, out)
     if imgui.collapsing_header("accuracy and view"):
         _accuracy(v, out, interactions)
@@ -92,29 +98,35 @@ def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
     return out
 
 
+def draw_status(text: str) -> None:
+    """A one-line status (a screenshot's path) at the foot of the window, HUD shown or not."""
+    if not text:
+        return
+    foot = imgui.get_io().display_size
+    imgui.set_next_window_pos(imgui.ImVec2(8, foot.y - 8), imgui.Cond_.always, imgui.ImVec2(0, 1))
+    imgui.set_next_window_bg_alpha(0.75)
+    flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
+    imgui.begin("##status", None, flags | imgui.WindowFlags_.no_inputs)
+    imgui.text(text)
+    imgui.end()
+
+
 def _performance(v: Viewed, out: list) -> None:
-    f = v.frames
-    times = np.array(f.frame_seconds[-120:] or [0.0], dtype=np.float32) * 1e3
-    fps = 1e3 / max(float(np.median(times)), 1e-6)
-    w, h = v.frames.adaptive.moving_size()
-    state = (
-        "refined"
-        if f.refined
-        else f"refining {f.refinement.next_row}/{f.refinement.size[1]}"
-        if f.refinement
-        else "moving"
-    )
-    imgui.text(
-        f"{fps:5.1f} FPS {np.median(times):6.1f} ms  {w}×{h} ({v.frames.adaptive.scale:.0%})"
-    )
-    imgui.text(f"{state}; {v.view} view")
-    if implot.begin_plot("##frametime", imgui.ImVec2(-1, 70), implot.Flags_.no_legend):
+    """The image on screen (state, resolution, time), then the moving frames' times against
+    the budget."""
+    shown = v.frames.frame_state()
+    imgui.text(shown.text())
+    imgui.text(f"traced in {shown.seconds * 1e3:.1f} ms; {v.view} view")
+    times = np.array(v.frames.frame_seconds[-PLOTTED:] or [0.0], dtype=np.float32) * 1e3
+    budget = 1e3 / v.frames.adaptive.target_fps
+    imgui.text(f"moving frames: median {np.median(times):.1f} ms, budget {budget:.1f} ms")
+    if implot.begin_plot("##frametime", imgui.ImVec2(-1, PLOT_HEIGHT), implot.Flags_.no_legend):
+        implot.setup_axes("moving frames", "ms")
         implot.setup_axes_limits(
-            0, 120, 0, max(60.0, float(times.max()) * 1.1), implot.Cond_.always
+            0, PLOTTED, 0, max(2 * budget, float(times.max()) * 1.1), implot.Cond_.always
         )
         implot.plot_line("frame ms", times)
-        budget = np.full(2, 1e3 / v.frames.adaptive.target_fps, dtype=np.float32)
-        implot.plot_line("budget", budget, xscale=120)
+        implot.plot_line("budget", np.full(2, budget, dtype=np.float32), xscale=PLOTTED)
         implot.end_plot()
     changed, fps_target = field_widget(
         "target FPS", v.frames.adaptive.target_fps, settings_meta("target_fps")

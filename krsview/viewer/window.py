@@ -29,15 +29,18 @@ from .adaptive import AdaptiveResolution
 from .camera import FlyCamera
 from .controls import Input
 from .frames import Frames
-from .hud import draw_hud
+from .hud import draw_hud, draw_status
 from .loop import run
 from .measured import load_measured
 from .navigation import Navigation
 from .picking import pick_center
 from .platform import Platform
 from .recording import Recorder, path_file
+from .screenshots import save_screenshot
 from .watch import FileWatcher
 from .widgets import Interactions
+
+STATUS_SECONDS = 6.0  # how long the status line stays
 
 
 class Viewer:
@@ -68,6 +71,7 @@ class Viewer:
         self.nav = Navigation(self.input, self.scene.camera)
         self.message, self.error = "", ""
         self.clock = 0.0
+        self.status = ("", 0.0)  # text, and the clock it goes at
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
@@ -316,9 +320,12 @@ class Viewer:
         self.move(dt)
         self.execute(self.watcher.poll())
         self.draw_image()
-        if self.hud:
+        status = self.status_line()
+        if self.hud or status:
             self.platform.new_frame()
-            self.execute(draw_hud(self, self.interactions))
+            if self.hud:
+                self.execute(draw_hud(self, self.interactions))
+            draw_status(status)
             self.platform.render()
         glfw.swap_buffers(self.window)
 
@@ -358,16 +365,23 @@ class Viewer:
         )
 
     # -------------------------------------------------------------------------- output
-    def screenshot(self, path: Path | None = None) -> Path:
-        """A full-resolution PNG of the current view and view mode."""
-        out = path or Path("screenshots") / f"{self.path.stem}-{time.strftime('%Y%m%d-%H%M%S')}.png"
-        out.parent.mkdir(parents=True, exist_ok=True)
+    def screenshot(self) -> Path | None:
+        """A full-resolution PNG of the current view and view mode, beside the scene (else in
+        the pictures folder); its full path is printed and shown for STATUS_SECONDS."""
         rgb = self.frames.still(self.view_scene(), self.krs, self.view, self._depth_scale())
-        from PIL import Image
-
-        Image.fromarray(rgb).save(out)
-        self.message = f"screenshot: {out.resolve()}"
+        try:
+            out = save_screenshot(rgb, self.path, time.strftime("%Y%m%d-%H%M%S"))
+        except OSError as e:
+            self.error = str(e)
+            return None
+        self.message = f"screenshot: {out}"
+        self.status = (self.message, self.clock + STATUS_SECONDS)
+        print(self.message, flush=True)
         return out
+
+    def status_line(self) -> str:
+        """The status line shown at the window's foot (a screenshot's path), while it lasts."""
+        return self.status[0] if self.clock < self.status[1] else ""
 
     def read_window(self) -> np.ndarray:
         """The window's pixels (H, W, 3), rows top → bottom (for tests and screenshots)."""
