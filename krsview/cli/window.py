@@ -38,7 +38,8 @@ def add(sub) -> None:
         "distance to the nearest surface; scroll scales it), right-drag "
         "looks, O orbits the point at the centre, R resets, B saves a "
         "bookmark in the preset, N cycles bookmarks, F5 records and F6 "
-        "replays a camera path, F12 saves a screenshot, F1 hides the "
+        "replays a camera path, F12 saves a screenshot beside the preset (NAME.screenshots/), "
+        "F1 hides the "
         "HUD; Ctrl+Z / Ctrl+Shift+Z undo and redo the HUD's changes. Editing the preset or "
         "a shader reloads it. "
         "Example: krsview view forest --fps 60 --prepass 8",

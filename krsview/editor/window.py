@@ -32,7 +32,7 @@ from ..scene import Bookmark, Scene, SceneError
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
 from ..viewer import commands as vc
 from ..viewer.controls import VIEWER_KEYS
-from ..viewer.hud import draw_hud
+from ..viewer.hud import draw_hud, draw_status
 from ..viewer.loop import run
 from ..viewer.picking import depth_at
 from ..viewer.window import Viewer
@@ -138,9 +138,12 @@ class Editor:
         self.execute(v.watcher.poll())
         v.draw_image()
         self._follow()
-        if v.hud:
+        status = v.status_line()
+        if v.hud or status:
             v.platform.new_frame()
-            self._draw_ui()
+            if v.hud:
+                self._draw_ui()
+            draw_status(status)
             v.platform.render()
         v.input.claimed = v.hud and self.gizmo.claims_mouse()
         glfw.swap_buffers(v.window)
