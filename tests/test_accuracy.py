@@ -124,7 +124,7 @@ def verdict_rows(ms_half: float, floor: float) -> list[dict]:
 
 def test_a_time_difference_under_the_noise_floor_is_said_to_be_within_noise():
     (small,) = verdict(verdict_rows(106.0, 0.1))
-    assert "+6% time (within noise: floor 10%)" in small and "+10% work" in small
+    assert "+6% time (within noise: floor 10.0%)" in small and "+10% work" in small
     (large,) = verdict(verdict_rows(150.0, 0.1))
     assert "+50% time and +10% work" in large and "within noise" not in large
     (no_floor,) = verdict(verdict_rows(106.0, 0.0))
@@ -162,7 +162,7 @@ def test_settings_doing_the_same_work_are_grouped_and_others_not():
     }
 
 
-def test_work_is_the_levels_walked_and_the_same_in_every_run():
+def test_work_counts_the_levels_walked_and_is_the_same_in_every_run():
     """Two renderers count the same levels, equal to the renderer's own count for the
     scene's geometry; a truncated geometry walks fewer levels, a looser ε fewer steps."""
     scene = load_scene(resolve("tree"))

@@ -80,5 +80,5 @@ def change(new: float, old: float, floor: float) -> str:
     ratio differs from 1 by no more than the noise ``floor``."""
     ratio = new / old - 1
     if abs(ratio) <= floor:
-        return f"{ratio:+.0%} time (within noise: floor {floor:.0%})"
+        return f"{ratio:+.0%} time (within noise: floor {floor:.1%})"
     return f"{ratio:+.0%} time"

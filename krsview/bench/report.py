@@ -54,7 +54,7 @@ def write_csv(rows: list[dict], path: str | Path) -> Path:
     return path
 
 
-AXES = (("ms", "ms per frame (median, bar: min–max)"), ("work", "levels walked per pixel"))
+AXES = (("ms", "ms per frame (median, bar: min–max)"), ("work", "kernels evaluated per pixel"))
 
 
 def accuracy_plots(rows: list[dict], fronts: dict[str, list[dict]], out: Path, title: str) -> None:
@@ -64,9 +64,14 @@ def accuracy_plots(rows: list[dict], fronts: dict[str, list[dict]], out: Path, t
     import matplotlib
 
     matplotlib.use("Agg")
+    knobs = [k for k in dict.fromkeys(r["knob"] for r in rows) if k != "scene"]
+    _knob_plots(rows, knobs, out, title)
+    _pareto_plots(rows, knobs, fronts, out, title)
+
+
+def _knob_plots(rows: list[dict], knobs: list[str], out: Path, title: str) -> None:
     import matplotlib.pyplot as plt
 
-    knobs = [k for k in dict.fromkeys(r["knob"] for r in rows) if k != "scene"]
     fig, axes = plt.subplots(2, len(knobs), figsize=(4.2 * len(knobs), 7.0), squeeze=False)
     for (cost, label), line in zip(AXES, axes):
         for ax, knob in zip(line, knobs):
@@ -94,12 +99,18 @@ def accuracy_plots(rows: list[dict], fronts: dict[str, list[dict]], out: Path, t
             ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
     fig.suptitle(
-        f"{title}: error against time (noise floor {rows[0]['noise_floor']:.0%}) and against "
+        f"{title}: error against time (noise floor {rows[0]['noise_floor']:.1%}) and against "
         "work, one knob at a time"
     )
     fig.tight_layout()
     fig.savefig(out / "time-vs-error.png", dpi=110)
     plt.close(fig)
+
+
+def _pareto_plots(
+    rows: list[dict], knobs: list[str], fronts: dict[str, list[dict]], out: Path, title: str
+) -> None:
+    import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(12.8, 4.6))
     colours = dict(zip(knobs + ["scene"], plt.rcParams["axes.prop_cycle"].by_key()["color"]))
@@ -136,9 +147,9 @@ def accuracy_plots(rows: list[dict], fronts: dict[str, list[dict]], out: Path, t
         ax.set_xlabel(label)
         ax.set_ylabel("hit-mask error (% of pixels)")
         ax.grid(alpha=0.3)
-    axes[0].set_title("time (the front allows for the noise floor)")
+    axes[0].set_title(f"time: medians' front (noise floor {rows[0]['noise_floor']:.1%})")
     axes[1].set_title("work (deterministic)")
-    axes[0].legend(fontsize=7)
+    axes[0].legend(fontsize=7, loc="lower left")
     fig.suptitle(f"{title}: every setting; below the line nothing is cheaper and better")
     fig.tight_layout()
     fig.savefig(out / "pareto.png", dpi=110)
