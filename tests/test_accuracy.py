@@ -129,6 +129,8 @@ def test_a_time_difference_under_the_noise_floor_is_said_to_be_within_noise():
     assert "+50% time and +10% work" in large and "within noise" not in large
     (no_floor,) = verdict(verdict_rows(106.0, 0.0))
     assert "within noise" not in no_floor
+    (same,) = verdict(verdict_rows(99.99, 0.0))
+    assert "costs 0% time and" in same  # no "-0%"
 
 
 def test_settings_doing_the_same_work_are_grouped_and_others_not():

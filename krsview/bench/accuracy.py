@@ -27,7 +27,7 @@ from ..frame import Frame
 from ..gpu.renderer import Renderer, read_plane
 from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PRECISIONS
-from .harness import Variant, change, noise_floor, round_times
+from .harness import Variant, change, noise_floor, percent, round_times
 from .metrics import compare, error_image
 from .paths import TILES as PREPASS_TILES
 from .report import Measured, accuracy_plots, write_csv
@@ -214,8 +214,8 @@ def same_work(
     rep: dict[str, str] = {}
     seen: list[tuple[tuple, str]] = []
     for s in runs:
-        r_ = s.scene.render
-        key = (r.prepare(s.scene, w, h, s.geometry), r_.path, r_.prepass, r_.prepass_levels)
+        rs = s.scene.render
+        key = (r.prepare(s.scene, w, h, s.geometry), rs.path, rs.prepass, rs.prepass_levels)
         a = images[s.name]
         rep[s.name] = next(
             (
@@ -374,7 +374,7 @@ def verdict(rows: list[dict]) -> list[str]:
         removed = 1 - b["mask_error"] / a["mask_error"] if a["mask_error"] > 0 else 0.0
         out.append(
             f"Halving ε (ε-scale 1 → 0.5) costs {change(b['ms'], a['ms'], floor)} and "
-            f"{b['work'] / a['work'] - 1:+.0%} work; holes "
+            f"{percent(b['work'] / a['work'] - 1)} work; holes "
             f"go from {a['holes']:.2%} to {b['holes']:.2%} of the pixels and false hits "
             f"from {a['false_hits']:.2%} to {b['false_hits']:.2%}: {removed:.0%} of the "
             "hit-mask error removed."
@@ -385,7 +385,7 @@ def verdict(rows: list[dict]) -> list[str]:
             gain = base["mask_error"] - r["mask_error"]
             out.append(
                 f"Precision {r['value']} costs {change(r['ms'], base['ms'], floor)} "
-                f"and {r['work'] / base['work'] - 1:+.0%} work; "
+                f"and {percent(r['work'] / base['work'] - 1)} work; "
                 f"hit-mask error {r['mask_error']:.2%} against {base['mask_error']:.2%} "
                 f"as saved, depth p99 {r['depth_eps_p99']:.2f} against "
                 f"{base['depth_eps_p99']:.2f} ε"

@@ -80,5 +80,11 @@ def change(new: float, old: float, floor: float) -> str:
     ratio differs from 1 by no more than the noise ``floor``."""
     ratio = new / old - 1
     if abs(ratio) <= floor:
-        return f"{ratio:+.0%} time (within noise: floor {floor:.1%})"
-    return f"{ratio:+.0%} time"
+        return f"{percent(ratio)} time (within noise: floor {floor:.1%})"
+    return f"{percent(ratio)} time"
+
+
+def percent(ratio: float) -> str:
+    """A relative change as a signed whole percentage, 0 unsigned (no "-0%")."""
+    text = f"{ratio:+.0%}"
+    return "0%" if text in ("+0%", "-0%") else text
