@@ -1,5 +1,7 @@
 """The accuracy benchmark: hit sets are nested in ε (so the errors it reports move the right
-way), the Pareto front, the ground-truth cache, and the report a run writes."""
+way), the Pareto front (with and without a noise floor), settings doing the same work
+grouped, the noise floor and 'within noise', work that no machine load changes, the
+ground-truth cache, and the report a run writes."""
 
 from __future__ import annotations
 
@@ -11,10 +13,20 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.bench.accuracy import pareto, settings
+from krsview.bench.accuracy import (
+    Setting,
+    levels_walked,
+    pareto,
+    same_work,
+    settings,
+    verdict,
+    work,
+)
+from krsview.bench.harness import noise_floor
 from krsview.bench.metrics import compare
 from krsview.bench.truth import cache_key, ground_truth
 from krsview.compile.camera import view_of
+from krsview.gpu.renderer import Renderer
 from krsview.reference import render_reference
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
@@ -66,6 +78,113 @@ def test_pareto_front_keeps_only_undominated_settings():
         dict(ms=25, mask_error=0.0),
     ]
     assert pareto(rows) == [rows[0], rows[2], rows[4]]
+
+
+def test_with_a_noise_floor_only_a_difference_beyond_it_dominates():
+    """A setting slower than another by less than the floor, and less accurate, stays on
+    the time front (within noise); without a floor it is beaten."""
+    rows = [
+        dict(ms=100, mask_error=0.02),
+        dict(ms=104, mask_error=0.03),
+        dict(ms=105, mask_error=0.01),
+        dict(ms=130, mask_error=0.03),
+    ]
+    assert pareto(rows) == [rows[0], rows[2]]
+    assert pareto(rows, floor=0.1) == [rows[0], rows[1], rows[2]]
+    # one setting per group doing the same work: a row the same as another is left out
+    same = [dict(r, same_as=k) for k, r in enumerate(rows)] + [dict(rows[0], same_as=0)]
+    assert pareto(same) == [same[0], same[2]]
+
+
+def test_the_noise_floor_is_the_spread_of_medians_of_the_same_work():
+    groups = [[[1.0, 1.1, 1.4], [1.2, 1.3, 1.25]], [[5.0, 9.0]], [[2.0, 2.0], [2.0, 2.2]]]
+    assert noise_floor(groups) == pytest.approx(1.25 / 1.1 - 1)
+    assert noise_floor([[[1.0, 3.0]]]) == 0.0  # no two variants of the same work: unmeasured
+
+
+def verdict_rows(ms_half: float, floor: float) -> list[dict]:
+    """Synthetic report rows: the scene (= ε-scale 1) and ε-scale 0.5 at ``ms_half`` ms."""
+    row = dict(
+        knob="scene",
+        value="as saved",
+        ms=100.0,
+        work=50.0,
+        mask_error=0.02,
+        holes=0.0,
+        false_hits=0.02,
+        depth_eps_p99=3.0,
+        noise_floor=floor,
+    )
+    return [
+        row,
+        dict(row, knob="epsilon_scale", value="1"),
+        dict(row, knob="epsilon_scale", value="0.5", ms=ms_half, work=55.0, mask_error=0.01),
+    ]
+
+
+def test_a_time_difference_under_the_noise_floor_is_said_to_be_within_noise():
+    (small,) = verdict(verdict_rows(106.0, 0.1))
+    assert "+6% time (within noise: floor 10.0%)" in small and "+10% work" in small
+    (large,) = verdict(verdict_rows(150.0, 0.1))
+    assert "+50% time and +10% work" in large and "within noise" not in large
+    (no_floor,) = verdict(verdict_rows(106.0, 0.0))
+    assert "within noise" not in no_floor
+    (same,) = verdict(verdict_rows(99.99, 0.0))
+    assert "costs 0% time and" in same  # no "-0%"
+
+
+def test_settings_doing_the_same_work_are_grouped_and_others_not():
+    """A cap that never binds and the compute path draw the very same frames as the scene;
+    only the cap compiles the same variant. A looser ε (another image) and double precision
+    (the same iterations, other colours) are not grouped either."""
+    scene = load_scene(resolve("sierpinski"))
+    runs = [Setting("scene", "as saved", scene)] + [
+        Setting(k, str(v), with_render(scene, **{k: v}))
+        for k, v in (
+            ("max_iterations", 4096),
+            ("path", "compute"),
+            ("epsilon_scale", 8.0),
+            ("precision", "double"),
+        )
+    ]
+    r = Renderer()
+    images = {s.name: r.render(s.scene, W, H, s.geometry) for s in runs}
+    walked = {s.name: levels_walked(r, s, (W, H)) for s in runs}
+    a = images["scene as saved"]
+    for name in ("max_iterations 4096", "path compute"):  # the premise: identical frames
+        assert np.array_equal(images[name].color, a.color)
+        assert np.array_equal(images[name].iterations, a.iterations)
+    rep = same_work(r, runs, images, walked, (W, H))
+    assert rep == {
+        "scene as saved": "scene as saved",
+        "max_iterations 4096": "scene as saved",
+        "path compute": "path compute",
+        "epsilon_scale 8.0": "epsilon_scale 8.0",
+        "precision double": "precision double",
+    }
+
+
+def test_work_counts_the_levels_walked_and_is_the_same_in_every_run():
+    """Two renderers count the same levels, equal to the renderer's own count for the
+    scene's geometry; a truncated geometry walks fewer levels, a looser ε fewer steps."""
+    scene = load_scene(resolve("tree"))
+    g = scene.geometry()
+    own = Setting("scene", "as saved", scene)
+    cut = Setting("levels", "8", scene, g.truncated(8))
+    loose = Setting("epsilon_scale", "8", with_render(scene, epsilon_scale=8.0))
+    r1, r2 = Renderer(), Renderer()
+    first = levels_walked(r1, own, (W, H))
+    assert np.array_equal(first, levels_walked(r2, own, (W, H)))
+    assert np.array_equal(first, r2.levels(scene, W, H))
+    works = {
+        s.name: [
+            work(r.render(s.scene, W, H, s.geometry), levels_walked(r, s, (W, H)), s)
+            for r in (r1, r2)
+        ]
+        for s in (own, cut, loose)
+    }
+    assert all(a == b for a, b in works.values())
+    assert works[cut.name][0] < works[own.name][0] and works[loose.name][0] < works[own.name][0]
 
 
 def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
@@ -144,6 +263,12 @@ def test_bench_accuracy_writes_a_readable_report(tmp_path):
     assert len(csv) == 1 + len(settings(load_scene(resolve("sierpinski"))))
     text = (out / "README.md").read_text()
     assert "## Verdict" in text and "Pareto front" in text and "Halving ε" in text
+    assert "Noise floor" in text and "| work |" in text and "= scene as saved" in text
+    head = csv[0].split(",")
+    assert {"knob", "value", "ms", "mask_error", "ms_min", "ms_max", "noise_floor", "work"} <= set(
+        head
+    )
+    assert "same_as" in head
 
 
 def test_bench_accuracy_refuses_a_file_as_its_folder_before_any_work(tmp_path):
