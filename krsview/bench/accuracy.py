@@ -24,7 +24,7 @@ import numpy as np
 
 from ..compile.camera import view_of
 from ..frame import Frame
-from ..gpu.renderer import Renderer, read_plane
+from ..gpu.renderer import Renderer
 from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PRECISIONS
 from .harness import Variant, change, noise_floor, percent, round_times
@@ -185,10 +185,7 @@ def bench_accuracy(
 def levels_walked(r: Renderer, s: Setting, size: tuple[int, int]) -> np.ndarray:
     """Per pixel, the levels Alg. 1 walked tracing the ray (the KRS_COUNT_LEVELS probe of
     :meth:`Renderer.levels`, here with the setting's own geometry, as a truncation needs)."""
-    w, h = size
-    with r.current():
-        prog = r.prepare(s.scene, w, h, s.geometry, probes=("KRS_COUNT_LEVELS",))
-        return read_plane(r.draw(prog, w, h), 2, w, h)[..., 1].astype(np.int64)
+    return r.levels(s.scene, *size, s.geometry)
 
 
 def work(image: Frame, walked: np.ndarray, s: Setting) -> float:

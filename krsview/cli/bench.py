@@ -171,11 +171,15 @@ def add_accuracy(bsub) -> None:
         "with plots",
         description="On one view: sweep ε-scale, the iteration cap, the tracer (sphere, "
         "over-relaxed with ω, binary with ξ pairs) and the level count; time each setting "
-        "on the GPU (interleaved rounds, medians) and compare its image with the ground "
+        "on the GPU (interleaved rounds, median [min–max]; settings doing the same work "
+        "share one time, and their spread is the run's noise floor, under which a "
+        "difference is 'within noise'), count its work (kernels evaluated per pixel, "
+        "deterministic) and compare its image with the ground "
         "truth (the float64 reference at ε/8, computed once and cached): holes, false "
         "hits, depth error in ε, normal error, PSNR, SSIM, iterations, capped rays. Writes "
-        "OUT/README.md, OUT/accuracy.csv, plots (time vs error per knob, the Pareto front) "
-        "and error images. Example: krsview bench accuracy tree rock --out out/accuracy",
+        "OUT/README.md, OUT/accuracy.csv, plots (error against time and against work per "
+        "knob, the Pareto fronts) and error images. "
+        "Example: krsview bench accuracy tree rock --out out/accuracy",
     )
     ba.add_argument(
         "preset",
@@ -199,8 +203,9 @@ def add_accuracy(bsub) -> None:
     ba.add_argument(
         "--rounds",
         type=options.number_in("--rounds", 1, 100),
-        default=3,
-        help="interleaved rounds; medians are reported (default 3)",
+        default=5,
+        help="interleaved rounds; medians with [min–max] and the run's noise floor are "
+        "reported (default 5)",
     )
     ba.add_argument(
         "--out",

@@ -262,12 +262,14 @@ class Renderer:
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
 
-    def levels(self, scene: Scene, width: int, height: int) -> np.ndarray:
+    def levels(
+        self, scene: Scene, width: int, height: int, geometry: Geometry | None = None
+    ) -> np.ndarray:
         """Per pixel (rows top → bottom), the levels Alg. 1 walked while tracing the ray (not
         shading it), summed over its steps: with culling, fewer than steps × n. Counted by
         a variant of the fragment path (the compute path takes the same steps)."""
         with self.current():
-            prog = self.prepare(scene, width, height, probes=("KRS_COUNT_LEVELS",))
+            prog = self.prepare(scene, width, height, geometry, probes=("KRS_COUNT_LEVELS",))
             fbo = self.draw(prog, width, height)
             return read_plane(fbo, 2, width, height)[..., 1].astype(np.int64)
 
