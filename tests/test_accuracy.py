@@ -13,15 +13,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.bench.accuracy import (
-    Setting,
-    levels_walked,
-    pareto,
-    same_work,
-    settings,
-    verdict,
-    work,
-)
+from krsview.bench.accuracy import Setting, levels_walked, same_work, settings, work
+from krsview.bench.accuracy_report import pareto, verdict
 from krsview.bench.harness import noise_floor
 from krsview.bench.metrics import compare
 from krsview.bench.truth import cache_key, ground_truth

@@ -155,7 +155,8 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     differ; errors are a function of the images and the ground truth)."""
     import csv
 
-    from krsview.bench.accuracy import bench_accuracy, write_report
+    from krsview.bench.accuracy import bench_accuracy
+    from krsview.bench.accuracy_report import write_report
     from krsview.share.batch import run_accuracy_sweep
 
     names = ("sierpinski", "rock")

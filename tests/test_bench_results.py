@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import krsview
-from krsview.bench import accuracy, effects, levels, paths, split, tracers
+from krsview.bench import accuracy, accuracy_report, effects, levels, paths, split, tracers
 from krsview.bench.report import Measured, markdown, write_csv
 from krsview.scene import SceneError
 from krsview.scene.effects import allowed_effects
@@ -111,7 +111,7 @@ def test_accuracy_returns_a_row_per_setting_and_error_images(tmp_path):
     # the loosest ε loses pixels the truth has; the scene's own setting far fewer
     eps = {r["value"]: r["mask_error"] for r in m.rows if r["knob"] == "epsilon_scale"}
     assert eps["8"] > eps["0.125"]
-    text = accuracy.write_report(acc, tmp_path / "report")
+    text = accuracy_report.write_report(acc, tmp_path / "report")
     assert text == (tmp_path / "report" / "README.md").read_text()
     assert {name for name in acc.errors} <= {p.name for p in (tmp_path / "report").iterdir()}
 

@@ -226,7 +226,8 @@ def report_folder(out: str | None, name: str, several: bool) -> Path:
 
 
 def run_accuracy(args: argparse.Namespace) -> int:
-    from ..bench.accuracy import bench_accuracy, write_report
+    from ..bench.accuracy import bench_accuracy
+    from ..bench.accuracy_report import write_report
     from ..bench.truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS
 
     names = args.preset or [DEFAULT_PRESET]

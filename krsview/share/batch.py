@@ -182,7 +182,8 @@ def accuracy_report(
     """One preset's `bench accuracy` (bench/accuracy.py) in a scratch folder: its files as
     bytes, so the driver writes them wherever it likes, and the report's verdict. ``cache``:
     the ground-truth cache on the worker's machine (None: its default)."""
-    from ..bench.accuracy import bench_accuracy, verdict, write_report
+    from ..bench.accuracy import bench_accuracy
+    from ..bench.accuracy_report import verdict, write_report
 
     acc = bench_accuracy(scene, size, rounds, cache)
     with tempfile.TemporaryDirectory() as d:
