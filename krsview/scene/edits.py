@@ -69,15 +69,3 @@ def apply_edit(scene: Any, path: Path, value: Any) -> Any:
         return validated(replace_at(scene, path, value))
     except (KeyError, IndexError, TypeError) as e:
         raise SceneError(path_text(path), value, f"not a field of this scene ({e})") from None
-
-
-def field_meta(scene: Any, path: Path) -> dict:
-    """The schema metadata (range, unit, help) of the field at ``path`` (the last name on it)."""
-    names = [k for k in path if isinstance(k, str)]
-    if not names:
-        return {}
-    owner = get_at(scene, path[: max(i for i, k in enumerate(path) if isinstance(k, str))])
-    for f in fields(owner) if is_dataclass(owner) else ():
-        if f.name == names[-1]:
-            return dict(f.metadata)
-    return {}
