@@ -7,6 +7,7 @@ work: a time difference under it is not a measurement."""
 from __future__ import annotations
 
 import statistics
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..gpu.renderer import Renderer
@@ -27,31 +28,36 @@ def round_times(
     r: Renderer, variants: dict[str, Variant], size: tuple[int, int], rounds: int, label: str
 ) -> dict[str, list[float]]:
     """name → seconds per frame in each of ``rounds`` interleaved rounds (in order)."""
-    w, h = size
-    for v in variants.values():
-        r.time_frame(
-            v.scene,
-            w,
-            h,
-            v.geometry,
-            all_effects=v.all_effects,
-            prepass_only=v.prepass_only,
-            probes=v.probes,
-        )
-    times: dict[str, list[float]] = {name: [] for name in variants}
-    bar = Progress(rounds * len(variants), f"{label} {w}×{h}")
+    timers = {name: frame_timer(r, v, size) for name, v in variants.items()}
+    return interleaved(timers, rounds, f"{label} {size[0]}×{size[1]}")
+
+
+def frame_timer(r: Renderer, v: Variant, size: tuple[int, int]) -> Callable[[], float]:
+    """A timer of one frame of ``v``: seconds, GPU finished (Renderer.time_frame draws it
+    once untimed first)."""
+    return lambda: r.time_frame(
+        v.scene,
+        *size,
+        v.geometry,
+        all_effects=v.all_effects,
+        prepass_only=v.prepass_only,
+        probes=v.probes,
+    )[0]
+
+
+def interleaved(
+    timers: dict[str, Callable[[], float]], rounds: int, label: str
+) -> dict[str, list[float]]:
+    """name → the seconds its timer returned in each of ``rounds`` rounds (in order): every
+    timer is called once first (warm-up), then once per round, one after the other, so machine
+    noise hits them alike. A timer times one frame of its own (a renderer's, or a peer's)."""
+    for timer in timers.values():
+        timer()
+    times: dict[str, list[float]] = {name: [] for name in timers}
+    bar = Progress(rounds * len(timers), label)
     for _ in range(rounds):
-        for name, v in variants.items():
-            times[name] += r.time_frame(
-                v.scene,
-                w,
-                h,
-                v.geometry,
-                repeats=1,
-                all_effects=v.all_effects,
-                prepass_only=v.prepass_only,
-                probes=v.probes,
-            )
+        for name, timer in timers.items():
+            times[name].append(timer())
             bar.step(name)
     return times
 

@@ -1,0 +1,416 @@
+"""`krsview bench peer`: krsview against the obvious CPU alternative [issue 27 §3]: the KRS
+expanded into the 2^(n−i) instances of every kernel K_i, each tessellated finely enough that
+the mesh stays within TOLERANCE pixels of the surface, in an Embree BVH (Open3D's
+RaycastingScene, which traces on every core as llvmpipe does), cast with krsview's own
+primary rays. Per frame time side by side in interleaved rounds, the BVH's build, the first
+frame and the peak memory of each in a fresh process, and where the two hit masks differ."""
+
+from __future__ import annotations
+
+import math
+import pickle
+import statistics
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..compile.camera import View, primary_rays, view_of
+from ..compile.krs import CompiledKRS, compile_krs, kernel_ball
+from ..gpu.renderer import Renderer
+from ..scene import KRS, Scene, SceneError
+from ..scene.model import VIEW_PREPASS, Empty
+from .harness import Variant, frame_timer, interleaved
+from .report import Measured, markdown
+
+PEER = "Embree (Open3D)"
+TOLERANCE = 0.5  # pixels: the mesh lies inside the surface by at most this, at the nearest instance
+MAX_PIECES = 256  # sides of a ring, bands of a cap, segments of an arc, at most (eye in a kernel)
+# krsview's rows: the scene's own [render] and the viewer's pre-pass, both with the effects off
+# (primary rays only, as the peer casts). Issue 27 §1's LOD knob ([render] lod) joins here as
+# a row of its own with the pre-pass, {"prepass": VIEW_PREPASS, "lod": …}, once it exists.
+VARIANTS = {"krsview, as saved": {}, f"krsview, pre-pass {VIEW_PREPASS}": {"prepass": VIEW_PREPASS}}
+INSTALL = "pip install 'krsview[peer]' (Linux also needs libusb-1.0: apt-get install libusb-1.0-0)"
+
+
+def load_peer():
+    """The peer library (open3d), or one line saying how to get it."""
+    try:
+        import open3d
+    except ImportError as e:
+        raise RuntimeError(f"bench peer needs open3d ({e}): {INSTALL}") from None
+    return open3d
+
+
+# ------------------------------------------------------------------ expansion and tessellation
+@dataclass(frozen=True)
+class Mesh:
+    vertices: np.ndarray  # (V, 3) float32, world
+    faces: np.ndarray  # (F, 3) uint32
+    instances: int  # kernel instances expanded
+
+
+def single_krs(scene: Scene) -> KRS:
+    """The scene's one KRS, every kernel bounded, or a one-line error."""
+    g = scene.geometry()
+    if not isinstance(g, KRS) or scene.compound:
+        raise SceneError(
+            "PRESET",
+            scene.name,
+            "bench peer expands one KRS into triangles: a [krs], [tree] or [route] scene "
+            "(not a compound or a MöKRS)",
+        )
+    for i, k in enumerate(g.kernels):
+        if kernel_ball(k) is None and not isinstance(k, Empty):
+            raise SceneError(f"levels[{i}].kernel", k.kind, "bench peer meshes bounded kernels")
+    return g
+
+
+def instance_maps(c: CompiledKRS) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per level j, the 2^(n−j) maps x ↦ M x + t taking K_j to its instances
+    R_{n−1}^{b_{n−1}} ∘ … ∘ R_j^{b_j} K_j (L_i = K_i ∪ L_{i−1} ∪ R_{i−1} L_{i−1} [KRS17 §3]);
+    unclipped: Alg. 1 clips a kernel that crosses a mirror, a tree's do not."""
+    M, t = np.eye(3)[None], np.zeros((1, 3))
+    out = [(M, t)]
+    for u, w in zip(c.mirrors[::-1, :3], c.mirrors[::-1, 3]):
+        H = np.eye(3) - 2.0 * np.outer(u, u)  # x ↦ H x + 2 w u, applied before the maps above
+        M, t = np.concatenate([M, M @ H]), np.concatenate([t, t + 2.0 * w * (M @ u)])
+        out.append((M, t))
+    return out[::-1]
+
+
+def pieces(angle: float, radius: float, tol: float, least: int) -> int:
+    """Equal chords that follow a circular arc of ``angle`` at ``radius`` within ``tol``."""
+    if tol >= radius:
+        return least
+    if tol <= 0.0:
+        return MAX_PIECES
+    return min(MAX_PIECES, max(least, math.ceil(angle / (2.0 * math.acos(1.0 - tol / radius)))))
+
+
+def kernel_mesh(kind: str, rec: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """A closed mesh of one kernel (its core — point, segment or arc — swept by a ball, caps
+    as half spheres), every vertex on the surface and every triangle within ``tol`` inside
+    it (half for the rings, half for the arc or the caps)."""
+    r = rec[1, 3]
+    if kind == "sphere":
+        core, tangent = rec[1:2, :3], np.array([[0.0, 0.0, 1.0]])
+        n1, n2 = np.array([[1.0, 0.0, 0.0]]), np.array([[0.0, 1.0, 0.0]])
+    elif kind == "capsule":
+        a, b = rec[1, :3], rec[2, :3]
+        axis = (b - a) / np.linalg.norm(b - a)
+        side = np.cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
+        side /= np.linalg.norm(side)
+        core, tangent = np.stack([a, b]), np.stack([axis, axis])
+        n1, n2 = np.stack([side, side]), np.stack([np.cross(axis, side)] * 2)
+    elif kind == "toroidal_capsule":
+        O, R, e1, e2 = rec[3, :3], rec[3, 3], rec[4, :3], rec[5, :3]
+        phi = math.atan2(rec[5, 3], rec[4, 3]) % (2.0 * math.pi)
+        a = np.linspace(0.0, phi, pieces(phi, R + r, tol / 2, 1) + 1)[:, None]
+        n1 = np.cos(a) * e1 + np.sin(a) * e2
+        core, tangent = O + R * n1, -np.sin(a) * e1 + np.cos(a) * e2
+        n2 = np.broadcast_to(np.cross(e1, e2), n1.shape)
+    else:
+        raise ValueError(f"kernel_mesh: a {kind} kernel has no closed surface")
+    sides = pieces(2.0 * math.pi, r, tol / 2, 3)
+    bands = pieces(math.pi / 2, r, tol / 2, 1)
+    beta = np.arange(bands - 1, 0, -1) * (math.pi / 2 / bands)  # cap latitudes, pole side first
+    last = len(core) - 1
+    centres = np.concatenate(
+        [
+            core[0] - r * np.sin(beta)[:, None] * tangent[0],
+            core,
+            core[last] + r * np.sin(beta[::-1])[:, None] * tangent[last],
+        ]
+    )
+    radii = np.concatenate([r * np.cos(beta), np.full(len(core), r), r * np.cos(beta[::-1])])
+    ends = [0] * len(beta) + list(range(len(core))) + [last] * len(beta)
+    theta = np.linspace(0.0, 2.0 * math.pi, sides, endpoint=False)
+    around = (
+        np.cos(theta)[None, :, None] * n1[ends][:, None]
+        + np.sin(theta)[None, :, None] * n2[ends][:, None]
+    )
+    rings = centres[:, None] + radii[:, None, None] * around
+    poles = np.stack([core[0] - r * tangent[0], core[last] + r * tangent[last]])
+    vertices = np.concatenate([rings.reshape(-1, 3), poles])
+    return vertices, ring_faces(len(centres), sides)
+
+
+def ring_faces(count: int, sides: int) -> np.ndarray:
+    """Triangles joining ``count`` rings of ``sides`` vertices, each ring to the next, and
+    fans to the two poles stored after them (first pole before ring 0, second after the last)."""
+    s = np.arange(sides)
+    ring = np.arange(count - 1)[:, None] * sides
+    a, b = ring + s, ring + (s + 1) % sides
+    c, d = a + sides, b + sides
+    bands = np.stack([np.stack([a, b, d], -1), np.stack([a, d, c], -1)], 2).reshape(-1, 3)
+    first, second = count * sides, count * sides + 1
+    top = np.stack([np.full(sides, first), (s + 1) % sides, s], -1)
+    end = (count - 1) * sides
+    bottom = np.stack([np.full(sides, second), end + s, end + (s + 1) % sides], -1)
+    return np.concatenate([top, bands, bottom])
+
+
+def level_tolerances(krs: KRS, maps, view: View, tol_px: float) -> list[float]:
+    """Per level, ``tol_px`` pixels in world units at the nearest of its instances (0 where
+    the eye is inside one: the finest tessellation)."""
+    out = []
+    for k, (M, t) in zip(krs.kernels, maps):
+        ball = kernel_ball(k)
+        if ball is None:
+            out.append(0.0)
+            continue
+        centres = M @ ball[:3] + t
+        near = float(np.linalg.norm(centres - view.origin, axis=1).min()) - ball[3]
+        out.append(tol_px * view.footprint * max(near, 0.0))
+    return out
+
+
+def expand(krs: KRS, view: View, tol_px: float = TOLERANCE) -> Mesh:
+    """Every kernel instance of ``krs`` as triangles, within ``tol_px`` pixels of the surface
+    as ``view`` sees its nearest instance of each level."""
+    c = compile_krs(krs, (1.0, 1.0, 1.0))
+    maps = instance_maps(c)
+    tols = level_tolerances(krs, maps, view, tol_px)
+    vertices, faces, count, instances = [], [], 0, 0
+    for kind, rec, (M, t), tol in zip(c.types, c.records, maps, tols):
+        if kind == "empty":
+            continue
+        v, f = kernel_mesh(kind, rec, tol)
+        vertices.append((np.einsum("kij,vj->kvi", M, v) + t[:, None]).reshape(-1, 3))
+        faces.append((f[None] + count + len(v) * np.arange(len(M))[:, None, None]).reshape(-1, 3))
+        count += len(M) * len(v)
+        instances += len(M)
+    return Mesh(
+        np.concatenate(vertices).astype(np.float32),
+        np.concatenate(faces).astype(np.uint32),
+        instances,
+    )
+
+
+# ------------------------------------------------------------------------------- the peer
+def build(o3d, mesh: Mesh):
+    """(the Embree scene, seconds to build its BVH: Open3D builds it on the first query)."""
+    t0 = time.perf_counter()
+    bvh = o3d.t.geometry.RaycastingScene()
+    bvh.add_triangles(o3d.core.Tensor(mesh.vertices), o3d.core.Tensor(mesh.faces))
+    bvh.cast_rays(o3d.core.Tensor(np.array([[0, 0, 0, 0, 0, 1]], dtype=np.float32)))
+    return bvh, time.perf_counter() - t0
+
+
+def camera_rays(o3d, view: View):
+    """krsview's primary rays (compile/camera.py), rows top → bottom, as Open3D's tensor."""
+    d = primary_rays(view)
+    rays = np.concatenate([np.broadcast_to(view.origin, d.shape), d], axis=1)
+    return o3d.core.Tensor(rays.astype(np.float32).reshape(view.height, view.width, 6))
+
+
+def peer_hit(bvh, rays) -> np.ndarray:
+    """Per pixel, whether the ray hits a triangle."""
+    return np.isfinite(bvh.cast_rays(rays)["t_hit"].numpy())
+
+
+def peer_timer(bvh, rays):
+    """A timer of one peer frame, cast once untimed first as Renderer.time_frame draws."""
+
+    def timer() -> float:
+        bvh.cast_rays(rays)
+        t0 = time.perf_counter()
+        bvh.cast_rays(rays)
+        return time.perf_counter() - t0
+
+    return timer
+
+
+def krsview_scene(scene: Scene, knobs: dict) -> Scene:
+    """The scene as krsview's row draws it: its effects off, ``knobs`` set in [render]."""
+    out = scene.edit("effects", [])
+    for name, value in knobs.items():
+        out = out.edit(f"render.{name}", value)
+    return out
+
+
+def fresh_process(job: str, scene: Scene, levels: int, size: tuple[int, int], knobs: dict):
+    """(seconds to the first frame, peak RSS in MiB) of a process of its own doing one
+    ``job`` after its imports: "peer" (expand, tessellate, build, cast), "krsview" (compile
+    and draw with ``knobs``), or "idle" (nothing: the imports' share). The job travels
+    pickled through stdin, so no script is imported again (as multiprocessing's spawn does)."""
+    done = subprocess.run(
+        [sys.executable, "-c", "from krsview.bench.peer import child; child()"],
+        input=pickle.dumps((job, scene, levels, size, knobs)),
+        capture_output=True,
+        check=False,
+    )
+    if done.returncode:
+        raise RuntimeError(f"bench peer: the {job} process failed: {done.stderr.decode()[-500:]}")
+    return pickle.loads(done.stdout)
+
+
+def child() -> None:
+    """A fresh process's side of :func:`fresh_process`."""
+    sys.stdout.buffer.write(pickle.dumps(_first_frame(*pickle.loads(sys.stdin.buffer.read()))))
+
+
+def _first_frame(job: str, scene: Scene, levels: int, size: tuple[int, int], knobs: dict):
+    krs = single_krs(scene).truncated(levels)
+    o3d = load_peer() if job == "peer" else None
+    t0 = time.perf_counter()
+    if job == "peer":
+        view = view_of(scene.camera, *size)
+        peer_hit(build(o3d, expand(krs, view))[0], camera_rays(o3d, view))
+    elif job == "krsview":
+        Renderer().render(krsview_scene(scene, knobs), *size, krs)
+    return time.perf_counter() - t0, peak_rss_mib()
+
+
+def peak_rss_mib() -> float:
+    """This process's peak resident memory (Linux's VmHWM; ru_maxrss would also count the
+    parent's memory at fork); NaN where /proc does not say."""
+    try:
+        with open("/proc/self/status") as f:
+            line = next(x for x in f if x.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        return math.nan
+    return int(line.split()[1]) / 1024
+
+
+# ------------------------------------------------------------------------------- the bench
+def check_levels(krs: KRS, levels: tuple[int, ...], name: str) -> None:
+    for n in levels:
+        if not 1 <= n <= krs.depth:
+            raise SceneError("--levels", n, f"allowed: 1..{krs.depth} (the levels of {name})")
+
+
+def bench_peer(
+    scene: Scene, size: tuple[int, int], rounds: int = 5, levels: tuple[int, ...] = (16,)
+) -> Measured:
+    """Per level count (the coarsest ``levels`` of the scene's KRS), a row for the peer and
+    one per krsview variant (VARIANTS): ms per frame, median [min–max] over interleaved
+    rounds, the ratio to the peer (per round), the first frame and peak RSS of a fresh
+    process, the pixels whose hit differs from the peer's, and krsview's hits farther from
+    the mesh than its ε(t) and the mesh's tolerance allow."""
+    o3d = load_peer()
+    krs = single_krs(scene)
+    check_levels(krs, levels, scene.name)
+    idle = fresh_process("idle", scene, 1, size, {})[1]
+    r = Renderer()
+    rows = []
+    for n in levels:
+        rows += [
+            x | dict(idle_rss_mb=idle)
+            for x in measure_level(o3d, r, scene, krs.truncated(n), size, rounds)
+        ]
+    return Measured(scene, size, rounds, rows)
+
+
+def measure_level(o3d, r: Renderer, scene: Scene, g: KRS, size, rounds: int) -> list[dict]:
+    """The rows of one level count: the peer's, then each of VARIANTS'."""
+    view = view_of(scene.camera, *size)
+    rays = camera_rays(o3d, view)
+    scenes = {name: krsview_scene(scene, knobs) for name, knobs in VARIANTS.items()}
+    t0 = time.perf_counter()
+    mesh = expand(g, view)
+    setup = dict(instances=mesh.instances, triangles=len(mesh.faces))
+    setup |= dict(mesh_s=time.perf_counter() - t0)
+    bvh, setup["bvh_s"] = build(o3d, mesh)
+    hit = {PEER: peer_hit(bvh, rays)}
+    timers = {PEER: peer_timer(bvh, rays)}
+    timers |= {name: frame_timer(r, Variant(s, g), size) for name, s in scenes.items()}
+    times = interleaved(timers, rounds, f"bench peer {scene.name}, {g.depth} levels")
+    far = {PEER: 0.0}
+    for name, s in scenes.items():
+        frame = r.render(s, *size, g)
+        hit[name], far[name] = frame.hit, beyond_epsilon(o3d, bvh, frame, view, s)
+    del bvh  # its memory, before the fresh processes measure theirs
+    jobs = {PEER: ("peer", {})} | {name: ("krsview", knobs) for name, knobs in VARIANTS.items()}
+    rows = []
+    for name, (job, knobs) in jobs.items():
+        first, peak = fresh_process(job, scene, g.depth, size, knobs)
+        rows.append(row(g.depth, name, times, first, peak, hit[name], hit[PEER], far[name]) | setup)
+    return rows
+
+
+def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene) -> float:
+    """Fraction of pixels where krsview hits farther from the mesh than ε(t) + TOLERANCE
+    pixels at its depth t: a hit the mesh does not explain (the mesh lies inside the surface
+    by at most TOLERANCE pixels, and the tracer stops within ε(t) of it [KRS17 §4])."""
+    t = frame.depth[frame.hit]
+    d = primary_rays(view).reshape(*frame.hit.shape, 3)[frame.hit]
+    points = (view.origin + t[:, None] * d).astype(np.float32)
+    gap = bvh.compute_distance(o3d.core.Tensor(points)).numpy()
+    allowed = (scene.render.epsilon_scale + TOLERANCE) * view.footprint * t
+    return float((gap > allowed).sum() / frame.hit.size)
+
+
+def row(n: int, name: str, times: dict, first: float, peak: float, hit, peer_hit, far: float):
+    """One renderer's columns; ratios to the peer per round (the same round's frames)."""
+    t, peer = times[name], times[PEER]
+    ratios = [a / b for a, b in zip(t, peer)]
+    return dict(
+        levels=n,
+        renderer=name,
+        ms=statistics.median(t) * 1e3,
+        ms_min=min(t) * 1e3,
+        ms_max=max(t) * 1e3,
+        ratio=statistics.median(t) / statistics.median(peer),
+        ratio_min=min(ratios),
+        ratio_max=max(ratios),
+        first_frame_s=first,
+        peak_rss_mb=peak,
+        hit_differs=float((hit != peer_hit).mean()),
+        only_krsview=float((hit & ~peer_hit).mean()),
+        only_peer=float((peer_hit & ~hit).mean()),
+        beyond_epsilon=far,
+    )
+
+
+def table(m: Measured) -> str:
+    text = (
+        f"\nkrsview against {PEER} over the expanded, tessellated KRS — {m.scene.name}, "
+        f"{m.size[0]}×{m.size[1]}, the same primary rays, {m.rounds} interleaved rounds "
+        "(krsview with its effects off)\n\n"
+    )
+    text += markdown(
+        (
+            "levels",
+            "renderer",
+            "ms/frame [min–max]",
+            "× peer [min–max]",
+            "first frame",
+            "peak RSS",
+            "hit differs (krsview only / peer only)",
+            "hits beyond ε",
+        ),
+        "rlrrrrrr",
+        (
+            (
+                r["levels"],
+                r["renderer"],
+                f"{r['ms']:.1f} [{r['ms_min']:.1f}–{r['ms_max']:.1f}]",
+                f"{r['ratio']:.2f} [{r['ratio_min']:.2f}–{r['ratio_max']:.2f}]",
+                f"{r['first_frame_s']:.2f} s",
+                f"{r['peak_rss_mb']:,.0f} MiB",
+                f"{r['hit_differs']:.2%} ({r['only_krsview']:.2%} / {r['only_peer']:.2%})",
+                f"{r['beyond_epsilon']:.2%}",
+            )
+            for r in m.rows
+        ),
+    )
+    notes = [
+        f"{r['levels']} levels: {r['instances']:,} kernel instances, {r['triangles']:,} "
+        f"triangles (within {TOLERANCE} px of the surface): expansion and tessellation "
+        f"{r['mesh_s']:.2f} s, BVH build {r['bvh_s']:.2f} s"
+        for r in m.rows
+        if r["renderer"] == PEER
+    ]
+    notes += [
+        "hits beyond ε: pixels where krsview hits farther from the mesh than its ε(t) and the "
+        f"mesh's {TOLERANCE} px allow (the tracer stops within ε(t) of the surface, so it draws "
+        "sub-pixel twigs about a pixel wide, where the mesh's rays pass by: krsview only)",
+        "first frame (scene to image, shaders from Mesa's disk cache where it has them) and "
+        "peak RSS: each in a fresh process, after its imports (one that only imports krsview "
+        f"peaks at {m.rows[0]['idle_rss_mb']:,.0f} MiB)",
+    ]
+    return text + "\n\n" + "\n\n".join(notes)
