@@ -8,6 +8,7 @@ frame and the peak memory of each in a fresh process, and where the two hit mask
 from __future__ import annotations
 
 import math
+import os
 import pickle
 import statistics
 import subprocess
@@ -234,14 +235,17 @@ def krsview_scene(scene: Scene, knobs: dict) -> Scene:
 
 def fresh_process(job: str, scene: Scene, levels: int, size: tuple[int, int], knobs: dict):
     """(seconds to the first frame, peak RSS in MiB) of a process of its own doing one
-    ``job`` after its imports: "peer" (expand, tessellate, build, cast), "krsview" (compile
-    and draw with ``knobs``), or "idle" (nothing: the imports' share). The job travels
-    pickled through stdin, so no script is imported again (as multiprocessing's spawn does)."""
+    ``job`` after its imports: "peer" (expand within ``knobs["tolerance"]`` pixels,
+    tessellate, build, cast), "krsview" (compile and draw with ``knobs``; Mesa's shader cache
+    off, so it compiles from scratch), or "idle" (nothing: the imports' share). The job
+    travels pickled through stdin, so no script is imported again (as multiprocessing's
+    spawn does)."""
     done = subprocess.run(
         [sys.executable, "-c", "from krsview.bench.peer import child; child()"],
         input=pickle.dumps((job, scene, levels, size, knobs)),
         capture_output=True,
         check=False,
+        env=os.environ | {"MESA_SHADER_CACHE_DISABLE": "true"},
     )
     if done.returncode:
         raise RuntimeError(f"bench peer: the {job} process failed: {done.stderr.decode()[-500:]}")
@@ -259,7 +263,7 @@ def _first_frame(job: str, scene: Scene, levels: int, size: tuple[int, int], kno
     t0 = time.perf_counter()
     if job == "peer":
         view = view_of(scene.camera, *size)
-        peer_hit(build(o3d, expand(krs, view))[0], camera_rays(o3d, view))
+        peer_hit(build(o3d, expand(krs, view, knobs["tolerance"]))[0], camera_rays(o3d, view))
     elif job == "krsview":
         Renderer().render(krsview_scene(scene, knobs), *size, krs)
     return time.perf_counter() - t0, peak_rss_mib()
@@ -284,35 +288,41 @@ def check_levels(krs: KRS, levels: tuple[int, ...], name: str) -> None:
 
 
 def bench_peer(
-    scene: Scene, size: tuple[int, int], rounds: int = 5, levels: tuple[int, ...] = (16,)
+    scene: Scene,
+    size: tuple[int, int],
+    rounds: int = 5,
+    level_counts: tuple[int, ...] = (16,),
+    tolerance: float = TOLERANCE,
 ) -> Measured:
-    """Per level count (the coarsest ``levels`` of the scene's KRS), a row for the peer and
-    one per krsview variant (VARIANTS): ms per frame, median [min–max] over interleaved
+    """Per level count (the coarsest ``level_counts`` levels of the scene's KRS), a row for
+    the peer and one per krsview variant (VARIANTS): ms per frame, median [min–max] over interleaved
     rounds, the ratio to the peer (per round), the first frame and peak RSS of a fresh
     process, the pixels whose hit differs from the peer's, and krsview's hits farther from
-    the mesh than its ε(t) and the mesh's tolerance allow."""
+    the mesh than its ε(t) and the mesh's ``tolerance`` (pixels) allow."""
     o3d = load_peer()
     krs = single_krs(scene)
-    check_levels(krs, levels, scene.name)
+    check_levels(krs, level_counts, scene.name)
     idle = fresh_process("idle", scene, 1, size, {})[1]
     r = Renderer()
     rows = []
-    for n in levels:
+    for n in level_counts:
         rows += [
             x | dict(idle_rss_mb=idle)
-            for x in measure_level(o3d, r, scene, krs.truncated(n), size, rounds)
+            for x in measure_level(o3d, r, scene, krs.truncated(n), size, rounds, tolerance)
         ]
     return Measured(scene, size, rounds, rows)
 
 
-def measure_level(o3d, r: Renderer, scene: Scene, g: KRS, size, rounds: int) -> list[dict]:
+def measure_level(
+    o3d, r: Renderer, scene: Scene, g: KRS, size, rounds: int, tolerance: float
+) -> list[dict]:
     """The rows of one level count: the peer's, then each of VARIANTS'."""
     view = view_of(scene.camera, *size)
     rays = camera_rays(o3d, view)
     scenes = {name: krsview_scene(scene, knobs) for name, knobs in VARIANTS.items()}
     t0 = time.perf_counter()
-    mesh = expand(g, view)
-    setup = dict(instances=mesh.instances, triangles=len(mesh.faces))
+    mesh = expand(g, view, tolerance)
+    setup = dict(tolerance_px=tolerance, instances=mesh.instances, triangles=len(mesh.faces))
     setup |= dict(mesh_s=time.perf_counter() - t0)
     bvh, setup["bvh_s"] = build(o3d, mesh)
     hit = {PEER: peer_hit(bvh, rays)}
@@ -322,9 +332,11 @@ def measure_level(o3d, r: Renderer, scene: Scene, g: KRS, size, rounds: int) -> 
     far = {PEER: 0.0}
     for name, s in scenes.items():
         frame = r.render(s, *size, g)
-        hit[name], far[name] = frame.hit, beyond_epsilon(o3d, bvh, frame, view, s)
+        hit[name], far[name] = frame.hit, beyond_epsilon(o3d, bvh, frame, view, s, tolerance)
     del bvh  # its memory, before the fresh processes measure theirs
-    jobs = {PEER: ("peer", {})} | {name: ("krsview", knobs) for name, knobs in VARIANTS.items()}
+    jobs = {PEER: ("peer", {"tolerance": tolerance})} | {
+        name: ("krsview", knobs) for name, knobs in VARIANTS.items()
+    }
     rows = []
     for name, (job, knobs) in jobs.items():
         first, peak = fresh_process(job, scene, g.depth, size, knobs)
@@ -332,15 +344,15 @@ def measure_level(o3d, r: Renderer, scene: Scene, g: KRS, size, rounds: int) -> 
     return rows
 
 
-def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene) -> float:
-    """Fraction of pixels where krsview hits farther from the mesh than ε(t) + TOLERANCE
+def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene, tolerance: float) -> float:
+    """Fraction of pixels where krsview hits farther from the mesh than ε(t) + ``tolerance``
     pixels at its depth t: a hit the mesh does not explain (the mesh lies inside the surface
-    by at most TOLERANCE pixels, and the tracer stops within ε(t) of it [KRS17 §4])."""
+    by at most ``tolerance`` pixels, and the tracer stops within ε(t) of it [KRS17 §4])."""
     t = frame.depth[frame.hit]
     d = primary_rays(view).reshape(*frame.hit.shape, 3)[frame.hit]
     points = (view.origin + t[:, None] * d).astype(np.float32)
     gap = bvh.compute_distance(o3d.core.Tensor(points)).numpy()
-    allowed = (scene.render.epsilon_scale + TOLERANCE) * view.footprint * t
+    allowed = (scene.render.epsilon_scale + tolerance) * view.footprint * t
     return float((gap > allowed).sum() / frame.hit.size)
 
 
@@ -400,16 +412,17 @@ def table(m: Measured) -> str:
     )
     notes = [
         f"{r['levels']} levels: {r['instances']:,} kernel instances, {r['triangles']:,} "
-        f"triangles (within {TOLERANCE} px of the surface): expansion and tessellation "
+        f"triangles (within {r['tolerance_px']} px of the surface): expansion and tessellation "
         f"{r['mesh_s']:.2f} s, BVH build {r['bvh_s']:.2f} s"
         for r in m.rows
         if r["renderer"] == PEER
     ]
     notes += [
         "hits beyond ε: pixels where krsview hits farther from the mesh than its ε(t) and the "
-        f"mesh's {TOLERANCE} px allow (the tracer stops within ε(t) of the surface, so it draws "
-        "sub-pixel twigs about a pixel wide, where the mesh's rays pass by: krsview only)",
-        "first frame (scene to image, shaders from Mesa's disk cache where it has them) and "
+        f"mesh's {m.rows[0]['tolerance_px']} px allow (the tracer stops within ε(t) of the "
+        "surface, so it draws sub-pixel twigs about a pixel wide, where the mesh's rays pass "
+        "by: krsview only)",
+        "first frame (scene to image; krsview compiles its shaders, Mesa's disk cache off) and "
         "peak RSS: each in a fresh process, after its imports (one that only imports krsview "
         f"peaks at {m.rows[0]['idle_rss_mb']:,.0f} MiB)",
     ]

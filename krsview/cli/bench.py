@@ -28,6 +28,13 @@ class Bench:
     knobs: tuple[str, ...] = ()  # [render] fields it takes as options
     scene_options: bool = False  # --epsilon-scale, --max-iterations, --levels, --effects
     own: tuple[tuple[str, dict], ...] = field(default=())  # its own options: flag, argparse
+    needs: tuple[str, str] | None = None  # (module, extra) of an optional library it runs on
+
+
+def level_list(text: str) -> tuple[int, ...]:
+    """``--levels 16,18`` → (16, 18), each a level count in 1..MAX_LEVELS."""
+    parse = options.number_in("--levels", 1, MAX_LEVELS)
+    return tuple(parse(item) for item in text.split(","))
 
 
 BENCHES = {
@@ -118,13 +125,48 @@ BENCHES = {
             ),
         ),
     ),
+    "peer": Bench(
+        "krsview against an Embree BVH over the expanded, tessellated tree (same rays)",
+        "The obvious CPU alternative [issue 27 §3]: the KRS expanded into all its kernel "
+        "instances, each tessellated within --tolerance pixels of its surface, in an Embree BVH "
+        "(Open3D's RaycastingScene, on every core), cast with krsview's own primary rays. "
+        "Per level count: ms per frame of the peer and of krsview (the scene's [render], and "
+        f"the pre-pass {VIEW_PREPASS}; effects off) in interleaved rounds, median [min–max], "
+        "their ratio per round, the BVH's build, the first frame and peak memory of each "
+        "in a fresh process, and where the hit masks differ. Needs 'krsview[peer]'. "
+        "Example: krsview bench peer tree --levels 16,18 --csv out/peer.csv",
+        own=(
+            (
+                "--levels",
+                dict(
+                    dest="level_counts",
+                    metavar="N[,N…]",
+                    type=level_list,
+                    default=(16,),
+                    help="level counts to expand, comma-separated (default 16; each level "
+                    "doubles the peer's mesh)",
+                ),
+            ),
+            (
+                "--tolerance",
+                dict(
+                    type=options.number_in("--tolerance", 0.01, 8.0, float),
+                    metavar="PIXELS",
+                    default=0.5,
+                    help="pixels the peer's mesh may lie inside the surface, at the nearest "
+                    "instance of each level (default 0.5; finer: more triangles)",
+                ),
+            ),
+        ),
+        needs=("open3d", "peer"),
+    ),
 }
 
 
 def add(sub) -> None:
     b = sub.add_parser(
         "bench",
-        help="benchmarks (levels, paths, split, tracers, effects, zoom, accuracy)",
+        help="benchmarks (levels, paths, split, tracers, effects, zoom, peer, accuracy)",
         description="Benchmarks that report ratios measured side by side. "
         "Example: krsview bench tracers tree --csv out/tracers.csv",
     )
@@ -152,6 +194,9 @@ def add(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    needs = BENCHES[args.bench].needs
+    if needs is not None:
+        options.require(needs[0], extra=needs[1], what=f"bench {args.bench}")
     scene = options.scene_of(args)
     if args.csv:
         check_output_file(args.csv, "--csv", ".csv")
