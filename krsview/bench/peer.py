@@ -27,7 +27,7 @@ from .harness import Variant, frame_timer, interleaved
 from .report import Measured, markdown
 
 PEER = "Embree (Open3D)"
-TOLERANCE = 0.5  # pixels: the mesh lies inside the surface by at most this, at the nearest instance
+TOLERANCE = 0.5  # pixels: how far the mesh may lie from the surface, at the nearest instance
 MAX_PIECES = 256  # sides of a ring, bands of a cap, segments of an arc, at most (eye in a kernel)
 # krsview's rows: the scene's own [render] and the viewer's pre-pass, both with the effects off
 # (primary rays only, as the peer casts). Issue 27 §1's LOD knob ([render] lod) joins here as
@@ -93,8 +93,9 @@ def pieces(angle: float, radius: float, tol: float, least: int) -> int:
 
 def kernel_mesh(kind: str, rec: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     """A closed mesh of one kernel (its core — point, segment or arc — swept by a ball, caps
-    as half spheres), every vertex on the surface and every triangle within ``tol`` inside
-    it (half for the rings, half for the arc or the caps)."""
+    as half spheres), every vertex on the surface and every triangle within ``tol`` of it
+    (half for the rings, half for the arc or the caps): inside, except on a torus's inner
+    side, where chords along the arc pass outside by less than tol/2."""
     r = rec[1, 3]
     if kind == "sphere":
         core, tangent = rec[1:2, :3], np.array([[0.0, 0.0, 1.0]])
@@ -346,8 +347,8 @@ def measure_level(
 
 def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene, tolerance: float) -> float:
     """Fraction of pixels where krsview hits farther from the mesh than ε(t) + ``tolerance``
-    pixels at its depth t: a hit the mesh does not explain (the mesh lies inside the surface
-    by at most ``tolerance`` pixels, and the tracer stops within ε(t) of it [KRS17 §4])."""
+    pixels at its depth t: a hit the mesh does not explain (the mesh lies within
+    ``tolerance`` pixels of the surface, and the tracer stops within ε(t) of it [KRS17 §4])."""
     t = frame.depth[frame.hit]
     d = primary_rays(view).reshape(*frame.hit.shape, 3)[frame.hit]
     points = (view.origin + t[:, None] * d).astype(np.float32)

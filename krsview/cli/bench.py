@@ -153,7 +153,7 @@ BENCHES = {
                     type=options.number_in("--tolerance", 0.01, 8.0, float),
                     metavar="PIXELS",
                     default=0.5,
-                    help="pixels the peer's mesh may lie inside the surface, at the nearest "
+                    help="pixels the peer's mesh may lie from the surface, at the nearest "
                     "instance of each level (default 0.5; finer: more triangles)",
                 ),
             ),
