@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import krsview
-from krsview.bench import peer
+from krsview.bench import expansion, peer
 from krsview.bench.metrics import silhouette
 from krsview.cli import main
 from krsview.compile.camera import primary_rays, view_of
@@ -68,7 +68,7 @@ def tree_scene(levels: int):
 
 def test_instance_maps_match_reflecting_point_by_point():
     c = compile_krs(mixed_krs(), WHITE)
-    maps = peer.instance_maps(c)
+    maps = expansion.instance_maps(c)
     p = np.array([0.3, -0.2, 0.7])
     for j, (M, t) in enumerate(maps):
         got = rows(M @ p + t)
@@ -89,7 +89,7 @@ def test_instance_maps_match_reflecting_point_by_point():
 def test_instances_are_two_to_the_n_minus_i_per_non_empty_kernel():
     krs = mixed_krs()
     view = view_of(Camera(position=(0.0, 0.5, -8.0), target=(0.5, 0.5, 0.0)), 64, 36)
-    mesh = peer.expand(krs, view)
+    mesh = expansion.expand(krs, view)
     n = krs.n
     solid = [i for i, k in enumerate(krs.kernels) if not isinstance(k, Empty)]
     assert mesh.instances == sum(2 ** (n - i) for i in solid) == 8 + 4 + 1
@@ -120,7 +120,7 @@ def test_vertices_lie_on_the_kernels_surfaces_and_on_the_krs(case):
         scene, krs = tree_scene(5)
         camera = scene.camera
     c = compile_krs(krs, WHITE)
-    v = peer.expand(krs, view_of(camera, 96, 54)).vertices.astype(np.float64)
+    v = expansion.expand(krs, view_of(camera, 96, 54)).vertices.astype(np.float64)
     pushed = v + 1e-3 * np.array([0.6, 0.0, 0.8])
     assert nearest_surface(c, v).max() < 1e-5
     assert distance(c, v).max() < 1e-5
@@ -150,12 +150,12 @@ def surface_samples(v: np.ndarray, f: np.ndarray) -> np.ndarray:
 @pytest.mark.parametrize("share", [0.02, 0.3, 2.0])  # tolerance over radius: fine to one ring
 def test_triangles_lie_within_the_tolerance_inside_the_surface(kind, rec, share):
     tol = share * rec[1, 3]
-    v, f = peer.kernel_mesh(kind, rec, tol)
+    v, f = expansion.kernel_mesh(kind, rec, tol)
     k = kernel_distance(kind, rec, surface_samples(v, f))
     assert np.abs(k).max() <= tol
     if kind != "toroidal_capsule":  # convex: every chord inside (a torus's inner side is not)
         assert k.max() < 1e-12
-    coarse_v, coarse_f = peer.kernel_mesh(kind, rec, 6 * tol)  # negative control
+    coarse_v, coarse_f = expansion.kernel_mesh(kind, rec, 6 * tol)  # negative control
     if share < 1:
         assert kernel_distance(kind, rec, surface_samples(coarse_v, coarse_f)).min() < -tol
 
@@ -170,7 +170,7 @@ def closed(f: np.ndarray) -> bool:
 @pytest.mark.parametrize("kind, rec", kernel_cases())
 def test_kernel_meshes_are_closed(kind, rec):
     for share in (0.02, 2.0):
-        v, f = peer.kernel_mesh(kind, rec, share * rec[1, 3])
+        v, f = expansion.kernel_mesh(kind, rec, share * rec[1, 3])
         assert closed(f) and np.all(np.bincount(f.ravel(), minlength=len(v)) > 0)
         assert not closed(f[1:])  # negative control: a triangle missing
 
@@ -179,11 +179,11 @@ def test_tolerance_is_half_a_pixel_at_the_nearest_instance():
     krs = KRS([Level(Sphere((0.0, 0.0, 10.0), 1.0))])
     view = view_of(Camera(position=(0.0, 0.0, 0.0), target=(0.0, 0.0, 1.0), fov_y=45.0), 320, 180)
     c = compile_krs(krs, WHITE)
-    (tol,) = peer.level_tolerances(krs, peer.instance_maps(c), view, 0.5)
+    (tol,) = expansion.level_tolerances(krs, expansion.instance_maps(c), view, 0.5)
     assert tol == pytest.approx(0.5 * 2 * math.tan(math.radians(22.5)) / 180 * 9.0)
 
 
-def brute_force_hits(mesh: peer.Mesh, origin: np.ndarray, d: np.ndarray) -> np.ndarray:
+def brute_force_hits(mesh: expansion.Mesh, origin: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Möller–Trumbore over every ray and triangle, in float64."""
     tri = mesh.vertices.astype(np.float64)[mesh.faces]
     e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
@@ -211,7 +211,7 @@ def test_the_mesh_under_krsviews_rays_draws_krsviews_image(renderer):
     scene = scene.edit("camera.position", (0.0, 2.6, -5.0)).edit("render.epsilon_scale", 0.1)
     w, h = 64, 36
     view = view_of(scene.camera, w, h)
-    mesh = peer.expand(krs, view, 0.1)
+    mesh = expansion.expand(krs, view, 0.1)
     mine = renderer.render(peer.krsview_scene(scene, {}), w, h, krs).hit
     theirs = brute_force_hits(mesh, view.origin, primary_rays(view)).reshape(h, w)
     flipped = theirs[::-1]
@@ -223,12 +223,12 @@ def test_the_mesh_under_krsviews_rays_draws_krsviews_image(renderer):
 
 def test_a_scene_the_peer_cannot_mesh_gets_one_line():
     with pytest.raises(SceneError, match="one KRS into triangles"):
-        peer.single_krs(krsview.load("grove"))
+        expansion.single_krs(krsview.load("grove"))
     plane = krsview.load_dict(
         {"krs": {"levels": [{"kernel": {"type": "plane", "normal": [0, 1, 0], "offset": 0}}]}}
     )
     with pytest.raises(SceneError, match=r"levels\[0\]\.kernel.*bounded kernels"):
-        peer.single_krs(plane)
+        expansion.single_krs(plane)
     with pytest.raises(SceneError, match=r"--levels = 24: allowed: 1\.\.23"):
         peer.check_levels(krsview.load("tree").geometry(), (16, 24), "tree")
     peer.check_levels(krsview.load("tree").geometry(), (1, 23), "tree")  # the edges are allowed
@@ -270,8 +270,8 @@ def test_bench_peer_tiny_run(renderer):
     assert m.rows[0]["ratio"] == 1 and m.rows[0]["hit_differs"] == 0
     assert "| 4 | krsview, as saved |" in peer.table(m)
     view = view_of(scene.camera, *size)
-    bvh, _ = peer.build(o3d, peer.expand(krs, view))
+    bvh, _ = peer.build(o3d, expansion.expand(krs, view))
     frame = renderer.render(peer.krsview_scene(scene, {}), *size, krs)
-    assert peer.beyond_epsilon(o3d, bvh, frame, view, scene, peer.TOLERANCE) == 0
+    assert peer.beyond_epsilon(o3d, bvh, frame, view, scene, expansion.TOLERANCE) == 0
     frame.depth[frame.hit] *= 1.5  # negative control
-    assert peer.beyond_epsilon(o3d, bvh, frame, view, scene, peer.TOLERANCE) > 0.01
+    assert peer.beyond_epsilon(o3d, bvh, frame, view, scene, expansion.TOLERANCE) > 0.01
