@@ -149,7 +149,7 @@ def bench_peer(
 ) -> Measured:
     """Per level count (the coarsest ``level_counts`` levels of the scene's KRS), a row for
     the peer and one per krsview variant (VARIANTS): ms per frame, median [min–max] over
-    interleaved rounds, the ratio to the peer (of medians, and per round), the first frame
+    interleaved rounds, the ratio to the peer (the median of per-round ratios), the first frame
     and peak RSS of a fresh process, the pixels whose hit differs from the peer's, and
     krsview's hits farther from the mesh than its ε(t) and ``tolerance`` (pixels) allow."""
     o3d = load_peer()
@@ -210,7 +210,9 @@ def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene, tolerance: float) 
 
 
 def row(n: int, name: str, times: dict, first: float, peak: float, hit, peer_hit, far: float):
-    """One renderer's columns; ratios to the peer per round (the same round's frames)."""
+    """One renderer's columns. Its ratio to the peer is taken per round, between frames
+    drawn side by side, and the median of those reported: load that comes and goes over the
+    run moves both frames of a round, not their ratio."""
     t, peer = times[name], times[PEER]
     ratios = [a / b for a, b in zip(t, peer)]
     return dict(
@@ -219,7 +221,7 @@ def row(n: int, name: str, times: dict, first: float, peak: float, hit, peer_hit
         ms=statistics.median(t) * 1e3,
         ms_min=min(t) * 1e3,
         ms_max=max(t) * 1e3,
-        ratio=statistics.median(t) / statistics.median(peer),
+        ratio=statistics.median(ratios),
         ratio_min=min(ratios),
         ratio_max=max(ratios),
         first_frame_s=first,
