@@ -186,7 +186,7 @@ def measure_level(
     for name, s in scenes.items():
         frame = r.render(s, *size, g)
         hit[name], far[name] = frame.hit, beyond_epsilon(o3d, bvh, frame, view, s, tolerance)
-    del bvh  # its memory, before the fresh processes measure theirs
+    del bvh  # freed before the fresh processes build their own
     jobs = {PEER: ("peer", {"tolerance": tolerance})} | {
         name: ("krsview", knobs) for name, knobs in VARIANTS.items()
     }
