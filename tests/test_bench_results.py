@@ -37,6 +37,7 @@ def test_levels_returns_a_row_per_level_count():
         "time_ratio",
         "iterations",
         "ratio_per_iteration",
+        "ms_every_level",
     ]
     assert m.rows[0]["time_ratio"] == 1.0 and m.rows[0]["ratio_per_iteration"] == 1.0
     assert m.column("instances") == [

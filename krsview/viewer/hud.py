@@ -38,6 +38,7 @@ KNOBS = (
     *TRACER_KNOBS,
     "precision",
     "culling",
+    "lod",
     "path",
     "steps",
     "shadow_tasks",
