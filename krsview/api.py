@@ -248,9 +248,10 @@ def certify(
     tracer: str | None = None,
     max_segments: int | None = None,
 ):
-    """Certified holes and false hits of the GPU image, by the reliable oracle (interval and
-    revised affine arithmetic over ray segments [RAA09]): a
-    :class:`krsview.oracle.certify.Counts`. ``tracer`` overrides the scene's."""
+    """Certified holes and false hits of the GPU image :func:`render` draws (the viewer's
+    fast settings where the scene sets none), by the reliable oracle (interval and revised
+    affine arithmetic over ray segments [RAA09]): a :class:`krsview.oracle.certify.Counts`.
+    ``tracer`` overrides the scene's."""
     from .oracle.certify import MAX_SEGMENTS, count_errors
 
     scene = scene if isinstance(scene, Scene) else load(scene)
@@ -261,7 +262,6 @@ def certify(
             "the oracle covers scenes without twist or empty zones "
             "(their distortions are not in it)",
         )
-    if tracer is not None:
-        scene = configure(scene, tracer=tracer)
+    scene = fast_settings(scene if tracer is None else configure(scene, tracer=tracer))
     frame = render(scene, size)
     return count_errors(scene, frame, max_segments=max_segments or MAX_SEGMENTS)

@@ -100,16 +100,17 @@ def test_lod_off_compiles_nothing_new():
 
 @pytest.mark.parametrize("name", ["tree", "rock", "grass", "tree-mokrs"])
 def test_gpu_matches_the_reference_at_the_level_of_detail(renderer, name):
-    """The GLSL and the NumPy twin cut at the same balls: their images agree as every
-    pixel test does, and (negative control) the reference without LOD differs from both
-    by more hits than the GPU and the reference differ from each other."""
+    """The GLSL and the NumPy twin cut at the same balls: hits and colours (shadow rays
+    included) agree but where a cut, a float comparison, falls apart in float32 and
+    float64; and (negative control) the reference without LOD differs from it by more hits
+    than the GPU does."""
     scene = with_lod(load_scene(resolve(name)), 2.0)
     gpu = renderer.render(scene, W, H)
     from krsview.reference import render_reference
 
     ref = render_reference(scene, W, H)
     a = agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
-    assert a.hit >= 0.997, a
+    assert a.hit >= 0.997 and a.color >= 0.99, a  # a cut may fall apart in float32
     plain = render_reference(with_lod(scene, 0.0), W, H)
     if name == "tree":
         assert int((plain.hit != ref.hit).sum()) > int((gpu.hit != ref.hit).sum())
