@@ -30,9 +30,10 @@ def distance(
     Level of detail ``rho`` (a length per point, 0: none): at the first ball C_i of radius
     below rho the walk takes d = min(d, dist(x, C_i)) and stops. That is Alg. 1 of the *LOD
     geometry*: the levels above i, and in place of levels i..0 the 2^(n−i−1) copies of the
-    solid ball C_i (the culling test is implied). It holds the KRS (C_i holds all below it),
+    solid ball C_i. It holds the KRS (C_i holds all below it),
     so the value stays a lower bound of the full walk's and no ray passes the KRS; and every
-    point of C_i is within its diameter, 2·rho, of the geometry it holds."""
+    point of C_i is within its diameter, 2·rho, of the geometry it holds. Culling and the
+    level of detail are independent switches, as in the shader."""
     x = xw
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
     live = np.ones(len(x), dtype=bool)

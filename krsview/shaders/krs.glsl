@@ -28,13 +28,15 @@ real krs_distance(int first, int n, vec3r xw, real rho) {
 #ifdef KRS_COUNT_LEVELS
         ++g_levels;
 #endif
-#if defined(KRS_LOD)
+#if defined(KRS_CULLING) || defined(KRS_LOD)
         vec4r b = u_bounds[i];
         real db = length(x - b.xyz) - b.w;
-        if (b.w >= 0.0 && (db >= d || b.w < rho)) { d = min(d, db); break; }
-#elif defined(KRS_CULLING)
-        vec4r b = u_bounds[i];
-        if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
+#endif
+#ifdef KRS_CULLING
+        if (b.w >= 0.0 && db >= d) break;
+#endif
+#ifdef KRS_LOD
+        if (b.w >= 0.0 && b.w < rho) { d = min(d, db); break; }
 #endif
         fold(i, x);
         d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
