@@ -117,6 +117,14 @@ def test_accuracy_returns_a_row_per_setting_and_error_images(tmp_path):
     assert {name for name in acc.errors} <= {p.name for p in (tmp_path / "report").iterdir()}
 
 
+def test_accuracy_runs_on_a_mokrs(tmp_path):
+    """A MöKRS has no level count probe: its work is its bound, and the bench still runs."""
+    scene = krsview.load("palm")
+    m = accuracy.bench_accuracy(scene, (12, 8), rounds=1, cache=tmp_path / "cache").measured
+    n = scene.geometry().n
+    assert all(r["work"] == pytest.approx(r["iterations"] * (1 + n)) for r in m.rows[:3])
+
+
 def test_markdown_and_csv_hold_the_rows(tmp_path):
     rows = [dict(part="shadow rays, occlusion", ms=1.5), dict(part="frame", ms=3.0)]
     assert markdown(("part", "ms"), "lr", [(r["part"], r["ms"]) for r in rows]) == (

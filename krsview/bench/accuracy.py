@@ -186,7 +186,10 @@ def bench_accuracy(
 
 def levels_walked(r: Renderer, s: Setting, size: tuple[int, int]) -> np.ndarray:
     """Per pixel, the levels Alg. 1 walked tracing the ray (the KRS_COUNT_LEVELS probe of
-    :meth:`Renderer.levels`, here with the setting's own geometry, as a truncation needs)."""
+    :meth:`Renderer.levels`, here with the setting's own geometry, as a truncation needs);
+    zeros for a MöKRS, whose walk the probe does not count (see :func:`work`)."""
+    if s.scene.mokrs is not None:
+        return np.zeros((size[1], size[0]), dtype=np.int64)
     return r.levels(s.scene, *size, s.geometry)
 
 
