@@ -201,6 +201,7 @@ def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
         "max_iterations",
         "tracer",
         "precision",
+        "lod",
         "path",
         "prepass",
         "levels",

@@ -95,9 +95,9 @@ def settings(scene: Scene) -> list[Setting]:
     if scene.mokrs is None:  # Alg. 1's culling; not in a MöKRS
         other = "off" if r.culling == "on" else "on"
         out.append(Setting("culling", other, replace(scene, render=replace(r, culling=other))))
-        for lod in LODS:
-            if lod != r.lod:
-                out.append(Setting("lod", f"{lod:g}", replace(scene, render=replace(r, lod=lod))))
+    for lod in LODS:  # Alg. 1's balls, or a MöKRS's levels' bounds
+        if lod != r.lod:
+            out.append(Setting("lod", f"{lod:g}", replace(scene, render=replace(r, lod=lod))))
     if r.path == "fragment":
         out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
     for tile in PREPASS_TILES:
