@@ -103,7 +103,9 @@ def test_bands_make_the_image_of_one_draw_and_images_alternate_targets(renderer,
         assert image.passes[1][1:] == (80, 45)
         # a later image of the same size never draws into this one's targets
         after = PassImage(renderer, targets, tree, SIZE, tree.geometry(), 1, traced=image)
-        assert after.output is not image.output and [p[0] for p in after.passes] == ["shade"]
+        assert after.output is not image.output and [p[0] for p in after.passes] == [
+            "shadows+shade"
+        ]
         reused = read_buffers(after.draw_all(), *SIZE)
         holed = banded(("shade", 42))[1]  # negative control: one band left out
     assert np.array_equal(bands.color, whole.color)

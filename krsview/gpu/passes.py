@@ -3,9 +3,10 @@ turns and trace its shadow rays at reduced resolution [KRS17 §8.5 traces soft s
 resolution]. ``ratio`` picks the passes:
 
 - 0: ``render``, render.frag with every effect in one pass (the renderer's own image);
-- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY), then ``shade``,
-  upsampled.frag shading every pixel with its own shadow rays: render.frag's image in two
-  passes, so a later image of the same view and size can reuse the tracing;
+- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY), then
+  ``shadows+shade``, upsampled.frag shading every pixel with its own shadow rays:
+  render.frag's image in two passes, so a later image of the same view and size can reuse
+  the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
   each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
@@ -95,7 +96,7 @@ class PassImage:
             self.passes = [] if traced else [("trace", w, h)]
             if ratio > 1:
                 self.passes.append(("visibility", *self.coarse))
-            self.passes.append(("shade", w, h))
+            self.passes.append(("shade" if ratio > 1 else "shadows+shade", w, h))
         self.traced = traced.traced if traced else None  # the trace pass's targets
         with renderer.current():
             self.output = targets.output(size) if ratio else None
@@ -119,7 +120,7 @@ class PassImage:
             shade["u_depth_slack"].value = DEPTH_SLACK
             self._programs.update(visibility=vis, shade=shade)
         elif self.ratio == 1:
-            self._programs["shade"] = self.renderer.companion(main, "upsampled.frag")
+            self._programs["shadows+shade"] = self.renderer.companion(main, "upsampled.frag")
 
     def draw(self, name: str, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first."""

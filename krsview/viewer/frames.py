@@ -122,18 +122,17 @@ class Frames:
 
     def _refine(self, scene: Scene, krs: Geometry) -> None:
         r = self.refinement
-        spent, budget = 0.0, 0.8 * self.adaptive.budget
+        spent, budget = 0.0, self.adaptive.budget  # a turn no longer than a moving frame's
         prepared = None
         while not r.done and spent < budget:
             if not r.started:
                 step = r.steps[r.k]
                 size = self.adaptive.size_at(step.scale)
-                shown = self._on_screen
-                reuse = step.ratio == 1 and shown is not None and shown.has_trace(size)
+                shown = self._on_screen  # its tracing is reused where it has this size
+                traced = shown if step.ratio == 1 and shown and shown.has_trace(size) else None
                 self._tracing = PassImage(
-                    self.renderer, self.targets, scene, size, krs, step.ratio,
-                    shown if reuse else None,
-                )  # fmt: skip
+                    self.renderer, self.targets, scene, size, krs, step.ratio, traced
+                )
                 r.begin(self._tracing.passes)
                 self._step_seconds = 0.0
             if prepared is not self._tracing:
