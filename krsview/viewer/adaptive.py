@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 SHADOW_RATIO = 2  # moving frames and refinement steps: one shadow ray per 2 × 2 pixels
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
+STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
 
 
@@ -56,18 +57,24 @@ class Step:
     ratio: int
 
 
-def refinement_steps(moving_scale: float, supersample: int, split: bool) -> list[Step]:
-    """The images after the view stops, the last one the still image. Sides double up to the
-    window's, from the first at least STEP_GAIN times the moving frame's (so each step is
-    visibly sharper, and all of them cost at most 1/3 more than the last alone). ``split``
-    (shadows a pass of their own): those steps trace shadow rays at SHADOW_RATIO like the
-    moving frames, and the still image adds them per pixel, reusing the tracing of the image
-    before it where that has its size; else each step has every effect."""
-    scales: list[float] = []
-    s = 1.0
-    while s > moving_scale * STEP_GAIN:
-        scales.insert(0, s)
-        s /= 2
+def refinement_steps(
+    moving_scale: float, moving_seconds: float, supersample: int, split: bool
+) -> list[Step]:
+    """The images after the view stops, the last one the still image: one at the window's
+    size, and where that would take longer than STEP_WAIT to trace (predicted from the moving
+    frame's time, cost ∝ pixels) one of half its side before it, and so on down to STEP_GAIN
+    times the moving frame's side, so each step is visibly sharper and all
+    before the window-size one cost at most 1/3 of it. ``split`` (shadows a pass of their
+    own): those steps trace shadow rays at SHADOW_RATIO like the moving frames, and the still
+    image adds them per pixel, reusing the tracing of the image before it where that has its
+    size; else each step has every effect."""
+    scales = [1.0] if moving_scale * STEP_GAIN < 1.0 else []
+    while (
+        scales
+        and scales[0] / 2 > moving_scale * STEP_GAIN
+        and moving_seconds * (scales[0] / moving_scale) ** 2 > STEP_WAIT
+    ):
+        scales.insert(0, scales[0] / 2)
     if split:
         return [Step(s, SHADOW_RATIO) for s in scales] + [Step(float(supersample), 1)]
     if not scales and moving_scale < 1.0:

@@ -107,7 +107,7 @@ class Frames:
         seconds = time.perf_counter() - t0
         self.adaptive.frame_done(seconds)
         self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
-        steps = refinement_steps(scale, self.adaptive.supersample, split)
+        steps = refinement_steps(scale, seconds, self.adaptive.supersample, split)
         self.refinement = Refinement(steps, self._cost) if steps else None
         self._tracing = None
         state = "moving" if steps else "still"
