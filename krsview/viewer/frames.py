@@ -6,7 +6,7 @@ light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passe
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import moderngl
@@ -91,18 +91,15 @@ class Frames:
         elif self.refinement is not None and not self.refinement.done:
             self._refine(scene, krs)
 
-    def _split(self, scene: Scene) -> bool:
-        return not self.full_shadows and splits_shadows(scene)
-
     def _moving(self, scene: Scene, krs: Geometry) -> None:
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
-        split = self._split(scene)
+        split = not self.full_shadows and splits_shadows(scene)  # shadow rays per 2 × 2
         image = PassImage(
             self.renderer, self.targets, scene, size, krs, SHADOW_RATIO if split else 0
         )
         t0 = time.perf_counter()
-        fbo = image.draw_all()
+        image.draw_all()
         self.ctx.finish()
         seconds = time.perf_counter() - t0
         self.adaptive.frame_done(seconds)
@@ -111,14 +108,12 @@ class Frames:
         self.refinement = Refinement(steps, self._cost) if steps else None
         self._tracing = None
         state = "moving" if steps else "still"
-        self._show(image, fbo, FrameState(state, size, self.adaptive.full, seconds))
+        self._show(image, FrameState(state, size, self.adaptive.full, seconds))
 
-    def _show(self, image: PassImage, fbo: moderngl.Framebuffer, state: FrameState) -> None:
-        shadows = max(image.ratio, 1)
-        self.image, self._on_screen = (fbo, image.size), image
-        self.shown = FrameState(
-            state.state, state.size, state.window, state.seconds, state.step, shadows
-        )
+    def _show(self, image: PassImage, state: FrameState) -> None:
+        """``image`` goes on screen; ``state`` says what it is."""
+        self.image, self._on_screen = (image.output, image.size), image
+        self.shown = replace(state, shadows=max(image.ratio, 1))
 
     def _refine(self, scene: Scene, krs: Geometry) -> None:
         r = self.refinement
@@ -154,7 +149,7 @@ class Frames:
                     self._step_seconds,
                     (k, n) if k < n else (0, 0),
                 )
-                self._show(self._tracing, self._tracing.output, state)
+                self._show(self._tracing, state)
                 self._tracing = None
 
     def show(
