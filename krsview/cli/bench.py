@@ -60,7 +60,7 @@ BENCHES = {
     "split": Bench(
         "where a frame's time goes: coarse passes, tracing, shading, shadow rays",
         "On one scene and view, the fragment path: the frame, the frame without secondary "
-        "effects (shadow rays, occlusion; what the viewer's moving frames leave out), the "
+        "effects (shadow rays, occlusion), the "
         "tracing alone and the coarse passes alone, interleaved; each part of the frame is "
         "the difference of two of them. Example: krsview bench split tree "
         f"--prepass {VIEW_PREPASS} (the viewer's pre-pass).",
