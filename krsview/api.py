@@ -26,6 +26,7 @@ from typing import Any
 from .frame import Frame
 from .scene import Render, Scene, SceneError, load_scene
 from .scene.info import SceneInfo, describe
+from .scene.model import VIEW_PREPASS
 from .scene.presets import preset_names, resolve
 from .scene.schema import from_dict
 from .scene.settings import MAX_SIDE
@@ -86,6 +87,20 @@ def configure(
     return scene
 
 
+def fast_settings(scene: Scene) -> Scene:
+    """The scene with the viewer's fast settings where its file sets none: the pre-pass
+    tile VIEW_PREPASS (the level of detail is a scene field, DEFAULT_LOD unless the file
+    says otherwise). Both are certified hole-free by the reliable oracle; hits may move by
+    up to ε (pre-pass) and 2·lod·ε (level of detail)."""
+    return scene if scene.render.prepass else scene.edit(("render", "prepass"), VIEW_PREPASS)
+
+
+def exact_settings(scene: Scene) -> Scene:
+    """The scene drawn with every level and no pre-pass: the image the float64 reference
+    matches pixel for pixel (``exact=True``, ``krsview render --exact``)."""
+    return configure(scene, prepass=0, lod=0.0)
+
+
 def _shared_context():
     global _context
     with _lock:
@@ -136,13 +151,16 @@ class Renderer:
         scene: Scene,
         *,
         reference: bool = False,
+        exact: bool = False,
         progress: Callable[[int, int], None] | None = None,
         **knobs: Any,
     ) -> Frame:
-        """One frame of ``scene`` (``knobs``: see :func:`configure`); ``reference=True``
+        """One frame of ``scene`` (``knobs``: see :func:`configure`) with the viewer's fast
+        settings where neither the file nor ``knobs`` set them (:func:`fast_settings`), or with
+        ``exact=True`` every level and no pre-pass (:func:`exact_settings`); ``reference=True``
         traces it with the float64 NumPy reference instead of the GPU; ``progress(done,
         total)`` is called as bands of rows (GPU) or chunks of rays (reference) finish."""
-        scene = configure(scene, **knobs)
+        scene = configure(exact_settings(scene) if exact else fast_settings(scene), **knobs)
         if reference:
             from .reference import render_reference
 
@@ -174,20 +192,23 @@ def render(
     size: tuple[int, int] = DEFAULT_SIZE,
     *,
     reference: bool = False,
+    exact: bool = False,
     progress: Callable[[int, int], None] | None = None,
     **knobs: Any,
 ) -> Frame:
     """One frame of a scene (or a preset's name or a file) at ``size`` = (width, height) as
     NumPy arrays: ``color``, ``depth``, ``normal``, ``iterations``, ``hit``. Render knobs
     (``tracer="binary"``, ``epsilon_scale=0.5``, ``levels=8``, ``effects=[…]``, …) are
-    applied first (:func:`configure`). Variants stay compiled between calls."""
+    applied first (:func:`configure`), over the viewer's fast settings (:func:`fast_settings`), or
+    over every level without the pre-pass with ``exact=True``. Variants stay compiled
+    between calls."""
     if not isinstance(scene, Scene):
         scene = load(scene)
     r = Renderer(*size)
     with _lock:
         if not reference:
             r.gpu_shared()
-        return r.render(scene, reference=reference, progress=progress, **knobs)
+        return r.render(scene, reference=reference, exact=exact, progress=progress, **knobs)
 
 
 def check(scene: Scene | str | Path) -> SceneInfo:
@@ -227,9 +248,10 @@ def certify(
     tracer: str | None = None,
     max_segments: int | None = None,
 ):
-    """Certified holes and false hits of the GPU image, by the reliable oracle (interval and
-    revised affine arithmetic over ray segments [RAA09]): a
-    :class:`krsview.oracle.certify.Counts`. ``tracer`` overrides the scene's."""
+    """Certified holes and false hits of the GPU image :func:`render` draws (the viewer's
+    fast settings where the scene sets none), by the reliable oracle (interval and revised
+    affine arithmetic over ray segments [RAA09]): a :class:`krsview.oracle.certify.Counts`.
+    ``tracer`` overrides the scene's."""
     from .oracle.certify import MAX_SEGMENTS, count_errors
 
     scene = scene if isinstance(scene, Scene) else load(scene)
@@ -240,7 +262,6 @@ def certify(
             "the oracle covers scenes without twist or empty zones "
             "(their distortions are not in it)",
         )
-    if tracer is not None:
-        scene = configure(scene, tracer=tracer)
+    scene = fast_settings(scene if tracer is None else configure(scene, tracer=tracer))
     frame = render(scene, size)
     return count_errors(scene, frame, max_segments=max_segments or MAX_SEGMENTS)

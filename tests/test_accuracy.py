@@ -17,7 +17,7 @@ from krsview.bench.accuracy import Setting, levels_walked, same_work, settings, 
 from krsview.bench.accuracy_report import pareto, verdict
 from krsview.bench.harness import noise_floor
 from krsview.bench.metrics import compare
-from krsview.bench.truth import cache_key, ground_truth
+from krsview.bench.truth import cache_key, ground_truth, truth_scene
 from krsview.compile.camera import view_of
 from krsview.gpu.renderer import Renderer
 from krsview.reference import render_reference
@@ -189,6 +189,7 @@ def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
         "tracer",
         "precision",
         "culling",
+        "lod",
         "path",
         "prepass",
         "levels",
@@ -200,6 +201,7 @@ def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
         "max_iterations",
         "tracer",
         "precision",
+        "lod",
         "path",
         "prepass",
         "levels",
@@ -221,6 +223,16 @@ def test_ground_truth_is_cached_by_content(tmp_path):
     data["hit"][:] = False
     np.savez(f, **data)
     assert not ground_truth(scene, (16, 9), tmp_path).hit.any()
+
+
+def test_ground_truth_draws_every_level():
+    """The truth is the walk without the level of detail, whatever the scene's lod: the
+    settings are measured against it (and the same truth serves every lod)."""
+    scene = load_scene(resolve("tree"))
+    assert scene.render.lod > 0 and truth_scene(scene).render.lod == 0
+    assert cache_key(scene, (16, 9)) == cache_key(
+        replace(scene, render=replace(scene.render, lod=2.0)), (16, 9)
+    )
 
 
 def run(*args):

@@ -68,7 +68,7 @@ def test_edit_returns_a_new_validated_scene_and_leaves_the_old_one():
 def test_render_is_the_gpu_renderers_image_and_knobs_are_edits():
     scene = krsview.load("rock")
     frame = krsview.render(scene, SIZE)
-    direct = GpuRenderer().render(scene, *SIZE)
+    direct = GpuRenderer().render(krsview.api.fast_settings(scene), *SIZE)
     for name in ("color", "depth", "normal", "iterations", "hit"):
         assert np.array_equal(getattr(frame, name), getattr(direct, name)), name
     assert frame.size == SIZE and frame.color.shape == (SIZE[1], SIZE[0], 3)
@@ -77,12 +77,17 @@ def test_render_is_the_gpu_renderers_image_and_knobs_are_edits():
     assert np.array_equal(knobbed.color, edited.color)
     # negative control: the knobs change the image
     assert not np.array_equal(knobbed.color, frame.color)
+    # exact: every level, no pre-pass, as the scene would be drawn without the fast settings
+    exact = krsview.render(scene, SIZE, exact=True)
+    plain = GpuRenderer().render(krsview.configure(scene, prepass=0, lod=0.0), *SIZE)
+    assert np.array_equal(exact.color, plain.color)
+    assert not np.array_equal(exact.iterations, frame.iterations)  # the pre-pass saves steps
 
 
 def test_reference_render_agrees_with_the_gpu():
     scene = krsview.load("sierpinski")
-    gpu = krsview.render(scene, SIZE)
-    ref = krsview.render(scene, SIZE, reference=True)
+    gpu = krsview.render(scene, SIZE, exact=True)
+    ref = krsview.render(scene, SIZE, reference=True, exact=True)
     assert (gpu.hit == ref.hit).mean() > 0.98
     both = gpu.hit & ref.hit
     assert np.abs(gpu.color[both] - ref.color[both]).max() < 0.05

@@ -37,6 +37,7 @@ def test_levels_returns_a_row_per_level_count():
         "time_ratio",
         "iterations",
         "ratio_per_iteration",
+        "ms_every_level",
     ]
     assert m.rows[0]["time_ratio"] == 1.0 and m.rows[0]["ratio_per_iteration"] == 1.0
     assert m.column("instances") == [
@@ -114,6 +115,14 @@ def test_accuracy_returns_a_row_per_setting_and_error_images(tmp_path):
     text = accuracy_report.write_report(acc, tmp_path / "report")
     assert text == (tmp_path / "report" / "README.md").read_text()
     assert {name for name in acc.errors} <= {p.name for p in (tmp_path / "report").iterdir()}
+
+
+def test_accuracy_runs_on_a_mokrs(tmp_path):
+    """A MöKRS has no level count probe: its work is its bound, and the bench still runs."""
+    scene = krsview.load("palm")
+    m = accuracy.bench_accuracy(scene, (12, 8), rounds=1, cache=tmp_path / "cache").measured
+    n = scene.geometry().n
+    assert all(r["work"] == pytest.approx(r["iterations"] * (1 + n)) for r in m.rows[:3])
 
 
 def test_markdown_and_csv_hold_the_rows(tmp_path):

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+import krsview
 from krsview.cli import main
 
 
@@ -281,7 +282,8 @@ def test_check_stability_prints_the_table_and_fails_when_an_invariant_does(capsy
 def test_check_oracle_prints_certified_counts(capsys):
     assert main(["check", "--oracle", "sierpinski", "--size", "24x14"]) == 0
     out = capsys.readouterr().out
-    assert "| sphere | 336 | 111 | 0 | 0 | 0 | 0 |" in out and "| binary | 336 |" in out
+    hits = int(krsview.render("sierpinski", (24, 14)).hit.sum())  # the image it certifies
+    assert f"| sphere | 336 | {hits} | 0 | 0 | 0 | 0 |" in out and "| binary | 336 |" in out
     # a budget of one segment per ray decides only rays whose whole segment clears at once
     assert main(["check", "--oracle", "sierpinski", "--size", "24x14", "--segments", "1"]) == 0
     row = capsys.readouterr().out.splitlines()[2].split("|")
@@ -350,3 +352,25 @@ def test_view_options_come_from_the_settings_fields(capsys):
     with pytest.raises(SystemExit):
         parser.parse_args(["view", "--fps", "0.5"])
     assert "--fps = 0.5: allowed: 1 ≤ value ≤ 240" in capsys.readouterr().err
+
+
+def test_render_draws_fast_unless_exact(tmp_path, capsys):
+    """`render` draws with the pre-pass and the level of detail unless --exact; --exact
+    with either knob is refused in one line, and so is a level of detail out of range."""
+    out = tmp_path / "a.png"
+    fast = tmp_path / "fast.npz"
+    exact = tmp_path / "exact.npz"
+    base = ["render", "rock", "--size", "32x18", "--repeats", "1", "-o", str(out)]
+    assert main([*base, "--buffers", str(fast)]) == 0
+    assert main([*base, "--exact", "--buffers", str(exact)]) == 0
+    f, e = np.load(fast), np.load(exact)
+    plain = krsview.render("rock", (32, 18), prepass=0, lod=0.0)
+    assert np.array_equal(e["color"], plain.color)
+    assert f["iterations"].sum() < e["iterations"].sum()  # the pre-pass spared steps
+    capsys.readouterr()
+    assert main([*base, "--exact", "--lod", "1"]) == 2
+    assert "--lod = 1.0: cannot be combined with --exact" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as bad:
+        main([*base, "--lod", "-1"])
+    assert bad.value.code == 2
+    assert "--lod = -1.0: allowed: 0 ≤ value ≤ 8 ε" in capsys.readouterr().err

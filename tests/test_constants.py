@@ -178,6 +178,8 @@ TWIN_NAMES: dict[str, str | None] = {
     "krs_nearest": "nearest",
     "distort_distance": "distance",  # Distortion.distance
     "undistorted_distance": "reference/geometry.py:component_distances",
+    "component_distance_at": "component_distance",  # ρ given: component_distance's lod, reach
+    "lod_radius": "reference/geometry.py:Lod",  # Lod.radius
     "component": None,  # a compound's slot range from the uniforms
     "nearest_component": "nearest",  # geometry.nearest picks the component
     "scene_nearest": "nearest",

@@ -37,7 +37,8 @@ def validate(sources: dict[str, str], folder: Path, version: str) -> str:
 def variants() -> list[tuple[krsview.Scene, dict]]:
     """(scene, prepare's keywords) for every variant to check: each preset on both paths, in
     float and double, without and with the pre-pass; every hard case on both paths; the
-    knobs that change the source (tracers, culling, shadow and component tasks, the variant
+    knobs that change the source (tracers, culling, the level of detail off, shadow and
+    component tasks, the variant
     with every effect, the measuring probes)."""
     out = []
     for name in krsview.presets():
@@ -56,6 +57,9 @@ def variants() -> list[tuple[krsview.Scene, dict]]:
         (krsview.configure(tree, tracer="binary", prepass=4), {}),
         (krsview.configure(tree, tracer="relaxed"), {}),
         (krsview.configure(tree, culling="off"), {}),
+        (krsview.configure(tree, lod=0.0), {}),  # every level (the presets draw at lod 0.5)
+        (krsview.configure(krsview.load("palm"), lod=0.0, prepass=4), {}),
+        (krsview.configure(tree, lod=0.0, path="compute", precision="double"), {}),
         (krsview.configure(tree, path="compute", shadow_tasks="off"), {}),
         (krsview.configure(grove, path="compute", component_tasks="on", prepass=4), {}),
         (krsview.configure(grove, tracer="binary", precision="double"), {}),

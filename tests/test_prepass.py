@@ -111,6 +111,7 @@ def test_a_finer_pass_that_reads_the_wrong_coarse_tile_skips_surfaces(tmp_path):
         "ivec2(gl_FragCoord.xy) / (u_parent_ratio / 2)",
     )
     scene = passes(load_scene(resolve("tree")), 2, 2)
+    scene = replace(scene, render=replace(scene.render, lod=0.0))  # every level
     img = Renderer(shader_dir=shaders).render(scene, W, H)
     assert count_errors(scene, img, arithmetics=("affine",)).holes > 0
 

@@ -63,7 +63,7 @@ def test_bench_split_reports_every_part(tmp_path):
         "nearest kernel and shading",
         "secondary effects (shadow rays, occlusion)",
     )
-    assert set(rows) == {*parts, "frame", "moving frame (no secondary effects)"}
+    assert set(rows) == {*parts, "frame", "frame without secondary effects"}
     assert sum(rows[p] for p in parts) == pytest.approx(rows["frame"])
     assert rows["coarse passes"] > 0 and "| tracing |" in r.stdout
     bad = subprocess.run(

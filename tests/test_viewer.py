@@ -11,7 +11,6 @@ import pytest
 
 from krsview.scene import load_scene, save_scene
 from krsview.scene.presets import resolve
-from krsview.viewer.adaptive import AdaptiveResolution, Refinement
 from krsview.viewer.commands import (
     NextBookmark,
     Redo,
@@ -204,9 +203,9 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once
-    (its tracing program and its pre-pass, for the moving frames without the tree's soft
-    shadows and for the still image with them); switching back, and moving accuracy knobs,
-    compile nothing."""
+    (its tracing program and its pre-pass, the tree's shadow rays per 2 × 2 pixels, and the
+    shading with those and with its own: gpu/passes.py); switching back, and moving
+    accuracy knobs, compile nothing."""
     v = viewer
     settle(v)
     programs = v.renderer.programs
@@ -214,7 +213,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     sphere_image = v.read_window()
     v.set_render(tracer="binary")
     settle(v)
-    assert v.prepass and programs.compiles == before + 4
+    assert v.prepass and programs.compiles == before + 5
     assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
     binary_image = v.read_window()
     assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
@@ -222,7 +221,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     settle(v)
     v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
     settle(v)
-    assert programs.compiles == before + 4
+    assert programs.compiles == before + 5
 
 
 def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
@@ -260,23 +259,6 @@ def test_mokrs_presets_fly_in_the_viewer(viewer):
         assert np.isfinite(v.camera.position).all()
 
 
-def test_adaptive_controller_unit():
-    a = AdaptiveResolution((640, 360), target_fps=30)
-    for _ in range(20):
-        a.frame_done(0.2)  # far over budget: shrink to the floor
-    assert a.scale == a.min_scale
-    for _ in range(40):
-        a.frame_done(0.001)  # far under budget: grow back to full
-    assert a.scale == 1.0
-    r = Refinement((100, 50))
-    tiles = []
-    while not r.done:
-        tile = r.next_tile(0.01)
-        r.tile_done(tile, 0.004)
-        tiles.append(tile)
-    assert sum(t[3] for t in tiles) == 50 and tiles[0][1] == 0
-
-
 def test_preset_picker_and_levels_slider(viewer):
     v = viewer
     settle(v)
@@ -297,7 +279,8 @@ def test_preset_picker_and_levels_slider(viewer):
 
 def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     """The HUD's effect checkboxes go through Viewer.set_effect: a new effect set compiles one
-    variant with its define (tracing and pre-pass programs); switching back and forth again
+    variant with its define (with shadows: the tracing and its pre-pass, the shadow rays per
+    2 × 2 pixels and the two shading passes, gpu/passes.py); switching back and forth again
     compiles nothing."""
     v = viewer
     v.open_preset(resolve("sierpinski"))
@@ -307,7 +290,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     plain = v.read_window()
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 2
+    assert programs.compiles == before + 5
     assert any(("KRS_SHADOWS", None) in key[2] for key in programs._programs)
     assert np.abs(v.read_window().astype(int) - plain).max() > 0
     v.set_effect("soft_shadows", True)  # replaces the hard shadows: they exclude each other
@@ -317,7 +300,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     settle(v)
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 4
+    assert programs.compiles == before + 10
     v.open_preset(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error
@@ -439,36 +422,44 @@ def test_the_compute_path_draws_the_same_window(viewer):
     assert np.array_equal(v.read_window(), fragment)
 
 
-def test_moving_frames_leave_out_shadow_rays_and_the_still_image_has_them(viewer, tmp_path):
-    """While the view moves, frames skip the effects that trace the geometry again per pixel
-    (the tree's soft shadows), so the adaptive resolution can stay higher; the still image and
-    `--moving-effects` have them. Each frame is compared with a headless render of the same
-    view with and without the shadows (negative control: the other one differs)."""
-    v = viewer
-    v.frames.adaptive.target_fps, v.frames.adaptive.scale = (
-        0.5,
-        1.0,
-    )  # every frame fits: moving = full size
+def test_moving_frames_light_like_the_still_image(viewer, tmp_path):
+    """While the view moves, frames keep the tree's soft shadows, their rays traced per 2 × 2
+    pixels (gpu/passes.py): over the hit pixels, a moving frame at half the window's side has
+    the mean colour of the still image's render at its size (shadow rays per pixel) to 2/255
+    per channel, and a frame without the shadows (what moving frames drew before) does not.
+    `--moving-effects` traces them per pixel: the moving frame at the window's size is then
+    the still image itself."""
+    from krsview.gpu.renderer import read_buffers
 
-    def agree(shot, ref):
-        return (np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2).mean()
+    v = viewer
+    a = v.frames.adaptive
+    a.target_fps, a.scale = 0.5, 0.5  # every frame fits the budget: the scale only grows
+
+    def buffers():
+        fbo, size = v.frames.image
+        return read_buffers(fbo, *size)
 
     hold(v, "W", 1)
-    assert (
-        not v.frames.refined and v.frames.image[1] == SIZE
-    )  # full size, but shadows still to come
-    moving = v.read_window()
-    assert "soft_shadows" in v.scene.effects
-    assert "soft_shadows" not in v.view_scene(moving=True).effects
-    light = headless_render(v.view_scene(moving=True).with_geometry(v.krs), tmp_path / "m", SIZE)
-    full = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "f", SIZE)
-    shadowed = agree(light, full)
-    assert shadowed < 0.97, "the view has no shadows to leave out"
-    assert agree(moving, light) >= 0.99
+    assert v.frames.image[1] == (80, 60) and v.frames.frame_state().state == "moving"
+    assert v.frames.frame_state().shadows == 2
+    moving = buffers()
     settle(v)
-    assert agree(v.read_window(), full) >= 0.99
+    still = buffers()
+    assert still.color.shape[:2] == (SIZE[1], SIZE[0]) and v.frames.frame_state().shadows == 1
+    plain = replace(v.view_scene(), effects=[e for e in v.scene.effects if e != "soft_shadows"])
+    unshadowed = headless_render(plain.with_geometry(v.krs), tmp_path / "plain", (80, 60)) / 255
+
+    def lit(color, hit):
+        return color[hit].mean(0)
+
+    exact = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "exact", (80, 60))
+    target = lit(exact / 255, moving.hit)
+    assert np.abs(lit(moving.color, moving.hit) - target).max() < 2 / 255
+    assert np.abs(lit(unshadowed, moving.hit) - target).max() > 8 / 255
     v.set_moving_effects(True)
+    a.scale = 1.0
     hold(v, "S", 1)
-    full = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "f2", SIZE)
-    assert v.view_scene(moving=True).effects == v.scene.effects
-    assert agree(v.read_window(), full) >= 0.99
+    assert v.frames.frame_state().state == "still" and v.frames.refined  # no step to follow
+    full = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "full", SIZE)
+    close = np.abs(v.read_window().astype(int) - full.astype(int)).max(-1) <= 2
+    assert close.mean() >= 0.99

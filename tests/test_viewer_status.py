@@ -1,5 +1,5 @@
 """What the viewer says about itself: the HUD's state of the image on screen (moving, refining
-k/n rows, still) and where F12 wrote its screenshot."""
+k/n, still) and where F12 wrote its screenshot."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from imgui_bundle import imgui
 from PIL import Image
 
 from krsview.scene.presets import resolve
+from krsview.viewer.adaptive import Step
 from krsview.viewer.screenshots import pictures_folder, save_screenshot
 
 SIZE = (640, 360)  # wide enough to see the image right of the HUD
@@ -42,46 +43,62 @@ def turn(v) -> tuple:
     return v.frames.frame_state(), list(v.drawn), v.read_window()
 
 
-def test_the_hud_shows_the_image_on_screen_moving_then_refining_then_still(hud_viewer):
+def groups(seen: list[tuple]) -> list[list[tuple]]:
+    """Consecutive turns showing the same image (the same FrameState object)."""
+    out: list[list[tuple]] = []
+    for turn_ in seen:
+        if out and turn_[0] is out[-1][0][0]:
+            out[-1].append(turn_)
+        else:
+            out.append([turn_])
+    return out
+
+
+def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_viewer):
     v = hud_viewer
-    v.frames.adaptive.target_fps = 60.0  # the still image takes a few turns
+    v.frames.adaptive.target_fps = 60.0  # small moving frames; steps that take a few turns
     v.input.key("W", True)
     seen = [turn(v) for _ in range(4)]
     v.input.key("W", False)
+    steps = v.frames.refinement.steps  # planned after the last moving frame
+    n = len(steps)
     while seen[-1][0].state != "still":
         seen.append(turn(v))
         assert len(seen) < 400, "the view never became still"
-    states = [s.state for s, _, _ in seen]
-    k = states.index("refining")
-    assert states == ["moving"] * k + ["refining"] * (len(states) - k - 1) + ["still"]
-    assert k == 4 and len(states) - k - 1 >= 2, states  # moved 4 turns, refined in several
+    images = groups(seen)
+    # four moving frames (the last one stays while the first step is traced), then each
+    # step's image once it is done, the last one the still image
+    assert [g[0][0].state for g in images[:4]] == ["moving"] * 4
+    shown = [(g[0][0].state, g[0][0].step, g[0][0].size) for g in images[4:]]
+    sizes = [v.frames.adaptive.size_at(step.scale) for step in steps]
+    assert shown == [("refining", (k, n), sizes[k - 1]) for k in range(1, n)] + [
+        ("still", (0, 0), SIZE)
+    ]
+    assert n >= 2 and steps[-2] == Step(1.0, 2) and steps[-1] == Step(1.0, 1)
     # the HUD writes the state of the image on screen, for each state
     for s, drawn, _ in seen:
-        assert drawn[0] == s.text() and drawn[1].startswith(f"traced in {s.seconds * 1e3:.1f} ms")
-    moving, drawn, _ = seen[k - 1]
+        assert drawn[0] == s.text() and drawn[1] == f"{s.timing()}; shaded view"
+    moving = images[3][0][0]
     w, h = moving.size
-    assert moving.size == (w, h) != SIZE and w < SIZE[0]
-    assert drawn[0] == f"moving: {w}×{h} ({w / SIZE[0]:.0%} of the window)"
-    refining = [(s, d, window) for s, d, window in seen[k:-1]]
-    rows = [s.rows for s, _, _ in refining]
-    assert rows == sorted(rows) and rows[0][0] > 0 and rows[-1][0] < SIZE[1]
-    assert {n for _, n in rows} == {SIZE[1]}
-    assert refining[0][1][0] == f"refining {rows[0][0]}/{SIZE[1]} rows: {w}×{h} (" + (
-        f"{w / SIZE[0]:.0%} of the window)"
+    assert (
+        w < SIZE[0] and images[3][0][1][0] == f"moving: {w}×{h} ({w / SIZE[0]:.0%} of the window)"
     )
-    # while refining, the window keeps the last moving frame: its size and its very pixels
-    # (right of the HUD)
-    assert all(s.size == (w, h) for s, _, _ in refining)
-    right = [window[:, HUD_RIGHT:] for _, _, window in seen]
-    assert all(np.array_equal(r, right[k - 1]) for r in right[k:-1])
+    first = images[4][0]
+    w1, h1 = sizes[0]
+    assert first[1][0] == f"refining 1/{n}: {w1}×{h1} ({w1 / SIZE[0]:.0%} of the window)"
+    assert first[1][1].startswith("traced in ") and ", shadows per 2×2 px;" in first[1][1]
     still, lines, _ = seen[-1]
-    assert still.size == SIZE == v.frames.image[1] and still.rows == (0, 0)
-    assert lines[0] == f"still: {SIZE[0]}×{SIZE[1]} (100% of the window)"
-    assert not np.array_equal(right[-1], right[k - 1]), "the still image never reached the window"
-    # negative control: the old first line's size, the adaptive (moving) one, is not the
-    # still image's, nor is its text the refining one's
+    assert still.size == SIZE == v.frames.image[1] and lines[0] == (
+        f"still: {SIZE[0]}×{SIZE[1]} (100% of the window)"
+    )
+    assert "shadows per" not in lines[1]  # the still image's are per pixel
+    # each image stays on screen, its very pixels (right of the HUD), until the next
+    for g in images:
+        assert all(np.array_equal(t[2][:, HUD_RIGHT:], g[0][2][:, HUD_RIGHT:]) for t in g)
+    # negative control: the first step's image is not the moving frame's
+    assert not np.array_equal(first[2][:, HUD_RIGHT:], images[3][-1][2][:, HUD_RIGHT:])
     a = v.frames.adaptive.moving_size()
-    assert a != SIZE and f"{a[0]}×{a[1]}" not in lines[0] and lines[0] != refining[0][1][0]
+    assert a != SIZE and f"{a[0]}×{a[1]}" not in lines[0]
 
 
 def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):

@@ -65,8 +65,8 @@ def screenshot(page: Path, out: Path, fragment: str = "bare") -> np.ndarray:
 
 
 def reference(scene, tmp_path: Path, name: str) -> np.ndarray:
-    """`krsview render` of the scene (no pre-pass: the page has none)."""
-    return headless_render(scene, tmp_path / name, SIZE, "--prepass", "0").astype(int)
+    """`krsview render` of the scene (every level, no pre-pass: as the page draws it)."""
+    return headless_render(scene, tmp_path / name, SIZE, "--exact").astype(int)
 
 
 def agreement(a: np.ndarray, b: np.ndarray, tolerance: int) -> float:

@@ -7,10 +7,10 @@ shows each trade-off as no machine load changes it.
 
 Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
-float64 shader), exact level culling, the pre-pass tile, the path (fragment or compute)
-and level count (LOD by truncation). One run writes a CSV, a Markdown report, plots
-(error against time and against work per knob, the Pareto fronts over all settings) and
-error images (holes red, false hits blue)."""
+float64 shader), exact level culling, the level of detail in the walk (render.lod), the
+pre-pass tile, the path (fragment or compute) and level count (LOD by truncation). One run
+writes a CSV, a Markdown report, plots (error against time and against work per knob, the
+Pareto fronts over all settings) and error images (holes red, false hits blue)."""
 
 from __future__ import annotations
 
@@ -37,6 +37,7 @@ CAPS = (16, 32, 64, 128, 256, 1024)
 XI_PAIRS = ((2.0, 0.3), (1.5, 0.2), (3.0, 0.5))
 RELAXATIONS = (1.2, 1.6, 1.9)  # ω of over-relaxed sphere tracing [Keinert et al. 2014]
 LEVEL_CUTS = (12, 8, 4, 2)  # levels dropped from the finest end
+LODS = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0)  # render.lod: subtrees below lod × ε drawn as a ball
 
 
 @dataclass(frozen=True)
@@ -94,6 +95,9 @@ def settings(scene: Scene) -> list[Setting]:
     if scene.mokrs is None:  # Alg. 1's culling; not in a MöKRS
         other = "off" if r.culling == "on" else "on"
         out.append(Setting("culling", other, replace(scene, render=replace(r, culling=other))))
+    for lod in LODS:  # Alg. 1's balls, or a MöKRS's levels' bounds
+        if lod != r.lod:
+            out.append(Setting("lod", f"{lod:g}", replace(scene, render=replace(r, lod=lod))))
     if r.path == "fragment":
         out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
     for tile in PREPASS_TILES:
@@ -182,7 +186,10 @@ def bench_accuracy(
 
 def levels_walked(r: Renderer, s: Setting, size: tuple[int, int]) -> np.ndarray:
     """Per pixel, the levels Alg. 1 walked tracing the ray (the KRS_COUNT_LEVELS probe of
-    :meth:`Renderer.levels`, here with the setting's own geometry, as a truncation needs)."""
+    :meth:`Renderer.levels`, here with the setting's own geometry, as a truncation needs);
+    zeros for a MöKRS, whose walk the probe does not count (see :func:`work`)."""
+    if s.scene.mokrs is not None:
+        return np.zeros((size[1], size[0]), dtype=np.int64)
     return r.levels(s.scene, *size, s.geometry)
 
 

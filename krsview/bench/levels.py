@@ -7,6 +7,8 @@ every variant alike.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..gpu.renderer import Renderer
@@ -31,13 +33,10 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
     variants = {m: krs.truncated(m) for m in counts}
     r = Renderer()
     iters = {m: float(r.render(scene, w, h, k).iterations.mean()) for m, k in variants.items()}
-    med = median_times(
-        r,
-        {f"{m} levels": Variant(scene, variants[m]) for m in counts},
-        size,
-        rounds,
-        f"bench levels {scene.name}",
-    )
+    every = replace(scene, render=replace(scene.render, lod=0.0))  # today's walk, beside it
+    timed = {f"{m} levels": Variant(scene, variants[m]) for m in counts}
+    timed |= {f"{m} levels, every level": Variant(every, variants[m]) for m in counts}
+    med = median_times(r, timed, size, rounds, f"bench levels {scene.name}")
     base = counts[0]
     t_base = med[f"{base} levels"]
     rows = []
@@ -51,6 +50,7 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
                 time_ratio=t / t_base,
                 iterations=iters[m],
                 ratio_per_iteration=(t / iters[m]) / (t_base / iters[base]),
+                ms_every_level=med[f"{m} levels, every level"] * 1e3,
             )
         )
     return Measured(scene, size, rounds, rows)
@@ -68,8 +68,9 @@ def linear_fit(m: Measured) -> tuple[float, float, float]:
 def table(m: Measured) -> str:
     rows = m.rows
     text = (
-        f"\nFrame time against levels — {m.scene.name}, {m.size[0]}×{m.size[1]}, median of "
-        f"{m.rounds} interleaved rounds (ratios to {rows[0]['levels']} levels)\n\n"
+        f"\nFrame time against levels — {m.scene.name}, {m.size[0]}×{m.size[1]}, lod "
+        f"{m.scene.render.lod:g} beside every level, median of {m.rounds} interleaved rounds "
+        f"(ratios to {rows[0]['levels']} levels)\n\n"
     )
     text += markdown(
         (
@@ -79,8 +80,9 @@ def table(m: Measured) -> str:
             "time ratio",
             "iterations/px",
             "time/iteration ratio",
+            "ms/frame, every level (lod 0)",
         ),
-        "rrrrrr",
+        "rrrrrrr",
         (
             (
                 r["levels"],
@@ -89,6 +91,7 @@ def table(m: Measured) -> str:
                 f"{r['time_ratio']:.2f}",
                 f"{r['iterations']:.1f}",
                 f"{r['ratio_per_iteration']:.2f}",
+                f"{r['ms_every_level']:.2f}",
             )
             for r in rows
         ),

@@ -1,6 +1,6 @@
 """`krsview bench split`: where a frame's time goes — the pre-pass's coarse passes, the
 tracing of the primary rays, the nearest kernel and shading, and the secondary effects
-(shadow rays and occlusion samples, which the viewer's moving frames leave out). Each part
+(shadow rays and occlusion samples). Each part
 is the difference of two variants timed side by side, interleaved (bench/harness.py), each
 to the GPU's finish. GPU timer queries would split one frame instead, but llvmpipe's time
 only its command thread (a 138 ms draw read 29 ms), so each part is a variant of its own.
@@ -18,7 +18,7 @@ from .report import Measured, markdown
 
 def split_variants(scene: Scene) -> dict[str, Variant]:
     """The variants whose differences are the parts: the frame, the frame without secondary
-    effects (a moving frame), the tracing alone, and the coarse passes alone."""
+    effects, the tracing alone, and the coarse passes alone."""
     scene = replace(scene, render=replace(scene.render, path="fragment"))
     moving = replace(scene, effects=tuple(e for e in scene.effects if not EFFECTS[e].secondary))
     out = {
@@ -42,7 +42,7 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
         ("nearest kernel and shading", med["moving"] - med["trace"]),
         ("secondary effects (shadow rays, occlusion)", med["frame"] - med["moving"]),
         ("frame", med["frame"]),
-        ("moving frame (no secondary effects)", med["moving"]),
+        ("frame without secondary effects", med["moving"]),
     ]
     rows = [dict(part=name, ms=t * 1e3, share=t / med["frame"]) for name, t in parts]
     return Measured(scene, size, rounds, rows)

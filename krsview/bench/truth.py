@@ -19,12 +19,15 @@ TRUTH_ITERATIONS = 4096
 
 
 def truth_scene(scene: Scene) -> Scene:
-    """The scene at ground-truth accuracy: tight ε, generous cap, its own tracer (a MöKRS
-    keeps binary tracing: it has no distance)."""
+    """The scene at ground-truth accuracy: tight ε, generous cap, every level (no level of
+    detail), its own tracer (a MöKRS keeps binary tracing: it has no distance)."""
     return replace(
         scene,
         render=replace(
-            scene.render, epsilon_scale=TRUTH_EPSILON_SCALE, max_iterations=TRUTH_ITERATIONS
+            scene.render,
+            epsilon_scale=TRUTH_EPSILON_SCALE,
+            max_iterations=TRUTH_ITERATIONS,
+            lod=0.0,
         ),
     )
 

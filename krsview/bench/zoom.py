@@ -68,11 +68,12 @@ def bench_zoom(
     r = Renderer()
     centre = finest_kernel_ball(scene)[:3]
     names = [f"stop {k}" for k in range(len(views))]
-    med = median_times(
-        r, dict(zip(names, (Variant(v) for v in views))), size, rounds, f"bench zoom {scene.name}"
-    )
+    every = [replace(v, render=replace(v.render, lod=0.0)) for v in views]
+    variants = {n: Variant(v) for n, v in zip(names, views)}
+    variants |= {f"{n}, every level": Variant(v) for n, v in zip(names, every)}
+    med = median_times(r, variants, size, rounds, f"bench zoom {scene.name}")
     rows = []
-    for name, v in zip(names, views):
+    for name, v, e in zip(names, views, every):
         frame = r.render(v, w, h)
         walked = r.levels(v, w, h)
         iterations = float(frame.iterations.mean())
@@ -81,8 +82,12 @@ def bench_zoom(
                 stop=name,
                 distance=float(np.linalg.norm(np.array(v.camera.position) - centre)),
                 ms=med[name] * 1e3,
+                ms_every_level=med[f"{name}, every level"] * 1e3,
                 iterations=iterations,
                 levels_per_iteration=float(walked.sum() / max(frame.iterations.sum(), 1)),
+                levels_every_level=float(
+                    r.levels(e, w, h).sum() / max(r.render(e, w, h).iterations.sum(), 1)
+                ),
                 hit=float(frame.hit.mean()),
             )
         )
@@ -92,9 +97,9 @@ def bench_zoom(
     return m
 
 
-def spread(m: Measured) -> float:
+def spread(m: Measured, column: str = "ms") -> float:
     """The slowest frame's time over the fastest's along the flight."""
-    return max(m.column("ms")) / min(m.column("ms"))
+    return max(m.column(column)) / min(m.column(column))
 
 
 def table(m: Measured) -> str:
@@ -102,22 +107,37 @@ def table(m: Measured) -> str:
         f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, median of "
         f"{m.rounds} interleaved rounds\n\n"
     )
+    lod = m.scene.render.lod
     text += markdown(
-        ("stop", "distance", "ms/frame", "iterations/px", "levels/iteration", "hit"),
-        "lrrrrr",
+        (
+            "stop",
+            "distance",
+            f"ms/frame (lod {lod:g})",
+            "ms, every level (lod 0)",
+            "iterations/px",
+            "levels/iteration",
+            "levels/iteration, every level",
+            "hit",
+        ),
+        "lrrrrrrr",
         (
             (
                 r["stop"],
                 f"{r['distance']:.4g}",
                 f"{r['ms']:.1f}",
+                f"{r['ms_every_level']:.1f}",
                 f"{r['iterations']:.1f}",
                 f"{r['levels_per_iteration']:.1f}",
+                f"{r['levels_every_level']:.1f}",
                 f"{r['hit']:.0%}",
             )
             for r in m.rows
         ),
     )
-    return text + f"\n\nslowest frame / fastest: {spread(m):.2f}×"
+    return (
+        text + f"\n\nslowest frame / fastest: {spread(m):.2f}× (lod {lod:g}), "
+        f"{spread(m, 'ms_every_level'):.2f}× (every level)"
+    )
 
 
 def write_plot(m: Measured, path) -> None:
@@ -129,8 +149,10 @@ def write_plot(m: Measured, path) -> None:
 
     d = m.column("distance")
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    a.plot(d, m.column("ms"), "o-", color="C0")
+    a.plot(d, m.column("ms"), "o-", color="C0", label=f"lod {m.scene.render.lod:g}")
+    a.plot(d, m.column("ms_every_level"), "o--", color="C3", label="every level (lod 0)")
     a.set_ylabel("ms per frame")
+    a.legend()
     a.set_title(f"{m.scene.name}: zoom into the finest kernel, {m.size[0]}×{m.size[1]}")
     b.plot(d, m.column("iterations"), "o-", color="C1", label="iterations per pixel")
     b.plot(d, m.column("levels_per_iteration"), "s-", color="C2", label="levels per iteration")

@@ -43,7 +43,7 @@ BENCHES = {
         "Render the same view with the coarsest 4, 8, … levels, interleaved, median of "
         "several frames; print time relative to the smallest level count beside the kernel "
         "instances. Example: krsview bench levels tree --step 4",
-        knobs=("epsilon_scale", "max_iterations"),
+        knobs=("epsilon_scale", "max_iterations", "lod", "prepass"),
         own=(
             (
                 "--step",
@@ -67,11 +67,11 @@ BENCHES = {
     "split": Bench(
         "where a frame's time goes: coarse passes, tracing, shading, shadow rays",
         "On one scene and view, the fragment path: the frame, the frame without secondary "
-        "effects (shadow rays, occlusion; what the viewer's moving frames leave out), the "
+        "effects (shadow rays, occlusion), the "
         "tracing alone and the coarse passes alone, interleaved; each part of the frame is "
         "the difference of two of them. Example: krsview bench split tree "
         f"--prepass {VIEW_PREPASS} (the viewer's pre-pass).",
-        knobs=("culling", "prepass", "prepass_levels"),
+        knobs=("culling", "lod", "prepass", "prepass_levels"),
     ),
     "tracers": Bench(
         "sphere vs binary sphere tracing, and a ξ sweep",
@@ -105,7 +105,7 @@ BENCHES = {
         "(interleaved rounds), iterations per pixel and levels walked per iteration at each "
         "stop, and the slowest frame against the fastest. Example: krsview bench zoom tree "
         "--stops 12 --plot out/zoom.png",
-        knobs=("prepass", "culling"),
+        knobs=("prepass", "culling", "lod"),
         own=(
             (
                 "--stops",

@@ -13,6 +13,7 @@ from .. import api, export
 from ..frame import Frame
 from ..progress import Progress
 from ..scene import Scene, SceneError
+from ..scene.model import DEFAULT_LOD, VIEW_PREPASS
 from ..share.frames import DEFAULT_FPS
 from . import options
 from .options import SILENT_SECONDS, check_output_dir, check_output_file, render_option
@@ -22,6 +23,7 @@ KNOBS = (
     "relaxation",
     "precision",
     "culling",
+    "lod",
     "prepass",
     "prepass_levels",
     "path",
@@ -36,7 +38,10 @@ def add(sub) -> None:
         "render",
         help="render a scene headless to PNG (and raw buffers)",
         description="Render PRESET headless through EGL and write a PNG; prints the measured "
-        "frame time. Example: krsview render tree -o tree.png --size 640x360 --prepass 8",
+        "frame time. Draws with the viewer's fast settings (the pre-pass, the level of "
+        "detail) unless the scene or an option sets them; --exact draws every level "
+        "without the pre-pass. Example: krsview render tree -o tree.png --size 640x360 "
+        "--prepass 8",
     )
     options.preset(r)
     r.add_argument(
@@ -53,6 +58,14 @@ def add(sub) -> None:
         metavar="NPZ",
         help="also write color, depth, normal, iterations and hit arrays to this "
         "NumPy file, ending in .npz",
+    )
+    r.add_argument(
+        "--exact",
+        action="store_true",
+        help="every level and no pre-pass: the image the float64 reference matches, for "
+        "tests (default: the viewer's fast settings where the scene sets none: the "
+        f"pre-pass at {VIEW_PREPASS} pixels and the level of detail lod = {DEFAULT_LOD:g}, "
+        "both certified hole-free)",
     )
     r.add_argument(
         "--reference",
@@ -118,7 +131,7 @@ def camera_path_options(sp, required: bool) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    scene = options.scene_of(args)
+    scene = settled(args, options.scene_of(args))
     if args.camera_path is not None:
         for flag, given in (
             ("--buffers", args.buffers),
@@ -169,11 +182,26 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def settled(args: argparse.Namespace, scene: Scene) -> Scene:
+    """The viewer's fast settings where neither the file nor an option sets them, or with
+    --exact every level and no pre-pass (the reference's image)."""
+    if args.exact:
+        for knob in ("prepass", "lod"):
+            if getattr(args, knob) is not None:
+                flag = "--" + knob
+                raise SceneError(flag, getattr(args, knob), "cannot be combined with --exact")
+        return api.exact_settings(scene)
+    return scene if args.prepass is not None else api.fast_settings(scene)
+
+
 def reference_frame(scene: Scene, size: tuple[int, int]) -> Frame:
     """The float64 reference's frame, its time printed."""
     t0 = time.perf_counter()
     frame = api.Renderer(*size).render(
-        scene, reference=True, progress=Progress(1, "  rays", SILENT_SECONDS)
+        scene,
+        reference=True,
+        prepass=scene.render.prepass,  # as run() settled it
+        progress=Progress(1, "  rays", SILENT_SECONDS),
     )
     print(f"  traced in {(time.perf_counter() - t0) * 1e3:.0f} ms (float64 reference)")
     return frame
@@ -184,7 +212,11 @@ def timed_frame(scene: Scene, size: tuple[int, int], repeats: int) -> Frame:
     r = api.Renderer(*size)
     t0 = time.perf_counter()
     print("  compiling shader variant …", flush=True)
-    frame = r.render(scene, progress=Progress(1, "  first frame, rows", SILENT_SECONDS))
+    frame = r.render(
+        scene,
+        prepass=scene.render.prepass,  # as run() settled it
+        progress=Progress(1, "  first frame, rows", SILENT_SECONDS),
+    )
     print(f"  first frame {(time.perf_counter() - t0) * 1e3:.0f} ms (with compiling)", flush=True)
     bar = Progress(repeats, "  timing frames", SILENT_SECONDS)
     times = []

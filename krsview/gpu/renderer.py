@@ -42,6 +42,7 @@ class Renderer:
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
+        self._variant: dict[moderngl.Program, tuple[dict, dict]] = {}  # defines, uniforms
 
     @contextmanager
     def current(self) -> Iterator[None]:
@@ -118,6 +119,7 @@ class Renderer:
                 "separate scenes",
             )
         defines = variant_defines(scene, c, all_effects)
+        variant = dict(defines)  # before the probes: what companion passes compile with
         if probes:
             defines.update(dict.fromkeys(probes))
             scene = replace(scene, render=replace(scene.render, path="fragment"))
@@ -153,7 +155,24 @@ class Renderer:
             for name, value in uniforms.items():
                 if name in p:
                     p[name].value = value
+        self._variant[prog] = (variant, uniforms)
         return prog
+
+    def companion(
+        self, prog: moderngl.Program, fragment: str, defines: dict | None = None
+    ) -> moderngl.Program:
+        """The full-screen pass ``fragment`` compiled with the defines of ``prog``'s variant
+        (plus ``defines``) and given the uniforms :meth:`prepare` last gave ``prog``: a
+        further pass over the same frame (the viewer's reduced-resolution shadows)."""
+        variant, uniforms = self._variant[prog]
+        with self.current():
+            p = self.programs.get("fullscreen.vert", fragment, {**variant, **(defines or {})})
+            if "KRS_DOUBLE" not in variant and "KRSBlock" in p:
+                p["KRSBlock"].binding = BINDING_KRS_BLOCK
+            for name, value in uniforms.items():
+                if name in p:
+                    p[name].value = value
+            return p
 
     def _world(self, geometry: Geometry, albedo: tuple) -> Compiled:
         """The geometry compiled in world coordinates, redone only when it or the albedo

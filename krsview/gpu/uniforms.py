@@ -42,12 +42,15 @@ def variant_defines(
         defines[f"KRS_TRACER_{scene.render.tracer.upper()}"] = None
     if scene.render.precision == "double":
         defines["KRS_DOUBLE"] = None
-    if scene.render.culling == "on" and any(
+    balls = any(
         (part.bounds[:, 3] >= 0).any()
         for part, _ in component_slots(c)
         if not isinstance(part, CompiledMoKRS)
-    ):
-        defines["KRS_CULLING"] = None  # only where some level has a ball to test
+    )  # only where some level has a ball to test
+    if scene.render.culling == "on" and balls:
+        defines["KRS_CULLING"] = None
+    if scene.render.lod > 0 and (balls or (isinstance(c, CompiledMoKRS) and has_bounds(c))):
+        defines["KRS_LOD"] = None  # subtrees below the level of detail end the walk (krs.glsl)
     if scene.render.prepass:
         defines["KRS_PREPASS"] = None
     if (
@@ -73,6 +76,11 @@ def variant_defines(
     if isinstance(c, CompiledCompound):
         defines["KRS_COMPOUND"] = None
     return defines
+
+
+def has_bounds(c: CompiledMoKRS) -> bool:
+    """Some level of the MöKRS has a bounding ball (a level of detail to cut at)."""
+    return bool((c.bounds[:, 3] >= 0).any())
 
 
 def kernel_mask(kinds) -> int:
@@ -157,6 +165,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_resolution": (float(view.width), float(view.height)),
         "u_tan_half": view.tan_half,
         "u_eps_per_t": view.footprint * scene.render.epsilon_scale,
+        "u_lod": scene.render.lod,
         "u_max_iterations": scene.render.max_iterations,
         "u_max_distance": scene.render.max_distance,
         "u_xi_bonus": scene.render.xi_bonus,

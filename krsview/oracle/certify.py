@@ -7,7 +7,8 @@ rays a tracer got wrong:
   limit on a miss): the tracer went past geometry that exists;
 - **false hit beyond ε**: the box of half-size ε(t_hit) around the tracer's hit point is
   certified free of the surface (boxes subdivided up to BOX_DEPTH times): the tracer stopped
-  where nothing lies within ε;
+  where nothing lies within ε (within the reach the scene's level of detail allows,
+  ``hit_reach``);
 - **below the level of detail**: no surface on [0, T] except, perhaps, inside balls of
   radius ≤ δ (a quarter pixel) that hold whole subtrees the walk left out: the ray passes
   sub-pixel detail, which a tracer whose ε grows with the pixel may hit or pass;
@@ -151,6 +152,14 @@ def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
 HIT_REACH = {"sphere": 1.0, "relaxed": 1.0, "binary": 2.0}
 
 
+def hit_reach(scene: Scene, eps_per_t: float) -> float:
+    """How near a hit is to a surface, in ε(t): HIT_REACH, and with the level of detail
+    (render.lod) the diameter of a ball standing for the levels below it, 2·lod·ε at most
+    (reference/krs.py, distance; a binary probe takes lod·ε at its far side, 2ε further)."""
+    r = scene.render
+    return HIT_REACH[r.tracer] + 2.0 * r.lod * (1.0 + 2.0 * eps_per_t)
+
+
 @dataclass
 class Counts:
     rays: int
@@ -190,7 +199,8 @@ def count_errors(
             else np.where(DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
         )
     centres = view.origin + t[hit, None] * dirs[hit]
-    false_hits = int(free_boxes(c, centres, HIT_REACH[scene.render.tracer] * eps[hit]).sum())
+    reach = hit_reach(scene, view.footprint * scene.render.epsilon_scale)
+    false_hits = int(free_boxes(c, centres, reach * eps[hit]).sum())
     return Counts(
         len(hit),
         int(hit.sum()),

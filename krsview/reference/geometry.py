@@ -5,6 +5,7 @@ kernel and its world normal. A single KRS or MöKRS is the compound of one [KRS1
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,37 +16,72 @@ from .distortion import Distortion
 from .trace import Distance, Test
 
 
+@dataclass(frozen=True)
+class Lod:
+    """The level of detail as a field over space, ρ(x) = per_t · |x − eye| with per_t =
+    render.lod × ε_per_t: the camera's pixel footprint there, so primary rays, shadow rays
+    and occlusion meet the same geometry (krs.distance says which); a test of a ball takes
+    ρ at its far side, the most any of its points has. Twin of lod_radius in distance.glsl."""
+
+    eye: np.ndarray
+    per_t: float
+
+    @staticmethod
+    def of(lod: float, eye: np.ndarray, eps_per_t: float) -> Lod | None:
+        return Lod(np.asarray(eye, dtype=np.float64), lod * eps_per_t) if lod > 0 else None
+
+    def radius(self, x: np.ndarray, reach: np.ndarray | float = 0.0) -> np.ndarray:
+        """ρ at the points x (N, 3), or at the far side of balls of radius ``reach``."""
+        return self.per_t * (np.linalg.norm(x - self.eye, axis=1) + reach)
+
+
+def rho_at(lod: Lod | None, x: np.ndarray, reach: np.ndarray | float = 0.0):
+    return 0.0 if lod is None else lod.radius(x, reach)
+
+
 def component_distance(
-    part: CompiledKRS, x: np.ndarray, dist: Distortion | None = None
+    part: CompiledKRS,
+    x: np.ndarray,
+    dist: Distortion | None = None,
+    lod: Lod | None = None,
+    reach: np.ndarray | float = 0.0,
 ) -> np.ndarray:
-    """The distance bound of one KRS: Alg. 1, through the scene's distortion."""
+    """The distance bound of one KRS: Alg. 1 at the level of detail, through the scene's
+    distortion."""
+    rho = rho_at(lod, x, reach)
     if dist is None:
-        return krs.distance(part, x)
-    return dist.distance(x, krs.distance(part, dist.undistort(x)))
+        return krs.distance(part, x, rho=rho)
+    return dist.distance(x, krs.distance(part, dist.undistort(x), rho=rho))
 
 
 def scene_distance(
-    c: CompiledKRS | CompiledCompound, x: np.ndarray, dist: Distortion | None = None
+    c: CompiledKRS | CompiledCompound,
+    x: np.ndarray,
+    dist: Distortion | None = None,
+    lod: Lod | None = None,
 ) -> np.ndarray:
     """The distance bound of everything drawn: the least over the components (a distortion
     is monotone in the distance, so it may be applied once, after the minimum)."""
     q = x if dist is None else dist.undistort(x)
-    D = np.min([krs.distance(p, q) for p in components(c)], axis=0)
+    rho = rho_at(lod, x)
+    D = np.min([krs.distance(p, q, rho=rho) for p in components(c)], axis=0)
     return D if dist is None else dist.distance(x, D)
 
 
 def component_distances(
-    c: CompiledKRS | CompiledCompound, dist: Distortion | None
+    c: CompiledKRS | CompiledCompound, dist: Distortion | None, lod: Lod | None = None
 ) -> list[Distance]:
     """One distance bound per component, for the sphere tracer's free distances."""
-    return [lambda x, p=p: component_distance(p, x, dist) for p in components(c)]
+    return [lambda x, p=p: component_distance(p, x, dist, lod) for p in components(c)]
 
 
-def component_tests(c: Compiled, dist: Distortion | None) -> list[Test]:
+def component_tests(c: Compiled, dist: Distortion | None, lod: Lod | None = None) -> list[Test]:
     """One unbounding test per component, for the binary tracer's free distances."""
     if isinstance(c, mokrs.CompiledMoKRS):
-        return [lambda x, s: mokrs.is_unbounding(c, x, s)]
-    return [lambda x, s, p=p: component_distance(p, x, dist) >= s for p in components(c)]
+        return [lambda x, s: mokrs.is_unbounding(c, x, s, lod=rho_at(lod, x, s))]
+    return [
+        lambda x, s, p=p: component_distance(p, x, dist, lod, reach=s) >= s for p in components(c)
+    ]
 
 
 def nearest(

@@ -20,17 +20,31 @@ def fold(m: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.where((e > 0.0)[:, None], x - 2.0 * e[:, None] * m[:3], x), e
 
 
-def distance(c: CompiledKRS, xw: np.ndarray, cull: bool = True) -> np.ndarray:
+def distance(
+    c: CompiledKRS, xw: np.ndarray, cull: bool = True, rho: np.ndarray | float = 0.0
+) -> np.ndarray:
     """DISTANCE(x_w) [KRS17 Alg. 1] for points (N, 3). With ``cull``, a point stops walking
-    at level i once d ≤ dist(x, C_i), the ball of all it would still test (compiled.py,
-    krs_bounds): the value is the same, the shader saves the levels below."""
+    at level i once d ≤ dist(x, C_i), the ball of all it would still test (compile/krs.py,
+    krs_bounds): the value is the same, the shader saves the levels below.
+
+    Level of detail ``rho`` (a length per point, 0: none): at the first ball C_i of radius
+    below rho the walk takes d = min(d, dist(x, C_i)) and stops. That is Alg. 1 of the *LOD
+    geometry*: the levels above i, and in place of levels i..0 the 2^(n−i−1) copies of the
+    solid ball C_i. It holds the KRS (C_i holds all below it),
+    so the value stays a lower bound of the full walk's and no ray passes the KRS; and every
+    point of C_i is within its diameter, 2·rho, of the geometry it holds. Culling and the
+    level of detail are independent switches, as in the shader."""
     x = xw
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
     live = np.ones(len(x), dtype=bool)
+    rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (len(x),))
     for i in range(c.n - 1, -1, -1):
         b = c.bounds[i]
-        if cull and b[3] >= 0:
-            live &= np.linalg.norm(x - b[:3], axis=1) - b[3] < d
+        if b[3] >= 0 and (cull or rho.any()):
+            db = np.linalg.norm(x - b[:3], axis=1) - b[3]
+            cut = live & (b[3] < rho)
+            d = np.where(cut, np.minimum(d, db), d)
+            live &= ~cut & ((db < d) | (not cull))
         x, _ = fold(c.mirrors[i], x)
         if c.types[i] != "empty":
             d = np.where(live, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)

@@ -19,16 +19,24 @@ from .kernels import kernel_distance, world_normal
 
 
 def is_unbounding(
-    c: CompiledMoKRS, center: np.ndarray, radius: np.ndarray, pole_bounds: bool = True
+    c: CompiledMoKRS,
+    center: np.ndarray,
+    radius: np.ndarray,
+    pole_bounds: bool = True,
+    lod: np.ndarray | float = 0.0,
 ) -> np.ndarray:
     """ISUNBOUNDING(κ_w, ρ_w) [KRS17 Alg. 3] for balls (N, 3), (N,): whether each ball is free
     of the MöKRS. A ball that holds a level's pole maps to a ball's exterior: it is free when
     the level's bound lies inside that ball, else blocked (``pole_bounds=False``: always
     blocked, Alg. 3's inside-out rule). The mirror decision is taken on the ball's centre, as
-    in the paper."""
+    in the paper. Level of detail ``lod`` (world lengths per ball, 0: none): mapped into
+    level i's space, a bound smaller than lod in the ball's own scale (lod / ρ_w per unit of
+    its radius, the map's local scale to first order) stands for the levels below, and the
+    ball is free exactly when it misses that bound. Twin of mokrs.glsl."""
     free = np.ones(len(center), dtype=bool)
     live = np.arange(len(center))  # balls not yet decided (the shader returns early)
     kappa, rho = center, radius
+    per_radius = np.broadcast_to(np.asarray(lod, dtype=np.float64) / radius, (len(center),))
     with np.errstate(all="ignore"):
         for i in range(c.n - 1, -1, -1):
             kappa, rho, ok = mobius.map_ball(c.inverse[i], kappa, rho, exterior=True)
@@ -38,12 +46,20 @@ def is_unbounding(
                 outside = ~ok
                 free[live[outside & ~(inside & pole_bounds)]] = False
                 live, kappa, rho = live[ok], kappa[ok], rho[ok]  # decided: leave the walk
+                per_radius = per_radius[ok]
+            b = c.bounds[i]
+            cut = (b[3] >= 0) & (b[3] < per_radius * rho)
+            if cut.any():
+                miss = np.linalg.norm(kappa[cut] - b[:3], axis=1) - b[3] >= rho[cut]
+                free[live[cut][~miss]] = False
+                keep = ~cut
+                live, kappa, rho, per_radius = live[keep], kappa[keep], rho[keep], per_radius[keep]
             if c.reflect[i]:
                 kappa = kappa * np.where(kappa[:, :1] > 0.0, [-1.0, 1.0, 1.0], 1.0)
             if c.types[i] != "empty":
                 ok = kernel_distance(c.types[i], c.records[i], kappa) >= rho
                 free[live[~ok]] = False
-                live, kappa, rho = live[ok], kappa[ok], rho[ok]
+                live, kappa, rho, per_radius = live[ok], kappa[ok], rho[ok], per_radius[ok]
     return free
 
 

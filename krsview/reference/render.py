@@ -12,7 +12,7 @@ from ..frame import Frame
 from ..scene import Geometry, Scene
 from .atmosphere import background
 from .distortion import Distortion
-from .geometry import component_distances, component_tests, nearest
+from .geometry import Lod, component_distances, component_tests, nearest
 from .shade import Hits, encode, shade
 from .trace import binary_trace, relaxed_trace, sphere_trace
 
@@ -57,9 +57,10 @@ def _trace_and_shade(
     r = scene.render
     eps = view.footprint * r.epsilon_scale
     scale = dist.lod_scale if dist is not None else None
+    lod = Lod.of(r.lod, view.origin, eps)
     if r.tracer == "binary":
         tr = binary_trace(
-            component_tests(c, dist),
+            component_tests(c, dist, lod),
             view.origin,
             dirs,
             eps,
@@ -70,13 +71,13 @@ def _trace_and_shade(
             scale,
         )
     elif r.tracer == "relaxed":
-        (d,) = component_distances(c, dist)  # a single KRS (Scene.check_tracer)
+        (d,) = component_distances(c, dist, lod)  # a single KRS (Scene.check_tracer)
         tr = relaxed_trace(
             d, view.origin, dirs, eps, r.max_iterations, r.max_distance, r.relaxation, scale
         )
     else:
         tr = sphere_trace(
-            component_distances(c, dist),
+            component_distances(c, dist, lod),
             view.origin,
             dirs,
             eps,  # type: ignore[arg-type]
@@ -98,5 +99,5 @@ def _trace_and_shade(
         level, g, xk = nearest(c, p, width_, dist)
         normal[h] = g
         hits = Hits(p, dirs[h], tr.t[h], level, g, xk)
-        color[h] = encode(scene, shade(scene, c, dist, hits, view.footprint, eps))
+        color[h] = encode(scene, shade(scene, c, dist, hits, view.footprint, eps, lod))
     return color, np.where(tr.hit, tr.t, 0.0), normal, tr.iterations, tr.hit

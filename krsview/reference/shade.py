@@ -13,7 +13,7 @@ from ..compile.mokrs import CompiledMoKRS
 from ..scene import Scene
 from . import atmosphere, mokrs, occlusion, texture
 from .distortion import Distortion
-from .geometry import component_distances, scene_distance
+from .geometry import Lod, component_distances, rho_at, scene_distance
 
 
 def encode(scene: Scene, linear: np.ndarray) -> np.ndarray:
@@ -54,14 +54,21 @@ def albedo(scene: Scene, c: Compiled, h: Hits, footprint: np.ndarray) -> np.ndar
 
 
 def shade(
-    scene: Scene, c: Compiled, dist: Distortion | None, h: Hits, footprint: float, eps_per_t: float
+    scene: Scene,
+    c: Compiled,
+    dist: Distortion | None,
+    h: Hits,
+    footprint: float,
+    eps_per_t: float,
+    lod: Lod | None = None,
 ) -> np.ndarray:
-    """Linear radiance of each hit: albedo × (ambient·AO + Σ visibility·cos·light), fogged."""
+    """Linear radiance of each hit: albedo × (ambient·AO + Σ visibility·cos·light), fogged;
+    shadow rays and occlusion meet the geometry at the level of detail ``lod``."""
     fx = scene.effect_settings
     fp = footprint * h.t
 
     def distance(x: np.ndarray) -> np.ndarray:
-        return scene_distance(c, x, dist)  # type: ignore[arg-type]
+        return scene_distance(c, x, dist, lod)  # type: ignore[arg-type]
 
     ambient = np.broadcast_to(np.array(scene.material.ambient), h.p.shape).copy()
     if "ambient_occlusion" in scene.effects:
@@ -80,11 +87,16 @@ def shade(
             k = fx.shadow_softness if soft else None
             if isinstance(c, CompiledMoKRS):
                 vis = occlusion.shadow_by_probes(
-                    lambda x, s: mokrs.is_unbounding(c, x, s), o, l, eps[lit], scene.render, k
+                    lambda x, s: mokrs.is_unbounding(c, x, s, lod=rho_at(lod, x, s)),
+                    o,
+                    l,
+                    eps[lit],
+                    scene.render,
+                    k,
                 )
             else:
                 vis = occlusion.shadow_by_distance(
-                    component_distances(c, dist),
+                    component_distances(c, dist, lod),
                     o,
                     l,  # type: ignore[arg-type]
                     eps[lit],

@@ -20,7 +20,7 @@ class Effect:
     needs_distance: bool = False  # a KRS distance function and mirror planes (not a MöKRS)
     bit: int = 0  # its bit in u_effects when all effects are compiled in
     secondary: bool = False  # evaluates the geometry again per hit pixel (a shadow ray,
-    # occlusion samples): the viewer drops it while moving
+    # occlusion samples): bench split times the frame without it
 
 
 _LIST = [

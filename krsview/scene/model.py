@@ -21,6 +21,9 @@ SWITCH = ("on", "off")
 PATHS = ("fragment", "compute")
 PREPASS_RATIO = 4  # pre-pass: a coarse pass's tiles are this many times as wide as the next's
 VIEW_PREPASS = 4  # the viewer's pre-pass tile where the file has none (docs/speed.md)
+# render.lod where the file has none: +0.2 % hit-mask error against the ground truth on tree,
+# within noise elsewhere, no hole (docs/speed.md, docs/accuracy/); 0 draws every level
+DEFAULT_LOD = 0.5
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -291,6 +294,16 @@ class Render:
         help="exact level culling: Alg. 1 stops at the first level whose "
         "bounding ball is no nearer than the distance found (the same "
         "value, fewer levels walked)",
+    )
+    lod: float = param(
+        DEFAULT_LOD,
+        lo=0.0,
+        hi=8.0,
+        unit="ε",
+        help="level of detail: Alg. 1 stops at the first level whose bounding ball "
+        "is smaller than lod × ε at its distance from the eye, and draws that ball for "
+        "the levels below (0: off, every level; hit points move by at most "
+        "2·lod·ε, never a hole)",
     )
     path: str = param(
         "fragment",

@@ -3,6 +3,7 @@
 // Without twist and empty zones this is Alg. 1 itself [KRS17 Alg. 1]; in a compound, each
 // component is a KRS of its own [KRS17 §5.1].
 #include "krs.glsl"
+#include "lod.glsl"
 #ifdef KRS_TWIST
 #include "twist.glsl"
 #endif
@@ -50,14 +51,18 @@ ivec2 component(int c) {
 #endif
 }
 
-real undistorted_distance(int c, vec3r q) {
+real undistorted_distance(int c, vec3r q, real rho) {
     ivec2 k = component(c);
-    return krs_distance(k.x, k.y, q);
+    return krs_distance(k.x, k.y, q, rho);
+}
+
+real component_distance_at(int c, vec3r p, real rho) {
+    return distort_distance(p, undistorted_distance(c, undistort(p), rho));
 }
 
 // The distance bound of component c, which the tracer steps by.
 real component_distance(int c, vec3r p) {
-    return distort_distance(p, undistorted_distance(c, undistort(p)));
+    return component_distance_at(c, p, lod_radius(length(p)));
 }
 
 // The bound of everything drawn: the least over the components (a distortion is monotone in
@@ -65,8 +70,9 @@ real component_distance(int c, vec3r p) {
 real scene_distance(vec3r p) {
 #ifdef KRS_COMPOUND
     vec3r q = undistort(p);
-    real D = undistorted_distance(0, q);
-    for (int c = 1; c < COMPONENTS; ++c) D = min(D, undistorted_distance(c, q));
+    real rho = lod_radius(length(p));
+    real D = undistorted_distance(0, q, rho);
+    for (int c = 1; c < COMPONENTS; ++c) D = min(D, undistorted_distance(c, q, rho));
     return distort_distance(p, D);
 #else
     return component_distance(0, p);  // the loop above, though empty, costs llvmpipe 4 %
@@ -75,16 +81,16 @@ real scene_distance(vec3r p) {
 
 // A ball is free of component c when its distance bound at the centre covers it.
 bool is_unbounding(int c, vec3r center, real radius) {
-    return component_distance(c, center) >= radius;
+    return component_distance_at(c, center, lod_radius(length(center) + radius)) >= radius;
 }
 
-// The component nearest to the undistorted point q (ties: the first).
+// The component nearest to the undistorted point q (ties: the first), without LOD.
 int nearest_component(vec3r q) {
     int win = 0;
 #ifdef KRS_COMPOUND
-    real best = undistorted_distance(0, q);
+    real best = undistorted_distance(0, q, 0.0);
     for (int c = 1; c < COMPONENTS; ++c) {
-        real d = undistorted_distance(c, q);
+        real d = undistorted_distance(c, q, 0.0);
         if (d < best) { best = d; win = c; }
     }
 #endif

@@ -14,19 +14,29 @@ real fold(int i, inout vec3r p) {
 // Exact level culling [issue 17]: once d ≤ dist(x, C_i), the ball of everything levels i..0
 // would still test (compile/krs.py, krs_bounds; r < 0: none), the walk stops with the
 // same value. Most rays far from the finer levels pay for a few levels instead of n.
+// Level of detail [issue 27, KRS14 LOD]: at the first ball C_i whose radius is below rho,
+// the ball stands for levels i..0 (d = min(d, dist(x, C_i)), a lower bound of what they
+// would give) and the walk stops: detail smaller than rho costs nothing (distance.glsl,
+// lod_radius; reference/krs.py says which geometry that draws).
 #ifdef KRS_COUNT_LEVELS
 int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
 #endif
-real krs_distance(int first, int n, vec3r xw) {
+real krs_distance(int first, int n, vec3r xw, real rho) {
     vec3r x = xw;
     real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
     for (int i = first + n - 1; i >= first; --i) {
 #ifdef KRS_COUNT_LEVELS
         ++g_levels;
 #endif
-#ifdef KRS_CULLING
+#if defined(KRS_CULLING) || defined(KRS_LOD)
         vec4r b = u_bounds[i];
-        if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
+        real db = length(x - b.xyz) - b.w;
+#endif
+#ifdef KRS_CULLING
+        if (b.w >= 0.0 && db >= d) break;
+#endif
+#ifdef KRS_LOD
+        if (b.w >= 0.0 && b.w < rho) { d = min(d, db); break; }
 #endif
         fold(i, x);
         d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));

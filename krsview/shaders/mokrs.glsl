@@ -2,6 +2,7 @@
 // [KRS17 §8.1, App. C]; twin of reference/mokrs.py.
 #include "kernels.glsl"
 #include "mobius.glsl"
+#include "lod.glsl"
 
 bool reflects(int i) { return (int(mobius_rec(i, 4).w) & 2) != 0; }
 
@@ -16,9 +17,19 @@ bool exterior_is_free(int i, vec3r center, real radius) {
 real lod_scale(vec3r p) { return 1.0; }   // a MöKRS takes no distortion
 
 // c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
+// Level of detail (lod.glsl): mapped into level i's space, the probe and the level's bound
+// share a unit; a bound smaller than ρ in the probe's own scale (ρ / radius world units per
+// unit of its radius: the map's local scale, to first order) stands for the levels below,
+// and the probe is free exactly when it misses that bound (which holds them all).
 bool is_unbounding(int c, vec3r center, real radius) {
+    real lod_per_radius = lod_radius(length(center) + radius) / radius;
     for (int i = u_n - 1; i >= 0; --i) {
         if (!map_ball(i, center, radius)) return exterior_is_free(i, center, radius);
+#ifdef KRS_LOD
+        vec4r b = mobius_rec(i, 5);
+        if (b.w >= 0.0 && b.w < lod_per_radius * radius)
+            return length(b.xyz - center) - b.w >= radius;
+#endif
         if (reflects(i)) center.x = -abs(center.x);      // mirror decision on the centre
         if (kernel_distance(i, center) < radius) return false;
     }

@@ -95,9 +95,10 @@ float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
     return sh.vis;
 }
 
-#ifdef KRS_SHADOW_TASKS
+#if defined(KRS_SHADOW_TASKS) || defined(KRS_SHADOW_UPSAMPLED)
 float g_shadow[MAX_LIGHTS];    // the compute path: each light's visibility, traced as tasks
-                               // (compute.comp) and loaded by deferred.frag before shading
+                               // (compute.comp) and loaded by deferred.frag before shading;
+                               // the viewer's: upsampled by upsampled.frag (< 0: none)
 #endif
 
 // The visibility of light k that shade() multiplies in.
@@ -105,6 +106,9 @@ float light_visibility(int k, vec3r p, vec3 n, float eps) {
 #ifdef KRS_SHADOW_TASKS
     return g_shadow[k];
 #else
+#ifdef KRS_SHADOW_UPSAMPLED
+    if (g_shadow[k] >= 0.0) return g_shadow[k];
+#endif
     return shadow_visibility(p, n, u_light_dir[k], eps);
 #endif
 }

@@ -67,6 +67,11 @@ def export_notes(scene: Scene) -> list[str]:
             f"render.prepass = {r.prepass}: the page traces without the pre-pass "
             "(the same surfaces, a slower frame)"
         )
+    if r.lod:
+        notes.append(
+            f"render.lod = {r.lod:g}: the page draws every level (its orbiting eye moves "
+            "away from the origin the level of detail is measured from)"
+        )
     return notes
 
 
@@ -74,7 +79,7 @@ def web_shader(scene: Scene, shadertoy: bool = False) -> str:
     """The fragment stage of the page (``#version 300 es``), or Shadertoy's body (Shadertoy
     adds the version, precision and its uniforms)."""
     export_notes(scene)
-    scene = replace(scene, render=replace(scene.render, prepass=0, path="fragment"))
+    scene = replace(scene, render=replace(scene.render, prepass=0, path="fragment", lod=0.0))
     view = view_of(scene.camera, 640, 360)  # only its eye O matters: the rest is live
     c = compile_geometry(scene.geometry(), scene.material.albedo).relative_to(view.origin)
     defines = variant_defines(scene, c)

@@ -1,11 +1,17 @@
 """Adaptive internal resolution: while the view moves, scale the image so a frame fits the
-target frame time; when it is still, refine to full resolution in tiles within a per-turn
-time budget, so input is never blocked by a slow frame."""
+target frame time; when it stops, refine through sharper images, each traced in bands of rows
+within a per-turn time budget (so input is never blocked by a slow frame) and shown when done.
+No GL here: frames.py draws what this schedules."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+
+SHADOW_RATIO = 2  # moving frames and refinement steps: one shadow ray per 2 × 2 pixels
+STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
+STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
+FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
 
 
 @dataclass
@@ -21,11 +27,15 @@ class AdaptiveResolution:
     def budget(self) -> float:
         return 1.0 / self.target_fps
 
+    def size_at(self, scale: float) -> tuple[int, int]:
+        """The internal resolution at ``scale`` of the window's side."""
+        return (max(1, round(self.full[0] * scale)), max(1, round(self.full[1] * scale)))
+
     def moving_size(self) -> tuple[int, int]:
-        return (max(1, round(self.full[0] * self.scale)), max(1, round(self.full[1] * self.scale)))
+        return self.size_at(self.scale)
 
     def still_size(self) -> tuple[int, int]:
-        return (self.full[0] * self.supersample, self.full[1] * self.supersample)
+        return self.size_at(self.supersample)
 
     def frame_done(self, seconds: float) -> None:
         """After a moving frame: cost ∝ pixels ∝ scale², so aim scale at the budget, damped."""
@@ -37,31 +47,88 @@ class AdaptiveResolution:
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
 
 
+@dataclass(frozen=True)
+class Step:
+    """One image the view refines through: ``scale`` of the window's side, and its shadow
+    rays (gpu/passes.py's ratio): 0 every effect in one pass, 1 a shadow ray per pixel in a
+    pass after the tracing, r ≥ 2 one per r × r pixels, blended along depth."""
+
+    scale: float
+    ratio: int
+
+
+def refinement_steps(
+    moving_scale: float, moving_seconds: float, supersample: int, split: bool
+) -> list[Step]:
+    """The images after the view stops, the last one the still image: one at the window's
+    size, and where that would take longer than STEP_WAIT to trace (predicted from the moving
+    frame's time, cost ∝ pixels) one of half its side before it, and so on down to STEP_GAIN
+    times the moving frame's side, so each step is visibly sharper and all
+    before the window-size one cost at most 1/3 of it. ``split`` (shadows a pass of their
+    own): those steps trace shadow rays at SHADOW_RATIO like the moving frames, and the still
+    image adds them per pixel, reusing the tracing of the image before it where that has its
+    size; else each step has every effect."""
+    scales = [1.0] if moving_scale * STEP_GAIN < 1.0 else []
+    while (
+        scales
+        and scales[0] / 2 > moving_scale * STEP_GAIN
+        and moving_seconds * (scales[0] / moving_scale) ** 2 > STEP_WAIT
+    ):
+        scales.insert(0, scales[0] / 2)
+    if split:
+        return [Step(s, SHADOW_RATIO) for s in scales] + [Step(float(supersample), 1)]
+    if not scales and moving_scale < 1.0:
+        scales = [1.0]
+    return [Step(s, 0) for s in scales] + ([Step(float(supersample), 0)] if supersample > 1 else [])
+
+
 @dataclass
 class Refinement:
-    """Full-resolution image traced in horizontal bands, a few per event-loop turn."""
+    """The steps' images traced pass by pass in bands of rows, a few bands per event-loop
+    turn, each band sized to the turn's budget by the measured seconds per pixel of its pass
+    (``cost``, by pass name, shared between refinements)."""
 
-    size: tuple[int, int]
-    band: int = 16  # rows per tile
+    steps: list[Step]
+    cost: dict[str, float] = field(default_factory=dict)
+    k: int = 0  # the step being traced; len(steps): all shown
+    passes: list[tuple[str, int, int]] = field(default_factory=list)  # step k's: name, w, rows
+    p: int = 0  # the pass being drawn
     next_row: int = 0
-    seconds_per_row: float = 0.0
 
     @property
     def done(self) -> bool:
-        return self.next_row >= self.size[1]
+        return self.k >= len(self.steps)
 
-    def next_tile(self, budget: float) -> tuple[int, int, int, int]:
-        """The next band, sized so it should fit ``budget`` seconds by the measured row cost."""
-        rows = self.band
-        if self.seconds_per_row > 0:
-            rows = max(1, min(self.size[1], int(budget / self.seconds_per_row)))
-        rows = min(rows, self.size[1] - self.next_row)
-        tile = (0, self.next_row, self.size[0], rows)
-        self.next_row += rows
-        return tile
+    @property
+    def started(self) -> bool:
+        """Step k's passes are known (:meth:`begin`)."""
+        return bool(self.passes)
 
-    def tile_done(self, tile: tuple[int, int, int, int], seconds: float) -> None:
-        per_row = seconds / max(tile[3], 1)
-        self.seconds_per_row = (
-            per_row if self.seconds_per_row == 0 else (0.5 * self.seconds_per_row + 0.5 * per_row)
-        )
+    def begin(self, passes: list[tuple[str, int, int]]) -> None:
+        """Step k's passes, in order: name, width and rows of each."""
+        self.passes, self.p, self.next_row = passes, 0, 0
+
+    def next_band(self, budget: float) -> tuple[str, int, int]:
+        """The next band of the current pass, (name, first row, rows), sized to ``budget``
+        seconds by its measured cost."""
+        name, width, height = self.passes[self.p]
+        rows = FIRST_BAND
+        if self.cost.get(name, 0.0) > 0:
+            rows = max(1, int(budget / (self.cost[name] * width)))
+        return name, self.next_row, min(rows, height - self.next_row)
+
+    def band_done(self, band: tuple[str, int, int], seconds: float) -> bool:
+        """Record a drawn band; True when it finished step k's image (k moves on)."""
+        name, y0, rows = band
+        width, height = self.passes[self.p][1:]
+        per_pixel = seconds / max(rows * width, 1)
+        old = self.cost.get(name, 0.0)
+        self.cost[name] = per_pixel if old == 0 else 0.5 * old + 0.5 * per_pixel
+        self.next_row = y0 + rows
+        if self.next_row < height:
+            return False
+        self.p, self.next_row = self.p + 1, 0
+        if self.p < len(self.passes):
+            return False
+        self.k, self.passes, self.p = self.k + 1, [], 0
+        return True

@@ -1,77 +1,79 @@
 """Scheduling the tracing: after a change of view one moving frame at the adaptive resolution;
-while the view is still, the full-resolution image in tiles within the frame budget, so input
-is never blocked by a slow frame."""
+when the view stops, the refinement's images (adaptive.py), each traced in bands within the
+frame budget and shown when done, so input is never blocked by a slow frame. Moving frames
+light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py)."""
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import moderngl
 import numpy as np
 
 from ..gpu.display import Display
+from ..gpu.passes import PassImage, Targets, splits_shadows
 from ..gpu.program import ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.scene import Geometry
-from .adaptive import AdaptiveResolution, Refinement
+from .adaptive import SHADOW_RATIO, AdaptiveResolution, Refinement, refinement_steps
 
 KEPT_FRAME_TIMES = 240  # for the HUD's frame-time plot
 
 
 @dataclass(frozen=True)
 class FrameState:
-    """The image on screen, as the HUD reports it: ``state`` is "moving" (adaptive resolution),
-    "refining" (the still image is being traced in tiles; this image stays until it is done)
-    or "still" (final); ``seconds`` is the time its tracing took (all tiles for a still one)."""
+    """The image on screen, as the HUD reports it: ``state`` is "moving" (adaptive
+    resolution), "refining" (image ``step`` = (k, n) of the refinement, k < n; the next one
+    is being traced) or "still" (the last one: final); ``seconds`` is the time its tracing
+    took (all its bands for a refinement's), ``shadows`` the side of the pixel blocks that
+    share a shadow ray (1: each pixel its own)."""
 
     state: str
     size: tuple[int, int]  # internal resolution of the image on screen
     window: tuple[int, int]  # the window's framebuffer
     seconds: float
-    rows: tuple[int, int] = (0, 0)  # refining: rows of the still image done, of all
+    step: tuple[int, int] = (0, 0)  # refining: (k, n)
+    shadows: int = 1
 
     def text(self) -> str:
         w, h = self.size
         share = w / max(self.window[0], 1)
-        state = (
-            f"refining {self.rows[0]}/{self.rows[1]} rows"
-            if self.state == "refining"
-            else self.state
-        )
+        k, n = self.step
+        state = f"refining {k}/{n}" if self.state == "refining" else self.state
         return f"{state}: {w}×{h} ({share:.0%} of the window)"
+
+    def timing(self) -> str:
+        """How it was traced: time, and the shadow rays' blocks where they are shared."""
+        rays = f", shadows per {self.shadows}×{self.shadows} px" if self.shadows > 1 else ""
+        return f"traced in {self.seconds * 1e3:.1f} ms{rays}"
 
 
 class Frames:
     def __init__(self, ctx: moderngl.Context, renderer: Renderer, adaptive: AdaptiveResolution):
         self.ctx, self.renderer, self.adaptive = ctx, renderer, adaptive
         self.display = Display(ctx, renderer.programs)
+        self.targets = Targets(ctx)
         self.dirty = True  # the view changed: trace a moving frame next
+        self.full_shadows = False  # moving frames and steps trace a shadow ray per pixel
         self.image: tuple[moderngl.Framebuffer, tuple[int, int]] | None = None
         self.refinement: Refinement | None = None
         self.frame_seconds: list[float] = []  # moving frames
         self.shown = FrameState("moving", (0, 0), adaptive.full, 0.0)  # no image yet
-        self._tile_seconds = 0.0  # the refinement's tiles so far
+        self._on_screen: PassImage | None = None
+        self._tracing: PassImage | None = None  # the refinement's next image
+        self._cost: dict[str, float] = {}  # seconds per pixel of each pass, kept across
+        self._step_seconds = 0.0
 
     @property
     def refined(self) -> bool:
-        """The window shows the full-resolution image of the current view."""
+        """The window shows the final image of the current view."""
         return not self.dirty and (self.refinement is None or self.refinement.done)
 
     def frame_state(self) -> FrameState:
-        """The image on screen: its state, internal resolution and tracing time; a moving
-        frame stays "moving" until the first tile of the still image is traced."""
-        r = self.refinement
-        if self.shown.state == "moving" and r is not None and r.next_row > 0:
-            return FrameState(
-                "refining",
-                self.shown.size,
-                self.adaptive.full,
-                self.shown.seconds,
-                (min(r.next_row, r.size[1]), r.size[1]),
-            )
+        """The image on screen: its state, internal resolution and tracing time."""
         return self.shown
 
     def resize(self, fb: tuple[int, int]) -> None:
@@ -80,44 +82,75 @@ class Frames:
             self.adaptive.full = fb
             self.dirty = True
 
-    def trace(self, moving: Scene, still: Scene, krs: Geometry) -> None:
-        """One turn's tracing: a moving frame of ``moving`` after a change, else some tiles of
-        the still image of ``still``. A ShaderError leaves the last image in place."""
+    def trace(self, scene: Scene, krs: Geometry) -> None:
+        """One turn's tracing: a moving frame of ``scene`` after a change, else some bands of
+        the refinement's next image. A ShaderError leaves the last image in place."""
         if self.dirty:
             self.dirty = False  # a shader error is not retried every turn
-            size = self.adaptive.moving_size()
-            t0 = time.perf_counter()
-            prog = self.renderer.prepare(moving, *size, krs)
-            fbo = self.renderer.draw(prog, *size)
-            self.ctx.finish()
-            seconds = time.perf_counter() - t0
-            self.adaptive.frame_done(seconds)
-            self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
-            self.image = (fbo, size)
-            full = self.adaptive.still_size()
-            final = full == size and moving.effects == still.effects
-            self.refinement = None if final else Refinement(full)
-            self.shown = FrameState("still" if final else "moving", size, full, seconds)
-            self._tile_seconds = 0.0
+            self._moving(scene, krs)
         elif self.refinement is not None and not self.refinement.done:
-            self._refine(still, krs)
+            self._refine(scene, krs)
 
-    def _refine(self, still: Scene, krs: Geometry) -> None:
+    def _moving(self, scene: Scene, krs: Geometry) -> None:
+        size = self.adaptive.moving_size()
+        scale = size[0] / self.adaptive.full[0]
+        split = not self.full_shadows and splits_shadows(scene)  # shadow rays per 2 × 2
+        image = PassImage(
+            self.renderer, self.targets, scene, size, krs, SHADOW_RATIO if split else 0
+        )
+        t0 = time.perf_counter()
+        image.draw_all()
+        self.ctx.finish()
+        seconds = time.perf_counter() - t0
+        self.adaptive.frame_done(seconds)
+        self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
+        steps = refinement_steps(scale, seconds, self.adaptive.supersample, split)
+        self.refinement = Refinement(steps, self._cost) if steps else None
+        self._tracing = None
+        state = "moving" if steps else "still"
+        self._show(image, FrameState(state, size, self.adaptive.full, seconds))
+
+    def _show(self, image: PassImage, state: FrameState) -> None:
+        """``image`` goes on screen; ``state`` says what it is."""
+        self.image, self._on_screen = (image.output, image.size), image
+        self.shown = replace(state, shadows=max(image.ratio, 1))
+
+    def _refine(self, scene: Scene, krs: Geometry) -> None:
         r = self.refinement
-        prog = self.renderer.prepare(still, *r.size, krs)
-        spent, budget = 0.0, 0.8 * self.adaptive.budget
+        spent, budget = 0.0, self.adaptive.budget  # a turn no longer than a moving frame's
+        prepared = None
         while not r.done and spent < budget:
-            tile = r.next_tile(budget - spent)
+            if not r.started:
+                step = r.steps[r.k]
+                size = self.adaptive.size_at(step.scale)
+                shown = self._on_screen  # its tracing is reused where it has this size
+                traced = shown if step.ratio == 1 and shown and shown.has_trace(size) else None
+                self._tracing = PassImage(
+                    self.renderer, self.targets, scene, size, krs, step.ratio, traced
+                )
+                r.begin(self._tracing.passes)
+                self._step_seconds = 0.0
+            if prepared is not self._tracing:
+                self._tracing.prepare()  # once a turn: other drawing may have come between
+                prepared = self._tracing
+            band = r.next_band(budget - spent)
             t0 = time.perf_counter()
-            fbo = self.renderer.draw(prog, *r.size, tile)
+            self._tracing.draw(*band)
             self.ctx.finish()
             seconds = time.perf_counter() - t0
-            r.tile_done(tile, seconds)
             spent += seconds
-        self._tile_seconds += spent
-        if r.done:
-            self.image = (fbo, r.size)
-            self.shown = FrameState("still", r.size, self.adaptive.full, self._tile_seconds)
+            self._step_seconds += seconds
+            if r.band_done(band, seconds):
+                k, n = r.k, len(r.steps)
+                state = FrameState(
+                    "still" if k == n else "refining",
+                    self._tracing.size,
+                    self.adaptive.full,
+                    self._step_seconds,
+                    (k, n) if k < n else (0, 0),
+                )
+                self._show(self._tracing, state)
+                self._tracing = None
 
     def show(
         self,

@@ -38,6 +38,7 @@ KNOBS = (
     *TRACER_KNOBS,
     "precision",
     "culling",
+    "lod",
     "path",
     "steps",
     "shadow_tasks",
@@ -116,7 +117,7 @@ def _performance(v: Viewed, out: list) -> None:
     the budget."""
     shown = v.frames.frame_state()
     imgui.text(shown.text())
-    imgui.text(f"traced in {shown.seconds * 1e3:.1f} ms; {v.view} view")
+    imgui.text(f"{shown.timing()}; {v.view} view")
     times = np.array(v.frames.frame_seconds[-PLOTTED:] or [0.0], dtype=np.float32) * 1e3
     budget = 1e3 / v.frames.adaptive.target_fps
     imgui.text(f"moving frames: median {np.median(times):.1f} ms, budget {budget:.1f} ms")
@@ -137,7 +138,7 @@ def _performance(v: Viewed, out: list) -> None:
     if changed:
         out.append(c.SetSupersample(2 if ss else 1))
     changed, on = field_widget(
-        "shadows and occlusion while moving", v.moving_effects, settings_meta("moving_effects")
+        "a shadow ray per pixel while moving", v.moving_effects, settings_meta("moving_effects")
     )
     if changed:
         out.append(c.SetMovingEffects(on))

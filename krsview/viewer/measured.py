@@ -61,6 +61,8 @@ def matches(
         return same_but(epsilon_scale=float(value))
     if knob == "max_iterations":
         return same_but(max_iterations=int(value))
+    if knob == "lod":
+        return same_but(lod=float(value))
     if knob == "tracer":
         return same_but(**_tracer(value))
     if knob in ("precision", "culling", "path"):
@@ -95,6 +97,7 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
     render = {
         "epsilon_scale": lambda: replace(base, epsilon_scale=float(value)),
         "max_iterations": lambda: replace(base, max_iterations=int(value)),
+        "lod": lambda: replace(base, lod=float(value)),
         "tracer": lambda: replace(base, **_tracer(value)),
         "precision": lambda: replace(base, precision=value),
         "culling": lambda: replace(base, culling=value),

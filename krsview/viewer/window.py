@@ -21,7 +21,7 @@ from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
-from ..scene.effects import EFFECTS, EXCLUSIVE
+from ..scene.effects import EXCLUSIVE
 from ..scene.model import VIEW_PREPASS
 from ..scene.settings import ViewerSettings, make_settings
 from . import commands as c
@@ -58,7 +58,7 @@ class Viewer:
         self.settings = make_settings(settings or ViewerSettings(), **options)
         self.shader_dir = Path(shader_dir)
         self.doc = Document(path)  # a bad file is a SceneError before any window
-        self.moving_effects = self.settings.moving_effects  # False: moving frames skip some
+        self.moving_effects = self.settings.moving_effects  # True: shadow rays per pixel
         self.platform = Platform(self.settings.size, f"krsview — {self.scene.name}", visible)
         self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
@@ -76,6 +76,7 @@ class Viewer:
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
         )
+        self.frames.full_shadows = self.moving_effects
         self._measured_for: str | None = None
         self._opened()
         self.platform.route_events(self.input)
@@ -139,17 +140,13 @@ class Viewer:
         if part.error:
             self.error, part.error = part.error, ""
 
-    def view_scene(self, moving: bool = False) -> Scene:
-        """The scene as drawn now: the viewer's camera and settings. A moving frame leaves out
-        the effects that trace the geometry again per pixel (shadow rays, occlusion samples:
-        40 % of a `tree` frame) unless ``moving_effects``; the still image has them all."""
-        effects = self.scene.effects
-        if moving and not self.moving_effects:
-            effects = [e for e in effects if not EFFECTS[e].secondary]
+    def view_scene(self) -> Scene:
+        """The scene as drawn now: the viewer's camera and pre-pass. Moving frames have every
+        effect too; unless ``moving_effects``, their shadow rays are traced per 2 × 2 pixels
+        (frames.py)."""
         return replace(
             self.scene,
             camera=self.camera.to_camera(),
-            effects=effects,
             render=replace(self.scene.render, prepass=self.prepass),
         )
 
@@ -212,6 +209,7 @@ class Viewer:
 
     def set_moving_effects(self, on: bool) -> None:
         self.moving_effects, self.frames.dirty = on, True
+        self.frames.full_shadows = on
 
     def undo(self) -> None:
         if self.doc.undo():
@@ -350,7 +348,7 @@ class Viewer:
         """Follow the document, trace within the frame budget and show the image."""
         self.sync()
         try:
-            self.frames.trace(self.view_scene(moving=True), self.view_scene(), self.krs)
+            self.frames.trace(self.view_scene(), self.krs)
         except ShaderError as e:
             self.error = str(e)
         fb = glfw.get_framebuffer_size(self.window)

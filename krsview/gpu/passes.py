@@ -1,0 +1,162 @@
+"""An image drawn in passes, each in bands of rows, so the viewer can spread it over event-loop
+turns and trace its shadow rays at reduced resolution [KRS17 §8.5 traces soft shadows at ¼
+resolution]. ``ratio`` picks the passes:
+
+- 0: ``render``, render.frag with every effect in one pass (the renderer's own image);
+- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY), then
+  ``shadows+shade``, upsampled.frag shading every pixel with its own shadow rays:
+  render.frag's image in two passes, so a later image of the same view and size can reuse
+  the tracing;
+- r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
+  each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
+  visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
+  its depth (an outline) traces its own."""
+
+from __future__ import annotations
+
+import moderngl
+
+from ..scene import Geometry, Scene
+from .renderer import Renderer
+
+SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
+DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
+MAX_KEPT = 6  # targets kept (least recently used released)
+TRACED = ("u_traced_color", "u_traced_depth", "u_traced_iterations")  # units 0, 1, 2
+COARSE = ("u_coarse_visibility", "u_coarse_depth")  # units 3, 4
+
+
+def splits_shadows(scene: Scene) -> bool:
+    """Whether ``scene``'s shadow rays can be a pass of their own: it has shadows, on the
+    fragment path, in float (the trace pass hands each ray's distance on as a float)."""
+    return (
+        bool(SHADOW_EFFECTS & set(scene.effects))
+        and scene.render.path == "fragment"
+        and scene.render.precision == "float"
+    )
+
+
+class Targets:
+    """The passes' float render targets by size, layers and slot, the MAX_KEPT most recently
+    used kept. Finished images alternate between two slots, so the image on screen is never
+    the one being drawn."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
+        self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
+        self.flip = 0
+
+    def get(self, size: tuple[int, int], layers: int, slot: int = 0) -> moderngl.Framebuffer:
+        key = (*size, layers, slot)
+        if key in self._kept:
+            self._kept[key] = self._kept.pop(key)  # most recent last
+            return self._kept[key]
+        while len(self._kept) >= MAX_KEPT:
+            old = self._kept.pop(next(iter(self._kept)))
+            for tex in old.color_attachments:
+                tex.release()
+            old.release()
+        tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
+        self._kept[key] = self.ctx.framebuffer(color_attachments=tex)
+        return self._kept[key]
+
+    def output(self, size: tuple[int, int]) -> moderngl.Framebuffer:
+        """A finished image's three targets, the other slot than the last image's."""
+        self.flip ^= 1
+        return self.get(size, 3, self.flip)
+
+    def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
+        if prog not in self._vaos:
+            self._vaos[prog] = self.ctx.vertex_array(prog, [])
+        return self._vaos[prog]
+
+
+class PassImage:
+    """One image of ``scene`` at ``size`` in passes (the module's docstring); ``traced``: an
+    image of the same view and size whose trace pass this one reuses (it has none)."""
+
+    def __init__(
+        self,
+        renderer: Renderer,
+        targets: Targets,
+        scene: Scene,
+        size: tuple[int, int],
+        geometry: Geometry,
+        ratio: int,
+        traced: PassImage | None = None,
+    ):
+        self.renderer, self.targets = renderer, targets
+        self.scene, self.size, self.geometry, self.ratio = scene, size, geometry, ratio
+        w, h = size
+        self.coarse = (-(-w // max(ratio, 1)), -(-h // max(ratio, 1)))
+        if ratio == 0:
+            self.passes = [("render", w, h)]
+        else:
+            self.passes = [] if traced else [("trace", w, h)]
+            if ratio > 1:
+                self.passes.append(("visibility", *self.coarse))
+            self.passes.append(("shade" if ratio > 1 else "shadows+shade", w, h))
+        self.traced = traced.traced if traced else None  # the trace pass's targets
+        with renderer.current():
+            self.output = targets.output(size) if ratio else None
+        self._programs: dict[str, moderngl.Program] = {}
+
+    def has_trace(self, size: tuple[int, int]) -> bool:
+        """Whether a later image of this view at ``size`` can reuse this one's trace pass."""
+        return self.ratio >= 1 and self.size == size and self.traced is not None
+
+    def prepare(self) -> None:
+        """Compile or fetch the passes' programs and upload the uniforms: at each turn's
+        start, since other drawing may have happened in between."""
+        probes = ("KRS_TRACE_ONLY",) if self.ratio else ()
+        main = self.renderer.prepare(self.scene, *self.size, self.geometry, probes=probes)
+        self._programs = {"render" if not self.ratio else "trace": main}
+        if self.ratio > 1:
+            vis = self.renderer.companion(main, "coarse_visibility.frag")
+            shade = self.renderer.companion(main, "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None})
+            for prog in (vis, shade):
+                prog["u_shadow_ratio"].value = self.ratio
+            shade["u_depth_slack"].value = DEPTH_SLACK
+            self._programs.update(visibility=vis, shade=shade)
+        elif self.ratio == 1:
+            self._programs["shadows+shade"] = self.renderer.companion(main, "upsampled.frag")
+
+    def draw(self, name: str, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first."""
+        prog = self._programs[name]
+        if name in ("render", "trace"):
+            fbo = self.renderer.draw(prog, *self.size, (0, y0, self.size[0], rows))
+            if name == "render":
+                self.output = fbo
+            else:
+                self.traced = fbo
+            return
+        ctx = self.renderer.ctx
+        with self.renderer.current():
+            for unit, tex in enumerate(self.traced.color_attachments):
+                tex.use(unit)
+                if TRACED[unit] in prog:
+                    prog[TRACED[unit]].value = unit
+            if name == "visibility":
+                target, size = self.targets.get(self.coarse, 2), self.coarse
+            else:
+                target, size = self.output, self.size
+                if self.ratio > 1:
+                    coarse = self.targets.get(self.coarse, 2)
+                    for k, tex in enumerate(coarse.color_attachments):
+                        tex.use(len(TRACED) + k)
+                        if COARSE[k] in prog:
+                            prog[COARSE[k]].value = len(TRACED) + k
+            target.use()
+            ctx.viewport = (0, 0, *size)
+            ctx.scissor = (0, y0, size[0], rows)
+            self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
+            ctx.scissor = None
+
+    def draw_all(self) -> moderngl.Framebuffer:
+        """Every pass at once (a moving frame); the finished image's targets."""
+        self.prepare()
+        for name, _, rows in self.passes:
+            self.draw(name, 0, rows)
+        return self.output

@@ -1,0 +1,54 @@
+// The trace-only pass (render.frag with KRS_TRACE_ONLY) shaded as render.frag shades it:
+// with KRS_SHADOW_UPSAMPLED each light's visibility comes from coarse_visibility.frag's
+// blocks around the pixel whose depth is within u_depth_slack footprints of its own
+// (bilinear weights); where none is, the pixel traces its own shadow ray (shadows.glsl).
+// Without it every pixel traces its own: render.frag's image, in two passes.
+#include "effects.glsl"
+#include "scene_block.glsl"
+#include "trace.glsl"
+#include "pixel.glsl"
+
+uniform sampler2D u_traced_color;       // a: hit
+uniform sampler2D u_traced_depth;       // w: ray distance t
+uniform sampler2D u_traced_iterations;  // x
+
+#ifdef KRS_SHADOW_UPSAMPLED
+uniform sampler2D u_coarse_visibility;  // per light; < 0: none
+uniform sampler2D u_coarse_depth;       // x: t; < 0: no hit
+uniform int u_shadow_ratio;
+uniform float u_depth_slack;            // coarse pixel footprints of depth a block may differ
+
+// g_shadow: each light's visibility blended from the blocks near pixel px at depth t.
+void upsample_visibility(ivec2 px, float t) {
+    vec2 c = (vec2(px) + 0.5) / float(u_shadow_ratio) - 0.5;
+    ivec2 c0 = ivec2(floor(c));
+    vec2 f = c - vec2(c0);
+    ivec2 last = textureSize(u_coarse_depth, 0) - 1;
+    float slack = u_depth_slack * u_footprint * float(u_shadow_ratio) * t;
+    vec4 sum = vec4(0.0), weight = vec4(0.0);
+    for (int j = 0; j < 2; ++j) {
+        for (int i = 0; i < 2; ++i) {
+            ivec2 q = clamp(c0 + ivec2(i, j), ivec2(0), last);
+            float tq = texelFetch(u_coarse_depth, q, 0).x;
+            if (tq < 0.0 || abs(tq - t) > slack) continue;
+            float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y) + 1e-3;
+            vec4 v = texelFetch(u_coarse_visibility, q, 0);
+            for (int k = 0; k < MAX_LIGHTS; ++k) {
+                if (v[k] >= 0.0) { sum[k] += w * v[k]; weight[k] += w; }
+            }
+        }
+    }
+    for (int k = 0; k < MAX_LIGHTS; ++k) g_shadow[k] = weight[k] > 0.0 ? sum[k] / weight[k] : -1.0;
+}
+#endif
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    bool hit = texelFetch(u_traced_color, px, 0).a > 0.5;
+    float t = texelFetch(u_traced_depth, px, 0).w;
+#ifdef KRS_SHADOW_UPSAMPLED
+    if (hit) upsample_visibility(px, t);
+#endif
+    int iterations = int(texelFetch(u_traced_iterations, px, 0).x);
+    write_pixel(pixel_ray(gl_FragCoord.xy), hit, real(t), iterations);
+}

@@ -1,0 +1,137 @@
+"""The viewer's scheduling without a window (viewer/adaptive.py): the moving frames' scale
+controller, the refinement's steps after the view stops, and the bands each step is traced in
+within a turn's budget."""
+
+from __future__ import annotations
+
+import pytest
+
+from krsview.viewer.adaptive import (
+    FIRST_BAND,
+    AdaptiveResolution,
+    Refinement,
+    Step,
+    refinement_steps,
+)
+
+
+def test_the_scale_drops_when_slow_and_grows_back_when_fast():
+    a = AdaptiveResolution((640, 360), target_fps=30)
+    for _ in range(20):
+        a.frame_done(0.2)  # far over budget: shrink to the floor
+    assert a.scale == a.min_scale and a.moving_size() == (64, 36)
+    for _ in range(40):
+        a.frame_done(0.001)  # far under budget: grow back to full
+    assert a.scale == 1.0 and a.moving_size() == (640, 360)
+    a.supersample = 2
+    assert a.still_size() == (1280, 720) and a.size_at(0.5) == (320, 180)
+
+
+@pytest.mark.parametrize(
+    "moving, seconds, supersample, split, steps",
+    [
+        # shadows a pass of their own: sharper images with shadow rays per 2 × 2 pixels, then
+        # the still image adds them per pixel (reusing the window-size tracing)
+        (0.35, 0.03, 1, True, [(1.0, 2), (1.0, 1)]),
+        (0.2, 0.03, 1, True, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # 0.75 s at the window's size
+        (0.2, 0.01, 1, True, [(1.0, 2), (1.0, 1)]),  # 0.25 s: no step before it
+        (0.1, 0.03, 1, True, [(0.25, 2), (0.5, 2), (1.0, 2), (1.0, 1)]),
+        (0.1, 0.005, 1, True, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # ½: 0.125 s
+        (0.8, 0.03, 1, True, [(1.0, 1)]),  # too close to the window for a step between
+        (1.0, 0.03, 1, True, [(1.0, 1)]),  # the moving frame's tracing, shadowed per pixel
+        (0.35, 0.03, 2, True, [(1.0, 2), (2.0, 1)]),  # supersampled: traced anew, twice the side
+        # every effect in each image (full shadows while moving, or no shadows to split)
+        (0.35, 0.03, 1, False, [(1.0, 0)]),
+        (0.2, 0.03, 1, False, [(0.5, 0), (1.0, 0)]),
+        (0.8, 0.03, 1, False, [(1.0, 0)]),
+        (1.0, 0.03, 1, False, []),  # the moving frame is the still image
+        (1.0, 0.03, 2, False, [(2.0, 0)]),
+    ],
+)
+def test_refinement_steps(moving, seconds, supersample, split, steps):
+    assert refinement_steps(moving, seconds, supersample, split) == [Step(*s) for s in steps]
+
+
+def ladder_ok(moving: float, steps: list[Step]) -> bool:
+    """Each image at least 1.5× the side of the one before, and all but the still image
+    together costing at most 1/3 more pixels than the last of them."""
+    sides = [moving] + [s.scale for s in steps if s.ratio != 1]
+    pixels = [s * s for s in sides[1:]]
+    return all(b >= 1.5 * a for a, b in zip(sides, sides[1:])) and sum(pixels) <= (
+        4 / 3 * pixels[-1] + 1e-12
+    )
+
+
+def test_each_step_is_visibly_sharper_and_all_cost_at_most_a_third_more():
+    for k in range(1, 100):
+        moving = k / 100
+        steps = refinement_steps(moving, 1.0, 1, True)  # slow: every step there can be
+        assert steps[-1] == Step(1.0, 1)
+        if moving < 1 / 1.5:
+            assert ladder_ok(moving, steps), moving
+    # negative controls: a step too close to the one before, and a ladder too dense
+    assert not ladder_ok(0.4, [Step(0.5, 2), Step(1.0, 2)])
+    assert not ladder_ok(0.1, [Step(0.2, 2), Step(0.4, 2), Step(0.7, 2), Step(1.0, 2)])
+
+
+PASSES = [("trace", 100, 50), ("visibility", 50, 25), ("shade", 100, 50)]
+COST = {"trace": 4e-5, "visibility": 2e-5, "shade": 1e-5}  # seconds per pixel
+
+
+def run_turns(r: Refinement, budget: float, cost: dict[str, float]) -> list[list[tuple]]:
+    """Drive ``r`` as frames.py does, each band costing ``cost`` per pixel: the bands drawn
+    in each turn, and the steps finished."""
+    turns = []
+    while not r.done:
+        bands, spent = [], 0.0
+        while not r.done and spent < budget:
+            if not r.started:
+                r.begin(list(PASSES))
+            band = r.next_band(budget - spent)
+            width = next(w for name, w, _ in PASSES if name == band[0])
+            seconds = cost[band[0]] * width * band[2]
+            spent += seconds
+            bands.append((*band, r.band_done(band, seconds)))
+        turns.append(bands)
+    return turns
+
+
+def test_bands_cover_every_row_of_every_pass_in_order_within_the_budget():
+    r = Refinement([Step(1.0, 2), Step(1.0, 1)])
+    turns = run_turns(r, 0.02, COST)
+    bands = [b for t in turns for b in t]
+    end = [k for k, b in enumerate(bands) if b[3]]  # the bands finishing a step
+    assert len(end) == 2 and end[-1] == len(bands) - 1 and r.done and r.k == 2
+    for step in (bands[: end[0] + 1], bands[end[0] + 1 :]):
+        rows = {name: [] for name, _, _ in PASSES}
+        for name, y0, n, _ in step:
+            rows[name].append((y0, n))
+        for name, _, height in PASSES:
+            ys = [y for y0, n in rows[name] for y in range(y0, y0 + n)]
+            assert ys == list(range(height)), name  # each row once, bottom to top
+    assert bands[0][2] == FIRST_BAND  # before any cost is known
+    # once its pass is measured, no band overruns its turn's budget by more than a row
+    seen: set[str] = set()
+    width = {name: w for name, w, _ in PASSES}
+    for t in turns:
+        measured = [(name, n) for name, _, n, _ in t if name in seen]
+        seen |= {name for name, _, _, _ in t}
+        spent = sum(COST[name] * width[name] * n for name, n in measured)
+        assert spent <= 0.02 + 100 * COST["trace"] + 1e-12
+    assert len(turns) > 10 and seen == set(width)
+    # negative control: a pass twice as costly as measured gets bands half as tall
+    r2 = Refinement([Step(1.0, 2)], cost=dict(COST))
+    r2.begin(list(PASSES))
+    tall = r2.next_band(0.02)[2]
+    r2.band_done(("trace", 0, tall), 2 * COST["trace"] * 100 * tall)
+    assert r2.next_band(0.02)[2] < tall
+
+
+def test_costs_carry_over_to_the_next_refinement():
+    cost: dict[str, float] = {}
+    run_turns(Refinement([Step(1.0, 2)], cost), 0.02, COST)
+    assert cost == pytest.approx(COST)
+    r = Refinement([Step(1.0, 2)], cost)
+    r.begin(list(PASSES))
+    assert r.next_band(0.02)[2] == int(0.02 / (COST["trace"] * 100))
+    assert Refinement([Step(1.0, 2)]).cost == {}  # control: a fresh one knows none
