@@ -212,7 +212,7 @@ def test_the_mesh_under_krsviews_rays_draws_krsviews_image(renderer):
     w, h = 64, 36
     view = view_of(scene.camera, w, h)
     mesh = expansion.expand(krs, view, 0.1)
-    mine = renderer.render(peer.krsview_scene(scene, {}), w, h, krs).hit
+    mine = renderer.render(peer.krsview_scene(scene, {"lod": 0.0}), w, h, krs).hit
     theirs = brute_force_hits(mesh, view.origin, primary_rays(view)).reshape(h, w)
     flipped = theirs[::-1]
     assert theirs.mean() > 0.03
@@ -262,16 +262,18 @@ def test_bench_peer_tiny_run(renderer):
     size = (48, 27)
     m = peer.bench_peer(scene, size, rounds=1, level_counts=(3, 4))
     assert m.column("renderer") == [peer.PEER, *peer.VARIANTS] * 2
-    assert m.column("levels") == [3] * 3 + [4] * 3
-    assert m.column("instances") == [7] * 3 + [15] * 3
+    per_level = 1 + len(peer.VARIANTS)
+    assert m.column("levels") == [3] * per_level + [4] * per_level
+    assert m.column("instances") == [7] * per_level + [15] * per_level
     for r in m.rows:
         assert r["ms_min"] <= r["ms"] <= r["ms_max"] and r["peak_rss_mb"] > 0
         assert r["only_peer"] == 0 and r["beyond_epsilon"] == 0
     assert m.rows[0]["ratio"] == 1 and m.rows[0]["hit_differs"] == 0
-    assert "| 4 | krsview, as saved |" in peer.table(m)
+    assert "| 4 | krsview, exact |" in peer.table(m)
     view = view_of(scene.camera, *size)
     bvh, _ = peer.build(o3d, expansion.expand(krs, view))
-    frame = renderer.render(peer.krsview_scene(scene, {}), *size, krs)
-    assert peer.beyond_epsilon(o3d, bvh, frame, view, scene, expansion.TOLERANCE) == 0
+    exact = peer.krsview_scene(scene, {"lod": 0.0})
+    frame = renderer.render(exact, *size, krs)
+    assert peer.beyond_epsilon(o3d, bvh, frame, view, exact, expansion.TOLERANCE) == 0
     frame.depth[frame.hit] *= 1.5  # negative control
-    assert peer.beyond_epsilon(o3d, bvh, frame, view, scene, expansion.TOLERANCE) > 0.01
+    assert peer.beyond_epsilon(o3d, bvh, frame, view, exact, expansion.TOLERANCE) > 0.01

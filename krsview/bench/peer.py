@@ -20,16 +20,24 @@ import numpy as np
 from ..compile.camera import View, primary_rays, view_of
 from ..gpu.renderer import Renderer
 from ..scene import KRS, Scene, SceneError
-from ..scene.model import VIEW_PREPASS
+from ..scene.model import DEFAULT_LOD, VIEW_PREPASS
 from .expansion import TOLERANCE, Mesh, expand, single_krs
 from .harness import Variant, frame_timer, interleaved
 from .report import Measured, markdown
 
 PEER = "Embree (Open3D)"
-# krsview's rows: the scene's own [render] and the viewer's pre-pass, both with the effects off
-# (primary rays only, as the peer casts). Issue 27 §1's LOD knob ([render] lod) joins here as
-# a row of its own with the pre-pass, {"prepass": VIEW_PREPASS, "lod": …}, once it exists.
-VARIANTS = {"krsview, as saved": {}, f"krsview, pre-pass {VIEW_PREPASS}": {"prepass": VIEW_PREPASS}}
+# krsview's rows, each with the effects off (primary rays only, as the peer casts): every
+# level without the pre-pass (`render --exact`), the level of detail alone, the pre-pass
+# alone, and both (what `render` and the API draw where the file sets neither).
+VARIANTS = {
+    "krsview, exact": {"prepass": 0, "lod": 0.0},
+    f"krsview, lod {DEFAULT_LOD}": {"prepass": 0, "lod": DEFAULT_LOD},
+    f"krsview, pre-pass {VIEW_PREPASS}": {"prepass": VIEW_PREPASS, "lod": 0.0},
+    f"krsview, pre-pass {VIEW_PREPASS} + lod {DEFAULT_LOD} (render's default)": {
+        "prepass": VIEW_PREPASS,
+        "lod": DEFAULT_LOD,
+    },
+}
 INSTALL = "pip install 'krsview[peer]' (Linux also needs libusb-1.0: apt-get install libusb-1.0-0)"
 
 
@@ -198,14 +206,16 @@ def measure_level(
 
 
 def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene, tolerance: float) -> float:
-    """Fraction of pixels where krsview hits farther from the mesh than ε(t) + ``tolerance``
-    pixels at its depth t: a hit the mesh does not explain (the mesh lies within
-    ``tolerance`` pixels of the surface, and the tracer stops within ε(t) of it [KRS17 §4])."""
+    """Fraction of pixels where krsview hits farther from the mesh than (1 + 2·lod)·ε(t) +
+    ``tolerance`` pixels at its depth t: a hit the mesh does not explain (the mesh lies within
+    ``tolerance`` pixels of the surface, the tracer stops within ε(t) of it [KRS17 §4], and
+    the level of detail moves a hit by at most 2·lod·ε)."""
     t = frame.depth[frame.hit]
     d = primary_rays(view).reshape(*frame.hit.shape, 3)[frame.hit]
     points = (view.origin + t[:, None] * d).astype(np.float32)
     gap = bvh.compute_distance(o3d.core.Tensor(points)).numpy()
-    allowed = (scene.render.epsilon_scale + tolerance) * view.footprint * t
+    eps = scene.render.epsilon_scale * (1.0 + 2.0 * scene.render.lod)
+    allowed = (eps + tolerance) * view.footprint * t
     return float((gap > allowed).sum() / frame.hit.size)
 
 
@@ -273,7 +283,8 @@ def table(m: Measured) -> str:
         if r["renderer"] == PEER
     ]
     notes += [
-        "hits beyond ε: pixels where krsview hits farther from the mesh than its ε(t) and the "
+        "hits beyond ε: pixels where krsview hits farther from the mesh than its ε(t) "
+        "(1 + 2·lod of them with the level of detail) and the "
         f"mesh's {m.rows[0]['tolerance_px']} px allow (the tracer stops within ε(t) of the "
         "surface, so it draws sub-pixel twigs about a pixel wide, where the mesh's rays pass "
         "by: krsview only)",

@@ -130,8 +130,9 @@ BENCHES = {
         "The obvious CPU alternative [issue 27 §3]: the KRS expanded into all its kernel "
         "instances, each tessellated within --tolerance pixels of its surface, in an Embree BVH "
         "(Open3D's RaycastingScene, on every core), cast with krsview's own primary rays. "
-        "Per level count: ms per frame of the peer and of krsview (the scene's [render], and "
-        f"the pre-pass {VIEW_PREPASS}; effects off) in interleaved rounds, median [min–max], "
+        "Per level count: ms per frame of the peer and of krsview (exact, the level of "
+        f"detail, the pre-pass {VIEW_PREPASS}, and both: render's default; effects off) in "
+        "interleaved rounds, median [min–max], "
         "their ratio per round, the BVH's build, the first frame and peak memory of each "
         "in a fresh process, and where the hit masks differ. Needs 'krsview[peer]'. "
         "Example: krsview bench peer tree --levels 16,18 --csv out/peer.csv",
