@@ -10,6 +10,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..bench.expansion import TOLERANCE
 from ..bench.report import write_csv
 from ..scene import MAX_LEVELS, SceneError
 from ..scene.model import VIEW_PREPASS
@@ -132,8 +133,8 @@ BENCHES = {
         "(Open3D's RaycastingScene, on every core), cast with krsview's own primary rays. "
         "Per level count: ms per frame of the peer and of krsview (exact, the level of "
         f"detail, the pre-pass {VIEW_PREPASS}, and both: render's default; effects off) in "
-        "interleaved rounds, median [min–max], "
-        "their ratio per round, the BVH's build, the first frame and peak memory of each "
+        "interleaved rounds, median [min–max], their ratio (the median of the rounds' "
+        "ratios), the BVH's build, the first frame and peak memory of each "
         "in a fresh process, and where the hit masks differ. Needs 'krsview[peer]'. "
         "Example: krsview bench peer tree --levels 16,18 --csv out/peer.csv",
         own=(
@@ -153,9 +154,9 @@ BENCHES = {
                 dict(
                     type=options.number_in("--tolerance", 0.01, 8.0, float),
                     metavar="PIXELS",
-                    default=0.5,
+                    default=TOLERANCE,
                     help="pixels the peer's mesh may lie from the surface, at the nearest "
-                    "instance of each level (default 0.5; finer: more triangles)",
+                    f"instance of each level (default {TOLERANCE}; finer: more triangles)",
                 ),
             ),
         ),
