@@ -30,13 +30,12 @@ real krs_distance(int first, int n, vec3r xw, real rho) {
 #endif
 #if defined(KRS_CULLING) || defined(KRS_LOD)
         vec4r b = u_bounds[i];
-        real db = length(x - b.xyz) - b.w;
 #endif
 #ifdef KRS_CULLING
-        if (b.w >= 0.0 && db >= d) break;
+        if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
 #endif
-#ifdef KRS_LOD
-        if (b.w >= 0.0 && b.w < rho) { d = min(d, db); break; }
+#ifdef KRS_LOD  // the ball's distance only where it cuts: culling off pays no more
+        if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); break; }
 #endif
         fold(i, x);
         d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
