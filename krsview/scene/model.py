@@ -21,8 +21,8 @@ SWITCH = ("on", "off")
 PATHS = ("fragment", "compute")
 PREPASS_RATIO = 4  # pre-pass: a coarse pass's tiles are this many times as wide as the next's
 VIEW_PREPASS = 4  # the viewer's pre-pass tile where the file has none (docs/speed.md)
-# render.lod where the file has none: +0.2 % hit-mask error against the ground truth on tree,
-# within noise elsewhere, no hole (docs/speed.md, docs/accuracy/); 0 draws every level
+# render.lod where the file has none: at most +0.2 % hit-mask error against the ground truth
+# on every preset, no hole (docs/speed.md, docs/accuracy/); 0 draws every level
 DEFAULT_LOD = 0.5
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
