@@ -30,14 +30,7 @@ class Mesh:
 
 def single_krs(scene: Scene) -> KRS:
     """The scene's one KRS, every kernel bounded, or a one-line error."""
-    g = scene.geometry()
-    if not isinstance(g, KRS) or scene.compound:
-        raise SceneError(
-            "PRESET",
-            scene.name,
-            "bench peer expands one KRS into triangles: a [krs], [tree] or [route] scene "
-            "(not a compound or a MöKRS)",
-        )
+    g = scene.single_krs("bench peer expands one KRS into triangles")
     for i, k in enumerate(g.kernels):
         if kernel_ball(k) is None and not isinstance(k, Empty):
             raise SceneError(f"levels[{i}].kernel", k.kind, "bench peer meshes bounded kernels")

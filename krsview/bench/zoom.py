@@ -13,7 +13,7 @@ import numpy as np
 
 from ..compile.krs import kernel_ball
 from ..gpu.renderer import Renderer
-from ..scene import KRS, Scene, SceneError
+from ..scene import Scene, SceneError
 from .harness import Variant, median_times
 from .report import Measured, markdown
 
@@ -23,14 +23,7 @@ END_RADII = 3.0  # the last stop is this many of the finest kernel's ball radii 
 def finest_kernel_ball(scene: Scene) -> np.ndarray:
     """(centre, radius) of the finest non-empty kernel K_i as the KRS holds it (one of its
     2^n instances: the branch every fold leaves in place), in world coordinates."""
-    g = scene.geometry()
-    if not isinstance(g, KRS) or scene.compound:
-        raise SceneError(
-            "PRESET",
-            scene.name,
-            "bench zoom flies into one KRS's finest kernel: a [krs], "
-            "[tree] or [route] scene (not a compound or a MöKRS)",
-        )
+    g = scene.single_krs("bench zoom flies into one KRS's finest kernel")
     for kernel in g.kernels:
         ball = kernel_ball(kernel)
         if ball is not None:

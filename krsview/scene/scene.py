@@ -103,6 +103,19 @@ class Scene:
                 "allowed here: 'sphere', 'binary'",
             )
 
+    def single_krs(self, purpose: str) -> KRS:
+        """The scene's one KRS ([krs], [tree] or [route]), or a one-line error saying that
+        ``purpose`` (e.g. "bench zoom flies into its finest kernel") needs one."""
+        g = self.geometry()
+        if not isinstance(g, KRS) or self.compound:
+            raise SceneError(
+                "PRESET",
+                self.name,
+                f"{purpose}: it needs one KRS, a [krs], [tree] or [route] scene "
+                "(not a compound or a MöKRS)",
+            )
+        return g
+
     def geometry(self) -> Geometry:
         """What is drawn: the explicit KRS or MöKRS, the tree expanded [KRS17 §9.2], or the
         compound's components placed in the world [KRS17 §5.1]."""
