@@ -21,7 +21,7 @@ class Lod:
     """The level of detail as a field over space, ρ(x) = per_t · |x − eye| with per_t =
     render.lod × ε_per_t: the camera's pixel footprint there, so primary rays, shadow rays
     and occlusion meet the same geometry (krs.distance says which); a test of a ball takes
-    ρ at its far side, the most any of its points has. Twin of lod_radius in distance.glsl."""
+    ρ at its far side, the most any of its points has. Twin of lod_radius in lod.glsl."""
 
     eye: np.ndarray
     per_t: float
@@ -36,6 +36,7 @@ class Lod:
 
 
 def rho_at(lod: Lod | None, x: np.ndarray, reach: np.ndarray | float = 0.0):
+    """ρ at the points x (or the far side of balls of radius ``reach``); 0 without LOD."""
     return 0.0 if lod is None else lod.radius(x, reach)
 
 
