@@ -89,16 +89,18 @@ def configure(
 
 def fast_settings(scene: Scene) -> Scene:
     """The scene with the viewer's fast settings where its file sets none: the pre-pass
-    tile VIEW_PREPASS (the level of detail is a scene field, DEFAULT_LOD unless the file
-    says otherwise). Both are certified hole-free by the reliable oracle; hits may move by
-    up to ε (pre-pass) and 2·lod·ε (level of detail)."""
+    tile VIEW_PREPASS (the level of detail and the shadow rays' pixel blocks are scene
+    fields, DEFAULT_LOD and DEFAULT_SHADOW_BLOCK unless the file says otherwise). The
+    oracle certifies both geometry settings hole-free; hits may move by up to ε (pre-pass)
+    and 2·lod·ε (level of detail)."""
     return scene if scene.render.prepass else scene.edit(("render", "prepass"), VIEW_PREPASS)
 
 
 def exact_settings(scene: Scene) -> Scene:
-    """The scene drawn with every level and no pre-pass: the image the float64 reference
-    matches pixel for pixel (``exact=True``, ``krsview render --exact``)."""
-    return configure(scene, prepass=0, lod=0.0)
+    """The scene drawn with every level, no pre-pass and a shadow ray per pixel: the image
+    the float64 reference matches pixel for pixel (``exact=True``, ``krsview render
+    --exact``)."""
+    return configure(scene, prepass=0, lod=0.0, shadow_block=1)
 
 
 def _shared_context():

@@ -30,6 +30,13 @@ def renderer():
     return Renderer()
 
 
+def per_pixel(scene):
+    """``scene`` with a shadow ray per pixel: as the NumPy reference shades it (the GPU's
+    shared shadow rays, ``[render] shadow_block`` > 1, are held to per-pixel ones by
+    tests/test_passes.py)."""
+    return scene.edit(("render", "shadow_block"), 1)
+
+
 def preset_paths() -> list[Path]:
     return sorted(PRESET_DIR.glob("*.toml"))
 

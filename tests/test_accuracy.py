@@ -190,6 +190,7 @@ def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
         "precision",
         "culling",
         "lod",
+        "shadow_block",  # its soft shadows: rays shared by pixel blocks or not
         "path",
         "prepass",
         "levels",

@@ -28,28 +28,33 @@ def test_the_scale_drops_when_slow_and_grows_back_when_fast():
 
 
 @pytest.mark.parametrize(
-    "moving, seconds, supersample, split, steps",
+    "moving, seconds, supersample, ratio, still, steps",
     [
-        # shadows a pass of their own: sharper images with shadow rays per 2 × 2 pixels, then
-        # the still image adds them per pixel (reusing the window-size tracing)
-        (0.35, 0.03, 1, True, [(1.0, 2), (1.0, 1)]),
-        (0.2, 0.03, 1, True, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # 0.75 s at the window's size
-        (0.2, 0.01, 1, True, [(1.0, 2), (1.0, 1)]),  # 0.25 s: no step before it
-        (0.1, 0.03, 1, True, [(0.25, 2), (0.5, 2), (1.0, 2), (1.0, 1)]),
-        (0.1, 0.005, 1, True, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # ½: 0.125 s
-        (0.8, 0.03, 1, True, [(1.0, 1)]),  # too close to the window for a step between
-        (1.0, 0.03, 1, True, [(1.0, 1)]),  # the moving frame's tracing, shadowed per pixel
-        (0.35, 0.03, 2, True, [(1.0, 2), (2.0, 1)]),  # supersampled: traced anew, twice the side
-        # every effect in each image (full shadows while moving, or no shadows to split)
-        (0.35, 0.03, 1, False, [(1.0, 0)]),
-        (0.2, 0.03, 1, False, [(0.5, 0), (1.0, 0)]),
-        (0.8, 0.03, 1, False, [(1.0, 0)]),
-        (1.0, 0.03, 1, False, []),  # the moving frame is the still image
-        (1.0, 0.03, 2, False, [(2.0, 0)]),
+        # the still image with shadow rays per pixel: sharper images with shadow rays per 2 × 2
+        # pixels, then the still image adds them per pixel (reusing the window-size tracing)
+        (0.35, 0.03, 1, 2, 1, [(1.0, 2), (1.0, 1)]),
+        (0.2, 0.03, 1, 2, 1, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # 0.75 s at the window's size
+        (0.2, 0.01, 1, 2, 1, [(1.0, 2), (1.0, 1)]),  # 0.25 s: no step before it
+        (0.1, 0.03, 1, 2, 1, [(0.25, 2), (0.5, 2), (1.0, 2), (1.0, 1)]),
+        (0.1, 0.005, 1, 2, 1, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # ½: 0.125 s
+        (0.8, 0.03, 1, 2, 1, [(1.0, 1)]),  # too close to the window for a step between
+        (1.0, 0.03, 1, 2, 1, [(1.0, 1)]),  # the moving frame's tracing, shadowed per pixel
+        (0.35, 0.03, 2, 2, 1, [(1.0, 2), (2.0, 1)]),  # supersampled: traced anew, twice the side
+        # moving frames drawn as the still image (shadow rays per block, or every effect in
+        # one pass): the window-size image is the still one
+        (0.35, 0.03, 1, 2, 2, [(1.0, 2)]),
+        (0.2, 0.03, 1, 3, 3, [(0.5, 3), (1.0, 3)]),
+        (1.0, 0.03, 1, 2, 2, []),
+        (1.0, 0.03, 2, 2, 2, [(2.0, 2)]),
+        (0.35, 0.03, 1, 0, 0, [(1.0, 0)]),
+        (0.2, 0.03, 1, 0, 0, [(0.5, 0), (1.0, 0)]),
+        (0.8, 0.03, 1, 0, 0, [(1.0, 0)]),
+        (1.0, 0.03, 1, 0, 0, []),  # the moving frame is the still image
+        (1.0, 0.03, 2, 0, 0, [(2.0, 0)]),
     ],
 )
-def test_refinement_steps(moving, seconds, supersample, split, steps):
-    assert refinement_steps(moving, seconds, supersample, split) == [Step(*s) for s in steps]
+def test_refinement_steps(moving, seconds, supersample, ratio, still, steps):
+    assert refinement_steps(moving, seconds, supersample, ratio, still) == [Step(*s) for s in steps]
 
 
 def ladder_ok(moving: float, steps: list[Step]) -> bool:
@@ -65,7 +70,7 @@ def ladder_ok(moving: float, steps: list[Step]) -> bool:
 def test_each_step_is_visibly_sharper_and_all_cost_at_most_a_third_more():
     for k in range(1, 100):
         moving = k / 100
-        steps = refinement_steps(moving, 1.0, 1, True)  # slow: every step there can be
+        steps = refinement_steps(moving, 1.0, 1, 2, 1)  # slow: every step there can be
         assert steps[-1] == Step(1.0, 1)
         if moving < 1 / 1.5:
             assert ladder_ok(moving, steps), moving

@@ -79,7 +79,9 @@ def test_render_is_the_gpu_renderers_image_and_knobs_are_edits():
     assert not np.array_equal(knobbed.color, frame.color)
     # exact: every level, no pre-pass, as the scene would be drawn without the fast settings
     exact = krsview.render(scene, SIZE, exact=True)
-    plain = GpuRenderer().render(krsview.configure(scene, prepass=0, lod=0.0), *SIZE)
+    plain = GpuRenderer().render(
+        krsview.configure(scene, prepass=0, lod=0.0, shadow_block=1), *SIZE
+    )
     assert np.array_equal(exact.color, plain.color)
     assert not np.array_equal(exact.iterations, frame.iterations)  # the pre-pass saves steps
 

@@ -166,7 +166,7 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
     failed = run_accuracy_sweep(
         scenes, (32, 18), 1, outs, 2, None, lambda n, lines, err: seen.setdefault(n, (lines, err))
     )
-    assert failed == [] and set(seen) == set(names) and all(v[0] for v in seen.values())
+    assert failed == [] and set(seen) == set(names) and all(v[0] for v in seen.values()), seen
     columns = ("knob", "value", "holes", "false_hits", "mask_error", "depth_eps_p99")
     for n in names:
         assert (outs[n] / "README.md").exists() and (outs[n] / "pareto.png").exists()

@@ -364,7 +364,7 @@ def test_render_draws_fast_unless_exact(tmp_path, capsys):
     assert main([*base, "--buffers", str(fast)]) == 0
     assert main([*base, "--exact", "--buffers", str(exact)]) == 0
     f, e = np.load(fast), np.load(exact)
-    plain = krsview.render("rock", (32, 18), prepass=0, lod=0.0)
+    plain = krsview.render("rock", (32, 18), prepass=0, lod=0.0, shadow_block=1)
     assert np.array_equal(e["color"], plain.color)
     assert f["iterations"].sum() < e["iterations"].sum()  # the pre-pass spared steps
     capsys.readouterr()

@@ -29,7 +29,7 @@ from krsview.scene import (
 )
 from krsview.scene.compound import Placement
 
-from .conftest import assert_finite, check_against_reference
+from .conftest import assert_finite, check_against_reference, per_pixel
 
 W, H = 96, 72
 CAP = 2048  # far above what any pixel needs, so the cap never cuts a trace short
@@ -144,7 +144,7 @@ def test_gpu_compound_is_the_nearest_of_its_components(renderer):
 def test_compound_shadows_fall_across_components(renderer):
     """A tree's shadow darkens the ground, another component: shadow rays see the whole
     compound (and agree with the reference)."""
-    s = replace(compound_scene(), effects=["soft_shadows"])
+    s = per_pixel(replace(compound_scene(), effects=["soft_shadows"]))
     gpu, ref = renderer.render(s, W, H), render_reference(s, W, H)
     check_against_reference("compound-soft-shadows", gpu, ref)
     plain = render_reference(replace(s, effects=[]), W, H)

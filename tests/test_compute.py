@@ -24,7 +24,9 @@ FIELDS = ("color", "depth", "normal", "iterations", "hit")
 
 
 def on_path(scene, path, **render):
-    return replace(scene, render=replace(scene.render, path=path, **render))
+    """``scene`` on ``path`` with ``render`` knobs, a shadow ray per pixel: the compute path
+    traces no other (passes.still_ratio), so the fragment path's image it equals is that."""
+    return replace(scene, render=replace(scene.render, path=path, shadow_block=1, **render))
 
 
 def same(a, b) -> bool:
@@ -66,7 +68,7 @@ def test_every_preset_draws_the_same_on_both_paths(renderer, name):
 def test_compute_in_bands_double_precision_and_any_round_size(renderer):
     """Drawn in progress bands (each band its own rays and rounds), in double precision,
     and with rounds of 1 or 1000 iterations: the same image."""
-    scene = load_scene(resolve("tree"))
+    scene = on_path(load_scene(resolve("tree")), "fragment")
     fragment = renderer.render(on_path(scene, "fragment", precision="double"), W, H)
     banded = renderer.render(
         on_path(scene, "compute", precision="double", steps=3),

@@ -30,7 +30,7 @@ from krsview.scene import (
 )
 from krsview.scene.presets import resolve
 
-from .conftest import assert_finite, check_against_reference
+from .conftest import assert_finite, check_against_reference, per_pixel
 from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples
 
 W, H = 160, 120
@@ -89,7 +89,7 @@ def test_effect_matches_reference(renderer, case):
     """Every level is drawn: the level of detail's cut, a float comparison, may fall
     differently in float32 and float64 and move a penumbra (tests/test_lod.py)."""
     scene = CASES[case]()
-    scene = replace(scene, render=replace(scene.render, lod=0.0))
+    scene = per_pixel(replace(scene, render=replace(scene.render, lod=0.0)))
     gpu = renderer.render(scene, W, H)
     ref = render_reference(scene, W, H)
     plain = render_reference(replace(scene, effects=[]), W, H)
@@ -103,7 +103,7 @@ def test_all_effects_variant_switched_by_uniforms_equals_the_specialised(rendere
     """The benchmark's baseline draws the same image: bits on ⇒ the effects, bits off ⇒ none."""
     scene = CASES["shadows"]()
     for effects in (["shadows", "kernel_texture", "fog"], []):
-        s = replace(scene, effects=effects)
+        s = per_pixel(replace(scene, effects=effects))  # the all-effects variant: one pass
         with renderer.current():
             prog = renderer.prepare(s, W, H, all_effects=True)
             uber = read_buffers(renderer.draw(prog, W, H), W, H)

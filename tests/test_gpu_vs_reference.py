@@ -11,7 +11,7 @@ from krsview.compile.camera import view_of
 from krsview.reference import render_reference
 from krsview.scene import load_scene
 
-from .conftest import assert_finite, check_against_reference, preset_paths
+from .conftest import assert_finite, check_against_reference, per_pixel, preset_paths
 
 W, H = 160, 120
 
@@ -27,7 +27,7 @@ def test_preset_matches_reference(renderer, path):
     level is drawn: the level of detail's cut, a float comparison, may fall differently in
     float32 and float64 (its own agreement is tests/test_lod.py's)."""
     scene = load_scene(path)
-    scene = replace(scene, render=replace(scene.render, lod=0.0))
+    scene = per_pixel(replace(scene, render=replace(scene.render, lod=0.0)))
     ref = render_reference(scene, W, H)
     assert ref.hit.mean() > 0.02, "the preset's camera sees (almost) nothing"
     gpu = renderer.render(scene, W, H)

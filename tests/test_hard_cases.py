@@ -13,7 +13,7 @@ from krsview.bench import hard_cases, stability
 from krsview.bench.hard_cases import CASES
 from krsview.reference import render_reference
 
-from .conftest import agreement, assert_finite, check_against_reference, failures
+from .conftest import agreement, assert_finite, check_against_reference, failures, per_pixel
 
 W, H = 120, 90
 
@@ -116,7 +116,7 @@ def deep_zoom_thirty_levels():
 
 
 def test_deep_zoom_thirty_levels_down_is_stable(renderer):
-    scene = deep_zoom_thirty_levels()
+    scene = per_pixel(deep_zoom_thirty_levels())
     assert scene.geometry().kernels[0].radius < 3e-5
     gpu = renderer.render(scene, W, H)
     ref = render_reference(scene, W, H)

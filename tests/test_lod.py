@@ -23,6 +23,7 @@ from krsview.scene import load_scene
 from krsview.scene.model import DEFAULT_LOD
 from krsview.scene.presets import resolve
 
+from .conftest import per_pixel
 from .test_culling import points
 from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples, seeds
 
@@ -104,7 +105,7 @@ def test_gpu_matches_the_reference_at_the_level_of_detail(renderer, name):
     included) agree but where a cut, a float comparison, falls apart in float32 and
     float64; and (negative control) the reference without LOD differs from it by more hits
     than the GPU does."""
-    scene = with_lod(load_scene(resolve(name)), 2.0)
+    scene = per_pixel(with_lod(load_scene(resolve(name)), 2.0))
     gpu = renderer.render(scene, W, H)
     from krsview.reference import render_reference
 

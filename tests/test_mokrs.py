@@ -18,7 +18,7 @@ from krsview.scene.mokrs import mokrs_of
 from krsview.scene.presets import resolve
 from krsview.scene.toml_writer import dumps
 
-from .conftest import assert_finite, check_against_reference
+from .conftest import assert_finite, check_against_reference, per_pixel
 
 W, H = 160, 120
 CLOSE_UP = Camera(position=(1.2, 2.0, -2.0), target=(0.0, 2.6, 0.0))  # branches ≫ a pixel
@@ -52,7 +52,7 @@ def test_tree_mokrs_preset_is_the_tree_rewritten():
 
 @pytest.mark.parametrize("preset", ["tree", "sierpinski", "grass"])
 def test_binary_tracer_matches_reference_on_krs(renderer, preset):
-    scene = binary(load_scene(resolve(preset)))
+    scene = per_pixel(binary(load_scene(resolve(preset))))
     gpu, ref = renderer.render(scene, W, H), render_reference(scene, W, H)
     assert_finite(gpu, scene.render.max_iterations)
     check_against_reference(f"binary-{preset}", gpu, ref)

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import krsview
+from krsview import api
 from krsview.frame import Frame
 from krsview.gpu import passes, program
 from krsview.gpu.passes import PassImage, Targets, splits_shadows
@@ -136,3 +137,34 @@ def test_the_passes_are_valid_desktop_glsl(renderer, tmp_path, monkeypatch):
     key = next(k for k in sources if "upsampled" in k and "u_coarse_depth" in sources[k])
     bad = {"bad.frag": sources[key].replace("(u_coarse_depth, q, 0)", "(u_coarse_depth, q)")}
     assert "texelFetch" in validate(bad, tmp_path, VERSIONS[1])
+
+
+def test_a_headless_frame_shares_shadow_rays_as_its_scene_says(renderer, targets):
+    """Renderer.render draws the still image in passes per ``[render] shadow_block``, the
+    same pixels as the viewer's PassImage, with or without progress bands; 1 is the one-pass
+    image; the exact settings (the reference's image) trace a shadow ray per pixel."""
+    tree = scene_of("tree")
+    assert tree.render.shadow_block == 2 and passes.still_ratio(tree) == 2
+    w, h = SIZE
+    for block, ratio in ((1, 0), (2, 2), (3, 3)):
+        scene = tree.edit(("render", "shadow_block"), block)
+        expected = draw(renderer, targets, scene, ratio)
+        calls: list[tuple[int, int]] = []
+        assert np.array_equal(renderer.render(scene, w, h).color, expected.color), block
+        banded = renderer.render(scene, w, h, progress=lambda *c, out=calls: out.append(c))
+        assert np.array_equal(banded.color, expected.color), block
+        assert calls[-1][0] == calls[-1][1] == len(calls) > 1
+    # negative control: the blocks' sizes light the image differently
+    assert not np.array_equal(
+        renderer.render(tree, w, h).color,
+        renderer.render(tree.edit(("render", "shadow_block"), 3), w, h).color,
+    )
+    assert api.exact_settings(tree).render.shadow_block == 1
+
+
+def test_shadow_rays_are_per_pixel_where_they_cannot_be_a_pass_of_their_own():
+    tree = scene_of("tree")
+    assert passes.still_ratio(tree) == 2
+    for knob, value in (("path", "compute"), ("precision", "double"), ("shadow_block", 1)):
+        assert passes.still_ratio(tree.edit(("render", knob), value)) == 0, knob
+    assert passes.still_ratio(tree.with_effects(["sky"])) == 0

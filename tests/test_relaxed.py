@@ -15,7 +15,7 @@ from krsview.reference.trace import relaxed_trace
 from krsview.scene import SceneError, load_scene, scene_from_toml
 from krsview.scene.presets import resolve
 
-from .conftest import check_against_reference
+from .conftest import check_against_reference, per_pixel
 from .test_distance_bound import brute_force_distance, clipped_samples, separated_krs, unit
 
 EPS = 1e-4
@@ -67,7 +67,7 @@ def test_relaxed_tracing_never_skips_a_surface(seed):
 @pytest.mark.parametrize("preset", ["tree", "rock", "sierpinski"])
 def test_gpu_relaxed_tracer_matches_the_reference(renderer, preset):
     scene = load_scene(resolve(preset))
-    scene = replace(scene, render=replace(scene.render, tracer="relaxed"))
+    scene = per_pixel(replace(scene, render=replace(scene.render, tracer="relaxed")))
     gpu, ref = renderer.render(scene, 96, 54), render_reference(scene, 96, 54)
     check_against_reference(f"relaxed-{preset}", gpu, ref)
 

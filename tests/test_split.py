@@ -63,9 +63,14 @@ def test_bench_split_reports_every_part(tmp_path):
         "nearest kernel and shading",
         "secondary effects (shadow rays, occlusion)",
     )
-    assert set(rows) == {*parts, "frame", "frame without secondary effects"}
+    per_pixel = ("secondary effects, a shadow ray per pixel", "frame, a shadow ray per pixel")
+    assert set(rows) == {*parts, "frame", "frame without secondary effects", *per_pixel}
     assert sum(rows[p] for p in parts) == pytest.approx(rows["frame"])
+    assert rows["frame without secondary effects"] + rows[per_pixel[0]] == pytest.approx(
+        rows[per_pixel[1]]
+    )
     assert rows["coarse passes"] > 0 and "| tracing |" in r.stdout
+    assert "shadow rays per 2×2 px;" in r.stdout  # the tree's still frame shares them
     bad = subprocess.run(
         [sys.executable, "-m", "krsview", "bench", "split", "tree", "--prepass-levels", "9"],
         capture_output=True,

@@ -204,8 +204,8 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once
     (its tracing program and its pre-pass, the tree's shadow rays per 2 × 2 pixels, and the
-    shading with those and with its own: gpu/passes.py); switching back, and moving
-    accuracy knobs, compile nothing."""
+    shading with those: gpu/passes.py; the still image shares them too, [render]
+    shadow_block); switching back, and moving accuracy knobs, compile nothing."""
     v = viewer
     settle(v)
     programs = v.renderer.programs
@@ -213,7 +213,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     sphere_image = v.read_window()
     v.set_render(tracer="binary")
     settle(v)
-    assert v.prepass and programs.compiles == before + 5
+    assert v.prepass and programs.compiles == before + 4
     assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
     binary_image = v.read_window()
     assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
@@ -221,13 +221,15 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     settle(v)
     v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
     settle(v)
-    assert programs.compiles == before + 5
+    assert programs.compiles == before + 4
 
 
 def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
     """render.precision from the HUD: a double variant compiles, the window shows the same
-    picture as float32 at the preset's view (to rounding), and no error appears."""
+    picture as float32 at the preset's view (to rounding), and no error appears. A shadow
+    ray per pixel in both: the double variant traces no other (gpu/passes.py)."""
     v = viewer
+    v.set_render(shadow_block=1)
     settle(v)
     single = v.read_window()
     v.set_render(precision="double")
@@ -236,7 +238,7 @@ def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
     double = v.read_window()
     assert not v.error and v.scene.render.precision == "double"
     assert (np.abs(double.astype(int) - single).max(-1) > 2).mean() < 0.01
-    v.set_render(precision="float")
+    v.set_render(precision="float", shadow_block=2)
     settle(v)
 
 
@@ -280,7 +282,7 @@ def test_preset_picker_and_levels_slider(viewer):
 def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     """The HUD's effect checkboxes go through Viewer.set_effect: a new effect set compiles one
     variant with its define (with shadows: the tracing and its pre-pass, the shadow rays per
-    2 × 2 pixels and the two shading passes, gpu/passes.py); switching back and forth again
+    2 × 2 pixels and the shading with them, gpu/passes.py); switching back and forth again
     compiles nothing."""
     v = viewer
     v.open_preset(resolve("sierpinski"))
@@ -290,7 +292,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     plain = v.read_window()
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 5
+    assert programs.compiles == before + 4
     assert any(("KRS_SHADOWS", None) in key[2] for key in programs._programs)
     assert np.abs(v.read_window().astype(int) - plain).max() > 0
     v.set_effect("soft_shadows", True)  # replaces the hard shadows: they exclude each other
@@ -300,7 +302,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     settle(v)
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 10
+    assert programs.compiles == before + 8
     v.open_preset(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error
@@ -412,14 +414,17 @@ def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(view
 def test_the_compute_path_draws_the_same_window(viewer):
     """The HUD's path knob: the compute path (rays traced in rounds, shaded in a deferred
     pass) shows the window the fragment path shows, pixel for pixel, while the adaptive
-    resolution and the refinement tiles draw it."""
+    resolution and the refinement tiles draw it (a shadow ray per pixel: the compute path
+    traces no other)."""
     v = viewer
+    v.set_render(shadow_block=1)
     settle(v)
     fragment = v.read_window()
     v.set_render(path="compute", steps=4)
     settle(v)
     assert v.view_scene().render.path == "compute"
     assert np.array_equal(v.read_window(), fragment)
+    v.set_render(path="fragment", shadow_block=2)
 
 
 def test_moving_frames_light_like_the_still_image(viewer, tmp_path):
@@ -428,10 +433,15 @@ def test_moving_frames_light_like_the_still_image(viewer, tmp_path):
     the mean colour of the still image's render at its size (shadow rays per pixel) to 2/255
     per channel, and a frame without the shadows (what moving frames drew before) does not.
     `--moving-effects` traces them per pixel: the moving frame at the window's size is then
-    the still image itself."""
+    the still image itself. (The still image here has a shadow ray per pixel,
+    ``shadow_block = 1``; with the default 2 it is the window-size image with 2 × 2 blocks.)"""
     from krsview.gpu.renderer import read_buffers
 
     v = viewer
+    v.set_render(shadow_block=2)
+    settle(v)
+    assert v.frames.frame_state().state == "still" and v.frames.frame_state().shadows == 2
+    v.set_render(shadow_block=1)
     a = v.frames.adaptive
     a.target_fps, a.scale = 0.5, 0.5  # every frame fits the budget: the scale only grows
 

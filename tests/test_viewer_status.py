@@ -56,6 +56,7 @@ def groups(seen: list[tuple]) -> list[list[tuple]]:
 
 def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_viewer):
     v = hud_viewer
+    v.set_render(shadow_block=1)  # the still image adds shadow rays per pixel: a step of its own
     v.frames.adaptive.target_fps = 60.0  # small moving frames; steps that take a few turns
     v.input.key("W", True)
     seen = [turn(v) for _ in range(4)]
@@ -99,6 +100,12 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
     assert not np.array_equal(first[2][:, HUD_RIGHT:], images[3][-1][2][:, HUD_RIGHT:])
     a = v.frames.adaptive.moving_size()
     assert a != SIZE and f"{a[0]}×{a[1]}" not in lines[0]
+    # the default [render] shadow_block: the still image shares its shadow rays too
+    v.set_render(shadow_block=2)
+    while not (v.frames.refined and seen[-1][0].state == "still" and seen[-1][0].shadows == 2):
+        seen.append(turn(v))
+        assert len(seen) < 800, "the view never became still"
+    assert ", shadows per 2×2 px;" in seen[-1][1][1] and seen[-1][0].size == SIZE
 
 
 def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):

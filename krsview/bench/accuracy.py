@@ -8,7 +8,8 @@ shows each trade-off as no machine load changes it.
 Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
 float64 shader), exact level culling, the level of detail in the walk (render.lod), the
-pre-pass tile, the path (fragment or compute) and level count (LOD by truncation). One run
+pixel blocks sharing a soft shadow ray (render.shadow_block: colour only), the pre-pass
+tile, the path (fragment or compute) and level count (LOD by truncation). One run
 writes a CSV, a Markdown report, plots (error against time and against work per knob, the
 Pareto fronts over all settings) and error images (holes red, false hits blue)."""
 
@@ -23,6 +24,7 @@ import numpy as np
 
 from ..compile.camera import view_of
 from ..frame import Frame
+from ..gpu.passes import splits_shadows
 from ..gpu.renderer import Renderer
 from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PRECISIONS
@@ -38,6 +40,7 @@ XI_PAIRS = ((2.0, 0.3), (1.5, 0.2), (3.0, 0.5))
 RELAXATIONS = (1.2, 1.6, 1.9)  # ω of over-relaxed sphere tracing [Keinert et al. 2014]
 LEVEL_CUTS = (12, 8, 4, 2)  # levels dropped from the finest end
 LODS = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0)  # render.lod: subtrees below lod × ε drawn as a ball
+SHADOW_BLOCKS = (1, 2, 3, 4)  # render.shadow_block: pixels sharing a shadow ray
 
 
 @dataclass(frozen=True)
@@ -98,6 +101,16 @@ def settings(scene: Scene) -> list[Setting]:
     for lod in LODS:  # Alg. 1's balls, or a MöKRS's levels' bounds
         if lod != r.lod:
             out.append(Setting("lod", f"{lod:g}", replace(scene, render=replace(r, lod=lod))))
+    if splits_shadows(scene):  # soft shadows shared by pixel blocks [KRS17 §8.5]
+        for block in SHADOW_BLOCKS:
+            if block != r.shadow_block:
+                out.append(
+                    Setting(
+                        "shadow_block",
+                        f"{block}",
+                        replace(scene, render=replace(r, shadow_block=block)),
+                    )
+                )
     if r.path == "fragment":
         out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
     for tile in PREPASS_TILES:
@@ -218,6 +231,7 @@ def same_work(
     for s in runs:
         rs = s.scene.render
         key = (r.prepare(s.scene, w, h, s.geometry), rs.path, rs.prepass, rs.prepass_levels)
+        key += (rs.shadow_block,)
         a = images[s.name]
         rep[s.name] = next(
             (

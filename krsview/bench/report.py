@@ -113,7 +113,7 @@ def _pareto_plots(
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(12.8, 4.6))
-    colours = dict(zip(knobs + ["scene"], plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+    colours = dict(zip(knobs + ["scene"], plt.get_cmap("tab20").colors))  # ≤ 20 knobs
     for ax, (cost, label) in zip(axes, AXES):
         for knob in knobs + ["scene"]:
             group = [r for r in rows if r["knob"] == knob]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from ..gpu.passes import still_ratio
 from ..gpu.renderer import Renderer
 from ..scene import EFFECTS, Scene
 from .harness import Variant, median_times
@@ -28,12 +29,16 @@ def split_variants(scene: Scene) -> dict[str, Variant]:
     }
     if scene.render.prepass:
         out["coarse"] = Variant(scene, prepass_only=True)
+    if still_ratio(scene):  # shadow rays shared by pixel blocks: and one per pixel beside
+        out["per pixel"] = Variant(scene.edit(("render", "shadow_block"), 1))
     return out
 
 
 def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
     """One row per part of the frame (coarse passes, tracing, nearest kernel and shading,
-    secondary effects) and the frame and the moving frame whole: ms and share of the frame."""
+    secondary effects) and the frame and the moving frame whole: ms and share of the frame;
+    where the frame shares shadow rays among pixel blocks, the secondary effects and the
+    frame with a shadow ray per pixel too (shares of that frame)."""
     med = median_times(Renderer(), split_variants(scene), size, rounds, f"bench split {scene.name}")
     coarse = med.get("coarse", 0.0)
     parts = [
@@ -45,16 +50,27 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
         ("frame without secondary effects", med["moving"]),
     ]
     rows = [dict(part=name, ms=t * 1e3, share=t / med["frame"]) for name, t in parts]
+    if "per pixel" in med:  # shares of that frame
+        whole = med["per pixel"]
+        rows += [
+            dict(part=name, ms=t * 1e3, share=t / whole)
+            for name, t in (
+                ("secondary effects, a shadow ray per pixel", whole - med["moving"]),
+                ("frame, a shadow ray per pixel", whole),
+            )
+        ]
     return Measured(scene, size, rounds, rows)
 
 
 def table(m: Measured) -> str:
     r = m.scene.render
+    block = still_ratio(m.scene)
+    shared = f", shadow rays per {block}×{block} px" if block else ""
     return (
         f"\nWhere the time goes — {m.scene.name} at {m.size[0]}×{m.size[1]}, pre-pass "
         f"{f'{r.prepass} × {r.prepass_levels}' if r.prepass else 'off'}, culling "
-        f"{r.culling}; median of {m.rounds} interleaved rounds, each part the difference of "
-        "two variants\n\n"
+        f"{r.culling}, lod {r.lod:g}{shared}; median of {m.rounds} interleaved rounds, each "
+        "part the difference of two variants\n\n"
     ) + markdown(
         ("part", "ms", "share of the frame"),
         "lrr",

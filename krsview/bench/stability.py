@@ -81,6 +81,7 @@ def check(
 ) -> Outcome:
     w, h = size
     cap = scene.render.max_iterations
+    scene = scene.edit(("render", "shadow_block"), 1)  # as the reference: a ray per pixel
     ref = render_reference(scene, w, h)
     gpu = renderer.render(scene, w, h)
     precision = scene.render.precision

@@ -20,7 +20,8 @@ TRUTH_ITERATIONS = 4096
 
 def truth_scene(scene: Scene) -> Scene:
     """The scene at ground-truth accuracy: tight ε, generous cap, every level (no level of
-    detail), its own tracer (a MöKRS keeps binary tracing: it has no distance)."""
+    detail), a shadow ray per pixel, its own tracer (a MöKRS keeps binary tracing: it has no
+    distance)."""
     return replace(
         scene,
         render=replace(
@@ -28,6 +29,7 @@ def truth_scene(scene: Scene) -> Scene:
             epsilon_scale=TRUTH_EPSILON_SCALE,
             max_iterations=TRUTH_ITERATIONS,
             lod=0.0,
+            shadow_block=1,
         ),
     )
 

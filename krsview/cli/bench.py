@@ -70,9 +70,11 @@ BENCHES = {
         "On one scene and view, the fragment path: the frame, the frame without secondary "
         "effects (shadow rays, occlusion), the "
         "tracing alone and the coarse passes alone, interleaved; each part of the frame is "
-        "the difference of two of them. Example: krsview bench split tree "
+        "the difference of two of them. Where pixel blocks share shadow rays (the "
+        "still frame's [render] shadow_block), the frame with a shadow ray per pixel beside "
+        "it. Example: krsview bench split tree "
         f"--prepass {VIEW_PREPASS} (the viewer's pre-pass).",
-        knobs=("culling", "lod", "prepass", "prepass_levels"),
+        knobs=("culling", "lod", "prepass", "prepass_levels", "shadow_block"),
     ),
     "tracers": Bench(
         "sphere vs binary sphere tracing, and a ξ sweep",

@@ -13,7 +13,7 @@ from .. import api, export
 from ..frame import Frame
 from ..progress import Progress
 from ..scene import Scene, SceneError
-from ..scene.model import DEFAULT_LOD, VIEW_PREPASS
+from ..scene.model import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, VIEW_PREPASS
 from ..share.frames import DEFAULT_FPS
 from . import options
 from .options import SILENT_SECONDS, check_output_dir, check_output_file, render_option
@@ -24,6 +24,7 @@ KNOBS = (
     "precision",
     "culling",
     "lod",
+    "shadow_block",
     "prepass",
     "prepass_levels",
     "path",
@@ -62,10 +63,11 @@ def add(sub) -> None:
     r.add_argument(
         "--exact",
         action="store_true",
-        help="every level and no pre-pass: the image the float64 reference matches, for "
-        "tests (default: the viewer's fast settings where the scene sets none: the "
-        f"pre-pass at {VIEW_PREPASS} pixels and the level of detail lod = {DEFAULT_LOD:g}, "
-        "both certified hole-free)",
+        help="every level, no pre-pass and a shadow ray per pixel: the image the float64 "
+        "reference matches, for tests (default: the viewer's fast settings where the scene "
+        f"sets none: the pre-pass at {VIEW_PREPASS} pixels and the level of detail lod = "
+        f"{DEFAULT_LOD:g}, both certified hole-free, and soft shadows shared by "
+        f"{DEFAULT_SHADOW_BLOCK}×{DEFAULT_SHADOW_BLOCK} pixels)",
     )
     r.add_argument(
         "--reference",
@@ -186,7 +188,7 @@ def settled(args: argparse.Namespace, scene: Scene) -> Scene:
     """The viewer's fast settings where neither the file nor an option sets them, or with
     --exact every level and no pre-pass (the reference's image)."""
     if args.exact:
-        for knob in ("prepass", "lod"):
+        for knob in ("prepass", "lod", "shadow_block"):
             if getattr(args, knob) is not None:
                 flag = "--" + knob
                 raise SceneError(flag, getattr(args, knob), "cannot be combined with --exact")

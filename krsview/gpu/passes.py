@@ -14,10 +14,13 @@ resolution]. ``ratio`` picks the passes:
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from typing import Protocol
+
 import moderngl
 
 from ..scene import Geometry, Scene
-from .renderer import Renderer
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
@@ -34,6 +37,41 @@ def splits_shadows(scene: Scene) -> bool:
         and scene.render.path == "fragment"
         and scene.render.precision == "float"
     )
+
+
+def still_ratio(scene: Scene) -> int:
+    """The passes a still image of ``scene`` is drawn in (the module's docstring): its
+    ``[render] shadow_block`` where the shadows can be a pass of their own, else 0 (one pass,
+    every pixel its own shadow rays)."""
+    block = scene.render.shadow_block
+    return block if block > 1 and splits_shadows(scene) else 0
+
+
+class Tracer(Protocol):
+    """What the passes need of the renderer (gpu/renderer.py): its context, its programs for
+    a frame and further passes over it, and drawing a program's pass."""
+
+    ctx: moderngl.Context
+
+    def current(self) -> AbstractContextManager: ...
+
+    def prepare(
+        self,
+        scene: Scene,
+        width: int,
+        height: int,
+        geometry: Geometry | None = None,
+        all_effects: bool = False,
+        probes: tuple[str, ...] = (),
+    ) -> moderngl.Program: ...
+
+    def companion(
+        self, prog: moderngl.Program, fragment: str, defines: dict | None = None
+    ) -> moderngl.Program: ...
+
+    def draw(
+        self, prog: moderngl.Program, width: int, height: int, tile=None
+    ) -> moderngl.Framebuffer: ...
 
 
 class Targets:
@@ -78,7 +116,7 @@ class PassImage:
 
     def __init__(
         self,
-        renderer: Renderer,
+        renderer: Tracer,
         targets: Targets,
         scene: Scene,
         size: tuple[int, int],
@@ -154,9 +192,21 @@ class PassImage:
             self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
             ctx.scissor = None
 
-    def draw_all(self) -> moderngl.Framebuffer:
-        """Every pass at once (a moving frame); the finished image's targets."""
+    def draw_all(
+        self, bands: int = 1, progress: Callable[[int, int], None] | None = None
+    ) -> moderngl.Framebuffer:
+        """Every pass (a moving frame, a headless one), each in ``bands`` bands of rows,
+        ``progress(done, total)`` after each band (GPU finished); the finished image's
+        targets."""
         self.prepare()
-        for name, _, rows in self.passes:
-            self.draw(name, 0, rows)
+        cuts = [(name, rows, min(bands, rows)) for name, _, rows in self.passes]
+        total, done = sum(n for *_, n in cuts), 0
+        for name, rows, n in cuts:
+            for b in range(n):
+                y0, y1 = rows * b // n, rows * (b + 1) // n
+                self.draw(name, y0, y1 - y0)
+                done += 1
+                if progress is not None:
+                    self.renderer.ctx.finish()
+                    progress(done, total)
         return self.output

@@ -22,6 +22,7 @@ from ..scene import Geometry, Scene, SceneError
 from ..scene.model import PREPASS_RATIO
 from .compute import ComputePath, Rounds
 from .context import headless_context
+from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
 
@@ -43,6 +44,7 @@ class Renderer:
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
         self._variant: dict[moderngl.Program, tuple[dict, dict]] = {}  # defines, uniforms
+        self._pass_targets: Targets | None = None  # images drawn in passes (passes.py)
 
     @contextmanager
     def current(self) -> Iterator[None]:
@@ -268,8 +270,15 @@ class Renderer:
         progress: Callable[[int, int], None] | None = None,
     ) -> Frame:
         """The image; with ``progress`` it is drawn in PROGRESS_BANDS bands of rows, each
-        finished before progress(done, total) is called (the same pixels either way)."""
+        finished before progress(done, total) is called (the same pixels either way). Where
+        the scene's shadow rays are shared by pixel blocks (passes.still_ratio), the image is
+        drawn in passes: trace, shadow rays per block, shade."""
         with self.current():
+            ratio = still_ratio(scene)
+            if ratio:
+                image = self._passes(scene, (width, height), geometry, ratio)
+                bands = PROGRESS_BANDS if progress else 1
+                return read_buffers(image.draw_all(bands, progress), width, height)
             prog = self.prepare(scene, width, height, geometry)
             if progress is None:
                 return read_buffers(self.draw(prog, width, height), width, height)
@@ -280,6 +289,13 @@ class Renderer:
                 self.ctx.finish()
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
+
+    def _passes(
+        self, scene: Scene, size: tuple[int, int], geometry: Geometry | None, ratio: int
+    ) -> PassImage:
+        if self._pass_targets is None:
+            self._pass_targets = Targets(self.ctx)
+        return PassImage(self, self._pass_targets, scene, size, geometry or scene.geometry(), ratio)
 
     def levels(
         self, scene: Scene, width: int, height: int, geometry: Geometry | None = None
@@ -321,12 +337,17 @@ class Renderer:
         """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up;
         ``prepass_only``: of the pre-pass's coarse passes alone; ``probes``: see prepare."""
         with self.current():
-            prog = self.prepare(scene, width, height, geometry, all_effects, probes)
-            draw = (
-                (lambda: self._prepass(prog, width, height, None))
-                if prepass_only
-                else (lambda: self.draw(prog, width, height))
-            )
+            ratio = 0 if prepass_only or probes or all_effects else still_ratio(scene)
+            if ratio:  # as render() draws it
+                image = self._passes(scene, (width, height), geometry, ratio)
+                draw = image.draw_all
+            else:
+                prog = self.prepare(scene, width, height, geometry, all_effects, probes)
+                draw = (
+                    (lambda: self._prepass(prog, width, height, None))
+                    if prepass_only
+                    else (lambda: self.draw(prog, width, height))
+                )
             draw()
             self.ctx.finish()
             times = []

@@ -24,6 +24,9 @@ VIEW_PREPASS = 4  # the viewer's pre-pass tile where the file has none (docs/spe
 # render.lod where the file has none: at most +0.2 % hit-mask error against the ground truth
 # on every preset, no hole (docs/speed.md, docs/accuracy/); 0 draws every level
 DEFAULT_LOD = 0.5
+# render.shadow_block where the file has none: soft shadows within 1/255 of per-pixel ones in
+# mean colour, for 14–26 % of a still frame on tree and grove (docs/speed.md); 1: per pixel
+DEFAULT_SHADOW_BLOCK = 2
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -304,6 +307,16 @@ class Render:
         "is smaller than lod × ε at its distance from the eye, and draws that ball for "
         "the levels below (0: off, every level; hit points move by at most "
         "2·lod·ε, never a hole)",
+    )
+    shadow_block: int = param(
+        DEFAULT_SHADOW_BLOCK,
+        lo=1,
+        hi=4,
+        unit="pixels",
+        help="side of the pixel blocks that share a shadow ray: the nearest hit of each "
+        "block traces one per light, and each pixel blends the blocks near its depth "
+        "[KRS17 §8.5: soft shadows at ¼ resolution] (1: a shadow ray per pixel, as on the "
+        "compute path and in double precision, which always trace per pixel)",
     )
     path: str = param(
         "fragment",

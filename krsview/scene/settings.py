@@ -39,9 +39,10 @@ class ViewerSettings:
     hud: bool = param(True, help="show the HUD (F1 hides and shows it)")
     moving_effects: bool = param(
         False,
-        help="trace a shadow ray per pixel in moving frames and refinement steps too, as in "
-        "the still image (a lower resolution at the target FPS); off: one per 2×2 pixels, "
-        "blended along depth, for the same lighting at a higher resolution",
+        help="trace shadow rays in moving frames and refinement steps as in the still image "
+        "(the scene's [render] shadow_block; a lower resolution at the target FPS); off: "
+        "one per 2×2 pixels at least, blended along depth, for the same lighting at a "
+        "higher resolution",
     )
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-SHADOW_RATIO = 2  # moving frames and refinement steps: one shadow ray per 2 × 2 pixels
+SHADOW_RATIO = 2  # moving frames and refinement steps: a shadow ray per 2 × 2 pixels at least
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
@@ -58,16 +58,16 @@ class Step:
 
 
 def refinement_steps(
-    moving_scale: float, moving_seconds: float, supersample: int, split: bool
+    moving_scale: float, moving_seconds: float, supersample: int, ratio: int, still: int
 ) -> list[Step]:
     """The images after the view stops, the last one the still image: one at the window's
     size, and where that would take longer than STEP_WAIT to trace (predicted from the moving
     frame's time, cost ∝ pixels) one of half its side before it, and so on down to STEP_GAIN
     times the moving frame's side, so each step is visibly sharper and all
-    before the window-size one cost at most 1/3 of it. ``split`` (shadows a pass of their
-    own): those steps trace shadow rays at SHADOW_RATIO like the moving frames, and the still
-    image adds them per pixel, reusing the tracing of the image before it where that has its
-    size; else each step has every effect."""
+    before the window-size one cost at most 1/3 of it. ``ratio``: the passes (gpu/passes.py)
+    of the moving frames and these steps; ``still``: those of the still image. Where they
+    differ (shadow rays per pixel in the still image only), the still image adds them to the
+    tracing of the window-size image before it; else that image is the still one."""
     scales = [1.0] if moving_scale * STEP_GAIN < 1.0 else []
     while (
         scales
@@ -75,11 +75,12 @@ def refinement_steps(
         and moving_seconds * (scales[0] / moving_scale) ** 2 > STEP_WAIT
     ):
         scales.insert(0, scales[0] / 2)
-    if split:
-        return [Step(s, SHADOW_RATIO) for s in scales] + [Step(float(supersample), 1)]
-    if not scales and moving_scale < 1.0:
-        scales = [1.0]
-    return [Step(s, 0) for s in scales] + ([Step(float(supersample), 0)] if supersample > 1 else [])
+    steps = [Step(s, ratio) for s in scales]
+    if still != ratio:
+        return steps + [Step(float(supersample), still)]
+    if not steps and moving_scale < 1.0:
+        steps = [Step(1.0, ratio)]
+    return steps + ([Step(float(supersample), still)] if supersample > 1 else [])
 
 
 @dataclass

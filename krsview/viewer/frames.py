@@ -1,7 +1,8 @@
 """Scheduling the tracing: after a change of view one moving frame at the adaptive resolution;
 when the view stops, the refinement's images (adaptive.py), each traced in bands within the
 frame budget and shown when done, so input is never blocked by a slow frame. Moving frames
-light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py)."""
+light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py), or
+per the scene's larger blocks (``[render] shadow_block``), as the still image is."""
 
 from __future__ import annotations
 
@@ -57,7 +58,7 @@ class Frames:
         self.display = Display(ctx, renderer.programs)
         self.targets = Targets(ctx)
         self.dirty = True  # the view changed: trace a moving frame next
-        self.full_shadows = False  # moving frames and steps trace a shadow ray per pixel
+        self.full_shadows = False  # moving frames and steps trace shadow rays as still ones
         self.image: tuple[moderngl.Framebuffer, tuple[int, int]] | None = None
         self.refinement: Refinement | None = None
         self.frame_seconds: list[float] = []  # moving frames
@@ -94,17 +95,18 @@ class Frames:
     def _moving(self, scene: Scene, krs: Geometry) -> None:
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
-        split = not self.full_shadows and splits_shadows(scene)  # shadow rays per 2 × 2
-        image = PassImage(
-            self.renderer, self.targets, scene, size, krs, SHADOW_RATIO if split else 0
-        )
+        # the still image's passes: 0 one pass, 1 shadow rays per pixel in a pass of their
+        # own, ≥ 2 per block; moving frames share a shadow ray per 2 × 2 pixels at least
+        still = scene.render.shadow_block if splits_shadows(scene) else 0
+        ratio = max(SHADOW_RATIO, still) if still and not self.full_shadows else still
+        image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)
         t0 = time.perf_counter()
         image.draw_all()
         self.ctx.finish()
         seconds = time.perf_counter() - t0
         self.adaptive.frame_done(seconds)
         self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
-        steps = refinement_steps(scale, seconds, self.adaptive.supersample, split)
+        steps = refinement_steps(scale, seconds, self.adaptive.supersample, ratio, still)
         self.refinement = Refinement(steps, self._cost) if steps else None
         self._tracing = None
         state = "moving" if steps else "still"

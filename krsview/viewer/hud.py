@@ -138,7 +138,7 @@ def _performance(v: Viewed, out: list) -> None:
     if changed:
         out.append(c.SetSupersample(2 if ss else 1))
     changed, on = field_widget(
-        "a shadow ray per pixel while moving", v.moving_effects, settings_meta("moving_effects")
+        "shadows as still while moving", v.moving_effects, settings_meta("moving_effects")
     )
     if changed:
         out.append(c.SetMovingEffects(on))

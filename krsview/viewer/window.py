@@ -142,7 +142,7 @@ class Viewer:
 
     def view_scene(self) -> Scene:
         """The scene as drawn now: the viewer's camera and pre-pass. Moving frames have every
-        effect too; unless ``moving_effects``, their shadow rays are traced per 2 × 2 pixels
+        effect too; unless ``moving_effects``, their shadow rays are shared by 2 × 2 pixels at least
         (frames.py)."""
         return replace(
             self.scene,
