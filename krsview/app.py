@@ -32,3 +32,11 @@ def edit(path: Path, **options) -> None:
         "looks, WASD/QE fly"
     )
     editor.run()
+
+
+def drag_latency(path: Path, size: tuple[int, int], steps: int) -> list[dict]:
+    """`krsview bench latency`: drag a fork of the scene at ``path`` in an editor window of
+    ``size`` for ``steps`` turns; one row of medians and p90s (krsview.editor.latency)."""
+    from .editor import latency
+
+    return latency.summary(latency.drag_latency(path, size, steps))

@@ -10,8 +10,9 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .. import app
 from ..bench.expansion import TOLERANCE
-from ..bench.report import write_csv
+from ..bench.report import markdown, write_csv
 from ..scene import MAX_LEVELS, SceneError
 from ..scene.model import VIEW_PREPASS
 from ..scene.presets import DEFAULT_PRESET, resolve
@@ -170,7 +171,7 @@ BENCHES = {
 def add(sub) -> None:
     b = sub.add_parser(
         "bench",
-        help="benchmarks (levels, paths, split, tracers, effects, zoom, peer, accuracy)",
+        help="benchmarks (levels, paths, split, tracers, effects, zoom, peer, accuracy, latency)",
         description="Benchmarks that report ratios measured side by side. "
         "Example: krsview bench tracers tree --csv out/tracers.csv",
     )
@@ -195,6 +196,7 @@ def add(sub) -> None:
             options.scene_options(sp)
         sp.set_defaults(func=run, own=own)
     add_accuracy(bsub)
+    add_latency(bsub)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -324,3 +326,63 @@ def run_accuracy_on_ray(args: argparse.Namespace, scenes: dict, outs: dict, cach
         scenes, args.size, args.rounds, outs, args.workers, args.address, done, cache
     )
     return 1 if failed else 0
+
+
+def add_latency(bsub) -> None:
+    bl = bsub.add_parser(
+        "latency",
+        help="how fast the editor answers a drag, in a real window",
+        description="Open PRESET in the editor (a grown tree baked into its route), let the "
+        "view settle, then drag the fork halfway down the route in small steps, one per "
+        "turn of the event loop, through the gizmo's own path; each frame is time-stamped "
+        "once on screen. Prints the latency from a drag step to the first frame traced "
+        "from it and the frame rate while dragging (median and p90), the internal size "
+        "while dragging, and after the release the first full-resolution image and the "
+        "still one. Needs a display (DISPLAY; Xvfb will do). "
+        "Example: krsview bench latency grove --size 1280x720",
+    )
+    options.preset(bl)
+    bl.add_argument("--size", type=options.size, default=(1280, 720), help="default 1280x720")
+    bl.add_argument(
+        "--steps",
+        type=options.number_in("--steps", 2, 10000),
+        default=40,
+        help="drag steps, one per turn (default 40)",
+    )
+    bl.add_argument("--csv", metavar="PATH", help="also write the row to this file, ending in .csv")
+    bl.set_defaults(func=run_latency)
+
+
+def run_latency(args: argparse.Namespace) -> int:
+    if args.csv:
+        check_output_file(args.csv, "--csv", ".csv")
+    rows = app.drag_latency(resolve(args.preset), args.size, args.steps)
+    print(
+        markdown(
+            (
+                "scene",
+                "window",
+                "latency ms (median, p90)",
+                "FPS dragging (median, p10)",
+                "internal size",
+                "first full resolution",
+                "still",
+            ),
+            "llrrlrr",
+            (
+                (
+                    r["scene"],
+                    r["window"],
+                    f"{r['latency_ms_median']:.0f}, {r['latency_ms_p90']:.0f}",
+                    f"{r['fps_median']:.1f}, {r['fps_p10']:.1f}",
+                    r["drag_size"],
+                    f"{r['first_full_s']:.2f} s",
+                    f"{r['still_s']:.2f} s",
+                )
+                for r in rows
+            ),
+        )
+    )
+    if args.csv:
+        print(f"wrote {write_csv(rows, args.csv)}")
+    return 0
