@@ -10,8 +10,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.editor.gizmo import snap_direction
 from krsview.editor.handles import handles, outline, polyline
+from krsview.editor.trackball import snap_direction
 from krsview.scene import SceneError, load_scene
 from krsview.scene.edits import apply_edit
 from krsview.scene.presets import resolve

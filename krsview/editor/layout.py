@@ -1,0 +1,48 @@
+"""Where the edit panel sits (docked left or right, as wide as the person drags it, at most
+half the window) and the camera that frames the scene in the part of the window it leaves:
+the scene camera's target is turned to the centre of that part."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..compile.camera import view_of
+from ..viewer.camera import FlyCamera
+
+MARGIN = 8.0  # pixels between the panel and the window's edge
+PANEL_WIDTH = 340.0  # at first
+MIN_WIDTH, MAX_SHARE = 220.0, 0.5  # the narrowest panel, and the widest share of the window
+
+
+@dataclass
+class Layout:
+    side: str = "right"  # where the edit panel docks: "left" or "right"
+    width: float = PANEL_WIDTH
+
+    def panel(self, size: tuple[float, float]) -> tuple[float, float, float, float]:
+        """The panel's window rectangle (x, y, width, height) in a window of ``size``."""
+        w, h = size
+        width = self.clamped(w)
+        x = MARGIN if self.side == "left" else w - width - MARGIN
+        return x, MARGIN, width, max(h - 2 * MARGIN, 1.0)
+
+    def clamped(self, window_width: float) -> float:
+        return max(min(self.width, MAX_SHARE * window_width), min(MIN_WIDTH, window_width))
+
+    def free(self, size: tuple[float, float]) -> tuple[float, float]:
+        """The span (x0, x1) of window columns the panel leaves to the view."""
+        x, _, width, _ = self.panel(size)
+        return (x + width + MARGIN, size[0]) if self.side == "left" else (0.0, x - MARGIN)
+
+
+def frame(camera: FlyCamera, target: np.ndarray, size: tuple[int, int], x: float) -> None:
+    """Turn ``camera`` about its up axis so that ``target`` lies at window column ``x``."""
+    for _ in range(3):  # the turn is about the world's up, the column the screen's: converge
+        v = view_of(camera.to_camera(), *size)
+        rel = np.asarray(target, dtype=np.float64) - v.origin
+        now = math.atan2(float(rel @ v.right), float(rel @ v.forward))
+        want = math.atan((2.0 * x / v.width - 1.0) * v.tan_half * v.aspect)
+        camera.look(want - now, 0.0)  # a larger yaw turns the view left
