@@ -38,10 +38,28 @@ class Layout:
         return (x + width + MARGIN, size[0]) if self.side == "left" else (0.0, x - MARGIN)
 
 
-def frame(camera: FlyCamera, target: np.ndarray, size: tuple[int, int], x: float) -> None:
-    """Turn ``camera`` about its up axis so that ``target`` lies at window column ``x``."""
+def frame(
+    camera: FlyCamera,
+    target: np.ndarray,
+    size: tuple[int, int],
+    span: tuple[float, float],
+    ball: np.ndarray | None = None,
+) -> None:
+    """Turn ``camera`` about its up axis so that ``target`` lies in the middle of the window
+    columns ``span``; with a bounding ``ball`` (centre, radius) wider than the span, step back
+    until it fits, at most by the ratio of the window's width to the span's (a close-up
+    stays a close-up)."""
+    w, h = size
+    width = max(span[1] - span[0], 1.0)
+    if ball is not None:
+        v = view_of(camera.to_camera(), w, h)
+        distance = float(np.linalg.norm(np.asarray(target) - v.origin))
+        fits = ball[3] / (width / w * v.tan_half * v.aspect)  # the ball's half-width = span's
+        back = min(max(fits / distance, 1.0), w / width)
+        camera.position = np.asarray(target) + (camera.position - np.asarray(target)) * back
+    x = 0.5 * (span[0] + span[1])
     for _ in range(3):  # the turn is about the world's up, the column the screen's: converge
-        v = view_of(camera.to_camera(), *size)
+        v = view_of(camera.to_camera(), w, h)
         rel = np.asarray(target, dtype=np.float64) - v.origin
         now = math.atan2(float(rel @ v.right), float(rel @ v.forward))
         want = math.atan((2.0 * x / v.width - 1.0) * v.tan_half * v.aspect)

@@ -26,6 +26,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ..compile.camera import View, project, view_of
+from ..compile.geometry import scene_ball
 from ..document.document import ConflictError, Document
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
 from ..scene import Bookmark, Scene, SceneError
@@ -274,6 +275,7 @@ class Editor:
         self.viewer.open_preset(path)
         self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
         self.save_as_text = str(self.path)
+        self.frame()
 
     def place_panel(self, side: str, width: float) -> None:
         """Dock the panel on ``side`` at ``width``; a new side frames the scene again."""
@@ -290,8 +292,10 @@ class Editor:
         """Turn the camera so the scene camera's target sits in the middle of the part of the
         window the panel leaves."""
         size = glfw.get_window_size(self.viewer.window)
-        x0, x1 = self.layout.free(size)
-        frame(self.viewer.camera, np.array(self.scene.camera.target), size, 0.5 * (x0 + x1))
+        target = np.array(self.scene.camera.target)
+        frame(
+            self.viewer.camera, target, size, self.layout.free(size), scene_ball(self.viewer.world)
+        )
         self.viewer.frames.dirty = True
 
     # ------------------------------------------------------------------- mouse and picking
