@@ -173,6 +173,7 @@ def test_the_clipped_part_is_the_branch_on_the_mirrors_positive_side(route_scene
     samples = np.linspace(0.0, 1.0, 4001)
     g = arc_points(route.kernel(20), len(samples)) @ np.array(m.normal) - m.offset
     spans = positive_spans(route, 21)
+
     def within(spans):
         return np.array([any(a <= x <= b for a, b in spans) for x in samples])
 

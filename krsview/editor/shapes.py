@@ -21,7 +21,7 @@ FORK, CONTROL, NORMAL, SELECTED = (
 ROUTE = (1.0, 0.9, 0.5, 0.9)
 DISC = (0.5, 0.8, 1.0, 0.25)
 CLIPPED = (1.0, 0.1, 0.05, 1.0)
-CLIPPED_DOT = 5.0  # pixels: dots along a clipped part, so it reads thicker than a line
+CLIPPED_DOT = 6.0  # pixels: dots along a clipped part, so it reads thicker than a line
 
 
 def editor_shapes(scene: Scene, shown: list[Handle], selected: Handle | None) -> Shapes:
@@ -29,10 +29,6 @@ def editor_shapes(scene: Scene, shown: list[Handle], selected: Handle | None) ->
     route = polyline(scene)
     for a, b in zip(route[:-1], route[1:]):
         s.lines.append((a, b, ROUTE))
-    if scene.route is not None:
-        for _, line in clipped_parts(scene.route):
-            s.lines += [(a, b, CLIPPED) for a, b in zip(line[:-1], line[1:])]
-            s.points += [(p, CLIPPED, CLIPPED_DOT) for p in line]
     for h in shown:
         colour = {"normal": NORMAL}.get(h.kind, CONTROL if h.path[-1] == "control" else FORK)
         big = selected is not None and h.level == selected.level
@@ -43,6 +39,10 @@ def editor_shapes(scene: Scene, shown: list[Handle], selected: Handle | None) ->
             s.lines.append((h.pivot, h.position, NORMAL))
     if selected is not None:
         _mirror_disc(s, shown, selected)
+    if scene.route is not None:  # last: over the handles
+        for _, line in clipped_parts(scene.route):
+            s.lines += [(a, b, CLIPPED) for a, b in zip(line[:-1], line[1:])]
+            s.points += [(p, CLIPPED, CLIPPED_DOT) for p in line]
     return s
 
 
