@@ -426,6 +426,21 @@ def test_the_rocks_twelve_normals_are_each_picked_and_turned_by_small_drags(rock
     pump(e, 3)
     tips = [h for h in e.shown() if h.kind == "normal"]
     assert len(tips) == 12
+
+    def label_pixels(h) -> int:
+        """White text where the hover label of ``h`` goes (right of and above its tip)."""
+        from krsview.compile.camera import project
+
+        pump(e, 2)
+        shot = e.viewer.read_window().astype(int)
+        x, y, _ = project(e.window_view(), h.position)
+        box = shot[round(y) - 20 : round(y) - 4, round(x) + 10 : round(x) + 90]
+        return int((box.min(-1) > 245).sum())
+
+    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
+    assert label_pixels(tips[4]) == 0
+    xdo("mousemove", *map(round, screen_of(e, tips[4].position)))
+    assert label_pixels(tips[4]) > 30, "no hover label naming the arrow"
     most = math.degrees(RADIANS_PER_PIXEL) * 3
     for h in tips:
         click(e, screen_of(e, h.position))
@@ -647,7 +662,6 @@ def test_nothing_is_cut_off_and_the_scene_is_framed_beside_the_panel(display, tm
         e.execute([Bake()])
         e.select_level(LEVEL)
         assert e.edit(("render", "epsilon_scale"), 2.0)
-        e.asking = ("close", None)
         pump(e, 4)
 
         def inside(name: str) -> None:
@@ -659,14 +673,27 @@ def test_nothing_is_cut_off_and_the_scene_is_framed_beside_the_panel(display, tm
             if w.content_size.y > height:
                 assert w.scroll_max.y > 0, f"{name} hides what it cannot show"
 
+        # the panel's edge dragged 80 px into the view widens it (where it is already half
+        # the window, 60 px the other way narrows it), still docked right
+        x, _, width, _ = e.layout.panel(size)
+        grow = 80.0 if 0.5 * size[0] - width >= 80 else -60.0
+        drag(e, window_xy(e, x + 1, size[1] / 2), (-grow, 0))
+        now = e.layout.clamped(size[0])
+        assert abs(now - (width + grow)) <= 2, (now, width, grow)
+        w = imgui.internal.find_window_by_name("edit")
+        assert abs(w.pos.x + w.size.x - (size[0] - 8)) <= 1
         inside("edit")
+        e.asking = ("close", None)
+        pump(e, 3)
         inside("unsaved changes")
-        for side in ("right", "left"):
+        e.answer_cancel()
+        for side in ("left", "right"):  # each a new side: framed again
             e.execute([PlacePanel(side, e.layout.width)])
             pump(e, 2)
             x0, x1 = e.layout.free(size)
             x, _, _ = project(e.window_view(), np.array(e.scene.camera.target))
             assert abs(x - (x0 + x1) / 2) < 2, (side, x, x0, x1)
-            assert not (x0 <= size[0] / 2 <= x1) or abs(size[0] / 2 - (x0 + x1) / 2) > 50
+            # negative control: the scene camera, unframed, has it in the window's middle
+            assert abs(size[0] / 2 - (x0 + x1) / 2) > 50
     finally:
         e.close()

@@ -22,12 +22,16 @@ class Layout:
     side: str = "right"  # where the edit panel docks: "left" or "right"
     width: float = PANEL_WIDTH
 
-    def panel(self, size: tuple[float, float]) -> tuple[float, float, float, float]:
-        """The panel's window rectangle (x, y, width, height) in a window of ``size``."""
+    def panel(
+        self, size: tuple[float, float], hud: float = 0.0
+    ) -> tuple[float, float, float, float]:
+        """The panel's window rectangle (x, y, width, height) in a window of ``size``; docked
+        left, it leaves the top ``hud`` pixels to the viewer's HUD (its title bar there)."""
         w, h = size
         width = self.clamped(w)
         x = MARGIN if self.side == "left" else w - width - MARGIN
-        return x, MARGIN, width, max(h - 2 * MARGIN, 1.0)
+        y = MARGIN + (hud + MARGIN if self.side == "left" and hud else 0.0)
+        return x, y, width, max(h - y - MARGIN, 1.0)
 
     def clamped(self, window_width: float) -> float:
         return max(min(self.width, MAX_SHARE * window_width), min(MIN_WIDTH, window_width))

@@ -53,7 +53,7 @@ class Edited(Protocol):
 def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
     size = imgui.get_io().display_size
-    x, y, width, height = e.layout.panel((size.x, size.y))
+    x, y, width, height = e.layout.panel((size.x, size.y), imgui.get_frame_height())
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
     imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
     imgui.set_next_window_bg_alpha(0.8)
@@ -137,13 +137,13 @@ def _file(e: Edited, out: list) -> None:
     if imgui.button("save (Ctrl+S)"):
         out.append(ec.Save())
     imgui.same_line()
-    imgui.set_next_item_width(150)
+    if imgui.button("save as"):
+        out.append(ec.SaveAs())
+    imgui.same_line()
+    imgui.set_next_item_width(-1)  # the rest of the line, however wide the panel
     changed, text = imgui.input_text("##saveas", e.save_as_text)
     if changed:
         out.append(ec.SetSaveAsText(text))
-    imgui.same_line()
-    if imgui.button("save as"):
-        out.append(ec.SaveAs())
     done, undone = doc.history.labels()
     imgui.begin_disabled(not done)
     if imgui.button("undo (Ctrl+Z)"):
