@@ -9,7 +9,6 @@ import numpy as np
 
 from ..gpu.overlay import Shapes
 from ..scene import Scene
-from .clipped import clipped_parts
 from .handles import Handle, polyline
 
 FORK, CONTROL, NORMAL, SELECTED = (
@@ -24,7 +23,13 @@ CLIPPED = (1.0, 0.1, 0.05, 1.0)
 CLIPPED_DOT = 6.0  # pixels: dots along a clipped part, so it reads thicker than a line
 
 
-def editor_shapes(scene: Scene, shown: list[Handle], selected: Handle | None) -> Shapes:
+def editor_shapes(
+    scene: Scene,
+    shown: list[Handle],
+    selected: Handle | None,
+    clipped: list[tuple[int, np.ndarray]],
+) -> Shapes:
+    """``clipped``: the route's clipped parts (clipped.clipped_parts, made once per scene)."""
     s = Shapes()
     route = polyline(scene)
     for a, b in zip(route[:-1], route[1:]):
@@ -39,10 +44,9 @@ def editor_shapes(scene: Scene, shown: list[Handle], selected: Handle | None) ->
             s.lines.append((h.pivot, h.position, NORMAL))
     if selected is not None:
         _mirror_disc(s, shown, selected)
-    if scene.route is not None:  # last: over the handles
-        for _, line in clipped_parts(scene.route):
-            s.lines += [(a, b, CLIPPED) for a, b in zip(line[:-1], line[1:])]
-            s.points += [(p, CLIPPED, CLIPPED_DOT) for p in line]
+    for _, line in clipped:  # last: over the handles
+        s.lines += [(a, b, CLIPPED) for a, b in zip(line[:-1], line[1:])]
+        s.points += [(p, CLIPPED, CLIPPED_DOT) for p in line]
     return s
 
 

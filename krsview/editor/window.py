@@ -37,6 +37,7 @@ from ..viewer.hud import draw_hud, draw_status
 from ..viewer.loop import run
 from ..viewer.window import Viewer
 from . import commands as ec
+from .clipped import clipped_parts
 from .gizmo import Gizmo
 from .handles import Handle, handles
 from .layout import Layout, frame
@@ -66,6 +67,7 @@ class Editor:
         self._handles_of: Scene | None = None  # the scene the handles were made for
         self._handles: list[Handle] = []
         self.warnings: list[str] = []
+        self.clipped: list[tuple[int, np.ndarray]] = []  # what Alg. 1 clips (drawn red)
         self.save_as_text = str(self.path)
         self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
         self.recovered = self.doc.recovery()  # offered in a modal
@@ -102,6 +104,7 @@ class Editor:
             self._handles = handles(self.scene)
             route = self.scene.route
             self.warnings = route.warnings() if route else []
+            self.clipped = clipped_parts(route) if route else []
             if self.selected is not None:  # keep the selection across edits, undo, reload
                 self.selected = next((h for h in self._handles if h.same(self.selected)), None)
 
@@ -325,7 +328,7 @@ class Editor:
         if v.frames.image is not None:
             fb = glfw.get_framebuffer_size(v.window)
             view_matrix, proj = camera_matrices(view, NEAR, FAR)
-            shapes = editor_shapes(self.scene, shown, self.selected)
+            shapes = editor_shapes(self.scene, shown, self.selected, self.clipped)
             self.overlay.draw(
                 shapes, v.frames.image[0], v.ctx.screen, fb, proj @ view_matrix, view.origin
             )
