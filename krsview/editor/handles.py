@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..scene import KRS, Capsule, Mirror, Route, Scene, Sphere, ToroidalCapsule
+from ..scene import KRS, Capsule, Kernel, Mirror, Route, Scene, Sphere, ToroidalCapsule
 from ..scene.edits import Path, get_at
 
 ARROW = 0.6  # a normal arrow's length, × its level's branch length (route) or kernel size
@@ -153,7 +153,8 @@ def krs_handles(krs: KRS, at: Path) -> list[Handle]:
     return out
 
 
-def _kernel_points(k) -> list[tuple[str, np.ndarray]]:
+def _kernel_points(k: Kernel) -> list[tuple[str, np.ndarray]]:
+    """A kernel's points a person can grab, by field name (none for empty and plane kernels)."""
     names = {
         Sphere: ("center",),
         Capsule: ("a", "b"),
@@ -162,7 +163,7 @@ def _kernel_points(k) -> list[tuple[str, np.ndarray]]:
     return [(f, np.array(getattr(k, f))) for f in names]
 
 
-def _size(k, pts: list[np.ndarray]) -> float:
+def _size(k: Kernel, pts: list[np.ndarray]) -> float:
     """A kernel's size, for the length of its mirror's arrow."""
     return max(
         float(getattr(k, "radius", 0.0)) * 4.0,

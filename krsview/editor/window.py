@@ -152,7 +152,10 @@ class Editor:
                 self._draw_ui()
             draw_status(status)
             v.platform.render()
-        v.input.claimed = v.hud and (self.gizmo.claims_mouse() or self.trackball.claims_mouse())
+        turning = self.selected is not None and self.selected.kind == "normal"
+        v.input.claimed = v.hud and (
+            self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
+        )
         glfw.swap_buffers(v.window)
         self.doc.autosave(time.monotonic())
         self._update_title()
