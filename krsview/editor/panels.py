@@ -52,6 +52,7 @@ class Edited(Protocol):
 
 def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
+    interactions.inline.clear()  # the fields drawn this frame show their own errors
     size = imgui.get_io().display_size
     x, y, width, height = e.layout.panel((size.x, size.y), imgui.get_frame_height())
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
