@@ -1,7 +1,10 @@
 """The editor in a real window under Xvfb, driven by real X pointer and key events (xdotool):
 select by clicking, drag the gizmo and a normal's arrow tip, undo/redo/save by keyboard, and
 compare the saved file's headless render with the window. Also: killed mid-edit, the
-recovery is offered; closing or a disk change with unsaved edits asks first."""
+recovery is offered; closing or a disk change with unsaved edits asks first; the rock's twelve
+normals picked and turned by small drags; a refused value kept in its field with its message;
+the gizmo's axes, snapping and float64 values; the clipped part in red; nothing cut off at
+640×360 and 1280×720, the scene framed beside the panel."""
 
 from __future__ import annotations
 
@@ -12,6 +15,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -25,6 +29,7 @@ from .conftest import headless_render
 
 SIZE = (800, 500)
 LEVEL = 19  # a fork near the top of the shipped tree, clear of the panels
+ROCK_SIZE = (640, 400)  # small: the rock's test draws some 500 frames
 
 
 @pytest.fixture
@@ -150,11 +155,16 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     settle(e)
     shot = e.viewer.read_window()
     same_prepass = ("--prepass", str(e.viewer.prepass))  # the window's pre-pass tile
-    ref = headless_render(load_scene(e.path), tmp_path / "saved", SIZE, *same_prepass)
+    seen = e.viewer.camera.to_camera()  # framed in the part the panel leaves
+    ref = headless_render(
+        replace(load_scene(e.path), camera=seen), tmp_path / "saved", SIZE, *same_prepass
+    )
     close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
     # negative control: the unedited tree differs where the fork moved
-    before = headless_render(load_scene(resolve("tree")), tmp_path / "before", SIZE, *same_prepass)
+    before = headless_render(
+        replace(load_scene(resolve("tree")), camera=seen), tmp_path / "before", SIZE, *same_prepass
+    )
     same = np.abs(shot.astype(int) - before.astype(int)).max(-1) <= 2
     assert same.mean() < 0.97, f"the edit changed only {1 - same.mean():.2%} of the pixels"
     from PIL import Image
@@ -253,8 +263,6 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
 
 
 def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor):
-    from dataclasses import replace
-
     from krsview.scene import save_scene
 
     e = editor
@@ -386,3 +394,312 @@ def test_the_hud_prepass_knob_is_an_edit_saved_with_the_scene_and_undone_by_ctrl
     xdo("key", "ctrl+s")
     pump(e)
     assert load_scene(e.path).render.prepass == 8 and not e.doc.dirty
+
+
+def window_xy(e, x, y) -> tuple[float, float]:
+    """Screen point of window point (x, y)."""
+    import glfw
+
+    wx, wy = glfw.get_window_pos(e.viewer.window)
+    return wx + x, wy + y
+
+
+def angle(a, b) -> float:
+    return math.degrees(math.acos(np.clip(np.dot(a, b), -1.0, 1.0)))
+
+
+@pytest.fixture
+def rock_editor(display, tmp_path):
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "rock.toml"
+    shutil.copy(resolve("rock"), path)
+    e = Editor(path, size=ROCK_SIZE)
+    yield e
+    e.close()
+
+
+def test_the_rocks_twelve_normals_are_each_picked_and_turned_by_small_drags(rock_editor):
+    """Each of the rock's twelve mirror arrows is selected by a click at its projected tip,
+    then turned by three 3-pixel drags up (real pointer events): three small turns of about
+    1.5° each (k × 3 px at most), each raising the normal on screen. Negative controls: no
+    label away from the tips; the same drag started 30 px beside a tip turns nothing (and
+    tests/test_handles.py: the tip-translate it replaces jumps)."""
+    from krsview.editor.trackball import RADIANS_PER_PIXEL
+
+    e = rock_editor
+    pump(e, 3)
+    tips = [h for h in e.shown() if h.kind == "normal"]
+    assert len(tips) == 12
+
+    def label_pixels(h) -> int:
+        """White text where the hover label of ``h`` goes (right of and above its tip)."""
+        from krsview.compile.camera import project
+
+        pump(e, 2)
+        shot = e.viewer.read_window().astype(int)
+        x, y, _ = project(e.window_view(), h.position)
+        box = shot[round(y) - 20 : round(y) - 4, round(x) + 10 : round(x) + 90]
+        return int((box.min(-1) > 245).sum())
+
+    xdo("mousemove", *map(round, window_xy(e, 5, ROCK_SIZE[1] - 5)))
+    assert label_pixels(tips[4]) == 0
+    xdo("mousemove", *map(round, screen_of(e, tips[4].position)))
+    assert label_pixels(tips[4]) > 30, "no hover label naming the arrow"
+    most = math.degrees(RADIANS_PER_PIXEL) * 3
+    for h in tips:
+        click(e, screen_of(e, h.position))
+        assert e.selected is not None and e.selected.same(h), (h.label, e.selected)
+        n = np.array(e.scene.krs.levels[h.level].mirror.normal)
+        up = e.window_view().up
+        for _ in range(3):
+            drag(e, screen_of(e, e.selected.position), (0, -3), steps=3)
+            m = np.array(e.scene.krs.levels[h.level].mirror.normal)
+            assert 0.2 * most < angle(n, m) <= most * 1.001, (h.label, angle(n, m))
+            assert (m - n) @ up > 0, f"{h.label}: dragging up lowered the normal"
+            n = m
+        if h is tips[0]:
+            x, y = screen_of(e, e.selected.position)
+            drag(e, (x + 30, y), (0, -3), steps=3)
+            assert np.array_equal(e.scene.krs.levels[h.level].mirror.normal, n), "turned off it"
+    assert len(e.doc.history.steps) == 36, "each drag is one undo step"
+
+
+def test_a_zero_normal_typed_stays_red_in_its_field_with_the_message_under_it(editor):
+    """Type 0 into the three components of a normal (ctrl+click, keys): the last one makes
+    the zero vector, which is refused. The field keeps (0, 0, 0) on red with the message under
+    it, the scene keeps its last valid normal, nothing goes to the HUD; a valid value clears
+    it, Esc cancels it (negative control: no red before)."""
+    e = editor
+    e.execute([Bake()])
+    e.select_level(LEVEL)
+    pump(e, 3)
+    path = ("route", "levels", LEVEL, "normal")
+
+    def red_below() -> int:
+        """Red message pixels in the two lines under the field, and red field background."""
+        x0, y0, x1, y1 = e.viewer.interactions.rects[path]  # warnings come and go above it
+        part = (x1 - x0 - 50) / 3  # three components, then the label (about 50 px)
+        shot = e.viewer.read_window().astype(int)
+        r, g, b = (shot[round(y1) : round(y1) + 34, round(x0) : round(x1), k] for k in range(3))
+        text = (r > 180) & (g < 140) & (b < 130) & (r - g > 80)
+        field = shot[round(y0) + 2 : round(y1) - 2, round(x0) + 2 : round(x0 + part) - 2]
+        frame = (np.abs(field - [140, 20, 15]) < 40).all(-1)
+        return int(text.sum()) + int(frame.sum())
+
+    def type_into(k: int, text: str) -> None:
+        for _ in range(10):  # the warnings above push it down: scroll the panel to it
+            x0, y0, x1, y1 = e.viewer.interactions.rects[path]
+            if y1 < SIZE[1] - 60:
+                break
+            xdo("mousemove", *map(round, window_xy(e, x0, SIZE[1] - 30)))  # not the outline
+            xdo("click", 5)
+            pump(e, 2)
+        part = (x1 - x0 - 50) / 3
+        xdo("mousemove", *map(round, window_xy(e, x0 + (k + 0.5) * part, (y0 + y1) / 2)))
+        pump(e, 2)
+        xdo("keydown", "ctrl")
+        xdo("click", 1)
+        xdo("keyup", "ctrl")
+        pump(e, 2)
+        xdo("type", text)
+        pump(e, 2)
+        xdo("key", "Return")
+        pump(e, 3)
+
+    assert red_below() == 0
+    for k in range(3):
+        type_into(k, "0")
+    last = e.scene.route.levels[LEVEL].normal
+    assert abs(last[2]) == 1.0, "two zeros typed: the normal is ±z"
+    assert path in e.viewer.interactions.refused, (e.viewer.error, e.doc.history.labels())
+    refused = e.viewer.interactions.refused[path]
+    assert refused.value == (0.0, 0.0, 0.0) and "must not be the zero vector" in refused.message
+    assert e.viewer.error == "", "the message went to the HUD"
+    pump(e, 2)
+    assert red_below() > 40, "no red field and message under it"
+    type_into(2, "0.5")
+    assert path not in e.viewer.interactions.refused and red_below() == 0
+    type_into(2, "0")
+    assert path in e.viewer.interactions.refused
+    xdo("key", "Escape")
+    pump(e, 3)
+    assert path not in e.viewer.interactions.refused and red_below() == 0
+    assert e.scene.route.levels[LEVEL].normal == last
+
+
+def test_the_gizmo_axes_point_the_way_the_world_axes_do(editor, monkeypatch):
+    """The translate gizmo on a fork: its red and green arrows (X, Y) run along the screen
+    directions of the world's +x and +y there. Negative control: ImGuizmo's axis flip (what
+    the editor had) turns the tree's Y arrow down."""
+    from imgui_bundle import imguizmo
+
+    from krsview.compile.camera import project
+    from krsview.editor.gizmo import Gizmo
+
+    e = editor
+    e.execute([Bake()])
+    h = handle(e, ("route", "levels", LEVEL, "fork"))
+    e.select(h)
+    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
+
+    def arrows() -> dict[str, float]:
+        pump(e, 3)
+        shot = e.viewer.read_window().astype(int)
+        v = e.window_view()
+        x, y, _ = project(v, h.position)
+        rows, cols = np.mgrid[0 : shot.shape[0], 0 : shot.shape[1]]
+        near = np.hypot(cols - x, rows - y) < 120
+        out = {}
+        for name, k, axis in (("x", 0, [1, 0, 0]), ("y", 1, [0, 1, 0])):
+            others = [c for c in range(3) if c != k]
+            mask = near & (shot[..., k] > 150) & (shot[..., others].max(-1) < 60)
+            assert mask.sum() > 20, f"no {name} arrow"
+            d = np.array([cols[mask].mean() - x, rows[mask].mean() - y])
+            tx, ty, _ = project(v, h.position + 0.1 * np.array(axis))
+            want = np.array([tx - x, ty - y])
+            out[name] = float(d @ want / np.linalg.norm(d) / np.linalg.norm(want))
+        return out
+
+    assert min(arrows().values()) > 0.9
+    flip = imguizmo.im_guizmo.begin_frame
+    monkeypatch.setattr(
+        Gizmo,
+        "begin_frame",
+        staticmethod(lambda: (flip(), imguizmo.im_guizmo.allow_axis_flip(True))),
+    )
+    assert arrows()["y"] < 0, "negative control: the flipped Y arrow points down"
+
+
+def test_a_shift_drag_lands_on_the_absolute_grid_and_saves_no_float32_noise(editor):
+    """Drag the fork's X arrow with Shift held: x lands on the 0.05 grid (not start + k ×
+    0.05), y and z keep their float64 values bit for bit, and so does the saved file."""
+    from krsview.compile.camera import project
+
+    e = editor
+    e.execute([Bake()])
+    h = handle(e, ("route", "levels", LEVEL, "fork"))
+    e.select(h)
+    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
+    pump(e, 3)
+    old = e.scene.route.levels[LEVEL].fork
+    assert abs(old[0] / 0.05 - round(old[0] / 0.05)) > 0.01, "the start is off the grid"
+    shot = e.viewer.read_window().astype(int)
+    v = e.window_view()
+    x, y, _ = project(v, h.position)
+    rows, cols = np.mgrid[0 : shot.shape[0], 0 : shot.shape[1]]
+    red = (np.hypot(cols - x, rows - y) < 120) & (shot[..., 0] > 150) & (shot[..., 1:].max(-1) < 60)
+    far = np.argmax(np.hypot(cols[red] - x, rows[red] - y))
+    grab = (x + 0.8 * (cols[red][far] - x), y + 0.8 * (rows[red][far] - y))
+    step = np.array([cols[red][far] - x, rows[red][far] - y])
+    xdo("keydown", "shift")
+    drag(e, window_xy(e, *grab), tuple(40 * step / np.linalg.norm(step)))
+    xdo("keyup", "shift")
+    new = e.scene.route.levels[LEVEL].fork
+    assert (
+        new[0] != old[0]
+        and round(new[0] / 0.05) * 0.05 == new[0]
+        or (repr(new[0]) == repr(round(round(new[0] / 0.05) * 0.05, 3)))
+    ), new
+    assert new[1] == old[1] and new[2] == old[2]
+    xdo("key", "ctrl+s")
+    pump(e)
+    assert load_scene(e.path).route.levels[LEVEL].fork == new
+    # negative control: the position read back through ImGuizmo's float32 matrix is noisy
+    noisy = np.float64(np.float32(old[1] - v.origin[1])) + v.origin[1]
+    assert noisy != old[1]
+
+
+def test_the_clipped_part_of_a_warned_branch_is_drawn_red_in_the_view(editor):
+    """Turn the mirror at fork 21 by 36° (its child branch 20 crosses it): the panel names
+    the level and the view draws the part Alg. 1 clips in red where it projects. Negative
+    control: the same pixels before the turn are not red."""
+    from krsview.compile.camera import project
+    from krsview.editor.clipped import clipped_parts
+
+    e = editor
+    e.execute([Bake()])
+    settle(e)
+
+    def red_at(points) -> float:
+        pump(e, 3)
+        shot = e.viewer.read_window().astype(int)
+        v = e.window_view()
+        hits = []
+        for p in points:
+            x, y, z = project(v, p)
+            px = shot[round(y) - 1 : round(y) + 2, round(x) - 1 : round(x) + 2]
+            hits.append(((px[..., 0] > 200) & (px[..., 1:].max(-1) < 80)).any())
+        return float(np.mean(hits))
+
+    n = np.array(e.scene.route.levels[21].normal)
+    a = np.cross(n, [0.0, 0.0, 1.0])
+    a /= np.linalg.norm(a)
+    t = math.radians(36.0)
+    turned = n * math.cos(t) + np.cross(a, n) * math.sin(t)
+    before = e.scene
+    assert e.edit(("route", "levels", 21, "normal"), tuple(turned))
+    settle(e)
+    parts = clipped_parts(e.scene.route)
+    assert [level for level, _ in parts] == [20] and e.warnings[0].startswith("levels[20]")
+    points = parts[0][1][::4]
+    assert red_at(points) > 0.8
+    e.doc.commit(before, "back")
+    e.viewer.sync()
+    settle(e)
+    assert red_at(points) < 0.1, "negative control: red before the turn"
+
+
+@pytest.mark.parametrize("size", [(640, 360), (1280, 720)])
+def test_nothing_is_cut_off_and_the_scene_is_framed_beside_the_panel(display, tmp_path, size):
+    """The edit panel and the unsaved-changes dialog lie inside the window (the panel
+    scrolls what it cannot show), and the scene camera's target is in the middle of the part
+    the panel leaves, docked right or left."""
+    from imgui_bundle import imgui
+
+    from krsview.compile.camera import project
+    from krsview.editor.commands import PlacePanel
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    e = Editor(path, size=size)
+    try:
+        e.execute([Bake()])
+        e.select_level(LEVEL)
+        assert e.edit(("render", "epsilon_scale"), 2.0)
+        pump(e, 4)
+
+        def inside(name: str) -> None:
+            w = imgui.internal.find_window_by_name(name)
+            assert w is not None, name
+            x, y, width, height = w.pos.x, w.pos.y, w.size.x, w.size.y
+            assert x >= 0 and y >= 0 and x + width <= size[0] and y + height <= size[1], name
+            assert w.content_size.x <= width, f"{name} is cut off on the right"
+            if w.content_size.y > height:
+                assert w.scroll_max.y > 0, f"{name} hides what it cannot show"
+
+        # the panel's edge dragged 80 px into the view widens it (where it is already half
+        # the window, 60 px the other way narrows it), still docked right
+        x, _, width, _ = e.layout.panel(size)
+        grow = 80.0 if 0.5 * size[0] - width >= 80 else -60.0
+        drag(e, window_xy(e, x + 1, size[1] / 2), (-grow, 0))
+        now = e.layout.clamped(size[0])
+        assert abs(now - (width + grow)) <= 2, (now, width, grow)
+        w = imgui.internal.find_window_by_name("edit")
+        assert abs(w.pos.x + w.size.x - (size[0] - 8)) <= 1
+        inside("edit")
+        e.asking = ("close", None)
+        pump(e, 3)
+        inside("unsaved changes")
+        e.answer_cancel()
+        for side in ("left", "right"):  # each a new side: framed again
+            e.execute([PlacePanel(side, e.layout.width)])
+            pump(e, 2)
+            x0, x1 = e.layout.free(size)
+            x, _, _ = project(e.window_view(), np.array(e.scene.camera.target))
+            assert abs(x - (x0 + x1) / 2) < 2, (side, x, x0, x1)
+            # negative control: the scene camera, unframed, has it in the window's middle
+            assert abs(size[0] / 2 - (x0 + x1) / 2) > 50
+    finally:
+        e.close()

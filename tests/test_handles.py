@@ -10,8 +10,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.editor.gizmo import snap_direction
 from krsview.editor.handles import handles, outline, polyline
+from krsview.editor.trackball import snap_direction
 from krsview.scene import SceneError, load_scene
 from krsview.scene.edits import apply_edit
 from krsview.scene.presets import resolve
@@ -107,12 +107,23 @@ def test_the_rocks_twelve_mirrors_have_handles_that_keep_each_plane_on_its_pivot
     m = s.krs.levels[h.level].mirror
     assert np.allclose(m.normal, tilt / np.linalg.norm(tilt))
     assert abs(np.array(m.normal) @ h.pivot - m.offset) < 1e-12
-    # its position handle slides the plane along the normal through the dragged point
+    # its slider moves the plane along the normal by the drag's part along it: the slider
+    # keeps its height above the plane, and the plane its normal
     pos = by(hs, h.path, "point")
-    p = pos.position + np.array([0.3, 0.0, 0.0])
-    s = apply_edit(rock, pos.path, pos.value_at(rock, p))
+    step = np.array([0.3, 0.0, 0.0])
+    s = apply_edit(rock, pos.path, pos.value_at(rock, pos.position + step))
     m0, m1 = rock.krs.levels[h.level].mirror, s.krs.levels[h.level].mirror
-    assert m1.normal == m0.normal and math.isclose(m1.offset, np.array(m0.normal) @ p)
+    u = np.array(m0.normal)
+    assert m1.normal == m0.normal
+    assert math.isclose(u @ (pos.position + step) - m1.offset, u @ pos.position - m0.offset)
+    assert math.isclose(m1.offset - m0.offset, u @ step) and abs(u @ step) > 0.01
+    # the arrows fan out: every tip sits ARROW × the sphere's size from its plane's point
+    # nearest the sphere's centre, so the twelve are as far apart as their normals
+    for n in normals:
+        m = rock.krs.levels[n.level].mirror
+        foot = m.offset * np.array(m.normal)  # the plane's point nearest the centre (origin)
+        tip = foot + 0.6 * 4.0 * np.array(m.normal)  # ARROW × 4 × the sphere's radius
+        assert np.allclose(n.pivot, foot) and np.allclose(n.position, tip)
 
 
 def test_a_compound_component_handle_moves_the_whole_component():
@@ -137,3 +148,121 @@ def test_snapped_directions_lie_on_the_angle_grid():
         theta = math.degrees(math.acos(s[1] / np.linalg.norm(s)))
         assert abs(theta / 5.0 - round(theta / 5.0)) < 1e-9
         assert math.degrees(math.acos(np.clip(s @ d / (d @ d), -1, 1))) < 5.0
+
+
+def turned_route(route_scene, i: int = 21, degrees: float = 36.0):
+    """The tree with level i's normal turned about the axis n × z: its child crosses it."""
+    n = np.array(route_scene.route.levels[i].normal)
+    a = np.cross(n, [0.0, 0.0, 1.0])
+    a /= np.linalg.norm(a)
+    t = math.radians(degrees)
+    u = n * math.cos(t) + np.cross(a, n) * math.sin(t)
+    return apply_edit(route_scene, ("route", "levels", i, "normal"), tuple(u))
+
+
+def test_the_clipped_part_is_the_branch_on_the_mirrors_positive_side(route_scene):
+    """The spans found in closed form against 4001 points sampled along the branch, each
+    classified by its side of the plane; the parts drawn are exactly the levels warned."""
+    from krsview.editor.clipped import clipped_parts, positive_spans
+    from krsview.scene.route import arc_points
+
+    s = turned_route(route_scene)
+    route = s.route
+    assert route.warnings() and route.warnings()[0].startswith("levels[20]")
+    m = route.mirror(21)
+    samples = np.linspace(0.0, 1.0, 4001)
+    g = arc_points(route.kernel(20), len(samples)) @ np.array(m.normal) - m.offset
+    spans = positive_spans(route, 21)
+
+    def within(spans):
+        return np.array([any(a <= x <= b for a, b in spans) for x in samples])
+
+    inside = within(spans)
+    clear = np.abs(g) > 1e-9  # off the plane by more than rounding
+    assert (inside[clear] == (g > 0)[clear]).all()
+    assert inside.mean() > 0.5, "most of the turned branch lies across the mirror"
+    parts = clipped_parts(route)
+    assert {level for level, _ in parts} == {20}
+    for _, line in parts:
+        assert (line @ np.array(m.normal) - m.offset >= -1e-9).all()
+    # negative controls: the baked tree clips nothing; the other side of the same mirror is
+    # the complement
+    assert clipped_parts(route_scene.route) == []
+    flipped = apply_edit(s, ("route", "levels", 21, "normal"), tuple(-np.array(m.normal)))
+    assert (within(positive_spans(flipped.route, 21))[clear] == ~inside[clear]).all()
+
+
+def test_a_turn_is_proportional_to_the_pointer_and_dragging_up_tilts_up():
+    """trackball.turned: the angle is k × the drag's part perpendicular to the normal (never
+    more than k × its length), the normal stays unit, an upward drag raises it; the tip-
+    translate it replaces turns a short arrow far more for the same 3 pixels (the jump)."""
+    from krsview.compile.camera import pixel_ray, project, view_of
+    from krsview.editor.handles import Handle
+    from krsview.editor.trackball import RADIANS_PER_PIXEL, turned
+
+    rock = load_scene(resolve("rock"))
+    v = view_of(rock.camera, 800, 500)
+    rng = np.random.default_rng(7)
+    for n in rng.normal(size=(40, 3)):
+        n /= np.linalg.norm(n)
+        for dx, dy in ((0.0, -3.0), (2.0, -1.0), (0.0, -0.5)):
+            m = turned(n, v, dx, dy)
+            d = dx * v.right - dy * v.up
+            perp = d - n * (n @ d)
+            angle = math.acos(np.clip(n @ m, -1, 1))
+            assert math.isclose(angle, RADIANS_PER_PIXEL * np.linalg.norm(perp), rel_tol=1e-9)
+            assert angle <= RADIANS_PER_PIXEL * math.hypot(dx, dy) * (1 + 1e-12)
+            assert math.isclose(np.linalg.norm(m), 1.0, rel_tol=1e-14)
+            if dx == 0:
+                assert (m - n) @ v.up >= -1e-15
+    # negative control: the tip dragged 3 px up in the screen plane (the old translate) turns
+    # a short arrow pointing nearly at the eye by tens of degrees
+    pivot = np.array(rock.camera.target)
+    n = -v.forward + 0.05 * v.up
+    n /= np.linalg.norm(n)
+    tip = pivot + 0.15 * n
+    x, y, z = project(v, tip)
+    moved = v.origin + (z / (pixel_ray(v, x, y - 3) @ v.forward)) * pixel_ray(v, x, y - 3)
+    h = Handle(("krs", "levels", 1, "mirror"), "normal", tip, 1, "", (), pivot=pivot)
+    jumped = np.array(h.value_at(rock, moved).normal)
+    assert math.degrees(math.acos(np.clip(n @ jumped, -1, 1))) > 10.0
+    assert math.degrees(math.acos(np.clip(n @ turned(n, v, 0, -3), -1, 1))) <= 1.5 + 1e-9
+
+
+def test_a_gizmo_move_snaps_to_the_absolute_grid_and_writes_no_float32_noise():
+    from krsview.editor.gizmo import decimal_step, moved
+
+    p = np.array([1.0, 0.1, -2.3])
+    # snapping: 1.0 + 0.2125 = 1.2125 lands on 1.25 (grid 0.25), not 1.0 + 0.25 × k
+    q = moved(p, np.array([0.2125, 0.0, 0.0]), 1e-4, 0.25)
+    assert q[0] == 1.25 and q[1] == p[1] and q[2] == p[2]
+    assert moved(p + [0.1, 0, 0], np.array([0.1125, 0.0, 0.0]), 1e-4, 0.25)[0] == 1.25
+    # no snapping: the moved coordinate is a short decimal, the others bit-exact
+    rel = np.float32(p - [0.5, 3.0, 9.0])  # camera-relative, as ImGuizmo holds it
+    out = (rel + np.float32([0.0123456, 0.0, 0.0])).astype(np.float64)
+    q = moved(p, out - rel.astype(np.float64), decimal_step(3e-4), None)
+    assert q[1] == 0.1 and q[2] == -2.3 and repr(float(q[0])) == "1.0123"
+    # negative control: the float32 position read back directly carries the noise
+    noisy = out + [0.5, 3.0, 9.0]
+    assert noisy[1] != 0.1 and abs(noisy[1] - 0.1) < 1e-6
+    assert decimal_step(0.00731) == 0.001 and decimal_step(2.0) == 1.0
+
+
+def test_only_the_selected_level_and_its_neighbours_show_their_arrows(route_scene):
+    from krsview.editor.picking import visible
+
+    rock = load_scene(resolve("rock"))
+    hs = handles(rock)
+    shown = visible(hs, None)  # the sphere's centre, and the empty levels' arrows
+    assert [h.kind for h in shown] == ["point"] + ["normal"] * 12
+    sel = next(h for h in hs if h.level == 5 and h.kind == "normal")
+    near = visible(hs, sel)
+    assert {h.level for h in near if h.path[-1] == "mirror" and h.kind == "point"} == {4, 5, 6}
+    assert sum(h.kind == "normal" for h in near) == 12
+    # a route: every fork, but control points and arrows only around the selection
+    hs = handles(route_scene)
+    assert {h.path[-1] for h in visible(hs, None)} == {"fork", "base"}
+    sel = next(h for h in hs if h.level == 7)
+    near = visible(hs, sel)
+    assert {h.level for h in near if h.path[-1] in ("control", "normal")} == {6, 7, 8}
+    assert len(near) < len(hs), "negative control: not everything shows"

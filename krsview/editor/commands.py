@@ -91,3 +91,11 @@ class AnswerDiscard(Command):
 @dataclass(frozen=True)
 class AnswerCancel(Command):
     """Unsaved edits: stay."""
+
+
+@dataclass(frozen=True)
+class PlacePanel(Command):
+    """The edit panel docks on ``side`` ("left" or "right") and is ``width`` pixels wide."""
+
+    side: str
+    width: float

@@ -1,6 +1,8 @@
-"""The ImGuizmo translate gizmo on the selected handle: camera-relative matrices (float32
-stays precise at any zoom), snapping to a grid or, for a normal's arrow tip, to angles; each
-press-and-drag is one interaction, so its edits merge into one undo step."""
+"""The ImGuizmo translate gizmo on the selected point handle: camera-relative matrices (float32
+stays precise at any zoom), its axes the world's (never flipped to face the camera, so the Y
+arrow points up and the tripod stays right-handed), snapping to the absolute grid, and values
+free of float32 noise; each press-and-drag is one interaction, so its edits merge into one undo
+step. (A normal is turned by the trackball, trackball.py.)"""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from ..gpu.overlay import camera_matrices
 from .handles import Handle
 
 gizmo = imguizmo.im_guizmo
+QUANTUM_PIXELS = 0.05  # a dragged coordinate is rounded to a decimal step under this on screen
 
 
 @dataclass
@@ -33,6 +36,7 @@ class Gizmo:
     @staticmethod
     def begin_frame() -> None:
         gizmo.begin_frame()
+        gizmo.allow_axis_flip(False)  # flipped, the tree's Y arrow pointed down (issue 28)
 
     @staticmethod
     def claims_mouse() -> bool:
@@ -45,21 +49,18 @@ class Gizmo:
         io = imgui.get_io()
         gizmo.set_drawlist(imgui.get_background_draw_list())
         gizmo.set_rect(0.0, 0.0, io.display_size.x, io.display_size.y)
-        near = 1e-3 * max(float(np.linalg.norm(h.position - v.origin)), 1e-12)
-        view, proj = camera_matrices(v, near, 1e6 * near)
+        depth = max(float(np.linalg.norm(h.position - v.origin)), 1e-12)
+        view, proj = camera_matrices(v, 1e-3 * depth, 1e3 * depth)
         obj = np.eye(4)
         obj[:3, 3] = h.position - v.origin  # camera-relative: float32 stays precise
         m = gizmo.Matrix16(list(obj.T.flatten()))
-        snap = self.snap.on or bool(io.key_shift)
-        step = gizmo.Matrix3([self.snap.grid] * 3) if snap and h.kind == "point" else None
+        before = np.array(m.values[12:15], dtype=np.float64)  # as ImGuizmo holds it
         changed = gizmo.manipulate(
             gizmo.Matrix16(list(view.T.flatten())),
             gizmo.Matrix16(list(proj.T.flatten())),
             gizmo.OPERATION.translate,
             gizmo.MODE.world,
             m,
-            None,
-            step,
         )
         using = gizmo.is_using()
         if using and not self._was_using:
@@ -67,20 +68,26 @@ class Gizmo:
         self._was_using = using
         if not (changed and using):
             return None
-        p = np.array(m.values[12:15], dtype=np.float64) + v.origin
-        if snap and h.kind == "normal":
-            p = h.pivot + snap_direction(p - h.pivot, self.snap.angle)
-        return p, ("gizmo", self.drags)
+        delta = np.array(m.values[12:15], dtype=np.float64) - before
+        quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)
+        grid = self.snap.grid if self.snap.on or io.key_shift else None
+        return moved(h.position, delta, quantum, grid), ("gizmo", self.drags)
 
 
-def snap_direction(d: np.ndarray, degrees: float) -> np.ndarray:
-    """d with its polar angles (from +y, around y) rounded to multiples of ``degrees``."""
-    r = float(np.linalg.norm(d))
-    if r == 0:
-        return d
-    step = math.radians(degrees)
-    theta = round(math.acos(max(-1.0, min(1.0, d[1] / r))) / step) * step
-    phi = round(math.atan2(d[2], d[0]) / step) * step
-    return r * np.array(
-        [math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi)]
-    )
+def decimal_step(size: float) -> float:
+    """The largest power of ten not above ``size``."""
+    return 10.0 ** math.floor(math.log10(size))
+
+
+def moved(p: np.ndarray, delta: np.ndarray, quantum: float, grid: float | None) -> np.ndarray:
+    """``p`` moved by the gizmo's ``delta``: the coordinates it moves (by more than half a
+    ``quantum``; ImGuizmo leaves the others exactly) land on the absolute ``grid`` when
+    snapping, else on a multiple of ``quantum``, written as the shortest decimal; the others
+    keep their float64 value bit for bit (no float32 noise)."""
+    out = np.array(p, dtype=np.float64)
+    step = grid if grid is not None else quantum
+    digits = max(0, -math.floor(math.log10(step)) + 1)
+    for c in range(3):
+        if abs(delta[c]) > 0.5 * quantum:
+            out[c] = round(round((p[c] + delta[c]) / step) * step, digits)
+    return out

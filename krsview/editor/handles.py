@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..scene import KRS, Capsule, Mirror, Route, Scene, Sphere, ToroidalCapsule
+from ..scene import KRS, Capsule, Kernel, Mirror, Route, Scene, Sphere, ToroidalCapsule
 from ..scene.edits import Path, get_at
 
 ARROW = 0.6  # a normal arrow's length, × its level's branch length (route) or kernel size
@@ -64,9 +64,9 @@ class Handle:
 
     def value_at(self, scene: Scene, p: np.ndarray) -> Any:
         """The field's new value when the handle is dragged to ``p``."""
-        if self.kind == "point" and self.path[-1] == "mirror":  # a point on a KRS mirror
-            m = get_at(scene, self.path)
-            return Mirror(m.normal, float(np.array(m.normal) @ p))
+        if self.kind == "point" and self.path[-1] == "mirror":  # slides a KRS mirror
+            m = get_at(scene, self.path)  # along its normal, by the drag's part along it
+            return Mirror(m.normal, m.offset + float(np.array(m.normal) @ (p - self.position)))
         if self.kind == "point":
             return tuple(float(c) for c in p)
         d = p - self.pivot
@@ -127,36 +127,49 @@ def route_handles(route: Route, at: Path) -> list[Handle]:
 
 
 def krs_handles(krs: KRS, at: Path) -> list[Handle]:
+    """A kernel's points, and per mirror an arrow from the kernel's centre projected onto the
+    plane (a kernel without points: the KRS's centre) with a slider half way up it. The arrows
+    are as long as the kernel is big, or the KRS where the kernel is empty, so the rock's twelve
+    mirrors fan out around it instead of sitting in one cluster."""
     out: list[Handle] = []
-    for i, lv in enumerate(krs.levels):
-        k = lv.kernel
-        kp = (*at, "levels", i, "kernel")
-        names = {
-            Sphere: ("center",),
-            Capsule: ("a", "b"),
-            ToroidalCapsule: ("start", "control", "end"),
-        }.get(type(k), ())
-        pts = [np.array(getattr(k, f)) for f in names]
-        lev = (*at, "levels", i)
-        out += [Handle((*kp, f), "point", p, i, f"K{i} {f}", lev) for f, p in zip(names, pts)]
+    points = [_kernel_points(lv.kernel) for lv in krs.levels]
+    every = [p for _, p in sum(points, [])]
+    middle = np.mean(every, axis=0) if every else np.zeros(3)
+    sizes = [_size(lv.kernel, [p for _, p in pts]) for lv, pts in zip(krs.levels, points)]
+    for i, (lv, pts) in enumerate(zip(krs.levels, points)):
+        kp, lev = (*at, "levels", i, "kernel"), (*at, "levels", i)
+        out += [Handle((*kp, f), "point", p, i, f"K{i} {f}", lev) for f, p in pts]
         if lv.mirror is None:
             continue
         u, w = np.array(lv.mirror.normal), lv.mirror.offset
-        centre = np.mean(pts, axis=0) if pts else w * u
-        foot = centre - (u @ centre - w) * u  # the kernel's centre, projected
-        size = max(
-            float(getattr(k, "radius", 0.0)) * 4.0,
-            float(np.ptp(np.array(pts), axis=0).max()) if len(pts) > 1 else 0.0,
-            0.25,
-        )
+        centre = np.mean([p for _, p in pts], axis=0) if pts else middle
+        foot = centre - (u @ centre - w) * u  # the centre, projected onto the plane
+        length = ARROW * (sizes[i] if pts else max(sizes))
         mp = (*at, "levels", i, "mirror")
-        out.append(Handle(mp, "point", foot, i, f"mirror R{i - 1} position", lev))
-        out.append(
-            Handle(
-                mp, "normal", foot + ARROW * size * u, i, f"mirror R{i - 1} normal", lev, pivot=foot
-            )
-        )
+        slider = foot + 0.5 * length * u
+        out.append(Handle(mp, "point", slider, i, f"mirror R{i - 1} offset", lev))
+        tip = foot + length * u
+        out.append(Handle(mp, "normal", tip, i, f"mirror R{i - 1} normal", lev, pivot=foot))
     return out
+
+
+def _kernel_points(k: Kernel) -> list[tuple[str, np.ndarray]]:
+    """A kernel's points a person can grab, by field name (none for empty and plane kernels)."""
+    names = {
+        Sphere: ("center",),
+        Capsule: ("a", "b"),
+        ToroidalCapsule: ("start", "control", "end"),
+    }.get(type(k), ())
+    return [(f, np.array(getattr(k, f))) for f in names]
+
+
+def _size(k: Kernel, pts: list[np.ndarray]) -> float:
+    """A kernel's size, for the length of its mirror's arrow."""
+    return max(
+        float(getattr(k, "radius", 0.0)) * 4.0,
+        float(np.ptp(np.array(pts), axis=0).max()) if len(pts) > 1 else 0.0,
+        0.25,
+    )
 
 
 def outline(scene: Scene) -> list[str]:

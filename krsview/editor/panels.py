@@ -19,10 +19,12 @@ from ..viewer.window import Viewer
 from . import commands as ec
 from .gizmo import Snap
 from .handles import Handle, outline
+from .layout import MIN_WIDTH, Layout
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+MODAL_WIDTH = 420.0  # pixels, or the window's width where it is narrower
 
 
 class Edited(Protocol):
@@ -38,6 +40,7 @@ class Edited(Protocol):
     scroll_outline: bool
     asking: tuple[str, Path | None] | None
     recovered: Scene | None
+    layout: Layout
 
     @property
     def doc(self) -> Document: ...
@@ -49,15 +52,20 @@ class Edited(Protocol):
 
 def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
-    imgui.set_next_window_pos(
-        imgui.ImVec2(e.viewer.frames.adaptive.full[0] - 348, 8), imgui.Cond_.first_use_ever
-    )
-    imgui.set_next_window_size(
-        imgui.ImVec2(340, e.viewer.frames.adaptive.full[1] - 16), imgui.Cond_.first_use_ever
-    )
+    interactions.inline.clear()  # the fields drawn this frame show their own errors
+    size = imgui.get_io().display_size
+    x, y, width, height = e.layout.panel((size.x, size.y), imgui.get_frame_height())
+    imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
+    imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
     imgui.set_next_window_bg_alpha(0.8)
-    imgui.begin("edit")
+    imgui.begin("edit")  # scrolls when taller than the window; collapses by its arrow
+    if not imgui.is_window_collapsed():
+        _dock(e, out, width)
     _file(e, out)
+    if e.viewer.error:
+        imgui.push_style_color(imgui.Col_.text, RED)
+        imgui.text_wrapped(e.viewer.error)
+        imgui.pop_style_color()
     scene = e.scene
     if scene.tree is not None:
         imgui.text_wrapped(
@@ -71,10 +79,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
             "A MöKRS has no handles yet; edit its file (it reloads) or the fields below."
         )
     else:
-        for w in e.warnings:
-            imgui.push_style_color(imgui.Col_.text, YELLOW)
-            imgui.text_wrapped("route." + w)
-            imgui.pop_style_color()
+        _warnings(e, out)
         _outline(e, out)
         if imgui.collapsing_header("selection", imgui.TreeNodeFlags_.default_open):
             _selection(e, out, interactions)
@@ -103,19 +108,43 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     return out
 
 
+def _dock(e: Edited, out: list, width: float) -> None:
+    """The panel's side, and its width as the person drags its edge."""
+    now = imgui.get_window_width()
+    if abs(now - width) >= 1.0:
+        out.append(ec.PlacePanel(e.layout.side, max(now, MIN_WIDTH)))
+    other = "left" if e.layout.side == "right" else "right"
+    if imgui.small_button(f"dock {other}"):
+        out.append(ec.PlacePanel(other, e.layout.width))
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("drag the panel's edge to resize it; its title bar's arrow folds it")
+
+
+def _warnings(e: Edited, out: list) -> None:
+    """Each warning names its level; a click selects that level (the view shows the clipped
+    part in red)."""
+    for w in e.warnings:
+        imgui.push_style_color(imgui.Col_.text, YELLOW)
+        imgui.text_wrapped("route." + w)
+        imgui.pop_style_color()
+        level = int(w[w.index("[") + 1 : w.index("]")])
+        if imgui.small_button(f"select level {level}##warn{level}"):
+            out.append(ec.SelectLevel(level))
+
+
 def _file(e: Edited, out: list) -> None:
     doc = e.doc
     imgui.text(("* unsaved: " if doc.dirty else "saved: ") + str(doc.path.name))
     if imgui.button("save (Ctrl+S)"):
         out.append(ec.Save())
     imgui.same_line()
-    imgui.set_next_item_width(150)
+    if imgui.button("save as"):
+        out.append(ec.SaveAs())
+    imgui.same_line()
+    imgui.set_next_item_width(-1)  # the rest of the line, however wide the panel
     changed, text = imgui.input_text("##saveas", e.save_as_text)
     if changed:
         out.append(ec.SetSaveAsText(text))
-    imgui.same_line()
-    if imgui.button("save as"):
-        out.append(ec.SaveAs())
     done, undone = doc.history.labels()
     imgui.begin_disabled(not done)
     if imgui.button("undo (Ctrl+Z)"):
@@ -131,9 +160,13 @@ def _file(e: Edited, out: list) -> None:
     if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
         imgui.set_tooltip("redo: " + undone[0])
     if e.conflict:
-        imgui.text_colored(RED, f"{doc.path.name} changed on disk, and you have unsaved edits.")
-        if imgui.button("take the file (your edits stay undoable)"):
+        imgui.push_style_color(imgui.Col_.text, RED)
+        imgui.text_wrapped(f"{doc.path.name} changed on disk, and you have unsaved edits.")
+        imgui.pop_style_color()
+        if imgui.button("take the file"):
             out.append(ec.TakeFile())
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("load the file's contents; your edits stay undoable")
         imgui.same_line()
         if imgui.button("keep mine"):
             out.append(ec.KeepMine())
@@ -141,8 +174,9 @@ def _file(e: Edited, out: list) -> None:
 
 def _outline(e: Edited, out: list) -> None:
     entries = outline(e.scene)
-    imgui.text("outline (click an entry, a handle or the geometry)")
-    if imgui.begin_child("outline", imgui.ImVec2(-1, 120), imgui.ChildFlags_.borders):
+    imgui.text_wrapped("outline (click an entry, a handle or the geometry)")
+    tall = min(120.0, 0.3 * imgui.get_io().display_size.y)
+    if imgui.begin_child("outline", imgui.ImVec2(-1, tall), imgui.ChildFlags_.borders):
         for k in range(len(entries) - 1, -1, -1):  # trunk first, as it grows
             selected = e.selected is not None and e.selected.level == k
             clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
@@ -181,8 +215,9 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
             )
             _fields(value, path, out, interactions)
             continue
+        refused = interactions.refusal(path)
         changed, new = field_widget(
-            f"{f.name}##{'.'.join(map(str, path))}", value, dict(f.metadata)
+            f"{f.name}##{'.'.join(map(str, path))}", value, dict(f.metadata), refused
         )
         key = interactions.key(path)
         if changed:
@@ -192,9 +227,9 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
 def _modals(e: Edited, out: list) -> None:
     if e.asking is not None and not imgui.is_popup_open("unsaved changes"):
         imgui.open_popup("unsaved changes")
-    if imgui.begin_popup_modal("unsaved changes", None, imgui.WindowFlags_.always_auto_resize)[0]:
+    if _begin_modal("unsaved changes"):
         what = "closing" if e.asking == ("close", None) else "opening another scene"
-        imgui.text(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
+        imgui.text_wrapped(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
         for label, command in (
             ("save", ec.AnswerSave()),
             ("discard", ec.AnswerDiscard()),
@@ -207,8 +242,8 @@ def _modals(e: Edited, out: list) -> None:
         imgui.end_popup()
     if e.recovered is not None and not imgui.is_popup_open("recover"):
         imgui.open_popup("recover")
-    if imgui.begin_popup_modal("recover", None, imgui.WindowFlags_.always_auto_resize)[0]:
-        imgui.text(
+    if _begin_modal("recover"):
+        imgui.text_wrapped(
             f"{e.doc.recovery_path.name} holds unsaved edits from a session that "
             "did not end cleanly."
         )
@@ -220,3 +255,14 @@ def _modals(e: Edited, out: list) -> None:
             out.append(ec.DiscardRecovery())
             imgui.close_current_popup()
         imgui.end_popup()
+
+
+def _begin_modal(name: str) -> bool:
+    """A modal dialog in the middle of the window, never wider than it (its text wraps)."""
+    size = imgui.get_io().display_size
+    width = min(MODAL_WIDTH, size.x - 16)
+    imgui.set_next_window_pos(
+        imgui.ImVec2(size.x / 2, size.y / 2), imgui.Cond_.always, imgui.ImVec2(0.5, 0.5)
+    )
+    imgui.set_next_window_size(imgui.ImVec2(width, 0))
+    return imgui.begin_popup_modal(name, None, imgui.WindowFlags_.no_resize)[0]

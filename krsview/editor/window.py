@@ -1,19 +1,20 @@
 """`krsview edit`: a viewer plus direct manipulation. Click a handle, an outline entry or the
-geometry to select; drag with the ImGuizmo translate gizmo (a normal by its arrow tip); every
-change is an edit through the document, so Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo it,
-Ctrl+S saves atomically, and unsaved work is autosaved beside the scene.
+geometry to select; drag a point with the ImGuizmo translate gizmo, turn a normal by dragging
+its arrow tip (a trackball about its foot); every change is an edit through the document, so
+Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo it, Ctrl+S saves atomically, and unsaved work is
+autosaved beside the scene.
 
 The editor composes a :class:`Viewer`: it turns the event loop itself, calling the viewer's
-parts (keys, camera, file watching, tracing, HUD) and adding its overlay, panels and gizmo.
-Commands of its own go to EDITOR_HANDLERS, and those the editor decides differently
-(bookmark, open, a file changed on disk); the rest to the viewer's.
+parts (keys, camera, file watching, tracing, HUD) and adding its overlay (shapes.py), panels,
+gizmo, trackball and picking (picking.py). Commands of its own go to EDITOR_HANDLERS, and those
+the editor decides differently (bookmark, open, a file changed on disk, a field's edit, reset
+view); the rest to the viewer's.
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -24,32 +25,28 @@ import glfw  # noqa: E402  (after imgui, as the viewer)
 import numpy as np
 from imgui_bundle import imgui
 
-from ..compile.camera import View, pixel_ray, project, view_of
+from ..compile.camera import View, project, view_of
+from ..compile.geometry import scene_ball
 from ..document.document import ConflictError, Document
-from ..gpu.overlay import FAR, NEAR, Overlay, Shapes, camera_matrices
-from ..reference.geometry import nearest
+from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
 from ..scene import Bookmark, Scene, SceneError
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
 from ..viewer import commands as vc
 from ..viewer.controls import VIEWER_KEYS
 from ..viewer.hud import draw_hud, draw_status
 from ..viewer.loop import run
-from ..viewer.picking import depth_at
 from ..viewer.window import Viewer
 from . import commands as ec
+from .clipped import clipped_parts
 from .gizmo import Gizmo
-from .handles import Handle, handles, polyline
+from .handles import Handle, handles
+from .layout import Layout, frame
 from .panels import edit_panel
+from .picking import pick, under, visible
+from .shapes import editor_shapes
+from .trackball import Trackball
 
-PICK_PIXELS = 12.0  # a click this close to a handle grabs it
-FORK, CONTROL, NORMAL, SELECTED = (
-    (1.0, 0.6, 0.15, 1.0),
-    (0.3, 0.85, 1.0, 1.0),
-    (1.0, 0.3, 0.8, 1.0),
-    (1.0, 1.0, 0.3, 1.0),
-)
-ROUTE = (1.0, 0.9, 0.5, 0.9)
-DISC = (0.5, 0.8, 1.0, 0.25)
+LABEL = 0xFFFFFFFF  # hover labels: white (ImGui's packed ABGR)
 EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs()}
 
 
@@ -63,11 +60,14 @@ class Editor:
         self.overlay = Overlay(self.viewer.ctx, self.viewer.renderer.programs)
         self.gizmo = Gizmo()
         self.snap = self.gizmo.snap
+        self.trackball = Trackball(self.snap)
+        self.layout = Layout()
         self.carry = True  # a fork drag takes its subtree along
         self.selected: Handle | None = None
         self._handles_of: Scene | None = None  # the scene the handles were made for
         self._handles: list[Handle] = []
         self.warnings: list[str] = []
+        self.clipped: list[tuple[int, np.ndarray]] = []  # what Alg. 1 clips (drawn red)
         self.save_as_text = str(self.path)
         self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
         self.recovered = self.doc.recovery()  # offered in a modal
@@ -76,6 +76,7 @@ class Editor:
         self._quit = False
         self._title = ""
         self._update_title()
+        self.frame()
 
     # ------------------------------------------------------------------------- the scene
     @property
@@ -103,11 +104,17 @@ class Editor:
             self._handles = handles(self.scene)
             route = self.scene.route
             self.warnings = route.warnings() if route else []
+            self.clipped = clipped_parts(route) if route else []
             if self.selected is not None:  # keep the selection across edits, undo, reload
                 self.selected = next((h for h in self._handles if h.same(self.selected)), None)
 
     def edit(self, path: tuple, value, interaction=None) -> bool:
-        return self.viewer.edit(path, value, interaction)
+        """An edit through the document; a value refused for a field the panel shows keeps
+        its message at that field (viewer/widgets.py), any other in the panel's error line."""
+        ok = self.viewer.edit(path, value, interaction)
+        if self.viewer.interactions.settle(path, value, self.viewer.error):
+            self.viewer.error = ""
+        return ok
 
     def _update_title(self) -> None:
         title = f"krsview edit — {self.doc.title}"
@@ -145,7 +152,10 @@ class Editor:
                 self._draw_ui()
             draw_status(status)
             v.platform.render()
-        v.input.claimed = v.hud and self.gizmo.claims_mouse()
+        turning = self.selected is not None and self.selected.kind == "normal"
+        v.input.claimed = v.hud and (
+            self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
+        )
         glfw.swap_buffers(v.window)
         self.doc.autosave(time.monotonic())
         self._update_title()
@@ -271,100 +281,82 @@ class Editor:
         self.viewer.open_preset(path)
         self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
         self.save_as_text = str(self.path)
+        self.frame()
+
+    def place_panel(self, side: str, width: float) -> None:
+        """Dock the panel on ``side`` at ``width``; a new side frames the scene again."""
+        moved = side != self.layout.side
+        self.layout.side, self.layout.width = side, width
+        if moved:
+            self.frame()
+
+    def reset_view(self) -> None:
+        self.viewer.reset_view()
+        self.frame()
+
+    def frame(self) -> None:
+        """Turn the camera so the scene camera's target sits in the middle of the part of the
+        window the panel leaves."""
+        size = glfw.get_window_size(self.viewer.window)
+        target = np.array(self.scene.camera.target)
+        frame(
+            self.viewer.camera, target, size, self.layout.free(size), scene_ball(self.viewer.world)
+        )
+        self.viewer.frames.dirty = True
 
     # ------------------------------------------------------------------- mouse and picking
     def window_view(self) -> View:
         w, h = glfw.get_window_size(self.viewer.window)
         return view_of(self.viewer.camera.to_camera(), max(w, 1), max(h, 1))
 
+    def shown(self) -> list[Handle]:
+        """The handles drawn and picked now (picking.visible)."""
+        return visible(self.handles, self.selected)
+
     def pick(self, x: float, y: float) -> Handle | None:
-        """Select what is under window point (x, y): the nearest handle within PICK_PIXELS,
-        else the level of the kernel nearest to the traced surface point there."""
-        v = self.window_view()
-        best, best_d = None, PICK_PIXELS
-        for h in self.handles:
-            px, py, z = project(v, h.position)
-            d = math.hypot(px - x, py - y) if z > 0 else math.inf
-            if d < best_d:
-                best, best_d = h, d
-        if best is None:
-            best = self._pick_surface(v, x, y)
+        """Select what is under window point (x, y): a shown handle within PICK_PIXELS, else
+        the level of the kernel nearest to the traced surface point there."""
+        best = pick(self, self.window_view(), x, y)
         self.select(best)
         return best
-
-    def _pick_surface(self, v: View, x: float, y: float) -> Handle | None:
-        if self.viewer.frames.image is None:
-            return None
-        fbo, (w, h) = self.viewer.frames.image
-        px = min(max(int(x / v.width * w), 0), w - 1)
-        py = min(max(int((v.height - y) / v.height * h), 0), h - 1)
-        t = depth_at(fbo, px, py)
-        if not t > 0:
-            return None
-        point = v.origin + t * pixel_ray(v, x, y)
-        slot = int(nearest(self.viewer.world, point[None])[0][0])
-        level = self._entry_of_slot(slot)
-        return next((h for h in self.handles if h.level == level), None)
-
-    def _entry_of_slot(self, slot: int) -> int:
-        """Outline entry of a compiled level slot: the level itself (shifted by the finest
-        levels the levels slider cut away), or a compound's component (slots are numbered
-        component after component)."""
-        if not self.scene.compound:
-            return slot + self.viewer.geometry.depth - self.viewer.krs.depth
-        bases = list(getattr(self.viewer.world, "bases", (0,)))
-        return max(k for k, b in enumerate(bases) if b <= slot)
 
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:
         """Inside the ImGui frame: the overlay over the image, the viewer's HUD (collapsed
-        at first: the view stays free), the edit panel and the gizmo."""
+        at first: the view stays free), the edit panel, the gizmo on a selected point or the
+        trackball on a selected normal, and the name of the handle under the pointer."""
         v = self.viewer
         view = self.window_view()
+        shown = self.shown()
         if v.frames.image is not None:
             fb = glfw.get_framebuffer_size(v.window)
             view_matrix, proj = camera_matrices(view, NEAR, FAR)
-            matrix = proj @ view_matrix
+            shapes = editor_shapes(self.scene, shown, self.selected, self.clipped)
             self.overlay.draw(
-                self._shapes(), v.frames.image[0], v.ctx.screen, fb, matrix, view.origin
+                shapes, v.frames.image[0], v.ctx.screen, fb, proj @ view_matrix, view.origin
             )
         self.gizmo.begin_frame()
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))
-        if self.selected is not None:
-            moved = self.gizmo.manipulate(self.selected, view)
+        sel = self.selected
+        if sel is not None:
+            tool = self.trackball.update if sel.kind == "normal" else self.gizmo.manipulate
+            moved = tool(sel, view)
             if moved is not None:
                 p, drag = moved
-                self.edit(*self.selected.edit_to(self.scene, p, self.carry), drag)
+                self.edit(*sel.edit_to(self.scene, p, self.carry), drag)
+        self._hover_label(shown, view)
 
-    def _shapes(self) -> Shapes:
-        s = Shapes()
-        route = polyline(self.scene)
-        for a, b in zip(route[:-1], route[1:]):
-            s.lines.append((a, b, ROUTE))
-        sel = self.selected
-        for h in self.handles:
-            colour = {"normal": NORMAL}.get(h.kind, CONTROL if h.path[-1] == "control" else FORK)
-            big = sel is not None and h.level == sel.level
-            if h.same(sel):
-                colour = SELECTED
-            s.points.append((h.position, colour, 13.0 if big else 8.0))
-            if h.kind == "normal" and big:
-                s.lines.append((h.pivot, h.position, NORMAL))
-        if sel is not None:
-            self._mirror_disc(s, sel)
-        return s
-
-    def _mirror_disc(self, s: Shapes, sel: Handle) -> None:
-        """The selected level's mirror as a translucent disc through its fork."""
-        arrow = next((h for h in self.handles if h.level == sel.level and h.kind == "normal"), None)
-        if arrow is None:
+    def _hover_label(self, shown: list[Handle], view: View) -> None:
+        io = imgui.get_io()
+        if io.want_capture_mouse:
             return
-        d = arrow.position - arrow.pivot
-        r = float(np.linalg.norm(d))
-        if r > 0:
-            s.disc(arrow.pivot, d / r, 1.6 * r, DISC)
+        h = under(shown, view, io.mouse_pos.x, io.mouse_pos.y)
+        if h is not None:
+            x, y, _ = project(view, h.position)
+            draw = imgui.get_foreground_draw_list()
+            draw.add_text(imgui.ImVec2(x + 10, y - 20), LABEL, h.label)
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
@@ -389,4 +381,7 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     vc.AddBookmark: lambda e, c: e.add_bookmark(),
     vc.OpenPreset: lambda e, c: e.open_preset(c.path),
     vc.ReloadScene: lambda e, c: e.reload_scene(),
+    vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction),
+    vc.ResetView: lambda e, c: e.reset_view(),
+    ec.PlacePanel: lambda e, c: e.place_panel(c.side, c.width),
 }

@@ -51,7 +51,7 @@ class Tree:
         None,
         lo=0.0,
         hi=1.0,
-        help="colour of a ground plane through the base, ⟂ up (kernel of the last forest level)",
+        help="colour of a ground plane through the base (kernel of the last forest level)",
     )
 
     def validate(self, path: str) -> None:

@@ -11,6 +11,7 @@ import glfw  # noqa: E402  (order matters)
 from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
 
 from .controls import LOOK_BUTTON, Input
+from .fonts import load_font
 
 GLFW_KEYS = {getattr(glfw, f"KEY_{c}"): c for c in string.ascii_uppercase} | {
     getattr(glfw, f"KEY_F{i}"): f"F{i}" for i in range(1, 13)
@@ -28,6 +29,7 @@ class Platform:
         imgui.create_context()
         implot.create_context()
         imgui.get_io().set_ini_filename("")
+        load_font()
         self.addr = ctypes.cast(self.window, ctypes.c_void_p).value
         imgui.backends.glfw_init_for_opengl(self.addr, False)
         imgui.backends.opengl3_init("#version 430")

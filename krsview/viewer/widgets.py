@@ -3,7 +3,9 @@ type picks the widget, its metadata gives the range, unit and tooltip, so panels
 a range by hand. A widget returns the new value; the document validates it.
 
 Each widget reports its interaction: a slider or drag held down is one interaction, so the
-many values it produces merge into one undo step (DESIGN.md, One seam for edits)."""
+many values it produces merge into one undo step (DESIGN.md, One seam for edits). A value the
+schema refuses stays in its field, marked red, with the message under it, until a valid value
+replaces it or Esc cancels it (the scene keeps its last valid value meanwhile)."""
 
 from __future__ import annotations
 
@@ -13,23 +15,62 @@ from typing import Any
 from imgui_bundle import imgui
 
 LOG_RATIO = 100.0  # a range spanning more than this factor gets a logarithmic slider
+RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+RED_FRAME = imgui.ImVec4(0.55, 0.08, 0.06, 1.0)
+
+
+@dataclass(frozen=True)
+class Refused:
+    """A value typed or dragged into a field that the schema refused, and why."""
+
+    value: Any
+    message: str
 
 
 @dataclass
 class Interactions:
     """Numbers each press-and-drag of a widget, so its edits merge into one undo step; keeps
-    where each field's widget was drawn (window pixels), for automation and window tests."""
+    where each field's widget was drawn (window pixels), for automation and window tests; and
+    the refused values of the fields that show their errors themselves."""
 
     count: int = 0
     rects: dict[tuple, tuple[float, float, float, float]] = field(default_factory=dict)
+    refused: dict[tuple, Refused] = field(default_factory=dict)
+    inline: set[tuple] = field(default_factory=set)  # fields drawn with refusal()
+
+    def refusal(self, path: tuple) -> Refused | None:
+        """Call before the field's widget: its refused value, if any (and from now on its
+        errors are shown at the field, not elsewhere)."""
+        self.inline.add(path)
+        return self.refused.get(path)
 
     def key(self, path: tuple) -> tuple:
-        """Call right after the widget: a new number when it was just activated."""
+        """Call right after the widget: a new number when it was just activated. A refused
+        field's message goes under it; Esc cancels the refused value."""
         if imgui.is_item_activated():
             self.count += 1
         lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
         self.rects[path] = (lo.x, lo.y, hi.x, hi.y)
+        if path in self.refused:
+            if imgui.is_key_pressed(imgui.Key.escape):
+                del self.refused[path]
+            else:
+                imgui.push_style_color(imgui.Col_.text, RED)
+                imgui.text_wrapped(self.refused[path].message)
+                imgui.pop_style_color()
         return ("panel", path, self.count)
+
+    def settle(self, path: tuple, value: Any, error: str) -> bool:
+        """An edit of ``path`` was applied (``error`` empty) or refused: a field showing its
+        own errors keeps the refused value, or drops it once a value is taken. True when the
+        error is shown at the field."""
+        if not error:
+            self.refused.pop(path, None)
+            return False
+        if path not in self.inline:
+            return False
+        self.refused[path] = Refused(value, error)
+        return True
 
 
 def _tooltip(meta: dict, typed: bool) -> None:
@@ -53,9 +94,20 @@ def _speed(value: float, meta: dict) -> float:
     return speed
 
 
-def field_widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
+def field_widget(
+    label: str, value: Any, meta: dict, refused: Refused | None = None
+) -> tuple[bool, Any]:
     """One widget for one field (of the scene, or of the viewer's settings); (changed, new
-    value)."""
+    value). A ``refused`` value is shown instead of ``value``, on red."""
+    if refused is None:
+        return _widget(label, value, meta)
+    imgui.push_style_color(imgui.Col_.frame_bg, RED_FRAME)
+    changed, new = _widget(label, refused.value, meta)
+    imgui.pop_style_color()
+    return changed, new
+
+
+def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
     lo, hi = meta.get("lo"), meta.get("hi")
     if isinstance(value, bool):
         changed, value = imgui.checkbox(label, value)

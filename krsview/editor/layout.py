@@ -1,0 +1,70 @@
+"""Where the edit panel sits (docked left or right, as wide as the person drags it, at most
+half the window) and the camera that frames the scene in the part of the window it leaves:
+the scene camera's target is turned to the centre of that part."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..compile.camera import view_of
+from ..viewer.camera import FlyCamera
+
+MARGIN = 8.0  # pixels between the panel and the window's edge
+PANEL_WIDTH = 340.0  # at first
+MIN_WIDTH, MAX_SHARE = 220.0, 0.5  # the narrowest panel, and the widest share of the window
+
+
+@dataclass
+class Layout:
+    side: str = "right"  # where the edit panel docks: "left" or "right"
+    width: float = PANEL_WIDTH
+
+    def panel(
+        self, size: tuple[float, float], hud: float = 0.0
+    ) -> tuple[float, float, float, float]:
+        """The panel's window rectangle (x, y, width, height) in a window of ``size``; docked
+        left, it leaves the top ``hud`` pixels to the viewer's HUD (its title bar there)."""
+        w, h = size
+        width = self.clamped(w)
+        x = MARGIN if self.side == "left" else w - width - MARGIN
+        y = MARGIN + (hud + MARGIN if self.side == "left" and hud else 0.0)
+        return x, y, width, max(h - y - MARGIN, 1.0)
+
+    def clamped(self, window_width: float) -> float:
+        return max(min(self.width, MAX_SHARE * window_width), min(MIN_WIDTH, window_width))
+
+    def free(self, size: tuple[float, float]) -> tuple[float, float]:
+        """The span (x0, x1) of window columns the panel leaves to the view."""
+        x, _, width, _ = self.panel(size)
+        return (x + width + MARGIN, size[0]) if self.side == "left" else (0.0, x - MARGIN)
+
+
+def frame(
+    camera: FlyCamera,
+    target: np.ndarray,
+    size: tuple[int, int],
+    span: tuple[float, float],
+    ball: np.ndarray | None = None,
+) -> None:
+    """Turn ``camera`` about its up axis so that ``target`` lies in the middle of the window
+    columns ``span``; with a bounding ``ball`` (centre, radius) wider than the span, step back
+    until it fits, at most by the ratio of the window's width to the span's (a close-up
+    stays a close-up)."""
+    w, h = size
+    width = max(span[1] - span[0], 1.0)
+    if ball is not None:
+        v = view_of(camera.to_camera(), w, h)
+        distance = float(np.linalg.norm(np.asarray(target) - v.origin))
+        fits = ball[3] / (width / w * v.tan_half * v.aspect)  # the ball's half-width = span's
+        back = min(max(fits / distance, 1.0), w / width)
+        camera.position = np.asarray(target) + (camera.position - np.asarray(target)) * back
+    x = 0.5 * (span[0] + span[1])
+    for _ in range(3):  # the turn is about the world's up, the column the screen's: converge
+        v = view_of(camera.to_camera(), w, h)
+        rel = np.asarray(target, dtype=np.float64) - v.origin
+        now = math.atan2(float(rel @ v.right), float(rel @ v.forward))
+        want = math.atan((2.0 * x / v.width - 1.0) * v.tan_half * v.aspect)
+        camera.look(want - now, 0.0)  # a larger yaw turns the view left
