@@ -19,7 +19,7 @@ def test_the_latency_bench_drags_a_fork_and_times_every_step(display, tmp_path):
     # the fork moved by the five steps, each one turn: nothing more (negative control of the
     # driver: a turn without a step moves nothing)
     assert np.allclose(m["moved"], 5 * m["step"]) and np.linalg.norm(m["step"]) > 0
-    assert len(m["latencies"]) == 4 and all(t > 0 for t in m["latencies"])
+    assert len(m["latencies"]) == 5 and all(t > 0 for t in m["latencies"])
     assert len(m["turns"]) == 4 and 0 < m["first_full"] <= m["still"]
     assert not path.with_suffix(".toml.recovery").exists() and not list(tmp_path.glob("*.rec*"))
     row = latency.summary(m)[0]

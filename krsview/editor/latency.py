@@ -82,18 +82,21 @@ def drag_latency(path: Path, size: tuple[int, int], steps: int = DRAG_STEPS) -> 
         scale = float(np.ptp(np.array([x.position for x in e.handles]), axis=0).max())
         drag = _Drag(e, np.array([STEP * scale, 0.0, 0.0]))
         e.gizmo.manipulate = drag.manipulate
+        traced: list[int] = []  # per turn: the drag steps its image was traced with
+        draw = e.viewer.draw_image
+        e.viewer.draw_image = lambda: (traced.append(drag.k), draw())
         shown, turns, sizes = [], [], []
         drag.on = True
         last = time.perf_counter()
-        for _ in range(steps):
+        for k in range(steps + 1):  # the last turn shows the last step
+            drag.on = k < steps
             t = _turn(e)
             shown.append(t)
             turns.append(t - last)
             sizes.append(e.viewer.frames.frame_state().size)
             last = t
-        drag.on = False
+        e.viewer.draw_image = draw
         released = drag.edited[-1]
-        _turn(e)  # the frame traced from the last step
         full = e.viewer.frames.adaptive.full
         first_full = None
         for _ in range(SETTLE_TURNS):
@@ -102,8 +105,12 @@ def drag_latency(path: Path, size: tuple[int, int], steps: int = DRAG_STEPS) -> 
                 first_full = t
             if e.viewer.frames.refined:
                 break
-        # a step made in turn j is traced and shown in turn j + 1
-        latencies = [b - a for a, b in zip(drag.edited[:-1], shown[1:])]
+        # a step's frame: the first turn that traced it (the same turn, when the gizmo
+        # runs before the trace), on screen at that turn's end
+        latencies = [
+            shown[next(j for j, n in enumerate(traced) if n >= k)] - drag.edited[k - 1]
+            for k in range(1, len(drag.edited) + 1)
+        ]
         moved = next(x.position for x in e.handles if x.same(h)) - start
         return dict(
             scene=e.scene.name,
@@ -111,8 +118,8 @@ def drag_latency(path: Path, size: tuple[int, int], steps: int = DRAG_STEPS) -> 
             step=drag.step,
             window=size,
             latencies=latencies,
-            turns=turns[1:],
-            sizes=sizes,
+            turns=turns[1:steps],
+            sizes=sizes[:steps],
             first_full=(first_full or t) - released,
             still=t - released,
         )

@@ -143,11 +143,16 @@ class Editor:
             self.pick(*click)
         v.move(dt)
         self.execute(v.watcher.poll())
-        v.draw_image()
         self._follow()
         status = v.status_line()
-        if v.hud or status:
+        ui = v.hud or bool(status)
+        if ui:
             v.platform.new_frame()
+        if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
+            self._manipulate()
+        v.draw_image()
+        self._follow()
+        if ui:
             if v.hud:
                 self._draw_ui()
             draw_status(status)
@@ -322,9 +327,9 @@ class Editor:
 
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:
-        """Inside the ImGui frame: the overlay over the image, the viewer's HUD (collapsed
-        at first: the view stays free), the edit panel, the gizmo on a selected point or the
-        trackball on a selected normal, and the name of the handle under the pointer."""
+        """Inside the ImGui frame, after the trace: the overlay over the image, the viewer's
+        HUD (collapsed at first: the view stays free), the edit panel, and the name of the
+        handle under the pointer (the gizmo came before the trace: :meth:`_manipulate`)."""
         v = self.viewer
         view = self.window_view()
         shown = self.shown()
@@ -335,18 +340,22 @@ class Editor:
             self.overlay.draw(
                 shapes, v.frames.image[0], v.ctx.screen, fb, proj @ view_matrix, view.origin
             )
-        self.gizmo.begin_frame()
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))
+        self._hover_label(shown, view)
+
+    def _manipulate(self) -> None:
+        """Inside the ImGui frame, before the turn's image is traced: the gizmo on a selected
+        point or the trackball on a selected normal; a drag's step is an edit at once."""
+        self.gizmo.begin_frame()
         sel = self.selected
         if sel is not None:
             tool = self.trackball.update if sel.kind == "normal" else self.gizmo.manipulate
-            moved = tool(sel, view)
+            moved = tool(sel, self.window_view())
             if moved is not None:
                 p, drag = moved
                 self.edit(*sel.edit_to(self.scene, p, self.carry), drag)
-        self._hover_label(shown, view)
 
     def _hover_label(self, shown: list[Handle], view: View) -> None:
         io = imgui.get_io()
