@@ -40,6 +40,7 @@ from . import commands as ec
 from .gizmo import Gizmo
 from .handles import Handle, handles, polyline
 from .panels import edit_panel
+from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools
 
 PICK_PIXELS = 12.0  # a click this close to a handle grabs it
 FORK, CONTROL, NORMAL, SELECTED = (
@@ -50,7 +51,7 @@ FORK, CONTROL, NORMAL, SELECTED = (
 )
 ROUTE = (1.0, 0.9, 0.5, 0.9)
 DISC = (0.5, 0.8, 1.0, 0.25)
-EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs()}
+EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs(), **STRUCTURE_KEYS}
 
 
 class Editor:
@@ -64,6 +65,7 @@ class Editor:
         self.gizmo = Gizmo()
         self.snap = self.gizmo.snap
         self.carry = True  # a fork drag takes its subtree along
+        self.structure = StructureTools()
         self.selected: Handle | None = None
         self._handles_of: Scene | None = None  # the scene the handles were made for
         self._handles: list[Handle] = []
@@ -389,4 +391,5 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     vc.AddBookmark: lambda e, c: e.add_bookmark(),
     vc.OpenPreset: lambda e, c: e.open_preset(c.path),
     vc.ReloadScene: lambda e, c: e.reload_scene(),
+    **STRUCTURE_HANDLERS,
 }

@@ -21,6 +21,7 @@ from .tree import as_vec3
 
 NORMAL_CANDIDATES = 720  # directions ⟂ the tangent tried for a new fork's mirror
 TAPER_RANGE = (0.05, 1.0)  # child / parent radius, as the growth parameters allow
+LINE = np.linspace(0.0, 1.0, 17)  # points along a branch weighed for a new mirror
 
 
 def _check_index(route: Route, i: int) -> None:
@@ -37,10 +38,13 @@ def tangent_at(k: ToroidalCapsule, s: float) -> np.ndarray:
     return t / np.linalg.norm(t)
 
 
-def free_normal(fork: np.ndarray, t: np.ndarray, finer: np.ndarray, hint) -> Vec3:
-    """The normal of a mirror through ``fork`` containing the tangent ``t`` that keeps the
-    ``finer`` route points (the branches it doubles) as far on its negative side as possible,
-    so Alg. 1 clips as little as it can; among equally good ones the nearest to ``hint``."""
+def free_normal(
+    fork: np.ndarray, t: np.ndarray, child: np.ndarray, finer: np.ndarray, hint
+) -> Vec3:
+    """The normal of a mirror through ``fork`` containing the tangent ``t``: first keeping
+    the ``child`` branch's centre line on its negative side (else Alg. 1 clips the branch,
+    ``Route.warnings``), then as much of the ``finer`` route as it can; among equally good
+    ones the nearest to ``hint``."""
     a = np.cross(t, hint if hint is not None else (0.0, 0.0, 0.0))
     if np.linalg.norm(a) < 1e-9:
         a = np.cross(t, [1.0, 0.0, 0.0] if abs(t[0]) < 0.9 else [0.0, 0.0, 1.0])
@@ -48,11 +52,13 @@ def free_normal(fork: np.ndarray, t: np.ndarray, finer: np.ndarray, hint) -> Vec
     b = np.cross(t, a)  # the hint projected ⟂ t is ±b
     phi = np.linspace(0.0, 2.0 * np.pi, NORMAL_CANDIDATES, endpoint=False)
     u = np.cos(phi)[:, None] * b + np.sin(phi)[:, None] * a
-    worst = ((finer - fork) @ u.T).max(axis=0)
-    size = max(float(np.ptp(finer, axis=0).max()), 1e-9)
-    good = worst <= worst.min() + 1e-6 * size
+    size = max(float(np.ptp(np.concatenate([child, finer]), axis=0).max()), 1e-9)
+    ok = np.ones(len(u), bool)
+    for points in (child, finer):
+        worst = np.where(ok, ((points - fork) @ u.T).max(axis=0), np.inf)
+        ok = worst <= worst.min() + 1e-6 * size
     hint_dot = u @ np.asarray(hint if hint is not None else b, dtype=float)
-    return as_vec3(u[np.argmax(np.where(good, hint_dot, -np.inf))])
+    return as_vec3(u[np.argmax(np.where(ok, hint_dot, -np.inf))])
 
 
 def split_level(route: Route, i: int, s: float = 0.5) -> Route:
@@ -69,11 +75,9 @@ def split_level(route: Route, i: int, s: float = 0.5) -> Route:
     q, mid_low, mid_up = centre_at(k, np.array([s, s / 2.0, (1.0 + s) / 2.0]))
     upper = replace(lv, control=as_vec3(mid_up))
     upper_k = replace(k, start=as_vec3(q), control=as_vec3(mid_up))
-    finer = np.concatenate(
-        [centre_at(upper_k, np.linspace(0.0, 1.0, 33))]
-        + [centre_at(route.kernel(j), np.linspace(0.0, 1.0, 17)) for j in range(i)]
-    )
-    normal = free_normal(q, tangent_at(k, s), finer, lv.normal)
+    child = centre_at(upper_k, np.linspace(0.0, 1.0, 33))
+    finer = np.concatenate([child] + [centre_at(route.kernel(j), LINE) for j in range(i)])
+    normal = free_normal(q, tangent_at(k, s), child, finer, lv.normal)
     lower = RouteLevel(as_vec3(q), as_vec3(mid_low), lv.radius, lv.color, normal, None)
     levels = route.levels[:i] + [upper, lower] + route.levels[i + 1 :]
     return replace(route, levels=levels)
@@ -119,10 +123,9 @@ def duplicate_level(route: Route, i: int) -> Route:
     if i + 1 < len(levels):
         normal = levels[i + 1].normal
     else:  # the trunk: its foot has no mirror to borrow
-        finer = np.concatenate(
-            [centre_at(route.kernel(j), np.linspace(0, 1, 17)) for j in range(i + 1)]
-        )
-        normal = free_normal(np.array(lv.fork), v / np.linalg.norm(v), finer + v, None)
+        child = centre_at(route.kernel(i), LINE) + v  # the copy
+        finer = np.concatenate([centre_at(route.kernel(j), LINE) for j in range(i + 1)]) + v
+        normal = free_normal(np.array(lv.fork), v / np.linalg.norm(v), child, finer, None)
     original = replace(lv, normal=normal)
     copy = moved(lv, None)
     finer_levels = [moved(x, x.grown) for x in levels[:i]]

@@ -1,0 +1,373 @@
+"""Structure edits of a route (scene/restructure.py) and growing a baked route again
+(scene/regrow.py), checked with the reference distance of the kernels and of the whole KRS,
+not with the construction itself; and the editor's glue (editor/structure.py): one undo step
+each, a refusal changes nothing and says why, re-growing asks before losing hand edits."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from krsview.compile.krs import compile_krs
+from krsview.document.document import Document
+from krsview.editor import commands as ec
+from krsview.editor.structure import STRUCTURE_HANDLERS, StructureTools
+from krsview.reference.krs import distance
+from krsview.scene import KRS, Level, SceneError, load_scene, save_scene, scene_from_toml
+from krsview.scene.edits import validated
+from krsview.scene.presets import resolve
+from krsview.scene.regrow import frame, grow, rebake
+from krsview.scene.restructure import (
+    NORMAL_CANDIDATES,
+    duplicate_level,
+    free_normal,
+    merge_level,
+    move_base,
+    scale_tree,
+    scale_widths,
+    split_level,
+    tangent_at,
+    taper,
+)
+from krsview.scene.route import centre_at
+
+ALBEDO = (0.5, 0.5, 0.5)
+LINE = np.linspace(0.0, 1.0, 41)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    """The shipped tree with 8 forks (fast), bent as shipped."""
+    s = load_scene(resolve("tree"))
+    return replace(s, tree=replace(s.tree, levels=8))
+
+
+@pytest.fixture(scope="module")
+def route(scene):
+    return scene.tree.route()
+
+
+def kernel_d(k, pts) -> np.ndarray:
+    return distance(compile_krs(KRS([Level(k)]), ALBEDO), np.asarray(pts, dtype=float))
+
+
+def krs_d(route, pts) -> np.ndarray:
+    return distance(compile_krs(route.krs(), ALBEDO), np.asarray(pts, dtype=float))
+
+
+def route_points(route) -> np.ndarray:
+    """Points along every branch of the route itself (the identity instances)."""
+    return np.concatenate([centre_at(route.kernel(i), LINE) for i in range(len(route.levels))])
+
+
+# ---------------------------------------------------------------------------- insert
+@pytest.mark.parametrize("i,s", [(0, 0.5), (3, 0.3), (8, 0.7)])
+def test_the_split_halves_trace_the_old_branch(route, i, s):
+    old = route.kernel(i)
+    new = split_level(route, i, s)
+    upper, lower = new.kernel(i), new.kernel(i + 1)
+    assert new.levels[i + 1].fork == upper.start == lower.end
+    # every point of each half lies on the old branch's centre line, and the old line is
+    # covered by the two halves: measured by the reference kernel distance (−radius on it)
+    tol = 1e-9
+    for half in (upper, lower):
+        np.testing.assert_allclose(kernel_d(old, centre_at(half, LINE)), -old.radius, atol=tol)
+    on_old = centre_at(old, LINE)
+    both = np.minimum(kernel_d(upper, on_old), kernel_d(lower, on_old))
+    np.testing.assert_allclose(both, -old.radius, atol=tol)
+    # the fork lies at fraction s of the arc length: the halves' lengths are s : 1 − s
+    lengths = [
+        np.linalg.norm(np.diff(centre_at(k, LINE), axis=0), axis=1).sum() for k in (lower, upper)
+    ]
+    assert lengths[0] / sum(lengths) == pytest.approx(s, abs=1e-3)
+
+
+def test_negative_control_a_split_that_drops_the_control_points_moves_the_curve(route):
+    i = 3
+    old, new = route.kernel(i), split_level(route, i, 0.5)
+    lv = new.levels[i]
+    naive_start = np.array(new.levels[i + 1].fork)
+    naive = replace(new.kernel(i), control=tuple((naive_start + np.array(lv.fork)) / 2))
+    off = kernel_d(old, centre_at(naive, LINE)) + old.radius
+    assert off.max() > 1e-3, "the bent branch should leave the old curve when straightened"
+
+
+def test_the_new_forks_mirror_contains_the_tangent_and_keeps_the_route_unclipped(route):
+    for i in range(len(route.levels)):
+        new = split_level(route, i, 0.4)
+        u, q = np.array(new.levels[i + 1].normal), np.array(new.levels[i + 1].fork)
+        t = tangent_at(route.kernel(i), 0.4)
+        assert abs(u @ t) < 1e-9 and abs(np.linalg.norm(u) - 1) < 1e-12
+        assert new.warnings() == route.warnings() == []
+        # no other plane through the tangent keeps the finer route further on its negative
+        # side (the choice is optimal), and some plane does cross it (the choice matters)
+        child = centre_at(new.kernel(i), LINE)
+        finer = np.concatenate([centre_at(new.kernel(j), LINE) for j in range(i + 1)])
+        worst = float(((finer - q) @ u).max())
+        a = np.cross(t, [0.3, 0.2, 0.9])
+        a /= np.linalg.norm(a)
+        b = np.cross(t, a)
+        others = [np.cos(p) * a + np.sin(p) * b for p in np.linspace(0, 2 * np.pi, 37)]
+        step = np.linalg.norm(finer - q, axis=1).max() * 2 * np.pi / NORMAL_CANDIDATES
+        assert float(((child - q) @ u).max()) <= step
+        keeping = [v for v in others if float(((child - q) @ v).max()) <= 0.0]
+        assert all(worst <= float(((finer - q) @ v).max()) + step for v in keeping)
+        if i > 0:
+            assert max(float(((finer - q) @ v).max()) for v in others) > worst + 1e-3
+
+
+def test_free_normal_prefers_the_hint_among_equally_good_planes():
+    t = np.array([0.0, 1.0, 0.0])
+    finer = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])  # on the tangent: every plane is good
+    assert free_normal(np.zeros(3), t, finer, finer, (0.0, 0.0, 1.0)) == pytest.approx((0, 0, 1))
+    assert free_normal(np.zeros(3), t, finer, finer, (1.0, 0.0, 0.0)) == pytest.approx((1, 0, 0))
+
+
+def test_the_tree_keeps_its_old_geometry_after_an_insert(route):
+    """The reference distance of the whole KRS: along the old route (the identity instances)
+    it stays what it was; the new mirror only adds (its image of the crown)."""
+    pts = route_points(route)
+    before = krs_d(route, pts)
+    for i in (2, 5):
+        after = krs_d(split_level(route, i, 0.5), pts)
+        assert (after <= before + 1e-9).all()
+        np.testing.assert_allclose(after, before, atol=1e-9)
+    # negative control: turning the new mirror to face the crown clips the old route
+    bad = split_level(route, 5, 0.5)
+    lv = bad.levels[6]
+    bad = replace(
+        bad,
+        levels=[*bad.levels[:6], replace(lv, normal=tuple(-np.array(lv.normal))), *bad.levels[7:]],
+    )
+    assert (krs_d(bad, pts) - before).max() > 1e-3
+
+
+# ----------------------------------------------------------------- remove, duplicate
+@pytest.mark.parametrize("i", [0, 1, 4, 8])
+@pytest.mark.parametrize("s", [0.2, 0.5, 0.9])
+def test_remove_after_insert_is_the_identity(route, i, s):
+    back = merge_level(split_level(route, i, s), i + 1)
+    assert len(back.levels) == len(route.levels)
+    for a, b in zip(back.levels, route.levels):
+        assert (a.radius, a.color, a.normal, a.grown) == (b.radius, b.color, b.normal, b.grown)
+        np.testing.assert_allclose(a.fork, b.fork, atol=1e-12)
+        np.testing.assert_allclose(a.control, b.control, atol=1e-12)
+
+
+def test_removing_a_fork_merges_two_branches_through_it(route):
+    i = 4
+    merged = merge_level(route, i)
+    k = merged.kernel(i - 1)
+    assert len(merged.levels) == len(route.levels) - 1
+    assert k.start == route.starts()[i] and k.end == route.levels[i - 1].fork
+    assert kernel_d(k, [route.levels[i].fork])[0] == pytest.approx(-k.radius, abs=1e-9)
+    twigless = merge_level(route, 0)
+    assert twigless.levels[0].normal is None and twigless.levels[0].fork == route.levels[1].fork
+    with pytest.raises(SceneError, match="at least one level"):
+        merge_level(replace(route, levels=route.levels[-1:]), 0)
+
+
+@pytest.mark.parametrize("i", [0, 3, 8])
+def test_a_duplicate_repeats_the_branch_at_its_tip_and_carries_the_finer_levels(route, i):
+    dup = duplicate_level(route, i)
+    v = np.subtract(route.levels[i].fork, route.starts()[i])
+    assert len(dup.levels) == len(route.levels) + 1
+    np.testing.assert_allclose(np.subtract(dup.levels[i].fork, dup.levels[i + 1].fork), v)
+    for j in range(i):  # the finer levels, moved along
+        np.testing.assert_allclose(np.subtract(dup.levels[j].fork, route.levels[j].fork), v)
+    assert dup.levels[i + 1].fork == route.levels[i].fork and dup.levels[i].grown is None
+    assert dup.warnings() == []
+    pts = centre_at(route.kernel(i), LINE) + v  # the copy lies where the branch, moved, is
+    np.testing.assert_allclose(kernel_d(dup.kernel(i), pts), -route.levels[i].radius, atol=1e-9)
+
+
+# --------------------------------------------------------------------------- whole tree
+def test_taper_sets_each_radius_to_the_ratio_times_its_parents(route):
+    t = taper(route, 0.6)
+    r = [lv.radius for lv in t.levels]
+    np.testing.assert_allclose(np.array(r[:-1]) / np.array(r[1:]), 0.6, rtol=1e-12)
+    assert r[-1] == route.levels[-1].radius
+    with pytest.raises(SceneError, match="taper"):
+        taper(route, 1.5)
+
+
+def test_scaling_the_tree_scales_its_distance_and_moving_it_moves_it(route):
+    pts = np.random.default_rng(3).normal((0, 3, 0), 2.0, (300, 3))
+    base = np.array(route.base)
+    d = krs_d(route, pts)
+    big = scale_tree(route, 1.7)
+    np.testing.assert_allclose(krs_d(big, base + 1.7 * (pts - base)), 1.7 * d, atol=1e-9)
+    moved = move_base(route, (1.0, -2.0, 0.5))
+    np.testing.assert_allclose(krs_d(moved, pts + (1.0, -2.0, 0.5)), d, atol=1e-9)
+    wide = scale_widths(route, 2.0)
+    assert [lv.radius for lv in wide.levels] == [2.0 * lv.radius for lv in route.levels]
+    assert not np.allclose(krs_d(wide, pts), d), "negative control: wider branches differ"
+    with pytest.raises(SceneError, match="factor > 0"):
+        scale_tree(route, 0.0)
+
+
+def test_scaling_a_forest_moves_its_mirrors_with_it():
+    s = load_scene(resolve("forest"))
+    r = replace(s.tree, levels=6).route()
+    pts = np.random.default_rng(4).normal((0, 2, 0), 4.0, (200, 3))
+    base = np.array(r.base)
+    np.testing.assert_allclose(
+        krs_d(scale_tree(r, 0.5), base + 0.5 * (pts - base)), 0.5 * krs_d(r, pts), atol=1e-9
+    )
+
+
+# ------------------------------------------------------------------------------ re-grow
+def test_a_baked_route_keeps_its_growth_and_depths_through_a_file(scene, tmp_path):
+    baked = replace(scene, tree=None, route=scene.tree.route())
+    save_scene(baked, tmp_path / "b.toml")
+    again = load_scene(tmp_path / "b.toml")
+    assert again == baked and again.route.growth.levels == 8
+    assert [lv.grown for lv in again.route.levels] == list(range(8, -1, -1))
+    text = (tmp_path / "b.toml").read_text()
+    bad = text.replace("grown = 3", "grown = 9", 1)
+    with pytest.raises(SceneError, match=r"route\.levels\[5\]\.grown.*0\.\.8"):
+        scene_from_toml(bad)
+    with pytest.raises(SceneError, match="does not have"):
+        validated(replace(baked, route=replace(baked.route, growth=None)))
+
+
+def test_growing_again_unchanged_is_the_identity_and_new_growth_is_the_new_bake(route):
+    same, lost = rebake(route, route.growth)
+    assert same == route and lost == []
+    g = replace(route.growth, branch_angle=40.0, levels=6)
+    assert rebake(route, g) == (grow(g), [])
+
+
+def test_hand_edits_survive_a_change_of_the_growth_parameters(route):
+    k = 5  # bend level 5's branch and thicken level 2
+    lv = route.levels[k]
+    edited = replace(
+        route,
+        levels=[
+            *route.levels[:2],
+            replace(route.levels[2], radius=route.levels[2].radius * 1.5),
+            *route.levels[3:k],
+            replace(lv, control=tuple(np.add(lv.control, (0.1, 0.0, 0.05)))),
+            *route.levels[k + 1 :],
+        ],
+    )
+    g = replace(route.growth, branch_angle=40.0)
+    new, lost = rebake(edited, g)
+    fresh = grow(g)
+    assert lost == []
+    assert new.levels[2].radius == pytest.approx(fresh.levels[2].radius * 1.5, rel=1e-12)
+
+    # the control's offset from the bake, in the branch's frame and length, is the same
+    def offset(r, b, j):
+        L = np.linalg.norm(np.subtract(b.levels[j].fork, b.starts()[j]))
+        return frame(b, j).T @ (np.subtract(r.levels[j].control, b.levels[j].control)) / L
+
+    np.testing.assert_allclose(offset(new, fresh, k), offset(edited, route, k), atol=1e-12)
+    untouched = [j for j in range(len(route.levels)) if j not in (2, k)]
+    for j in untouched:  # the rest is the new bake (forks move only below edited ones)
+        assert new.levels[j].radius == fresh.levels[j].radius
+    assert new.levels[-1] == fresh.levels[-1]
+    assert offset(new, fresh, 4).any() == 0 and np.abs(offset(edited, route, 4)).max() == 0
+
+
+def test_growing_again_lists_what_it_cannot_keep(route):
+    inserted = split_level(route, 3, 0.5)
+    _, lost = rebake(inserted, route.growth)
+    assert any("levels[4]: a fork made by hand" in line for line in lost)
+    _, lost = rebake(merge_level(route, 3), route.growth)
+    assert any("depth 5 was removed by hand" in line for line in lost)
+    moved = replace(route, levels=[replace(route.levels[0], radius=0.5), *route.levels[1:]])
+    _, lost = rebake(moved, replace(route.growth, levels=5))
+    assert any("levels[0]: its edits are dropped" in line for line in lost)
+    _, nothing = rebake(route, replace(route.growth, levels=5))  # unedited: nothing to lose
+    assert nothing == []
+
+
+# -------------------------------------------------------------------------- editor glue
+class FakeEditor:
+    """What editor/structure.py reads and calls of the editor, without a window."""
+
+    def __init__(self, path):
+        self.viewer = SimpleNamespace(doc=None, sync=lambda: None, error="", message="")
+        self.viewer.doc = Document(path)
+        self.selected = SimpleNamespace(level=3)
+        self.structure = StructureTools()
+        self.chosen: list[int] = []
+
+    @property
+    def doc(self):
+        return self.viewer.doc
+
+    @property
+    def scene(self):
+        return self.doc.scene
+
+    def select_level(self, level):
+        self.chosen.append(level)
+
+    def run(self, command):
+        STRUCTURE_HANDLERS[type(command)](self, command)
+
+
+@pytest.fixture
+def editor(scene, tmp_path):
+    path = tmp_path / "tree.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), path)
+    return FakeEditor(path)
+
+
+def test_each_operation_is_one_undo_step(editor):
+    start = editor.scene
+    for command in (
+        ec.InsertLevel(),
+        ec.RemoveLevel(2),
+        ec.DuplicateLevel(),
+        ec.WholeTree("taper"),
+    ):
+        before = editor.scene
+        editor.run(command)
+        assert editor.scene != before and editor.viewer.error == "", command
+        editor.doc.undo()
+        assert editor.scene == before
+        editor.doc.redo()
+    assert len(editor.doc.history.steps) == 4 and editor.chosen == [4, 2, 3]
+    while editor.doc.undo():
+        pass
+    assert editor.scene == start
+
+
+def test_a_refused_operation_changes_nothing_and_says_why(scene, tmp_path):
+    path = tmp_path / "full.toml"  # 63 forks: 64 levels, as many as the shaders hold
+    save_scene(replace(scene, tree=None, route=replace(scene.tree, levels=63).route()), path)
+    editor = FakeEditor(path)
+    before = editor.scene
+    editor.run(ec.InsertLevel(10))
+    assert editor.scene == before and editor.doc.history.steps == []
+    assert "refused" in editor.structure.message and "≤ 64" in editor.structure.message
+    assert editor.viewer.error == editor.structure.message and "\n" not in editor.viewer.error
+    editor.run(ec.RemoveLevel(10))  # negative control: the same editor does take an edit
+    assert len(editor.scene.route.levels) == 63 and editor.viewer.error == ""
+    editor.selected = None
+    editor.run(ec.RemoveLevel())
+    assert "select a level first" in editor.viewer.error
+
+
+def test_growing_again_asks_before_losing_hand_edits(editor):
+    editor.run(ec.InsertLevel(3))
+    inserted = editor.scene
+    editor.run(ec.SetGrowth("branch_angle", 40.0, ("drag", 1)))
+    assert editor.scene == inserted, "nothing lands before the answer"
+    new, lost, _ = editor.structure.pending
+    assert any("made by hand" in line for line in lost)
+    editor.run(ec.CancelRegrow())
+    assert editor.structure.pending is None and editor.scene == inserted
+    editor.run(ec.SetGrowth("branch_angle", 40.0, ("drag", 1)))
+    editor.run(ec.ConfirmRegrow())
+    assert editor.scene.route == new and editor.scene.route.growth.branch_angle == 40.0
+    editor.doc.undo()
+    assert editor.scene == inserted
+    editor.run(ec.SetGrowth("branch_angle", 200.0, None))
+    assert "branch_angle" in editor.viewer.error and editor.scene == inserted
