@@ -155,3 +155,21 @@ class ConfirmRegrow(Command):
 @dataclass(frozen=True)
 class CancelRegrow(Command):
     """Keep the route as it is."""
+
+
+# ------------------------------------------------- a shipped preset's copy (editor/saving.py)
+@dataclass(frozen=True)
+class SetCopyText(Command):
+    """Where the copy of a shipped preset goes (the dialog's field)."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class SaveCopy(Command):
+    """Save the shipped preset's edits to the copy named in the dialog."""
+
+
+@dataclass(frozen=True)
+class CancelCopy(Command):
+    """Close the copy dialog without saving."""

@@ -19,6 +19,7 @@ from ..viewer.window import Viewer
 from . import commands as ec
 from .gizmo import Snap
 from .handles import Handle, outline
+from .saving import copy_dialog
 from .structure import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
@@ -102,6 +103,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
     imgui.end()
     _modals(e, out)
+    out += copy_dialog(e)
     return out
 
 

@@ -40,6 +40,7 @@ from . import commands as ec
 from .gizmo import Gizmo
 from .handles import Handle, handles, polyline
 from .panels import edit_panel
+from .saving import SAVING_HANDLERS, ask_copy, autosave
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools
 
 PICK_PIXELS = 12.0  # a click this close to a handle grabs it
@@ -66,6 +67,7 @@ class Editor:
         self.snap = self.gizmo.snap
         self.carry = True  # a fork drag takes its subtree along
         self.structure = StructureTools()
+        self.copy_to: str | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
         self._handles_of: Scene | None = None  # the scene the handles were made for
         self._handles: list[Handle] = []
@@ -149,7 +151,7 @@ class Editor:
             v.platform.render()
         v.input.claimed = v.hud and self.gizmo.claims_mouse()
         glfw.swap_buffers(v.window)
-        self.doc.autosave(time.monotonic())
+        autosave(self, time.monotonic())
         self._update_title()
 
     def should_close(self) -> bool:
@@ -190,6 +192,8 @@ class Editor:
 
     def save(self, path: str | None = None, overwrite: bool = False) -> bool:
         v = self.viewer
+        if not path and self.doc.template:
+            return ask_copy(self)
         try:
             saved = self.doc.save(path or None, overwrite=overwrite)
         except ConflictError as e:
@@ -392,4 +396,5 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     vc.OpenPreset: lambda e, c: e.open_preset(c.path),
     vc.ReloadScene: lambda e, c: e.reload_scene(),
     **STRUCTURE_HANDLERS,
+    **SAVING_HANDLERS,
 }
