@@ -218,16 +218,20 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
     route, t = e.scene.route, e.structure
     if route is None or not imgui.collapsing_header("structure", imgui.TreeNodeFlags_.default_open):
         return out
-    sel = "the selected level" if e.selected is not None else "(select a level)"
-    imgui.text_disabled(f"on {sel}; right-click an outline entry for the same")
+    imgui.push_text_wrap_pos(0.0)
+    imgui.text_disabled(
+        ("on the selected level" if e.selected is not None else "select a level first")
+        + "; or right-click an outline entry"
+    )
+    imgui.pop_text_wrap_pos()
     imgui.set_next_item_width(120)
     changed, s = imgui.slider_float("split at##structure", t.split_at, 0.05, 0.95, "%.2f")
     if changed:
         out.append(ec.SetToolValue("split_at", s))
     for k, (text, command) in enumerate(
         (
-            ("insert fork (Insert)", ec.InsertLevel()),
-            ("remove (Delete)", ec.RemoveLevel()),
+            ("insert (Ins)", ec.InsertLevel()),
+            ("remove (Del)", ec.RemoveLevel()),
             ("duplicate (Ctrl+D)", ec.DuplicateLevel()),
         )
     ):

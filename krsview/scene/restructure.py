@@ -19,9 +19,12 @@ from .route import Route, RouteLevel, centre_at
 from .schema import SceneError, Vec3
 from .tree import as_vec3
 
-NORMAL_CANDIDATES = 720  # directions ⟂ the tangent tried for a new fork's mirror
+NORMAL_CANDIDATES = 360  # directions around the branch tried for a new fork's mirror
+TILTS = np.radians(np.arange(0.0, 46.0, 2.5))  # … at these angles back from ⟂ the branch
+KEEP_OUT = 0.01  # the share of the doubled subtree a new mirror may leave on its far side
 TAPER_RANGE = (0.05, 1.0)  # child / parent radius, as the growth parameters allow
-LINE = np.linspace(0.0, 1.0, 17)  # points along a branch weighed for a new mirror
+LINE = np.linspace(0.0, 1.0, 33)  # points along a new mirror's child branch
+SUBTREE_SAMPLES = 4000  # points of the subtree a new mirror doubles, weighed to place it
 
 
 def _check_index(route: Route, i: int) -> None:
@@ -38,35 +41,66 @@ def tangent_at(k: ToroidalCapsule, s: float) -> np.ndarray:
     return t / np.linalg.norm(t)
 
 
+def subtree_points(kernels: list[ToroidalCapsule], mirrors: list[Mirror]) -> np.ndarray:
+    """Points of the subtree L_i that ``kernels`` K_0..K_i and ``mirrors`` R_0..R_{i−1}
+    expand into [KRS17 Alg. 1], sampled (fixed seed): a branch, a point on its centre line,
+    and a random choice at each mirror above it; the same number from every level."""
+    rng = np.random.default_rng(0)
+    j = rng.integers(0, len(kernels), SUBTREE_SAMPLES)
+    pts = np.empty((SUBTREE_SAMPLES, 3))
+    for level, k in enumerate(kernels):
+        at = j == level
+        pts[at] = centre_at(k, rng.random(int(at.sum())))
+    for level, m in enumerate(mirrors):  # R_level doubles L_level: branches 0..level
+        u = np.array(m.normal)
+        flip = (j <= level) & (rng.random(SUBTREE_SAMPLES) < 0.5)
+        pts[flip] -= 2.0 * (pts[flip] @ u - m.offset)[:, None] * u
+    return pts
+
+
 def free_normal(
-    fork: np.ndarray, t: np.ndarray, child: np.ndarray, finer: np.ndarray, hint
+    fork: np.ndarray, t: np.ndarray, child: np.ndarray, subtree: np.ndarray, hint
 ) -> Vec3:
-    """The normal of a mirror through ``fork`` containing the tangent ``t``: first keeping
-    the ``child`` branch's centre line on its negative side (else Alg. 1 clips the branch,
-    ``Route.warnings``), then as much of the ``finer`` route as it can; among equally good
-    ones the nearest to ``hint``."""
+    """The normal of a new mirror through ``fork`` on a branch of direction ``t``. Alg. 1
+    folds away what the mirror's positive side holds, so it keeps the ``child`` branch's
+    centre line on the negative side, and as much of the ``subtree`` it doubles as it can:
+    a plane containing ``t`` if one leaves at most KEEP_OUT of the subtree's points outside,
+    else tilted back from ``t`` by the least angle that does (its mirror image of the crown
+    then leaves the branch at twice that angle, as a fork does); among equally good
+    directions the nearest to ``hint``."""
     a = np.cross(t, hint if hint is not None else (0.0, 0.0, 0.0))
     if np.linalg.norm(a) < 1e-9:
         a = np.cross(t, [1.0, 0.0, 0.0] if abs(t[0]) < 0.9 else [0.0, 0.0, 1.0])
     a /= np.linalg.norm(a)
     b = np.cross(t, a)  # the hint projected ⟂ t is ±b
     phi = np.linspace(0.0, 2.0 * np.pi, NORMAL_CANDIDATES, endpoint=False)
-    u = np.cos(phi)[:, None] * b + np.sin(phi)[:, None] * a
-    size = max(float(np.ptp(np.concatenate([child, finer]), axis=0).max()), 1e-9)
-    ok = np.ones(len(u), bool)
-    for points in (child, finer):
-        worst = np.where(ok, ((points - fork) @ u.T).max(axis=0), np.inf)
-        ok = worst <= worst.min() + 1e-6 * size
-    hint_dot = u @ np.asarray(hint if hint is not None else b, dtype=float)
-    return as_vec3(u[np.argmax(np.where(ok, hint_dot, -np.inf))])
+    around = np.cos(phi)[:, None] * b + np.sin(phi)[:, None] * a
+    size = max(float(np.ptp(np.concatenate([child, subtree]), axis=0).max()), 1e-9)
+    best, best_out = around[0], np.inf
+    for tilt in TILTS:
+        u = np.cos(tilt) * around - np.sin(tilt) * t
+        worst = ((child - fork) @ u.T).max(axis=0)
+        e = (subtree - fork) @ u.T
+        clipped = np.where(
+            worst <= worst.min() + 1e-6 * size, np.maximum(e, 0.0).mean(axis=0), np.inf
+        )
+        ok = clipped <= clipped.min() + 1e-9 * size
+        hint_dot = u @ np.asarray(hint if hint is not None else b, dtype=float)
+        k = int(np.argmax(np.where(ok, hint_dot, -np.inf)))
+        out = float((e[:, k] > 1e-6 * size).mean())
+        if out < best_out:
+            best, best_out = u[k], out
+        if out <= KEEP_OUT:
+            break
+    return as_vec3(best / np.linalg.norm(best))
 
 
 def split_level(route: Route, i: int, s: float = 0.5) -> Route:
     """Insert a fork at fraction ``s`` (0 < s < 1) along level i's branch: the lower half
     becomes a new level i + 1 ending at the new fork, the upper half stays level i. Both
     halves lie on the old curve (their control points are their arcs' midpoints), and the
-    new fork's mirror contains the tangent there, turned to keep the finer route on its
-    negative side."""
+    new fork's mirror keeps the subtree it doubles on its negative side
+    (:func:`free_normal`)."""
     _check_index(route, i)
     if not 0.0 < s < 1.0:
         raise SceneError(f"route.levels[{i}]", s, "a split point lies inside the branch: 0 < s < 1")
@@ -75,9 +109,11 @@ def split_level(route: Route, i: int, s: float = 0.5) -> Route:
     q, mid_low, mid_up = centre_at(k, np.array([s, s / 2.0, (1.0 + s) / 2.0]))
     upper = replace(lv, control=as_vec3(mid_up))
     upper_k = replace(k, start=as_vec3(q), control=as_vec3(mid_up))
-    child = centre_at(upper_k, np.linspace(0.0, 1.0, 33))
-    finer = np.concatenate([child] + [centre_at(route.kernel(j), LINE) for j in range(i)])
-    normal = free_normal(q, tangent_at(k, s), child, finer, lv.normal)
+    child = centre_at(upper_k, LINE)
+    subtree = subtree_points(
+        [route.kernel(j) for j in range(i)] + [upper_k], [route.mirror(j) for j in range(1, i + 1)]
+    )
+    normal = free_normal(q, tangent_at(k, s), child, subtree, lv.normal)
     lower = RouteLevel(as_vec3(q), as_vec3(mid_low), lv.radius, lv.color, normal, None)
     levels = route.levels[:i] + [upper, lower] + route.levels[i + 1 :]
     return replace(route, levels=levels)
@@ -123,9 +159,11 @@ def duplicate_level(route: Route, i: int) -> Route:
     if i + 1 < len(levels):
         normal = levels[i + 1].normal
     else:  # the trunk: its foot has no mirror to borrow
-        child = centre_at(route.kernel(i), LINE) + v  # the copy
-        finer = np.concatenate([centre_at(route.kernel(j), LINE) for j in range(i + 1)]) + v
-        normal = free_normal(np.array(lv.fork), v / np.linalg.norm(v), child, finer, None)
+        subtree = subtree_points(
+            [route.kernel(j) for j in range(i + 1)], [route.mirror(j) for j in range(1, i + 1)]
+        )  # the copy's, less v
+        child = centre_at(route.kernel(i), LINE) + v
+        normal = free_normal(np.array(lv.fork), v / np.linalg.norm(v), child, subtree + v, None)
     original = replace(lv, normal=normal)
     copy = moved(lv, None)
     finer_levels = [moved(x, x.grown) for x in levels[:i]]
