@@ -5,6 +5,7 @@ each, a refusal changes nothing and says why, re-growing asks before losing hand
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from types import SimpleNamespace
 
@@ -373,3 +374,96 @@ def test_growing_again_asks_before_losing_hand_edits(editor):
     assert editor.scene == inserted
     editor.run(ec.SetGrowth("branch_angle", 200.0, None))
     assert "branch_angle" in editor.viewer.error and editor.scene == inserted
+
+
+# ---------------------------------------------------------------------- in a real window
+WINDOW = (640, 400)
+
+
+def xdo(*args) -> None:
+    import shutil
+    import subprocess
+
+    assert shutil.which("xdotool"), "xdotool is needed for real X key events"
+    subprocess.run(["xdotool", *map(str, args)], check=True, timeout=10)
+
+
+def pump(e, turns: int = 4) -> None:
+    import glfw
+
+    for _ in range(turns):
+        glfw.poll_events()
+        e.step(0.02)
+
+
+@pytest.fixture
+def window_editor(display, scene, tmp_path):
+    import glfw
+
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "tree.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), path)
+    e = Editor(path, size=WINDOW)
+    x, y = glfw.get_window_pos(e.viewer.window)
+    xdo("mousemove", x + 100, y + WINDOW[1] - 60)  # over the view, off the panels
+    pump(e)
+    yield e
+    e.close()
+
+
+def test_insert_delete_and_ctrl_d_keys_edit_the_selected_level(window_editor):
+    e = window_editor
+    n = len(e.scene.route.levels)
+    xdo("key", "Insert")  # nothing selected: refused, nothing changes
+    pump(e)
+    assert len(e.scene.route.levels) == n and "select a level first" in e.viewer.error
+    e.select_level(3)
+    for key, change in (("Insert", 1), ("Delete", -1), ("ctrl+d", 1)):
+        before = len(e.scene.route.levels)
+        xdo("key", key)
+        pump(e)
+        assert len(e.scene.route.levels) == before + change, key
+    assert len(e.doc.history.steps) == 3
+    xdo("key", "ctrl+z")
+    pump(e)
+    assert len(e.scene.route.levels) == n
+
+
+def test_saving_a_shipped_preset_asks_for_a_copy_and_never_writes_the_package(
+    display, tmp_path, monkeypatch
+):
+    from krsview.document.document import copy_target
+    from krsview.editor.window import Editor
+    from krsview.scene.presets import PRESET_DIR
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    before = {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()}
+    e = Editor(resolve("tree"), size=WINDOW)
+    try:
+        e.execute([ec.Bake()])
+        assert e.save() is False and e.copy_to == str(tmp_path / "tree.toml")
+        assert copy_target(e.path) == tmp_path / "tree.toml"
+        pump(e)  # the dialog is drawn
+        e.execute([ec.SetCopyText(str(tmp_path / "mine.toml")), ec.SaveCopy()])
+        assert e.copy_to is None and e.path == tmp_path / "mine.toml" and not e.doc.dirty
+        assert load_scene(tmp_path / "mine.toml").route is not None
+        e.execute([ec.InsertLevel(2)])
+        assert e.save() is True, "the copy is an ordinary file: Ctrl+S saves it"
+    finally:
+        e.close()
+    assert {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()} == before
+
+
+def test_an_autosave_that_cannot_write_is_said_in_the_status_line(window_editor):
+    from krsview.document.document import AUTOSAVE_SECONDS
+
+    e = window_editor
+    e.execute([ec.WholeTree("widths")])
+    e.doc.recovery_path.mkdir()  # no one may write there, root neither
+    pump(e, 1)  # the interval starts
+    time.sleep(AUTOSAVE_SECONDS + 0.1)
+    pump(e, 1)
+    assert "autosave cannot write" in e.viewer.status_line()
+    assert e.viewer.error == e.doc.autosave_error
