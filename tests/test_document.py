@@ -347,3 +347,12 @@ def test_an_autosave_that_cannot_write_says_so_and_recovers(route_file):
     assert str(doc.recovery_path) in doc.autosave_error and "save" in doc.autosave_error
     doc.recovery_path.rmdir()  # negative control: once it can write, it does, and is quiet
     assert doc.autosave(2 * AUTOSAVE_SECONDS) and doc.autosave_error == ""
+
+
+def test_a_shipped_presets_camera_path_goes_beside_its_copy(data_home, tmp_path, monkeypatch):
+    from krsview.viewer.recording import path_file
+
+    monkeypatch.chdir(tmp_path)
+    assert path_file(resolve("tree")) == tmp_path / "tree.path.json"
+    mine = tmp_path / "elsewhere" / "tree.toml"  # negative control: a file of one's own
+    assert path_file(mine) == tmp_path / "elsewhere" / "tree.path.json"

@@ -467,3 +467,28 @@ def test_an_autosave_that_cannot_write_is_said_in_the_status_line(window_editor)
     pump(e, 1)
     assert "autosave cannot write" in e.viewer.status_line()
     assert e.viewer.error == e.doc.autosave_error
+
+
+def test_a_viewer_bookmark_of_a_shipped_preset_goes_to_its_copy(display, tmp_path, monkeypatch):
+    from krsview.scene.presets import PRESET_DIR
+    from krsview.viewer.window import Viewer
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    before = {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()}
+    v = Viewer(resolve("sierpinski"), size=WINDOW, hud=False)
+    try:
+        v.add_bookmark()
+        assert v.path == tmp_path / "sierpinski.toml" and not v.doc.dirty, v.error
+        assert (
+            len(load_scene(v.path).bookmarks)
+            == len(load_scene(resolve("sierpinski")).bookmarks) + 1
+        )
+        v.add_bookmark()  # the copy is an ordinary file now: the next one goes there too
+        assert (
+            len(load_scene(v.path).bookmarks)
+            == len(load_scene(resolve("sierpinski")).bookmarks) + 2
+        )
+    finally:
+        v.close()
+    assert {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()} == before
