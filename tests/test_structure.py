@@ -443,7 +443,7 @@ def test_saving_a_shipped_preset_asks_for_a_copy_and_never_writes_the_package(
     e = Editor(resolve("tree"), size=WINDOW)
     try:
         e.execute([ec.Bake()])
-        assert e.save() is False and e.copy_to == str(tmp_path / "tree.toml")
+        assert e.save() is False and e.copy_to.text == str(tmp_path / "tree.toml")
         assert copy_target(e.path) == tmp_path / "tree.toml"
         pump(e)  # the dialog is drawn
         e.execute([ec.SetCopyText(str(tmp_path / "mine.toml")), ec.SaveCopy()])
@@ -492,3 +492,29 @@ def test_a_viewer_bookmark_of_a_shipped_preset_goes_to_its_copy(display, tmp_pat
     finally:
         v.close()
     assert {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()} == before
+
+
+def test_closing_a_shipped_preset_with_edits_saves_the_copy_then_closes(
+    display, tmp_path, monkeypatch
+):
+    import glfw
+
+    from krsview.editor.window import Editor
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    e = Editor(resolve("sierpinski"), size=WINDOW)
+    try:
+        e.edit(("render", "epsilon_scale"), 2.0)
+        glfw.set_window_should_close(e.viewer.window, True)
+        assert not e.should_close() and e.asking == ("close", None)
+        pump(e)
+        e.execute([ec.AnswerSave()])
+        pump(e)
+        assert e.asking is None and e.copy_to.then == ("close", None)
+        assert not e.should_close(), "nothing saved yet: the window stays"
+        e.execute([ec.SaveCopy()])
+        assert e.should_close() and e.path == tmp_path / "sierpinski.toml"
+        assert load_scene(e.path).render.epsilon_scale == 2.0
+    finally:
+        e.close()

@@ -5,6 +5,7 @@ and an autosave that cannot write is said at once in the status line."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -18,29 +19,49 @@ from . import commands as ec
 DIALOG = "save a copy"
 
 
+@dataclass(frozen=True)
+class CopyAsk:
+    """The copy dialog: where the copy goes, and the question that wanted the save (closing
+    or opening another scene with unsaved edits), answered once the copy is saved."""
+
+    text: str
+    then: tuple[str, Path | None] | None = None
+
+
 class Saving(Protocol):
     """What saving reads and calls of the editor."""
 
     viewer: Viewer
-    copy_to: str | None  # the copy dialog's field; None: no dialog
+    copy_to: CopyAsk | None  # None: no dialog
+    asking: tuple[str, Path | None] | None
 
     @property
     def doc(self) -> Document: ...
     @property
     def path(self) -> Path: ...
     def save_as(self, text: str) -> None: ...
+    def answer_save(self) -> None: ...
 
 
 def ask_copy(e: Saving) -> bool:
-    """Ctrl+S on a template: open the dialog with the default copy; nothing saved yet."""
-    e.copy_to = str(copy_target(e.path))
+    """Saving a template: ask where the copy goes (the default filled in), taking over the
+    unsaved-edits question if that is what asked; nothing is saved yet."""
+    e.copy_to, e.asking = CopyAsk(str(copy_target(e.path)), e.asking), None
     return False
 
 
 def save_copy(e: Saving) -> None:
-    e.save_as(e.copy_to or "")
-    if not e.doc.template:
-        e.copy_to = None
+    """Save to the named copy; then go on with the question that asked (close, open)."""
+    ask = e.copy_to
+    if ask is None:
+        return
+    e.save_as(ask.text)
+    if e.doc.template:
+        return  # refused: the dialog stays, with the error
+    e.copy_to = None
+    if ask.then is not None:
+        e.asking = ask.then
+        e.answer_save()
 
 
 def autosave(e: Saving, now: float) -> None:
@@ -54,7 +75,7 @@ def autosave(e: Saving, now: float) -> None:
 
 
 SAVING_HANDLERS: dict[type[Command], Callable[[Any, Any], None]] = {
-    ec.SetCopyText: lambda e, c: setattr(e, "copy_to", c.text),
+    ec.SetCopyText: lambda e, c: setattr(e, "copy_to", replace(e.copy_to, text=c.text)),
     ec.SaveCopy: lambda e, c: save_copy(e),
     ec.CancelCopy: lambda e, c: setattr(e, "copy_to", None),
 }
@@ -70,7 +91,7 @@ def copy_dialog(e: Saving) -> list[Command]:
     imgui.text(f"{e.doc.path.name} is a preset shipped with krsview: a template, never")
     imgui.text("overwritten. Save your version as:")
     imgui.set_next_item_width(420)
-    changed, text = imgui.input_text("##copy", e.copy_to or "")
+    changed, text = imgui.input_text("##copy", e.copy_to.text if e.copy_to else "")
     if changed:
         out.append(ec.SetCopyText(text))
     if e.viewer.error and e.copy_to is not None:

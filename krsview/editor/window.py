@@ -40,7 +40,7 @@ from . import commands as ec
 from .gizmo import Gizmo
 from .handles import Handle, handles, polyline
 from .panels import edit_panel
-from .saving import SAVING_HANDLERS, ask_copy, autosave
+from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools
 
 PICK_PIXELS = 12.0  # a click this close to a handle grabs it
@@ -67,7 +67,7 @@ class Editor:
         self.snap = self.gizmo.snap
         self.carry = True  # a fork drag takes its subtree along
         self.structure = StructureTools()
-        self.copy_to: str | None = None  # a shipped preset's copy, being asked for
+        self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
         self._handles_of: Scene | None = None  # the scene the handles were made for
         self._handles: list[Handle] = []
