@@ -1,20 +1,23 @@
 """The editor's document: edits through one seam, undo/redo with drags merged by interaction,
-atomic saves, autosave and recovery, and files changed on disk never overwritten silently."""
+atomic saves that keep the file's mode, owner and links, autosave and recovery, files changed
+on disk never overwritten silently, and shipped presets kept as templates."""
 
 from __future__ import annotations
 
 import os
 import shutil
+import stat
+import tempfile
 from dataclasses import replace
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from krsview.document.document import AUTOSAVE_SECONDS, ConflictError, Document
+from krsview.document.document import AUTOSAVE_SECONDS, ConflictError, Document, copy_target
 from krsview.scene import SceneError, load_scene, save_scene
 from krsview.scene.edits import get_at, path_text
-from krsview.scene.presets import resolve
+from krsview.scene.presets import PRESET_DIR, resolve
 
 
 @pytest.fixture
@@ -233,3 +236,123 @@ def test_a_read_only_folder_fails_the_save_clearly_and_keeps_the_edit(route_file
         doc.save(target)
     assert doc.dirty and doc.path == route_file
     shutil.rmtree(tmp_path / "ro", ignore_errors=True)
+
+
+# ------------------------------------------------------------------------------ file safety
+@pytest.mark.parametrize("mode", [0o644, 0o664])
+def test_saving_keeps_the_files_mode(route_file, mode):
+    route_file.chmod(mode)
+    doc = Document(route_file)
+    doc.apply(FORK, [1.0, 5.0, 0.5])
+    doc.save()
+    assert stat.S_IMODE(route_file.stat().st_mode) == mode
+    assert load_scene(route_file) == doc.scene, "the contents were saved"
+
+
+def test_negative_control_a_bare_temporary_file_has_mode_600(tmp_path):
+    """What the save wrote before: mkstemp's 600, which the test above tells apart."""
+    fd, name = tempfile.mkstemp(dir=tmp_path)
+    os.close(fd)
+    assert stat.S_IMODE(os.stat(name).st_mode) == 0o600
+
+
+def test_a_new_file_gets_the_umasks_mode_and_a_link_stays_a_link(route_file, tmp_path):
+    doc = Document(route_file)
+    old = os.umask(0o002)
+    try:
+        doc.save(tmp_path / "new.toml")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE((tmp_path / "new.toml").stat().st_mode) == 0o664
+    link = tmp_path / "link.toml"
+    link.symlink_to(tmp_path / "new.toml")
+    linked = Document(link)
+    linked.apply(FORK, [2.0, 5.0, 0.5])
+    linked.save()
+    assert link.is_symlink() and load_scene(tmp_path / "new.toml") == linked.scene
+
+
+def test_saving_keeps_the_owner_where_permitted(route_file):
+    if os.geteuid() != 0:
+        pytest.skip("only root may give a file to another user")
+    os.chown(route_file, 12345, 23456)
+    doc = Document(route_file)
+    doc.apply(FORK, [1.0, 5.0, 0.5])
+    doc.save()
+    st_ = route_file.stat()
+    assert (st_.st_uid, st_.st_gid) == (12345, 23456)
+
+
+def test_saving_syncs_the_folder_after_the_rename(route_file, monkeypatch):
+    synced: list[bool] = []  # is each fsync'd descriptor a folder?
+    real = os.fsync
+    monkeypatch.setattr(
+        os, "fsync", lambda fd: (synced.append(stat.S_ISDIR(os.fstat(fd).st_mode)), real(fd))
+    )
+    doc = Document(route_file)
+    doc.apply(FORK, [1.0, 5.0, 0.5])
+    doc.save()
+    assert synced == [False, True], "the file, then its folder"
+
+
+@pytest.fixture
+def data_home(tmp_path, monkeypatch):
+    home = tmp_path / "data"
+    monkeypatch.setenv("XDG_DATA_HOME", str(home))
+    return home / "krsview"
+
+
+def package_files() -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()}
+
+
+def test_a_shipped_preset_is_a_template_saved_only_as_a_copy(data_home, tmp_path, monkeypatch):
+    before = package_files()
+    doc = Document(resolve("tree"))
+    assert doc.template
+    doc.apply(("tree", "levels"), 12)
+    with pytest.raises(SceneError, match="template that is never overwritten.*save a copy"):
+        doc.save()
+    with pytest.raises(SceneError, match="template"):
+        doc.save(PRESET_DIR / "rock.toml")
+    assert doc.autosave(0.0) is False and doc.autosave(AUTOSAVE_SECONDS)
+    assert doc.recovery_path.parent == data_home / "recovery"
+    assert package_files() == before, "something was written into the package"
+    monkeypatch.chdir(tmp_path)
+    target = copy_target(doc.path)
+    assert target == tmp_path / "tree.toml"
+    doc.save(target)
+    assert not doc.template and load_scene(target).tree.levels == 12 and doc.save() == target
+
+
+def test_a_presets_copy_goes_to_the_user_folder_when_the_working_one_is_taken(data_home, tmp_path):
+    preset = resolve("tree")
+    (tmp_path / "tree.toml").write_text("taken")
+    assert copy_target(preset, tmp_path) == data_home / "tree.toml"
+    data_home.mkdir(parents=True)
+    (data_home / "tree.toml").write_text("taken too")
+    assert copy_target(preset, tmp_path) == data_home / "tree-2.toml"
+    assert copy_target(preset, PRESET_DIR) == data_home / "tree-2.toml", "never the package"
+    free = tmp_path / "free"
+    free.mkdir()
+    assert copy_target(preset, free) == free / "tree.toml"
+
+
+def test_an_autosave_that_cannot_write_says_so_and_recovers(route_file):
+    doc = Document(route_file)
+    doc.apply(FORK, [1.0, 5.0, 0.5])
+    doc.recovery_path.mkdir()  # a folder where the file goes: no one may write it, root neither
+    doc.autosave(0.0)
+    assert not doc.autosave(AUTOSAVE_SECONDS)
+    assert str(doc.recovery_path) in doc.autosave_error and "save" in doc.autosave_error
+    doc.recovery_path.rmdir()  # negative control: once it can write, it does, and is quiet
+    assert doc.autosave(2 * AUTOSAVE_SECONDS) and doc.autosave_error == ""
+
+
+def test_a_shipped_presets_camera_path_goes_beside_its_copy(data_home, tmp_path, monkeypatch):
+    from krsview.viewer.recording import path_file
+
+    monkeypatch.chdir(tmp_path)
+    assert path_file(resolve("tree")) == tmp_path / "tree.path.json"
+    mine = tmp_path / "elsewhere" / "tree.toml"  # negative control: a file of one's own
+    assert path_file(mine) == tmp_path / "elsewhere" / "tree.path.json"

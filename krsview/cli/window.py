@@ -57,7 +57,11 @@ def add(sub) -> None:
         "one click. Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo, "
         "Ctrl+S saves atomically, Ctrl+Shift+S saves as; unsaved "
         "edits are autosaved to PRESET.recovery and offered back "
-        "after a crash. The viewer's keys fly the camera. Example: krsview edit tree",
+        "after a crash. Insert / Delete / Ctrl+D insert, remove or duplicate the selected "
+        "level (also by right-clicking an outline entry); the structure section tapers, "
+        "scales and moves the tree and grows it again from its growth parameters. A shipped "
+        "preset is a template: Ctrl+S asks where its copy goes (default ./NAME.toml). "
+        "The viewer's keys fly the camera. Example: krsview edit tree",
     )
     settings_options(e, EDITOR, size=EDITOR_SETTINGS.size)
     e.set_defaults(func=run_edit)

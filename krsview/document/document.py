@@ -3,9 +3,11 @@
 It owns the scene, its file, the undo history and the saved version. A drag, a panel field,
 an effect toggle, a render knob, a bookmark or a reload from disk is an edit applied here:
 validated by the scene schema first (a bad value leaves the last valid scene in place), then
-recorded for undo. Saves are atomic; while there are unsaved edits a recovery file beside the
-scene is rewritten every few seconds, and a file changed on disk is never overwritten
-silently.
+recorded for undo. Saves are atomic and keep the file's mode; while there are unsaved edits a
+recovery file beside the scene is rewritten every few seconds, and a file changed on disk is
+never overwritten silently. A preset shipped inside the package is a template: it is read,
+never written; its copy goes to the user's folder (:func:`copy_target`), its recovery file
+to the user's data folder.
 """
 
 from __future__ import annotations
@@ -19,11 +21,38 @@ from typing import Any
 from ..scene import Scene, SceneError, load_scene, scene_to_toml
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
+from ..scene.presets import PRESET_DIR
 from ..scene.scene import write_atomic
 from .history import History, Step
 
 AUTOSAVE_SECONDS = 3.0  # a crash loses at most this much work
 RECOVERY_SUFFIX = ".recovery"
+
+
+def shipped(path: str | os.PathLike) -> bool:
+    """A preset inside the installed package: a template, never written."""
+    return Path(os.path.realpath(path)).is_relative_to(os.path.realpath(PRESET_DIR))
+
+
+def user_folder() -> Path:
+    """krsview's folder in the user's data directory (``$XDG_DATA_HOME/krsview``, else
+    ``~/.local/share/krsview``): copies of presets where the working directory will not do,
+    and the recovery files of presets."""
+    data = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(data) / "krsview"
+
+
+def copy_target(preset: Path, cwd: Path | None = None) -> Path:
+    """Where a shipped preset's copy goes unless the user says otherwise: ``NAME.toml`` in
+    the working directory if that is free and writable, else in :func:`user_folder`
+    (numbered ``NAME-2.toml`` … if taken)."""
+    here = (cwd or Path.cwd()) / preset.name
+    if not here.exists() and os.access(here.parent, os.W_OK) and not shipped(here):
+        return here
+    folder, k = user_folder(), 1
+    while (folder / (preset.name if k == 1 else f"{preset.stem}-{k}.toml")).exists():
+        k += 1
+    return folder / (preset.name if k == 1 else f"{preset.stem}-{k}.toml")
 
 
 class ConflictError(RuntimeError):
@@ -57,6 +86,12 @@ class Document:
         self.version = 0  # bumps on every change: views redraw
         self._autosaved: Scene | None = None
         self._autosave_clock: float | None = None
+        self.autosave_error = ""  # why the last autosave could not write ("": it could)
+
+    @property
+    def template(self) -> bool:
+        """The file is a shipped preset: saving it needs a new name (a copy)."""
+        return shipped(self.path)
 
     # ----------------------------------------------------------------------------- state
     @property
@@ -134,12 +169,21 @@ class Document:
         """Write the scene atomically (to ``path``: save as). Refuses, with ConflictError, to
         overwrite a file changed on disk since we read it, unless ``overwrite``."""
         target = Path(path) if path is not None else self.path
+        if shipped(target):
+            raise SceneError(
+                "<file>",
+                str(target),
+                "is a preset shipped with krsview, a template that is never overwritten; "
+                f"save a copy instead, e.g. {copy_target(target)}",
+            )
         if target == self.path and not overwrite and self.changed_on_disk():
             raise ConflictError(
                 f"{self.path} changed on disk since it was opened here; "
                 "reload it (your edits stay undoable) or overwrite it"
             )
         try:
+            if target.parent == user_folder():  # a preset's copy: the folder may be new
+                target.parent.mkdir(parents=True, exist_ok=True)
             write_atomic(target, scene_to_toml(self._scene))
         except OSError as e:
             raise SceneError("<file>", str(target), f"cannot save: {e.strerror}") from None
@@ -159,27 +203,36 @@ class Document:
     # -------------------------------------------------------------------------- recovery
     @property
     def recovery_path(self) -> Path:
-        """Beside the scene: ``NAME.toml.recovery`` (not a ``.toml``, so never a preset)."""
-        return self.path.with_name(self.path.name + RECOVERY_SUFFIX)
+        """Beside the scene: ``NAME.toml.recovery`` (not a ``.toml``, so never a preset); a
+        shipped preset's in ``recovery/`` of the user's data folder, never in the package."""
+        name = self.path.name + RECOVERY_SUFFIX
+        return user_folder() / "recovery" / name if self.template else self.path.with_name(name)
 
     def autosave(self, now: float) -> bool:
         """Call every event-loop turn: while dirty, rewrite the recovery file at most every
-        AUTOSAVE_SECONDS (atomic); when clean, there is none. Returns True when it wrote."""
+        AUTOSAVE_SECONDS (atomic); when clean, there is none. Returns True when it wrote; when
+        it cannot write, ``autosave_error`` says why (and it tries again an interval later)."""
         if not self.dirty:
             if self._autosaved is not None:
                 self.recovery_path.unlink(missing_ok=True)
                 self._autosaved = None
-            self._autosave_clock = None
+            self._autosave_clock, self.autosave_error = None, ""
             return False
         if self._autosave_clock is None:
             self._autosave_clock = now  # first unsaved edit: start the interval
         if self._scene == self._autosaved or now - self._autosave_clock < AUTOSAVE_SECONDS:
             return False
         try:
+            self.recovery_path.parent.mkdir(parents=True, exist_ok=True)
             write_atomic(self.recovery_path, scene_to_toml(self._scene))
-        except OSError:
-            return False  # a read-only folder: editing goes on
-        self._autosaved, self._autosave_clock = self._scene, now
+        except OSError as e:  # a read-only folder: editing goes on, and the editor says so
+            self._autosave_clock = now
+            self.autosave_error = (
+                f"autosave cannot write {self.recovery_path}: {e.strerror}; "
+                "save your edits (Ctrl+S, or save as) to keep them"
+            )
+            return False
+        self._autosaved, self._autosave_clock, self.autosave_error = self._scene, now, ""
         return True
 
     def recovery(self) -> Scene | None:

@@ -99,3 +99,85 @@ class PlacePanel(Command):
 
     side: str
     width: float
+
+
+# ------------------------------------------------------------- structure (editor/structure.py)
+@dataclass(frozen=True)
+class InsertLevel(Command):
+    """Insert a fork along a level's branch (None: the selected level), at the split
+    point the structure section shows."""
+
+    level: int | None = None
+
+
+@dataclass(frozen=True)
+class RemoveLevel(Command):
+    """Remove a level's fork: its branch and the next finer one merge (None: selected)."""
+
+    level: int | None = None
+
+
+@dataclass(frozen=True)
+class DuplicateLevel(Command):
+    """The level once more at its own tip (None: the selected level)."""
+
+    level: int | None = None
+
+
+@dataclass(frozen=True)
+class WholeTree(Command):
+    """A whole-route operation with the structure section's value: "taper", "widths",
+    "scale" or "base"."""
+
+    op: str
+
+
+@dataclass(frozen=True)
+class SetToolValue(Command):
+    """A value of the structure section (split point, taper ratio, factors, base)."""
+
+    name: str
+    value: object
+
+
+@dataclass(frozen=True)
+class SetGrowth(Command):
+    """Grow the route again with one growth parameter changed (edits kept where they can
+    be; otherwise the editor asks first)."""
+
+    name: str
+    value: object
+    interaction: object = None
+
+
+@dataclass(frozen=True)
+class Regrow(Command):
+    """Grow the route again from its growth parameters as they are."""
+
+
+@dataclass(frozen=True)
+class ConfirmRegrow(Command):
+    """Re-grow although the listed hand edits will be lost."""
+
+
+@dataclass(frozen=True)
+class CancelRegrow(Command):
+    """Keep the route as it is."""
+
+
+# ------------------------------------------------- a shipped preset's copy (editor/saving.py)
+@dataclass(frozen=True)
+class SetCopyText(Command):
+    """Where the copy of a shipped preset goes (the dialog's field)."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class SaveCopy(Command):
+    """Save the shipped preset's edits to the copy named in the dialog."""
+
+
+@dataclass(frozen=True)
+class CancelCopy(Command):
+    """Close the copy dialog without saving."""

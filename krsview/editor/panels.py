@@ -20,6 +20,8 @@ from . import commands as ec
 from .gizmo import Snap
 from .handles import Handle, outline
 from .layout import MIN_WIDTH, Layout
+from .saving import copy_dialog
+from .structure import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
@@ -83,6 +85,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         _outline(e, out)
         if imgui.collapsing_header("selection", imgui.TreeNodeFlags_.default_open):
             _selection(e, out, interactions)
+        out += structure_section(e, interactions)
     if imgui.collapsing_header("material"):
         _fields(scene.material, ("material",), out, interactions)
     if imgui.collapsing_header("effect settings"):
@@ -105,6 +108,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
     imgui.end()
     _modals(e, out)
+    out += copy_dialog(e)
     return out
 
 
@@ -182,6 +186,7 @@ def _outline(e: Edited, out: list) -> None:
             clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
             if clicked:
                 out.append(ec.SelectLevel(k))
+            out += outline_menu(k)
             if selected and e.scroll_outline:
                 imgui.set_scroll_here_y()
                 out.append(ec.OutlineScrolled())

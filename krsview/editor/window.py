@@ -43,11 +43,13 @@ from .handles import Handle, handles
 from .layout import Layout, frame
 from .panels import edit_panel
 from .picking import pick, under, visible
+from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave
 from .shapes import editor_shapes
+from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools
 from .trackball import Trackball
 
 LABEL = 0xFFFFFFFF  # hover labels: white (ImGui's packed ABGR)
-EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs()}
+EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs(), **STRUCTURE_KEYS}
 
 
 class Editor:
@@ -63,6 +65,8 @@ class Editor:
         self.trackball = Trackball(self.snap)
         self.layout = Layout()
         self.carry = True  # a fork drag takes its subtree along
+        self.structure = StructureTools()
+        self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
         self._handles_of: Scene | None = None  # the scene the handles were made for
         self._handles: list[Handle] = []
@@ -162,7 +166,7 @@ class Editor:
             self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
         )
         glfw.swap_buffers(v.window)
-        self.doc.autosave(time.monotonic())
+        autosave(self, time.monotonic())
         self._update_title()
 
     def should_close(self) -> bool:
@@ -203,6 +207,8 @@ class Editor:
 
     def save(self, path: str | None = None, overwrite: bool = False) -> bool:
         v = self.viewer
+        if not path and self.doc.template:
+            return ask_copy(self)
         try:
             saved = self.doc.save(path or None, overwrite=overwrite)
         except ConflictError as e:
@@ -393,4 +399,6 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction),
     vc.ResetView: lambda e, c: e.reset_view(),
     ec.PlacePanel: lambda e, c: e.place_panel(c.side, c.width),
+    **STRUCTURE_HANDLERS,
+    **SAVING_HANDLERS,
 }

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .growth import Growth
 from .model import (
     _COLOR,
     KRS,
@@ -56,6 +57,13 @@ class RouteLevel:
         unit_vector="normalise",
         help="normal of the mirror through this fork (not on level 0)",
     )
+    grown: int | None = param(
+        None,
+        lo=0,
+        hi=MAX_LEVELS,
+        help="depth (0: the trunk) of the level of [route.growth] this one was baked as; "
+        "none for a level made by hand",
+    )
 
 
 @dataclass(frozen=True)
@@ -70,6 +78,9 @@ class Route:
         "kernels: 2^k trees from one [KRS17 §9.2]",
     )
     ground: Kernel | None = param(None, help="kernel of the last forest level: a ground plane, say")
+    growth: Growth | None = param(
+        None, help="the growth parameters this route was baked from: re-bake grows it again"
+    )
 
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
@@ -104,6 +115,28 @@ class Route:
                 "<kernel>",
                 "the ground is the kernel of the last forest level: add at least one forest mirror",
             )
+        self._check_grown(p)
+
+    def _check_grown(self, p: str) -> None:
+        """Each ``grown`` depth names one level of the growth parameters, at most once."""
+        seen: set[int] = set()
+        for i, lv in enumerate(self.levels):
+            if lv.grown is None:
+                continue
+            if self.growth is None:
+                raise SceneError(
+                    f"{p}[{i}].grown",
+                    lv.grown,
+                    "names a level of [route.growth], which this route does not have; remove it",
+                )
+            if lv.grown > self.growth.levels or lv.grown in seen:
+                raise SceneError(
+                    f"{p}[{i}].grown",
+                    lv.grown,
+                    f"allowed: a depth 0..{self.growth.levels} of [route.growth] "
+                    "that no other level names",
+                )
+            seen.add(lv.grown)
 
     def starts(self) -> list[Vec3]:
         """Where each level's branch starts: the fork of the level above, the base for the trunk."""
@@ -149,7 +182,13 @@ class Route:
 
 def arc_points(k: ToroidalCapsule, samples: int = ARC_SAMPLES) -> np.ndarray:
     """Points along a branch's centre line, start to end (the arc, or the chord if straight)."""
-    s = np.linspace(0.0, 1.0, samples)[:, None]
+    return centre_at(k, np.linspace(0.0, 1.0, samples))
+
+
+def centre_at(k: ToroidalCapsule, s: np.ndarray) -> np.ndarray:
+    """Points of a branch's centre line at fractions ``s`` of its length (0: start, 1: end):
+    on the arc through start, control and end, or on the chord where that is straight."""
+    s = np.asarray(s, dtype=float)[:, None]
     a = arc_of(k)
     if a is None:
         return np.array(k.start) + s * (np.array(k.end) - np.array(k.start))

@@ -12,62 +12,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import _COLOR, KRS, Mirror, Plane
+from .growth import Growth, growth_of
+from .model import KRS, Plane
 from .route import Route, RouteLevel
-from .schema import SceneError, Vec3, param
+from .schema import Vec3
 
 
 @dataclass(frozen=True)
-class Tree:
+class Tree(Growth):
     """Growth parameters of a KRS tree; :meth:`krs` expands them into levels."""
-
-    levels: int = param(20, lo=1, hi=63, help="forks from trunk to twig (2^levels twigs)")
-    base: Vec3 = param((0.0, 0.0, 0.0), help="foot of the trunk")
-    up: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="trunk direction")
-    trunk_length: float = param(1.5, lo=0.0, lo_open=True, help="length of the trunk")
-    trunk_radius: float = param(0.12, lo=0.0, lo_open=True, help="section radius of the trunk")
-    length_ratio: float = param(0.8, lo=0.05, hi=1.0, help="child / parent branch length")
-    radius_ratio: float = param(0.72, lo=0.05, hi=1.0, help="child / parent branch radius")
-    branch_angle: float = param(
-        32.0, lo=0.0, hi=89.0, unit="degrees", help="angle between a branch and each child"
-    )
-    divergence: float = param(
-        90.0,
-        lo=0.0,
-        hi=180.0,
-        unit="degrees",
-        help="turn of successive fork planes around the branch",
-    )
-    bend: float = param(0.08, lo=-0.5, hi=0.5, help="upward bow of a branch, × its length")
-    bark: Vec3 = param((0.30, 0.20, 0.12), **_COLOR)
-    leaf: Vec3 = param((0.20, 0.45, 0.10), **_COLOR)
-    leaf_levels: int = param(5, lo=0, hi=63, help="finest levels coloured as leaves")
-    forest: list[Mirror] = param(
-        [],
-        help="extra reflections above the trunk, with empty "
-        "kernels: 2^k trees from one [KRS17 §9.2]",
-    )
-    ground: Vec3 | None = param(
-        None,
-        lo=0.0,
-        hi=1.0,
-        help="colour of a ground plane through the base (kernel of the last forest level)",
-    )
-
-    def validate(self, path: str) -> None:
-        if self.levels + 1 + len(self.forest) > 64:
-            raise SceneError(
-                f"{path}.forest",
-                f"<{len(self.forest)} mirrors>",
-                f"levels + 1 + forest mirrors must be ≤ 64; allowed: at most "
-                f"{63 - self.levels} forest mirrors with {self.levels} levels",
-            )
-        if self.ground is not None and not self.forest:
-            raise SceneError(
-                f"{path}.ground",
-                list(self.ground),
-                "the ground is the kernel of the last forest level: add at least one forest mirror",
-            )
 
     def krs(self) -> KRS:
         """Grow the route and expand it into KRS levels (level 0 = twig tip, level n = trunk)."""
@@ -75,7 +28,8 @@ class Tree:
 
     def route(self) -> Route:
         """Bake the growth parameters into a route: fork points, control points, radii,
-        colours and fork mirror normals, each then editable [KRS17 §9.2]."""
+        colours and fork mirror normals, each then editable [KRS17 §9.2]. The route keeps
+        the growth parameters and each level its depth in them, to be grown again."""
         n = self.levels
         theta = math.radians(self.branch_angle)
         up = np.array(self.up)
@@ -91,11 +45,15 @@ class Tree:
             control = P + 0.5 * length * d + self.bend * length * side
             color = self.leaf if i < self.leaf_levels else self.bark
             if i == 0:
-                entries.append(RouteLevel(as_vec3(end), as_vec3(control), radius, color))
+                entries.append(
+                    RouteLevel(as_vec3(end), as_vec3(control), radius, color, grown=n - i)
+                )
                 break
             # Mirror R_{i-1} through the fork P_i = end, containing the parent direction.
             u = _rotate(s, d, math.radians(self.divergence))
-            entries.append(RouteLevel(as_vec3(end), as_vec3(control), radius, color, as_vec3(u)))
+            entries.append(
+                RouteLevel(as_vec3(end), as_vec3(control), radius, color, as_vec3(u), n - i)
+            )
             d_child = math.cos(theta) * d - math.sin(theta) * u  # child on the negative side
             s = math.sin(theta) * d + math.cos(theta) * u
             d, P = d_child / np.linalg.norm(d_child), end
@@ -106,7 +64,7 @@ class Tree:
             if self.ground is not None
             else None
         )
-        return Route(self.base, entries[::-1], list(self.forest), ground)
+        return Route(self.base, entries[::-1], list(self.forest), ground, growth_of(self))
 
 
 def as_vec3(v: np.ndarray | tuple) -> Vec3:

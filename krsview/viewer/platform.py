@@ -13,9 +13,11 @@ from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack fa
 from .controls import LOOK_BUTTON, Input
 from .fonts import load_font
 
-GLFW_KEYS = {getattr(glfw, f"KEY_{c}"): c for c in string.ascii_uppercase} | {
-    getattr(glfw, f"KEY_F{i}"): f"F{i}" for i in range(1, 13)
-}
+GLFW_KEYS = (
+    {getattr(glfw, f"KEY_{c}"): c for c in string.ascii_uppercase}
+    | {getattr(glfw, f"KEY_F{i}"): f"F{i}" for i in range(1, 13)}
+    | {glfw.KEY_INSERT: "Insert", glfw.KEY_DELETE: "Delete"}
+)
 GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
 
 

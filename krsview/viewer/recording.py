@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..document.document import copy_target, shipped
 from ..scene import SceneError
 from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
 from ..scene.scene import write_atomic
@@ -15,7 +16,10 @@ from .camera import FlyCamera
 
 
 def path_file(scene_file: Path) -> Path:
-    """Where the camera path of a preset is kept: beside it, ``NAME.path.json``."""
+    """Where the camera path of a preset is kept: beside it, ``NAME.path.json``; for a
+    preset shipped in the package (a template, never written), beside its copy."""
+    if shipped(scene_file):
+        scene_file = copy_target(scene_file)
     return scene_file.with_name(scene_file.stem + ".path.json")
 
 
@@ -47,6 +51,7 @@ class Recorder:
     def save(self) -> None:
         poses = list(self.path.poses)
         try:
+            self.file.parent.mkdir(parents=True, exist_ok=True)
             write_atomic(self.file, camera_path_json(poses))
             self.message = (
                 f"recorded {len(poses)} poses to {self.file.name} "

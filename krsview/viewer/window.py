@@ -16,7 +16,7 @@ import numpy as np
 from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
 
 from ..compile.geometry import compile_geometry
-from ..document.document import Document
+from ..document.document import Document, copy_target
 from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
@@ -247,7 +247,19 @@ class Viewer:
             self.go_to_bookmark((self.nav.bookmark_index + 1) % len(self.scene.bookmarks))
 
     def add_bookmark(self) -> None:
-        """Append the current camera to the preset file's bookmarks (atomic save)."""
+        """Append the current camera to the preset file's bookmarks (atomic save); a shipped
+        preset's go to its copy (document.copy_target), which the viewer shows from then on."""
+        if self.doc.template:
+            b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.camera.to_camera())
+            self.edit(("bookmarks",), self.scene.bookmarks + [b])
+            try:
+                saved = self.doc.save(copy_target(self.path))
+            except SceneError as e:
+                self.error = f"bookmark not saved: {e}"
+                return
+            self.follow_file()
+            self.message = f"saved bookmark {b.name!r} in a copy of the preset: {saved}"
+            return
         try:
             on_disk = load_scene(self.path)
         except SceneError as e:

@@ -1,0 +1,520 @@
+"""Structure edits of a route (scene/restructure.py) and growing a baked route again
+(scene/regrow.py), checked with the reference distance of the kernels and of the whole KRS,
+not with the construction itself; and the editor's glue (editor/structure.py): one undo step
+each, a refusal changes nothing and says why, re-growing asks before losing hand edits."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from krsview.compile.krs import compile_krs
+from krsview.document.document import Document
+from krsview.editor import commands as ec
+from krsview.editor.structure import STRUCTURE_HANDLERS, StructureTools
+from krsview.reference.krs import distance
+from krsview.scene import KRS, Level, SceneError, load_scene, save_scene, scene_from_toml
+from krsview.scene.edits import validated
+from krsview.scene.presets import resolve
+from krsview.scene.regrow import frame, grow, rebake
+from krsview.scene.restructure import (
+    duplicate_level,
+    free_normal,
+    merge_level,
+    move_base,
+    scale_tree,
+    scale_widths,
+    split_level,
+    tangent_at,
+    taper,
+)
+from krsview.scene.route import centre_at
+
+ALBEDO = (0.5, 0.5, 0.5)
+LINE = np.linspace(0.0, 1.0, 41)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    """The shipped tree with 8 forks (fast), bent as shipped."""
+    s = load_scene(resolve("tree"))
+    return replace(s, tree=replace(s.tree, levels=8))
+
+
+@pytest.fixture(scope="module")
+def route(scene):
+    return scene.tree.route()
+
+
+def kernel_d(k, pts) -> np.ndarray:
+    return distance(compile_krs(KRS([Level(k)]), ALBEDO), np.asarray(pts, dtype=float))
+
+
+def krs_d(route, pts) -> np.ndarray:
+    return distance(compile_krs(route.krs(), ALBEDO), np.asarray(pts, dtype=float))
+
+
+def route_points(route) -> np.ndarray:
+    """Points along every branch of the route itself (the identity instances)."""
+    return np.concatenate([centre_at(route.kernel(i), LINE) for i in range(len(route.levels))])
+
+
+# ---------------------------------------------------------------------------- insert
+@pytest.mark.parametrize("i,s", [(0, 0.5), (3, 0.3), (8, 0.7)])
+def test_the_split_halves_trace_the_old_branch(route, i, s):
+    old = route.kernel(i)
+    new = split_level(route, i, s)
+    upper, lower = new.kernel(i), new.kernel(i + 1)
+    assert new.levels[i + 1].fork == upper.start == lower.end
+    # every point of each half lies on the old branch's centre line, and the old line is
+    # covered by the two halves: measured by the reference kernel distance (−radius on it)
+    tol = 1e-9
+    for half in (upper, lower):
+        np.testing.assert_allclose(kernel_d(old, centre_at(half, LINE)), -old.radius, atol=tol)
+    on_old = centre_at(old, LINE)
+    both = np.minimum(kernel_d(upper, on_old), kernel_d(lower, on_old))
+    np.testing.assert_allclose(both, -old.radius, atol=tol)
+    # the fork lies at fraction s of the arc length: the halves' lengths are s : 1 − s
+    lengths = [
+        np.linalg.norm(np.diff(centre_at(k, LINE), axis=0), axis=1).sum() for k in (lower, upper)
+    ]
+    assert lengths[0] / sum(lengths) == pytest.approx(s, abs=1e-3)
+
+
+def test_negative_control_a_split_that_drops_the_control_points_moves_the_curve(route):
+    i = 3
+    old, new = route.kernel(i), split_level(route, i, 0.5)
+    lv = new.levels[i]
+    naive_start = np.array(new.levels[i + 1].fork)
+    naive = replace(new.kernel(i), control=tuple((naive_start + np.array(lv.fork)) / 2))
+    off = kernel_d(old, centre_at(naive, LINE)) + old.radius
+    assert off.max() > 1e-3, "the bent branch should leave the old curve when straightened"
+
+
+def test_the_new_forks_mirror_passes_through_it_and_keeps_its_branch_unclipped(route):
+    for i in range(len(route.levels)):
+        new = split_level(route, i, 0.4)
+        u, q = np.array(new.levels[i + 1].normal), np.array(new.levels[i + 1].fork)
+        t = tangent_at(route.kernel(i), 0.4)
+        assert abs(np.linalg.norm(u) - 1) < 1e-12
+        assert -np.sin(np.radians(45.01)) <= u @ t <= 1e-9, "tilted back by at most 45°"
+        assert new.krs().levels[i + 1].mirror.offset == pytest.approx(u @ q, abs=1e-12)
+        assert new.warnings() == route.warnings() == []
+
+
+def test_free_normal_prefers_the_hint_among_equally_good_planes():
+    t = np.array([0.0, 1.0, 0.0])
+    line = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])  # on the tangent: every plane is good
+    assert free_normal(np.zeros(3), t, line, line, (0.0, 0.0, 1.0)) == pytest.approx((0, 0, 1))
+    assert free_normal(np.zeros(3), t, line, line, (1.0, 0.0, 0.0)) == pytest.approx((1, 0, 0))
+
+
+@pytest.fixture(scope="module")
+def old_surface(route):
+    """Points on the surface of the tree before any edit (|reference distance| < 0.02)."""
+    pts = np.random.default_rng(0).uniform((-4, 0, -4), (4, 8, 4), (120_000, 3))
+    return pts[np.abs(krs_d(route, pts)) < SURFACE]
+
+
+SURFACE = 0.02
+
+
+def test_the_tree_keeps_its_old_geometry_after_an_insert(route, old_surface):
+    """The reference distance of the whole KRS after an insert: along the old route (the
+    identity instances) it is what it was, and on the old tree's surface it stays on the
+    surface (the new mirror adds its image of the crown and folds away almost nothing)."""
+    pts = route_points(route)
+    before = krs_d(route, pts)
+    assert len(old_surface) > 200
+    for i in (2, 5, 8):
+        new = split_level(route, i, 0.5)
+        np.testing.assert_allclose(krs_d(new, pts), before, atol=1e-9)
+        kept = (krs_d(new, old_surface) < SURFACE).mean()
+        assert kept >= 0.98, (i, kept)
+    # negative control: the mirror in the plane of the branch (no tilt, the old neighbour's
+    # normal made ⟂ the branch) folds away a large part of the crown
+    new = split_level(route, 5, 0.5)
+    t = tangent_at(route.kernel(5), 0.5)
+    n = np.array(route.levels[5].normal)
+    flat = (n - (n @ t) * t) / np.linalg.norm(n - (n @ t) * t)
+    lv = new.levels[6]
+    flat_route = replace(
+        new, levels=[*new.levels[:6], replace(lv, normal=tuple(flat)), *new.levels[7:]]
+    )
+    assert (krs_d(flat_route, old_surface) < SURFACE).mean() < 0.9
+
+
+# ----------------------------------------------------------------- remove, duplicate
+@pytest.mark.parametrize("i", [0, 1, 4, 8])
+@pytest.mark.parametrize("s", [0.2, 0.5, 0.9])
+def test_remove_after_insert_is_the_identity(route, i, s):
+    back = merge_level(split_level(route, i, s), i + 1)
+    assert len(back.levels) == len(route.levels)
+    for a, b in zip(back.levels, route.levels):
+        assert (a.radius, a.color, a.normal, a.grown) == (b.radius, b.color, b.normal, b.grown)
+        np.testing.assert_allclose(a.fork, b.fork, atol=1e-12)
+        np.testing.assert_allclose(a.control, b.control, atol=1e-12)
+
+
+def test_removing_a_fork_merges_two_branches_through_it(route):
+    i = 4
+    merged = merge_level(route, i)
+    k = merged.kernel(i - 1)
+    assert len(merged.levels) == len(route.levels) - 1
+    assert k.start == route.starts()[i] and k.end == route.levels[i - 1].fork
+    assert kernel_d(k, [route.levels[i].fork])[0] == pytest.approx(-k.radius, abs=1e-9)
+    twigless = merge_level(route, 0)
+    assert twigless.levels[0].normal is None and twigless.levels[0].fork == route.levels[1].fork
+    with pytest.raises(SceneError, match="at least one level"):
+        merge_level(replace(route, levels=route.levels[-1:]), 0)
+
+
+@pytest.mark.parametrize("i", [0, 3, 8])
+def test_a_duplicate_repeats_the_branch_at_its_tip_and_carries_the_finer_levels(route, i):
+    dup = duplicate_level(route, i)
+    v = np.subtract(route.levels[i].fork, route.starts()[i])
+    assert len(dup.levels) == len(route.levels) + 1
+    np.testing.assert_allclose(np.subtract(dup.levels[i].fork, dup.levels[i + 1].fork), v)
+    for j in range(i):  # the finer levels, moved along
+        np.testing.assert_allclose(np.subtract(dup.levels[j].fork, route.levels[j].fork), v)
+    assert dup.levels[i + 1].fork == route.levels[i].fork and dup.levels[i].grown is None
+    assert dup.warnings() == []
+    pts = centre_at(route.kernel(i), LINE) + v  # the copy lies where the branch, moved, is
+    np.testing.assert_allclose(kernel_d(dup.kernel(i), pts), -route.levels[i].radius, atol=1e-9)
+
+
+# --------------------------------------------------------------------------- whole tree
+def test_taper_sets_each_radius_to_the_ratio_times_its_parents(route):
+    t = taper(route, 0.6)
+    r = [lv.radius for lv in t.levels]
+    np.testing.assert_allclose(np.array(r[:-1]) / np.array(r[1:]), 0.6, rtol=1e-12)
+    assert r[-1] == route.levels[-1].radius
+    with pytest.raises(SceneError, match="taper"):
+        taper(route, 1.5)
+
+
+def test_scaling_the_tree_scales_its_distance_and_moving_it_moves_it(route):
+    pts = np.random.default_rng(3).normal((0, 3, 0), 2.0, (300, 3))
+    base = np.array(route.base)
+    d = krs_d(route, pts)
+    big = scale_tree(route, 1.7)
+    np.testing.assert_allclose(krs_d(big, base + 1.7 * (pts - base)), 1.7 * d, atol=1e-9)
+    moved = move_base(route, (1.0, -2.0, 0.5))
+    np.testing.assert_allclose(krs_d(moved, pts + (1.0, -2.0, 0.5)), d, atol=1e-9)
+    wide = scale_widths(route, 2.0)
+    assert [lv.radius for lv in wide.levels] == [2.0 * lv.radius for lv in route.levels]
+    assert not np.allclose(krs_d(wide, pts), d), "negative control: wider branches differ"
+    with pytest.raises(SceneError, match="factor > 0"):
+        scale_tree(route, 0.0)
+
+
+def test_scaling_a_forest_moves_its_mirrors_with_it():
+    s = load_scene(resolve("forest"))
+    r = replace(s.tree, levels=6).route()
+    pts = np.random.default_rng(4).normal((0, 2, 0), 4.0, (200, 3))
+    base = np.array(r.base)
+    np.testing.assert_allclose(
+        krs_d(scale_tree(r, 0.5), base + 0.5 * (pts - base)), 0.5 * krs_d(r, pts), atol=1e-9
+    )
+
+
+# ------------------------------------------------------------------------------ re-grow
+def test_a_baked_route_keeps_its_growth_and_depths_through_a_file(scene, tmp_path):
+    baked = replace(scene, tree=None, route=scene.tree.route())
+    save_scene(baked, tmp_path / "b.toml")
+    again = load_scene(tmp_path / "b.toml")
+    assert again == baked and again.route.growth.levels == 8
+    assert [lv.grown for lv in again.route.levels] == list(range(8, -1, -1))
+    text = (tmp_path / "b.toml").read_text()
+    bad = text.replace("grown = 3", "grown = 9", 1)
+    with pytest.raises(SceneError, match=r"route\.levels\[5\]\.grown.*0\.\.8"):
+        scene_from_toml(bad)
+    with pytest.raises(SceneError, match="does not have"):
+        validated(replace(baked, route=replace(baked.route, growth=None)))
+
+
+def test_growing_again_unchanged_is_the_identity_and_new_growth_is_the_new_bake(route):
+    same, lost = rebake(route, route.growth)
+    assert same == route and lost == []
+    g = replace(route.growth, branch_angle=40.0, levels=6)
+    assert rebake(route, g) == (grow(g), [])
+
+
+def test_hand_edits_survive_a_change_of_the_growth_parameters(route):
+    k = 5  # bend level 5's branch and thicken level 2
+    lv = route.levels[k]
+    edited = replace(
+        route,
+        levels=[
+            *route.levels[:2],
+            replace(route.levels[2], radius=route.levels[2].radius * 1.5),
+            *route.levels[3:k],
+            replace(lv, control=tuple(np.add(lv.control, (0.1, 0.0, 0.05)))),
+            *route.levels[k + 1 :],
+        ],
+    )
+    g = replace(route.growth, branch_angle=40.0)
+    new, lost = rebake(edited, g)
+    fresh = grow(g)
+    assert lost == []
+    assert new.levels[2].radius == pytest.approx(fresh.levels[2].radius * 1.5, rel=1e-12)
+
+    # the control's offset from the bake, in the branch's frame and length, is the same
+    def offset(r, b, j):
+        L = np.linalg.norm(np.subtract(b.levels[j].fork, b.starts()[j]))
+        return frame(b, j).T @ (np.subtract(r.levels[j].control, b.levels[j].control)) / L
+
+    np.testing.assert_allclose(offset(new, fresh, k), offset(edited, route, k), atol=1e-12)
+    untouched = [j for j in range(len(route.levels)) if j not in (2, k)]
+    for j in untouched:  # the rest is the new bake (forks move only below edited ones)
+        assert new.levels[j].radius == fresh.levels[j].radius
+    assert new.levels[-1] == fresh.levels[-1]
+    assert offset(new, fresh, 4).any() == 0 and np.abs(offset(edited, route, 4)).max() == 0
+
+
+def test_growing_again_lists_what_it_cannot_keep(route):
+    inserted = split_level(route, 3, 0.5)
+    _, lost = rebake(inserted, route.growth)
+    assert any("levels[4]: a fork made by hand" in line for line in lost)
+    _, lost = rebake(merge_level(route, 3), route.growth)
+    assert any("depth 5 was removed by hand" in line for line in lost)
+    moved = replace(route, levels=[replace(route.levels[0], radius=0.5), *route.levels[1:]])
+    _, lost = rebake(moved, replace(route.growth, levels=5))
+    assert any("levels[0]: its edits are dropped" in line for line in lost)
+    _, nothing = rebake(route, replace(route.growth, levels=5))  # unedited: nothing to lose
+    assert nothing == []
+
+
+# -------------------------------------------------------------------------- editor glue
+class FakeEditor:
+    """What editor/structure.py reads and calls of the editor, without a window."""
+
+    def __init__(self, path):
+        self.viewer = SimpleNamespace(doc=None, sync=lambda: None, error="", message="")
+        self.viewer.doc = Document(path)
+        self.selected = SimpleNamespace(level=3)
+        self.structure = StructureTools()
+        self.chosen: list[int] = []
+
+    @property
+    def doc(self):
+        return self.viewer.doc
+
+    @property
+    def scene(self):
+        return self.doc.scene
+
+    def select_level(self, level):
+        self.chosen.append(level)
+
+    def run(self, command):
+        STRUCTURE_HANDLERS[type(command)](self, command)
+
+
+@pytest.fixture
+def editor(scene, tmp_path):
+    path = tmp_path / "tree.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), path)
+    return FakeEditor(path)
+
+
+def test_each_operation_is_one_undo_step(editor):
+    start = editor.scene
+    for command in (
+        ec.InsertLevel(),
+        ec.RemoveLevel(2),
+        ec.DuplicateLevel(),
+        ec.WholeTree("taper"),
+    ):
+        before = editor.scene
+        editor.run(command)
+        assert editor.scene != before and editor.viewer.error == "", command
+        editor.doc.undo()
+        assert editor.scene == before
+        editor.doc.redo()
+    assert len(editor.doc.history.steps) == 4 and editor.chosen == [4, 2, 3]
+    while editor.doc.undo():
+        pass
+    assert editor.scene == start
+
+
+def test_a_refused_operation_changes_nothing_and_says_why(scene, tmp_path):
+    path = tmp_path / "full.toml"  # 63 forks: 64 levels, as many as the shaders hold
+    save_scene(replace(scene, tree=None, route=replace(scene.tree, levels=63).route()), path)
+    editor = FakeEditor(path)
+    before = editor.scene
+    editor.run(ec.InsertLevel(10))
+    assert editor.scene == before and editor.doc.history.steps == []
+    assert "refused" in editor.structure.message and "≤ 64" in editor.structure.message
+    assert editor.viewer.error == editor.structure.message and "\n" not in editor.viewer.error
+    editor.run(ec.RemoveLevel(10))  # negative control: the same editor does take an edit
+    assert len(editor.scene.route.levels) == 63 and editor.viewer.error == ""
+    editor.selected = None
+    editor.run(ec.RemoveLevel())
+    assert "select a level first" in editor.viewer.error
+
+
+def test_growing_again_asks_before_losing_hand_edits(editor):
+    editor.run(ec.InsertLevel(3))
+    inserted = editor.scene
+    editor.run(ec.SetGrowth("branch_angle", 40.0, ("drag", 1)))
+    assert editor.scene == inserted, "nothing lands before the answer"
+    new, lost, _ = editor.structure.pending
+    assert any("made by hand" in line for line in lost)
+    editor.run(ec.CancelRegrow())
+    assert editor.structure.pending is None and editor.scene == inserted
+    editor.run(ec.SetGrowth("branch_angle", 40.0, ("drag", 1)))
+    editor.run(ec.ConfirmRegrow())
+    assert editor.scene.route == new and editor.scene.route.growth.branch_angle == 40.0
+    editor.doc.undo()
+    assert editor.scene == inserted
+    editor.run(ec.SetGrowth("branch_angle", 200.0, None))
+    assert "branch_angle" in editor.viewer.error and editor.scene == inserted
+
+
+# ---------------------------------------------------------------------- in a real window
+WINDOW = (640, 400)
+
+
+def xdo(*args) -> None:
+    import shutil
+    import subprocess
+
+    assert shutil.which("xdotool"), "xdotool is needed for real X key events"
+    subprocess.run(["xdotool", *map(str, args)], check=True, timeout=10)
+
+
+def pump(e, turns: int = 4) -> None:
+    import glfw
+
+    for _ in range(turns):
+        glfw.poll_events()
+        e.step(0.02)
+
+
+@pytest.fixture
+def window_editor(display, scene, tmp_path):
+    import glfw
+
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "tree.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), path)
+    e = Editor(path, size=WINDOW)
+    x, y = glfw.get_window_pos(e.viewer.window)
+    xdo("mousemove", x + 100, y + WINDOW[1] - 60)  # over the view, off the panels
+    pump(e)
+    yield e
+    e.close()
+
+
+def test_insert_delete_and_ctrl_d_keys_edit_the_selected_level(window_editor):
+    e = window_editor
+    n = len(e.scene.route.levels)
+    xdo("key", "Insert")  # nothing selected: refused, nothing changes
+    pump(e)
+    assert len(e.scene.route.levels) == n and "select a level first" in e.viewer.error
+    e.select_level(3)
+    for key, change in (("Insert", 1), ("Delete", -1), ("ctrl+d", 1)):
+        before = len(e.scene.route.levels)
+        xdo("key", key)
+        pump(e)
+        assert len(e.scene.route.levels) == before + change, key
+    assert len(e.doc.history.steps) == 3
+    xdo("key", "ctrl+z")
+    pump(e)
+    assert len(e.scene.route.levels) == n
+
+
+def test_saving_a_shipped_preset_asks_for_a_copy_and_never_writes_the_package(
+    display, tmp_path, monkeypatch
+):
+    from krsview.document.document import copy_target
+    from krsview.editor.window import Editor
+    from krsview.scene.presets import PRESET_DIR
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    before = {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()}
+    e = Editor(resolve("tree"), size=WINDOW)
+    try:
+        e.execute([ec.Bake()])
+        assert e.save() is False and e.copy_to.text == str(tmp_path / "tree.toml")
+        assert copy_target(e.path) == tmp_path / "tree.toml"
+        pump(e)  # the dialog is drawn
+        e.execute([ec.SetCopyText(str(tmp_path / "mine.toml")), ec.SaveCopy()])
+        assert e.copy_to is None and e.path == tmp_path / "mine.toml" and not e.doc.dirty
+        assert load_scene(tmp_path / "mine.toml").route is not None
+        e.execute([ec.InsertLevel(2)])
+        assert e.save() is True, "the copy is an ordinary file: Ctrl+S saves it"
+    finally:
+        e.close()
+    assert {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()} == before
+
+
+def test_an_autosave_that_cannot_write_is_said_in_the_status_line(window_editor):
+    from krsview.document.document import AUTOSAVE_SECONDS
+
+    e = window_editor
+    e.execute([ec.WholeTree("widths")])
+    e.doc.recovery_path.mkdir()  # no one may write there, root neither
+    pump(e, 1)  # the interval starts
+    time.sleep(AUTOSAVE_SECONDS + 0.1)
+    pump(e, 1)
+    assert "autosave cannot write" in e.viewer.status_line()
+    assert e.viewer.error == e.doc.autosave_error
+
+
+def test_a_viewer_bookmark_of_a_shipped_preset_goes_to_its_copy(display, tmp_path, monkeypatch):
+    from krsview.scene.presets import PRESET_DIR
+    from krsview.viewer.window import Viewer
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    before = {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()}
+    v = Viewer(resolve("sierpinski"), size=WINDOW, hud=False)
+    try:
+        v.add_bookmark()
+        assert v.path == tmp_path / "sierpinski.toml" and not v.doc.dirty, v.error
+        assert (
+            len(load_scene(v.path).bookmarks)
+            == len(load_scene(resolve("sierpinski")).bookmarks) + 1
+        )
+        v.add_bookmark()  # the copy is an ordinary file now: the next one goes there too
+        assert (
+            len(load_scene(v.path).bookmarks)
+            == len(load_scene(resolve("sierpinski")).bookmarks) + 2
+        )
+    finally:
+        v.close()
+    assert {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()} == before
+
+
+def test_closing_a_shipped_preset_with_edits_saves_the_copy_then_closes(
+    display, tmp_path, monkeypatch
+):
+    import glfw
+
+    from krsview.editor.window import Editor
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    e = Editor(resolve("sierpinski"), size=WINDOW)
+    try:
+        e.edit(("render", "epsilon_scale"), 2.0)
+        glfw.set_window_should_close(e.viewer.window, True)
+        assert not e.should_close() and e.asking == ("close", None)
+        pump(e)
+        e.execute([ec.AnswerSave()])
+        pump(e)
+        assert e.asking is None and e.copy_to.then == ("close", None)
+        assert not e.should_close(), "nothing saved yet: the window stays"
+        e.execute([ec.SaveCopy()])
+        assert e.should_close() and e.path == tmp_path / "sierpinski.toml"
+        assert load_scene(e.path).render.epsilon_scale == 2.0
+    finally:
+        e.close()
