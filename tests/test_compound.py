@@ -229,3 +229,20 @@ def test_compound_round_trips_and_truncates():
     cut = g.truncated(3)
     assert [p.depth for p in cut.parts] == [3, 3, 1]
     assert s.with_geometry(cut).geometry() == cut
+
+
+def test_an_edit_of_one_component_compiles_that_component_alone():
+    """Compiled components are kept by value: moving one tree of the grove compiles that tree
+    anew (equal to compiling it alone), and hands back the others' compiled forms."""
+    from krsview.api import load
+
+    grove = load("grove")
+    before = compile_geometry(grove.geometry(), (1, 1, 1)).parts
+    moved = grove.edit(("compound", 2, "position"), (-4.0, 0.0, 3.0))
+    after = compile_geometry(moved.geometry(), (1, 1, 1)).parts
+    alone = compile_krs(moved.geometry().parts[2], (1, 1, 1))
+    assert all(after[k] is before[k] for k in range(len(before)) if k != 2)
+    assert after[2] is not before[2]  # negative control: the moved tree is compiled anew
+    for name in ("mirrors", "bounds", "records", "ball"):
+        assert np.array_equal(getattr(after[2], name), getattr(alone, name)), name
+        assert not np.array_equal(getattr(after[2], name), getattr(before[2], name)), name

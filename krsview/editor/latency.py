@@ -1,13 +1,13 @@
 """`krsview bench latency`: how fast the editor answers a drag, in a real window [issue 28 §5].
 
 The editor opens the scene at the window size asked (a grown tree baked into its route) and
-lets the view settle. Then a fork is dragged in small steps, one per turn of the event loop,
-through the gizmo's own path: the step is the edit ``Gizmo.manipulate`` returns inside the
-UI pass, after the turn's image was traced, as a pointer drag gives it (the pointer's
+lets the view settle. Then a fork (in a compound: one of its trees) is dragged in small
+steps, one per turn of the event loop, through the gizmo's own path: each step is the edit
+``Gizmo.manipulate`` returns inside the UI pass, as a pointer drag gives it (the pointer's
 reading by ImGuizmo is the only part left out). Every turn is time-stamped when its frame is
 on screen (after the buffer swap), so a step's latency is the time from the gizmo's edit to
-the first frame traced from it. After the release: the first full-resolution image and the
-still one. Wall times on whatever else runs: median and p90, not a test."""
+the end of the first turn that traced it. After the release: the first full-resolution
+image and the still one. Wall times on whatever else runs: median and p90, not a test."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ from pathlib import Path
 import glfw
 import numpy as np
 
+from ..scene import SceneError
 from .window import Editor
 
 DRAG_STEPS = 40  # turns with a drag step each
@@ -41,12 +42,14 @@ def _settle(e: Editor) -> float:
     raise RuntimeError(f"{e.path}: the view did not become still in {SETTLE_TURNS} turns")
 
 
-def _fork(e: Editor):
-    """The fork halfway down the route: a drag there moves about half the tree."""
+def _handle(e: Editor):
+    """What a person drags: the fork halfway down a route (it moves about half the tree),
+    else the middle one of the points (a compound's component, a kernel's point)."""
     forks = [h for h in e.handles if h.path[-1] == "fork"]
-    if not forks:
-        raise ValueError(f"{e.path}: no route fork to drag (a tree or route scene is needed)")
-    return forks[len(forks) // 2]
+    points = forks or [h for h in e.handles if h.kind == "point"]
+    if not points:
+        raise SceneError("PRESET", str(e.path), "has no point to drag (a MöKRS has none yet)")
+    return points[len(points) // 2]
 
 
 class _Drag:
@@ -75,7 +78,7 @@ def drag_latency(path: Path, size: tuple[int, int], steps: int = DRAG_STEPS) -> 
         if e.scene.route is None and e.scene.tree is not None:
             e.bake()
         _settle(e)
-        h = _fork(e)
+        h = _handle(e)
         e.select(h)
         _settle(e)
         start = h.position

@@ -104,9 +104,7 @@ class Renderer:
         probes: tuple[str, ...] = (),
     ) -> moderngl.Program:
         view = view_of(scene.camera, width, height)
-        c = self._world(geometry or scene.geometry(), scene.material.albedo).relative_to(
-            view.origin
-        )
+        c = self.world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         block = krs_block(c, scene.render.precision)
         storage = scene.render.precision == "double"  # scene_block.glsl: a storage buffer
         limit = self.ctx.info[
@@ -176,9 +174,10 @@ class Renderer:
                     p[name].value = value
             return p
 
-    def _world(self, geometry: Geometry, albedo: tuple) -> Compiled:
+    def world(self, geometry: Geometry, albedo: tuple) -> Compiled:
         """The geometry compiled in world coordinates, redone only when it or the albedo
-        changes (a moving camera only translates it: per-frame work stays per-frame)."""
+        changes (a moving camera only translates it: per-frame work stays per-frame); the
+        viewer's picking and navigation share it, so an edit compiles once."""
         if (
             self._compiled is None
             or self._compiled[0] is not geometry

@@ -15,7 +15,6 @@ import moderngl
 import numpy as np
 from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
 
-from ..compile.geometry import compile_geometry
 from ..document.document import Document, copy_target
 from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
@@ -130,7 +129,7 @@ class Viewer:
 
     def _apply_levels(self) -> None:
         self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
-        self.world = compile_geometry(self.krs, self.scene.material.albedo)  # speed, picking
+        self.world = self.renderer.world(self.krs, self.scene.material.albedo)  # speed, picking
         self.frames.dirty = True
 
     def _report(self, part: Any) -> None:
