@@ -19,6 +19,7 @@ from ..viewer.window import Viewer
 from . import commands as ec
 from .gizmo import Snap
 from .handles import Handle, outline
+from .mokrs_panel import mokrs_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
@@ -67,9 +68,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         if imgui.button("bake into a route"):
             out.append(ec.Bake())
     elif scene.mokrs is not None:
-        imgui.text_wrapped(
-            "A MöKRS has no handles yet; edit its file (it reloads) or the fields below."
-        )
+        mokrs_section(e, out, interactions, _fields)
     else:
         for w in e.warnings:
             imgui.push_style_color(imgui.Col_.text, YELLOW)
@@ -86,14 +85,15 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         )
         _fields(scene.effect_settings, ("effect_settings",), out, interactions)
     if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
-        changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
-        if changed:
-            out.append(ec.SetCarry(on))
-        if imgui.is_item_hovered():
-            imgui.set_tooltip(
-                "on: the finer forks, control points and mirrors move with a "
-                "dragged fork, so the crown stays attached; off: only the fork"
-            )
+        if scene.route is not None:  # only a route's forks carry anything
+            changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
+            if changed:
+                out.append(ec.SetCarry(on))
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(
+                    "on: the finer forks, control points and mirrors move with a "
+                    "dragged fork, so the crown stays attached; off: only the fork"
+                )
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
             out.append(ec.SetSnap(on))

@@ -39,6 +39,7 @@ from ..viewer.window import Viewer
 from . import commands as ec
 from .gizmo import Gizmo
 from .handles import Handle, handles, polyline
+from .mokrs_handles import MobiusHandle, guide_lines
 from .panels import edit_panel
 
 PICK_PIXELS = 12.0  # a click this close to a handle grabs it
@@ -354,6 +355,8 @@ class Editor:
                 s.lines.append((h.pivot, h.position, NORMAL))
         if sel is not None:
             self._mirror_disc(s, sel)
+        if isinstance(sel, MobiusHandle):  # a MöKRS step's circle, sphere or vector
+            s.lines += guide_lines(sel, NORMAL)
         return s
 
     def _mirror_disc(self, s: Shapes, sel: Handle) -> None:
