@@ -232,3 +232,56 @@ def test_drags_and_step_list_edits_keep_the_shader_variant():
     assert defines(dragged) == base and defines(longer) == base
     sphere = apply_edit(palm, (*LEVELS, 30, "kernel"), Sphere((0.0, 0.0, 0.0), 0.1))
     assert defines(sphere) != base
+
+
+def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, tmp_path):
+    """palm opens with its levels and handles; clicking a translate step's handle selects it
+    (over the kernel point it shares), a 40 px drag moves it in the screen plane as one undo
+    step without a recompile, Ctrl+S writes it. A refused value stays beside its step; a
+    level count the MöKRS cannot truncate to draws every level and says why."""
+    from krsview.editor.window import Editor
+    from krsview.scene.model import Empty
+    from krsview.viewer.commands import Edit
+
+    from .test_editor import click, drag, pump, screen_of, settle, xdo
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        settle(e)
+        assert len(e.handles) > 150 and not e.viewer.error
+        compiles = e.viewer.renderer.programs.compiles
+        by = (*LEVELS, 58, "transform", 2, "by")
+        h = next(h for h in e.handles if h.path == by)
+        click(e, screen_of(e, h.position))
+        assert e.selected is not None and e.selected.path == by, e.selected
+        old = np.array(h.position)
+        drag(e, screen_of(e, old), (40, 0))
+        new = next(k for k in e.handles if k.path == by).position
+        v = e.window_view()
+        depth = float((old - v.origin) @ v.forward)
+        expected = 40 * 2 * v.tan_half * depth / v.height * v.right  # the screen-plane move
+        assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected)
+        assert len(e.doc.history.steps) == 1, "the drag was not one undo step"
+        assert e.viewer.renderer.programs.compiles == compiles, "a drag recompiled the shader"
+        xdo("key", "ctrl+s")
+        pump(e)
+        saved = load_scene(path)
+        assert get_at(saved, by) == get_at(e.scene, by) != (0.0, 0.34, 0.0)
+        # a refused factor: the scene stays, the message names the step's field
+        factor = (*LEVELS, 58, "transform", 0, "factor")
+        e.execute([Edit(factor, 0.0)])
+        pump(e)
+        assert get_at(e.scene, factor) == 0.93
+        assert refusal_place(e.viewer.error, 58, 3) == "step 0", e.viewer.error
+        # the outermost level without a kernel: one level cannot be drawn, two can
+        e.execute([Edit((*LEVELS, 59, "kernel"), Empty())])
+        e.viewer.set_levels(1)
+        pump(e)
+        assert e.viewer.levels == 0 and "cannot be carried" in e.viewer.error
+        e.viewer.set_levels(2)
+        pump(e)
+        assert e.viewer.levels == 2 and e.viewer.krs.n == 2
+    finally:
+        e.close()

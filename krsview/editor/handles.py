@@ -13,7 +13,7 @@ import numpy as np
 
 from ..scene import KRS, Capsule, Mirror, Route, Scene, Sphere, ToroidalCapsule
 from ..scene.edits import Path, get_at
-from .mokrs_handles import mokrs_handles
+from .mokrs_handles import mokrs_handles, mokrs_outline
 
 ARROW = 0.6  # a normal arrow's length, × its level's branch length (route) or kernel size
 
@@ -164,6 +164,8 @@ def krs_handles(krs: KRS, at: Path) -> list[Handle]:
 
 def outline(scene: Scene) -> list[str]:
     """One line per selectable entry, in handle ``level`` order."""
+    if scene.mokrs is not None:
+        return mokrs_outline(scene.mokrs)
     if scene.route is not None:
         n = len(scene.route.levels)
         return [

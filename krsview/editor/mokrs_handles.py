@@ -12,7 +12,7 @@ sphere's centre and a point on it (an inversion maps its sphere onto itself)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -26,6 +26,7 @@ from ..scene.mokrs import Invert, MobiusLevel, Rotate, Scale, Translate
 KERNEL_POINTS = ("center", "a", "b", "start", "control", "end")  # the kernels' point fields
 SCALE_DIRECTION = np.array([1.0, 0.0, 0.0])  # u: where a scale step's handle sits
 RADIUS_DIRECTION = np.array([1.0, 0.0, 0.0])  # an inversion sphere's point handle
+SHARED = 1e-9  # a kernel point this close (× its size) to a step's handle is that handle
 GUIDE_SEGMENTS = 48  # a circle of a guide (a dial, a sphere's great circle) in segments
 
 
@@ -153,9 +154,7 @@ def mokrs_handles(m: MoKRS, at: Path) -> list[MobiusHandle]:
                    np.array(getattr(k, f), dtype=np.float64))
             for f in KERNEL_POINTS if hasattr(k, f)
         ]  # fmt: skip
-    # steps first: a click on a point they share with a kernel (palm: a segment's end is the
-    # next one's start) picks the step
-    return _mapped_all(sorted(out, key=lambda h: h.role == "point"))
+    return _steps_first(_mapped_all(out))
 
 
 def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
@@ -181,6 +180,26 @@ def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
             MobiusHandle(h.path, h.kind, mine[0][0], h.level, h.label, h.owner, h.to_world,
                          h.role, h.size, pivot, guides)
         )  # fmt: skip
+    return out
+
+
+def _steps_first(hs: list[MobiusHandle]) -> list[MobiusHandle]:
+    """Step handles first, and a kernel point that lies on one (palm: a segment's start is
+    where the translate puts it) given exactly its position: a click there, nearest-first,
+    grabs the step, which moves the point along; the outline and panel still reach the
+    point itself."""
+    steps = [h for h in hs if h.role != "point"]
+    at = np.array([h.position for h in steps]).reshape(-1, 3)
+    out = list(steps)
+    for h in hs:
+        if h.role != "point":
+            continue
+        if len(at):
+            gaps = np.linalg.norm(at - h.position, axis=1)
+            k = int(np.argmin(gaps))
+            if gaps[k] <= SHARED * max(1.0, float(np.abs(h.position).max())):
+                h = replace(h, position=steps[k].position)
+        out.append(h)
     return out
 
 

@@ -44,7 +44,7 @@ def removed(items: list, k: int) -> list:
     return [*items[:k], *items[k + 1 :]]
 
 
-MINE = ("mokrs", "camera", "bookmarks")  # refusals a MöKRS edit can cause
+MINE = ("mokrs", "camera", "bookmarks", "levels")  # refusals a MöKRS edit can cause
 
 
 def refusal_place(error: str, level: int, steps: int) -> str:
