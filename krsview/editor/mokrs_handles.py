@@ -37,7 +37,7 @@ class MobiusHandle:
     ``to_world`` of the frame its point lives in."""
 
     path: Path  # the field it edits
-    kind: str  # "point", or "axis" (a rotation axis' tip, drawn from ``pivot``)
+    kind: str  # "point"; "axis": a rotation axis' tip; "dial": turned about ``axis``
     position: np.ndarray  # world, float64
     level: int
     label: str
@@ -47,6 +47,7 @@ class MobiusHandle:
     size: float = 1.0  # ρ: the dial's radius, the unit a scale handle measures in
     pivot: np.ndarray | None = None
     guides: tuple[np.ndarray, ...] = field(default=(), repr=False)  # world polylines
+    axis: np.ndarray | None = None  # "dial": the world direction it turns about, at pivot
 
     def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
         """The edit (field path, new value) that puts the handle at world point ``p``
@@ -130,6 +131,7 @@ class _Local:
     point: np.ndarray
     guides: tuple[np.ndarray, ...] = ()
     pivot: np.ndarray | None = None
+    axis: np.ndarray | None = None
 
 
 def mokrs_handles(m: MoKRS, at: Path) -> list[MobiusHandle]:
@@ -178,7 +180,7 @@ def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
         guides = tuple(g[np.isfinite(g).all(axis=1)] for g in mine[1 + (pivot is not None) :])
         out.append(
             MobiusHandle(h.path, h.kind, mine[0][0], h.level, h.label, h.owner, h.to_world,
-                         h.role, h.size, pivot, guides)
+                         h.role, h.size, pivot, guides, _turning_axis(h))
         )  # fmt: skip
     return out
 
@@ -206,9 +208,9 @@ def _steps_first(hs: list[MobiusHandle]) -> list[MobiusHandle]:
 def _one_step(s, sp: Path, i: int, name: str, M, rho: float) -> list[_Local]:
     """The handles of one step ``s`` at path ``sp``, in the frame after it (mapped by M)."""
 
-    def handle(role, kind, point, label, guides=(), pivot=None):
+    def handle(role, kind, point, label, guides=(), pivot=None, axis=None):
         return _Local((*sp, role), kind, i, f"{name} {label}", sp, M, role, rho,
-                      np.asarray(point, dtype=np.float64), guides, pivot)  # fmt: skip
+                      np.asarray(point, dtype=np.float64), guides, pivot, axis)  # fmt: skip
 
     zero = np.zeros(3)
     if isinstance(s, Translate):
@@ -223,7 +225,9 @@ def _one_step(s, sp: Path, i: int, name: str, M, rho: float) -> list[_Local]:
         dial = mobius.apply(s.matrix(), rho * v[None])[0]
         ring = _circle(zero, rho * v, rho * np.cross(a, v))
         return [
-            handle("degrees", "point", dial, f"{s.degrees:g}°", (ring, _segment(zero, dial))),
+            handle(
+                "degrees", "dial", dial, f"{s.degrees:g} deg", (ring, _segment(zero, dial)), zero, a
+            ),
             handle("axis", "axis", rho * a, "axis", (_segment(-rho * a, rho * a),), zero),
         ]
     if isinstance(s, Invert):
@@ -236,6 +240,17 @@ def _one_step(s, sp: Path, i: int, name: str, M, rho: float) -> list[_Local]:
             handle("radius", "point", rim, f"radius {r:g}", (*rings, _segment(c, rim))),
         ]
     raise TypeError(f"no handles for a {type(s).__name__} step")  # every step kind has them
+
+
+def _turning_axis(h: _Local) -> np.ndarray | None:
+    """A dial's axis in the world: the derivative of its frame's map at the pivot applied to
+    the axis (a conformal map turns the dial about it there)."""
+    if h.axis is None or h.pivot is None:
+        return None
+    with np.errstate(all="ignore"):
+        d = mobius.jacobian(h.to_world, h.pivot[None])[0] @ h.axis
+    n = float(np.linalg.norm(d))
+    return d / n if n > 0 and np.isfinite(d).all() else None
 
 
 def _world(M, x: np.ndarray) -> np.ndarray:
