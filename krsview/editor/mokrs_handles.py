@@ -21,13 +21,14 @@ from ..algebra import mobius
 from ..scene import MoKRS, Scene
 from ..scene.edits import Path, get_at
 from ..scene.model import Empty
-from ..scene.mokrs import Invert, MobiusLevel, Rotate, Scale, Translate
+from ..scene.mokrs import Invert, MobiusLevel, Rotate, Scale, Translate, from_real
 
 KERNEL_POINTS = ("center", "a", "b", "start", "control", "end")  # the kernels' point fields
 SCALE_DIRECTION = np.array([1.0, 0.0, 0.0])  # u: where a scale step's handle sits
 RADIUS_DIRECTION = np.array([1.0, 0.0, 0.0])  # an inversion sphere's point handle
 SHARED = 1e-9  # a kernel point this close (× its size) to a step's handle is that handle
 GUIDE_SEGMENTS = 48  # a circle of a guide (a dial, a sphere's great circle) in segments
+AXIS_STEP = 1e-6  # × ρ: the step along a dial's axis whose image gives its world direction
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,16 +97,6 @@ def _dial_degrees(step: Rotate, q: np.ndarray) -> float:
     return new - 360.0 if new > 360.0 else new + 360.0 if new < -360.0 else new
 
 
-def _real(H: np.ndarray) -> np.ndarray:
-    return mobius.real_matrix(H)
-
-
-def _quaternion(R: np.ndarray) -> np.ndarray:
-    """The 2×2 quaternion matrix of a real 8×8 one (each block's first column), as
-    ``mobius.inverse`` reads it; composing as real 8×8 products is one matrix product."""
-    return np.array([[R[4 * r : 4 * r + 4, 4 * k] for k in range(2)] for r in range(2)])
-
-
 def level_size(lv: MobiusLevel) -> float:
     """ρ: the reach of the level's kernel from its origin (1 for an empty or plane kernel),
     so a level's handles sit at its own scale."""
@@ -143,14 +134,14 @@ def mokrs_handles(m: MoKRS, at: Path) -> list[MobiusHandle]:
         lv, lev = m.levels[i], (*at, "levels", i)
         frames = []  # frames[j]: the frame after step j → world
         for s in reversed(lv.transform):
-            frames.append(_quaternion(outside))
-            outside = outside @ _real(s.matrix())
+            frames.append(from_real(outside))
+            outside = outside @ mobius.real_matrix(s.matrix())
         frames.reverse()
         rho = level_size(lv)  # ρ before each step
         for j, (s, M) in enumerate(zip(lv.transform, frames)):
             out += _one_step(s, (*lev, "transform", j), i, f"L{i} step {j} {s.kind}", M, rho)
             rho *= s.factor if isinstance(s, Scale) else 1.0
-        k, M = lv.kernel, _quaternion(outside)
+        k, M = lv.kernel, from_real(outside)
         out += [
             _Local((*lev, "kernel", f), "point", i, f"K{i} {f}", lev, M, "point", 1.0,
                    np.array(getattr(k, f), dtype=np.float64))
@@ -162,7 +153,8 @@ def mokrs_handles(m: MoKRS, at: Path) -> list[MobiusHandle]:
 def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
     """Map every handle's points into the world in one vectorised Möbius application (the
     per-point matrices stacked as (2, 2, N, 4)); a handle sent to infinity is left out."""
-    parts = [[h.point[None], *([h.pivot[None]] if h.pivot is not None else []), *h.guides]
+    parts = [[h.point[None], *([h.pivot[None]] if h.pivot is not None else []), *h.guides,
+              *([(h.pivot + AXIS_STEP * h.size * h.axis)[None]] if h.axis is not None else [])]
              for h in local]  # fmt: skip
     pts = np.concatenate([x for p in parts for x in p])
     maps = np.stack([h.to_world for h in local])
@@ -177,10 +169,14 @@ def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
         if not np.isfinite(mine[0]).all():
             continue
         pivot = mine[1][0] if h.pivot is not None else None
+        axis = None
+        if h.axis is not None:  # the dial's axis in the world, at the pivot: a short step
+            step = mine.pop()[0] - pivot  # along it, mapped (a Möbius map is conformal)
+            axis = step / np.linalg.norm(step)
         guides = tuple(g[np.isfinite(g).all(axis=1)] for g in mine[1 + (pivot is not None) :])
         out.append(
             MobiusHandle(h.path, h.kind, mine[0][0], h.level, h.label, h.owner, h.to_world,
-                         h.role, h.size, pivot, guides, _turning_axis(h))
+                         h.role, h.size, pivot, guides, axis)
         )  # fmt: skip
     return out
 
@@ -240,17 +236,6 @@ def _one_step(s, sp: Path, i: int, name: str, M, rho: float) -> list[_Local]:
             handle("radius", "point", rim, f"radius {r:g}", (*rings, _segment(c, rim))),
         ]
     raise TypeError(f"no handles for a {type(s).__name__} step")  # every step kind has them
-
-
-def _turning_axis(h: _Local) -> np.ndarray | None:
-    """A dial's axis in the world: the derivative of its frame's map at the pivot applied to
-    the axis (a conformal map turns the dial about it there)."""
-    if h.axis is None or h.pivot is None:
-        return None
-    with np.errstate(all="ignore"):
-        d = mobius.jacobian(h.to_world, h.pivot[None])[0] @ h.axis
-    n = float(np.linalg.norm(d))
-    return d / n if n > 0 and np.isfinite(d).all() else None
 
 
 def _world(M, x: np.ndarray) -> np.ndarray:
