@@ -247,8 +247,9 @@ def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
                 raise SceneError(
                     path,
                     list(position),
-                    f"level {i}'s transform sends this point to infinity (its "
-                    f"pole); move the viewpoint or the transform's centre",
+                    f"level {i}'s transform sends this point to infinity (its pole, "
+                    f"mokrs.levels[{i}].transform); allowed: a viewpoint off the pole: "
+                    "move it, or the inversion's centre",
                 )
         x = mobius.apply(H, x)
         if mokrs.levels[i].reflect and x[0, 0] > 0.0:
