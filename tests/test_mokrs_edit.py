@@ -237,7 +237,8 @@ def test_drags_and_step_list_edits_keep_the_shader_variant():
 def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, tmp_path):
     """palm opens with its levels and handles; clicking a translate step's handle selects it
     (over the kernel point it shares), a 40 px drag moves it in the screen plane as one undo
-    step without a recompile, Ctrl+S writes it. A refused value stays beside its step; a
+    step without a recompile; a rotation step turns on its ring, monotone and proportional
+    to the pointer each way round; Ctrl+S writes it. A refused value stays beside its step; a
     level count the MöKRS cannot truncate to draws every level and says why."""
     from krsview.editor.window import Editor
     from krsview.scene.model import Empty
@@ -265,6 +266,12 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
         assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected)
         assert len(e.doc.history.steps) == 1, "the drag was not one undo step"
         assert e.viewer.renderer.programs.compiles == compiles, "a drag recompiled the shader"
+        turns = turn_the_dial(e, (*LEVELS, 58, "transform", 1, "degrees"))
+        assert len(e.doc.history.steps) == 3, "each way round was not one undo step"
+        assert e.viewer.renderer.programs.compiles == compiles, "a turn recompiled the shader"
+        forth, back = np.diff(turns[0]), np.diff(turns[1])
+        assert (forth > 0).all() and (back < 0).all(), turns  # monotone, each way
+        assert forth.max() < 3 * forth.min() and forth.max() < 10.0, forth  # proportional
         xdo("key", "ctrl+s")
         pump(e)
         saved = load_scene(path)
@@ -285,3 +292,49 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
         assert e.viewer.levels == 2 and e.viewer.krs.n == 2
     finally:
         e.close()
+
+
+def turn_the_dial(e, path, steps: int = 6, arc: float = 0.4) -> list[list[float]]:
+    """Select the rotation step's dial, find the ImGuizmo ring about its axis by hovering
+    (points at growing radii around the pivot, in the plane ⊥ axis), then drag along the
+    ring by equal arcs one way and back: the step's angle after each small move."""
+    from .test_editor import click, pump, screen_of, xdo
+
+    h = next(h for h in e.handles if h.path == path)
+    click(e, screen_of(e, h.position))
+    assert e.selected is not None and e.selected.path == path, e.selected
+    y = np.cross(h.axis, [0.0, 1.0, 0.0] if abs(h.axis[1]) < 0.9 else [1.0, 0.0, 0.0])
+    y /= np.linalg.norm(y)
+    z = np.cross(h.axis, y)
+
+    def at(r, t):
+        return screen_of(e, h.pivot + r * (np.cos(t) * y + np.sin(t) * z))
+
+    ring = None
+    for r in np.linspace(0.05, 1.5, 30):
+        for t in np.linspace(0.0, 2.0 * np.pi, 8, endpoint=False):
+            xdo("mousemove", *(round(c) for c in at(r, t)))
+            pump(e, 1)
+            if e.gizmo.claims_mouse():
+                ring = (r, t)
+                break
+        if ring:
+            break
+    assert ring is not None, "no rotate ring around the dial's pivot"
+    r, t0 = ring
+    out = []
+    for way in (1, -1):
+        start = t0 if way == 1 else t0 + arc
+        xdo("mousemove", *(round(c) for c in at(r, start)))
+        pump(e, 2)
+        xdo("mousedown", 1)
+        pump(e, 2)
+        angles = [get_at(e.scene, path)]
+        for k in range(1, steps + 1):
+            xdo("mousemove", *(round(c) for c in at(r, start + way * arc * k / steps)))
+            pump(e, 1)
+            angles.append(get_at(e.scene, path))
+        xdo("mouseup", 1)
+        pump(e, 2)
+        out.append(angles)
+    return out
