@@ -25,6 +25,15 @@ KERNEL_KINDS = tuple(Kernel.registry)
 LEVELS = ("mokrs", "levels")
 
 Fields = Callable[[Any, tuple, list, Interactions], None]  # the panel's field widgets
+HINTS = {  # what dragging each kind of handle changes
+    "point": "moves the kernel's point (in its level's space)",
+    "by": "moves the origin of the frame after the step: the translation vector",
+    "factor": "slides along x of the frame: the dilation factor",
+    "degrees": "turn the ring about the axis: the angle",
+    "axis": "re-aims the rotation axis (its tip)",
+    "center": "moves the inversion's centre (sent to infinity)",
+    "radius": "a point on the fixed sphere: its radius",
+}
 
 
 def moved(items: list, k: int, by: int) -> list:
@@ -93,6 +102,8 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     sel = e.selected.path if e.selected is not None else ()
     step_selected = sel[: len(lev) + 1] == (*lev, "transform")
     imgui.separator_text(f"level {i} of {len(levels)}")
+    if e.selected is not None and e.selected.level == i:
+        imgui.text_wrapped(f"{e.selected.label}: {HINTS.get(e.selected.role, '')}")
     for label, value, tip in (
         ("duplicate", inserted(levels, i + 1, lv), "a copy of this level above it"),
         ("insert", inserted(levels, i + 1, MobiusLevel(Empty(), [], False)), "an identity level"),
