@@ -170,6 +170,28 @@ def test_a_drag_that_puts_the_viewpoint_on_a_pole_is_refused_and_the_scene_stays
     assert len(doc.history.steps) == 1
 
 
+def test_an_inserted_identity_level_can_be_grabbed_and_a_drag_gives_it_a_translate():
+    """An identity level without a kernel has its origin as a handle (else nothing selects
+    it); dragging it adds a translate step whose handle, on the same path, is where the
+    origin was dragged, so the drag goes on. Negative control: a level with steps has none."""
+    from krsview.scene.model import Empty
+    from krsview.scene.mokrs import MobiusLevel
+
+    palm = load_scene(resolve("palm"))
+    levels = palm.mokrs.levels
+    s = apply_edit(palm, LEVELS, inserted(levels, 31, MobiusLevel(Empty(), [], False)))
+    origin = [h for h in handles(s) if h.role == "origin"]
+    assert [h.level for h in origin] == [31]
+    h = origin[0]
+    assert np.allclose(h.position, outward(s.mokrs, 31, -1, np.zeros(3)))
+    p = h.position + np.array([0.2, -0.1, 0.3])
+    moved_level = apply_edit(s, *h.edit_to(s, p))
+    assert [st.kind for st in moved_level.mokrs.levels[31].transform] == ["translate"]
+    by = next(k for k in handles(moved_level) if k.same(h))
+    assert by.role == "by" and np.allclose(by.position, p, atol=1e-9)
+    assert not [k for k in handles(moved_level) if k.role == "origin"]
+
+
 def test_a_refusal_is_shown_under_the_step_or_kernel_it_names():
     assert refusal_place("mokrs.levels[3].transform[1].factor = 0.0: allowed", 3, 3) == "step 1"
     assert refusal_place("mokrs.levels[3].kernel.radius = -1.0: allowed", 3, 3) == "kernel"

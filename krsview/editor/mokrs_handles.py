@@ -44,7 +44,7 @@ class MobiusHandle:
     label: str
     owner: Path  # the step or level the panel shows
     to_world: np.ndarray  # Möbius matrix: the handle's frame → world
-    role: str  # "point", "by", "factor", "degrees", "axis", "center", "radius"
+    role: str  # "point", "by", "factor", "degrees", "axis", "center", "radius", "origin"
     size: float = 1.0  # ρ: the dial's radius, the unit a scale handle measures in
     pivot: np.ndarray | None = None
     guides: tuple[np.ndarray, ...] = field(default=(), repr=False)  # world polylines
@@ -53,6 +53,8 @@ class MobiusHandle:
     def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
         """The edit (field path, new value) that puts the handle at world point ``p``
         (``carry`` is a route's option; a MöKRS step moves alone)."""
+        if self.role == "origin":  # an identity level gains the translate its handle is
+            return (*self.owner, "transform"), [Translate(self.value_at(scene, p))]
         return self.path, self.value_at(scene, p)
 
     def value_at(self, scene: Scene, p: np.ndarray) -> Any:
@@ -147,12 +149,25 @@ def mokrs_handles(m: MoKRS, at: Path) -> list[MobiusHandle]:
                    np.array(getattr(k, f), dtype=np.float64))
             for f in KERNEL_POINTS if hasattr(k, f)
         ]  # fmt: skip
+        if not lv.transform and not any(hasattr(k, f) for f in KERNEL_POINTS):
+            out.append(_origin(i, lev, M))
     return _steps_first(_mapped_all(out))
+
+
+def _origin(i: int, lev: Path, M) -> _Local:
+    """A level with nothing to grab (no steps, no kernel point: an inserted identity level)
+    shows its origin, so it can be selected; a drag gives it a translate step, whose
+    handle this becomes (the same path), so the drag goes on."""
+    by = (*lev, "transform", 0, "by")
+    return _Local(by, "point", i, f"L{i} origin", lev, M, "origin", 1.0, np.zeros(3))
 
 
 def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
     """Map every handle's points into the world in one vectorised Möbius application (the
-    per-point matrices stacked as (2, 2, N, 4)); a handle sent to infinity is left out."""
+    per-point matrices stacked as (2, 2, N, 4)); a handle sent to infinity is left out, and
+    a dial whose pivot is (it cannot turn there)."""
+    if not local:
+        return []
     parts = [[h.point[None], *([h.pivot[None]] if h.pivot is not None else []), *h.guides,
               *([(h.pivot + AXIS_STEP * h.size * h.axis)[None]] if h.axis is not None else [])]
              for h in local]  # fmt: skip
@@ -173,6 +188,8 @@ def _mapped_all(local: list[_Local]) -> list[MobiusHandle]:
         if h.axis is not None:  # the dial's axis in the world, at the pivot: a short step
             step = mine.pop()[0] - pivot  # along it, mapped (a Möbius map is conformal)
             axis = step / np.linalg.norm(step)
+            if not np.isfinite(axis).all():
+                continue
         guides = tuple(g[np.isfinite(g).all(axis=1)] for g in mine[1 + (pivot is not None) :])
         out.append(
             MobiusHandle(h.path, h.kind, mine[0][0], h.level, h.label, h.owner, h.to_world,

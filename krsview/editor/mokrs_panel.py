@@ -33,6 +33,7 @@ HINTS = {  # what dragging each kind of handle changes
     "axis": "re-aims the rotation axis (its tip)",
     "center": "moves the inversion's centre (sent to infinity)",
     "radius": "a point on the fixed sphere: its radius",
+    "origin": "an identity level: a drag gives it a translate step",
 }
 
 
