@@ -309,6 +309,7 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
         e.viewer.set_levels(1)
         pump(e)
         assert e.viewer.levels == 0 and "cannot be carried" in e.viewer.error
+        assert refusal_place(e.viewer.error, 59, 0) == "selection"  # shown in the panel
         e.viewer.set_levels(2)
         pump(e)
         assert e.viewer.levels == 2 and e.viewer.krs.n == 2
