@@ -192,6 +192,27 @@ def test_an_inserted_identity_level_can_be_grabbed_and_a_drag_gives_it_a_transla
     assert not [k for k in handles(moved_level) if k.role == "origin"]
 
 
+def test_a_linked_step_drag_bends_the_finer_levels_with_the_same_steps_alike():
+    """palm's leaflets share their steps: turning level 30's dial (linked, the default)
+    turns every finer leaflet level the same and no coarser one, and the dial still lands
+    where it was dragged; unlinked (the negative control) only level 30 turns."""
+    palm = load_scene(resolve("palm"))
+    m = palm.mokrs
+    h = next(h for h in handles(palm) if h.role == "degrees" and h.level == 30)
+    st = get_at(palm, h.owner)
+    local = mobius.apply(Rotate(st.axis, 7.5).matrix(), _zero_dial(st, h.size)[None])[0]
+    p = outward(m, 30, h.path[4], local)
+    leaflets = [i for i, lv in enumerate(m.levels) if lv.transform == m.levels[30].transform]
+    assert len(leaflets) == 30
+    for carry, turned in ((True, [i for i in leaflets if i <= 30]), (False, [30])):
+        s = apply_edit(palm, *h.edit_to(palm, p, carry))
+        now = [i for i, lv in enumerate(s.mokrs.levels) if lv.transform and
+               lv.transform[1].degrees == pytest.approx(7.5)]  # fmt: skip
+        assert now == turned, (carry, now)
+        moved_to = next(k for k in handles(s) if k.same(h)).position
+        assert np.linalg.norm(moved_to - p) < 1e-9 * max(1.0, float(np.linalg.norm(p)))
+
+
 def test_a_refusal_is_shown_under_the_step_or_kernel_it_names():
     assert refusal_place("mokrs.levels[3].transform[1].factor = 0.0: allowed", 3, 3) == "step 1"
     assert refusal_place("mokrs.levels[3].kernel.radius = -1.0: allowed", 3, 3) == "kernel"

@@ -21,7 +21,15 @@ from ..algebra import mobius
 from ..scene import MoKRS, Scene
 from ..scene.edits import Path, get_at
 from ..scene.model import Empty
-from ..scene.mokrs import Invert, MobiusLevel, Rotate, Scale, Translate, from_real
+from ..scene.mokrs import (
+    Invert,
+    MobiusLevel,
+    Rotate,
+    Scale,
+    Translate,
+    from_real,
+    linked_edit,
+)
 
 KERNEL_POINTS = ("center", "a", "b", "start", "control", "end")  # the kernels' point fields
 SCALE_DIRECTION = np.array([1.0, 0.0, 0.0])  # u: where a scale step's handle sits
@@ -51,11 +59,15 @@ class MobiusHandle:
     axis: np.ndarray | None = None  # "dial": the world direction it turns about, at pivot
 
     def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
-        """The edit (field path, new value) that puts the handle at world point ``p``
-        (``carry`` is a route's option; a MöKRS step moves alone)."""
+        """The edit (field path, new value) that puts the handle at world point ``p``; with
+        ``carry``, a step's change goes to the finer levels with the same steps too
+        (``linked_levels``: palm's leaflets bend alike)."""
+        value = self.value_at(scene, p)
         if self.role == "origin":  # an identity level gains the translate its handle is
-            return (*self.owner, "transform"), [Translate(self.value_at(scene, p))]
-        return self.path, self.value_at(scene, p)
+            return (*self.owner, "transform"), [Translate(value)]
+        if carry and self.role != "point":
+            return linked_edit(scene.mokrs, self.path, value)
+        return self.path, value
 
     def value_at(self, scene: Scene, p: np.ndarray) -> Any:
         """The field's new value: ``p`` mapped into the handle's frame, then read as the

@@ -13,7 +13,7 @@ from imgui_bundle import imgui
 
 from ..scene.edits import path_text
 from ..scene.model import Empty, Kernel
-from ..scene.mokrs import MobiusLevel, MobiusStep
+from ..scene.mokrs import MobiusLevel, MobiusStep, linked_edit, linked_levels
 from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions
 from . import commands as ec
@@ -121,6 +121,13 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     changed, on = imgui.checkbox("reflect (x = 0 of this level)", lv.reflect)
     if changed:
         out.append(Edit((*lev, "reflect"), on))
+    linked = len(linked_levels(e.scene.mokrs, i)) - 1
+    if linked:
+        changed, on = imgui.checkbox(f"step edits also go to {linked} finer levels", e.carry)
+        if changed:
+            out.append(ec.SetCarry(on))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("the finer levels whose steps equal this level's (linked)")
     kinds = list(KERNEL_KINDS)
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
     if changed and kinds[k] != lv.kernel.kind:
@@ -156,7 +163,11 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
         if imgui.small_button(f"{label}##s{j}"):
             out.append(Edit((*LEVELS, i, "transform"), value))
     imgui.indent()
+    first = len(out)
     fields(s, sp, out, interactions)
+    if e.carry:  # linked: the same change in the finer levels with the same steps
+        m = e.scene.mokrs
+        out[first:] = [Edit(*linked_edit(m, c.path, c.value), c.interaction) for c in out[first:]]
     imgui.unindent()
     _message(error)
 

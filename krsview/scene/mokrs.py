@@ -231,6 +231,29 @@ class MoKRS:
         return MoKRS(keep)
 
 
+def linked_levels(m: MoKRS, i: int) -> list[int]:
+    """Level i and every finer level whose steps equal its own (palm's leaflets, shell's
+    turns): the levels a linked step edit changes. The coarser ones stay, so level i's frame,
+    and a handle dragged in it, stay where the pointer puts them."""
+    return [j for j in range(i + 1) if m.levels[j].transform == m.levels[i].transform]
+
+
+def linked_edit(m: MoKRS, path: tuple, value) -> tuple[tuple, object]:
+    """The edit that sets a step's field (``path`` = ("mokrs", "levels", i, "transform", j,
+    field)) in level i and its linked levels: the whole level list where others follow,
+    else the field alone."""
+    i, j, name = path[2], path[4], path[5]
+    linked = linked_levels(m, i)
+    if len(linked) == 1:
+        return path, value
+    levels = list(m.levels)
+    for k in linked:
+        steps = list(levels[k].transform)
+        steps[j] = replace(steps[j], **{name: value})
+        levels[k] = replace(levels[k], transform=steps)
+    return path[:2], levels
+
+
 POLE_DISTANCE = 1e-6  # a viewpoint closer than this (× the level's scale) to a pole is rejected
 
 
