@@ -46,6 +46,8 @@ class Gizmo:
     def manipulate(self, h: Handle, v: View) -> tuple[np.ndarray, tuple] | None:
         """Draw the gizmo on ``h``; while it is dragged, where ``h`` goes (world) and the
         drag's interaction key."""
+        if h.kind == "dial":  # a MöKRS rotation step: a ring about its axis
+            return self.turn(h, v)
         io = imgui.get_io()
         gizmo.set_drawlist(imgui.get_background_draw_list())
         gizmo.set_rect(0.0, 0.0, io.display_size.x, io.display_size.y)
@@ -72,6 +74,42 @@ class Gizmo:
         quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)
         grid = self.snap.grid if self.snap.on or io.key_shift else None
         return moved(h.position, delta, quantum, grid), ("gizmo", self.drags)
+
+    def turn(self, h, v: View) -> tuple[np.ndarray, tuple] | None:
+        """The ImGuizmo rotate ring about a dial handle's world ``axis`` through its ``pivot``
+        (a MöKRS rotation step); while it is dragged, where the dial point turns to and the
+        drag's interaction key. Shift or snap turns in steps of the snap angle."""
+        io = imgui.get_io()
+        gizmo.set_drawlist(imgui.get_background_draw_list())
+        gizmo.set_rect(0.0, 0.0, io.display_size.x, io.display_size.y)
+        near = 1e-3 * max(float(np.linalg.norm(h.pivot - v.origin)), 1e-12)
+        view, proj = camera_matrices(v, near, 1e6 * near)
+        x = h.axis
+        y = np.cross(x, [1.0, 0.0, 0.0] if abs(x[0]) < 0.9 else [0.0, 1.0, 0.0])
+        y /= np.linalg.norm(y)
+        obj = np.eye(4)
+        obj[:3, 0], obj[:3, 1], obj[:3, 2] = x, y, np.cross(x, y)
+        obj[:3, 3] = h.pivot - v.origin  # camera-relative: float32 stays precise
+        m = gizmo.Matrix16(list(obj.T.flatten()))
+        snap = self.snap.on or bool(io.key_shift)
+        step = gizmo.Matrix3([self.snap.angle] * 3) if snap else None
+        changed = gizmo.manipulate(
+            gizmo.Matrix16(list(view.T.flatten())),
+            gizmo.Matrix16(list(proj.T.flatten())),
+            gizmo.OPERATION.rotate_x,
+            gizmo.MODE.local,
+            m,
+            None,
+            step,
+        )
+        using = gizmo.is_using()
+        if using and not self._was_using:
+            self.drags += 1  # a new drag: a new undo step
+        self._was_using = using
+        if not (changed and using):
+            return None
+        turned = np.array(m.values, dtype=np.float64).reshape(4, 4).T[:3, :3] @ obj[:3, :3].T
+        return h.pivot + turned @ (h.position - h.pivot), ("gizmo", self.drags)
 
 
 def decimal_step(size: float) -> float:

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..scene import KRS, Capsule, Kernel, Mirror, Route, Scene, Sphere, ToroidalCapsule
 from ..scene.edits import Path, get_at
+from .mokrs_handles import mokrs_handles, mokrs_outline
 
 ARROW = 0.6  # a normal arrow's length, × its level's branch length (route) or kernel size
 
@@ -81,6 +82,8 @@ class Handle:
 
 
 def handles(scene: Scene) -> list[Handle]:
+    if scene.mokrs is not None:
+        return mokrs_handles(scene.mokrs, ("mokrs",))  # type: ignore[return-value]
     if scene.route is not None:
         return route_handles(scene.route, ("route",))
     if scene.krs is not None:
@@ -174,6 +177,8 @@ def _size(k: Kernel, pts: list[np.ndarray]) -> float:
 
 def outline(scene: Scene) -> list[str]:
     """One line per selectable entry, in handle ``level`` order."""
+    if scene.mokrs is not None:
+        return mokrs_outline(scene.mokrs)
     if scene.route is not None:
         n = len(scene.route.levels)
         return [

@@ -20,6 +20,7 @@ from . import commands as ec
 from .gizmo import Snap
 from .handles import Handle, outline
 from .layout import MIN_WIDTH, Layout
+from .mokrs_panel import mokrs_section
 from .saving import copy_dialog
 from .structure import outline_menu, structure_section
 
@@ -77,9 +78,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         if imgui.button("bake into a route"):
             out.append(ec.Bake())
     elif scene.mokrs is not None:
-        imgui.text_wrapped(
-            "A MöKRS has no handles yet; edit its file (it reloads) or the fields below."
-        )
+        mokrs_section(e, out, interactions, _fields)
     else:
         _warnings(e, out)
         _outline(e, out)
@@ -94,14 +93,15 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         )
         _fields(scene.effect_settings, ("effect_settings",), out, interactions)
     if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
-        changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
-        if changed:
-            out.append(ec.SetCarry(on))
-        if imgui.is_item_hovered():
-            imgui.set_tooltip(
-                "on: the finer forks, control points and mirrors move with a "
-                "dragged fork, so the crown stays attached; off: only the fork"
-            )
+        if scene.route is not None:  # only a route's forks carry anything
+            changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
+            if changed:
+                out.append(ec.SetCarry(on))
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(
+                    "on: the finer forks, control points and mirrors move with a "
+                    "dragged fork, so the crown stays attached; off: only the fork"
+                )
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
             out.append(ec.SetSnap(on))

@@ -10,6 +10,7 @@ import numpy as np
 from ..gpu.overlay import Shapes
 from ..scene import Scene
 from .handles import Handle, polyline
+from .mokrs_handles import MobiusHandle, guide_lines
 
 FORK, CONTROL, NORMAL, SELECTED = (
     (1.0, 0.6, 0.15, 1.0),
@@ -44,6 +45,8 @@ def editor_shapes(
             s.lines.append((h.pivot, h.position, NORMAL))
     if selected is not None:
         _mirror_disc(s, shown, selected)
+    if isinstance(selected, MobiusHandle):  # a MöKRS step's circle, sphere or vector
+        s.lines += guide_lines(selected, NORMAL)
     for _, line in clipped:  # last: over the handles
         s.lines += [(a, b, CLIPPED) for a, b in zip(line[:-1], line[1:])]
         s.points += [(p, CLIPPED, CLIPPED_DOT) for p in line]

@@ -29,6 +29,33 @@ from .schema import SceneError, Tagged, Vec3, param
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
 
 
+def cached(obj, name: str, make):
+    """``make()`` computed once per frozen instance and kept read-only beside its fields: a
+    drag's edit asks each step and level for its matrix several times (validation, the
+    viewpoint check, compiling, the editor's handles)."""
+    value = obj.__dict__.get(name)
+    if value is None:
+        value = make()
+        value.flags.writeable = False
+        object.__setattr__(obj, name, value)
+    return value
+
+
+def composed(*Hs: np.ndarray) -> np.ndarray:
+    """H_1 · H_2 · … as ``mobius.compose``, by products of the real 8×8 forms (one matrix
+    product each instead of eight quaternion products)."""
+    R = mobius.real_matrix(Hs[0])
+    for H in Hs[1:]:
+        R = R @ mobius.real_matrix(H)
+    return from_real(R)
+
+
+def from_real(R: np.ndarray) -> np.ndarray:
+    """The quaternion matrix of a real 8×8 one (``mobius.real_matrix``'s inverse): each
+    block's first column, as ``mobius.inverse`` reads it."""
+    return np.array([[R[4 * r : 4 * r + 4, 4 * k] for k in range(2)] for r in range(2)])
+
+
 class MobiusStep(Tagged):
     """One elementary transformation; ``type`` picks it. Steps apply in the order listed."""
 
@@ -36,6 +63,10 @@ class MobiusStep(Tagged):
     noun: ClassVar[str] = "Möbius step"
 
     def matrix(self):
+        """The step as a quaternion matrix (read-only, made once)."""
+        return cached(self, "_matrix", self.make_matrix)
+
+    def make_matrix(self):
         raise NotImplementedError
 
 
@@ -46,7 +77,7 @@ class Translate(MobiusStep):
     kind: ClassVar[str] = "translate"
     by: Vec3 = param((0.0, 0.0, 0.0), help="translation vector")
 
-    def matrix(self):
+    def make_matrix(self):
         return mobius.translation(self.by)
 
 
@@ -57,7 +88,7 @@ class Scale(MobiusStep):
     kind: ClassVar[str] = "scale"
     factor: float = param(1.0, lo=1e-6, hi=1e6, help="dilation factor s")
 
-    def matrix(self):
+    def make_matrix(self):
         return mobius.dilation(self.factor)
 
 
@@ -69,7 +100,7 @@ class Rotate(MobiusStep):
     axis: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="rotation axis")
     degrees: float = param(0.0, lo=-360.0, hi=360.0, unit="degrees", help="angle (right hand)")
 
-    def matrix(self):
+    def make_matrix(self):
         return mobius.rotation(self.axis, math.radians(self.degrees))
 
 
@@ -82,10 +113,10 @@ class Invert(MobiusStep):
     center: Vec3 = param((0.0, 0.0, 0.0), help="centre c (mapped to infinity)")
     radius: float = param(1.0, lo=1e-6, hi=1e6, help="radius r of the fixed sphere")
 
-    def matrix(self):
+    def make_matrix(self):
         M = mobius
         neg = tuple(-v for v in self.center)
-        return M.compose(
+        return composed(
             M.translation(self.center),
             M.dilation(self.radius),
             M.inversion(),
@@ -107,12 +138,16 @@ class MobiusLevel:
     )
 
     def matrix(self):
-        """G_i as a quaternion matrix: the last step applied last (leftmost)."""
-        return mobius.compose(mobius.identity(), *[s.matrix() for s in reversed(self.transform)])
+        """G_i as a quaternion matrix: the last step applied last (leftmost); made once."""
+
+        def make():
+            return composed(mobius.identity(), *[s.matrix() for s in reversed(self.transform)])
+
+        return cached(self, "_matrix", make)
 
     def inverse(self):
         """G_i⁻¹, which the tracer applies going inwards, with a rounding-level c zeroed."""
-        return mobius.tidy(mobius.inverse(self.matrix()))
+        return cached(self, "_inverse", lambda: mobius.tidy(mobius.inverse(self.matrix())))
 
 
 @dataclass(frozen=True)
@@ -196,6 +231,29 @@ class MoKRS:
         return MoKRS(keep)
 
 
+def linked_levels(m: MoKRS, i: int) -> list[int]:
+    """Level i and every finer level whose steps equal its own (palm's leaflets, shell's
+    turns): the levels a linked step edit changes. The coarser ones stay, so level i's frame,
+    and a handle dragged in it, stay where the pointer puts them."""
+    return [j for j in range(i + 1) if m.levels[j].transform == m.levels[i].transform]
+
+
+def linked_edit(m: MoKRS, path: tuple, value) -> tuple[tuple, object]:
+    """The edit that sets a step's field (``path`` = ("mokrs", "levels", i, "transform", j,
+    field)) in level i and its linked levels: the whole level list where others follow,
+    else the field alone."""
+    i, j, name = path[2], path[4], path[5]
+    linked = linked_levels(m, i)
+    if len(linked) == 1:
+        return path, value
+    levels = list(m.levels)
+    for k in linked:
+        steps = list(levels[k].transform)
+        steps[j] = replace(steps[j], **{name: value})
+        levels[k] = replace(levels[k], transform=steps)
+    return path[:2], levels
+
+
 POLE_DISTANCE = 1e-6  # a viewpoint closer than this (× the level's scale) to a pole is rejected
 
 
@@ -212,8 +270,9 @@ def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
                 raise SceneError(
                     path,
                     list(position),
-                    f"level {i}'s transform sends this point to infinity (its "
-                    f"pole); move the viewpoint or the transform's centre",
+                    f"level {i}'s transform sends this point to infinity (its pole, "
+                    f"mokrs.levels[{i}].transform); allowed: a viewpoint off the pole: "
+                    "move it, or the inversion's centre",
                 )
         x = mobius.apply(H, x)
         if mokrs.levels[i].reflect and x[0, 0] > 0.0:

@@ -128,7 +128,10 @@ class Viewer:
             self._set_scene(self.doc.scene)
 
     def _apply_levels(self) -> None:
-        self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
+        try:
+            self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
+        except SceneError as e:  # a MöKRS whose kept levels cannot carry a kernel up
+            self.levels, self.krs, self.error = 0, self.geometry, f"{e}; drawing every level"
         self.world = self.renderer.world(self.krs, self.scene.material.albedo)  # speed, picking
         self.frames.dirty = True
 

@@ -1,0 +1,179 @@
+"""The edit panel's section for a MöKRS [KRS17 §7]: its levels (select, duplicate, insert,
+remove, reorder), the selected level's reflection, kernel and transform steps as fields from
+the schema (add, remove, reorder steps), and a refused value's message next to what it
+refused. Every change is an ``Edit`` of the scene (one undo step, validated by the schema);
+the panel returns commands and writes nothing."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from imgui_bundle import imgui
+
+from ..scene.edits import path_text
+from ..scene.model import Empty, Kernel
+from ..scene.mokrs import MobiusLevel, MobiusStep, linked_edit, linked_levels
+from ..viewer.commands import Command, Edit
+from ..viewer.widgets import Interactions
+from . import commands as ec
+from .mokrs_handles import mokrs_outline
+
+RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+STEP_KINDS = tuple(MobiusStep.registry)  # translate, scale, rotate, invert
+KERNEL_KINDS = tuple(Kernel.registry)
+LEVELS = ("mokrs", "levels")
+
+Fields = Callable[[Any, tuple, list, Interactions], None]  # the panel's field widgets
+HINTS = {  # what dragging each kind of handle changes
+    "point": "moves the kernel's point (in its level's space)",
+    "by": "moves the origin of the frame after the step: the translation vector",
+    "factor": "slides along x of the frame: the dilation factor",
+    "degrees": "turn the ring about the axis: the angle",
+    "axis": "re-aims the rotation axis (its tip)",
+    "center": "moves the inversion's centre (sent to infinity)",
+    "radius": "a point on the fixed sphere: its radius",
+    "origin": "an identity level: a drag gives it a translate step",
+}
+
+
+def moved(items: list, k: int, by: int) -> list:
+    """``items`` with entry k swapped with entry k + by (unchanged at either end)."""
+    j = k + by
+    out = list(items)
+    if 0 <= j < len(out):
+        out[k], out[j] = out[j], out[k]
+    return out
+
+
+def inserted(items: list, k: int, item: Any) -> list:
+    return [*items[:k], item, *items[k:]]
+
+
+def removed(items: list, k: int) -> list:
+    return [*items[:k], *items[k + 1 :]]
+
+
+MINE = ("mokrs", "camera", "bookmarks", "levels")  # refusals a MöKRS edit can cause
+
+
+def refusal_place(error: str, level: int, steps: int) -> str:
+    """Where the section shows the viewer's last refusal: under the step or kernel of
+    ``level`` it names ("step J", "kernel"), else, for another MöKRS field or a viewpoint
+    on a pole, beside the selection ("selection"); "" for none or another part's."""
+    path = error.split(" = ", 1)[0]
+    if not error or not path.startswith(MINE):
+        return ""
+    lev = path_text((*LEVELS, level))
+    for j in range(steps):
+        if _under(path, f"{lev}.transform[{j}]"):
+            return f"step {j}"
+    return "kernel" if _under(path, f"{lev}.kernel") else "selection"
+
+
+def _under(path: str, prefix: str) -> bool:
+    return path == prefix or path.startswith((prefix + ".", prefix + "["))
+
+
+def mokrs_section(e: Any, out: list[Command], interactions: Interactions, fields: Fields) -> None:
+    """Levels, then the selected level's reflection, kernel and steps."""
+    m = e.scene.mokrs
+    entries = mokrs_outline(m)
+    level = e.selected.level if e.selected is not None else None
+    imgui.text("levels (click one, a handle or the geometry)")
+    if imgui.begin_child("mokrs levels", imgui.ImVec2(-1, 120), imgui.ChildFlags_.borders):
+        for i in range(len(entries) - 1, -1, -1):  # the outermost first
+            clicked, _ = imgui.selectable(f"{entries[i]}##m{i}", i == level)
+            if clicked:
+                out.append(ec.SelectLevel(i))
+            if i == level and e.scroll_outline:
+                imgui.set_scroll_here_y()
+                out.append(ec.OutlineScrolled())
+    imgui.end_child()
+    if level is None:
+        imgui.text_disabled("select a level: its steps get handles in the view")
+        return
+    _level(e, m.levels, level, out, interactions, fields)
+
+
+def _level(e, levels: list, i: int, out: list, interactions: Interactions, fields) -> None:
+    lv, lev = levels[i], (*LEVELS, i)
+    error = e.viewer.error
+    place = refusal_place(error, i, len(lv.transform))
+    sel = e.selected.path if e.selected is not None else ()
+    step_selected = sel[: len(lev) + 1] == (*lev, "transform")
+    imgui.separator_text(f"level {i} of {len(levels)}")
+    if e.selected is not None and e.selected.level == i:
+        imgui.text_wrapped(f"{e.selected.label}: {HINTS.get(e.selected.role, '')}")
+    for label, value, tip in (
+        ("duplicate", inserted(levels, i + 1, lv), "a copy of this level above it"),
+        ("insert", inserted(levels, i + 1, MobiusLevel(Empty(), [], False)), "an identity level"),
+        ("remove", removed(levels, i), "remove this level"),
+        ("inward", moved(levels, i, -1), "swap with the level inside it"),
+        ("outward", moved(levels, i, 1), "swap with the level outside it"),
+    ):
+        if imgui.small_button(f"{label}##lv"):
+            out.append(Edit(LEVELS, value))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(tip)
+        imgui.same_line()
+    imgui.new_line()
+    changed, on = imgui.checkbox("reflect (x = 0 of this level)", lv.reflect)
+    if changed:
+        out.append(Edit((*lev, "reflect"), on))
+    linked = len(linked_levels(e.scene.mokrs, i)) - 1
+    if linked:
+        changed, on = imgui.checkbox(f"step edits also go to {linked} finer levels", e.carry)
+        if changed:
+            out.append(ec.SetCarry(on))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("the finer levels whose steps equal this level's (linked)")
+    kinds = list(KERNEL_KINDS)
+    changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
+    if changed and kinds[k] != lv.kernel.kind:
+        out.append(Edit((*lev, "kernel"), Kernel.registry[kinds[k]]()))
+    fields(lv.kernel, (*lev, "kernel"), out, interactions)
+    _message(error if place == "kernel" else "")
+    for j, s in enumerate(lv.transform):
+        mine = step_selected and sel[len(lev) + 1] == j
+        here = place == f"step {j}" or (place == "selection" and mine)
+        _step(e, lv, i, j, s, mine, error if here else "", out, interactions, fields)
+    imgui.set_next_item_width(110)
+    changed, k = imgui.combo("##newstep", 0, ["add a step", *STEP_KINDS])
+    if changed and k > 0:
+        step = MobiusStep.registry[STEP_KINDS[k - 1]]()
+        out.append(Edit((*lev, "transform"), [*lv.transform, step]))
+    _message(error if place == "selection" and not step_selected else "")
+
+
+def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interactions, fields):
+    """One step: a header that selects its handle, reorder and remove buttons, its fields,
+    and a refusal of one of them (or of a drag of its handle: a pole) beneath."""
+    sp, steps = (*LEVELS, i, "transform", j), lv.transform
+    clicked, _ = imgui.selectable(f"step {j}: {s.kind}##s{j}", mine, size=imgui.ImVec2(150, 0))
+    if clicked:
+        first = next((h for h in e.handles if h.owner == sp), None)
+        out.append(ec.Select(first))
+    for label, value in (
+        ("up", moved(steps, j, -1)),
+        ("down", moved(steps, j, 1)),
+        ("x", removed(steps, j)),
+    ):
+        imgui.same_line()
+        if imgui.small_button(f"{label}##s{j}"):
+            out.append(Edit((*LEVELS, i, "transform"), value))
+    imgui.indent()
+    first = len(out)
+    fields(s, sp, out, interactions)
+    if e.carry:  # linked: the same change in the finer levels with the same steps
+        m = e.scene.mokrs
+        out[first:] = [Edit(*linked_edit(m, c.path, c.value), c.interaction) for c in out[first:]]
+    imgui.unindent()
+    _message(error)
+
+
+def _message(text: str) -> None:
+    if text:
+        imgui.push_style_color(imgui.Col_.text, RED)
+        imgui.text_wrapped(text)
+        imgui.pop_style_color()

@@ -1,0 +1,384 @@
+"""Editing a MöKRS [KRS17 §7]: handles placed in the world through the Möbius maps above their
+frame, drags mapped back (round trip), a drag onto a pole refused, the panel's structural
+edits validated and one undo step each, drags and step-list edits keeping the shader variant;
+and the editor on palm in a real window under Xvfb, dragged with real pointer events."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from krsview.algebra import mobius
+from krsview.document.document import Document
+from krsview.editor.handles import handles
+from krsview.editor.mokrs_handles import RADIUS_DIRECTION, SCALE_DIRECTION
+from krsview.editor.mokrs_panel import LEVELS, inserted, moved, refusal_place, removed
+from krsview.scene import SceneError, load_scene
+from krsview.scene.edits import apply_edit, get_at
+from krsview.scene.mokrs import Rotate, Scale, Translate
+from krsview.scene.presets import resolve
+
+PRESETS = ("palm", "shell", "inversion")
+
+
+@pytest.fixture(scope="module", params=PRESETS)
+def scene(request):
+    return load_scene(resolve(request.param))
+
+
+def outward(m, level: int, step: int, q: np.ndarray) -> np.ndarray:
+    """A point of the frame after step ``step`` of ``level`` carried into the world one step
+    at a time (each step's own map applied to the point, no composed matrices): the rest of
+    the level's steps, then every coarser level's."""
+    x = np.asarray(q, dtype=np.float64)[None]
+    for s in m.levels[level].transform[step + 1 :]:
+        x = mobius.apply(s.matrix(), x)
+    for lv in m.levels[level + 1 :]:
+        for s in lv.transform:
+            x = mobius.apply(s.matrix(), x)
+    return x[0]
+
+
+def sample(hs, role: str, count: int = 6):
+    """Up to ``count`` handles of a role, spread over the levels (the deepest included)."""
+    mine = [h for h in hs if h.role == role]
+    if not mine:
+        return []
+    return [mine[k] for k in sorted({round(t) for t in np.linspace(0, len(mine) - 1, count)})]
+
+
+def test_every_preset_opens_with_handles_for_each_kind_of_step(scene):
+    hs = handles(scene)
+    kinds = {s.kind for lv in scene.mokrs.levels for s in lv.transform}
+    roles = {h.role for h in hs}
+    want = {"translate": {"by"}, "scale": {"factor"}, "rotate": {"degrees", "axis"}}
+    want["invert"] = {"center", "radius"}
+    for kind in kinds:
+        assert want[kind] <= roles, (kind, roles)
+    points = {i for i, lv in enumerate(scene.mokrs.levels) if hasattr(lv.kernel, "radius")}
+    steps = {i for i, lv in enumerate(scene.mokrs.levels) if lv.transform}
+    assert {h.level for h in hs} == points | steps
+
+
+def test_a_handle_sits_at_its_point_carried_through_every_map_above_it(scene):
+    """Kernel points, translate vectors and inversion centres: the handle is the point of its
+    frame mapped step by step into the world; read in the level's own space (the negative
+    control) it lies elsewhere for a level below a transform."""
+    m, hs = scene.mokrs, handles(scene)
+    checked = misplaced = 0
+    for role in ("point", "by", "center"):
+        for h in sample(hs, role):
+            i = h.level
+            step = h.path[4] if h.path[3] == "transform" else -1  # -1: the level's space
+            q = np.array(get_at(m, h.path[1:]))  # the point as the file holds it
+            expected = outward(m, i, step, q)
+            scale = max(1.0, float(np.linalg.norm(expected)))
+            assert np.linalg.norm(h.position - expected) <= 1e-9 * scale, (h.label, expected)
+            checked += 1
+            misplaced += np.linalg.norm(h.position - q) > 1e-3 * scale
+    assert checked >= 4
+    assert misplaced >= checked // 2, "the level's own space would have placed them as well"
+
+
+def _targets(m, h):
+    """(a point of the handle's frame, the field's value it stands for) for a drag of ``h``."""
+    s = get_at(m, h.owner[1:])
+    rho = h.size
+    if h.role == "by":
+        return np.add(s.by, (0.3, -0.2, 0.1)), None
+    if h.role == "center":
+        return np.add(s.center, (2.0, -1.0, 0.5)), None
+    if h.role == "point":
+        return np.add(get_at(m, h.path[1:]), (0.05, 0.02, -0.04)), None
+    if h.role == "factor":
+        f = s.factor * 1.1
+        return f * rho * SCALE_DIRECTION, f
+    if h.role == "radius":
+        r = s.radius * 1.3
+        return np.array(s.center) + r * RADIUS_DIRECTION, r
+    if h.role == "degrees":
+        deg = s.degrees + 10.0
+        return mobius.apply(Rotate(s.axis, deg).matrix(), _zero_dial(s, rho)[None])[0], deg
+    axis = np.array(s.axis) + np.array([0.3, 0.2, -0.1])
+    axis /= np.linalg.norm(axis)
+    return rho * axis, tuple(axis)
+
+
+def _zero_dial(s: Rotate, rho: float) -> np.ndarray:
+    """The dial's 0° point: ρ·v, v the unit vector ⊥ axis from the coordinate axis least
+    along it (computed here from the rule, not by the module)."""
+    a = np.array(s.axis)
+    e = np.eye(3)[int(np.argmin(np.abs(a)))]
+    v = e - (e @ a) * a
+    return rho * v / np.linalg.norm(v)
+
+
+def test_a_drag_puts_the_handle_where_it_was_dragged(scene):
+    """Handle position → drag to a world point → edit → the new handle is at that point (and
+    the field holds the value the point stands for). Negative control: the dragged point
+    written as the value, as if the handle's frame were the world, lands elsewhere (where
+    the maps above it move the frame's origin)."""
+    m, hs = scene.mokrs, handles(scene)
+    for h in [h for role in {h.role for h in hs} for h in sample(hs, role, 3)]:
+        step = h.path[4] if h.path[3] == "transform" else -1
+        q, value = _targets(m, h)
+        p = outward(m, h.level, step, q)
+        s = apply_edit(scene, *h.edit_to(scene, p))
+        new = next(k for k in handles(s) if k.same(h))
+        scale = max(1.0, float(np.linalg.norm(p)))
+        assert np.linalg.norm(new.position - p) <= 1e-7 * scale, (h.label, new.position, p)
+        if value is not None:
+            assert np.allclose(get_at(s, h.path), value, rtol=1e-9), (h.label, value)
+        if value is None and np.linalg.norm(outward(m, h.level, step, p) - p) > 1e-3 * scale:
+            wrong = apply_edit(scene, h.path, tuple(p))  # the world point as the frame's
+            moved_to = next(k for k in handles(wrong) if k.same(h)).position
+            assert np.linalg.norm(moved_to - p) > 1e-3 * scale, h.label
+
+
+def test_a_dial_dragged_past_half_a_turn_keeps_turning():
+    """The rotate dial reads the angle nearest the present one: 170° + 20° is 190°, not −170°
+    (a monotone response); its negative control, 0° + 20°, is 20°."""
+    s0 = load_scene(resolve("shell"))
+    h = next(h for h in handles(s0) if h.role == "degrees" and h.level == 10)
+    for start, expected in ((170.0, 190.0), (0.0, 20.0), (-350.0, -330.0)):
+        sc = apply_edit(s0, h.path, start)
+        k = next(k for k in handles(sc) if k.same(h))
+        st = get_at(sc, h.owner)
+        local = mobius.apply(Rotate(st.axis, expected).matrix(), _zero_dial(st, k.size)[None])[0]
+        p = outward(sc.mokrs, h.level, h.path[4], local)
+        assert get_at(apply_edit(sc, *k.edit_to(sc, p)), h.path) == pytest.approx(expected)
+
+
+def test_a_drag_that_puts_the_viewpoint_on_a_pole_is_refused_and_the_scene_stays(tmp_path):
+    """inversion's outer step maps its centre to infinity: dragging the centre onto the
+    camera is refused with a message naming the viewpoint and the pole, and the document
+    keeps its scene and history; the negative control, a drag beside it, lands."""
+    path = tmp_path / "inversion.toml"
+    shutil.copy(resolve("inversion"), path)
+    doc = Document(path)
+    before = doc.scene
+    h = next(h for h in handles(before) if h.role == "center")
+    eye = np.array(before.camera.position)
+    with pytest.raises(SceneError, match=r"camera\.position.*infinity"):
+        doc.apply(*h.edit_to(before, eye), ("gizmo", 1))
+    assert doc.scene is before and not doc.history.steps
+    beside = eye + np.array([3.0, 0.0, 0.0])
+    doc.apply(*h.edit_to(before, beside), ("gizmo", 2))
+    assert np.allclose(next(k for k in handles(doc.scene) if k.same(h)).position, beside)
+    assert len(doc.history.steps) == 1
+
+
+def test_an_inserted_identity_level_can_be_grabbed_and_a_drag_gives_it_a_translate():
+    """An identity level without a kernel has its origin as a handle (else nothing selects
+    it); dragging it adds a translate step whose handle, on the same path, is where the
+    origin was dragged, so the drag goes on. Negative control: a level with steps has none."""
+    from krsview.scene.model import Empty
+    from krsview.scene.mokrs import MobiusLevel
+
+    palm = load_scene(resolve("palm"))
+    levels = palm.mokrs.levels
+    s = apply_edit(palm, LEVELS, inserted(levels, 31, MobiusLevel(Empty(), [], False)))
+    origin = [h for h in handles(s) if h.role == "origin"]
+    assert [h.level for h in origin] == [31]
+    h = origin[0]
+    assert np.allclose(h.position, outward(s.mokrs, 31, -1, np.zeros(3)))
+    p = h.position + np.array([0.2, -0.1, 0.3])
+    moved_level = apply_edit(s, *h.edit_to(s, p))
+    assert [st.kind for st in moved_level.mokrs.levels[31].transform] == ["translate"]
+    by = next(k for k in handles(moved_level) if k.same(h))
+    assert by.role == "by" and np.allclose(by.position, p, atol=1e-9)
+    assert not [k for k in handles(moved_level) if k.role == "origin"]
+
+
+def test_a_linked_step_drag_bends_the_finer_levels_with_the_same_steps_alike():
+    """palm's leaflets share their steps: turning level 30's dial (linked, the default)
+    turns every finer leaflet level the same and no coarser one, and the dial still lands
+    where it was dragged; unlinked (the negative control) only level 30 turns."""
+    palm = load_scene(resolve("palm"))
+    m = palm.mokrs
+    h = next(h for h in handles(palm) if h.role == "degrees" and h.level == 30)
+    st = get_at(palm, h.owner)
+    local = mobius.apply(Rotate(st.axis, 7.5).matrix(), _zero_dial(st, h.size)[None])[0]
+    p = outward(m, 30, h.path[4], local)
+    leaflets = [i for i, lv in enumerate(m.levels) if lv.transform == m.levels[30].transform]
+    assert len(leaflets) == 30
+    for carry, turned in ((True, [i for i in leaflets if i <= 30]), (False, [30])):
+        s = apply_edit(palm, *h.edit_to(palm, p, carry))
+        now = [i for i, lv in enumerate(s.mokrs.levels) if lv.transform and
+               lv.transform[1].degrees == pytest.approx(7.5)]  # fmt: skip
+        assert now == turned, (carry, now)
+        moved_to = next(k for k in handles(s) if k.same(h)).position
+        assert np.linalg.norm(moved_to - p) < 1e-9 * max(1.0, float(np.linalg.norm(p)))
+
+
+def test_a_refusal_is_shown_under_the_step_or_kernel_it_names():
+    assert refusal_place("mokrs.levels[3].transform[1].factor = 0.0: allowed", 3, 3) == "step 1"
+    assert refusal_place("mokrs.levels[3].kernel.radius = -1.0: allowed", 3, 3) == "kernel"
+    pole = "camera.position = [12.0, 12.0, 12.0]: level 21's transform sends this point"
+    assert refusal_place(pole, 3, 3) == "selection"
+    assert refusal_place("mokrs.levels = <65 levels>: too many", 3, 3) == "selection"
+    # negative controls: another level's step, no error, another part of the scene
+    assert refusal_place("mokrs.levels[4].transform[1].factor = 0.0: x", 3, 3) == "selection"
+    assert refusal_place("", 3, 3) == ""
+    assert refusal_place("render.tracer = 'sphere': this scene is a MöKRS", 3, 3) == ""
+
+
+def test_structural_edits_are_validated_and_one_undo_step_each(tmp_path):
+    path = tmp_path / "shell.toml"
+    shutil.copy(resolve("shell"), path)
+    doc = Document(path)
+    m = doc.scene.mokrs
+    steps = list(m.levels[5].transform)
+    assert moved(steps, 0, 1) == [steps[1], steps[0], steps[2]]
+    assert moved(steps, 2, 1) == steps  # the outermost stays: nothing to swap with
+    doc.apply((*LEVELS, 5, "transform"), moved(steps, 0, 1))
+    doc.apply((*LEVELS, 5, "transform"), removed(steps, 1))
+    doc.apply((*LEVELS, 5, "transform"), [*steps, Translate((0.0, 0.1, 0.0))])
+    assert len(doc.history.steps) == 3
+    assert [s.kind for s in doc.scene.mokrs.levels[5].transform] == [
+        "scale",
+        "rotate",
+        "translate",
+        "translate",
+    ]
+    # shell has 64 levels, the most a MöKRS may have: a duplicate is refused with the limit
+    with pytest.raises(SceneError, match="at most 64"):
+        doc.apply(LEVELS, inserted(m.levels, 6, m.levels[5]))
+    doc.apply(LEVELS, removed(m.levels, 0))
+    assert doc.scene.mokrs.n == 63 and len(doc.history.steps) == 4
+    with pytest.raises(SceneError, match="numerically singular|allowed"):
+        doc.apply((*LEVELS, 5, "transform"), [Scale(1e-6), Scale(1e-6), Scale(1e-6)])
+    assert doc.scene.mokrs.n == 63 and len(doc.history.steps) == 4
+    doc.undo()
+    assert doc.scene.mokrs.n == 64
+
+
+def test_drags_and_step_list_edits_keep_the_shader_variant():
+    """What the renderer compiles (its defines) is the same after a step's drag and after a
+    level is duplicated (uniforms only); a kernel of a new kind is a new variant."""
+    from krsview.compile.geometry import compile_geometry
+    from krsview.gpu.uniforms import variant_defines
+    from krsview.scene.model import Sphere
+
+    palm = load_scene(resolve("palm"))
+
+    def defines(s):
+        return variant_defines(s, compile_geometry(s.geometry(), s.material.albedo))
+
+    base = defines(palm)
+    h = next(h for h in handles(palm) if h.role == "degrees" and h.level == 30)
+    dragged = apply_edit(palm, h.path, 12.0)
+    levels = palm.mokrs.levels
+    longer = apply_edit(palm, LEVELS, inserted(levels, 31, levels[30]))
+    assert defines(dragged) == base and defines(longer) == base
+    sphere = apply_edit(palm, (*LEVELS, 30, "kernel"), Sphere((0.0, 0.0, 0.0), 0.1))
+    assert defines(sphere) != base
+
+
+def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, tmp_path):
+    """palm opens with its levels and handles; clicking a translate step's handle selects it
+    (over the kernel point it shares), a 40 px drag moves it in the screen plane as one undo
+    step without a recompile; a rotation step turns on its ring, monotone and proportional
+    to the pointer each way round; Ctrl+S writes it. A refused value stays beside its step; a
+    level count the MöKRS cannot truncate to draws every level and says why."""
+    from krsview.editor.window import Editor
+    from krsview.scene.model import Empty
+    from krsview.viewer.commands import Edit
+
+    from .test_editor import click, drag, pump, screen_of, settle, xdo
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        settle(e)
+        assert len(e.handles) > 150 and not e.viewer.error
+        compiles = e.viewer.renderer.programs.compiles
+        by = (*LEVELS, 58, "transform", 2, "by")
+        h = next(h for h in e.handles if h.path == by)
+        click(e, screen_of(e, h.position))
+        assert e.selected is not None and e.selected.path == by, e.selected
+        old = np.array(h.position)
+        drag(e, screen_of(e, old), (40, 0))
+        new = next(k for k in e.handles if k.path == by).position
+        v = e.window_view()
+        depth = float((old - v.origin) @ v.forward)
+        expected = 40 * 2 * v.tan_half * depth / v.height * v.right  # the screen-plane move
+        assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected)
+        assert len(e.doc.history.steps) == 1, "the drag was not one undo step"
+        assert e.viewer.renderer.programs.compiles == compiles, "a drag recompiled the shader"
+        turns = turn_the_dial(e, (*LEVELS, 58, "transform", 1, "degrees"))
+        assert len(e.doc.history.steps) == 3, "each way round was not one undo step"
+        assert e.viewer.renderer.programs.compiles == compiles, "a turn recompiled the shader"
+        forth, back = np.diff(turns[0]), np.diff(turns[1])
+        assert (forth > 0).all() and (back < 0).all(), turns  # monotone, each way
+        assert forth.max() < 3 * forth.min() and forth.max() < 10.0, forth  # proportional
+        xdo("key", "ctrl+s")
+        pump(e)
+        saved = load_scene(path)
+        assert get_at(saved, by) == get_at(e.scene, by) != (0.0, 0.34, 0.0)
+        # a refused factor: the scene stays, the message names the step's field
+        factor = (*LEVELS, 58, "transform", 0, "factor")
+        e.execute([Edit(factor, 0.0)])
+        pump(e)
+        assert get_at(e.scene, factor) == 0.93
+        assert refusal_place(e.viewer.error, 58, 3) == "step 0", e.viewer.error
+        # the outermost level without a kernel: one level cannot be drawn, two can
+        e.execute([Edit((*LEVELS, 59, "kernel"), Empty())])
+        e.viewer.set_levels(1)
+        pump(e)
+        assert e.viewer.levels == 0 and "cannot be carried" in e.viewer.error
+        assert refusal_place(e.viewer.error, 59, 0) == "selection"  # shown in the panel
+        e.viewer.set_levels(2)
+        pump(e)
+        assert e.viewer.levels == 2 and e.viewer.krs.n == 2
+    finally:
+        e.close()
+
+
+def turn_the_dial(e, path, steps: int = 6, arc: float = 0.4) -> list[list[float]]:
+    """Select the rotation step's dial, find the ImGuizmo ring about its axis by hovering
+    (points at growing radii around the pivot, in the plane ⊥ axis), then drag along the
+    ring by equal arcs one way and back: the step's angle after each small move."""
+    from .test_editor import click, pump, screen_of, xdo
+
+    h = next(h for h in e.handles if h.path == path)
+    click(e, screen_of(e, h.position))
+    assert e.selected is not None and e.selected.path == path, e.selected
+    y = np.cross(h.axis, [0.0, 1.0, 0.0] if abs(h.axis[1]) < 0.9 else [1.0, 0.0, 0.0])
+    y /= np.linalg.norm(y)
+    z = np.cross(h.axis, y)
+
+    def at(r, t):
+        return screen_of(e, h.pivot + r * (np.cos(t) * y + np.sin(t) * z))
+
+    ring = None
+    for r in np.linspace(0.05, 1.5, 30):
+        for t in np.linspace(0.0, 2.0 * np.pi, 8, endpoint=False):
+            xdo("mousemove", *(round(c) for c in at(r, t)))
+            pump(e, 1)
+            if e.gizmo.claims_mouse():
+                ring = (r, t)
+                break
+        if ring:
+            break
+    assert ring is not None, "no rotate ring around the dial's pivot"
+    r, t0 = ring
+    out = []
+    for way in (1, -1):
+        start = t0 if way == 1 else t0 + arc
+        xdo("mousemove", *(round(c) for c in at(r, start)))
+        pump(e, 2)
+        xdo("mousedown", 1)
+        pump(e, 2)
+        angles = [get_at(e.scene, path)]
+        for k in range(1, steps + 1):
+            xdo("mousemove", *(round(c) for c in at(r, start + way * arc * k / steps)))
+            pump(e, 1)
+            angles.append(get_at(e.scene, path))
+        xdo("mouseup", 1)
+        pump(e, 2)
+        out.append(angles)
+    return out
