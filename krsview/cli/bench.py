@@ -333,7 +333,8 @@ def add_latency(bsub) -> None:
         "latency",
         help="how fast the editor answers a drag, in a real window",
         description="Open PRESET in the editor (a grown tree baked into its route), let the "
-        "view settle, then drag the fork halfway down the route in small steps, one per "
+        "view settle, then drag the fork halfway down the route (in a compound, one of its "
+        "trees) in small steps, one per "
         "turn of the event loop, through the gizmo's own path; each frame is time-stamped "
         "once on screen. Prints the latency from a drag step to the first frame traced "
         "from it and the frame rate while dragging (median and p90), the internal size "
