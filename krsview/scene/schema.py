@@ -7,6 +7,7 @@ panels read the same metadata (the Fragmentarium habit, see DESIGN.md).
 
 from __future__ import annotations
 
+import functools
 import math
 import types
 import typing
@@ -190,11 +191,18 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
     raise TypeError(f"unsupported field type {hint!r} at {path}")  # a programming error
 
 
+@functools.cache
+def type_hints(cls: type) -> dict[str, Any]:
+    """A dataclass's field types, resolved once per class: resolving them is most of the
+    cost of validating a scene, and a drag validates one per step."""
+    return typing.get_type_hints(cls)
+
+
 def from_dict(cls: type, data: Any, path: str = "") -> Any:
     """Build dataclass ``cls`` from TOML data, rejecting unknown keys and bad values."""
     if not isinstance(data, dict):
         raise SceneError(path or "<root>", data, f"expected a table of {cls.__name__} fields")
-    hints = typing.get_type_hints(cls)
+    hints = type_hints(cls)
     known = {f.name for f in fields(cls) if f.init}
     for key in data:
         if key not in known:
