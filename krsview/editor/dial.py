@@ -34,7 +34,7 @@ class Dial:
         self.drags = 0
         self.active = False
         self.hovered = False
-        self._angle = 0.0  # the pointer's angle about the axis at the last frame
+        self._last = 0.0  # the pointer's angle about the axis at the last frame
         self._turned = 0.0  # radians turned since the press
         self._start = np.zeros(3)  # the dial point at the press
 
@@ -44,25 +44,25 @@ class Dial:
         (degrees), it turns by whole multiples of it from the press."""
         io = imgui.get_io()
         x, y = io.mouse_pos.x, io.mouse_pos.y
-        basis = _basis(h.axis)
+        basis = plane_basis(h.axis)
         ring = self._ring(h, v, basis)
-        self.hovered = not io.want_capture_mouse and _near(ring, x, y) <= GRAB_PIXELS
+        self.hovered = not io.want_capture_mouse and distance_to(ring, x, y) <= GRAB_PIXELS
         draw = imgui.get_background_draw_list()
         pts = [imgui.ImVec2(px, py) for px, py in ring]
         draw.add_polyline(pts, HOT if self.hovered or self.active else RED, 3.0, 0)
         if not imgui.is_mouse_down(imgui.MouseButton_.left):
             self.active = False
             return None
-        angle = _angle(h, v, basis, x, y)
+        angle = pointer_angle(h, v, basis, x, y)
         if imgui.is_mouse_clicked(imgui.MouseButton_.left) and self.hovered and angle is not None:
-            self.active, self._angle, self._turned = True, angle, 0.0
+            self.active, self._last, self._turned = True, angle, 0.0
             self._start = np.array(h.position, dtype=np.float64)
             self.drags += 1
             return None
-        if not self.active or angle is None or angle == self._angle:
+        if not self.active or angle is None or angle == self._last:
             return None
-        self._turned += math.remainder(angle - self._angle, 2.0 * math.pi)
-        self._angle = angle
+        self._turned += math.remainder(angle - self._last, 2.0 * math.pi)
+        self._last = angle
         turned = self._turned
         if snap:
             step = math.radians(snap)
@@ -84,14 +84,14 @@ class Dial:
         return out
 
 
-def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def plane_basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors spanning the plane ⊥ ``axis``, right-handed with it."""
     e = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
     e /= np.linalg.norm(e)
     return e, np.cross(axis, e)
 
 
-def _near(ring: list[tuple[float, float]], x: float, y: float) -> float:
+def distance_to(ring: list[tuple[float, float]], x: float, y: float) -> float:
     """The distance in pixels from (x, y) to the ring's polyline (inf without one)."""
     best = math.inf
     for (ax, ay), (bx, by) in zip(ring, ring[1:]):
@@ -102,7 +102,7 @@ def _near(ring: list[tuple[float, float]], x: float, y: float) -> float:
     return best
 
 
-def _angle(h, v: View, basis, x: float, y: float) -> float | None:
+def pointer_angle(h, v: View, basis, x: float, y: float) -> float | None:
     """The angle about ``h.axis`` of where the ray through window point (x, y) crosses the
     ring's plane; None where the plane is seen edge-on or lies behind the eye."""
     d = pixel_ray(v, x, y)
