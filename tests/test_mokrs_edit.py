@@ -319,12 +319,15 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
         pump(e)
         saved = load_scene(path)
         assert get_at(saved, by) == get_at(e.scene, by) != (0.0, 0.34, 0.0)
-        # a refused factor: the scene stays, the message names the step's field
+        # a refused factor: the scene stays; the step's field, drawn in the panel, keeps the
+        # refused value and its message (naming that field), not the panel's error line
         factor = (*LEVELS, 58, "transform", 0, "factor")
         e.execute([Edit(factor, 0.0)])
         pump(e)
         assert get_at(e.scene, factor) == 0.93
-        assert refusal_place(e.viewer.error, 58, 3) == "step 0", e.viewer.error
+        refused = e.viewer.interactions.refused.get(factor)
+        assert refused is not None and refused.value == 0.0 and not e.viewer.error
+        assert refusal_place(refused.message, 58, 3) == "step 0", refused.message
         # the outermost level without a kernel: one level cannot be drawn, two can
         e.execute([Edit((*LEVELS, 59, "kernel"), Empty())])
         e.viewer.set_levels(1)

@@ -2,7 +2,7 @@
 stays precise at any zoom), its axes the world's (never flipped to face the camera, so the Y
 arrow points up and the tripod stays right-handed), snapping to the absolute grid, and values
 free of float32 noise; each press-and-drag is one interaction, so its edits merge into one undo
-step. (A normal is turned by the trackball, trackball.py.)"""
+step. (A normal is turned by the trackball, trackball.py; a MöKRS rotation by its ring, dial.py.)"""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from imgui_bundle import imgui, imguizmo
 
 from ..compile.camera import View
 from ..gpu.overlay import camera_matrices
+from .dial import Dial
 from .handles import Handle
 
 gizmo = imguizmo.im_guizmo
@@ -32,22 +33,28 @@ class Gizmo:
         self.snap = Snap()
         self.drags = 0  # numbers each drag: one undo step each
         self._was_using = False
+        self._over = False  # the pointer is on a part of the gizmo drawn this frame
+        self.dial = Dial()
 
-    @staticmethod
-    def begin_frame() -> None:
+    def begin_frame(self) -> None:
         gizmo.begin_frame()
         gizmo.allow_axis_flip(False)  # flipped, the tree's Y arrow pointed down (issue 28)
+        self._over = False
 
-    @staticmethod
-    def claims_mouse() -> bool:
-        """The pointer is on the gizmo, or drags it: a press there is not the camera's."""
-        return bool(gizmo.is_over() or gizmo.is_using())
+    def claims_mouse(self) -> bool:
+        """The pointer is on the gizmo drawn this frame, or drags it: a press there is not
+        the camera's. (ImGuizmo's own ``is_over`` answers for the frame before, so a pointer
+        just moved onto or off a ring was claimed wrongly for one frame.)"""
+        return self._over or self.dial.active or bool(gizmo.is_using())
 
     def manipulate(self, h: Handle, v: View) -> tuple[np.ndarray, tuple] | None:
         """Draw the gizmo on ``h``; while it is dragged, where ``h`` goes (world) and the
         drag's interaction key."""
-        if h.kind == "dial":  # a MöKRS rotation step: a ring about its axis
-            return self.turn(h, v)
+        if h.kind == "dial":  # a MöKRS rotation step: a ring about its axis (dial.py)
+            snap = self.snap.angle if self.snap.on or imgui.get_io().key_shift else None
+            turned = self.dial.update(h, v, snap)
+            self._over = self.dial.hovered
+            return turned
         io = imgui.get_io()
         gizmo.set_drawlist(imgui.get_background_draw_list())
         gizmo.set_rect(0.0, 0.0, io.display_size.x, io.display_size.y)
@@ -64,10 +71,7 @@ class Gizmo:
             gizmo.MODE.world,
             m,
         )
-        using = gizmo.is_using()
-        if using and not self._was_using:
-            self.drags += 1  # a new drag: a new undo step
-        self._was_using = using
+        using = self._track()
         if not (changed and using):
             return None
         delta = np.array(m.values[12:15], dtype=np.float64) - before
@@ -75,41 +79,15 @@ class Gizmo:
         grid = self.snap.grid if self.snap.on or io.key_shift else None
         return moved(h.position, delta, quantum, grid), ("gizmo", self.drags)
 
-    def turn(self, h, v: View) -> tuple[np.ndarray, tuple] | None:
-        """The ImGuizmo rotate ring about a dial handle's world ``axis`` through its ``pivot``
-        (a MöKRS rotation step); while it is dragged, where the dial point turns to and the
-        drag's interaction key. Shift or snap turns in steps of the snap angle."""
-        io = imgui.get_io()
-        gizmo.set_drawlist(imgui.get_background_draw_list())
-        gizmo.set_rect(0.0, 0.0, io.display_size.x, io.display_size.y)
-        near = 1e-3 * max(float(np.linalg.norm(h.pivot - v.origin)), 1e-12)
-        view, proj = camera_matrices(v, near, 1e6 * near)
-        x = h.axis
-        y = np.cross(x, [1.0, 0.0, 0.0] if abs(x[0]) < 0.9 else [0.0, 1.0, 0.0])
-        y /= np.linalg.norm(y)
-        obj = np.eye(4)
-        obj[:3, 0], obj[:3, 1], obj[:3, 2] = x, y, np.cross(x, y)
-        obj[:3, 3] = h.pivot - v.origin  # camera-relative: float32 stays precise
-        m = gizmo.Matrix16(list(obj.T.flatten()))
-        snap = self.snap.on or bool(io.key_shift)
-        step = gizmo.Matrix3([self.snap.angle] * 3) if snap else None
-        changed = gizmo.manipulate(
-            gizmo.Matrix16(list(view.T.flatten())),
-            gizmo.Matrix16(list(proj.T.flatten())),
-            gizmo.OPERATION.rotate_x,
-            gizmo.MODE.local,
-            m,
-            None,
-            step,
-        )
-        using = gizmo.is_using()
+    def _track(self) -> bool:
+        """Right after ``gizmo.manipulate``: note whether the pointer is on the gizmo now and
+        whether a new drag began (a new undo step); whether it is being dragged."""
+        self._over = gizmo.get_hovered_handle_type() != gizmo.MOVETYPE.mt_none
+        using = bool(gizmo.is_using())
         if using and not self._was_using:
-            self.drags += 1  # a new drag: a new undo step
+            self.drags += 1
         self._was_using = using
-        if not (changed and using):
-            return None
-        turned = np.array(m.values, dtype=np.float64).reshape(4, 4).T[:3, :3] @ obj[:3, :3].T
-        return h.pivot + turned @ (h.position - h.pivot), ("gizmo", self.drags)
+        return using
 
 
 def decimal_step(size: float) -> float:
