@@ -11,6 +11,7 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from .animation import Animation, check_time
 from .compound import Component, Compound, check_compound
 from .edits import apply_edit, parse_path
 from .effects import EffectSettings, check_effects
@@ -62,6 +63,24 @@ class Scene:
         [], help="up to 8 placed KRSs or trees, drawn as one scene (instead of krs) [KRS17 §5.1]"
     )
     bookmarks: list[Bookmark] = param([], help="saved cameras")
+    animation: Animation | None = param(
+        None, help="time: the moment drawn and the playback loop (issue 29); none: time 0"
+    )
+
+    @property
+    def time(self) -> float:
+        """The moment drawn, in seconds (0 without an [animation] table)."""
+        return self.animation.time if self.animation is not None else 0.0
+
+    def at(self, t: float, path: str = "time") -> Scene:
+        """This scene at time ``t`` (seconds): what moves is read from the scene's time.
+
+        >>> from krsview import load
+        >>> load("tree").at(2.5).time
+        2.5
+        """
+        t = check_time(t, path)
+        return replace(self, animation=replace(self.animation or Animation(), time=t))
 
     def validate(self, path: str) -> None:
         given = [k for k in GEOMETRY_KEYS if getattr(self, k)]
