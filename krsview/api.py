@@ -71,11 +71,13 @@ def configure(
     *,
     levels: int | None = None,
     effects: list[str] | None = None,
+    time: float | None = None,
     **knobs: Any,
 ) -> Scene:
     """The scene with render knobs (the ``[render]`` fields: ``tracer``, ``epsilon_scale``,
-    ``max_iterations``, ``precision``, ``prepass``, ``path``, …), an effect set and a level
-    count applied, each checked by the scene schema."""
+    ``max_iterations``, ``precision``, ``prepass``, ``path``, …), an effect set, a level
+    count and the moment drawn (``time``, seconds: :meth:`Scene.at`) applied, each checked by
+    the scene schema."""
     for name, value in knobs.items():
         if name not in RENDER_KNOBS:
             raise SceneError(name, value, "not a render knob; allowed: " + ", ".join(RENDER_KNOBS))
@@ -84,7 +86,7 @@ def configure(
         scene = scene.with_effects(effects)
     if levels is not None:
         scene = scene.with_levels(levels)
-    return scene
+    return scene if time is None else scene.at(time)
 
 
 def fast_settings(scene: Scene) -> Scene:

@@ -31,3 +31,12 @@ def test_a_bad_time_in_a_file_names_the_file_and_field():
     assert "time = -3.0" in text  # the negative control: the edit above took
     with pytest.raises(SceneError, match=r"scene\.toml.*animation\.time"):
         scene_from_toml(text, "scene.toml")
+
+
+def test_the_api_takes_time_as_a_knob():
+    from krsview import api
+
+    assert api.configure(load("tree"), time=2.5).time == 2.5
+    assert api.configure(load("tree")).time == 0.0
+    with pytest.raises(SceneError, match="time = -1"):
+        api.configure(load("tree"), time=-1)

@@ -72,6 +72,9 @@ def test_reference_render_matches_size(tmp_path):
             "not a file and not a preset; presets: bent-tree, forest, grass, grove",
         ),
         (["render", "tree", "--levels", "40"], "this scene has 23 levels"),
+        (["render", "tree", "--time", "-2"], "--time = -2.0: a time in seconds; allowed 0..1e+06"),
+        (["render", "tree", "--time", "nan"], "--time = nan: a time in seconds"),
+        (["render", "tree", "--time", "soon"], "--time: invalid float value: 'soon'"),
         (["check", "missing.toml"], "no such scene file"),
         (["frobnicate"], "invalid choice"),
         # values starting with '-' reach the option's own check (not "expected one argument")

@@ -73,6 +73,19 @@ def test_poses_interpolate_linearly_and_clamp(path_file):
     assert math.isclose(wrap.pose_at(0.5).yaw, math.pi, rel_tol=1e-12)
 
 
+def test_scene_time_advances_with_the_frames_from_the_scenes_own(path_file, tmp_path):
+    path = load_camera_path(path_file)
+    scene = load_scene(resolve("tree"))
+    times = [FrameJob(scene, path, FPS, SIZE, tmp_path).frame_scene(k).time for k in range(5)]
+    assert times == [k / FPS for k in range(5)]
+    later = FrameJob(scene.at(2.0), path, FPS, SIZE, tmp_path)  # krsview render --time 2
+    assert [later.frame_scene(k).time for k in range(3)] == [2.0 + k / FPS for k in range(3)]
+    assert (
+        later.frame_scene(2).camera
+        == FrameJob(scene, path, FPS, SIZE, tmp_path).frame_scene(2).camera
+    ), "the start time moved the camera"
+
+
 def test_each_frame_is_the_headless_render_of_its_camera(path_file, tmp_path):
     r = krsview(
         "render",

@@ -138,8 +138,8 @@ def render_option(sp: argparse.ArgumentParser, name: str) -> None:
 
 
 def scene_options(sp: argparse.ArgumentParser) -> None:
-    """The accuracy options every scene-drawing command takes: ε-scale, iteration cap,
-    level count and effect set."""
+    """The options every scene-drawing command takes: ε-scale, iteration cap, level count,
+    effect set and the moment drawn."""
     render_option(sp, "epsilon_scale")
     render_option(sp, "max_iterations")
     sp.add_argument(
@@ -153,6 +153,13 @@ def scene_options(sp: argparse.ArgumentParser) -> None:
         metavar="LIST",
         help="comma-separated effects replacing the scene's, or 'none'; one of: "
         + ", ".join(EFFECTS),
+    )
+    sp.add_argument(
+        "--time",
+        type=float,
+        metavar="SECONDS",
+        help="the moment drawn, for scenes that move (wind, keyframe tracks, sway; "
+        "default: the scene's [animation] time, else 0)",
     )
 
 
@@ -174,7 +181,10 @@ def scene_of(args: argparse.Namespace, name: str | None = None) -> Scene:
         names = [] if effects.strip() == "none" else [e.strip() for e in effects.split(",")]
         scene = scene.with_effects(names, "--effects")
     levels = getattr(args, "levels", None)
-    return scene if levels is None else scene.with_levels(levels, "--levels")
+    if levels is not None:
+        scene = scene.with_levels(levels, "--levels")
+    t = getattr(args, "time", None)
+    return scene if t is None else scene.at(t, "--time")
 
 
 def check_output_file(path: str, flag: str, suffix: str) -> Path:

@@ -1,7 +1,8 @@
 """Frames of a camera path, and a video of them: what ``krsview render --camera-path`` and
 each worker of ``krsview batch`` do. Frame k is ``frame_00042.png`` in the output folder,
 written atomically, so a folder holds only whole frames; a run skips the frames already
-there, which makes an interrupted run resumable and lets chunks be rendered anywhere."""
+there, which makes an interrupted run resumable and lets chunks be rendered anywhere. The
+scene's time advances with the frames, so a moving scene plays along with the flight."""
 
 from __future__ import annotations
 
@@ -40,7 +41,10 @@ class FrameJob:
         return self.path.frame_count(self.fps)
 
     def frame_scene(self, k: int) -> Scene:
-        return replace(self.scene, camera=self.path.camera(k, self.fps, self.scene.camera))
+        """Frame k: the path's camera k / fps seconds in, and the scene's time as far past
+        its own (``--time``)."""
+        camera = self.path.camera(k, self.fps, self.scene.camera)
+        return replace(self.scene, camera=camera).at(self.scene.time + k / self.fps)
 
     def missing(self, frames: range) -> list[int]:
         """Frames of ``frames`` with no file yet (what a resumed run still renders)."""
