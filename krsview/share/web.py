@@ -26,6 +26,7 @@ from ..compile.geometry import compile_geometry
 from ..gpu.program import ES_HEADER, Source
 from ..gpu.uniforms import block_arrays, variant_defines, view_uniforms
 from ..scene import Scene, SceneError
+from ..scene.animation import Animation
 from ..scene.camera_path import horizontal_axes
 
 # Set per pixel by orbit_camera (web.frag): declared as plain globals.
@@ -39,6 +40,7 @@ CAMERA = (
     "u_eps_per_t",
 )
 PAGE = ("u_orbit", "u_canvas")  # the page's own uniforms (Shadertoy has iMouse instead)
+CLOCK = "u_time"  # the moment drawn: live on the page, Shadertoy's iTime in mainImage
 _UNIFORM = re.compile(r"^\s*uniform\s+(\w+)\s+(\w+)\s*(\[\s*(\w+)\s*\])?\s*;.*$", re.M)
 _BLOCK = re.compile(r"layout\(std140\) uniform KRSBlock \{.*?\};", re.S)
 _REAL = {"real": "float", "vec2r": "vec2", "vec3r": "vec3", "vec4r": "vec4", "mat3r": "mat3"}
@@ -123,8 +125,10 @@ def orbit_uniforms(scene: Scene, origin: np.ndarray) -> dict[str, object]:
 
 def _bake(m: re.Match, values: dict, shadertoy: bool) -> str:
     kind, name, count = _REAL.get(m.group(1), m.group(1)), m.group(2), m.group(4)
-    if name in CAMERA:
+    if name in CAMERA or (name == CLOCK and shadertoy):
         return f"{kind} {name}{m.group(3) or ''};"
+    if name == CLOCK:
+        return m.group(0)
     if name in PAGE and not shadertoy:
         return m.group(0)
     if name not in values:
@@ -169,6 +173,8 @@ def html_page(scene: Scene) -> str:
     return (
         template.replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
         .replace("{{NOTES}}", html.escape(" · ".join(notes)))
+        .replace("{{TIME}}", json.dumps(scene.time))
+        .replace("{{DURATION}}", json.dumps(_duration(scene)))
         .replace("{{VERTEX}}", json.dumps(vertex_shader()))
         .replace("{{FRAGMENT}}", json.dumps(web_shader(scene)))
     )
@@ -184,11 +190,18 @@ def shadertoy_source(scene: Scene) -> str:
     )
     notes = "".join(f"// note: {n}\n" for n in export_notes(scene))
     body = web_shader(scene, shadertoy=True)
-    return head + notes + body + SHADERTOY_MAIN
+    clock = f"mod({_float(scene.time)} + iTime, {_float(_duration(scene))})"
+    return head + notes + body + SHADERTOY_MAIN.replace("CLOCK", clock)
+
+
+def _duration(scene: Scene) -> float:
+    """One loop of the scene's time (the viewer's, the page's and Shadertoy's)."""
+    return scene.animation.duration if scene.animation else Animation.duration
 
 
 SHADERTOY_MAIN = """
 void mainImage(out vec4 fragColor, in vec2 fragCoord) {
+    u_time = CLOCK;  // the scene's moment: its own time, then playing round its loop
     vec3 orbit = vec3(0.05 * iTime, 0.0, 1.0);
     if (iMouse.z > 0.0) orbit.xy += vec2(-6.0, 3.0) * (iMouse.xy / iResolution.xy - 0.5);
     orbit_camera(iResolution.xy, orbit);

@@ -143,3 +143,22 @@ class ReloadScene(Command):
 @dataclass(frozen=True)
 class ReloadShaders(Command):
     """A shader file changed on disk (from the file watcher)."""
+
+
+@dataclass(frozen=True)
+class TogglePlay(Command):
+    """Play or pause the scene's time (Space)."""
+
+
+@dataclass(frozen=True)
+class SetTime(Command):
+    """Show the moment ``time`` (seconds; the HUD's time slider)."""
+
+    time: float
+
+
+@dataclass(frozen=True)
+class SetSpeed(Command):
+    """Play at ``speed`` × real time."""
+
+    speed: float

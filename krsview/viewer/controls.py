@@ -16,6 +16,7 @@ from .commands import (
     Screenshot,
     ToggleHud,
     ToggleOrbit,
+    TogglePlay,
     ToggleRecording,
     Undo,
 )
@@ -39,6 +40,7 @@ VIEWER_KEYS: dict[str, Command] = {
     "N": NextBookmark(),
     "F5": ToggleRecording(),
     "F6": Replay(),
+    "Space": TogglePlay(),
     "ctrl+Z": Undo(),
     "ctrl+shift+Z": Redo(),
     "ctrl+Y": Redo(),

@@ -22,7 +22,9 @@ from . import commands as c
 from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
+from .playback import Playback
 from .recording import Recorder
+from .timeline import draw_time
 from .widgets import Interactions, field_widget
 
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
@@ -60,6 +62,7 @@ class Viewed(Protocol):
     levels: int
     nav: Navigation
     moving_effects: bool
+    playback: Playback
     measured: list[dict] | None
     message: str
     error: str
@@ -83,6 +86,8 @@ def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
     imgui.set_next_window_bg_alpha(0.75)
     imgui.begin("krsview (F1 hides)", None, imgui.WindowFlags_.always_auto_resize)
     _performance(v, out)
+    if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
+        draw_time(v.playback, out)
     if imgui.collapsing_header("accuracy and view"):
         _accuracy(v, out, interactions)
     if imgui.collapsing_header("measured accuracy"):

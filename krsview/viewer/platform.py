@@ -16,7 +16,7 @@ from .fonts import load_font
 GLFW_KEYS = (
     {getattr(glfw, f"KEY_{c}"): c for c in string.ascii_uppercase}
     | {getattr(glfw, f"KEY_F{i}"): f"F{i}" for i in range(1, 13)}
-    | {glfw.KEY_INSERT: "Insert", glfw.KEY_DELETE: "Delete"}
+    | {glfw.KEY_INSERT: "Insert", glfw.KEY_DELETE: "Delete", glfw.KEY_SPACE: "Space"}
 )
 GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
 

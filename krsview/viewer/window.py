@@ -34,6 +34,7 @@ from .measured import load_measured
 from .navigation import Navigation
 from .picking import pick_center
 from .platform import Platform
+from .playback import Playback
 from .recording import Recorder, path_file
 from .screenshots import save_screenshot
 from .watch import FileWatcher
@@ -71,6 +72,7 @@ class Viewer:
         self.message, self.error = "", ""
         self.clock = 0.0
         self.status = ("", 0.0)  # text, and the clock it goes at
+        self.playback = Playback()
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
@@ -105,6 +107,8 @@ class Viewer:
         self._view_prepass = (
             p if p is not None else (None if self.scene.render.prepass else VIEW_PREPASS)
         )
+        a = self.scene.animation
+        self.playback = Playback(self.scene.time, a.duration if a else Playback.duration)
         self._set_scene(self.scene, reset_camera=True)
         self.watcher = FileWatcher(self.path, self.shader_dir)
         self.recorder = Recorder(self.path)
@@ -116,11 +120,36 @@ class Viewer:
         self._seen_version = self.doc.version
         if self._measured_for != self.path.stem:  # per preset, not per edit
             self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
-        self.geometry = scene.geometry()
+        self.geometry = self.posed(scene).geometry()
         self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()
         if reset_camera:
             self.nav.reset(scene.camera)
+
+    def posed(self, scene: Scene) -> Scene:
+        """``scene`` as drawn at the moment shown: its tracks and sway applied there."""
+        return scene.at(self.playback.time).posed()
+
+    def _time_moved(self) -> None:
+        """The moment shown changed: a new image (a moving one while playing, so the
+        adaptive resolution counts time as motion), and new geometry if tracks or sway
+        move it."""
+        geometry = self.posed(self.scene).geometry()
+        if geometry != self.geometry:
+            self.geometry = geometry
+            self.levels = min(self.levels, geometry.depth)
+            self._apply_levels()
+        self.frames.dirty = True
+
+    def toggle_play(self) -> None:
+        if not self.scene.animated:
+            self.message = "nothing in this scene moves (no wind, keyframe tracks or sway)"
+            return
+        self.playback.playing = not self.playback.playing
+
+    def set_time(self, t: float) -> None:
+        self.playback.seek(t)
+        self._time_moved()
 
     def sync(self) -> None:
         """Redraw when the document changed (an edit, undo, redo, reload)."""
@@ -143,13 +172,14 @@ class Viewer:
             self.error, part.error = part.error, ""
 
     def view_scene(self) -> Scene:
-        """The scene as drawn now: the viewer's camera and pre-pass. Moving frames have every
-        effect too; unless ``moving_effects``, their shadow rays are shared by 2 × 2 pixels at least
-        (frames.py)."""
+        """The scene as drawn now: at the moment shown, with the viewer's camera and pre-pass.
+        Moving frames have every effect too; unless ``moving_effects``, their shadow rays are
+        shared by 2 × 2 pixels at least (frames.py)."""
+        scene = self.posed(self.scene)
         return replace(
-            self.scene,
+            scene,
             camera=self.camera.to_camera(),
-            render=replace(self.scene.render, prepass=self.prepass),
+            render=replace(scene.render, prepass=self.prepass),
         )
 
     def nearest_distance(self) -> float:
@@ -322,6 +352,7 @@ class Viewer:
             and not self.input.held
             and not self.input.buttons
             and self.recorder.replay_start is None
+            and not (self.playback.playing and self.scene.animated)
         )
 
     def step(self, dt: float) -> None:
@@ -351,7 +382,10 @@ class Viewer:
             self.window = None
 
     def move(self, dt: float) -> None:
-        """Move the camera by the input; a recording takes the pose, a replay sets it."""
+        """Move the camera by the input (a recording takes the pose, a replay sets it) and
+        the clock while playing."""
+        if self.scene.animated and self.playback.advance(dt):
+            self._time_moved()
         if self.nav.move(dt, self.nearest_distance):
             self.frames.dirty = True
         if self.recorder.tick(self.clock, self.camera):
@@ -427,4 +461,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.Replay: lambda v, e: v.recorder.replay(v.clock),
     c.ReloadScene: lambda v, e: v.reload_scene(),
     c.ReloadShaders: lambda v, e: v.reload_shaders(),
+    c.TogglePlay: lambda v, e: v.toggle_play(),
+    c.SetTime: lambda v, e: v.set_time(e.time),
+    c.SetSpeed: lambda v, e: v.playback.set_speed(e.speed),
 }
