@@ -92,7 +92,7 @@ def _refuse(path: str, sway: Sway, i: int, k: int, t: float, depth: float, limit
     return SceneError(
         f"{path}.amplitude",
         sway.amplitude,
-        f"at t = {t:.4g} s the mirror of route.levels[{i}] (sway level {k}, from the trunk) "
+        f"at t = {t:.6g} s the mirror of route.levels[{i}] (sway level {k}, from the trunk) "
         f"turns across the branch of route.levels[{i - 1}] by {depth:.3g} "
         f"(allowed {limit:.3g}, {CLIP_TOLERANCE:g} × its radius): Alg. 1 would clip it; "
         "allowed: a smaller amplitude",
