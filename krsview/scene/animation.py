@@ -32,6 +32,11 @@ INTERPOLATIONS = ("linear", "smooth")
 TIME_EFFECTS: frozenset[str] = frozenset()
 
 
+def reads_time(effects: list[str]) -> bool:
+    """Whether one of ``effects`` reads the scene's time (it moves though nothing is keyed)."""
+    return not TIME_EFFECTS.isdisjoint(effects)
+
+
 def check_time(t: object, path: str = "time") -> float:
     """``t`` as a time in seconds, or a one-line error saying what is allowed."""
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not 0.0 <= t <= MAX_TIME:

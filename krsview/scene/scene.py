@@ -11,7 +11,7 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .animation import TIME_EFFECTS, Animation, check_animation, check_time, pose
+from .animation import Animation, check_animation, check_time, pose, reads_time
 from .compound import Component, Compound, check_compound
 from .edits import apply_edit, parse_path
 from .effects import EffectSettings, check_effects
@@ -87,7 +87,7 @@ class Scene:
         """Whether anything drawn changes with time: keyframe tracks, sway, or an effect that
         reads the time (``animation.TIME_EFFECTS``)."""
         a = self.animation
-        return (a is not None and a.moves) or not TIME_EFFECTS.isdisjoint(self.effects)
+        return (a is not None and a.moves) or reads_time(self.effects)
 
     def posed(self) -> Scene:
         """The static scene drawn at this scene's time: its tracks' values there and its sway
@@ -187,8 +187,9 @@ class Scene:
         return apply_edit(self, parse_path(path), value)
 
     def with_levels(self, levels: int, path: str = "levels") -> Scene:
-        """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation)."""
-        g = self.geometry()
+        """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation), as
+        posed at its time (see :meth:`with_geometry`)."""
+        g = self.posed().geometry()
         if not (isinstance(levels, int) and 1 <= levels <= g.depth):
             raise SceneError(path, levels, f"this scene has {g.depth} levels; allowed 1..{g.depth}")
         return self.with_geometry(g.truncated(levels))
@@ -199,12 +200,15 @@ class Scene:
         return replace(self, effects=list(effects))
 
     def with_geometry(self, geometry: Geometry) -> Scene:
+        """This scene drawing ``geometry`` instead; a scene that moves is posed at its time
+        first, since its tracks and sway address the geometry that is replaced."""
+        base = self.posed()
         none = dict(krs=None, tree=None, route=None, mokrs=None, compound=[])
         if isinstance(geometry, MoKRS):
-            return replace(self, **{**none, "mokrs": geometry})
+            return replace(base, **{**none, "mokrs": geometry})
         if isinstance(geometry, Compound):
-            return replace(self, **{**none, "compound": [Component(krs=p) for p in geometry.parts]})
-        return replace(self, **{**none, "krs": geometry})
+            return replace(base, **{**none, "compound": [Component(krs=p) for p in geometry.parts]})
+        return replace(base, **{**none, "krs": geometry})
 
 
 MAX_FILE_BYTES = 4 * 1024 * 1024
