@@ -240,7 +240,10 @@ def check_animation(scene: Any) -> None:
     rest = replace(scene, animation=None)
     for k, tr in enumerate(a.tracks):
         where = f"animation.tracks[{k}]"
-        path = parse_path(tr.path)
+        try:
+            path = parse_path(tr.path)
+        except SceneError as e:
+            raise SceneError(f"{where}.path", tr.path, e.allowed) from None
         if path[:1] == ("animation",):
             raise SceneError(
                 f"{where}.path",
@@ -275,7 +278,7 @@ def pose(scene: Any) -> Any:
     between keys that breaks its field's rule is a one-line error naming the track and time."""
     a = scene.animation
     t = a.time
-    rest = replace(scene, animation=replace(a, tracks=[], sway=None, duration=a.duration))
+    rest = replace(scene, animation=replace(a, tracks=[], sway=None))
     values = []
     for tr in a.tracks:
         path = parse_path(tr.path)
