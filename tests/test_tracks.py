@@ -260,17 +260,20 @@ def test_revalidating_what_changed_is_the_whole_validation(path, value):
     assert scene_to_toml(got) == scene_to_toml(want) and got == want
 
 
-def test_gpu_draws_what_the_reference_draws_at_three_times(renderer):
-    """Both renderers pose the scene at its time. Negative control: the GPU's image at one
-    time against the reference's at another fails the comparison (the tracks show)."""
-    s = load(PRESETS / "tree-growing.toml")
+@pytest.mark.parametrize(
+    "name, times", [("tree-growing", (0.5, 3.0, 6.0)), ("tree-sway", (0.3, 0.9, 1.7))]
+)
+def test_gpu_draws_what_the_reference_draws_at_three_times(renderer, name, times):
+    """Both renderers pose the scene at its time (tracks; sway). Negative control: the GPU's
+    image at one time against the reference's at another fails the comparison (it moves)."""
+    s = load(PRESETS / f"{name}.toml")
     s = per_pixel(replace(s, render=replace(s.render, lod=0.0)))
     w, h = 64, 48
     refs = {}
-    for t in (0.5, 3.0, 6.0):
+    for t in times:
         scene = s.at(t)
         refs[t] = render_reference(scene, w, h)
         assert refs[t].hit.mean() > 0.01
-        check_against_reference(f"tree-growing-t{t:g}", renderer.render(scene, w, h), refs[t])
-    wrong = gpu_reference_agreement(renderer.render(s.at(0.5), w, h), refs[6.0])
+        check_against_reference(f"{name}-t{t:g}", renderer.render(scene, w, h), refs[t])
+    wrong = gpu_reference_agreement(renderer.render(s.at(times[0]), w, h), refs[times[-1]])
     assert tolerance_failures(wrong)
