@@ -40,3 +40,46 @@ def test_the_api_takes_time_as_a_knob():
     assert api.configure(load("tree")).time == 0.0
     with pytest.raises(SceneError, match="time = -1"):
         api.configure(load("tree"), time=-1)
+
+
+def test_animated_is_tracks_sway_or_an_effect_that_reads_time(monkeypatch):
+    from krsview.scene import animation
+
+    s = load("tree")
+    assert not s.animated and not s.at(3.0).animated  # time alone moves nothing
+    assert s.edit("animation", {"sway": {}}).animated
+    assert s.edit("animation", {"tracks": [{"path": "tree.bend", "keys": [[0, 0.1]]}]}).animated
+    monkeypatch.setattr(animation, "TIME_EFFECTS", frozenset({"sky"}))  # the effects' hook
+    assert load("tree").animated and not load("rock").with_effects([]).animated
+
+
+def test_truncating_a_moving_scene_truncates_it_as_posed():
+    """The levels slider and --levels on a tree whose tracks address [tree]: the truncated
+    scene is the pose's (the tracks cannot address the [krs] that replaces the tree)."""
+    s = load("tree").edit(
+        "animation", {"time": 2.0, "tracks": [{"path": "tree.trunk_length", "keys": [[2.0, 0.7]]}]}
+    )
+    cut = s.with_levels(4)
+    assert cut.krs.levels[-1].kernel.end[1] == pytest.approx(0.7) and not cut.animated
+    assert load("tree").with_levels(4).krs.levels[-1].kernel.end[1] == pytest.approx(1.6)
+
+
+def test_equal_geometry_compiles_once_and_a_change_compiles_anew():
+    """Posed frames whose tracks move only the camera give new but equal geometry: the
+    compile cache answers by value with what compiling it gives."""
+    import numpy as np
+
+    from krsview.compile.geometry import compile_geometry
+    from krsview.compile.krs import compile_krs
+
+    s = load("tree").edit(
+        "animation", {"tracks": [{"path": "camera.fov_y", "keys": [[0, 40.0], [1, 50.0]]}]}
+    )
+    a, b = (s.at(t).posed() for t in (0.2, 0.7))
+    assert a.geometry() is not b.geometry() and a.camera != b.camera
+    ca = compile_geometry(a.geometry(), a.material.albedo)
+    assert compile_geometry(b.geometry(), b.material.albedo) is ca
+    fresh = compile_krs(a.geometry(), a.material.albedo)
+    assert all(np.array_equal(getattr(ca, f), getattr(fresh, f)) for f in ("mirrors", "records"))
+    moved = a.edit("tree.bend", 0.1)  # negative control: another geometry, another compile
+    assert compile_geometry(moved.geometry(), moved.material.albedo) is not ca

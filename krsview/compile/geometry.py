@@ -15,31 +15,40 @@ Compiled = CompiledKRS | CompiledCompound | CompiledMoKRS
 
 
 KEPT_PARTS = 64  # compiled compound components kept, by value
+KEPT_WHOLE = 8  # compiled single KRSs and MöKRSs kept, by value
 
 
 def compile_geometry(g: Geometry, albedo: tuple[float, float, float]) -> Compiled:
-    if isinstance(g, MoKRS):
-        return compile_mokrs(g, albedo)
+    """``g`` compiled, or the same value compiled before: a scene posed at a new time whose
+    tracks move only the camera or an effect compiles nothing (its geometry is new but
+    equal), and playing back and forth over the same moments compiles each once."""
     if isinstance(g, Compound):
         return CompiledCompound(tuple(_compiled_part(p, albedo) for p in g.parts))
-    return compile_krs(g, albedo)
+    make = compile_mokrs if isinstance(g, MoKRS) else compile_krs
+    return _kept(_whole, KEPT_WHOLE, (repr(g), tuple(albedo)), lambda: make(g, albedo))
 
 
 _parts: OrderedDict[tuple[str, tuple], CompiledKRS] = OrderedDict()
+_whole: OrderedDict[tuple[str, tuple], CompiledKRS | CompiledMoKRS] = OrderedDict()
 
 
 def _compiled_part(krs: KRS, albedo: tuple) -> CompiledKRS:
     """A compound's component compiled, or the same value compiled before: an edit of one
     tree of a grove compiles that tree alone (the text of a KRS costs a fraction of a
     millisecond; compiling it, about 9 ms). Compiled arrays are never written in place."""
-    key = (repr(krs), tuple(albedo))
-    if key in _parts:
-        _parts.move_to_end(key)
-        return _parts[key]
-    _parts[key] = compiled = compile_krs(krs, albedo)
-    while len(_parts) > KEPT_PARTS:
-        _parts.popitem(last=False)
-    return compiled
+    return _kept(_parts, KEPT_PARTS, (repr(krs), tuple(albedo)), lambda: compile_krs(krs, albedo))
+
+
+def _kept(cache: OrderedDict, size: int, key: tuple, make):
+    """``cache[key]``, made by ``make()`` the first time; at most ``size`` kept, the least
+    recently used dropped first."""
+    if key in cache:
+        cache.move_to_end(key)
+        return cache[key]
+    cache[key] = made = make()
+    while len(cache) > size:
+        cache.popitem(last=False)
+    return made
 
 
 def components(c: CompiledKRS | CompiledCompound) -> tuple[CompiledKRS, ...]:

@@ -103,6 +103,7 @@ class Renderer:
         all_effects: bool,
         probes: tuple[str, ...] = (),
     ) -> moderngl.Program:
+        scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
         view = view_of(scene.camera, width, height)
         c = self.world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
         block = krs_block(c, scene.render.precision)
@@ -294,6 +295,7 @@ class Renderer:
     ) -> PassImage:
         if self._pass_targets is None:
             self._pass_targets = Targets(self.ctx)
+        scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
         return PassImage(self, self._pass_targets, scene, size, geometry or scene.geometry(), ratio)
 
     def levels(

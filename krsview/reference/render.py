@@ -28,6 +28,7 @@ def render_reference(
 ) -> Frame:
     """The image in float64. With ``progress``, rays go in chunks and progress(done, total)
     is called after each (every ray is independent: the image is the same)."""
+    scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
     view = view_of(scene.camera, width, height)
     c = compile_geometry(geometry or scene.geometry(), scene.material.albedo)
     dist = Distortion.of(scene)

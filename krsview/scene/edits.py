@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
-from .schema import SceneError, from_dict, to_dict
+from .schema import SceneError, Tagged, from_dict, to_dict
 
 Path = tuple[str | int, ...]
 
@@ -62,10 +62,44 @@ def parse_path(text: str | Path) -> Path:
     return tuple(out)
 
 
+def revalidated(scene: Any, paths: list[Path]) -> Any:
+    """``scene`` (valid before the values at ``paths`` were replaced) as a file holding it
+    would load: each table holding a replaced value is rebuilt from its data (checked and
+    normalised as a file's), and the tables around it run their own rules (``validate``),
+    innermost first, up to the scene's. The rest was valid and is shared, not rebuilt: a
+    palm's edit validates in a fraction of the time the whole scene takes."""
+    owners = {_owner(scene, p) for p in paths}
+    around = {q[:n] for q in owners for n in range(len(q))} - owners
+    for prefix in sorted(owners | around, key=len, reverse=True):
+        obj, text = get_at(scene, prefix), path_text(prefix) if prefix else ""
+        if prefix in owners:
+            data = to_dict(obj)
+            fresh = (
+                type(obj).from_toml(data, text)
+                if isinstance(obj, Tagged)
+                else from_dict(type(obj), data, text)
+            )
+            scene = replace_at(scene, prefix, fresh)
+        elif is_dataclass(obj) and hasattr(obj, "validate"):
+            obj.validate(text)
+    return scene
+
+
+def _owner(scene: Any, path: Path) -> Path:
+    """The longest proper prefix of ``path`` that names a table (a dataclass): the table
+    whose field the path changes."""
+    obj, owner = scene, ()
+    for n, key in enumerate(path[:-1], 1):
+        obj = obj[key] if isinstance(key, int) else getattr(obj, key)
+        if is_dataclass(obj):
+            owner = path[:n]
+    return owner
+
+
 def apply_edit(scene: Any, path: Path, value: Any) -> Any:
     """Replace the value at ``path`` and validate the result; a SceneError leaves nothing
     changed (the caller keeps its last valid scene)."""
     try:
-        return validated(replace_at(scene, path, value))
-    except (KeyError, IndexError, TypeError) as e:
+        return revalidated(replace_at(scene, path, value), [path])
+    except (KeyError, IndexError, TypeError, AttributeError) as e:
         raise SceneError(path_text(path), value, f"not a field of this scene ({e})") from None

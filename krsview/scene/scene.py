@@ -11,7 +11,7 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .animation import Animation, check_time
+from .animation import Animation, check_animation, check_time, pose, reads_time
 from .compound import Component, Compound, check_compound
 from .edits import apply_edit, parse_path
 from .effects import EffectSettings, check_effects
@@ -82,6 +82,31 @@ class Scene:
         t = check_time(t, path)
         return replace(self, animation=replace(self.animation or Animation(), time=t))
 
+    @property
+    def animated(self) -> bool:
+        """Whether anything drawn changes with time: keyframe tracks, sway, or an effect that
+        reads the time (``animation.TIME_EFFECTS``)."""
+        a = self.animation
+        return (a is not None and a.moves) or reads_time(self.effects)
+
+    def posed(self) -> Scene:
+        """The static scene drawn at this scene's time: its tracks' values there and its sway
+        applied, without tracks or sway (posing twice is posing once), time kept. Made once
+        per scene (scenes are frozen); a scene that does not move is its own pose.
+
+        >>> from krsview import load
+        >>> swaying = load("tree").edit("animation", {"time": 1.0, "sway": {"amplitude": 2.0}})
+        >>> s = swaying.posed()
+        >>> s.time, s.animation.sway, s.posed() is s, s.route.levels[-1].normal != (
+        ...     swaying.tree.route().levels[-1].normal)
+        (1.0, None, True, True)
+        """
+        if self.animation is None or not self.animation.moves:
+            return self
+        if "_posed" not in self.__dict__:
+            object.__setattr__(self, "_posed", pose(self))
+        return self.__dict__["_posed"]
+
     def validate(self, path: str) -> None:
         given = [k for k in GEOMETRY_KEYS if getattr(self, k)]
         if len(given) != 1:
@@ -102,6 +127,8 @@ class Scene:
             check_view(self.mokrs, self.camera.position, "camera.position")
             for i, b in enumerate(self.bookmarks):
                 check_view(self.mokrs, b.camera.position, f"bookmarks[{i}].camera.position")
+        if self.animation is not None and self.animation.moves:
+            check_animation(self)  # last: the keys are edits of the scene checked above
 
     def check_tracer(self, tracer: str, path: str = "render.tracer") -> None:
         """The one rule for a tracer choice, from a file, the CLI or the HUD: a MöKRS needs
@@ -160,8 +187,9 @@ class Scene:
         return apply_edit(self, parse_path(path), value)
 
     def with_levels(self, levels: int, path: str = "levels") -> Scene:
-        """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation)."""
-        g = self.geometry()
+        """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation), as
+        posed at its time (see :meth:`with_geometry`)."""
+        g = self.posed().geometry()
         if not (isinstance(levels, int) and 1 <= levels <= g.depth):
             raise SceneError(path, levels, f"this scene has {g.depth} levels; allowed 1..{g.depth}")
         return self.with_geometry(g.truncated(levels))
@@ -172,12 +200,15 @@ class Scene:
         return replace(self, effects=list(effects))
 
     def with_geometry(self, geometry: Geometry) -> Scene:
+        """This scene drawing ``geometry`` instead; a scene that moves is posed at its time
+        first, since its tracks and sway address the geometry that is replaced."""
+        base = self.posed()
         none = dict(krs=None, tree=None, route=None, mokrs=None, compound=[])
         if isinstance(geometry, MoKRS):
-            return replace(self, **{**none, "mokrs": geometry})
+            return replace(base, **{**none, "mokrs": geometry})
         if isinstance(geometry, Compound):
-            return replace(self, **{**none, "compound": [Component(krs=p) for p in geometry.parts]})
-        return replace(self, **{**none, "krs": geometry})
+            return replace(base, **{**none, "compound": [Component(krs=p) for p in geometry.parts]})
+        return replace(base, **{**none, "krs": geometry})
 
 
 MAX_FILE_BYTES = 4 * 1024 * 1024
