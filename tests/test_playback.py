@@ -29,3 +29,81 @@ def test_speed_stays_in_the_sliders_range():
     assert p.speed == SPEED_RANGE[0]
     p.set_speed(1.5)
     assert p.speed == 1.5
+
+
+def press(v, key: str) -> None:
+    v.input.key(key, True)
+    v.step(0.0)
+    v.input.key(key, False)
+
+
+def test_space_plays_the_sway_in_a_window_and_the_paused_frame_is_render_at_that_time(
+    display, tmp_path
+):
+    """A real window (Xvfb): Space plays, time advances by wall time and each turn draws the
+    tree anew (time counts as motion); paused, the image refines to what
+    `krsview render --time T` draws (another process, no window)."""
+    import shutil
+    from dataclasses import replace
+
+    import numpy as np
+
+    from krsview.scene import load_scene
+    from krsview.scene.presets import resolve
+    from krsview.viewer.window import Viewer
+
+    from .conftest import headless_render
+
+    path = tmp_path / "tree-sway.toml"
+    shutil.copy(resolve("tree-sway"), path)
+    v = Viewer(path, size=(160, 120), hud=False)
+    try:
+        for _ in range(400):
+            v.step(0.02)
+            if v.frames.refined:
+                break
+        assert v.is_idle() and v.playback.time == 0.0
+        rest = v.read_window()
+        press(v, "Space")
+        assert v.playback.playing
+        changed, last = 0, rest
+        for _ in range(6):
+            v.step(0.25)
+            now = v.read_window()
+            changed += int(np.abs(now.astype(int) - last).max() > 40)
+            last = now
+            assert not v.is_idle(), "a playing scene let the loop wait for events"
+        assert v.playback.time == pytest.approx(1.5)
+        assert changed >= 5, f"the tree moved in {changed} of 6 turns"
+        press(v, "Space")
+        assert not v.playback.playing
+        for _ in range(400):
+            v.step(0.02)
+            if v.frames.refined:
+                break
+        t = v.playback.time
+        shot = v.read_window().astype(int)
+        scene = replace(load_scene(path), camera=v.camera.to_camera())
+        ref = headless_render(scene, tmp_path / "at", (160, 120), "--time", str(t)).astype(int)
+        close = np.abs(shot - ref).max(-1) <= 2
+        assert close.mean() >= 0.99, f"window and render --time agree on {close.mean():.2%}"
+        # negative control: the rest pose is another picture
+        assert (np.abs(rest - ref).max(-1) <= 2).mean() < close.mean() - 0.005
+    finally:
+        v.close()
+
+
+def test_space_on_a_scene_that_does_not_move_says_so(display, tmp_path):
+    import shutil
+
+    from krsview.scene.presets import resolve
+    from krsview.viewer.window import Viewer
+
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=(64, 48), hud=False)
+    try:
+        press(v, "Space")
+        assert not v.playback.playing and "nothing in this scene moves" in v.message
+    finally:
+        v.close()

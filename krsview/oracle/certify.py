@@ -178,6 +178,7 @@ def count_errors(
     KRS, compound or MöKRS (the twist and empty zones are not in the oracle)."""
     if {"twist", "empty_zones"} & set(scene.effects):
         raise ValueError(f"{scene.name}: the oracle covers scenes without twist or empty zones")
+    scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
     h, w = image.hit.shape
     view = view_of(scene.camera, w, h)
     c = compile_geometry(scene.geometry(), scene.material.albedo)

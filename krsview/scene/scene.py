@@ -165,8 +165,11 @@ class Scene:
         return g
 
     def geometry(self) -> Geometry:
-        """What is drawn: the explicit KRS or MöKRS, the tree expanded [KRS17 §9.2], or the
-        compound's components placed in the world [KRS17 §5.1]."""
+        """What is drawn at the scene's time: the explicit KRS or MöKRS, the tree expanded
+        [KRS17 §9.2], or the compound's components placed in the world [KRS17 §5.1]; where
+        tracks or sway move it, its pose's (:meth:`posed`)."""
+        if self.animation is not None and self.animation.moves:
+            return self.posed().geometry()
         if self.tree is not None:
             return self.tree.krs()
         if self.route is not None:

@@ -74,6 +74,7 @@ def build_mesh(
     from skimage.measure import marching_cubes
 
     t0 = time.perf_counter()
+    scene = scene.posed()  # the surface at the scene's time (tracks, sway)
     geometry = scene.geometry()
     c = compile_geometry(geometry, scene.material.albedo)
     dist = Distortion.of(scene) if scene.mokrs is None else None

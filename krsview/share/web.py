@@ -26,7 +26,7 @@ from ..compile.geometry import compile_geometry
 from ..gpu.program import ES_HEADER, Source
 from ..gpu.uniforms import block_arrays, variant_defines, view_uniforms
 from ..scene import Scene, SceneError
-from ..scene.animation import Animation
+from ..scene.animation import DEFAULT_DURATION
 from ..scene.camera_path import horizontal_axes
 
 # Set per pixel by orbit_camera (web.frag): declared as plain globals.
@@ -74,6 +74,12 @@ def export_notes(scene: Scene) -> list[str]:
             f"render.lod = {r.lod:g}: the page draws every level (its orbiting eye moves "
             "away from the origin the level of detail is measured from)"
         )
+    a = scene.animation
+    if a is not None and a.moves:
+        notes.append(
+            f"keyframe tracks and sway are drawn as at t = {scene.time:g} s (the page bakes "
+            "the geometry; only effects that read time play)"
+        )
     return notes
 
 
@@ -81,6 +87,7 @@ def web_shader(scene: Scene, shadertoy: bool = False) -> str:
     """The fragment stage of the page (``#version 300 es``), or Shadertoy's body (Shadertoy
     adds the version, precision and its uniforms)."""
     export_notes(scene)
+    scene = scene.posed()  # tracks and sway baked at the scene's time (export_notes)
     scene = replace(scene, render=replace(scene.render, prepass=0, path="fragment", lod=0.0))
     view = view_of(scene.camera, 640, 360)  # only its eye O matters: the rest is live
     c = compile_geometry(scene.geometry(), scene.material.albedo).relative_to(view.origin)
@@ -191,17 +198,19 @@ def shadertoy_source(scene: Scene) -> str:
     notes = "".join(f"// note: {n}\n" for n in export_notes(scene))
     body = web_shader(scene, shadertoy=True)
     clock = f"mod({_float(scene.time)} + iTime, {_float(_duration(scene))})"
-    return head + notes + body + SHADERTOY_MAIN.replace("CLOCK", clock)
+    plays = f"    {CLOCK} = {clock};  // the scene's time, round its loop\n"
+    main = SHADERTOY_MAIN.replace("    PLAYS\n", plays if CLOCK in body else "")
+    return head + notes + body + main
 
 
 def _duration(scene: Scene) -> float:
     """One loop of the scene's time (the viewer's, the page's and Shadertoy's)."""
-    return scene.animation.duration if scene.animation else Animation.duration
+    return scene.animation.duration if scene.animation else DEFAULT_DURATION
 
 
 SHADERTOY_MAIN = """
 void mainImage(out vec4 fragColor, in vec2 fragCoord) {
-    u_time = CLOCK;  // the scene's moment: its own time, then playing round its loop
+    PLAYS
     vec3 orbit = vec3(0.05 * iTime, 0.0, 1.0);
     if (iMouse.z > 0.0) orbit.xy += vec2(-6.0, 3.0) * (iMouse.xy / iResolution.xy - 0.5);
     orbit_camera(iResolution.xy, orbit);

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..scene.animation import DEFAULT_DURATION
+
 SPEED_RANGE = (0.05, 8.0)  # × real time, the HUD's slider
 
 
 @dataclass
 class Playback:
     time: float = 0.0  # seconds, within [0, duration]
-    duration: float = 10.0  # one loop, the scene's [animation] duration
+    duration: float = DEFAULT_DURATION  # one loop, the scene's [animation] duration
     playing: bool = False
     speed: float = 1.0
 
