@@ -181,3 +181,8 @@ class SaveCopy(Command):
 @dataclass(frozen=True)
 class CancelCopy(Command):
     """Close the copy dialog without saving."""
+
+
+@dataclass(frozen=True)
+class SetKey(Command):
+    """K: a key for the selected value at the moment shown (an edit of the tracks)."""

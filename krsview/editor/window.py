@@ -40,6 +40,7 @@ from . import commands as ec
 from .clipped import clipped_parts
 from .gizmo import Gizmo
 from .handles import Handle, handles
+from .keys import Timeline, key_now, keyed_edit, track_index
 from .layout import Layout, frame
 from .panels import edit_panel
 from .picking import pick, under, visible
@@ -49,7 +50,13 @@ from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools
 from .trackball import Trackball
 
 LABEL = 0xFFFFFFFF  # hover labels: white (ImGui's packed ABGR)
-EDITOR_KEYS = {**VIEWER_KEYS, "ctrl+S": ec.Save(), "ctrl+shift+S": ec.SaveAs(), **STRUCTURE_KEYS}
+EDITOR_KEYS = {
+    **VIEWER_KEYS,
+    "ctrl+S": ec.Save(),
+    "ctrl+shift+S": ec.SaveAs(),
+    "K": ec.SetKey(),
+    **STRUCTURE_KEYS,
+}
 
 
 class Editor:
@@ -66,9 +73,10 @@ class Editor:
         self.layout = Layout()
         self.carry = True  # a fork drag takes its subtree along
         self.structure = StructureTools()
+        self.timeline = Timeline()
         self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
-        self._handles_of: Scene | None = None  # the scene the handles were made for
+        self._handles_of: tuple | None = None  # the scene and moment the handles were made for
         self._handles: list[Handle] = []
         self.warnings: list[str] = []
         self.clipped: list[tuple[int, np.ndarray]] = []  # what Alg. 1 clips (drawn red)
@@ -103,14 +111,24 @@ class Editor:
         return self._handles
 
     def _follow(self) -> None:
-        if self._handles_of is not self.scene:
-            self._handles_of = self.scene
-            self._handles = handles(self.scene)
+        made_for = (self.scene, self.viewer.playback.time)
+        if self._handles_of is None or any(a is not b for a, b in zip(self._handles_of, made_for)):
+            self._handles_of = made_for
+            self._handles = handles(self._handled())
             route = self.scene.route
             self.warnings = route.warnings() if route else []
             self.clipped = clipped_parts(route) if route else []
             if self.selected is not None:  # keep the selection across edits, undo, reload
                 self.selected = next((h for h in self._handles if h.same(self.selected)), None)
+
+    def _handled(self) -> Scene:
+        """The scene whose values the handles sit at: with keyframe tracks, as drawn at the
+        moment shown (a keyed handle is where its track puts it); else, and with sway (which
+        turns mirrors a drag must not write back), the scene's own values."""
+        a = self.scene.animation
+        if a is not None and a.tracks and a.sway is None:
+            return self.viewer.posed(self.scene)
+        return self.scene
 
     def edit(self, path: tuple, value, interaction=None) -> bool:
         """An edit through the document; a value refused for a field the panel shows keeps
@@ -238,6 +256,15 @@ class Editor:
         self.viewer.sync()
         self.viewer.message = "baked: drag forks, control points and mirror normals"
 
+    def set_key(self) -> None:
+        """K: a key for the selected value at the moment shown, holding the value drawn."""
+        if self.selected is None:
+            self.viewer.message = "select a handle to key its value (K)"
+            return
+        t = self.viewer.playback.time
+        if self.edit(("animation",), key_now(self.scene, self.selected.path, t)):
+            self.viewer.message = f"key at {t:.2f} s for {self.selected.label}"
+
     def select(self, h: Handle | None) -> None:
         self.selected = h
         self.scroll_outline = True
@@ -349,6 +376,9 @@ class Editor:
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))
+        size = glfw.get_window_size(v.window)
+        path = self.selected.path if self.selected is not None else None
+        self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
         self._hover_label(shown, view)
 
     def _manipulate(self) -> None:
@@ -359,9 +389,11 @@ class Editor:
         if sel is not None:
             tool = self.trackball.update if sel.kind == "normal" else self.gizmo.manipulate
             moved = tool(sel, self.window_view())
-            if moved is not None:
+            if moved is not None:  # a keyed value's drag sets its key (keys.py)
                 p, drag = moved
-                self.edit(*sel.edit_to(self.scene, p, self.carry), drag)
+                keyed = track_index(self.scene, sel.path) is not None
+                path, value = sel.edit_to(self.scene, p, self.carry and not keyed)
+                self.edit(*keyed_edit(self.scene, path, value, self.viewer.playback.time), drag)
 
     def _hover_label(self, shown: list[Handle], view: View) -> None:
         io = imgui.get_io()
@@ -378,6 +410,7 @@ class Editor:
 # edit, opening or reloading asks about unsaved edits); tests/test_commands.py checks them.
 EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.Bake: lambda e, c: e.bake(),
+    ec.SetKey: lambda e, c: e.set_key(),
     ec.Select: lambda e, c: e.select(c.handle),
     ec.SelectLevel: lambda e, c: e.select_level(c.level),
     ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),

@@ -1,0 +1,180 @@
+"""Keyframes in the editor (issue 29): K sets a key for the selected value at the moment shown;
+a drag of a value that has a track sets its key there (auto-key: the track would override the
+rest value); the timeline strip at the foot of the view plays, scrubs, and shows the
+selection's keys, which drag along it in time (right-click deletes one). Each change is one
+edit of the scene's ``[animation]`` table: validated, undoable, saved."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+from imgui_bundle import imgui
+
+from ..scene import Scene
+from ..scene.animation import Animation, Key, Track
+from ..scene.edits import get_at, path_text
+from ..viewer import commands as vc
+from ..viewer.playback import Playback
+from . import commands as ec
+
+KEY_SNAP = 1e-3  # seconds: a key set this close to one already there replaces it
+KEY_GAP = 1e-3  # seconds kept between neighbouring keys when one is dragged in time
+STRIP_HEIGHT = 64.0  # pixels: the timeline strip at the window's foot
+DIAMOND = 6.0  # pixels: a key's half size on the strip
+KEY, KEY_HOT = 0xFF40C0FF, 0xFF40FFFF  # ImGui's packed ABGR: a key, the key under the pointer
+
+
+def track_index(scene: Scene, path: tuple) -> int | None:
+    """Which of the scene's tracks moves the value at ``path`` (None: none)."""
+    if scene.animation is None:
+        return None
+    text = path_text(path)
+    return next((i for i, tr in enumerate(scene.animation.tracks) if tr.path == text), None)
+
+
+def with_key(scene: Scene, path: tuple, t: float, value: Any) -> Animation:
+    """The scene's animation with the key (t, value) in the track of ``path`` (a new track if
+    it has none; a key within KEY_SNAP of t is replaced). The loop grows to reach the key."""
+    a = scene.animation or Animation()
+    value = tuple(value) if isinstance(value, (list, tuple)) else value
+    tracks = list(a.tracks)
+    i = track_index(scene, path)
+    if i is None:
+        tracks.append(Track(path_text(path), [Key(t, value)]))
+    else:
+        keys = [k for k in tracks[i].keys if abs(k.time - t) > KEY_SNAP] + [Key(t, value)]
+        tracks[i] = replace(tracks[i], keys=sorted(keys, key=lambda k: k.time))
+    return replace(a, tracks=tracks, duration=max(a.duration, t))
+
+
+def key_now(scene: Scene, path: tuple, t: float) -> Animation:
+    """K: a key at ``t`` holding the value at ``path`` as drawn at ``t``."""
+    return with_key(scene, path, t, get_at(scene.at(t).posed(), path))
+
+
+def keyed_edit(scene: Scene, path: tuple, value: Any, t: float) -> tuple[tuple, Any]:
+    """A drag's edit: of the value itself, or, where a track moves that value, of its key
+    at ``t`` (auto-key)."""
+    if track_index(scene, path) is None:
+        return path, value
+    return ("animation",), with_key(scene, path, t, value)
+
+
+def moved_key(scene: Scene, track: int, key: int, t: float) -> Animation:
+    """The animation with key ``key`` of track ``track`` moved to time ``t``, kept between
+    its neighbours (so the keys keep their order)."""
+    a = scene.animation
+    keys = list(a.tracks[track].keys)
+    lo = keys[key - 1].time + KEY_GAP if key > 0 else 0.0
+    hi = keys[key + 1].time - KEY_GAP if key + 1 < len(keys) else a.duration
+    keys[key] = Key(min(max(t, lo), hi), keys[key].value)
+    tracks = list(a.tracks)
+    tracks[track] = replace(tracks[track], keys=keys)
+    return replace(a, tracks=tracks)
+
+
+def without_key(scene: Scene, track: int, key: int) -> Animation:
+    """The animation without key ``key`` of track ``track`` (a track left with no key goes)."""
+    a = scene.animation
+    tracks = list(a.tracks)
+    keys = [k for j, k in enumerate(tracks[track].keys) if j != key]
+    if keys:
+        tracks[track] = replace(tracks[track], keys=keys)
+    else:
+        del tracks[track]
+    return replace(a, tracks=tracks)
+
+
+class Timeline:
+    """The strip's drag state: the key being dragged, and its drag's number (one undo step)."""
+
+    def __init__(self) -> None:
+        self.dragging: tuple[int, int] | None = None  # (track, key)
+        self.drags = 0
+
+    def draw(
+        self, scene: Scene, playback: Playback, path: tuple | None, span: tuple[float, float]
+    ) -> list[vc.Command]:
+        """Inside the ImGui frame: play/pause, the time bar over the loop with the keys of the
+        selected value (``path``) on it, across the window columns ``span``."""
+        out: list[vc.Command] = []
+        io = imgui.get_io()
+        x0, x1 = span[0] + 8.0, span[1] - 8.0
+        imgui.set_next_window_pos(imgui.ImVec2(x0, io.display_size.y - STRIP_HEIGHT - 8.0))
+        imgui.set_next_window_size(imgui.ImVec2(max(x1 - x0, 200.0), STRIP_HEIGHT))
+        imgui.set_next_window_bg_alpha(0.75)
+        flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.no_move
+        imgui.begin("##timeline", None, flags)
+        if imgui.button("pause" if playback.playing else "play"):
+            out.append(vc.TogglePlay())
+        imgui.same_line()
+        if imgui.button("key (K)") and path is not None:
+            out.append(ec.SetKey())
+        imgui.same_line()
+        track = track_index(scene, path) if path is not None else None
+        what = path_text(path) if path is not None else "select a handle to key it"
+        imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {what}")
+        out += self._bar(scene, playback, track)
+        imgui.end()
+        return out
+
+    def _bar(self, scene: Scene, playback: Playback, track: int | None) -> list[vc.Command]:
+        out: list[vc.Command] = []
+        origin = imgui.get_cursor_screen_pos()
+        width = max(imgui.get_content_region_avail().x, 1.0)
+        imgui.invisible_button("##timebar", imgui.ImVec2(width, 2 * DIAMOND + 4))
+        draw = imgui.get_window_draw_list()
+        y = origin.y + DIAMOND + 2
+
+        def x_of(t: float) -> float:
+            return origin.x + width * t / playback.duration
+
+        def t_of(x: float) -> float:
+            return min(max((x - origin.x) / width, 0.0), 1.0) * playback.duration
+
+        draw.add_line(imgui.ImVec2(origin.x, y), imgui.ImVec2(origin.x + width, y), 0xFF808080, 2)
+        mouse = imgui.get_io().mouse_pos
+        keys = scene.animation.tracks[track].keys if track is not None else []
+        hot = (
+            next(
+                (j for j, k in enumerate(keys) if abs(x_of(k.time) - mouse.x) <= DIAMOND),
+                None,
+            )
+            if imgui.is_item_hovered()
+            else None
+        )
+        for j, k in enumerate(keys):
+            x = x_of(k.time)
+            d = DIAMOND
+            pts = [
+                imgui.ImVec2(x, y - d),
+                imgui.ImVec2(x + d, y),
+                imgui.ImVec2(x, y + d),
+                imgui.ImVec2(x - d, y),
+            ]
+            draw.add_convex_poly_filled(pts, KEY_HOT if j == hot else KEY)
+        now = x_of(playback.time)
+        draw.add_line(
+            imgui.ImVec2(now, y - 2 * DIAMOND), imgui.ImVec2(now, y + 2 * DIAMOND), 0xFFFFFFFF, 2
+        )
+        if imgui.is_item_activated():
+            if hot is not None:
+                self.dragging, self.drags = (track, hot), self.drags + 1
+            else:
+                out.append(vc.SetTime(t_of(mouse.x)))
+        elif imgui.is_item_active():
+            if self.dragging is not None:
+                tr, j = self.dragging
+                out.append(
+                    vc.Edit(
+                        ("animation",), moved_key(scene, tr, j, t_of(mouse.x)), ("key", self.drags)
+                    )
+                )
+            else:
+                out.append(vc.SetTime(t_of(mouse.x)))
+        else:
+            self.dragging = None
+        if hot is not None and imgui.is_item_clicked(imgui.MouseButton_.right):
+            out.append(vc.Edit(("animation",), without_key(scene, track, hot)))
+        return out

@@ -1,0 +1,106 @@
+"""Keyframes in the editor (issue 29): K keys the selected value at the moment shown, a drag
+of a keyed value sets its key (auto-key), keys move in time between their neighbours and go
+with a right-click; in a real window, a fork keyed at two moments plays between them and the
+keys are saved."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from krsview import load
+from krsview.editor.keys import KEY_SNAP, key_now, keyed_edit, moved_key, with_key, without_key
+from krsview.scene.scene import scene_from_toml, scene_to_toml
+
+FORK = ("route", "levels", 20, "fork")
+
+
+@pytest.fixture(scope="module")
+def bent():
+    return load("bent-tree")
+
+
+def test_a_key_makes_a_track_and_a_key_at_the_same_moment_replaces_it(bent):
+    a = with_key(bent, FORK, 2.0, (0.0, 1.0, 0.0))
+    assert [(tr.path, [k.time for k in tr.keys]) for tr in a.tracks] == [
+        ("route.levels[20].fork", [2.0])
+    ]
+    s = bent.edit("animation", a)  # validated like a file's
+    b = with_key(s, FORK, 2.0 + KEY_SNAP / 2, (0.0, 1.1, 0.0))
+    assert len(b.tracks[0].keys) == 1 and b.tracks[0].keys[0].value == (0.0, 1.1, 0.0)
+    c = with_key(s, FORK, 0.5, (0.0, 0.9, 0.0))  # before it: sorted in front
+    assert [k.time for k in c.tracks[0].keys] == [0.5, 2.0]
+    assert with_key(s, FORK, 14.0, (0.0, 1.0, 0.0)).duration == 14.0  # the loop reaches it
+    saved = scene_from_toml(scene_to_toml(bent.edit("animation", c)))
+    assert saved.animation.tracks == c.tracks
+
+
+def test_k_holds_the_value_drawn_then_and_a_drag_of_a_keyed_value_sets_its_key(bent):
+    rest = bent.route.levels[20].fork
+    moved = tuple(x + 0.1 for x in rest)
+    s = bent.edit("animation", with_key(bent, FORK, 0.0, rest))
+    s = s.edit("animation", with_key(s, FORK, 2.0, moved))
+    middle = key_now(s, FORK, 1.0).tracks[0].keys[1]
+    assert middle.time == 1.0
+    assert np.allclose(middle.value, (np.array(rest) + moved) / 2, atol=1e-12)  # smooth: the middle
+    assert not np.allclose(middle.value, rest), "K took the rest value, not the one drawn"
+    path, value = keyed_edit(s, FORK, (0.0, 0.0, 0.0), 2.0)
+    assert path == ("animation",) and value.tracks[0].keys[-1].value == (0.0, 0.0, 0.0)
+    other = ("route", "levels", 19, "fork")  # not keyed: the drag edits the value itself
+    assert keyed_edit(s, other, (0.0, 0.0, 0.0), 2.0) == (other, (0.0, 0.0, 0.0))
+
+
+def test_a_key_dragged_in_time_stays_between_its_neighbours_and_right_click_deletes(bent):
+    s = bent
+    for t in (1.0, 2.0, 3.0):
+        s = s.edit("animation", with_key(s, FORK, t, (0.0, t, 0.0)))
+    times = [k.time for k in moved_key(s, 0, 1, 2.5).tracks[0].keys]
+    assert times == [1.0, 2.5, 3.0]
+    times = [k.time for k in moved_key(s, 0, 1, 9.0).tracks[0].keys]
+    assert times[1] < times[2] == 3.0, "a key passed its neighbour"
+    assert [k.time for k in without_key(s, 0, 0).tracks[0].keys] == [2.0, 3.0]
+    one = bent.edit("animation", with_key(bent, FORK, 1.0, (0.0, 1.0, 0.0)))
+    assert without_key(one, 0, 0).tracks == [], "a track without keys stayed"
+
+
+def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(display, tmp_path):
+    import shutil
+
+    from krsview.editor.window import Editor
+    from krsview.scene import load_scene
+    from krsview.scene.presets import resolve
+    from krsview.viewer.commands import SetTime
+
+    from .test_editor import click, drag, handle, pump, screen_of, settle, xdo
+
+    path = tmp_path / "bent.toml"
+    shutil.copy(resolve("bent-tree"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        settle(e)
+        h = handle(e, FORK)
+        rest = np.array(h.position)
+        click(e, screen_of(e, h.position))
+        assert e.selected is not None and e.selected.path == FORK
+        xdo("key", "k")  # a key at 0 s, holding the fork where it is
+        pump(e, 3)
+        e.execute([SetTime(2.0)])
+        pump(e, 2)
+        drag(e, screen_of(e, rest), (60, 0))
+        track = e.scene.animation.tracks[0]
+        assert track.path == "route.levels[20].fork" and [k.time for k in track.keys] == [0, 2.0]
+        assert e.scene.route.levels[20].fork == tuple(rest), "the drag moved the rest value"
+        keyed = np.array(track.keys[1].value)
+        assert np.linalg.norm(keyed - rest) > 0.05
+        assert np.allclose(handle(e, FORK).position, keyed), "the handle is not where drawn"
+        e.execute([SetTime(1.0)])
+        pump(e, 2)
+        between = handle(e, FORK).position  # the fork drawn half way: between its keys
+        assert 0.3 < np.linalg.norm(between - rest) / np.linalg.norm(keyed - rest) < 0.7
+        xdo("key", "ctrl+s")
+        pump(e, 3)
+        saved = load_scene(path)
+        assert saved.animation.tracks == e.scene.animation.tracks and not e.doc.dirty
+        assert len(e.doc.history.steps) == 2, "K and the drag were not one undo step each"
+    finally:
+        e.close()
