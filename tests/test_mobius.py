@@ -225,3 +225,15 @@ def test_condition_flags_singular():
         M.condition(M.matrix(M.ONE, M.ONE, M.ONE, M.ONE)) == float("inf")
         or M.condition(M.matrix(M.ONE, M.ONE, M.ONE, M.ONE)) > 1e15
     )
+
+
+def test_the_real_matrix_is_the_four_left_multiplication_blocks():
+    """M.real_matrix (built at once from a sign pattern) against its definition, block
+    by block from quaternion.left_matrix; a swapped block is the negative control."""
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        H = rng.normal(size=(2, 2, 4))
+        blocks = [[Q.left_matrix(H[r, k]) for k in range(2)] for r in range(2)]
+        assert np.array_equal(M.real_matrix(H), np.block(blocks))
+        swapped = np.block([blocks[0][::-1], blocks[1]])
+        assert not np.array_equal(M.real_matrix(H), swapped)

@@ -67,9 +67,17 @@ def compose(*Hs: np.ndarray) -> np.ndarray:
     return out
 
 
+# The 4 × 4 real matrix of q ↦ h q (quaternion.left_matrix) as a sign pattern over a
+# permutation of h's components: L[i, j] = SIGN[i, j] · h[PERM[i, j]].
+_PERM = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+_SIGN = np.array([[1.0, -1, -1, -1], [1, 1, -1, 1], [1, 1, 1, -1], [1, -1, 1, 1]])
+
+
 def real_matrix(H: np.ndarray) -> np.ndarray:
-    """H as the real 8×8 matrix of the left-linear map (q1, q2) ↦ (a q1 + b q2, c q1 + d q2)."""
-    return np.block([[Q.left_matrix(H[r, k]) for k in range(2)] for r in range(2)])
+    """H as the real 8×8 matrix of the left-linear map (q1, q2) ↦ (a q1 + b q2, c q1 + d q2):
+    the four blocks quaternion.left_matrix(H[r, k]), built at once (a drag or a playing frame
+    asks it of every level)."""
+    return (_SIGN * H[:, :, _PERM]).transpose(0, 2, 1, 3).reshape(8, 8)
 
 
 def condition(H: np.ndarray) -> float:

@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .schema import SceneError, Tagged, Vec3, param, to_dict
+from .schema import SceneError, Tagged, Vec3, cached, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
 TRACERS = ("sphere", "binary", "relaxed")
@@ -384,7 +384,12 @@ class Arc:
 
 
 def arc_of(k: ToroidalCapsule) -> Arc | None:
-    """The arc through start, control, end; None when nearly straight (draw as a capsule)."""
+    """The arc through start, control, end; None when nearly straight (draw as a capsule).
+    Made once per kernel (kernels are frozen)."""
+    return cached(k, "_arc", lambda: _arc(k))
+
+
+def _arc(k: ToroidalCapsule) -> Arc | None:
     A, C, B = (np.array(p, dtype=float) for p in (k.start, k.control, k.end))
     a, b = A - C, B - C
     axb = np.cross(a, b)

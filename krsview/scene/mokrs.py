@@ -24,21 +24,9 @@ import numpy as np
 
 from ..algebra import mobius
 from .model import Empty, Kernel, Plane, Sphere, check_level_count
-from .schema import SceneError, Tagged, Vec3, param
+from .schema import SceneError, Tagged, Vec3, cached, param
 
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
-
-
-def cached(obj, name: str, make):
-    """``make()`` computed once per frozen instance and kept read-only beside its fields: a
-    drag's edit asks each step and level for its matrix several times (validation, the
-    viewpoint check, compiling, the editor's handles)."""
-    value = obj.__dict__.get(name)
-    if value is None:
-        value = make()
-        value.flags.writeable = False
-        object.__setattr__(obj, name, value)
-    return value
 
 
 def composed(*Hs: np.ndarray) -> np.ndarray:
@@ -160,7 +148,7 @@ class MoKRS:
         p = f"{path}.levels"
         check_level_count(self.levels, p, "a MöKRS needs at least one level")
         for i, lv in enumerate(self.levels):
-            cond = mobius.condition(lv.matrix())
+            cond = cached(lv, "_condition", lambda lv=lv: mobius.condition(lv.matrix()))
             if not cond <= SINGULAR_CONDITION:
                 raise SceneError(
                     f"{p}[{i}].transform",

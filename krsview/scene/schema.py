@@ -45,6 +45,18 @@ class SceneError(ValueError):
         return SceneError(self.path, self.value, self.allowed, file)
 
 
+def cached(obj: Any, name: str, make: Any) -> Any:
+    """``make()`` computed once per frozen instance and kept beside its fields (an array
+    read-only): a drag's edit, or a frame of a playing scene, asks the same unchanged kernels,
+    steps and levels for their arcs, matrices and condition numbers many times."""
+    if name not in obj.__dict__:
+        value = make()
+        if hasattr(value, "flags"):
+            value.flags.writeable = False
+        object.__setattr__(obj, name, value)
+    return obj.__dict__[name]
+
+
 def param(
     default: Any = MISSING,
     *,
