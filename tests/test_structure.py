@@ -363,7 +363,8 @@ def test_growing_again_asks_before_losing_hand_edits(editor):
     inserted = editor.scene
     editor.run(ec.SetGrowth("branch_angle", 40.0, ("drag", 1)))
     assert editor.scene == inserted, "nothing lands before the answer"
-    new, lost, _ = editor.structure.pending
+    at, new, lost, _ = editor.structure.pending
+    assert at == ("route",)
     assert any("made by hand" in line for line in lost)
     editor.run(ec.CancelRegrow())
     assert editor.structure.pending is None and editor.scene == inserted

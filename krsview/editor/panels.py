@@ -4,6 +4,7 @@ so the arrows run one way: editor window → panels."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import fields
 from pathlib import Path
 from typing import Any, Protocol
@@ -61,8 +62,11 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
     imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
     imgui.set_next_window_bg_alpha(0.8)
-    imgui.begin("edit")  # scrolls when taller than the window; collapses by its arrow
-    if not imgui.is_window_collapsed():
+    imgui.begin("edit")  # scrolls when taller than the window; folds by its arrow
+    folded = imgui.is_window_collapsed()
+    if folded != e.layout.folded:
+        out.append(ec.FoldPanel(folded))
+    if not folded:
         _dock(e, out, width)
     _file(e, out)
     if e.viewer.error:
@@ -208,10 +212,14 @@ def _selection(e: Edited, out: list, interactions: Interactions) -> None:
 
 
 def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
-    """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse."""
+    """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse; the
+    fields the program keeps (BOOKKEEPING) as a line of text."""
     for f in fields(obj):
         value = getattr(obj, f.name)
         path = (*at, f.name)
+        if f.name in BOOKKEEPING:
+            _bookkeeping(f.name, value, path, interactions)
+            continue
         if value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
             continue
         if hasattr(value, "__dataclass_fields__"):
@@ -227,6 +235,31 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))
+
+
+def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions) -> None:
+    """A field the program writes, shown as text: the person reads it, never edits it (its
+    place is kept in ``interactions.rects`` like a widget's, for tests and automation)."""
+    text, tip = BOOKKEEPING[name](value)
+    imgui.text_disabled(text)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip(tip)
+    lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    interactions.rects[path] = (lo.x, lo.y, hi.x, hi.y)
+
+
+def _grown(depth: int | None) -> tuple[str, str]:
+    """A route level's ``grown``: which level of the growth parameters it was baked as."""
+    if depth is None:
+        return "made by hand", "not baked from growth parameters (growing again drops it)"
+    return f"grown at depth {depth}", (
+        f"baked from level {depth} (0: the trunk) of the growth parameters; growing again "
+        "puts this level's edits back on the level grown there"
+    )
+
+
+# Fields the program keeps for itself: (text, tooltip) of the value, shown instead of a widget.
+BOOKKEEPING: dict[str, Callable[[Any], tuple[str, str]]] = {"grown": _grown}
 
 
 def _modals(e: Edited, out: list) -> None:
