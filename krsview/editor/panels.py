@@ -29,6 +29,7 @@ GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a 
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 MODAL_WIDTH = 420.0  # pixels, or the window's width where it is narrower
+TIP_EMS = 22.0  # a bookkeeping field's tooltip wraps at this many font sizes
 
 
 class Edited(Protocol):
@@ -242,8 +243,12 @@ def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions)
     place is kept in ``interactions.rects`` like a widget's, for tests and automation)."""
     text, tip = BOOKKEEPING[name](value)
     imgui.text_disabled(text)
-    if imgui.is_item_hovered():
-        imgui.set_tooltip(tip)
+    if imgui.is_item_hovered():  # wrapped: a narrow window cuts nothing off
+        imgui.begin_tooltip()
+        imgui.push_text_wrap_pos(TIP_EMS * imgui.get_font_size())
+        imgui.text(tip)
+        imgui.pop_text_wrap_pos()
+        imgui.end_tooltip()
     lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
     interactions.rects[path] = (lo.x, lo.y, hi.x, hi.y)
 
@@ -251,10 +256,10 @@ def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions)
 def _grown(depth: int | None) -> tuple[str, str]:
     """A route level's ``grown``: which level of the growth parameters it was baked as."""
     if depth is None:
-        return "made by hand", "not baked from growth parameters (growing again drops it)"
+        return "made by hand", "not baked from growth parameters: growing again drops it"
     return f"grown at depth {depth}", (
-        f"baked from level {depth} (0: the trunk) of the growth parameters; growing again "
-        "puts this level's edits back on the level grown there"
+        f"baked from depth {depth} (0: the trunk) of the growth parameters: growing the "
+        "tree again puts this level's edits back on the level grown there"
     )
 
 
