@@ -153,9 +153,9 @@ def commit_route(
     except SceneError as err:
         _say(e, f"{label} refused: {err}", True)
         return False
-    e.doc.commit(
-        scene, label if at == ("route",) else f"{label} of {path_text(at[:2])}", interaction
-    )
+    if at != ("route",):
+        label += f" (component {at[1]})"
+    e.doc.commit(scene, label, interaction)
     e.viewer.sync()
     warned = get_at(scene, at).warnings()
     _say(e, label + (f" ({len(warned)} warnings)" if warned else ""), False)
@@ -165,8 +165,11 @@ def commit_route(
 def _level(e: Structured, level: int | None, what: str) -> int | None:
     if level is not None:
         return level
-    if e.scene.compound and component(e) is not None:
-        return e.structure.level  # the level chosen in the section
+    if e.scene.compound:  # the level chosen in the section, of the component's route
+        at, why = target(e)
+        if at is None:
+            _say(e, f"{what}: {why}", True)
+        return None if at is None else e.structure.level
     if e.selected is None or e.scene.route is None:
         _say(e, f"{what}: select a level first (click it in the outline or the view)", True)
         return None
