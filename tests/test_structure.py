@@ -609,3 +609,44 @@ def test_a_grown_component_is_baked_in_place_then_its_route_grows_again(compound
     assert e.scene.compound[0].route.growth.branch_angle == 40.0
     assert e.scene.compound[1].route.growth == start.compound[1].route.growth
     assert placed(e.scene, 0) != placed(scene, 0)
+
+
+def test_in_a_window_a_clicked_component_takes_the_insert_key_once_baked(display, compound_editor):
+    """A compound in a real window: click component 0's handle, press Insert: refused (a
+    grown tree), said in the section and nothing changes; baked (the section's button's
+    command), Insert adds a fork to that component's route alone, one undo step; Ctrl+Z
+    takes it back."""
+    import glfw
+
+    from krsview.compile.camera import project
+    from krsview.editor.window import Editor
+
+    e = Editor(compound_editor.doc.path, size=WINDOW)
+    try:
+        pump(e)
+        h = next(h for h in e.handles if h.level == 0)
+        x, y, _ = project(e.window_view(), h.position)
+        wx, wy = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", round(wx + x), round(wy + y))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e)
+        assert e.selected is not None and e.selected.level == 0, e.selected
+        start = e.scene
+        xdo("key", "Insert")
+        pump(e)
+        assert "component 0 is grown from ratios" in e.structure.message
+        assert e.structure.refused and e.scene is start
+        e.execute([ec.Bake(0)])
+        baked = e.scene
+        n = len(baked.compound[0].route.levels)
+        e.execute([ec.SetToolValue("level", 4)])
+        xdo("key", "Insert")
+        pump(e)
+        assert len(e.scene.compound[0].route.levels) == n + 1, e.structure.message
+        assert e.scene.compound[1:] == start.compound[1:]
+        xdo("key", "ctrl+z")
+        pump(e)
+        assert e.scene == baked
+    finally:
+        e.close()
