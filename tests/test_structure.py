@@ -650,3 +650,45 @@ def test_in_a_window_a_clicked_component_takes_the_insert_key_once_baked(display
         assert e.scene == baked
     finally:
         e.close()
+
+
+def outline_row(e, row: int) -> tuple[float, float]:
+    """Screen point of the outline's entry ``row`` (0: the top one)."""
+    import glfw
+    from imgui_bundle import imgui
+
+    child = next(
+        w for w in imgui.get_current_context().windows if w.name.startswith("edit/outline")
+    )
+    wx, wy = glfw.get_window_pos(e.viewer.window)
+    y = child.pos.y + 4 + imgui.get_text_line_height_with_spacing() * (row + 0.5)
+    return wx + child.pos.x + 40, wy + y
+
+
+def test_a_compounds_outline_entries_have_no_level_menu(display, scene, tmp_path, compound_editor):
+    """A right-click on a compound's outline entry (a component, not a level) opens no
+    insert/remove menu (its level would be a component's number); the entry still selects
+    by a left click. Negative control: on a route, the same right-click opens the menu."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.window import Editor
+
+    def right_click(e, row: int) -> int:
+        xdo("mousemove", *map(round, outline_row(e, row)))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 2)
+        xdo("click", 3)
+        pump(e, 3)
+        return imgui.get_current_context().open_popup_stack.size()
+
+    route = tmp_path / "route.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), route)
+    for path, menus, level in ((route, 1, len(scene.tree.route().levels) - 3), (None, 0, 0)):
+        e = Editor(path or compound_editor.doc.path, size=WINDOW)
+        try:
+            pump(e)
+            assert right_click(e, 2) == menus, path
+            assert e.selected is not None and e.selected.level == level, "no selection"
+        finally:
+            e.close()

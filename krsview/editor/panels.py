@@ -191,7 +191,8 @@ def _outline(e: Edited, out: list) -> None:
             clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
             if clicked:
                 out.append(ec.SelectLevel(k))
-            out += outline_menu(k)
+            if e.scene.route is not None:  # entries are levels (a compound's: components)
+                out += outline_menu(k)
             if selected and e.scroll_outline:
                 imgui.set_scroll_here_y()
                 out.append(ec.OutlineScrolled())
