@@ -385,3 +385,35 @@ def turn_the_dial(e, path, steps: int = 6, arc: float = 0.4) -> list[list[float]
         pump(e, 2)
         out.append(angles)
     return out
+
+
+def test_an_edit_that_puts_the_viewpoint_flown_in_the_editor_on_a_pole_is_refused(
+    display, tmp_path
+):
+    """The person has flown to p (the editor's camera, not the file's): moving inversion's
+    centre onto p sends the viewpoint to infinity, so the edit is refused with a message
+    naming the view, shown in the MöKRS section, and the scene and history stay. Negative
+    controls: the file's camera alone accepts that edit (the document's own check), and
+    with the view flown elsewhere the editor takes it too."""
+    from krsview.editor.window import VIEW, Editor
+
+    path = tmp_path / "inversion.toml"
+    shutil.copy(resolve("inversion"), path)
+    e = Editor(path, size=(320, 200))
+    try:
+        before = e.scene
+        h = next(h for h in e.handles if h.role == "center")
+        p = h.position + np.array([0.4, 0.3, -0.2])
+        assert np.linalg.norm(p - np.array(before.camera.position)) > 1.0
+        Document(path).apply(*h.edit_to(before, p))  # the file's camera is off that pole
+        e.viewer.camera.position = p.copy()
+        assert not e.edit(*h.edit_to(before, p), ("gizmo", 1))
+        error = e.viewer.error
+        assert error.startswith(VIEW + " = [") and "np." not in error and "infinity" in error, error
+        assert e.scene is before and not e.doc.history.steps
+        assert refusal_place(error, h.level, len(before.mokrs.levels[h.level].transform))
+        e.viewer.camera.position = np.array(before.camera.position, dtype=float)
+        assert e.edit(*h.edit_to(before, p), ("gizmo", 2)), e.viewer.error
+        assert np.allclose(next(k for k in e.handles if k.same(h)).position, p)
+    finally:
+        e.close()

@@ -363,7 +363,8 @@ def test_growing_again_asks_before_losing_hand_edits(editor):
     inserted = editor.scene
     editor.run(ec.SetGrowth("branch_angle", 40.0, ("drag", 1)))
     assert editor.scene == inserted, "nothing lands before the answer"
-    new, lost, _ = editor.structure.pending
+    at, new, lost, _ = editor.structure.pending
+    assert at == ("route",)
     assert any("made by hand" in line for line in lost)
     editor.run(ec.CancelRegrow())
     assert editor.structure.pending is None and editor.scene == inserted
@@ -518,3 +519,176 @@ def test_closing_a_shipped_preset_with_edits_saves_the_copy_then_closes(
         assert load_scene(e.path).render.epsilon_scale == 2.0
     finally:
         e.close()
+
+
+# ------------------------------------------------------------------ a compound's components
+@pytest.fixture
+def compound_editor(scene, tmp_path):
+    """A compound of the 8-fork tree grown (component 0), the same tree as a route, turned,
+    scaled and moved (1), and the rock's explicit KRS (2); nothing selected."""
+    from krsview.scene.compound import Component
+
+    rock = load_scene(resolve("rock")).krs
+    parts = [
+        Component(tree=scene.tree),
+        Component(route=scene.tree.route(), position=(3.0, 0.0, 1.0), angle=40.0, scale=0.7),
+        Component(krs=rock, position=(-3.0, 0.0, 0.0)),
+    ]
+    path = tmp_path / "compound.toml"
+    save_scene(replace(scene, tree=None, compound=parts), path)
+    e = FakeEditor(path)
+    e.selected = None
+    return e
+
+
+def placed(scene, k: int) -> KRS:
+    return scene.compound[k].placed()
+
+
+def test_structure_tools_act_on_the_selected_components_route(compound_editor):
+    """Component 1 (a route): insert at the section's level adds a level to it alone (the
+    compiled world-space KRS one level deeper, the others as they were), one undo step;
+    remove by the Delete key's command takes it out again; scale widths scales its world
+    radii alone. Negative controls: nothing selected, a grown component and an explicit KRS
+    are refused, each with its reason, and nothing changes."""
+    e = compound_editor
+    start = e.scene
+    for selected, why in (
+        (None, "select a component first"),
+        (0, "component 0 is grown from ratios: bake it"),
+        (2, "component 2 is an explicit KRS"),
+    ):
+        e.selected = None if selected is None else SimpleNamespace(level=selected)
+        e.run(ec.InsertLevel())
+        assert why in e.viewer.error and e.structure.refused, (selected, e.viewer.error)
+        assert e.scene is start and not e.doc.history.steps
+    e.selected = SimpleNamespace(level=1)
+    e.structure.level = 3
+    e.run(ec.InsertLevel())
+    assert not e.structure.refused, e.structure.message
+    after = e.scene
+    assert len(after.compound[1].route.levels) == len(start.compound[1].route.levels) + 1
+    assert placed(after, 1).depth == placed(start, 1).depth + 1
+    assert [placed(after, k) for k in (0, 2)] == [placed(start, k) for k in (0, 2)]
+    assert e.structure.level == 4 and e.chosen == [], "the new fork, not component 4"
+    assert e.doc.history.labels()[0] == ["insert a fork in L3 at 0.50 (component 1)"]
+    e.run(ec.RemoveLevel())  # the key's command: the section's level (the new fork)
+    forks = lambda s: [lv.fork for lv in s.compound[1].route.levels]  # noqa: E731
+    assert forks(e.scene) == forks(start)
+    e.structure.widths = 1.5
+    e.run(ec.WholeTree("widths"))
+    world = lambda s: [k.radius for k in placed(s, 1).kernels if hasattr(k, "radius")]  # noqa: E731
+    np.testing.assert_allclose(world(e.scene), 1.5 * np.array(world(start)), rtol=1e-12)
+    assert [placed(e.scene, k) for k in (0, 2)] == [placed(start, k) for k in (0, 2)]
+    assert len(e.doc.history.steps) == 3
+
+
+def test_a_grown_component_is_baked_in_place_then_its_route_grows_again(compound_editor):
+    """Baking component 0 gives it a route that draws the same surface (reference distance
+    of the world-space KRS at points around it, before and after); then growing again with
+    a new branch angle acts on that component's route (its growth changed, the others not).
+    Negative control: the route component's growth is untouched."""
+    from krsview.editor.structure import baked
+
+    e = compound_editor
+    start = e.scene
+    scene, label, _ = baked(start, 0)
+    assert scene.compound[0].tree is None and scene.compound[0].route is not None
+    assert scene.compound[1:] == start.compound[1:] and "component 0" in label
+    rng = np.random.default_rng(1)
+    pts = rng.uniform([-1.5, 0.0, -1.5], [1.5, 3.5, 1.5], (400, 3))
+    np.testing.assert_allclose(
+        distance(compile_krs(placed(scene, 0), ALBEDO), pts),
+        distance(compile_krs(placed(start, 0), ALBEDO), pts),
+        atol=1e-9,
+    )
+    e.doc.commit(scene, label)
+    e.selected = SimpleNamespace(level=0)
+    e.run(ec.SetGrowth("branch_angle", 40.0, None))
+    assert not e.structure.refused and e.structure.pending is None, e.structure.message
+    assert e.scene.compound[0].route.growth.branch_angle == 40.0
+    assert e.scene.compound[1].route.growth == start.compound[1].route.growth
+    assert placed(e.scene, 0) != placed(scene, 0)
+
+
+def test_in_a_window_a_clicked_component_takes_the_insert_key_once_baked(display, compound_editor):
+    """A compound in a real window: click component 0's handle, press Insert: refused (a
+    grown tree), said in the section and nothing changes; baked (the section's button's
+    command), Insert adds a fork to that component's route alone, one undo step; Ctrl+Z
+    takes it back."""
+    import glfw
+
+    from krsview.compile.camera import project
+    from krsview.editor.window import Editor
+
+    e = Editor(compound_editor.doc.path, size=WINDOW)
+    try:
+        pump(e)
+        h = next(h for h in e.handles if h.level == 0)
+        x, y, _ = project(e.window_view(), h.position)
+        wx, wy = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", round(wx + x), round(wy + y))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e)
+        assert e.selected is not None and e.selected.level == 0, e.selected
+        start = e.scene
+        xdo("key", "Insert")
+        pump(e)
+        assert "component 0 is grown from ratios" in e.structure.message
+        assert e.structure.refused and e.scene is start
+        e.execute([ec.Bake(0)])
+        baked = e.scene
+        n = len(baked.compound[0].route.levels)
+        e.execute([ec.SetToolValue("level", 4)])
+        xdo("key", "Insert")
+        pump(e)
+        assert len(e.scene.compound[0].route.levels) == n + 1, e.structure.message
+        assert e.scene.compound[1:] == start.compound[1:]
+        xdo("key", "ctrl+z")
+        pump(e)
+        assert e.scene == baked
+    finally:
+        e.close()
+
+
+def outline_row(e, row: int) -> tuple[float, float]:
+    """Screen point of the outline's entry ``row`` (0: the top one)."""
+    import glfw
+    from imgui_bundle import imgui
+
+    child = next(
+        w for w in imgui.get_current_context().windows if w.name.startswith("edit/outline")
+    )
+    wx, wy = glfw.get_window_pos(e.viewer.window)
+    y = child.pos.y + 4 + imgui.get_text_line_height_with_spacing() * (row + 0.5)
+    return wx + child.pos.x + 40, wy + y
+
+
+def test_a_compounds_outline_entries_have_no_level_menu(display, scene, tmp_path, compound_editor):
+    """A right-click on a compound's outline entry (a component, not a level) opens no
+    insert/remove menu (its level would be a component's number); the entry still selects
+    by a left click. Negative control: on a route, the same right-click opens the menu."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.window import Editor
+
+    def right_click(e, row: int) -> int:
+        xdo("mousemove", *map(round, outline_row(e, row)))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 2)
+        xdo("click", 3)
+        pump(e, 3)
+        return imgui.get_current_context().open_popup_stack.size()
+
+    route = tmp_path / "route.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), route)
+    for path, menus, level in ((route, 1, len(scene.tree.route().levels) - 3), (None, 0, 0)):
+        e = Editor(path or compound_editor.doc.path, size=WINDOW)
+        try:
+            pump(e)
+            assert right_click(e, 2) == menus, path
+            assert e.selected is not None and e.selected.level == level, "no selection"
+        finally:
+            e.close()

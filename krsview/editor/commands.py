@@ -11,7 +11,10 @@ from .handles import Handle
 
 @dataclass(frozen=True)
 class Bake(Command):
-    """Grown tree → route (one undo step): every fork becomes a handle."""
+    """Grown tree → route (one undo step): every fork becomes a handle; in a compound, the
+    tree of component ``component``."""
+
+    component: int | None = None
 
 
 @dataclass(frozen=True)
@@ -99,6 +102,13 @@ class PlacePanel(Command):
 
     side: str
     width: float
+
+
+@dataclass(frozen=True)
+class FoldPanel(Command):
+    """The edit panel was folded to its title bar (``folded``) or unfolded by its arrow."""
+
+    folded: bool
 
 
 # ------------------------------------------------------------- structure (editor/structure.py)

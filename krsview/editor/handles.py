@@ -180,15 +180,20 @@ def outline(scene: Scene) -> list[str]:
     if scene.mokrs is not None:
         return mokrs_outline(scene.mokrs)
     if scene.route is not None:
-        n = len(scene.route.levels)
-        return [
-            f"L{i} " + ("trunk" if i == n - 1 else "twig" if i == 0 else "branch") for i in range(n)
-        ]
+        return route_outline(scene.route)
     if scene.krs is not None:
         return [f"L{i} {lv.kernel.kind}" for i, lv in enumerate(scene.krs.levels)]
     return [
         f"component {k}: {'tree' if c.tree else 'route' if c.route else 'KRS'}"
         for k, c in enumerate(scene.compound)
+    ]
+
+
+def route_outline(route: Route) -> list[str]:
+    """A route's levels by name, twig first."""
+    n = len(route.levels)
+    return [
+        f"L{i} " + ("trunk" if i == n - 1 else "twig" if i == 0 else "branch") for i in range(n)
     ]
 
 

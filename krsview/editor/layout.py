@@ -1,6 +1,8 @@
 """Where the edit panel sits (docked left or right, as wide as the person drags it, at most
-half the window) and the camera that frames the scene in the part of the window it leaves:
-the scene camera's target is turned to the centre of that part."""
+half the window, or folded to its title bar) and the camera that frames the scene in the part
+of the window it leaves: the scene camera's target is turned to the centre of that part, and
+when that part changes (the panel folded, unfolded or docked on the other side) what was in
+its middle stays in the middle of the new part."""
 
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ MIN_WIDTH, MAX_SHARE = 220.0, 0.5  # the narrowest panel, and the widest share o
 class Layout:
     side: str = "right"  # where the edit panel docks: "left" or "right"
     width: float = PANEL_WIDTH
+    folded: bool = False  # only the panel's title bar shows: the view has the whole width
 
     def panel(
         self, size: tuple[float, float], hud: float = 0.0
@@ -37,7 +40,10 @@ class Layout:
         return max(min(self.width, MAX_SHARE * window_width), min(MIN_WIDTH, window_width))
 
     def free(self, size: tuple[float, float]) -> tuple[float, float]:
-        """The span (x0, x1) of window columns the panel leaves to the view."""
+        """The span (x0, x1) of window columns the panel leaves to the view (all of them
+        while it is folded: its title bar covers a strip of the top only)."""
+        if self.folded:
+            return 0.0, float(size[0])
         x, _, width, _ = self.panel(size)
         return (x + width + MARGIN, size[0]) if self.side == "left" else (0.0, x - MARGIN)
 
@@ -61,7 +67,28 @@ def frame(
         fits = ball[3] / (width / w * v.tan_half * v.aspect)  # the ball's half-width = span's
         back = min(max(fits / distance, 1.0), w / width)
         camera.position = np.asarray(target) + (camera.position - np.asarray(target)) * back
-    x = 0.5 * (span[0] + span[1])
+    _turn_to(camera, target, size, 0.5 * (span[0] + span[1]))
+
+
+def shift(
+    camera: FlyCamera, size: tuple[int, int], old: tuple[float, float], new: tuple[float, float]
+) -> bool:
+    """Turn ``camera`` about its up axis so that what is seen in the middle of the columns
+    ``old`` is seen in the middle of ``new`` (the view's part of the window changed); False
+    when they are the same."""
+    if old == new:
+        return False
+    w, h = size
+    v = view_of(camera.to_camera(), w, h)
+    x = 0.5 * (old[0] + old[1])
+    ray = v.forward + (2.0 * x / w - 1.0) * v.tan_half * v.aspect * v.right
+    _turn_to(camera, v.origin + ray, size, 0.5 * (new[0] + new[1]))
+    return True
+
+
+def _turn_to(camera: FlyCamera, target: np.ndarray, size: tuple[int, int], x: float) -> None:
+    """Turn ``camera`` about the world's up so that ``target`` is seen in window column x."""
+    w, h = size
     for _ in range(3):  # the turn is about the world's up, the column the screen's: converge
         v = view_of(camera.to_camera(), w, h)
         rel = np.asarray(target, dtype=np.float64) - v.origin

@@ -54,7 +54,8 @@ def removed(items: list, k: int) -> list:
     return [*items[:k], *items[k + 1 :]]
 
 
-MINE = ("mokrs", "camera", "bookmarks", "levels")  # refusals a MöKRS edit can cause
+# refusals a MöKRS edit can cause ("view": the viewpoint flown in the editor on a pole)
+MINE = ("mokrs", "camera", "bookmarks", "levels", "view")
 
 
 def refusal_place(error: str, level: int, steps: int) -> str:

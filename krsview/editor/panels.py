@@ -4,6 +4,7 @@ so the arrows run one way: editor window → panels."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import fields
 from pathlib import Path
 from typing import Any, Protocol
@@ -28,6 +29,7 @@ GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a 
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 MODAL_WIDTH = 420.0  # pixels, or the window's width where it is narrower
+TIP_EMS = 22.0  # a bookkeeping field's tooltip wraps at this many font sizes
 
 
 class Edited(Protocol):
@@ -61,8 +63,11 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
     imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
     imgui.set_next_window_bg_alpha(0.8)
-    imgui.begin("edit")  # scrolls when taller than the window; collapses by its arrow
-    if not imgui.is_window_collapsed():
+    imgui.begin("edit")  # scrolls when taller than the window; folds by its arrow
+    folded = imgui.is_window_collapsed()
+    if folded != e.layout.folded:
+        out.append(ec.FoldPanel(folded))
+    if not folded:
         _dock(e, out, width)
     _file(e, out)
     if e.viewer.error:
@@ -186,7 +191,8 @@ def _outline(e: Edited, out: list) -> None:
             clicked, _ = imgui.selectable(f"{entries[k]}##{k}", selected)
             if clicked:
                 out.append(ec.SelectLevel(k))
-            out += outline_menu(k)
+            if e.scene.route is not None:  # entries are levels (a compound's: components)
+                out += outline_menu(k)
             if selected and e.scroll_outline:
                 imgui.set_scroll_here_y()
                 out.append(ec.OutlineScrolled())
@@ -208,10 +214,14 @@ def _selection(e: Edited, out: list, interactions: Interactions) -> None:
 
 
 def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
-    """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse."""
+    """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse; the
+    fields the program keeps (BOOKKEEPING) as a line of text."""
     for f in fields(obj):
         value = getattr(obj, f.name)
         path = (*at, f.name)
+        if f.name in BOOKKEEPING:
+            _bookkeeping(f.name, value, path, interactions)
+            continue
         if value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
             continue
         if hasattr(value, "__dataclass_fields__"):
@@ -227,6 +237,35 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))
+
+
+def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions) -> None:
+    """A field the program writes, shown as text: the person reads it, never edits it (its
+    place is kept in ``interactions.rects`` like a widget's, for tests and automation)."""
+    text, tip = BOOKKEEPING[name](value)
+    imgui.text_disabled(text)
+    if imgui.is_item_hovered():  # wrapped: a narrow window cuts nothing off
+        imgui.begin_tooltip()
+        imgui.push_text_wrap_pos(TIP_EMS * imgui.get_font_size())
+        imgui.text(tip)
+        imgui.pop_text_wrap_pos()
+        imgui.end_tooltip()
+    lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    interactions.rects[path] = (lo.x, lo.y, hi.x, hi.y)
+
+
+def _grown(depth: int | None) -> tuple[str, str]:
+    """A route level's ``grown``: which level of the growth parameters it was baked as."""
+    if depth is None:
+        return "made by hand", "not baked from growth parameters: growing again drops it"
+    return f"grown at depth {depth}", (
+        f"baked from depth {depth} (0: the trunk) of the growth parameters: growing the "
+        "tree again puts this level's edits back on the level grown there"
+    )
+
+
+# Fields the program keeps for itself: (text, tooltip) of the value, shown instead of a widget.
+BOOKKEEPING: dict[str, Callable[[Any], tuple[str, str]]] = {"grown": _grown}
 
 
 def _modals(e: Edited, out: list) -> None:

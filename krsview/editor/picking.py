@@ -8,6 +8,8 @@ from __future__ import annotations
 import math
 from typing import Protocol
 
+from imgui_bundle import imgui
+
 from ..compile.camera import View, pixel_ray, project
 from ..reference.geometry import nearest
 from ..scene import Scene
@@ -15,6 +17,7 @@ from ..viewer.picking import depth_at
 from ..viewer.window import Viewer
 from .handles import Handle
 
+LABEL = 0xFFFFFFFF  # hover labels: white (ImGui's packed ABGR)
 PICK_PIXELS = 12.0  # a click this close to a handle grabs it
 NEIGHBOURS = 1  # levels either side of the selected one whose handles show in full
 
@@ -92,3 +95,16 @@ def _entry_of_slot(e: Picked, slot: int) -> int:
         return slot + e.viewer.geometry.depth - e.viewer.krs.depth
     bases = list(getattr(e.viewer.world, "bases", (0,)))
     return max(k for k, b in enumerate(bases) if b <= slot)
+
+
+def hover_label(shown: list[Handle], view: View) -> None:
+    """Inside the ImGui frame: the name of the shown handle under the pointer, beside it
+    (none while the pointer is over a panel)."""
+    io = imgui.get_io()
+    if io.want_capture_mouse:
+        return
+    h = under(shown, view, io.mouse_pos.x, io.mouse_pos.y)
+    if h is not None:
+        x, y, _ = project(view, h.position)
+        draw = imgui.get_foreground_draw_list()
+        draw.add_text(imgui.ImVec2(x + 10, y - 20), LABEL, h.label)

@@ -43,6 +43,12 @@ class Saving(Protocol):
     def answer_save(self) -> None: ...
 
 
+def save_as_default(doc: Document) -> str:
+    """What the save-as field starts with: the file itself, or for a shipped preset the
+    copy's default (``./NAME.toml``, else the user's folder), never the package's folder."""
+    return str(copy_target(doc.path) if doc.template else doc.path)
+
+
 def ask_copy(e: Saving) -> bool:
     """Saving a template: ask where the copy goes (the default filled in), taking over the
     unsaved-edits question if that is what asked; nothing is saved yet."""

@@ -1,6 +1,8 @@
 """The editor's structure tools [KRS17 §9.2]: insert, remove and duplicate a route's levels
 (keys, the outline's right-click menu and the panel's "structure" section), taper, scale the
 widths or the tree, move its foot, and grow a baked tree again from its growth parameters.
+In a compound they act on the selected component's route (its level chosen in the section);
+a component grown from ratios is baked first, an explicit KRS has no route to act on.
 
 Each operation is a pure function of the route (``scene/restructure.py``,
 ``scene/regrow.py``); here its result is validated by the scene's schema and committed as one
@@ -17,7 +19,7 @@ from imgui_bundle import imgui
 
 from ..document.document import Document
 from ..scene import Route, Scene, SceneError
-from ..scene.edits import validated
+from ..scene.edits import Path, get_at, path_text, replace_at, validated
 from ..scene.growth import Growth
 from ..scene.regrow import rebake
 from ..scene.restructure import (
@@ -34,7 +36,7 @@ from ..viewer.commands import Command
 from ..viewer.widgets import Interactions, field_widget
 from ..viewer.window import Viewer
 from . import commands as ec
-from .handles import Handle
+from .handles import Handle, route_outline
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
@@ -57,9 +59,10 @@ class StructureTools:
     widths: float = 1.25  # × every radius
     scale: float = 1.25  # × the whole tree, about its foot
     base: Vec3 | None = None  # where "move the foot" puts it (None: where it is)
+    level: int = 0  # in a compound: the level of the component's route the keys act on
     message: str = ""
     refused: bool = False
-    pending: tuple[Route, list[str], str] | None = None  # a re-grow waiting for a yes
+    pending: tuple[Path, Route, list[str], str] | None = None  # a re-grow waiting for a yes
 
 
 class Structured(Protocol):
@@ -76,6 +79,23 @@ class Structured(Protocol):
     def select_level(self, level: int) -> None: ...
 
 
+def baked(scene: Scene, component: int | None) -> tuple[Scene, str, str]:
+    """The scene with its grown tree (or a compound's ``component``'s) baked into a route,
+    the undo step's label, and what to say."""
+    if component is None:
+        return (
+            replace(scene, tree=None, route=scene.tree.route()),
+            "bake the tree into a route",
+            "baked: drag forks, control points and mirror normals",
+        )
+    c = replace(scene.compound[component], tree=None, route=scene.compound[component].tree.route())
+    return (
+        replace_at(scene, ("compound", component), c),
+        f"bake component {component}'s tree into a route",
+        f"baked component {component}: the structure tools act on its route",
+    )
+
+
 # ----------------------------------------------------------------------------- applying
 def _say(e: Structured, text: str, refused: bool) -> None:
     t = e.structure
@@ -86,22 +106,58 @@ def _say(e: Structured, text: str, refused: bool) -> None:
         e.viewer.error, e.viewer.message = "", text
 
 
+def component(e: Structured) -> int | None:
+    """In a compound, the selected component (None: nothing selected, or no compound)."""
+    return e.selected.level if e.scene.compound and e.selected is not None else None
+
+
+def target(e: Structured) -> tuple[Path | None, str]:
+    """Where the route the tools act on lies: ``("route",)``, or a compound's selected
+    component's ``("compound", k, "route")``; else None and why not."""
+    s = e.scene
+    if s.route is not None:
+        return ("route",), ""
+    if not s.compound:
+        bake = "; bake the tree first" if s.tree is not None else " (a tree's)"
+        return None, f"structure edits need a route{bake}"
+    k = component(e)
+    if k is None:
+        return None, "select a component first (click it in the outline or the view)"
+    c = s.compound[k]
+    if c.route is not None:
+        return ("compound", k, "route"), ""
+    if c.tree is not None:
+        return None, f"component {k} is grown from ratios: bake it into a route first"
+    return None, f"component {k} is an explicit KRS: structure edits need a tree's route"
+
+
 def commit_route(
-    e: Structured, make: Callable[[Route], Route], label: str, interaction: Any = None
+    e: Structured,
+    make: Callable[[Route], Route],
+    label: str,
+    interaction: Any = None,
+    at: Path | None = None,
 ) -> bool:
-    """Replace the route by ``make(route)``, validated, as one undo step; a SceneError
-    (from the operation or the schema) changes nothing and is said."""
-    if e.scene.route is None:
-        _say(e, f"{label}: structure edits need a route; bake the tree first", True)
+    """Replace the route at ``at`` (default: :func:`target`) by ``make(route)``, validated,
+    as one undo step; a SceneError (from the operation or the schema) changes nothing and
+    is said."""
+    why = ""
+    if at is None:
+        at, why = target(e)
+    if at is None:
+        _say(e, f"{label}: {why}", True)
         return False
     try:
-        scene = validated(replace(e.scene, route=make(e.scene.route)))
+        route = make(get_at(e.scene, at))
+        scene = validated(replace_at(e.scene, at, route))
     except SceneError as err:
         _say(e, f"{label} refused: {err}", True)
         return False
+    if at != ("route",):
+        label += f" (component {at[1]})"
     e.doc.commit(scene, label, interaction)
     e.viewer.sync()
-    warned = scene.route.warnings()
+    warned = get_at(scene, at).warnings()
     _say(e, label + (f" ({len(warned)} warnings)" if warned else ""), False)
     return True
 
@@ -109,10 +165,24 @@ def commit_route(
 def _level(e: Structured, level: int | None, what: str) -> int | None:
     if level is not None:
         return level
+    if e.scene.compound:  # the level chosen in the section, of the component's route
+        at, why = target(e)
+        if at is None:
+            _say(e, f"{what}: {why}", True)
+        return None if at is None else e.structure.level
     if e.selected is None or e.scene.route is None:
         _say(e, f"{what}: select a level first (click it in the outline or the view)", True)
         return None
     return e.selected.level
+
+
+def _choose(e: Structured, level: int) -> None:
+    """Select ``level`` after an operation: in the outline, or in a compound the section's
+    level of the component's route."""
+    if e.scene.compound:
+        e.structure.level = level
+    else:
+        e.select_level(level)
 
 
 def insert(e: Structured, level: int | None) -> None:
@@ -121,19 +191,20 @@ def insert(e: Structured, level: int | None) -> None:
     if i is not None and commit_route(
         e, lambda r: split_level(r, i, s), f"insert a fork in L{i} at {s:.2f}"
     ):
-        e.select_level(i + 1)
+        _choose(e, i + 1)
 
 
 def remove(e: Structured, level: int | None) -> None:
     i = _level(e, level, "remove a fork")
     if i is not None and commit_route(e, lambda r: merge_level(r, i), f"remove the fork of L{i}"):
-        e.select_level(min(i, len(e.scene.route.levels) - 1))
+        at, _ = target(e)
+        _choose(e, min(i, len(get_at(e.scene, at).levels) - 1))
 
 
 def duplicate(e: Structured, level: int | None) -> None:
     i = _level(e, level, "duplicate a level")
     if i is not None and commit_route(e, lambda r: duplicate_level(r, i), f"duplicate L{i}"):
-        e.select_level(i)
+        _choose(e, i)
 
 
 def whole_tree(e: Structured, op: str) -> None:
@@ -149,38 +220,41 @@ def whole_tree(e: Structured, op: str) -> None:
 
 def set_growth(e: Structured, name: str, value: Any, interaction: Any) -> None:
     """Grow again with one parameter changed; ask first when hand edits would be lost."""
-    route = e.scene.route
-    label = f"grow again with {name} = {value}"
+    _grow_again(e, f"grow again with {name} = {value}", interaction, name, value)
+
+
+def regrow(e: Structured) -> None:
+    _grow_again(e, "grow again from the growth parameters", None)
+
+
+def _grow_again(e: Structured, label: str, interaction: Any, *change: Any) -> None:
+    """Re-grow the target route, with ``change`` (a growth parameter's name and value) if
+    given; commit it, or keep it pending when hand edits would be lost."""
+    at, why = target(e)
+    if at is None:
+        _say(e, f"{label}: {why}", True)
+        return
+    route = get_at(e.scene, at)
     try:
-        growth = from_dict(Growth, {**to_dict(route.growth), name: value}, "route.growth")
+        growth = route.growth
+        if change:
+            where = path_text((*at, "growth"))
+            growth = from_dict(Growth, {**to_dict(growth), change[0]: change[1]}, where)
         new, lost = rebake(route, growth)
     except SceneError as err:
         _say(e, f"{label} refused: {err}", True)
         return
-    _regrown(e, new, lost, label, interaction)
-
-
-def regrow(e: Structured) -> None:
-    try:
-        new, lost = rebake(e.scene.route, e.scene.route.growth)
-    except SceneError as err:
-        _say(e, f"grow again refused: {err}", True)
-        return
-    _regrown(e, new, lost, "grow again from the growth parameters", None)
-
-
-def _regrown(e: Structured, new: Route, lost: list[str], label: str, interaction: Any) -> None:
     if lost:
-        e.structure.pending = (new, lost, label)
+        e.structure.pending = (at, new, lost, label)
     else:
-        commit_route(e, lambda r: new, label, interaction)
+        commit_route(e, lambda r: new, label, interaction, at)
 
 
 def confirm_regrow(e: Structured) -> None:
     pending, e.structure.pending = e.structure.pending, None
     if pending is not None:
-        new, lost, label = pending
-        commit_route(e, lambda r: new, f"{label} (losing {len(lost)} hand edits)")
+        at, new, lost, label = pending
+        commit_route(e, lambda r: new, f"{label} (losing {len(lost)} hand edits)", at=at)
 
 
 STRUCTURE_HANDLERS: dict[type[Command], Callable[[Any, Any], None]] = {
@@ -215,14 +289,29 @@ def outline_menu(k: int) -> list[Command]:
 def structure_section(e: Structured, interactions: Interactions) -> list[Command]:
     """The panel's "structure" section (a route only), and the re-grow dialog."""
     out: list[Command] = []
-    route, t = e.scene.route, e.structure
-    if route is None or not imgui.collapsing_header("structure", imgui.TreeNodeFlags_.default_open):
+    t = e.structure
+    at, why = target(e)
+    if (at is None and not e.scene.compound) or not imgui.collapsing_header(
+        "structure", imgui.TreeNodeFlags_.default_open
+    ):
         return out
     imgui.push_text_wrap_pos(0.0)
-    imgui.text_disabled(
-        ("on the selected level" if e.selected is not None else "select a level first")
-        + "; or right-click an outline entry"
-    )
+    if at is None:  # a compound's component without a route
+        imgui.text_disabled(why)
+        k = component(e)
+        tree = k is not None and e.scene.compound[k].tree is not None
+        if tree and imgui.button(f"bake component {k} into a route"):
+            out.append(ec.Bake(k))
+        imgui.pop_text_wrap_pos()
+        return out
+    route = get_at(e.scene, at)
+    if at == ("route",):
+        imgui.text_disabled(
+            ("on the selected level" if e.selected is not None else "select a level first")
+            + "; or right-click an outline entry"
+        )
+    else:
+        _component_level(t, route, out)
     imgui.pop_text_wrap_pos()
     imgui.set_next_item_width(120)
     changed, s = imgui.slider_float("split at##structure", t.split_at, 0.05, 0.95, "%.2f")
@@ -265,6 +354,18 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
         _growth(route.growth, out, interactions)
     _regrow_dialog(t, out)
     return out
+
+
+def _component_level(t: StructureTools, route: Route, out: list[Command]) -> None:
+    """In a compound: which level of the selected component's route the tools act on."""
+    n = len(route.levels)
+    names = route_outline(route)
+    level = min(t.level, n - 1)
+    imgui.text_disabled("on this level of the component's route:")
+    imgui.set_next_item_width(160)
+    changed, k = imgui.combo("##component level", n - 1 - level, names[::-1])  # trunk first
+    if changed or level != t.level:
+        out.append(ec.SetToolValue("level", n - 1 - k if changed else level))
 
 
 def _growth(growth: Growth, out: list[Command], interactions: Interactions) -> None:

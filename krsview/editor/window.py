@@ -25,11 +25,13 @@ import glfw  # noqa: E402  (after imgui, as the viewer)
 import numpy as np
 from imgui_bundle import imgui
 
-from ..compile.camera import View, project, view_of
+from ..compile.camera import View, view_of
 from ..compile.geometry import scene_ball
 from ..document.document import ConflictError, Document
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
 from ..scene import Bookmark, Scene, SceneError
+from ..scene.edits import apply_edit, path_text
+from ..scene.mokrs import check_view
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
 from ..viewer import commands as vc
 from ..viewer.controls import VIEWER_KEYS
@@ -41,15 +43,15 @@ from .clipped import clipped_parts
 from .gizmo import Gizmo
 from .handles import Handle, handles
 from .keys import Timeline, key_now, keyed_edit, track_index
-from .layout import Layout, frame
+from .layout import Layout, frame, shift
 from .panels import edit_panel
-from .picking import pick, under, visible
-from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave
+from .picking import hover_label, pick, visible
+from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave, save_as_default
 from .shapes import editor_shapes
-from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools
+from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
 
-LABEL = 0xFFFFFFFF  # hover labels: white (ImGui's packed ABGR)
+VIEW = "view.position"  # the viewpoint flown in the editor, in a refused edit's message
 EDITOR_KEYS = {
     **VIEWER_KEYS,
     "ctrl+S": ec.Save(),
@@ -80,7 +82,7 @@ class Editor:
         self._handles: list[Handle] = []
         self.warnings: list[str] = []
         self.clipped: list[tuple[int, np.ndarray]] = []  # what Alg. 1 clips (drawn red)
-        self.save_as_text = str(self.path)
+        self.save_as_text = save_as_default(self.doc)
         self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
         self.recovered = self.doc.recovery()  # offered in a modal
         self.conflict = False
@@ -131,11 +133,24 @@ class Editor:
         return self.scene
 
     def edit(self, path: tuple, value, interaction=None) -> bool:
-        """An edit through the document; a value refused for a field the panel shows keeps
-        its message at that field (viewer/widgets.py), any other in the panel's error line."""
-        ok = self.viewer.edit(path, value, interaction)
-        if self.viewer.interactions.settle(path, value, self.viewer.error):
-            self.viewer.error = ""
+        """An edit through the document, validated by the schema; in a MöKRS the viewpoint
+        the person flies must stay off every pole too, not only the file's camera
+        [KRS17 §7]. A value refused for a field the panel shows keeps its message at that
+        field (viewer/widgets.py), any other in the panel's error line."""
+        v = self.viewer
+        try:
+            scene = apply_edit(self.scene, path, value)
+            if scene.mokrs is not None:
+                check_view(scene.mokrs, tuple(v.camera.position), VIEW)
+        except SceneError as e:
+            v.error = str(e)
+        else:
+            self.doc.commit(scene, f"set {path_text(path)}", interaction)
+            v.error = ""
+            v.sync()
+        ok = not v.error
+        if v.interactions.settle(path, value, v.error):
+            v.error = ""
         return ok
 
     def _update_title(self) -> None:
@@ -247,14 +262,13 @@ class Editor:
             return
         self.save(str(target))
 
-    def bake(self) -> None:
-        """Grown tree → route (one undo step): every fork becomes a handle."""
-        t = self.scene.tree
-        self.doc.commit(
-            replace(self.scene, tree=None, route=t.route()), "bake the tree into a route"
-        )
+    def bake(self, component: int | None = None) -> None:
+        """Grown tree → route (one undo step): every fork becomes a handle; or the tree of a
+        compound's ``component`` (the structure tools then act on its route)."""
+        scene, label, said = baked(self.scene, component)
+        self.doc.commit(scene, label)
         self.viewer.sync()
-        self.viewer.message = "baked: drag forks, control points and mirror normals"
+        self.viewer.message = said
 
     def set_key(self) -> None:
         """K: a key for the selected value at the moment shown, holding the value drawn."""
@@ -318,15 +332,24 @@ class Editor:
     def _open(self, path: Path) -> None:
         self.viewer.open_preset(path)
         self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
-        self.save_as_text = str(self.path)
+        self.save_as_text = save_as_default(self.doc)
         self.frame()
 
     def place_panel(self, side: str, width: float) -> None:
-        """Dock the panel on ``side`` at ``width``; a new side frames the scene again."""
-        moved = side != self.layout.side
-        self.layout.side, self.layout.width = side, width
-        if moved:
-            self.frame()
+        """Dock the panel on ``side`` at ``width``; what was in the middle of the view stays
+        in the middle of the part the panel leaves."""
+        self._relayout(replace(self.layout, side=side, width=width))
+
+    def fold_panel(self, folded: bool) -> None:
+        """The panel folded (the view has the whole window) or unfolded: what was in the
+        middle of the view stays there."""
+        self._relayout(replace(self.layout, folded=folded))
+
+    def _relayout(self, layout: Layout) -> None:
+        size = glfw.get_window_size(self.viewer.window)
+        if shift(self.viewer.camera, size, self.layout.free(size), layout.free(size)):
+            self.viewer.frames.dirty = True
+        self.layout = layout
 
     def reset_view(self) -> None:
         self.viewer.reset_view()
@@ -379,7 +402,7 @@ class Editor:
         size = glfw.get_window_size(v.window)
         path = self.selected.path if self.selected is not None else None
         self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
-        self._hover_label(shown, view)
+        hover_label(shown, view)
 
     def _manipulate(self) -> None:
         """Inside the ImGui frame, before the turn's image is traced: the gizmo on a selected
@@ -395,21 +418,11 @@ class Editor:
                 path, value = sel.edit_to(self.scene, p, self.carry and not keyed)
                 self.edit(*keyed_edit(self.scene, path, value, self.viewer.playback.time), drag)
 
-    def _hover_label(self, shown: list[Handle], view: View) -> None:
-        io = imgui.get_io()
-        if io.want_capture_mouse:
-            return
-        h = under(shown, view, io.mouse_pos.x, io.mouse_pos.y)
-        if h is not None:
-            x, y, _ = project(view, h.position)
-            draw = imgui.get_foreground_draw_list()
-            draw.add_text(imgui.ImVec2(x + 10, y - 20), LABEL, h.label)
-
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
 # edit, opening or reloading asks about unsaved edits); tests/test_commands.py checks them.
 EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
-    ec.Bake: lambda e, c: e.bake(),
+    ec.Bake: lambda e, c: e.bake(c.component),
     ec.SetKey: lambda e, c: e.set_key(),
     ec.Select: lambda e, c: e.select(c.handle),
     ec.SelectLevel: lambda e, c: e.select_level(c.level),
@@ -432,6 +445,7 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction),
     vc.ResetView: lambda e, c: e.reset_view(),
     ec.PlacePanel: lambda e, c: e.place_panel(c.side, c.width),
+    ec.FoldPanel: lambda e, c: e.fold_panel(c.folded),
     **STRUCTURE_HANDLERS,
     **SAVING_HANDLERS,
 }

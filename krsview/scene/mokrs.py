@@ -257,7 +257,7 @@ def check_view(mokrs: MoKRS, position: Vec3, path: str) -> None:
             if np.linalg.norm(x[0] - p) <= POLE_DISTANCE * scale:
                 raise SceneError(
                     path,
-                    list(position),
+                    [float(c) for c in position],  # a NumPy camera prints as plain numbers
                     f"level {i}'s transform sends this point to infinity (its pole, "
                     f"mokrs.levels[{i}].transform); allowed: a viewpoint off the pole: "
                     "move it, or the inversion's centre",

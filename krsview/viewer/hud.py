@@ -78,6 +78,7 @@ class Viewed(Protocol):
 
 def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
     out: list[c.Command] = []
+    interactions.inline.clear()  # the fields drawn this frame show their own errors
     imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
     tallest = imgui.get_io().display_size.y - 16
     imgui.set_next_window_size_constraints(
@@ -159,11 +160,13 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
         meta = RENDER_META[name]
         if name == "tracer" and v.scene.mokrs is not None:
             meta = {**meta, "choices": ("binary",)}  # a MöKRS has only unbounding tests
-        changed, value = field_widget(f"{name}##render", getattr(r, name), meta)
+        refused = interactions.refusal(("render", name))  # a refused value stays here
+        changed, value = field_widget(f"{name}##render", getattr(r, name), meta, refused)
         key = interactions.key(("render", name))
         if changed:
             out.append(c.Edit(("render", name), value, key))
-    changed, tile = field_widget("prepass##render", v.prepass, RENDER_META["prepass"])
+    refused = interactions.refusal(("render", "prepass"))
+    changed, tile = field_widget("prepass##render", v.prepass, RENDER_META["prepass"], refused)
     key = interactions.key(("render", "prepass"))
     if changed:
         out.append(c.SetPrepass(tile, key))

@@ -203,10 +203,11 @@ class Viewer:
         the last valid scene in place."""
         try:
             self.doc.apply(path, value, interaction)
-        except SceneError as e:
-            self.error = str(e)
+        except SceneError as e:  # shown at its field where the HUD draws one (widgets.py)
+            self.error = "" if self.interactions.settle(path, value, str(e)) else str(e)
             return False
         self.error = ""
+        self.interactions.settle(path, value, "")
         self.sync()
         return True
 

@@ -1,0 +1,212 @@
+"""The edit panel and the HUD in real windows under Xvfb, with real pointer and key events:
+folding the panel gives the view the whole width (the scene stays in the middle of what is
+free); a route level's ``grown`` is text, not a field; a shipped preset's save-as field
+starts at its copy, never in the package; a value the viewer's HUD refuses stays in its
+field with the message under it, as the editor's panel keeps its own."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from krsview.editor.commands import Bake, SaveAs
+from krsview.scene import load_scene
+from krsview.scene.presets import PRESET_DIR, resolve
+
+from .test_editor import LEVEL, pump, window_xy, xdo
+
+SIZE = (640, 400)
+
+
+@pytest.fixture
+def tree_editor(display, tmp_path):
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    e = Editor(path, size=SIZE)
+    e.execute([Bake()])
+    yield e
+    e.close()
+
+
+def target_column(e) -> float:
+    from krsview.compile.camera import project
+
+    x, _, _ = project(e.window_view(), np.array(e.scene.camera.target))
+    return x
+
+
+def test_folding_the_panel_gives_the_view_the_whole_width_and_unfolding_takes_it_back(
+    tree_editor,
+):
+    """A click on the panel's fold arrow: the scene's target moves to the middle of the
+    window, and back to the middle of the part left of the panel on unfolding. Negative
+    control: unfolded, it is well off the window's middle."""
+    from imgui_bundle import imgui
+
+    e = tree_editor
+    pump(e, 3)
+    x0, x1 = e.layout.free(SIZE)
+    assert abs(target_column(e) - (x0 + x1) / 2) < 2
+    assert abs(target_column(e) - SIZE[0] / 2) > 50, "negative control: already centred"
+    w = imgui.internal.find_window_by_name("edit")
+    arrow = window_xy(e, w.pos.x + 10, w.pos.y + imgui.get_frame_height() / 2)
+    for folded, middle in ((True, SIZE[0] / 2), (False, (x0 + x1) / 2)):
+        xdo("mousemove", *map(round, arrow))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 3)
+        assert e.layout.folded is folded
+        assert imgui.internal.find_window_by_name("edit").collapsed is folded
+        assert abs(target_column(e) - middle) < 2, (folded, target_column(e), middle)
+
+
+def test_a_levels_grown_depth_is_text_that_clicks_and_typing_do_not_change(tree_editor):
+    """The selected level's ``grown`` (bookkeeping for growing again) is a line of text:
+    ctrl+click on it and typing a number changes nothing and refuses nothing (a field took
+    the typing and refused the depth). Negative control: the same on the radius field just
+    above edits the radius (one undo step)."""
+    e = tree_editor
+    e.select_level(LEVEL)
+    pump(e, 3)
+    level = ("route", "levels", LEVEL)
+    grown = e.scene.route.levels[LEVEL].grown
+    assert grown is not None
+
+    def type_at(field: str, text: str) -> None:
+        for _ in range(10):  # the panel scrolls to bring the field into view
+            x0, y0, x1, y1 = e.viewer.interactions.rects[(*level, field)]
+            if y1 < SIZE[1] - 40:
+                break
+            xdo("mousemove", *map(round, window_xy(e, x0 + 5, SIZE[1] - 30)))
+            xdo("click", 5)
+            pump(e, 2)
+        xdo("mousemove", *map(round, window_xy(e, x0 + 20, (y0 + y1) / 2)))
+        pump(e, 2)
+        xdo("keydown", "ctrl")
+        xdo("click", 1)
+        xdo("keyup", "ctrl")
+        pump(e, 2)
+        xdo("type", text)
+        pump(e, len(text) + 2)  # ImGui takes the typed characters one per frame
+        xdo("key", "Return")
+        pump(e, 3)
+
+    steps = len(e.doc.history.steps)
+    type_at("grown", "7")  # a depth another level has: a field would refuse it, and say so
+    assert e.scene.route.levels[LEVEL].grown == grown
+    assert len(e.doc.history.steps) == steps
+    assert e.viewer.error == "" and (*level, "grown") not in e.viewer.interactions.refused
+    type_at("radius", "0.125")
+    assert e.scene.route.levels[LEVEL].radius == 0.125, "negative control: a field edits"
+    assert len(e.doc.history.steps) == steps + 1
+
+
+def test_a_shipped_presets_save_as_field_starts_at_its_copy(display, tmp_path, monkeypatch):
+    """Opened from the package, the save-as field holds ./tree.toml in the working folder
+    and "save as" writes there, the package untouched. Negative control: a user's own file
+    starts with its own path."""
+    from krsview.editor.window import Editor
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    before = {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()}
+    e = Editor(resolve("tree"), size=SIZE)
+    try:
+        assert e.save_as_text == str(tmp_path / "tree.toml")
+        e.execute([Bake()])
+        pump(e)
+        e.execute([SaveAs()])
+        assert e.path == tmp_path / "tree.toml" and load_scene(e.path).route is not None
+    finally:
+        e.close()
+    assert {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()} == before
+    mine = tmp_path / "mine.toml"
+    shutil.copy(resolve("tree"), mine)
+    e = Editor(mine, size=SIZE)
+    try:
+        assert e.save_as_text == str(mine)
+    finally:
+        e.close()
+
+
+def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
+    display, tmp_path, monkeypatch
+):
+    """In the viewer (no editor), type 0 into the HUD's max_iterations (allowed 1..10000):
+    the field keeps 0 on red with the message under it, the scene keeps 256, the HUD's error
+    line stays empty; a valid value clears it, Esc cancels a refused one. Negative control:
+    no red there before."""
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.viewer.window import Viewer
+
+    header = imgui.collapsing_header  # open the "accuracy and view" section from the start
+    monkeypatch.setattr(
+        imgui,
+        "collapsing_header",
+        lambda label, *a: (
+            header(label, imgui.TreeNodeFlags_.default_open)
+            if label == "accuracy and view"
+            else header(label, *a)
+        ),
+    )
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=(640, 720))
+    field = ("render", "max_iterations")
+
+    def turn(n: int = 3) -> None:
+        for _ in range(n):
+            glfw.poll_events()
+            v.step(0.02)
+
+    def red_below() -> int:
+        x0, y0, x1, y1 = v.interactions.rects[field]
+        shot = v.read_window().astype(int)
+        r, g, b = (shot[round(y1) : round(y1) + 34, round(x0) : round(x1), k] for k in range(3))
+        text = (r > 180) & (g < 140) & (b < 130) & (r - g > 80)
+        box = shot[round(y0) + 2 : round(y1) - 2, round(x0) + 2 : round(x1) - 60]
+        return int(text.sum()) + int((np.abs(box - [140, 20, 15]) < 40).all(-1).sum())
+
+    def type_in(text: str) -> None:
+        x0, y0, x1, y1 = v.interactions.rects[field]
+        wx, wy = glfw.get_window_pos(v.window)
+        xdo("mousemove", round(wx + x0 + 30), round(wy + (y0 + y1) / 2))
+        turn(2)
+        xdo("keydown", "ctrl")
+        xdo("click", 1)
+        xdo("keyup", "ctrl")
+        turn(2)
+        xdo("key", "ctrl+a")
+        xdo("type", text)
+        turn(len(text) + 2)  # ImGui takes the typed characters one per frame
+        xdo("key", "Return")
+        turn(3)
+
+    try:
+        turn(4)
+        assert field in v.interactions.rects, "the section is not open"
+        assert red_below() == 0
+        type_in("0")
+        refused = v.interactions.refused.get(field)
+        assert refused is not None and refused.value == 0, v.error
+        assert "max_iterations" in refused.message and v.error == ""
+        assert v.scene.render.max_iterations == 256
+        turn(2)
+        assert red_below() > 40, "no red field and message under it"
+        type_in("300")
+        assert v.scene.render.max_iterations == 300 and field not in v.interactions.refused
+        assert red_below() == 0
+        type_in("0")
+        assert field in v.interactions.refused
+        xdo("key", "Escape")
+        turn(3)
+        assert field not in v.interactions.refused and red_below() == 0
+        assert v.scene.render.max_iterations == 300
+    finally:
+        v.close()
