@@ -399,9 +399,10 @@ class Editor:
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))
-        size = glfw.get_window_size(v.window)
-        path = self.selected.path if self.selected is not None else None
-        self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
+        if self.scene.animated:  # a still scene keeps the whole view (K starts a track)
+            size = glfw.get_window_size(v.window)
+            path = self.selected.path if self.selected is not None else None
+            self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
         hover_label(shown, view)
 
     def _manipulate(self) -> None:
