@@ -317,3 +317,18 @@ def test_a_ray_through_a_pole_is_decided():
             c, view.origin, dirs, np.array([s.render.max_distance]), view.footprint, arithmetic
         )
         assert list(cert.surface) == [0], arithmetic
+
+
+def test_the_oracle_certifies_a_swaying_frame_and_finds_the_rest_pose_wrong(renderer):
+    """Issue 29: a frame of tree-sway at t = 0.9 s (the coarsest mirrors turned) has no
+    certified hole or false hit; the rest pose's image judged as that moment's has both."""
+    from krsview.api import exact_settings
+
+    s = exact_settings(load_scene(resolve("tree-sway"))).at(0.9)
+    img = renderer.render(s, 48, 27)
+    counts = count_errors(s, img)
+    assert (counts.holes, counts.false_hits) == (0, 0), counts
+    assert counts.hits > 20
+    rest = renderer.render(s.at(0.0), 48, 27)  # the negative control: another moment
+    wrong = count_errors(s, rest)
+    assert wrong.holes + wrong.false_hits > 0, wrong
