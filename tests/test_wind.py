@@ -149,18 +149,22 @@ def test_gusts_are_bounded_and_phases_differ():
     rates = np.array([Wind.of(grove.at(t)).rates for t in np.linspace(0, 20, 201)])
     w = Wind.of(grove)
     assert np.abs(rates).max() <= w.most
-    sways = rates[:, w.sways > 0]
+    sways = rates[:, w.reach > 0]
     corr = np.corrcoef(sways.T)[np.triu_indices(sways.shape[1], 1)]
     assert corr.max() < 0.9, corr
-    assert np.all(rates[:, w.sways == 0] == 0)  # the ground stands
+    assert np.all(rates[:, w.reach == 0] == 0)  # the ground stands
 
 
 def test_a_compound_bends_each_component_about_its_placed_foot():
+    """Each foot is moved by its component's placement; the reach holds the component's
+    ball, and the ground (unbounded) stands."""
     grove = preset("grove-wind")
-    kinds = [["toroidal_capsule"]] * 7 + [["plane"]]
-    feet = wind_feet(grove, kinds)
+    balls = [(1.0, 2.0, 3.0, 0.5)] * 7 + [(0.0, 0.0, 0.0, -1.0)]
+    feet = wind_feet(grove, balls)
     assert [f for f, _ in feet][:2] == [(0.0, 0.0, 0.0), (-4.2, 0.0, 3.0)]
-    assert [s for _, s in feet] == [1.0] * 7 + [0.0]
+    assert feet[0][1] == pytest.approx(np.sqrt(14) + 0.5)
+    assert feet[1][1] == pytest.approx(np.sqrt(5.2**2 + 4 + 0) + 0.5)
+    assert feet[7][1] == 0.0
 
 
 def test_a_vertical_wind_is_a_one_line_error():

@@ -160,9 +160,9 @@ def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     a0 = np.radians(fx.wind_strength) / fx.wind_height
     phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
     feet = []
-    if "wind" in scene.effects:  # a MöKRS has no components' kinds to sway
-        kinds = [part.types for part, _ in component_slots(c)]
-        feet = [(*(np.array(b) - view.origin), s) for b, s in wind_feet(scene, kinds)]
+    if "wind" in scene.effects:  # not on a MöKRS
+        balls = [(*(part.ball[:3] + view.origin), part.ball[3]) for part, _ in component_slots(c)]
+        feet = [(*(np.array(b) - view.origin), r) for b, r in wind_feet(scene, balls)]
     feet += [(0.0, 0.0, 0.0, 0.0)] * (MAX_COMPONENTS - len(feet))
     return {
         "u_time": scene.time,

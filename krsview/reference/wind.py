@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.krs import grown, krs_ball
 from ..scene import Compound, Scene
 from ..scene.effects import WIND_PHASE, WIND_RATIOS, WIND_WEIGHTS, EffectSettings, wind_feet
 
@@ -44,7 +45,7 @@ class Wind:
     axis: np.ndarray  # A, unit and horizontal (3,)
     rates: np.ndarray  # a_c(t) per component, radians per unit height (C,); 0: it stands
     bases: np.ndarray  # each component's foot b_c (C, 3)
-    sways: np.ndarray  # 1 where the component sways, 0 where it stands (C,)
+    reach: np.ndarray  # how far each component gets from its foot; 0: it stands (C,)
     most: float  # the largest |a_c(t)| at any time: radians(strength)/height · (1 + gust)
 
     @staticmethod
@@ -53,14 +54,14 @@ class Wind:
         w = np.array([fx.wind_direction[0], 0.0, fx.wind_direction[2]])
         geometry = scene.geometry()
         parts = geometry.parts if isinstance(geometry, Compound) else (geometry,)
-        feet = wind_feet(scene, [[k.kind for k in krs.kernels] for krs in parts])
-        sways = np.array([s for _, s in feet])
+        feet = wind_feet(scene, [grown(krs_ball(krs)) for krs in parts])
+        reach = np.array([r for _, r in feet])
         phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
         return Wind(
             np.cross(UP, w / np.linalg.norm(w)),
-            sways * wind_rate(fx, scene.time + phase * np.arange(len(feet))),
+            (reach > 0) * wind_rate(fx, scene.time + phase * np.arange(len(feet))),
             np.array([b for b, _ in feet], dtype=float),
-            sways,
+            reach,
             float(np.radians(fx.wind_strength) / fx.wind_height * (1.0 + fx.wind_gust)),
         )
 
@@ -85,13 +86,14 @@ class Wind:
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
     def lod_scale(self, p: np.ndarray) -> np.ndarray:
-        """1 / (1 + most·ρ), ρ to the nearest swaying component's axis: ε shrinks as the step
-        does to first order (distortion.py, lod_scale), at any time; exact for one KRS, and in
-        a compound ε only sets where a ray stops, never how far it may step."""
-        rho = np.full(len(p), np.inf)
-        for c in np.flatnonzero(self.sways):
-            rho = np.minimum(rho, self.wind_rho(c, p))
-        return 1.0 / (1.0 + self.most * np.where(np.isinf(rho), 0.0, rho))
+        """1 / (1 + most·ρ): ε shrinks as the step does to first order (distortion.py,
+        lod_scale), at any time. ρ: to the farthest axis of the components within whose
+        reach p lies; elsewhere no component can stop a ray, so ε stays (a ground's)."""
+        rho = np.zeros(len(p))
+        for c in np.flatnonzero(self.reach):
+            near = np.linalg.norm(p - self.bases[c], axis=1) <= self.reach[c]
+            rho = np.where(near, np.maximum(rho, self.wind_rho(c, p)), rho)
+        return 1.0 / (1.0 + self.most * rho)
 
 
 def wind_rate(fx: EffectSettings, t: np.ndarray) -> np.ndarray:

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from .compound import Placement
 from .schema import SceneError, Vec3, param
 
@@ -229,16 +231,19 @@ def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> Non
             raise SceneError(path, effects, f"'{a}' and '{b}' exclude each other; choose one")
 
 
-def wind_feet(scene, kinds: list) -> list[tuple[Vec3, float]]:
-    """Per component of ``scene`` (a Scene with a KRS or a compound), given its kernels' kinds
-    (``Kernel.kind``, ``CompiledKRS.types``): its foot, ``wind_base`` moved by the component's
-    placement, and 1 where it sways or 0 where it stands: a KRS with a plane kernel (a ground)
-    is unbounded, so its bend and Lipschitz bound would be too."""
+def wind_feet(scene, balls: list) -> list[tuple[Vec3, float]]:
+    """Per component of ``scene`` (a Scene with a KRS or a compound), given the ball around
+    it (``CompiledKRS.ball``, world; radius < 0: unbounded): its foot, ``wind_base`` moved by
+    the component's placement, and its reach, the farthest its geometry gets from the foot (a
+    turn about the foot keeps it), or 0 where it stands: an unbounded KRS (a ground plane)
+    would make the bend and its Lipschitz bound unbounded too."""
     base = scene.effect_settings.wind_base
-    sways = [0.0 if "plane" in k else 1.0 for k in kinds]
-    if not scene.compound:
-        return [(base, sways[0])]
+    feet = (
+        [Placement(c.position, c.axis, c.angle, c.scale).point(base) for c in scene.compound]
+        if scene.compound
+        else [base]
+    )
     return [
-        (Placement(c.position, c.axis, c.angle, c.scale).point(base), s)
-        for c, s in zip(scene.compound, sways)
+        (foot, float(np.linalg.norm(np.array(ball[:3]) - foot) + ball[3]) if ball[3] >= 0 else 0.0)
+        for foot, ball in zip(feet, balls)
     ]

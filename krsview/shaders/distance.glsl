@@ -38,14 +38,15 @@ vec3r undistort(int c, vec3r p) {
 // The factor of the LOD threshold ε(t) at p: the twist's safe step is D / (1 + |k|ρ) to
 // first order, so ε shrinks by the same factor and rays converge where the undistorted
 // distance is within ε(t), not high above a twisted ground (reference/distortion.py, lod_scale).
-// The wind's takes the largest rate any time gives and the nearest swaying component's axis.
+// The wind's takes the largest rate any time gives and the farthest axis of the components
+// within whose reach p lies (elsewhere none can stop a ray: a ground keeps its ε).
 real lod_scale(vec3r p) {
 #ifdef KRS_WIND
     if (EFFECT_ON(KRS_WIND_BIT)) {
-        real rho = FAR_AWAY;
+        real rho = 0.0;
         for (int c = 0; c < COMPONENTS; ++c)
-            if (u_wind_base[c].w > 0.0) rho = min(rho, wind_rho(c, p));
-        return 1.0 / (1.0 + u_wind.w * (rho < FAR_AWAY ? rho : 0.0));
+            if (length(p - u_wind_base[c].xyz) <= u_wind_base[c].w) rho = max(rho, wind_rho(c, p));
+        return 1.0 / (1.0 + u_wind.w * rho);
     }
 #endif
 #ifdef KRS_TWIST

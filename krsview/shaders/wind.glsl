@@ -6,7 +6,7 @@ uniform vec3 u_wind_axis;      // A = normalize(up × wind), horizontal
 uniform vec4 u_wind;           // radians of lean per unit height, gust, phase step (s), most |a|
 uniform vec3 u_wind_freq;      // the gusts' three angular frequencies, radians per second
 uniform vec3 u_wind_weight;    // and their weights (sum 1)
-uniform vec4 u_wind_base[COMPONENT_SLOTS];  // foot (camera-relative); w: 1 sways, 0 stands
+uniform vec4 u_wind_base[COMPONENT_SLOTS];  // foot (camera-relative); w: reach, 0: stands
 
 // n(t): the gusts' sway about the mean lean, |n| ≤ 1.
 float wind_gust(float t) { return dot(u_wind_weight, sin(u_wind_freq * t)); }
@@ -15,7 +15,7 @@ float wind_gust(float t) { return dot(u_wind_weight, sin(u_wind_freq * t)); }
 // in step.
 float wind_rate(int c) {
     float t = u_time + float(c) * u_wind.z;
-    return u_wind_base[c].w * u_wind.x * (1.0 + u_wind.y * wind_gust(t));
+    return float(u_wind_base[c].w > 0.0) * u_wind.x * (1.0 + u_wind.y * wind_gust(t));
 }
 
 // How far v moves when turned about A by `angle` (Rodrigues, with 1 − cos = 2 sin²(angle/2)
