@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from krsview.compile.krs import compile_krs
+from krsview.oracle.certify import count_errors
 from krsview.reference import render_reference
 from krsview.reference.distortion import Distortion
 from krsview.reference.geometry import scene_distance
@@ -239,3 +240,12 @@ def test_idle_wind_draws_the_still_scene(renderer):
     assert np.abs(wind.color - base.color).max() < 1e-6
     slight = replace(idle, effect_settings=replace(idle.effect_settings, wind_strength=0.5))
     assert not np.array_equal(renderer.render(slight, 64, 36).depth, base.depth)
+
+
+def test_the_oracle_refuses_wind(renderer):
+    """The oracle has no wind in it, so it refuses to certify a windy frame rather than
+    certify the still geometry; the still scene it takes (negative control)."""
+    s = small_tree(6)
+    with pytest.raises(ValueError, match="without twist, wind or empty zones"):
+        count_errors(s, renderer.render(s, 4, 3))
+    assert count_errors(still(s), renderer.render(still(s), 4, 3)).holes == 0
