@@ -89,11 +89,13 @@ class Wind:
         """1 / (1 + most·ρ): ε shrinks as the step does to first order (distortion.py,
         lod_scale), at any time. ρ: to the farthest axis of the components within whose
         reach p lies; elsewhere no component can stop a ray, so ε stays (a ground's)."""
-        rho = np.zeros(len(p))
+        rho2 = np.zeros(len(p))  # squared: ρ² = |r|² − (A·r)²
         for c in np.flatnonzero(self.reach):
-            near = np.linalg.norm(p - self.bases[c], axis=1) <= self.reach[c]
-            rho = np.where(near, np.maximum(rho, self.wind_rho(c, p)), rho)
-        return 1.0 / (1.0 + self.most * rho)
+            r = p - self.bases[c]
+            rr = np.einsum("ij,ij->i", r, r)
+            near = rr <= self.reach[c] ** 2
+            rho2 = np.where(near, np.maximum(rho2, rr - (r @ self.axis) ** 2), rho2)
+        return 1.0 / (1.0 + self.most * np.sqrt(rho2))
 
 
 def wind_rate(fx: EffectSettings, t: np.ndarray) -> np.ndarray:

@@ -43,10 +43,16 @@ vec3r undistort(int c, vec3r p) {
 real lod_scale(vec3r p) {
 #ifdef KRS_WIND
     if (EFFECT_ON(KRS_WIND_BIT)) {
-        real rho = 0.0;
-        for (int c = 0; c < COMPONENTS; ++c)
-            if (length(p - u_wind_base[c].xyz) <= u_wind_base[c].w) rho = max(rho, wind_rho(c, p));
-        return 1.0 / (1.0 + u_wind.w * rho);
+        // squared, as is all of the loop: ρ² = |r|² − (A·r)²; over every slot, a constant
+        // count the compiler unrolls (an unused slot's reach is 0)
+        float rho2 = 0.0;
+        for (int c = 0; c < COMPONENT_SLOTS; ++c) {
+            vec4 foot = u_wind_base[c];
+            vec3 r = vec3(p) - foot.xyz;
+            float rr = dot(r, r), ar = dot(u_wind_axis, r);
+            if (rr <= foot.w * foot.w) rho2 = max(rho2, rr - ar * ar);
+        }
+        return 1.0 / (1.0 + u_wind.w * sqrt(rho2));
     }
 #endif
 #ifdef KRS_TWIST
