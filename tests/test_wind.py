@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
+from krsview.compile.camera import view_of
 from krsview.compile.krs import compile_krs
 from krsview.oracle.certify import count_errors
 from krsview.reference import render_reference
@@ -207,6 +209,44 @@ def test_gpu_matches_the_reference_on_the_grove(renderer, t):
     gpu, ref = renderer.render(s, 48, 32), render_reference(s, 48, 32)
     assert_finite(gpu, s.render.max_iterations)
     check_against_reference(f"wind-grove-t{t}", gpu, ref)
+
+
+@pytest.mark.parametrize(
+    "name, knob, value",
+    [
+        ("tree-wind", "precision", "double"),
+        ("tree-wind", "path", "compute"),
+        ("tree-wind", "tracer", "binary"),  # its probes ask the wind's unbounding test
+        ("grove-wind", "precision", "double"),
+        ("grove-wind", "path", "compute"),
+    ],
+)
+def test_every_path_follows_the_wind(renderer, name, knob, value):
+    """Double precision, the compute path and the binary tracer's ball probes all step by
+    the wind's bound: each matches the reference in a strong wind."""
+    s = small_tree() if name == "tree-wind" else per_pixel(preset(name).edit("render.lod", 0.0))
+    s = replace(s, effect_settings=replace(s.effect_settings, wind_strength=12.0))
+    s = s.edit(("render", knob), value).at(2.2)
+    check_against_reference(
+        f"wind-{name}-{value}", renderer.render(s, 48, 32), render_reference(s, 48, 32)
+    )
+
+
+@pytest.mark.parametrize("name", ["tree-wind", "grove-wind"])
+def test_the_prepass_follows_the_wind(renderer, name):
+    """The pre-pass's cones ask the wind's bound (is_unbounding): with it, away from outlines
+    every pixel has the same hit state as without it and a depth within about one ε
+    (tests/test_prepass.py's check; the oracle has no wind). Negative control: the still
+    scene's image does not agree with the windy one."""
+    s = replace(preset(name), render=replace(preset(name).render, prepass=0)).at(1.1)
+    s = replace(s, effect_settings=replace(s.effect_settings, wind_strength=12.0))
+    plain = renderer.render(s, 96, 54)
+    img = renderer.render(replace(s, render=replace(s.render, prepass=4)), 96, 54)
+    eps_per_t = view_of(s.camera, 96, 54).footprint * s.render.epsilon_scale
+    a = agreement(img, plain, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
+    assert a.off_edge_hit == 0 and a.off_edge_depth <= 1.5 * eps_per_t, a
+    control = agreement(renderer.render(still(s), 96, 54), plain, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
+    assert control.off_edge_hit > 0
 
 
 def changed(a, b) -> float:

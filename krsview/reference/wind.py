@@ -19,12 +19,12 @@ Bound. With s = g(p) − b, ∂/∂θ R_A(−θ)(p − b) = −A × s and ∇θ 
 So over the ball of radius δ around p, ‖Dg‖ ≤ 1 + |a|(ρ + δ), and g maps that ball into the
 ball of radius D around g(p) when δ(1 + |a|(ρ + δ)) = D: the twist's step (distortion.py,
 safe_step) with k = |a(t)| and this ρ (Distortion.distance applies it). ε shrinks by
-1/(1 + |a|ρ) as for the twist (here with the largest |a| any time gives, ``most``, so the
+1/(1 + |a|ρ) as for the twist (lod_scale: with the largest |a| any time gives, ``most``, so the
 shader computes no gust for it). The normal is Dgᵀ ∇D = R_A(θ) ∇D − a [h > 0] up ((A × s)·∇D).
 
 Gusts: a_c(t) = radians(strength)/height · (1 + gust · n(t + c·WIND_PHASE/f)), with
-n = Σ w_k sin(2π r_k f t) (scene/effects.py); a component with a plane kernel (a ground)
-stands (a_c = 0). A compound bends each component about its own foot, with its own phase.
+n = Σ w_k sin(2π r_k f t) (scene/effects.py). A compound bends each component about its own
+foot, with its own phase; an unbounded component (a ground plane) stands (a_c = 0).
 """
 
 from __future__ import annotations

@@ -27,7 +27,9 @@ vec3r wind_turn(vec3r v, float angle) {
 }
 
 // Distance from p to component c's axis line: ρ of the bound 1 + |a|ρ.
-real wind_rho(int c, vec3r p) { return length(cross(vec3r(u_wind_axis), p - u_wind_base[c].xyz)); }
+real wind_rho(int c, vec3r p) {
+    return length(cross(vec3r(u_wind_axis), p - u_wind_base[c].xyz));
+}
 
 // g: where component c's rest geometry is looked up for the world point p, with its rate a.
 vec3r unwind(int c, vec3r p, float a) {
