@@ -14,6 +14,7 @@ import pytest
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
 from krsview.compile.camera import view_of
 from krsview.compile.krs import compile_krs
+from krsview.gpu.renderer import read_buffers
 from krsview.oracle.certify import count_errors
 from krsview.reference import render_reference
 from krsview.reference.distortion import Distortion
@@ -289,3 +290,19 @@ def test_the_oracle_refuses_wind(renderer):
     with pytest.raises(ValueError, match="without twist, wind or empty zones"):
         count_errors(s, renderer.render(s, 4, 3))
     assert count_errors(still(s), renderer.render(still(s), 4, 3)).holes == 0
+
+
+@pytest.mark.parametrize("name", ["tree-wind", "grove-wind"])
+def test_the_all_effects_variant_switches_the_wind_by_its_bit(renderer, name):
+    """The benchmark's variant with every effect compiled (twist and wind both in it, each
+    switched by its bit of u_effects) draws the specialised image; with the wind's bit off it
+    draws the still one (negative control: that differs)."""
+    s = per_pixel(preset(name)).at(0.7)
+    for scene in (s, still(s)):
+        with renderer.current():
+            prog = renderer.prepare(scene, 64, 36, all_effects=True)
+            uber = read_buffers(renderer.draw(prog, 64, 36), 64, 36)
+        special = renderer.render(scene, 64, 36)
+        assert (np.abs(uber.color - special.color).max(-1) <= 1 / 255).mean() > 0.999
+        assert (uber.hit == special.hit).all()
+    assert not np.array_equal(special.hit, renderer.render(s, 64, 36).hit)
