@@ -256,14 +256,14 @@ def certify(
     fast settings where the scene sets none), by the reliable oracle (interval and revised
     affine arithmetic over ray segments [RAA09]): a :class:`krsview.oracle.certify.Counts`.
     ``tracer`` overrides the scene's."""
-    from .oracle.certify import MAX_SEGMENTS, count_errors
+    from .oracle.certify import MAX_SEGMENTS, UNCOVERED, count_errors
 
     scene = scene if isinstance(scene, Scene) else load(scene)
-    if {"twist", "empty_zones"} & set(scene.effects):
+    if UNCOVERED & set(scene.effects):
         raise SceneError(
             scene.name,
-            ", ".join(sorted({"twist", "empty_zones"} & set(scene.effects))),
-            "the oracle covers scenes without twist or empty zones "
+            ", ".join(sorted(UNCOVERED & set(scene.effects))),
+            "the oracle covers scenes without twist, wind or empty zones "
             "(their distortions are not in it)",
         )
     scene = fast_settings(scene if tracer is None else configure(scene, tracer=tracer))

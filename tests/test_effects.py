@@ -62,6 +62,7 @@ CASES = {
         load_scene(resolve("rock")), ["ambient_occlusion"], ao_step=0.2, ao_strength=2.0
     ),
     "twist": lambda: with_effects(tree(), ["twist"], twist=25.0),
+    "wind": lambda: with_effects(tree(), ["wind"], wind_strength=12.0).at(1.5),
     "empty_zones": lambda: with_effects(
         tree(),
         ["empty_zones"],

@@ -12,7 +12,14 @@ from ..compile.krs import KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound
 from ..compile.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS
-from ..scene.effects import MAX_EMPTY_ZONES, allowed_effects
+from ..scene.effects import (
+    MAX_EMPTY_ZONES,
+    WIND_PHASE,
+    WIND_RATIOS,
+    WIND_WEIGHTS,
+    allowed_effects,
+    wind_feet,
+)
 from ..scene.scene import MAX_LIGHTS
 
 
@@ -68,6 +75,7 @@ def variant_defines(
     if (
         not isinstance(c, CompiledMoKRS)
         and "KRS_TWIST" not in defines
+        and "KRS_WIND" not in defines  # both move the geometry out of its balls
         and any(ball[3] >= 0 for ball in component_balls(c))
     ):
         defines["KRS_BALL_EXIT"] = None  # rays leave the components' balls (trace.glsl)
@@ -144,6 +152,28 @@ def component_balls(c: Compiled) -> list[tuple[float, ...]]:
     )
 
 
+def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
+    """The wind's uniforms (wind.glsl; reference/wind.py derives them): time is ``u_time``
+    alone, so an animated frame changes one value and compiles nothing."""
+    fx = scene.effect_settings
+    w = np.array([fx.wind_direction[0], 0.0, fx.wind_direction[2]])
+    a0 = np.radians(fx.wind_strength) / fx.wind_height
+    phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
+    feet = []
+    if "wind" in scene.effects:  # not on a MöKRS
+        balls = [(*(part.ball[:3] + view.origin), part.ball[3]) for part, _ in component_slots(c)]
+        feet = [(*(np.array(b) - view.origin), r) for b, r in wind_feet(scene, balls)]
+    feet += [(0.0, 0.0, 0.0, 0.0)] * (MAX_COMPONENTS - len(feet))
+    return {
+        "u_time": scene.time,
+        "u_wind_axis": tuple(np.cross((0.0, 1.0, 0.0), w / np.linalg.norm(w))),
+        "u_wind": (a0, fx.wind_gust, phase, a0 * (1.0 + fx.wind_gust)),
+        "u_wind_freq": tuple(2.0 * np.pi * fx.wind_frequency * np.array(WIND_RATIOS)),
+        "u_wind_weight": WIND_WEIGHTS,
+        "u_wind_base": feet if isinstance(c, CompiledCompound) else feet[0],  # per component
+    }
+
+
 def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     """Per-frame values; positions are camera-relative (the eye is the origin)."""
     lights = scene.lights
@@ -191,6 +221,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_texture_strength": fx.texture_strength,
         "u_twist": float(np.radians(fx.twist)),
         "u_twist_center": tuple(np.array(fx.twist_center) - view.origin),
+        **wind_uniforms(scene, view, c),
         "u_empty_zone_count": len(zones),
         "u_empty_zones": zones + [(0.0, 0.0, 0.0, 0.0)] * (MAX_EMPTY_ZONES - len(zones)),
         "u_sky_zenith": fx.sky_zenith,

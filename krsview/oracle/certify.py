@@ -171,13 +171,18 @@ class Counts:
     work: dict = field(default_factory=dict)  # arithmetic → (segments, seconds)
 
 
+UNCOVERED = frozenset({"twist", "wind", "empty_zones"})  # distortions not in the oracle
+
+
 def count_errors(
     scene: Scene, image: Frame, arithmetics=ARITHMETICS, max_segments: int = MAX_SEGMENTS
 ) -> Counts:
     """Certified holes and false hits of a traced image (GPU or reference) of ``scene``: a
-    KRS, compound or MöKRS (the twist and empty zones are not in the oracle)."""
-    if {"twist", "empty_zones"} & set(scene.effects):
-        raise ValueError(f"{scene.name}: the oracle covers scenes without twist or empty zones")
+    KRS, compound or MöKRS (the twist, wind and empty zones are not in the oracle)."""
+    if UNCOVERED & set(scene.effects):
+        raise ValueError(
+            f"{scene.name}: the oracle covers scenes without twist, wind or empty zones"
+        )
     scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
     h, w = image.hit.shape
     view = view_of(scene.camera, w, h)

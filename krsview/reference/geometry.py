@@ -46,13 +46,14 @@ def component_distance(
     dist: Distortion | None = None,
     lod: Lod | None = None,
     reach: np.ndarray | float = 0.0,
+    k: int = 0,
 ) -> np.ndarray:
-    """The distance bound of one KRS: Alg. 1 at the level of detail, through the scene's
-    distortion."""
+    """The distance bound of one KRS (component ``k``): Alg. 1 at the level of detail,
+    through the scene's distortion."""
     rho = rho_at(lod, x, reach)
     if dist is None:
         return krs.distance(part, x, rho=rho)
-    return dist.distance(x, krs.distance(part, dist.undistort(x), rho=rho))
+    return dist.distance(x, krs.distance(part, dist.undistort(x, k), rho=rho), k)
 
 
 def scene_distance(
@@ -62,7 +63,13 @@ def scene_distance(
     lod: Lod | None = None,
 ) -> np.ndarray:
     """The distance bound of everything drawn: the least over the components (a distortion
-    is monotone in the distance, so it may be applied once, after the minimum)."""
+    is monotone in the distance, so it may be applied once, after the minimum; the wind
+    bends each component about its own foot, so it is applied per component)."""
+    if dist is not None and dist.wind is not None:
+        return np.min(
+            [component_distance(p, x, dist, lod, k=k) for k, p in enumerate(components(c))],
+            axis=0,
+        )
     q = x if dist is None else dist.undistort(x)
     rho = rho_at(lod, x)
     D = np.min([krs.distance(p, q, rho=rho) for p in components(c)], axis=0)
@@ -73,7 +80,10 @@ def component_distances(
     c: CompiledKRS | CompiledCompound, dist: Distortion | None, lod: Lod | None = None
 ) -> list[Distance]:
     """One distance bound per component, for the sphere tracer's free distances."""
-    return [lambda x, p=p: component_distance(p, x, dist, lod) for p in components(c)]
+    return [
+        lambda x, p=p, k=k: component_distance(p, x, dist, lod, k=k)
+        for k, p in enumerate(components(c))
+    ]
 
 
 def component_tests(c: Compiled, dist: Distortion | None, lod: Lod | None = None) -> list[Test]:
@@ -81,7 +91,8 @@ def component_tests(c: Compiled, dist: Distortion | None, lod: Lod | None = None
     if isinstance(c, mokrs.CompiledMoKRS):
         return [lambda x, s: mokrs.is_unbounding(c, x, s, lod=rho_at(lod, x, s))]
     return [
-        lambda x, s, p=p: component_distance(p, x, dist, lod, reach=s) >= s for p in components(c)
+        lambda x, s, p=p, k=k: component_distance(p, x, dist, lod, reach=s, k=k) >= s
+        for k, p in enumerate(components(c))
     ]
 
 
@@ -96,10 +107,13 @@ def nearest(
         level, g = mokrs.nearest(c, x)
         return level, g, x
     q = x if dist is None else dist.undistort(x)
+    win = np.zeros(len(x), dtype=int)
     if isinstance(c, CompiledKRS):
         D, level, g, xk = krs.nearest(c, q, width)
     else:
-        win = np.argmin([krs.distance(p, q) for p in c.parts], axis=0)
+        qs = [q if dist is None else dist.undistort(x, k) for k in range(len(c.parts))]
+        win = np.argmin([krs.distance(p, qk) for p, qk in zip(c.parts, qs)], axis=0)
+        q = np.choose(win[:, None], qs)
         D, level, g, xk = (
             np.empty(len(q)),
             np.empty(len(q), int),
@@ -113,7 +127,7 @@ def nearest(
             )
             level[sel] += base
     if dist is not None:
-        g = dist.normal(x, q, D, g)
+        g = dist.normal(x, q, D, g, win)
     return level, g, xk
 
 

@@ -8,8 +8,12 @@ distance function or its mirror planes, which a MöKRS does not have [KRS17 §7]
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
+from .compound import Placement
 from .schema import SceneError, Vec3, param
 
 
@@ -59,6 +63,12 @@ _LIST = [
         needs_distance=True,
     ),
     Effect(
+        "wind",
+        "bend the geometry along the wind about its foot, swaying with gusts in time; "
+        "steps kept safe by the bend's Lipschitz bound at that time [KRS17 §5.2, §10]",
+        needs_distance=True,
+    ),
+    Effect(
         "empty_zones", "remove the geometry inside given spheres [KRS17 §8.4]", needs_distance=True
     ),
     Effect("sky", "sky gradient and sun instead of a flat background"),
@@ -66,8 +76,15 @@ _LIST = [
     Effect("tone_mapping", "exposure and filmic (ACES) tone curve before gamma"),
 ]
 EFFECTS: dict[str, Effect] = {e.name: replace(e, bit=1 << k) for k, e in enumerate(_LIST)}
-EXCLUSIVE = [("shadows", "soft_shadows")]  # pairs a scene may not list together
+EXCLUSIVE = [("shadows", "soft_shadows"), ("twist", "wind")]  # pairs a scene may not list together
 MAX_EMPTY_ZONES = 8
+MIN_HORIZONTAL = 1e-3  # the least horizontal part of wind_direction (sine of its tilt)
+# Gusts: n(t) = Σ w_k sin(2π r_k f t), |n| ≤ 1, at frequencies r_k f in irrational ratios so
+# the sway never repeats; component c sways at t + c·WIND_PHASE/f (a golden-ratio fraction of
+# the slowest period), so no two neighbours' sines keep in step (offsets .62, .38, .39 turns).
+WIND_RATIOS = (1.0, math.sqrt(5.0), math.sqrt(15.0))
+WIND_WEIGHTS = (0.5, 0.3, 0.2)
+WIND_PHASE = (math.sqrt(5.0) - 1.0) / 2.0
 
 _COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
@@ -122,6 +139,40 @@ class EffectSettings:
     twist_center: Vec3 = param(
         (0.0, 0.0, 0.0), help="twist: a point on the vertical axis (no turn at its height)"
     )
+    wind_direction: Vec3 = param(
+        (1.0, 0.0, 0.0),
+        unit_vector="normalise",
+        help="wind: where it blows to; only its horizontal part is used",
+    )
+    wind_strength: float = param(
+        4.0,
+        lo=0.0,
+        hi=30.0,
+        unit="degrees",
+        help="wind: mean lean at wind_height above the foot (the lean grows with height)",
+    )
+    wind_height: float = param(
+        5.0,
+        lo=0.0,
+        lo_open=True,
+        hi=1e6,
+        unit="scene units",
+        help="wind: the height above the foot that leans by wind_strength",
+    )
+    wind_gust: float = param(
+        0.5, lo=0.0, hi=1.0, help="wind: the sway about the mean lean, as a fraction of it"
+    )
+    wind_frequency: float = param(
+        0.3,
+        lo=0.0,
+        hi=10.0,
+        unit="Hz",
+        help="wind: of the slowest of the gusts' three sways (0: a steady lean)",
+    )
+    wind_base: Vec3 = param(
+        (0.0, 0.0, 0.0),
+        help="wind: the foot that stays put (in a compound, in each component's own frame)",
+    )
     empty_zones: list[EmptyZone] = param([], help=f"empty_zones: at most {MAX_EMPTY_ZONES} balls")
     sky_zenith: Vec3 = param((0.22, 0.42, 0.82), **_COLOR)
     fog_density: float = param(
@@ -146,6 +197,12 @@ class EffectSettings:
                 f"{path}.empty_zones",
                 f"<{len(self.empty_zones)} zones>",
                 f"allowed: at most {MAX_EMPTY_ZONES}",
+            )
+        if math.hypot(self.wind_direction[0], self.wind_direction[2]) < MIN_HORIZONTAL:
+            raise SceneError(
+                f"{path}.wind_direction",
+                self.wind_direction,
+                "a direction with a horizontal part (the wind blows along the ground)",
             )
 
 
@@ -172,3 +229,21 @@ def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> Non
     for a, b in EXCLUSIVE:
         if a in effects and b in effects:
             raise SceneError(path, effects, f"'{a}' and '{b}' exclude each other; choose one")
+
+
+def wind_feet(scene, balls: list) -> list[tuple[Vec3, float]]:
+    """Per component of ``scene`` (a Scene with a KRS or a compound), given the ball around
+    it (``CompiledKRS.ball``, world; radius < 0: unbounded): its foot, ``wind_base`` moved by
+    the component's placement, and its reach, the farthest its geometry gets from the foot (a
+    turn about the foot keeps it), or 0 where it stands: an unbounded KRS (a ground plane)
+    would make the bend and its Lipschitz bound unbounded too."""
+    base = scene.effect_settings.wind_base
+    feet = (
+        [Placement(c.position, c.axis, c.angle, c.scale).point(base) for c in scene.compound]
+        if scene.compound
+        else [base]
+    )
+    return [
+        (foot, float(np.linalg.norm(np.array(ball[:3]) - foot) + ball[3]) if ball[3] >= 0 else 0.0)
+        for foot, ball in zip(feet, balls)
+    ]

@@ -1,20 +1,36 @@
 // What is drawn, for the KRS family: the distance bound with the scene's distortions and the
 // nearest kernel with its world normal; twin of reference/geometry.py and reference/distortion.py.
-// Without twist and empty zones this is Alg. 1 itself [KRS17 Alg. 1]; in a compound, each
-// component is a KRS of its own [KRS17 §5.1].
+// Without twist, wind and empty zones this is Alg. 1 itself [KRS17 Alg. 1]; in a compound,
+// each component is a KRS of its own [KRS17 §5.1].
 #include "krs.glsl"
 #include "lod.glsl"
+#if defined(KRS_TWIST) || defined(KRS_WIND)
+// The δ with δ(1 + k(ρ + δ)) = D, in its cancellation-free form: a step that stays in the free
+// ball of radius D through a map whose Jacobian is at most 1 + k·(distance to its axis);
+// δ = D when k = 0 (reference/distortion.py, safe_step).
+real safe_step(real D, real k, real rho) {
+    if (D <= 0.0) return D;
+    real a = 1.0 + k * rho;
+    return 2.0 * D / (a + sqrt(a * a + 4.0 * k * D));
+}
+#endif
 #ifdef KRS_TWIST
 #include "twist.glsl"
+#endif
+#ifdef KRS_WIND
+#include "wind.glsl"
 #endif
 #ifdef KRS_EMPTY_ZONES
 #include "empty_zones.glsl"
 #endif
 
-// Where the undistorted KRS is looked up for the world point p.
-vec3r undistort(vec3r p) {
+// Where component c's undistorted KRS is looked up for the world point p.
+vec3r undistort(int c, vec3r p) {
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) return untwist(p);
+#endif
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) return unwind(c, p, wind_rate(c));
 #endif
     return p;
 }
@@ -22,7 +38,23 @@ vec3r undistort(vec3r p) {
 // The factor of the LOD threshold ε(t) at p: the twist's safe step is D / (1 + |k|ρ) to
 // first order, so ε shrinks by the same factor and rays converge where the undistorted
 // distance is within ε(t), not high above a twisted ground (reference/distortion.py, lod_scale).
+// The wind's takes the largest rate any time gives and the farthest axis of the components
+// within whose reach p lies (elsewhere none can stop a ray: a ground keeps its ε).
 real lod_scale(vec3r p) {
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) {
+        // squared, as is all of the loop: ρ² = |r|² − (A·r)²; over every slot, a constant
+        // count the compiler unrolls (an unused slot's reach is 0)
+        float rho2 = 0.0;
+        for (int c = 0; c < COMPONENT_SLOTS; ++c) {
+            vec4 foot = u_wind_base[c];
+            vec3 r = vec3(p) - foot.xyz;
+            float rr = dot(r, r), ar = dot(u_wind_axis, r);
+            if (rr <= foot.w * foot.w) rho2 = max(rho2, rr - ar * ar);
+        }
+        return 1.0 / (1.0 + u_wind.w * sqrt(rho2));
+    }
+#endif
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT))
         return 1.0 / (1.0 + abs(u_twist) * length(vec2(p.xz - u_twist_center.xz)));
@@ -56,8 +88,17 @@ real undistorted_distance(int c, vec3r q, real rho) {
     return krs_distance(k.x, k.y, q, rho);
 }
 
+// Component c's distance bound with the level of detail ρ; the wind bends it about its own
+// foot at its own rate a, and its step is safe for the bound 1 + |a|ρ (wind.glsl).
 real component_distance_at(int c, vec3r p, real rho) {
-    return distort_distance(p, undistorted_distance(c, undistort(p), rho));
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) {
+        float a = wind_rate(c);
+        real D = undistorted_distance(c, unwind(c, p, a), rho);
+        return distort_distance(p, safe_step(D, abs(a), wind_rho(c, p)));
+    }
+#endif
+    return distort_distance(p, undistorted_distance(c, undistort(c, p), rho));
 }
 
 // The distance bound of component c, which the tracer steps by.
@@ -66,11 +107,19 @@ real component_distance(int c, vec3r p) {
 }
 
 // The bound of everything drawn: the least over the components (a distortion is monotone in
-// the distance, so it is applied once, after the minimum).
+// the distance, so it is applied once, after the minimum; the wind bends each component about
+// its own foot, so there each component's bound is taken).
 real scene_distance(vec3r p) {
 #ifdef KRS_COMPOUND
-    vec3r q = undistort(p);
     real rho = lod_radius(length(p));
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) {
+        real D = component_distance_at(0, p, rho);
+        for (int c = 1; c < COMPONENTS; ++c) D = min(D, component_distance_at(c, p, rho));
+        return D;
+    }
+#endif
+    vec3r q = undistort(0, p);
     real D = undistorted_distance(0, q, rho);
     for (int c = 1; c < COMPONENTS; ++c) D = min(D, undistorted_distance(c, q, rho));
     return distort_distance(p, D);
@@ -84,13 +133,14 @@ bool is_unbounding(int c, vec3r center, real radius) {
     return component_distance_at(c, center, lod_radius(length(center) + radius)) >= radius;
 }
 
-// The component nearest to the undistorted point q (ties: the first), without LOD.
-int nearest_component(vec3r q) {
+// The component nearest to the world point p, each asked where it is undistorted (ties: the
+// first), without LOD.
+int nearest_component(vec3r p) {
     int win = 0;
 #ifdef KRS_COMPOUND
-    real best = undistorted_distance(0, q, 0.0);
+    real best = undistorted_distance(0, undistort(0, p), 0.0);
     for (int c = 1; c < COMPONENTS; ++c) {
-        real d = undistorted_distance(c, q, 0.0);
+        real d = undistorted_distance(c, undistort(c, p), 0.0);
         if (d < best) { best = d; win = c; }
     }
 #endif
@@ -101,16 +151,20 @@ int nearest_component(vec3r q) {
 // p, whose ray distance t sets the smoothing band (at least 2 pixel footprints, against
 // aliasing). In a compound, the component nearest to p is asked (ties: the first).
 void scene_nearest(vec3r p, real t, out int level, out vec3 normal, out vec3 xk) {
-    vec3r q = undistort(p), xkr;
+    int c = nearest_component(p);
+    vec3r q = undistort(c, p), xkr;
     float width = 0.0;
 #ifdef KRS_SMOOTH_SHADING
     width = max(u_smooth_width, 2.0 * u_footprint * float(t));
 #endif
-    ivec2 k = component(nearest_component(q));
+    ivec2 k = component(c);
     real D = krs_nearest(k.x, k.y, q, width, level, normal, xkr);
     xk = vec3(xkr);
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) normal = twist_normal(vec3(p), vec3(q), normal);
+#endif
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) normal = wind_normal(c, vec3(p), vec3(q), normal);
 #endif
 #ifdef KRS_EMPTY_ZONES
     int zone;   // on a cut face the zone's sphere is the surface

@@ -16,12 +16,10 @@ vec3r untwist(vec3r p) {
 }
 
 // A safe step from the untwisted distance D: ‖Dg‖ ≤ 1 + |k|ρ at axis distance ρ, so over the
-// ball of radius δ around p it is ≤ 1 + |k|(ρ + δ); δ(1 + |k|ρ + |k|δ) = D is solved in its
-// cancellation-free form, and δ = D when k = 0.
+// ball of radius δ around p it is ≤ 1 + |k|(ρ + δ); δ(1 + |k|ρ + |k|δ) = D is solved by
+// distance.glsl's safe_step.
 real twist_step(vec3r p, real D) {
-    if (D <= 0.0) return D;
-    real k = abs(u_twist), a = 1.0 + k * length(p.xz - u_twist_center.xz);
-    return 2.0 * D / (a + sqrt(a * a + 4.0 * k * D));
+    return safe_step(D, abs(u_twist), length(p.xz - u_twist_center.xz));
 }
 
 // World normal from the gradient g at q = g(p): Dgᵀ g; only Dg's y column is not a rotation.
