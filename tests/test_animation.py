@@ -42,15 +42,13 @@ def test_the_api_takes_time_as_a_knob():
         api.configure(load("tree"), time=-1)
 
 
-def test_animated_is_tracks_sway_or_an_effect_that_reads_time(monkeypatch):
-    from krsview.scene import animation
-
+def test_animated_is_tracks_sway_or_an_effect_that_reads_time():
     s = load("tree")
     assert not s.animated and not s.at(3.0).animated  # time alone moves nothing
     assert s.edit("animation", {"sway": {}}).animated
     assert s.edit("animation", {"tracks": [{"path": "tree.bend", "keys": [[0, 0.1]]}]}).animated
-    monkeypatch.setattr(animation, "TIME_EFFECTS", frozenset({"sky"}))  # the effects' hook
-    assert load("tree").animated and not load("rock").with_effects([]).animated
+    assert s.with_effects([*s.effects, "wind"]).animated and load("tree-wind").animated
+    assert not s.with_effects([*s.effects, "twist"]).animated  # the twist does not move
 
 
 def test_truncating_a_moving_scene_truncates_it_as_posed():

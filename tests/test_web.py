@@ -253,3 +253,20 @@ def test_export_on_the_command_line_and_its_refusals(tmp_path):
     save_scene(replace(deep, render=replace(deep.render, prepass=8)), tmp_path / "pre.toml")
     r = run("html", str(tmp_path / "pre.toml"), "-o", str(tmp_path / "p.html"))
     assert r.returncode == 0 and "note: render.prepass = 8" in r.stdout
+
+
+def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(tmp_path):
+    """Issue 29: the page keeps the scene's time live (u_time, not baked): held at 1.5 s
+    (#time=1.5) it hits what `krsview render --time 1.5` hits; held at 0 s, the crown stands
+    elsewhere (the negative control)."""
+    scene = silhouette(load_scene(resolve("tree-wind"))).with_effects(["wind"])
+    page = export_page(scene, tmp_path, "wind")
+    text = page.read_text(encoding="utf-8")
+    assert "uniform float u_time;" in text and "const float u_time" not in text
+    ref = reference(scene.at(1.5), tmp_path, "ref").max(-1) > 10
+    held = screenshot(page, tmp_path / "held.png", "bare&time=1.5").max(-1) > 10
+    still = screenshot(page, tmp_path / "still.png", "bare&time=0").max(-1) > 10
+    assert (held == ref).mean() >= 0.99
+    assert (still == ref).mean() < (held == ref).mean() - 0.002  # 0.9965 against 0.9999
+    toy = shadertoy_source(scene)
+    assert "u_time = mod(" in toy and "iTime" in toy

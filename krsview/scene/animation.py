@@ -17,6 +17,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .effects import EFFECTS
 from .edits import get_at, parse_path, replace_at, revalidated
 from .schema import SceneError, param, to_dict
 from .sway import Sway, check_sway, swayed
@@ -27,14 +28,10 @@ MAX_TRACKS = 64
 DEFAULT_DURATION = 10.0  # seconds: the loop of a scene without tracks
 INTERPOLATIONS = ("linear", "smooth")
 
-# Effects that read the scene's time in the shaders (``Scene.animated``); the effects that
-# move add their names here.
-TIME_EFFECTS: frozenset[str] = frozenset()
-
-
 def reads_time(effects: list[str]) -> bool:
-    """Whether one of ``effects`` reads the scene's time (it moves though nothing is keyed)."""
-    return not TIME_EFFECTS.isdisjoint(effects)
+    """Whether one of ``effects`` reads the scene's time in the shaders (the wind): the scene
+    moves though nothing is keyed."""
+    return any(EFFECTS[e].reads_time for e in effects if e in EFFECTS)
 
 
 def check_time(t: object, path: str = "time") -> float:

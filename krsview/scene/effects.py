@@ -25,6 +25,7 @@ class Effect:
     bit: int = 0  # its bit in u_effects when all effects are compiled in
     secondary: bool = False  # evaluates the geometry again per hit pixel (a shadow ray,
     # occlusion samples): bench split times the frame without it
+    reads_time: bool = False  # moves with the scene's time, nothing keyed (Scene.animated)
 
 
 _LIST = [
@@ -67,6 +68,7 @@ _LIST = [
         "bend the geometry along the wind about its foot, swaying with gusts in time; "
         "steps kept safe by the bend's Lipschitz bound at that time [KRS17 §5.2, §10]",
         needs_distance=True,
+        reads_time=True,
     ),
     Effect(
         "empty_zones", "remove the geometry inside given spheres [KRS17 §8.4]", needs_distance=True

@@ -85,7 +85,7 @@ class Scene:
     @property
     def animated(self) -> bool:
         """Whether anything drawn changes with time: keyframe tracks, sway, or an effect that
-        reads the time (``animation.TIME_EFFECTS``)."""
+        reads the time (the wind)."""
         a = self.animation
         return (a is not None and a.moves) or reads_time(self.effects)
 

@@ -147,6 +147,8 @@ def _bake(m: re.Match, values: dict, shadertoy: bool) -> str:
 
 def const_array(kind: str, name: str, rows) -> str:
     rows = list(rows)
+    if kind.startswith("vec") and rows and np.ndim(rows[0]) == 0:
+        rows = [rows]  # an array of one vector, uploaded as the vector (u_wind_base of a KRS)
     items = ",\n    ".join(literal(kind, r) for r in rows)
     return f"const {kind} {name}[{len(rows)}] = {kind}[{len(rows)}](\n    {items});"
 
