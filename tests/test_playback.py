@@ -107,3 +107,39 @@ def test_space_on_a_scene_that_does_not_move_says_so(display, tmp_path):
         assert not v.playback.playing and "nothing in this scene moves" in v.message
     finally:
         v.close()
+
+
+def test_a_moment_that_cannot_be_posed_shows_why_and_keeps_the_last_pose(display, tmp_path):
+    """A track whose blend breaks its field's rule between two valid keys (a mirror normal
+    turned through zero, at 1 s): scrubbing there shows the one-line error and draws the last
+    pose; scrubbing on poses again and clears it. No traceback, no NaN image."""
+    import numpy as np
+
+    from krsview import load
+    from krsview.scene import save_scene
+    from krsview.viewer.commands import SetTime
+    from krsview.viewer.window import Viewer
+
+    s = load("tree").with_geometry(load("tree").tree.route().krs())
+    s = s.edit("krs.levels[20].mirror.normal", [1.0, 0.0, 0.0])
+    track = {"path": "krs.levels[20].mirror.normal", "keys": [[0, [1, 0, 0]], [2, [-1, 0, 0]]]}
+    s = s.edit("animation", {"tracks": [dict(track, interpolation="linear")]})
+    path = tmp_path / "flip.toml"
+    save_scene(s, path)
+    v = Viewer(path, size=(64, 48), hud=False)
+    try:
+        v.execute([SetTime(0.5)])
+        v.step(0.02)
+        assert not v.error
+        before = v.read_window()
+        v.execute([SetTime(1.0)])
+        v.step(0.02)
+        assert "animation.tracks[0]" in v.error and "\n" not in v.error
+        assert np.isfinite(v.read_window()).all() and v.read_window().any()
+        assert v.view_scene().krs == s.at(0.5).posed().krs  # the last pose, still drawn
+        v.execute([SetTime(1.6)])
+        v.step(0.02)
+        assert not v.error, "posing again did not clear the error"
+        assert (v.read_window() != before).any()
+    finally:
+        v.close()

@@ -74,6 +74,8 @@ class Viewer:
         self.clock = 0.0
         self.status = ("", 0.0)  # text, and the clock it goes at
         self.playback = Playback()
+        self._last_pose: Scene | None = None  # drawn while a moment cannot be posed
+        self._pose_error = ""
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
@@ -130,8 +132,18 @@ class Viewer:
             self.nav.reset(scene.camera)
 
     def posed(self, scene: Scene) -> Scene:
-        """``scene`` as drawn at the moment shown: its tracks and sway applied there."""
-        return scene.at(self.playback.time).posed()
+        """``scene`` as drawn at the moment shown: its tracks and sway applied there. A moment
+        whose pose breaks a field's rule (a value between keys) shows why and keeps the last
+        pose drawn, until a moment poses again."""
+        try:
+            pose = scene.at(self.playback.time).posed()
+        except SceneError as e:
+            self.error = self._pose_error = str(e)
+            return self._last_pose if self._last_pose is not None else scene.at(0.0).posed()
+        if self._pose_error and self.error == self._pose_error:
+            self.error = ""
+        self._pose_error, self._last_pose = "", pose
+        return pose
 
     def _time_moved(self) -> None:
         """The moment shown changed: a new image (a moving one while playing, so the
