@@ -17,8 +17,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .effects import EFFECTS
 from .edits import get_at, parse_path, replace_at, revalidated
+from .effects import EFFECTS
 from .schema import SceneError, param, to_dict
 from .sway import Sway, check_sway, swayed
 
