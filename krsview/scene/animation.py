@@ -28,6 +28,7 @@ MAX_TRACKS = 64
 DEFAULT_DURATION = 10.0  # seconds: the loop of a scene without tracks
 INTERPOLATIONS = ("linear", "smooth")
 
+
 def reads_time(effects: list[str]) -> bool:
     """Whether one of ``effects`` reads the scene's time in the shaders (the wind): the scene
     moves though nothing is keyed."""
