@@ -396,6 +396,36 @@ def test_the_hud_prepass_knob_is_an_edit_saved_with_the_scene_and_undone_by_ctrl
     assert load_scene(e.path).render.prepass == 8 and not e.doc.dirty
 
 
+def scroll_to(e, path, margin: float, dx: float) -> tuple:
+    """Scroll the panel (wheel over it, at ``dx`` into the field) until the field of ``path``
+    is ``margin`` pixels above the window's foot; its rectangle."""
+    import glfw
+
+    height = glfw.get_window_size(e.viewer.window)[1]
+    for _ in range(10):
+        x0, y0, x1, y1 = e.viewer.interactions.rects[path]
+        if y1 < height - margin:
+            break
+        xdo("mousemove", *map(round, window_xy(e, x0 + dx, height - 30)))  # not the outline
+        xdo("click", 5)
+        pump(e, 2)
+    return e.viewer.interactions.rects[path]
+
+
+def type_at(e, at, text: str) -> None:
+    """Ctrl+click the field at window point ``at``, type ``text`` and press Return."""
+    xdo("mousemove", *map(round, at))
+    pump(e, 2)
+    xdo("keydown", "ctrl")
+    xdo("click", 1)
+    xdo("keyup", "ctrl")
+    pump(e, 2)
+    xdo("type", text)
+    pump(e, len(text) + 2)  # ImGui takes the typed characters one per frame
+    xdo("key", "Return")
+    pump(e, 3)
+
+
 def window_xy(e, x, y) -> tuple[float, float]:
     """Screen point of window point (x, y)."""
     import glfw
@@ -488,24 +518,9 @@ def test_a_zero_normal_typed_stays_red_in_its_field_with_the_message_under_it(ed
         return int(text.sum()) + int(frame.sum())
 
     def type_into(k: int, text: str) -> None:
-        for _ in range(10):  # the warnings above push it down: scroll the panel to it
-            x0, y0, x1, y1 = e.viewer.interactions.rects[path]
-            if y1 < SIZE[1] - 60:
-                break
-            xdo("mousemove", *map(round, window_xy(e, x0, SIZE[1] - 30)))  # not the outline
-            xdo("click", 5)
-            pump(e, 2)
+        x0, y0, x1, y1 = scroll_to(e, path, 60, 0)
         part = (x1 - x0 - 50) / 3
-        xdo("mousemove", *map(round, window_xy(e, x0 + (k + 0.5) * part, (y0 + y1) / 2)))
-        pump(e, 2)
-        xdo("keydown", "ctrl")
-        xdo("click", 1)
-        xdo("keyup", "ctrl")
-        pump(e, 2)
-        xdo("type", text)
-        pump(e, 2)
-        xdo("key", "Return")
-        pump(e, 3)
+        type_at(e, window_xy(e, x0 + (k + 0.5) * part, (y0 + y1) / 2), text)
 
     assert red_below() == 0
     for k in range(3):

@@ -15,7 +15,8 @@ from krsview.editor.commands import Bake, SaveAs
 from krsview.scene import load_scene
 from krsview.scene.presets import PRESET_DIR, resolve
 
-from .test_editor import LEVEL, pump, window_xy, xdo
+from .test_editor import LEVEL, pump, scroll_to, window_xy, xdo
+from .test_editor import type_at as type_into
 
 SIZE = (640, 400)
 
@@ -77,23 +78,8 @@ def test_a_levels_grown_depth_is_text_that_clicks_and_typing_do_not_change(tree_
     assert grown is not None
 
     def type_at(field: str, text: str) -> None:
-        for _ in range(10):  # the panel scrolls to bring the field into view
-            x0, y0, x1, y1 = e.viewer.interactions.rects[(*level, field)]
-            if y1 < SIZE[1] - 40:
-                break
-            xdo("mousemove", *map(round, window_xy(e, x0 + 5, SIZE[1] - 30)))
-            xdo("click", 5)
-            pump(e, 2)
-        xdo("mousemove", *map(round, window_xy(e, x0 + 20, (y0 + y1) / 2)))
-        pump(e, 2)
-        xdo("keydown", "ctrl")
-        xdo("click", 1)
-        xdo("keyup", "ctrl")
-        pump(e, 2)
-        xdo("type", text)
-        pump(e, len(text) + 2)  # ImGui takes the typed characters one per frame
-        xdo("key", "Return")
-        pump(e, 3)
+        x0, y0, _, y1 = scroll_to(e, (*level, field), 40, 5)
+        type_into(e, window_xy(e, x0 + 20, (y0 + y1) / 2), text)
 
     steps = len(e.doc.history.steps)
     type_at("grown", "7")  # a depth another level has: a field would refuse it, and say so
