@@ -143,3 +143,35 @@ def test_a_moment_that_cannot_be_posed_shows_why_and_keeps_the_last_pose(display
         assert (v.read_window() != before).any()
     finally:
         v.close()
+
+
+def test_a_keyed_camera_is_followed_while_playing_and_flown_when_paused(display, tmp_path):
+    """tree-growing keys the camera (it steps back as the tree grows): playing puts the view
+    where the track does; paused, W flies from there."""
+    import shutil
+
+    import numpy as np
+
+    from krsview.scene import load_scene
+    from krsview.scene.presets import resolve
+    from krsview.viewer.window import Viewer
+
+    path = tmp_path / "grow.toml"
+    shutil.copy(resolve("tree-growing"), path)
+    v = Viewer(path, size=(64, 48), hud=False)
+    try:
+        press(v, "Space")
+        for _ in range(8):
+            v.step(0.5)
+        t = v.playback.time
+        keyed = load_scene(path).at(t).posed().camera.position
+        assert np.allclose(v.camera.position, keyed, atol=1e-9)
+        assert not np.allclose(keyed, load_scene(path).camera.position, atol=0.1)  # it moved
+        press(v, "Space")
+        v.input.key("W", True)
+        for _ in range(4):
+            v.step(0.1)
+        v.input.key("W", False)
+        assert np.linalg.norm(v.camera.position - np.array(keyed)) > 0.05, "paused, W did not fly"
+    finally:
+        v.close()

@@ -147,9 +147,13 @@ class Viewer:
 
     def _time_moved(self) -> None:
         """The moment shown changed: a new image (a moving one while playing, so the
-        adaptive resolution counts time as motion), and new geometry if tracks or sway
-        move it."""
-        geometry = self.posed(self.scene).geometry()
+        adaptive resolution counts time as motion), new geometry if tracks or sway move it,
+        and the keyed camera where a track moves the camera (between moments, one flies)."""
+        pose = self.posed(self.scene)
+        a = self.scene.animation
+        if a is not None and any(t.path.startswith("camera") for t in a.tracks):
+            self.nav.reset(pose.camera)
+        geometry = pose.geometry()
         if geometry != self.geometry:
             self.geometry = geometry
             self.levels = min(self.levels, geometry.depth)
