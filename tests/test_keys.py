@@ -69,7 +69,7 @@ def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(displa
     from krsview.editor.window import Editor
     from krsview.scene import load_scene
     from krsview.scene.presets import resolve
-    from krsview.viewer.commands import SetTime
+    from krsview.viewer.commands import Edit, SetTime
 
     from .test_editor import click, drag, handle, pump, screen_of, settle, xdo
 
@@ -97,10 +97,14 @@ def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(displa
         pump(e, 2)
         between = handle(e, FORK).position  # the fork drawn half way: between its keys
         assert 0.3 < np.linalg.norm(between - rest) / np.linalg.norm(keyed - rest) < 0.7
+        e.execute([Edit(FORK, (0.1, 2.0, 0.3))])  # a value typed into the keyed field
+        track = e.scene.animation.tracks[0]
+        assert [k.time for k in track.keys] == [0, 1.0, 2.0] and track.keys[1].value[1] == 2.0
+        assert e.scene.route.levels[20].fork == tuple(rest), "typing moved the rest value"
         xdo("key", "ctrl+s")
         pump(e, 3)
         saved = load_scene(path)
         assert saved.animation.tracks == e.scene.animation.tracks and not e.doc.dirty
-        assert len(e.doc.history.steps) == 2, "K and the drag were not one undo step each"
+        assert len(e.doc.history.steps) == 3, "K, the drag and the typing: one step each"
     finally:
         e.close()

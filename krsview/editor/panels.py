@@ -210,7 +210,7 @@ def _selection(e: Edited, out: list, interactions: Interactions) -> None:
             out.append(ec.Select(other))
         if k % 2 == 0 and k + 1 < len(same_level):
             imgui.same_line()
-    _fields(get_at(e.scene, h.owner), h.owner, out, interactions)
+    _fields(get_at(e.handled_scene(), h.owner), h.owner, out, interactions)  # as drawn
 
 
 def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:

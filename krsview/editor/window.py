@@ -116,14 +116,14 @@ class Editor:
         made_for = (self.scene, self.viewer.playback.time)
         if self._handles_of is None or any(a is not b for a, b in zip(self._handles_of, made_for)):
             self._handles_of = made_for
-            self._handles = handles(self._handled())
+            self._handles = handles(self.handled_scene())
             route = self.scene.route
             self.warnings = route.warnings() if route else []
             self.clipped = clipped_parts(route) if route else []
             if self.selected is not None:  # keep the selection across edits, undo, reload
                 self.selected = next((h for h in self._handles if h.same(self.selected)), None)
 
-    def _handled(self) -> Scene:
+    def handled_scene(self) -> Scene:
         """The scene whose values the handles sit at: with keyframe tracks, as drawn at the
         moment shown (a keyed handle is where its track puts it); else, and with sway (which
         turns mirrors a drag must not write back), the scene's own values."""
@@ -136,8 +136,10 @@ class Editor:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
         the person flies must stay off every pole too, not only the file's camera
         [KRS17 §7]. A value refused for a field the panel shows keeps its message at that
-        field (viewer/widgets.py), any other in the panel's error line."""
+        field (viewer/widgets.py), any other in the panel's error line. A value a track
+        moves is keyed at the moment shown instead (keys.py), as a drag or a typed value."""
         v = self.viewer
+        path, value = keyed_edit(self.scene, path, value, v.playback.time)
         try:
             scene = apply_edit(self.scene, path, value)
             if scene.mokrs is not None:
@@ -413,11 +415,10 @@ class Editor:
         if sel is not None:
             tool = self.trackball.update if sel.kind == "normal" else self.gizmo.manipulate
             moved = tool(sel, self.window_view())
-            if moved is not None:  # a keyed value's drag sets its key (keys.py)
+            if moved is not None:  # a keyed value's drag sets its key (in edit)
                 p, drag = moved
                 keyed = track_index(self.scene, sel.path) is not None
-                path, value = sel.edit_to(self.scene, p, self.carry and not keyed)
-                self.edit(*keyed_edit(self.scene, path, value, self.viewer.playback.time), drag)
+                self.edit(*sel.edit_to(self.scene, p, self.carry and not keyed), drag)
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
