@@ -125,6 +125,13 @@ def test_check_prints_statistics(capsys):
     out = capsys.readouterr().out
     assert "levels          23" in out and "8,388,607" in out
     assert "effects         kernel_texture, soft_shadows, sky, tone_mapping" in out
+    assert "moves" not in out  # a still scene
+    assert main(["check", "palm-curl"]) == 0
+    assert "moves           30 keyframe tracks — loop 4 s" in capsys.readouterr().out
+    assert main(["check", "tree-sway"]) == 0
+    assert "moves           sway of 3 levels, 4° at 0.4 Hz — loop" in capsys.readouterr().out
+    assert main(["check", "tree-wind"]) == 0
+    assert "moves           wind — loop 12 s" in capsys.readouterr().out
 
 
 def test_bench_levels_prints_the_ratio_table(capsys):

@@ -185,6 +185,8 @@ def scene_text(info: SceneInfo, source: str | Path) -> str:
     lines.append(f"  kernel instances {info.instances:,}")
     lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in info.kernels.items()))
     lines.append(f"  effects         {', '.join(info.effects) or 'none'}")
+    if info.moves:
+        lines.append(f"  moves           {info.moves}")
     lines += [f"  warning         {w}" for w in info.warnings]
     binary = f" (ξ_bonus {info.xi[0]}, ξ_penalty {info.xi[1]})" if info.xi else ""
     lines.append(

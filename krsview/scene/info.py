@@ -6,6 +6,8 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 
+from .animation import DEFAULT_DURATION
+from .effects import EFFECTS
 from .scene import Scene
 
 
@@ -27,6 +29,7 @@ class SceneInfo:
     max_iterations: int
     max_distance: float
     xi: tuple[float, float] | None  # binary tracing's (ξ_bonus, ξ_penalty)
+    moves: str  # what changes with time ("" for a still scene), e.g. "wind; 2 keyframe tracks"
 
 
 def describe(scene: Scene) -> SceneInfo:
@@ -60,4 +63,19 @@ def describe(scene: Scene) -> SceneInfo:
         max_iterations=r.max_iterations,
         max_distance=r.max_distance,
         xi=(r.xi_bonus, r.xi_penalty) if r.tracer == "binary" else None,
+        moves=motion(scene),
     )
+
+
+def motion(scene: Scene) -> str:
+    """What moves the scene with time, in a line ("" when nothing does)."""
+    a = scene.animation
+    parts = [e for e in scene.effects if EFFECTS[e].reads_time]
+    if a is not None and a.tracks:
+        parts.append(f"{len(a.tracks)} keyframe track{'s' * (len(a.tracks) != 1)}")
+    if a is not None and a.sway is not None:
+        w = a.sway
+        parts.append(f"sway of {w.levels} levels, {w.amplitude:g}° at {w.frequency:g} Hz")
+    if not parts:
+        return ""
+    return "; ".join(parts) + f" — loop {a.duration if a else DEFAULT_DURATION:g} s"
