@@ -175,3 +175,36 @@ def test_a_keyed_camera_is_followed_while_playing_and_flown_when_paused(display,
         assert np.linalg.norm(v.camera.position - np.array(keyed)) > 0.05, "paused, W did not fly"
     finally:
         v.close()
+
+
+def test_playing_past_the_last_key_redraws_nothing_and_the_image_refines(display, tmp_path):
+    """tree-growing's keys end at 7.5 s: played on from 8 s nothing changes, so no turn asks
+    for a new image and the view refines to still; between keys every turn asks for one
+    (the control)."""
+    from krsview.scene import load_scene, save_scene
+    from krsview.scene.presets import resolve
+    from krsview.viewer.window import Viewer
+
+    s = load_scene(resolve("tree-growing"))
+    path = tmp_path / "grow.toml"
+    save_scene(s.at(8.0).edit("animation.duration", 20.0), path)
+    v = Viewer(path, size=(64, 48), hud=False)
+    try:
+        press(v, "Space")
+        asked = 0
+        for _ in range(20):
+            v.move(0.05)  # the clock advances here; a new image is asked for by `dirty`
+            asked += v.frames.dirty
+            v.step(0.0)
+        assert v.playback.playing and asked == 0, f"{asked} new images past the last key"
+        assert v.frames.refined
+        v.set_time(3.0)  # the control: between keys each turn asks
+        v.step(0.0)
+        asked = 0
+        for _ in range(5):
+            v.move(0.05)
+            asked += v.frames.dirty
+            v.step(0.0)
+        assert asked == 5
+    finally:
+        v.close()

@@ -20,7 +20,7 @@ from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
-from ..scene.animation import DEFAULT_DURATION
+from ..scene.animation import DEFAULT_DURATION, reads_time
 from ..scene.effects import EXCLUSIVE
 from ..scene.model import VIEW_PREPASS
 from ..scene.settings import ViewerSettings, make_settings
@@ -76,6 +76,7 @@ class Viewer:
         self.playback = Playback()
         self._last_pose: Scene | None = None  # drawn while a moment cannot be posed
         self._pose_error = ""
+        self._drawn: Scene | None = None  # the last moment's pose, time aside
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
@@ -125,7 +126,9 @@ class Viewer:
         self.playback.seek(self.playback.time)
         if self._measured_for != self.path.stem:  # per preset, not per edit
             self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
-        self.geometry = self.posed(scene).geometry()
+        pose = self.posed(scene)
+        self._drawn = replace(pose, animation=None)
+        self.geometry = pose.geometry()
         self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()
         if reset_camera:
@@ -158,7 +161,10 @@ class Viewer:
             self.geometry = geometry
             self.levels = min(self.levels, geometry.depth)
             self._apply_levels()
-        self.frames.dirty = True
+        drawn = replace(pose, animation=None)  # what the image shows, but for the shader's time
+        if drawn != self._drawn or reads_time(pose.effects):  # past the last key: nothing
+            self.frames.dirty = True
+        self._drawn = drawn
 
     def toggle_play(self) -> None:
         if not self.scene.animated:
