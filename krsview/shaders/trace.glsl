@@ -72,12 +72,16 @@ uniform vec4 u_bounding_ball;
 // For every t' in [t, T] (T: the far limit), d(t') ≥ L(t') = max(d − (t' − t), near +
 // g (t' − t)): the distance is 1-Lipschitz, and past c's ball (C, R) it is at least
 // |x + (t' − t) dir − C| − R, which lies above its tangent (near = |x − C| − R, g =
-// dir·(x − C)/|x − C|). The first bound falls, the second rises, so L is least where they
-// cross, t*, and L(t')/t' is least at t* or at T. Returns (L(t*), t*, L(T)); without a ball
-// or at t = 0, L(t*) = −1: nothing is known. near is computed in float, so it gives up the
-// rounding of x − C.
+// dir·(x − C)/|x − C|). The first bound falls, the second rises (g ≥ 0) or falls more
+// slowly, so L is least at their crossing t* or at T, and L(t')/t' is least at t* or at T.
+// Returns (min(L(t*), L(T)), t*, L(T)); without a ball or at t = 0, −1: nothing is known.
+// near is computed in float, so it gives up the rounding of x − C.
 vec3 bound_ahead(int c, vec3r x, real t, real d, vec3 dir) {
     vec4 ball = COMPONENT_BALL(c);
+#ifdef KRS_WIND  // the swept ball bounds the wind's stepped distance, which need not be
+    // 1-Lipschitz (its shrink changes along the ray): only the ball's bound is used
+    if (EFFECT_ON(KRS_WIND_BIT)) { ball = u_wind_ball[c]; d = -FAR_AWAY; }
+#endif
     vec3 v = vec3(x) - ball.xyz;
     float rho = length(v), g = dot(dir, v) / rho;
     float near = rho - ball.w - 1e-6 * (rho + length(vec3(x)));  // float rounding of x − C
@@ -85,7 +89,7 @@ vec3 bound_ahead(int c, vec3r x, real t, real d, vec3 dir) {
     float ts = min(t0 + max(d0 - near, 0.0) / max(1.0 + g, 1e-6), T);
     float Ls = max(d0 - (ts - t0), near + g * (ts - t0));
     float LT = max(d0 - (T - t0), near + g * (T - t0));
-    return ball.w < 0.0 || t <= 0.0 ? vec3(-1.0, 1.0, -1.0) : vec3(Ls, ts, LT);
+    return ball.w < 0.0 || t <= 0.0 ? vec3(-1.0, 1.0, -1.0) : vec3(min(Ls, LT), ts, LT);
 }
 
 // Component c has left the ray; the ray is done once all have.
@@ -143,7 +147,9 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
     if (!next_step(r, c, t)) return;
     real d = component_distance(c, origin + t * dir);
     ++r.iterations;
-    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+    // lod_scale ≤ 1: only a step under ε(t) asks for it (the wind's is a loop)
+    real eps = u_eps_per_t * t;
+    if (d <= eps && d <= eps * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
     r.tc[c] = t + d;
 #if defined(KRS_BALL_EXIT) && !defined(KRS_COMPOUND)
     // c leaves once d(t') > ε(t') = ε_per_t t' all the way to T: a miss, found early (in a
