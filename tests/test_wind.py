@@ -325,8 +325,8 @@ def test_time_is_continuous(renderer):
 
 def test_idle_wind_draws_the_still_scene(renderer):
     """With no lean the bend, its step and ε's factor are exact identities, so the wind's
-    variant traces the same rays as the scene without wind, bit for bit (the balls' exits, off
-    with wind, change no value); only the normal is normalised once more (a last bit).
+    variant traces the same rays as the scene without wind, bit for bit (the swept ball is then
+    the rest ball); only the normal is normalised once more (a last bit).
     Negative control: half a degree of lean changes the image."""
     s = replace(preset("grove-wind"), render=replace(preset("grove-wind").render, lod=0.0))
     idle = replace(s, effect_settings=replace(s.effect_settings, wind_strength=0.0)).at(3.0)

@@ -74,11 +74,7 @@ void shadow_step(inout Shadow sh) {
     real t = sh.tc[c];
     if (t > u_max_distance) { sh.state = SHADOW_DONE; return; }
     real d = component_distance(c, o + t * l);
-    if (d <= eps && d <= eps * lod_scale(o + t * l)) {  // lod_scale ≤ 1, the wind's a loop
-        sh.vis = 0.0;
-        sh.state = SHADOW_DONE;
-        return;
-    }
+    if (d <= eps * lod_scale(o + t * l)) { sh.vis = 0.0; sh.state = SHADOW_DONE; return; }
     if (soft && t > 0.0) sh.vis = min(sh.vis, u_shadow_softness * float(d / t));
     sh.tc[c] = t + d;
 #ifdef KRS_BALL_EXIT

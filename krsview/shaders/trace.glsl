@@ -147,9 +147,7 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
     if (!next_step(r, c, t)) return;
     real d = component_distance(c, origin + t * dir);
     ++r.iterations;
-    // lod_scale ≤ 1: only a step under ε(t) asks for it (the wind's is a loop)
-    real eps = u_eps_per_t * t;
-    if (d <= eps && d <= eps * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
     r.tc[c] = t + d;
 #if defined(KRS_BALL_EXIT) && !defined(KRS_COMPOUND)
     // c leaves once d(t') > ε(t') = ε_per_t t' all the way to T: a miss, found early (in a
