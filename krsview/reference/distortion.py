@@ -102,7 +102,7 @@ class Distortion:
             D = self.twist_step(p, D)
         if self.wind is not None:
             D = safe_step(D, np.abs(self.wind.rates[c]), self.wind.wind_rho(c, p, D))
-            D = np.maximum(D, self.wind.ball_distance(c, p))
+            D = np.maximum(D, self.wind.wind_ball_distance(c, p))
         return np.maximum(D, self.zone_depth(p)[0])
 
     def normal(self, p: np.ndarray, q: np.ndarray, D: np.ndarray, g: np.ndarray, c=0) -> np.ndarray:

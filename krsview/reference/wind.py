@@ -107,7 +107,7 @@ class Wind:
         beta = np.abs(a) * np.linalg.norm(np.cross(self.axis, r), axis=-1)
         return 0.5 * (beta + np.sqrt(4.0 + 4.0 * alpha + beta**2))
 
-    def ball_distance(self, c, p: np.ndarray) -> np.ndarray:
+    def wind_ball_distance(self, c, p: np.ndarray) -> np.ndarray:
         """Distance from the points p (N, 3) to component c's swept ball, a lower bound of
         the distance to it bent at any time that needs no shrinking (−inf: none)."""
         ball = self.balls[c]
