@@ -21,7 +21,8 @@ from krsview.oracle.certify import count_errors
 from krsview.reference import render_reference
 from krsview.reference.distortion import Distortion, safe_step
 from krsview.reference.geometry import scene_distance
-from krsview.reference.wind import Wind, wind_gust
+from krsview.reference.krs import distance as krs_distance
+from krsview.reference.wind import Wind, exit_fall, wind_gust
 from krsview.scene import (
     KRS,
     EffectSettings,
@@ -36,7 +37,7 @@ from krsview.scene.presets import resolve
 
 from .conftest import assert_finite, broken_shaders, check_against_reference, per_pixel
 from .test_ball_exit import H, W, shaders_without
-from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples
+from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples, separated_krs
 
 PRESETS = Path(__file__).resolve().parents[1] / "presets"
 UP = np.array([0.0, 1.0, 0.0])
@@ -198,6 +199,38 @@ def test_the_swept_ball_holds_the_bent_component_at_any_time():
             outside.append((np.linalg.norm(x - rest[:3], axis=1) - rest[3]).max())
     assert len(inside) >= 20 and max(inside) <= 1e-9, inside
     assert max(outside) > 1e-2
+
+
+def fall_excess(seed: int, wind_aware: bool = True) -> float:
+    """The most by which the exits' first bound (exit_fall; the still scene's, D − s, when not
+    ``wind_aware``) exceeds the stepped distance brute-forced along random rays of a separated
+    KRS (exact, so 1-Lipschitz, distance) in a random wind (> 0: the bound is wrong)."""
+    rng = np.random.default_rng(seed)
+    krs = separated_krs(rng, int(rng.integers(1, 4)))
+    while any(k.kind == "plane" for k in krs.kernels):
+        krs = separated_krs(rng, int(rng.integers(1, 4)))
+    scene = windy(krs, rng)
+    dist, c = Distortion.of(scene), compile_krs(krs, ALBEDO)
+    w = dist.wind
+    p = w.bases[0] + rng.normal(size=(100, 3)) * 3.0 + 2.0 * UP
+    D = krs_distance(c, w.unwind(0, p))
+    rho = np.linalg.norm(np.cross(w.axis, p - w.bases[0]), axis=1)
+    d0, fall = exit_fall(D, abs(w.rates[0]), rho) if wind_aware else (D, np.ones_like(D))
+    u = rng.normal(size=(100, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    worst = -np.inf
+    for f in np.linspace(0.0, 1.0, 41):
+        s = f * np.maximum(d0, 0.0) / fall  # while the bound is ≥ 0
+        stepped = scene_distance(c, p + s[:, None] * u, dist)
+        worst = max(worst, float((d0 - fall * s - stepped)[D > 0].max()))
+    return worst
+
+
+def test_the_exits_first_bound_holds_in_the_wind():
+    """Brute force along rays: the stepped distance never falls below the wind's first bound
+    of the balls' exits; negative control: the still scene's bound (D − s) is not one."""
+    assert max(fall_excess(seed) for seed in range(12)) <= 1e-9
+    assert max(fall_excess(seed, wind_aware=False) for seed in range(12)) > 1e-3
 
 
 def test_gusts_are_bounded_and_phases_differ():

@@ -155,3 +155,15 @@ def wind_turn(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     at angle 0, so an idle wind leaves every point as it is."""
     s, h = np.sin(angle)[:, None], np.sin(0.5 * angle)[:, None]
     return np.cross(axis, v) * s + (np.outer(v @ axis, axis) - v) * (2.0 * h * h)
+
+
+def exit_fall(D: np.ndarray, a: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The balls' exits' first bound in the wind (trace.glsl, bound_ahead): from a point's
+    undistorted distance D, rate |a| and axis distance ρ, (d0, fall) with the stepped distance
+    s further along any ray ≥ d0 − fall·s while that is ≥ 0. g moves the rest point by at
+    most sΛ, Λ = 1 + |a|ρ, so the undistorted distance stays ≥ E = D − sΛ (D 1-Lipschitz, as
+    the exits assume), and the step ≥ E / (1 + |a|(ρ + s + E)) ≥ E / m, m = 1 + |a|(ρ + D/Λ
+    + D), for s ≤ D/Λ; d0 = D/m, fall = Λ/m."""
+    lam = 1.0 + a * rho
+    m = 1.0 + a * (rho + D / lam + D)
+    return D / m, lam / m

@@ -78,6 +78,12 @@ real undistorted_distance(int c, vec3r q, real rho) {
     return krs_distance(k.x, k.y, q, rho);
 }
 
+#ifdef KRS_WIND
+// The last wind step's undistorted distance D, |a| and axis distance ρ, which the balls'
+// exits read right after the step (trace.glsl, bound_ahead).
+vec3 g_wind_step;
+#endif
+
 // Component c's distance bound with the level of detail ρ; the wind bends it about its own
 // foot at its own rate a, and its step is safe for the bound 1 + |a|ρ, or is the distance to
 // the ball that holds it at any time where that is larger (wind.glsl).
@@ -86,6 +92,7 @@ real component_distance_at(int c, vec3r p, real rho) {
     if (EFFECT_ON(KRS_WIND_BIT)) {
         float a = wind_rate(c);
         real D = undistorted_distance(c, unwind(c, p, a), rho);
+        g_wind_step = vec3(D, abs(a), length(cross(u_wind_axis, vec3(p) - u_wind_base[c].xyz)));
         D = safe_step(D, abs(a), wind_rho(c, p, D, a));
         return distort_distance(p, max(D, wind_ball_distance(c, p)));
     }
