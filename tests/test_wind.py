@@ -13,13 +13,16 @@ import pytest
 
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
 from krsview.compile.camera import view_of
-from krsview.compile.krs import compile_krs
-from krsview.gpu.renderer import read_buffers
+from krsview.compile.geometry import compile_geometry
+from krsview.compile.krs import compile_krs, grown, krs_ball
+from krsview.gpu.renderer import Renderer, read_buffers
+from krsview.gpu.uniforms import variant_defines
 from krsview.oracle.certify import count_errors
 from krsview.reference import render_reference
-from krsview.reference.distortion import Distortion
+from krsview.reference.distortion import Distortion, safe_step
 from krsview.reference.geometry import scene_distance
-from krsview.reference.wind import Wind, wind_gust
+from krsview.reference.krs import distance as krs_distance
+from krsview.reference.wind import Wind, exit_fall, wind_gust
 from krsview.scene import (
     KRS,
     EffectSettings,
@@ -32,8 +35,9 @@ from krsview.scene import (
 from krsview.scene.effects import wind_feet
 from krsview.scene.presets import resolve
 
-from .conftest import assert_finite, check_against_reference, per_pixel
-from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples
+from .conftest import assert_finite, broken_shaders, check_against_reference, per_pixel
+from .test_ball_exit import H, W, shaders_without
+from .test_distance_bound import ALBEDO, arbitrary_krs, clipped_samples, separated_krs
 
 PRESETS = Path(__file__).resolve().parents[1] / "presets"
 UP = np.array([0.0, 1.0, 0.0])
@@ -124,16 +128,18 @@ def jacobian(f, p: np.ndarray, h: float = 1e-6) -> np.ndarray:
 
 @pytest.mark.parametrize("seed", range(4))
 def test_the_jacobian_stays_under_the_bound_and_gives_the_normal(seed):
-    """‖Dg‖ ≤ 1 + |a|ρ at random points (the bound is tight: it is reached within 10 %), and
-    the normal is Dgᵀ∇ normalised (negative control: a plain rotation of ∇ is not)."""
+    """‖Dg‖ ≤ 1 + |a|ρ at random points (the bound is tight: it is reached within 10 %) and
+    equals ``stretch``, and the normal is Dgᵀ∇ normalised (negative control: a plain rotation
+    of ∇ is not)."""
     rng = np.random.default_rng(seed)
     w = Wind.of(windy(KRS([Level(Sphere((0.0, 1.0, 0.0), 0.5))]), rng))
     p = w.bases[0] + rng.normal(size=(400, 3)) * 2.0 + 1.5 * UP
     J = jacobian(lambda x: w.unwind(0, x), p)
     norm = np.linalg.norm(J, ord=2, axis=(1, 2))
-    bound = 1 + abs(w.rates[0]) * w.wind_rho(0, p)
+    bound = 1 + abs(w.rates[0]) * np.linalg.norm(np.cross(w.axis, p - w.bases[0]), axis=1)
     assert np.all(norm <= bound + 1e-6)
     assert np.max(norm / bound) > 0.9 and np.max(norm) > 1.01
+    assert np.abs(norm - w.stretch(0, p)).max() < 1e-6  # the exact norm
     g = rng.normal(size=(400, 3))
     g /= np.linalg.norm(g, axis=1, keepdims=True)
     want = np.einsum("nji,nj->ni", J, g)
@@ -142,6 +148,89 @@ def test_the_jacobian_stays_under_the_bound_and_gives_the_normal(seed):
     assert np.abs(got - want).max() < 1e-6
     rotated = w.wind_normal(0, p, w.bases[0] + 0 * p, g)  # the shear's term dropped
     assert np.abs(rotated - want).max() > 1e-2
+
+
+def step_escape(seed: int, shrink: float = 1.0) -> float:
+    """The most by which g takes a point of the step's ball B(p, δ) out of B(g(p), D), over
+    random points, free radii D and points of the ball (> 0: the step is not safe); δ is the
+    wind's step, with its ρ scaled by ``shrink``."""
+    rng = np.random.default_rng(seed)
+    w = Wind.of(windy(KRS([Level(Sphere((0.0, 1.0, 0.0), 0.5))]), rng))
+    p = w.bases[0] + rng.normal(size=(200, 3)) * 2.0 + 1.5 * UP
+    D = rng.uniform(0.0, 3.0, size=200)
+    delta = safe_step(D, abs(w.rates[0]), shrink * w.wind_rho(0, p, D))
+    u = rng.normal(size=(200, 64, 3))
+    u *= (rng.uniform(size=(200, 64, 1)) ** (1 / 3)) / np.linalg.norm(u, axis=2, keepdims=True)
+    u[:, 0] = (p - w.bases[0]) / np.linalg.norm(p - w.bases[0], axis=1)[:, None]
+    q = (p[:, None] + delta[:, None, None] * u).reshape(-1, 3)
+    moved = np.linalg.norm(w.unwind(0, q).reshape(200, 64, 3) - w.unwind(0, p)[:, None], axis=2)
+    return float((moved - D[:, None]).max())
+
+
+def test_the_step_stays_in_the_free_ball():
+    """Brute force over the step's ball: g maps B(p, δ) into B(g(p), D), δ from the tighter
+    ρ (about half the distance to the axis above the foot); negative control: a quarter of it
+    lets points out."""
+    assert max(step_escape(seed) for seed in range(8)) <= 1e-9
+    assert max(step_escape(seed, 0.25) for seed in range(8)) > 1e-4
+
+
+def bent_points(seed: int) -> tuple[Wind, np.ndarray, np.ndarray]:
+    """A random KRS in a random wind: its Wind at a random time, points of its bent, clipped
+    expansion at that time, and its rest ball."""
+    rng = np.random.default_rng(seed)
+    krs = arbitrary_krs(rng, int(rng.integers(1, 5)))
+    while any(k.kind == "plane" for k in krs.kernels):
+        krs = arbitrary_krs(rng, int(rng.integers(1, 5)))
+    wind = Wind.of(windy(krs, rng))
+    return wind, bent_forward(wind, clipped_samples(krs, rng, 200)), grown(krs_ball(krs))
+
+
+def test_the_swept_ball_holds_the_bent_component_at_any_time():
+    """Brute force over the bent expansion at random times: every point lies in the swept
+    ball, whose distance the step may take unshrunk; negative control: the rest ball misses
+    some."""
+    inside, outside = [], []
+    for seed in range(30):
+        wind, x, rest = bent_points(seed)
+        if len(x):
+            ball = wind.balls[0]
+            inside.append((np.linalg.norm(x - ball[:3], axis=1) - ball[3]).max())
+            outside.append((np.linalg.norm(x - rest[:3], axis=1) - rest[3]).max())
+    assert len(inside) >= 20 and max(inside) <= 1e-9, inside
+    assert max(outside) > 1e-2
+
+
+def fall_excess(seed: int, wind_aware: bool = True) -> float:
+    """The most by which the exits' first bound (exit_fall; the still scene's, D − s, when not
+    ``wind_aware``) exceeds the stepped distance brute-forced along random rays of a separated
+    KRS (exact, so 1-Lipschitz, distance) in a random wind (> 0: the bound is wrong)."""
+    rng = np.random.default_rng(seed)
+    krs = separated_krs(rng, int(rng.integers(1, 4)))
+    while any(k.kind == "plane" for k in krs.kernels):
+        krs = separated_krs(rng, int(rng.integers(1, 4)))
+    scene = windy(krs, rng)
+    dist, c = Distortion.of(scene), compile_krs(krs, ALBEDO)
+    w = dist.wind
+    p = w.bases[0] + rng.normal(size=(100, 3)) * 3.0 + 2.0 * UP
+    D = krs_distance(c, w.unwind(0, p))
+    rho = np.linalg.norm(np.cross(w.axis, p - w.bases[0]), axis=1)
+    d0, fall = exit_fall(D, abs(w.rates[0]), rho) if wind_aware else (D, np.ones_like(D))
+    u = rng.normal(size=(100, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    worst = -np.inf
+    for f in np.linspace(0.0, 1.0, 41):
+        s = f * np.maximum(d0, 0.0) / fall  # while the bound is ≥ 0
+        stepped = scene_distance(c, p + s[:, None] * u, dist)
+        worst = max(worst, float((d0 - fall * s - stepped)[D > 0].max()))
+    return worst
+
+
+def test_the_exits_first_bound_holds_in_the_wind():
+    """Brute force along rays: the stepped distance never falls below the wind's first bound
+    of the balls' exits; negative control: the still scene's bound (D − s) is not one."""
+    assert max(fall_excess(seed) for seed in range(12)) <= 1e-9
+    assert max(fall_excess(seed, wind_aware=False) for seed in range(12)) > 1e-3
 
 
 def test_gusts_are_bounded_and_phases_differ():
@@ -269,8 +358,8 @@ def test_time_is_continuous(renderer):
 
 def test_idle_wind_draws_the_still_scene(renderer):
     """With no lean the bend, its step and ε's factor are exact identities, so the wind's
-    variant traces the same rays as the scene without wind, bit for bit (the balls' exits, off
-    with wind, change no value); only the normal is normalised once more (a last bit).
+    variant traces the same rays as the scene without wind, bit for bit (the swept ball is then
+    the rest ball); only the normal is normalised once more (a last bit).
     Negative control: half a degree of lean changes the image."""
     s = replace(preset("grove-wind"), render=replace(preset("grove-wind").render, lod=0.0))
     idle = replace(s, effect_settings=replace(s.effect_settings, wind_strength=0.0)).at(3.0)
@@ -306,3 +395,28 @@ def test_the_all_effects_variant_switches_the_wind_by_its_bit(renderer, name):
         assert (np.abs(uber.color - special.color).max(-1) <= 1 / 255).mean() > 0.999
         assert (uber.hit == special.hit).all()
     assert not np.array_equal(special.hit, renderer.render(s, 64, 36).hit)
+
+
+@pytest.mark.parametrize("name", ["tree-wind", "grove-wind"])
+def test_the_exits_in_the_wind_change_no_pixel(tmp_path, renderer, name):
+    """The balls' exits take the swept ball in the wind (trace.glsl, bound_ahead): at sampled
+    times the image is the same bit for bit as without exits, and the tree's misses end
+    early. Negative control: a quarter of the swept ball's radius changes the image."""
+    none = Renderer(
+        shader_dir=shaders_without(tmp_path / "none", "    if (false && (!soft", "    if (false) {")
+    )
+    quarter = "ball = u_wind_ball[c] * vec4(1.0, 1.0, 1.0, 0.25);"
+    small = Renderer(
+        shader_dir=broken_shaders(
+            tmp_path / "small", "trace.glsl", "ball = u_wind_ball[c];", quarter
+        )
+    )
+    for t in (0.4, 2.9):
+        s = preset(name).at(t)
+        assert "KRS_BALL_EXIT" in variant_defines(s, compile_geometry(s.geometry(), ALBEDO))
+        a, b = renderer.render(s, W, H), none.render(s, W, H)
+        for field in ("color", "depth", "normal", "hit"):
+            assert np.array_equal(getattr(a, field), getattr(b, field)), (t, field)
+        assert (a.iterations <= b.iterations).all()
+        assert (a.iterations < b.iterations).any() or name == "grove-wind"  # primary: a KRS
+    assert not np.array_equal(small.render(s, W, H).color, a.color)

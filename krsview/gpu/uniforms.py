@@ -18,6 +18,7 @@ from ..scene.effects import (
     WIND_RATIOS,
     WIND_WEIGHTS,
     allowed_effects,
+    swept_ball,
     wind_feet,
 )
 from ..scene.scene import MAX_LIGHTS
@@ -74,8 +75,8 @@ def variant_defines(
         defines["KRS_COMPONENT_TASKS"] = None  # a task per pixel and component (compute.comp)
     if (
         not isinstance(c, CompiledMoKRS)
-        and "KRS_TWIST" not in defines
-        and "KRS_WIND" not in defines  # both move the geometry out of its balls
+        and "KRS_TWIST" not in defines  # moves the geometry out of its balls (the wind's
+        # exit takes a ball about each foot instead: trace.glsl, wind_bound_ahead)
         and any(ball[3] >= 0 for ball in component_balls(c))
     ):
         defines["KRS_BALL_EXIT"] = None  # rays leave the components' balls (trace.glsl)
@@ -159,18 +160,25 @@ def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     w = np.array([fx.wind_direction[0], 0.0, fx.wind_direction[2]])
     a0 = np.radians(fx.wind_strength) / fx.wind_height
     phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
-    feet = []
+    axis = np.cross((0.0, 1.0, 0.0), w / np.linalg.norm(w))
+    most = a0 * (1.0 + fx.wind_gust)
+    feet, swept = [], []
     if "wind" in scene.effects:  # not on a MöKRS
         balls = [(*(part.ball[:3] + view.origin), part.ball[3]) for part, _ in component_slots(c)]
-        feet = [(*(np.array(b) - view.origin), r) for b, r in wind_feet(scene, balls)]
+        for (b, r), ball in zip(wind_feet(scene, balls), balls):
+            feet.append((*(np.array(b) - view.origin), r))
+            held = swept_ball(b, r, ball, axis, most)
+            swept.append((*(np.array(held[:3]) - view.origin), held[3]))
     feet += [(0.0, 0.0, 0.0, 0.0)] * (MAX_COMPONENTS - len(feet))
+    swept += [(0.0, 0.0, 0.0, -1.0)] * (MAX_COMPONENTS - len(swept))
     return {
         "u_time": scene.time,
-        "u_wind_axis": tuple(np.cross((0.0, 1.0, 0.0), w / np.linalg.norm(w))),
-        "u_wind": (a0, fx.wind_gust, phase, a0 * (1.0 + fx.wind_gust)),
+        "u_wind_axis": tuple(axis),
+        "u_wind": (a0, fx.wind_gust, phase, most * max(f[3] for f in feet)),
         "u_wind_freq": tuple(2.0 * np.pi * fx.wind_frequency * np.array(WIND_RATIOS)),
         "u_wind_weight": WIND_WEIGHTS,
         "u_wind_base": feet if isinstance(c, CompiledCompound) else feet[0],  # per component
+        "u_wind_ball": swept if isinstance(c, CompiledCompound) else swept[0],
     }
 
 

@@ -96,12 +96,13 @@ class Distortion:
 
     def distance(self, p: np.ndarray, D: np.ndarray, c=0) -> np.ndarray:
         """From component c's undistorted distance D at undistort(p, c) to a bound that never
-        overshoots: the twist's or the wind's step, then max(·, depth in a zone) (what is left
-        lies outside every zone)."""
+        overshoots: the twist's or the wind's step (or, if larger, the distance to the wind's
+        swept ball), then max(·, depth in a zone) (what is left lies outside every zone)."""
         if self.twist != 0.0:
             D = self.twist_step(p, D)
         if self.wind is not None:
-            D = safe_step(D, np.abs(self.wind.rates[c]), self.wind.wind_rho(c, p))
+            D = safe_step(D, np.abs(self.wind.rates[c]), self.wind.wind_rho(c, p, D))
+            D = np.maximum(D, self.wind.wind_ball_distance(c, p))
         return np.maximum(D, self.zone_depth(p)[0])
 
     def normal(self, p: np.ndarray, q: np.ndarray, D: np.ndarray, g: np.ndarray, c=0) -> np.ndarray:

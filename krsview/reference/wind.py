@@ -18,9 +18,21 @@ Bound. With s = g(p) − b, ∂/∂θ R_A(−θ)(p − b) = −A × s and ∇θ 
 ρ = |A × s| = |A × (p − b)|, the distance from p to the axis line (a turn about A keeps it).
 So over the ball of radius δ around p, ‖Dg‖ ≤ 1 + |a|(ρ + δ), and g maps that ball into the
 ball of radius D around g(p) when δ(1 + |a|(ρ + δ)) = D: the twist's step (distortion.py,
-safe_step) with k = |a(t)| and this ρ (Distortion.distance applies it). ε shrinks by
-1/(1 + |a|ρ) as for the twist (lod_scale: with the largest |a| any time gives, ``most``, so the
-shader computes no gust for it). The normal is Dgᵀ ∇D = R_A(θ) ∇D − a [h > 0] up ((A × s)·∇D).
+safe_step) with k = |a(t)| and this ρ (Distortion.distance applies it). Far from the
+component that step is shortened for nothing: a bent point lies within its reach of b, so it
+turns by at most θ ≤ most·reach, and the rest ball turned by every such angle lies in one
+ball (scene/effects.py, swept_ball) whose distance, unshrunk, bounds the step from below
+too. ε shrinks by 1/(1 + |a|ρ) as for the twist, at its least (lod_scale: most·reach, the
+largest |a| any time gives and the largest ρ near a component). The normal is
+Dgᵀ ∇D = R_A(θ) ∇D − a [h > 0] up ((A × s)·∇D).
+
+Tighter. Dg = R_A(−θ)(I + x upᵀ) with x = −a (A × r), r = p − b; so ‖Dg‖ = ‖I + x upᵀ‖, which
+in the basis (up, the unit e of x's part ⊥ up) is [[1 + α, 0], [γ, 1]], α = x·up = a (ŵ·r)
+(ŵ = A × up, the wind), β = |x| = |a|ρ, γ² = β² − α²: its largest singular value is
+(β + √(4 + 4α + β²))/2 (``stretch``), increasing in α and β, and at most 1 + (β + α⁺)/2 + β²/8
+(square both sides). Over the ball of radius δ ≤ D, α⁺ ≤ |a|((ŵ·r)⁺ + δ) and β ≤ |a|(ρ + δ) ≤
+|a|(ρ + D), so ‖Dg‖ ≤ 1 + |a|(ρ' + δ) with ρ' = (ρ + (ŵ·r)⁺)/2 + |a|(ρ + D)²/8: the step's ρ is
+the smaller of ρ and ρ' (``wind_rho``), about half the distance to the axis above the foot.
 
 Gusts: a_c(t) = radians(strength)/height · (1 + gust · n(t + c·WIND_PHASE/f)), with
 n = Σ w_k sin(2π r_k f t) (scene/effects.py). A compound bends each component about its own
@@ -35,7 +47,14 @@ import numpy as np
 
 from ..compile.krs import grown, krs_ball
 from ..scene import Compound, Scene
-from ..scene.effects import WIND_PHASE, WIND_RATIOS, WIND_WEIGHTS, EffectSettings, wind_feet
+from ..scene.effects import (
+    WIND_PHASE,
+    WIND_RATIOS,
+    WIND_WEIGHTS,
+    EffectSettings,
+    swept_ball,
+    wind_feet,
+)
 
 UP = np.array([0.0, 1.0, 0.0])
 
@@ -47,6 +66,7 @@ class Wind:
     bases: np.ndarray  # each component's foot b_c (C, 3)
     reach: np.ndarray  # how far each component gets from its foot; 0: it stands (C,)
     most: float  # the largest |a_c(t)| at any time: radians(strength)/height · (1 + gust)
+    balls: np.ndarray  # per component a ball holding it bent at any time (C, 4); r < 0: none
 
     @staticmethod
     def of(scene: Scene) -> Wind:
@@ -54,20 +74,45 @@ class Wind:
         w = np.array([fx.wind_direction[0], 0.0, fx.wind_direction[2]])
         geometry = scene.geometry()
         parts = geometry.parts if isinstance(geometry, Compound) else (geometry,)
-        feet = wind_feet(scene, [grown(krs_ball(krs)) for krs in parts])
+        balls = [grown(krs_ball(krs)) for krs in parts]
+        feet = wind_feet(scene, balls)
         reach = np.array([r for _, r in feet])
         phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
+        axis = np.cross(UP, w / np.linalg.norm(w))
+        most = float(np.radians(fx.wind_strength) / fx.wind_height * (1.0 + fx.wind_gust))
         return Wind(
-            np.cross(UP, w / np.linalg.norm(w)),
+            axis,
             (reach > 0) * wind_rate(fx, scene.time + phase * np.arange(len(feet))),
             np.array([b for b, _ in feet], dtype=float),
             reach,
-            float(np.radians(fx.wind_strength) / fx.wind_height * (1.0 + fx.wind_gust)),
+            most,
+            np.array([swept_ball(b, r, ball, axis, most) for (b, r), ball in zip(feet, balls)]),
         )
 
-    def wind_rho(self, c, p: np.ndarray) -> np.ndarray:
-        """Distance from the points p (N, 3) to component c's axis line (c: int or (N,))."""
-        return np.linalg.norm(np.cross(self.axis, p - self.bases[c]), axis=-1)
+    def wind_rho(self, c, p: np.ndarray, D: np.ndarray) -> np.ndarray:
+        """The ρ of the step's bound 1 + |a|(ρ + δ) at the points p (N, 3) for component c
+        (int or (N,)) with free radii D: the distance to the axis line, or where smaller
+        (ρ + (ŵ·r)⁺)/2 + |a|(ρ + D⁺)²/8 (module docstring, Tighter)."""
+        r = p - self.bases[c]
+        rho = np.linalg.norm(np.cross(self.axis, r), axis=-1)
+        along = np.maximum(r @ np.cross(self.axis, UP), 0.0)
+        far = rho + np.maximum(D, 0.0)
+        return np.minimum(rho, 0.5 * (rho + along) + 0.125 * np.abs(self.rates[c]) * far**2)
+
+    def stretch(self, c, p: np.ndarray) -> np.ndarray:
+        """‖Dg‖ at the points p (N, 3), exactly: (β + √(4 + 4α + β²))/2 (module docstring)."""
+        r = p - self.bases[c]
+        a = np.where(r[:, 1] > 0.0, self.rates[c], 0.0)
+        alpha = a * (r @ np.cross(self.axis, UP))
+        beta = np.abs(a) * np.linalg.norm(np.cross(self.axis, r), axis=-1)
+        return 0.5 * (beta + np.sqrt(4.0 + 4.0 * alpha + beta**2))
+
+    def wind_ball_distance(self, c, p: np.ndarray) -> np.ndarray:
+        """Distance from the points p (N, 3) to component c's swept ball, a lower bound of
+        the distance to it bent at any time that needs no shrinking (−inf: none)."""
+        ball = self.balls[c]
+        d = np.linalg.norm(p - ball[..., :3], axis=-1) - ball[..., 3]
+        return np.where(ball[..., 3] < 0.0, -np.inf, d)
 
     def unwind(self, c, p: np.ndarray) -> np.ndarray:
         """g: where component c's rest geometry is looked up for world points p (N, 3)."""
@@ -86,16 +131,10 @@ class Wind:
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
     def lod_scale(self, p: np.ndarray) -> np.ndarray:
-        """1 / (1 + most·ρ): ε shrinks as the step does to first order (distortion.py,
-        lod_scale), at any time. ρ: to the farthest axis of the components within whose
-        reach p lies; elsewhere no component can stop a ray, so ε stays (a ground's)."""
-        rho2 = np.zeros(len(p))  # squared: ρ² = |r|² − (A·r)²
-        for c in np.flatnonzero(self.reach):
-            r = p - self.bases[c]
-            rr = np.einsum("ij,ij->i", r, r)
-            near = rr <= self.reach[c] ** 2
-            rho2 = np.where(near, np.maximum(rho2, rr - (r @ self.axis) ** 2), rho2)
-        return 1.0 / (1.0 + self.most * np.sqrt(rho2))
+        """1 / (1 + most·reach), reach the largest: the least the step's shrink 1 / (1 + |a|ρ)
+        gets at any time and point, so ε shrinks with it (distortion.py, lod_scale) by one
+        factor for the frame, which the shader reads without a loop over the components."""
+        return np.full(len(p), 1.0 / (1.0 + self.most * self.reach.max()))
 
 
 def wind_rate(fx: EffectSettings, t: np.ndarray) -> np.ndarray:
@@ -116,3 +155,15 @@ def wind_turn(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     at angle 0, so an idle wind leaves every point as it is."""
     s, h = np.sin(angle)[:, None], np.sin(0.5 * angle)[:, None]
     return np.cross(axis, v) * s + (np.outer(v @ axis, axis) - v) * (2.0 * h * h)
+
+
+def exit_fall(D: np.ndarray, a: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The balls' exits' first bound in the wind (trace.glsl, bound_ahead): from a point's
+    undistorted distance D, rate |a| and axis distance ρ, (d0, fall) with the stepped distance
+    s further along any ray ≥ d0 − fall·s while that is ≥ 0. g moves the rest point by at
+    most sΛ, Λ = 1 + |a|ρ, so the undistorted distance stays ≥ E = D − sΛ (D 1-Lipschitz, as
+    the exits assume), and the step ≥ E / (1 + |a|(ρ + s + E)) ≥ E / m, m = 1 + |a|(ρ + D/Λ
+    + D), for s ≤ D/Λ; d0 = D/m, fall = Λ/m."""
+    lam = 1.0 + a * rho
+    m = 1.0 + a * (rho + D / lam + D)
+    return D / m, lam / m

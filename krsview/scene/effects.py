@@ -249,3 +249,23 @@ def wind_feet(scene, balls: list) -> list[tuple[Vec3, float]]:
         (foot, float(np.linalg.norm(np.array(ball[:3]) - foot) + ball[3]) if ball[3] >= 0 else 0.0)
         for foot, ball in zip(feet, balls)
     ]
+
+
+def swept_ball(foot, reach: float, ball, axis, most: float) -> tuple[float, ...]:
+    """A ball (centre, radius) holding a component bent by the wind at any time, given its
+    foot and reach (wind_feet), its rest ball, the wind's axis A and the largest rate: a bent
+    point lies within reach of the foot, so its rest point turned about the axis line through
+    the foot by an angle in [0, most·reach]; the rest ball turned by half of that and grown by
+    the chord its centre sweeps holds them all. The foot's own ball where that is smaller;
+    radius −1 where the component stands (reach 0)."""
+    if reach <= 0.0:
+        return (0.0, 0.0, 0.0, -1.0)
+    foot, axis, v = np.array(foot), np.array(axis), np.array(ball[:3]) - foot
+    half = 0.5 * most * reach
+    axial = axis * (axis @ v)
+    turned = axial + (v - axial) * math.cos(half) + np.cross(axis, v) * math.sin(half)
+    chord = 2.0 * np.linalg.norm(np.cross(axis, v)) * math.sin(min(half / 2, math.pi / 2))
+    radius = ball[3] + chord
+    if radius >= reach:
+        return (*(float(x) for x in foot), float(reach))
+    return (*(float(x) for x in foot + turned), float(radius))

@@ -72,20 +72,34 @@ uniform vec4 u_bounding_ball;
 // For every t' in [t, T] (T: the far limit), d(t') ≥ L(t') = max(d − (t' − t), near +
 // g (t' − t)): the distance is 1-Lipschitz, and past c's ball (C, R) it is at least
 // |x + (t' − t) dir − C| − R, which lies above its tangent (near = |x − C| − R, g =
-// dir·(x − C)/|x − C|). The first bound falls, the second rises, so L is least where they
-// cross, t*, and L(t')/t' is least at t* or at T. Returns (L(t*), t*, L(T)); without a ball
-// or at t = 0, L(t*) = −1: nothing is known. near is computed in float, so it gives up the
-// rounding of x − C.
+// dir·(x − C)/|x − C|). The first bound falls, the second rises (g ≥ 0) or falls more
+// slowly, so L is least at their crossing t* or at T, and L(t')/t' is least at t* or at T.
+// Returns (min(L(t*), L(T)), t*, L(T)); without a ball or at t = 0, −1: nothing is known.
+// near is computed in float, so it gives up the rounding of x − C. In the wind, (C, R) is the
+// swept ball, and the first bound falls from D/m at the rate Λ/m (the stepped distance is
+// not 1-Lipschitz): g moves the rest point by at most s·Λ, Λ = 1 + |a|ρ, for s along the ray,
+// so the undistorted distance stays ≥ E = D − sΛ, and the step δ ≥ E / (1 + |a|(ρ + s + E))
+// ≥ E / m, m = 1 + |a|(ρ + D/Λ + D), while E ≥ 0 (reference/wind.py, exit_fall).
 vec3 bound_ahead(int c, vec3r x, real t, real d, vec3 dir) {
     vec4 ball = COMPONENT_BALL(c);
+    float d0 = float(d), fall = 1.0;  // the first bound: d0 − fall·(t' − t)
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) {  // the swept ball, and the wind's first bound
+        ball = u_wind_ball[c];
+        vec3 w = g_wind_step;
+        float lam = 1.0 + w.y * w.z, m = 1.0 + w.y * (w.z + w.x / lam + w.x);
+        d0 = w.x / m;
+        fall = lam / m;
+    }
+#endif
     vec3 v = vec3(x) - ball.xyz;
     float rho = length(v), g = dot(dir, v) / rho;
     float near = rho - ball.w - 1e-6 * (rho + length(vec3(x)));  // float rounding of x − C
-    float t0 = float(t), T = u_max_distance, d0 = float(d);
-    float ts = min(t0 + max(d0 - near, 0.0) / max(1.0 + g, 1e-6), T);
-    float Ls = max(d0 - (ts - t0), near + g * (ts - t0));
-    float LT = max(d0 - (T - t0), near + g * (T - t0));
-    return ball.w < 0.0 || t <= 0.0 ? vec3(-1.0, 1.0, -1.0) : vec3(Ls, ts, LT);
+    float t0 = float(t), T = u_max_distance;
+    float ts = min(t0 + max(d0 - near, 0.0) / max(fall + g, 1e-6), T);
+    float Ls = max(d0 - fall * (ts - t0), near + g * (ts - t0));
+    float LT = max(d0 - fall * (T - t0), near + g * (T - t0));
+    return ball.w < 0.0 || t <= 0.0 ? vec3(-1.0, 1.0, -1.0) : vec3(min(Ls, LT), ts, LT);
 }
 
 // Component c has left the ray; the ray is done once all have.
