@@ -177,9 +177,15 @@ def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_wind": (a0, fx.wind_gust, phase, most * max(f[3] for f in feet)),
         "u_wind_freq": tuple(2.0 * np.pi * fx.wind_frequency * np.array(WIND_RATIOS)),
         "u_wind_weight": WIND_WEIGHTS,
-        "u_wind_base": feet if isinstance(c, CompiledCompound) else feet[0],  # per component
-        "u_wind_ball": swept if isinstance(c, CompiledCompound) else swept[0],
+        "u_wind_base": per_component(c, feet),
+        "u_wind_ball": per_component(c, swept),
     }
+
+
+def per_component(c: Compiled, rows: list) -> object:
+    """A per-component uniform's value: its rows in a compound; for a single KRS its one row,
+    as moderngl takes a one-element array (and share/web.py bakes it back into one)."""
+    return rows if isinstance(c, CompiledCompound) else rows[0]
 
 
 def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
@@ -220,9 +226,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_effects": sum(EFFECTS[e].bit for e in scene.effects),
         "u_smooth_width": fx.smooth_width,
         "u_shadow_softness": fx.shadow_softness,
-        "u_bounding_ball": (
-            component_balls(c) if isinstance(c, CompiledCompound) else component_balls(c)[0]
-        ),  # an array only in a compound
+        "u_bounding_ball": per_component(c, component_balls(c)),
         "u_ao_step": fx.ao_step,
         "u_ao_strength": fx.ao_strength,
         "u_texture_scale": fx.texture_scale,

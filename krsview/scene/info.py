@@ -6,7 +6,6 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 
-from .animation import DEFAULT_DURATION
 from .effects import EFFECTS
 from .scene import Scene
 
@@ -78,4 +77,4 @@ def motion(scene: Scene) -> str:
         parts.append(f"sway of {w.levels} levels, {w.amplitude:g}° at {w.frequency:g} Hz")
     if not parts:
         return ""
-    return "; ".join(parts) + f" — loop {a.duration if a else DEFAULT_DURATION:g} s"
+    return "; ".join(parts) + f" — loop {scene.duration:g} s"

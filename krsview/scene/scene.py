@@ -11,7 +11,14 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .animation import Animation, check_animation, check_time, pose, reads_time
+from .animation import (
+    DEFAULT_DURATION,
+    Animation,
+    check_animation,
+    check_time,
+    pose,
+    reads_time,
+)
 from .compound import Component, Compound, check_compound
 from .edits import apply_edit, parse_path
 from .effects import EffectSettings, check_effects
@@ -71,6 +78,11 @@ class Scene:
     def time(self) -> float:
         """The moment drawn, in seconds (0 without an [animation] table)."""
         return self.animation.time if self.animation is not None else 0.0
+
+    @property
+    def duration(self) -> float:
+        """One playback loop, in seconds (the viewer's, the page's, Shadertoy's)."""
+        return self.animation.duration if self.animation is not None else DEFAULT_DURATION
 
     def at(self, t: float, path: str = "time") -> Scene:
         """This scene at time ``t`` (seconds): what moves is read from the scene's time.

@@ -26,7 +26,6 @@ from ..compile.geometry import compile_geometry
 from ..gpu.program import ES_HEADER, Source
 from ..gpu.uniforms import block_arrays, variant_defines, view_uniforms
 from ..scene import Scene, SceneError
-from ..scene.animation import DEFAULT_DURATION
 from ..scene.camera_path import horizontal_axes
 
 # Set per pixel by orbit_camera (web.frag): declared as plain globals.
@@ -183,7 +182,7 @@ def html_page(scene: Scene) -> str:
         template.replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
         .replace("{{NOTES}}", html.escape(" · ".join(notes)))
         .replace("{{TIME}}", json.dumps(scene.time))
-        .replace("{{DURATION}}", json.dumps(_duration(scene)))
+        .replace("{{DURATION}}", json.dumps(scene.duration))
         .replace("{{VERTEX}}", json.dumps(vertex_shader()))
         .replace("{{FRAGMENT}}", json.dumps(web_shader(scene)))
     )
@@ -199,15 +198,10 @@ def shadertoy_source(scene: Scene) -> str:
     )
     notes = "".join(f"// note: {n}\n" for n in export_notes(scene))
     body = web_shader(scene, shadertoy=True)
-    clock = f"mod({_float(scene.time)} + iTime, {_float(_duration(scene))})"
+    clock = f"mod({_float(scene.time)} + iTime, {_float(scene.duration)})"
     plays = f"    {CLOCK} = {clock};  // the scene's time, round its loop\n"
     main = SHADERTOY_MAIN.replace("    PLAYS\n", plays if CLOCK in body else "")
     return head + notes + body + main
-
-
-def _duration(scene: Scene) -> float:
-    """One loop of the scene's time (the viewer's, the page's and Shadertoy's)."""
-    return scene.animation.duration if scene.animation else DEFAULT_DURATION
 
 
 SHADERTOY_MAIN = """

@@ -20,7 +20,7 @@ from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
-from ..scene.animation import DEFAULT_DURATION, reads_time
+from ..scene.animation import reads_time
 from ..scene.effects import EXCLUSIVE
 from ..scene.model import VIEW_PREPASS
 from ..scene.settings import ViewerSettings, make_settings
@@ -121,8 +121,7 @@ class Viewer:
         """Follow the document: a new scene version redraws (and recompiles only if its
         variant changed: effects, tracer, geometry family)."""
         self._seen_version = self.doc.version
-        a = scene.animation
-        self.playback.duration = a.duration if a else DEFAULT_DURATION  # keys move its end
+        self.playback.duration = scene.duration  # new keys move its end
         self.playback.seek(self.playback.time)
         if self._measured_for != self.path.stem:  # per preset, not per edit
             self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
