@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import os
 from collections.abc import Hashable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from ..scene import Scene, SceneError, load_scene, scene_to_toml
+from ..scene import Bookmark, Camera, Scene, SceneError, load_scene, scene_to_toml
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
 from ..scene.presets import PRESET_DIR
@@ -194,6 +194,26 @@ class Document:
         self.recovery_path.unlink(missing_ok=True)
         self.version += 1
         return target
+
+    def add_bookmark(self, camera: Camera) -> tuple[str, Path]:
+        """Append a bookmark of ``camera`` to the file (one undo step), its name and the file
+        written. Other unsaved edits stay unsaved: the bookmark joins the file as it is on
+        disk. A shipped preset's goes to its copy (``copy_target``), the document's file
+        from then on. SceneError: the file cannot be read or written."""
+        if self.template:
+            name = f"view {len(self._scene.bookmarks) + 1}"
+            self.apply(("bookmarks",), self._scene.bookmarks + [Bookmark(name, camera)])
+            return name, self.save(copy_target(self.path))
+        on_disk = load_scene(self.path)
+        name = f"view {len(on_disk.bookmarks) + 1}"
+        written = replace(on_disk, bookmarks=on_disk.bookmarks + [Bookmark(name, camera)])
+        try:
+            write_atomic(self.path, scene_to_toml(written))
+        except OSError as e:
+            raise SceneError("<file>", str(self.path), f"cannot save: {e.strerror}") from None
+        self.apply(("bookmarks",), written.bookmarks)
+        self.mark_saved(written)
+        return name, self.path
 
     def mark_saved(self, scene: Scene) -> None:
         """The file now holds ``scene`` (written here, or by the viewer's bookmark)."""

@@ -1,12 +1,14 @@
 """The viewer's clock for scenes that move (issue 29): the moment shown, play/pause and speed.
 Time is view state, like the flying camera: playing never edits the document (no undo step
-per frame); the document's ``[animation] time`` is where a viewer opens. No GL."""
+per frame); the document's ``[animation] time`` is where a viewer opens. ``Posing`` keeps the
+scene posed at that moment. No GL."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from ..scene.animation import DEFAULT_DURATION
+from ..scene import Scene, SceneError
+from ..scene.animation import DEFAULT_DURATION, reads_time
 
 SPEED_RANGE = (0.05, 8.0)  # × real time, the HUD's slider
 
@@ -32,3 +34,31 @@ class Playback:
 
     def set_speed(self, speed: float) -> None:
         self.speed = min(max(float(speed), SPEED_RANGE[0]), SPEED_RANGE[1])
+
+
+class Posing:
+    """The scene as drawn at the moment shown: its tracks and sway applied there. A moment
+    whose pose breaks a field's rule (a value between keys) keeps the last pose drawn, with
+    ``error`` saying why, until a moment poses again."""
+
+    def __init__(self) -> None:
+        self.error = ""
+        self._last: Scene | None = None
+        self._drawn: Scene | None = None  # the last pose, time aside
+
+    def pose(self, scene: Scene, t: float) -> Scene:
+        try:
+            pose = scene.at(t).posed()
+        except SceneError as e:
+            self.error = str(e)
+            return self._last if self._last is not None else scene.at(0.0).posed()
+        self.error, self._last = "", pose
+        return pose
+
+    def changed(self, pose: Scene) -> bool:
+        """Whether ``pose`` needs a new image: it differs from the last one but for the
+        shader's time, or the shader reads time (past the last key nothing else moves)."""
+        drawn = replace(pose, animation=None)
+        changed = drawn != self._drawn or reads_time(pose.effects)
+        self._drawn = drawn
+        return changed

@@ -15,12 +15,11 @@ import moderngl
 import numpy as np
 from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
 
-from ..document.document import Document, copy_target
+from ..document.document import Document
 from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
-from ..scene import Bookmark, Scene, SceneError, load_scene, save_scene
-from ..scene.animation import reads_time
+from ..scene import Scene, SceneError
 from ..scene.effects import EXCLUSIVE
 from ..scene.model import VIEW_PREPASS
 from ..scene.settings import ViewerSettings, make_settings
@@ -35,7 +34,7 @@ from .measured import load_measured
 from .navigation import Navigation
 from .picking import pick_center
 from .platform import Platform
-from .playback import Playback
+from .playback import Playback, Posing
 from .recording import Recorder, path_file
 from .screenshots import save_screenshot
 from .watch import FileWatcher
@@ -74,9 +73,7 @@ class Viewer:
         self.clock = 0.0
         self.status = ("", 0.0)  # text, and the clock it goes at
         self.playback = Playback()
-        self._last_pose: Scene | None = None  # drawn while a moment cannot be posed
-        self._pose_error = ""
-        self._drawn: Scene | None = None  # the last moment's pose, time aside
+        self.posing = Posing()
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
@@ -126,7 +123,7 @@ class Viewer:
         if self._measured_for != self.path.stem:  # per preset, not per edit
             self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
         pose = self.posed(scene)
-        self._drawn = replace(pose, animation=None)
+        self.posing.changed(pose)
         self.geometry = pose.geometry()
         self.levels = min(self.levels, self.geometry.depth)
         self._apply_levels()
@@ -134,17 +131,14 @@ class Viewer:
             self.nav.reset(scene.camera)
 
     def posed(self, scene: Scene) -> Scene:
-        """``scene`` as drawn at the moment shown: its tracks and sway applied there. A moment
-        whose pose breaks a field's rule (a value between keys) shows why and keeps the last
-        pose drawn, until a moment poses again."""
-        try:
-            pose = scene.at(self.playback.time).posed()
-        except SceneError as e:
-            self.error = self._pose_error = str(e)
-            return self._last_pose if self._last_pose is not None else scene.at(0.0).posed()
-        if self._pose_error and self.error == self._pose_error:
+        """``scene`` as drawn at the moment shown (``Posing``); a moment that cannot be posed
+        shows why until one poses again."""
+        said = self.posing.error
+        pose = self.posing.pose(scene, self.playback.time)
+        if self.posing.error:
+            self.error = self.posing.error
+        elif said and self.error == said:
             self.error = ""
-        self._pose_error, self._last_pose = "", pose
         return pose
 
     def _time_moved(self) -> None:
@@ -160,10 +154,8 @@ class Viewer:
             self.geometry = geometry
             self.levels = min(self.levels, geometry.depth)
             self._apply_levels()
-        drawn = replace(pose, animation=None)  # what the image shows, but for the shader's time
-        if drawn != self._drawn or reads_time(pose.effects):  # past the last key: nothing
+        if self.posing.changed(pose):
             self.frames.dirty = True
-        self._drawn = drawn
 
     def toggle_play(self) -> None:
         if not self.scene.animated:
@@ -304,30 +296,16 @@ class Viewer:
             self.go_to_bookmark((self.nav.bookmark_index + 1) % len(self.scene.bookmarks))
 
     def add_bookmark(self) -> None:
-        """Append the current camera to the preset file's bookmarks (atomic save); a shipped
-        preset's go to its copy (document.copy_target), which the viewer shows from then on."""
-        if self.doc.template:
-            b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.camera.to_camera())
-            self.edit(("bookmarks",), self.scene.bookmarks + [b])
-            try:
-                saved = self.doc.save(copy_target(self.path))
-            except SceneError as e:
-                self.error = f"bookmark not saved: {e}"
-                return
-            self.follow_file()
-            self.message = f"saved bookmark {b.name!r} in a copy of the preset: {saved}"
-            return
+        """Append the current camera to the scene file's bookmarks (Document.add_bookmark: a
+        shipped preset's go to its copy, which the viewer shows and watches from then on)."""
         try:
-            on_disk = load_scene(self.path)
+            name, saved = self.doc.add_bookmark(self.camera.to_camera())
         except SceneError as e:
             self.error = f"bookmark not saved: {e}"
             return
-        b = Bookmark(f"view {len(on_disk.bookmarks) + 1}", self.camera.to_camera())
-        save_scene(replace(on_disk, bookmarks=on_disk.bookmarks + [b]), self.path)
-        self.watcher.forget()  # our own save is not an outside edit
-        self.edit(("bookmarks",), on_disk.bookmarks + [b])
-        self.doc.mark_saved(replace(on_disk, bookmarks=on_disk.bookmarks + [b]))
-        self.message = f"saved bookmark {b.name!r} in {self.path.name}"
+        self.sync()
+        self.follow_file()  # our own save is not an outside edit
+        self.message = f"saved bookmark {name!r} in {saved}"
 
     def follow_file(self) -> None:
         """The document was saved, perhaps under a new name: watch that file, and keep the
