@@ -1,19 +1,22 @@
 """Keyframes in the editor (issue 29): K sets a key for the selected value at the moment shown;
 a drag of a value that has a track sets its key there (auto-key: the track would override the
-rest value); the timeline strip at the foot of the view plays, scrubs, and shows the
-selection's keys, which drag along it in time (right-click deletes one). Each change is one
-edit of the scene's ``[animation]`` table: validated, undoable, saved."""
+rest value). A keyed fork's subtree follows it as bones do (scene/animation.py's
+``bone_offsets``), so a key holds the value less what the keyed forks above it add. The
+timeline strip at the foot of the view plays, scrubs, and shows the selection's keys, which
+drag along it in time (right-click deletes one). Each change is one edit of the scene's
+``[animation]`` table: validated, undoable, saved."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
 from imgui_bundle import imgui
 
 from ..scene import Scene
-from ..scene.animation import Animation, Key, Track
-from ..scene.edits import get_at, path_text
+from ..scene.animation import Animation, Key, Track, bone_offset
+from ..scene.edits import Path, get_at, parse_path, path_text
 from ..viewer import commands as vc
 from ..viewer.playback import Playback
 from . import commands as ec
@@ -48,17 +51,48 @@ def with_key(scene: Scene, path: tuple, t: float, value: Any) -> Animation:
     return replace(a, tracks=tracks, duration=max(a.duration, t))
 
 
+def held(scene: Scene, path: tuple, value: Any, t: float) -> Any:
+    """A value drawn at ``path`` at ``t`` as a key holds it: less what the keyed forks above
+    it add there (a route's fork or control point; any other value as it is)."""
+    off = bone_offset(scene.at(t), path)
+    return value if off is None else tuple(float(c) for c in np.subtract(value, off))
+
+
 def key_now(scene: Scene, path: tuple, t: float) -> Animation:
     """K: a key at ``t`` holding the value at ``path`` as drawn at ``t``."""
-    return with_key(scene, path, t, get_at(scene.at(t).posed(), path))
+    return with_key(scene, path, t, held(scene, path, get_at(scene.at(t).posed(), path), t))
 
 
 def keyed_edit(scene: Scene, path: tuple, value: Any, t: float) -> tuple[tuple, Any]:
     """A drag's edit: of the value itself, or, where a track moves that value, of its key
-    at ``t`` (auto-key)."""
+    at ``t`` (auto-key), ``value`` being where it is drawn."""
     if track_index(scene, path) is None:
         return path, value
-    return ("animation",), with_key(scene, path, t, value)
+    return ("animation",), with_key(scene, path, t, held(scene, path, value, t))
+
+
+def carried_tracks(scene: Scene, path: Path, delta: np.ndarray) -> Animation | None:
+    """A fork (or trunk foot) at ``path`` dragged by ``delta`` with its subtree: the tracks of
+    the subtree's forks and control points move along, every key by ``delta`` (level i's own
+    control point by half, as handles.py's carry moves it), so a keyed part of the subtree
+    stays on it; None where no track moves."""
+    a = scene.animation
+    if a is None or not a.tracks:
+        return None
+    at = path[:-1] if path[-1] == "base" else path[:-3]
+    i = len(get_at(scene, at).levels) if path[-1] == "base" else path[-2]
+    tracks, moved = list(a.tracks), False
+    for k, tr in enumerate(a.tracks):
+        p = parse_path(tr.path)
+        if p[:-2] != (*at, "levels") or p[-1] not in ("fork", "control"):
+            continue
+        f = 1.0 if p[-2] < i else 0.5 if (p[-2], p[-1]) == (i, "control") else 0.0
+        if f:
+            keys = [
+                Key(q.time, tuple(float(c) for c in np.add(q.value, f * delta))) for q in tr.keys
+            ]
+            tracks[k], moved = replace(tr, keys=keys), True
+    return replace(a, tracks=tracks) if moved else None
 
 
 def moved_key(scene: Scene, track: int, key: int, t: float) -> Animation:

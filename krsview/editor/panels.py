@@ -105,7 +105,8 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
             if imgui.is_item_hovered():
                 imgui.set_tooltip(
                     "on: the finer forks, control points and mirrors move with a "
-                    "dragged fork, so the crown stays attached; off: only the fork"
+                    "dragged fork, so the crown stays attached; off: only the fork. "
+                    "A keyed fork always takes its subtree along, as a bone does"
                 )
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:

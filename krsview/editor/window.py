@@ -40,9 +40,10 @@ from ..viewer.loop import run
 from ..viewer.window import Viewer
 from . import commands as ec
 from .clipped import clipped_parts
+from .dragging import manipulate
 from .gizmo import Gizmo
 from .handles import Handle, handles
-from .keys import Timeline, key_now, keyed_edit, track_index
+from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
 from .panels import edit_panel
 from .picking import hover_label, pick, visible
@@ -124,13 +125,14 @@ class Editor:
                 self.selected = next((h for h in self._handles if h.same(self.selected)), None)
 
     def handled_scene(self) -> Scene:
-        """The scene whose values the handles sit at: with keyframe tracks, as drawn at the
-        moment shown (a keyed handle is where its track puts it); else, and with sway (which
-        turns mirrors a drag must not write back), the scene's own values."""
+        """The scene whose values the handles and panels show: with keyframe tracks, as drawn
+        at the moment shown (a keyed handle is where its track puts it, a keyed fork's
+        subtree where the fork takes it); the sway's turn left out (a drag must not write
+        it back)."""
         a = self.scene.animation
-        if a is not None and a.tracks and a.sway is None:
-            return self.viewer.posed(self.scene)
-        return self.scene
+        if a is None or not a.tracks:
+            return self.scene
+        return self.viewer.posed(replace(self.scene, animation=replace(a, sway=None)))
 
     def edit(self, path: tuple, value, interaction=None) -> bool:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
@@ -188,7 +190,7 @@ class Editor:
         if ui:
             v.platform.new_frame()
         if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
-            self._manipulate()
+            manipulate(self)
         v.draw_image()
         self._follow()
         if ui:
@@ -387,7 +389,7 @@ class Editor:
     def _draw_ui(self) -> None:
         """Inside the ImGui frame, after the trace: the overlay over the image, the viewer's
         HUD (collapsed at first: the view stays free), the edit panel, and the name of the
-        handle under the pointer (the gizmo came before the trace: :meth:`_manipulate`)."""
+        handle under the pointer (the gizmo came before the trace: dragging.py)."""
         v = self.viewer
         view = self.window_view()
         shown = self.shown()
@@ -406,19 +408,6 @@ class Editor:
             path = self.selected.path if self.selected is not None else None
             self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
         hover_label(shown, view)
-
-    def _manipulate(self) -> None:
-        """Inside the ImGui frame, before the turn's image is traced: the gizmo on a selected
-        point or the trackball on a selected normal; a drag's step is an edit at once."""
-        self.gizmo.begin_frame()
-        sel = self.selected
-        if sel is not None:
-            tool = self.trackball.update if sel.kind == "normal" else self.gizmo.manipulate
-            moved = tool(sel, self.window_view())
-            if moved is not None:  # a keyed value's drag sets its key (in edit)
-                p, drag = moved
-                keyed = track_index(self.scene, sel.path) is not None
-                self.edit(*sel.edit_to(self.scene, p, self.carry and not keyed), drag)
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
