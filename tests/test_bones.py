@@ -59,7 +59,7 @@ def test_a_keyed_fork_drag_keys_it_and_its_subtree_follows_at_every_moment(bent)
     s = keyed(bent, FORK, (0.0, rest))  # K at 0 s: the rest value
     s = s.at(2.0)
     h = next(h for h in handles(s.posed()) if h.path == FORK)
-    s = apply(s, drag_edits(s, h, rest + MOVE, carry=True))  # the drag at 2 s
+    s = apply(s, drag_edits(s, h, rest + MOVE, carry=True, t=2.0))  # the drag at 2 s
     track = s.animation.tracks[0]
     assert [k.time for k in track.keys] == [0.0, 2.0] and s.route.levels[20].fork == tuple(rest)
     assert np.allclose(offsets(s, 2.0)[20], MOVE, atol=1e-12)
@@ -101,7 +101,7 @@ def test_an_unkeyed_fork_dragged_with_its_subtree_takes_the_keyed_forks_along(be
     rest = np.array(bent.route.levels[20].fork)
     s = keyed(bent, FORK, (0.0, rest), (2.0, rest + MOVE)).at(1.0)
     trunk = next(h for h in handles(s.posed()) if h.path == ("route", "levels", 22, "fork"))
-    edits = drag_edits(s, trunk, trunk.position + np.array([0.0, 0.0, 0.3]), carry=True)
+    edits = drag_edits(s, trunk, trunk.position + np.array([0.0, 0.0, 0.3]), carry=True, t=1.0)
     assert len(edits) == 2 and edits[1][0] == ("animation",)
     moved = apply(s, edits if carry_tracks else edits[:1])
     for t in (0.0, 1.0, 2.0):
