@@ -241,4 +241,18 @@ def polyline(scene: Scene) -> np.ndarray:
     """The route from the trunk's foot to the twig tip (empty for other scenes)."""
     if scene.route is None:
         return np.zeros((0, 3))
-    return np.array([scene.route.base] + [lv.fork for lv in scene.route.levels][::-1])
+    return _line(scene.route)
+
+
+def polylines(scene: Scene) -> list[np.ndarray]:
+    """The route's polyline, or each compound component's route's placed in the world."""
+    if scene.route is not None:
+        return [_line(scene.route)]
+    return [
+        np.array([placement.point(p) for p in _line(route)])
+        for _, _, route, placement in component_routes(scene)
+    ]
+
+
+def _line(route: Route) -> np.ndarray:
+    return np.array([route.base] + [lv.fork for lv in route.levels][::-1])

@@ -39,16 +39,16 @@ from ..viewer.hud import draw_hud, draw_status
 from ..viewer.loop import run
 from ..viewer.window import Viewer
 from . import commands as ec
-from .clipped import clipped_parts
 from .dragging import manipulate
 from .gizmo import Gizmo
-from .handles import Handle, handles
+from .handles import Handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
 from .panels import edit_panel
 from .picking import hover_label, pick, visible
 from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave, save_as_default
 from .shapes import editor_shapes
+from .shown import Shown
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
 
@@ -79,10 +79,7 @@ class Editor:
         self.timeline = Timeline()
         self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
-        self._handles_of: tuple | None = None  # the scene and moment the handles were made for
-        self._handles: list[Handle] = []
-        self.warnings: list[str] = []
-        self.clipped: list[tuple[int, np.ndarray]] = []  # what Alg. 1 clips (drawn red)
+        self.shown_now = Shown()  # the scene drawn now, its handles, warnings, clipped parts
         self.save_as_text = save_as_default(self.doc)
         self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
         self.recovered = self.doc.recovery()  # offered in a modal
@@ -108,31 +105,32 @@ class Editor:
 
     @property
     def handles(self) -> list[Handle]:
-        """The scene's handles, made again when the scene changed (an edit, undo, reload);
-        the selection and the route's warnings follow."""
+        """The scene's handles, made again when the scene changed (an edit, undo, reload)
+        or the moment shown; the selection and the route's warnings follow."""
         self._follow()
-        return self._handles
+        return self.shown_now.handles
+
+    @property
+    def warnings(self) -> list[str]:
+        self._follow()
+        return self.shown_now.warnings
+
+    @property
+    def clipped(self) -> list[tuple[int, np.ndarray]]:
+        """What Alg. 1 clips of the route drawn (red in the view)."""
+        self._follow()
+        return self.shown_now.clipped
 
     def _follow(self) -> None:
-        made_for = (self.scene, self.viewer.playback.time)
-        if self._handles_of is None or any(a is not b for a, b in zip(self._handles_of, made_for)):
-            self._handles_of = made_for
-            self._handles = handles(self.handled_scene())
-            route = self.scene.route
-            self.warnings = route.warnings() if route else []
-            self.clipped = clipped_parts(route) if route else []
-            if self.selected is not None:  # keep the selection across edits, undo, reload
-                self.selected = next((h for h in self._handles if h.same(self.selected)), None)
+        now = self.shown_now
+        if now.follow(self.scene, self.viewer.playback.time, self.viewer.posed) and self.selected:
+            # keep the selection across edits, undo, reload
+            self.selected = next((h for h in now.handles if h.same(self.selected)), None)
 
     def handled_scene(self) -> Scene:
-        """The scene whose values the handles and panels show: with keyframe tracks, as drawn
-        at the moment shown (a keyed handle is where its track puts it, a keyed fork's
-        subtree where the fork takes it); the sway's turn left out (a drag must not write
-        it back)."""
-        a = self.scene.animation
-        if a is None or not a.tracks:
-            return self.scene
-        return self.viewer.posed(replace(self.scene, animation=replace(a, sway=None)))
+        """The scene whose values the handles and panels show (shown.py's ``drawn``)."""
+        self._follow()
+        return self.shown_now.scene
 
     def edit(self, path: tuple, value, interaction=None) -> bool:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
@@ -284,8 +282,11 @@ class Editor:
             self.viewer.message = f"key at {t:.2f} s for {self.selected.label}"
 
     def select(self, h: Handle | None) -> None:
+        """Select ``h``; a compound component's fork also picks its level for the tools."""
         self.selected = h
         self.scroll_outline = True
+        if h is not None and self.scene.compound and "levels" in h.path:
+            self.structure.level = h.path[h.path.index("levels") + 1]
 
     def select_level(self, level: int) -> None:
         self.select(next((h for h in self.handles if h.level == level), None))
@@ -396,7 +397,7 @@ class Editor:
         if v.frames.image is not None:
             fb = glfw.get_framebuffer_size(v.window)
             view_matrix, proj = camera_matrices(view, NEAR, FAR)
-            shapes = editor_shapes(self.scene, shown, self.selected, self.clipped)
+            shapes = editor_shapes(self.handled_scene(), shown, self.selected, self.clipped)
             self.overlay.draw(
                 shapes, v.frames.image[0], v.ctx.screen, fb, proj @ view_matrix, view.origin
             )
