@@ -25,7 +25,7 @@ from .keys import key_marks, marked
 from .layout import MIN_WIDTH, Layout
 from .mokrs_panel import mokrs_section
 from .saving import copy_dialog
-from .structure import outline_menu, structure_section
+from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)

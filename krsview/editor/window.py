@@ -8,7 +8,8 @@ The editor composes a :class:`Viewer`: it turns the event loop itself, calling t
 parts (keys, camera, file watching, tracing, HUD) and adding its overlay (shapes.py), panels,
 gizmo, trackball and picking (picking.py). Commands of its own go to EDITOR_HANDLERS, and those
 the editor decides differently (bookmark, open, a file changed on disk, a field's edit, reset
-view); the rest to the viewer's.
+view); the rest to the viewer's. Its other jobs live beside it: the file (file_actions.py),
+what the view shows at the moment shown (shown.py) and a drag's edits (dragging.py).
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
@@ -27,9 +28,9 @@ from imgui_bundle import imgui
 
 from ..compile.camera import View, view_of
 from ..compile.geometry import scene_ball
-from ..document.document import ConflictError, Document
+from ..document.document import Document
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
-from ..scene import Bookmark, Scene, SceneError
+from ..scene import Scene, SceneError
 from ..scene.edits import apply_edit, path_text
 from ..scene.mokrs import check_view
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
@@ -40,13 +41,14 @@ from ..viewer.loop import run
 from ..viewer.window import Viewer
 from . import commands as ec
 from .dragging import manipulate
+from .file_actions import FileActions
 from .gizmo import Gizmo
 from .handles import Handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
 from .panels import edit_panel
 from .picking import hover_label, pick, visible
-from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave, save_as_default
+from .saving import SAVING_HANDLERS, CopyAsk, autosave, save_as_default
 from .shapes import editor_shapes
 from .shown import Shown
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
@@ -62,7 +64,7 @@ EDITOR_KEYS = {
 }
 
 
-class Editor:
+class Editor(FileActions):
     def __init__(self, path: Path, settings: ViewerSettings | None = None, **options: Any):
         """``options``: ``visible``, ``shader_dir``, or fields of ViewerSettings."""
         window = {k: options.pop(k) for k in ("visible", "shader_dir") if k in options}
@@ -225,45 +227,6 @@ class Editor:
                 handler(self, command)
 
     # --------------------------------------------------------------------------- actions
-    def add_bookmark(self) -> None:
-        """In the editor a bookmark is an edit like any other (saved with the scene)."""
-        b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.viewer.camera.to_camera())
-        if self.edit(("bookmarks",), self.scene.bookmarks + [b]):
-            self.viewer.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
-
-    def reload_scene(self) -> None:
-        """Unsaved edits are never overwritten by the file's new contents: ask first."""
-        if not self.doc.changed_on_disk():
-            return
-        if self.doc.dirty:
-            self.conflict = True
-        else:
-            self.viewer.take_file()
-
-    def save(self, path: str | None = None, overwrite: bool = False) -> bool:
-        v = self.viewer
-        if not path and self.doc.template:
-            return ask_copy(self)
-        try:
-            saved = self.doc.save(path or None, overwrite=overwrite)
-        except ConflictError as e:
-            v.error, self.conflict = str(e), True
-            return False
-        except SceneError as e:
-            v.error = str(e)
-            return False
-        v.follow_file()
-        v.error, v.message, self.conflict = "", f"saved {saved.resolve()}", False
-        self.save_as_text = str(saved)
-        return True
-
-    def save_as(self, text: str) -> None:
-        target = Path(text.strip()).expanduser()
-        if target.suffix != ".toml" or target.is_dir():
-            self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
-            return
-        self.save(str(target))
-
     def bake(self, component: int | None = None) -> None:
         """Grown tree → route (one undo step): every fork becomes a handle; or the tree of a
         compound's ``component`` (the structure tools then act on its route)."""
@@ -290,55 +253,6 @@ class Editor:
 
     def select_level(self, level: int) -> None:
         self.select(next((h for h in self.handles if h.level == level), None))
-
-    def take_file(self) -> None:
-        self.conflict = False
-        self.viewer.take_file()
-
-    def keep_mine(self) -> None:
-        self.conflict = False
-        self.viewer.message = "kept your edits; saving will ask to overwrite"
-
-    def restore(self) -> None:
-        self.doc.restore_recovery()
-        self.recovered = None
-        self.viewer.sync()
-        self.viewer.message = "restored the unsaved edits (Ctrl+Z undoes the restore)"
-
-    def discard_recovery(self) -> None:
-        self.doc.discard_recovery()
-        self.recovered = None
-
-    def answer_save(self) -> None:
-        if self.save():
-            self._answered()
-
-    def answer_discard(self) -> None:
-        self.doc.discard_recovery()
-        self._answered()
-
-    def answer_cancel(self) -> None:
-        self.asking = None
-
-    def _answered(self) -> None:
-        what, path = self.asking or (None, None)
-        self.asking = None
-        if what == "close":
-            self._quit = True
-        elif what == "open" and path is not None:
-            self._open(path)
-
-    def open_preset(self, path: Path) -> None:
-        if self.doc.dirty:
-            self.asking, self.viewer.hud = ("open", Path(path)), True
-        else:
-            self._open(path)
-
-    def _open(self, path: Path) -> None:
-        self.viewer.open_preset(path)
-        self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
-        self.save_as_text = save_as_default(self.doc)
-        self.frame()
 
     def place_panel(self, side: str, width: float) -> None:
         """Dock the panel on ``side`` at ``width``; what was in the middle of the view stays
