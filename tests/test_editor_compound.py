@@ -83,12 +83,13 @@ def test_a_real_pointer_drag_moves_a_component_fork_by_the_projected_amount(disp
 def test_a_component_routes_clipped_part_is_drawn_where_its_placed_mirror_clips():
     """The tree with mirror R20 turned 36° (its branch 20 crosses it, test_handles.py), as a
     component turned by 40°, scaled by 1.3 and moved: its red part lies on the positive side
-    of the placed mirror (what Alg. 1 removes there). Negative control: the unplaced part
-    does not."""
+    of the placed mirror (what Alg. 1 removes there), and its warning names the component.
+    Negative controls: the unplaced part does not; the tree as grown warns of nothing."""
     from dataclasses import replace
 
     from krsview import load
     from krsview.editor.clipped import clipped_parts, scene_clipped
+    from krsview.editor.shown import warnings
     from krsview.scene.compound import Component, Placement
 
     from .test_handles import turned_route
@@ -96,9 +97,16 @@ def test_a_component_routes_clipped_part_is_drawn_where_its_placed_mirror_clips(
     tree = load("tree")
     route = turned_route(replace(tree, tree=None, route=tree.tree.route())).route
     c = Component(route=route, position=(3.0, 0.5, 1.0), angle=40.0, scale=1.3)
-    parts = scene_clipped(replace(tree, tree=None, compound=[c]))
+    s = replace(tree, tree=None, compound=[c])
+    parts = scene_clipped(s)
     raw = clipped_parts(route)
     assert raw and [k for k, _ in parts] == [0] * len(raw)
+    said = warnings(s)  # the panel names the component's level, and selects the component
+    assert [k for k, _ in said] == [0] and said[0][1].startswith("compound[0].route.levels[20]")
+    plain = replace(c, route=tree.tree.route())  # negative control: the tree as grown
+    assert warnings(replace(s, compound=[plain])) == [] and not scene_clipped(
+        replace(s, compound=[plain])
+    )
     m = route.mirror(21)
     u, w = Placement(c.position, c.axis, c.angle, c.scale).plane(m.normal, m.offset)
     for (_, line), (_, unplaced) in zip(parts, raw):

@@ -39,7 +39,7 @@ class Edited(Protocol):
 
     viewer: Viewer
     selected: Handle | None
-    warnings: list[str]
+    warnings: list[tuple[int, str]]
     snap: Snap
     carry: bool
     save_as_text: str
@@ -136,15 +136,15 @@ def _dock(e: Edited, out: list, width: float) -> None:
 
 
 def _warnings(e: Edited, out: list) -> None:
-    """Each warning names its level; a click selects that level (the view shows the clipped
-    part in red)."""
-    for w in e.warnings:
+    """Each warning names its level (in a compound, its component's route's); a click
+    selects that level or component (the view shows the clipped part in red)."""
+    what = "component" if e.scene.compound else "level"
+    for k, (entry, text) in enumerate(e.warnings):
         imgui.push_style_color(imgui.Col_.text, YELLOW)
-        imgui.text_wrapped("route." + w)
+        imgui.text_wrapped(text)
         imgui.pop_style_color()
-        level = int(w[w.index("[") + 1 : w.index("]")])
-        if imgui.small_button(f"select level {level}##warn{level}"):
-            out.append(ec.SelectLevel(level))
+        if imgui.small_button(f"select {what} {entry}##warn{k}"):
+            out.append(ec.SelectLevel(entry))
 
 
 def _file(e: Edited, out: list) -> None:

@@ -12,8 +12,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..scene import Scene
+from ..scene.edits import path_text
 from .clipped import scene_clipped
-from .handles import Handle, handles
+from .handles import Handle, component_routes, handles
 
 
 def drawn(scene: Scene, posed: Callable[[Scene], Scene]) -> Scene:
@@ -25,6 +26,20 @@ def drawn(scene: Scene, posed: Callable[[Scene], Scene]) -> Scene:
     return posed(replace(scene, animation=replace(a, sway=None)))
 
 
+def warnings(scene: Scene) -> list[tuple[int, str]]:
+    """The route's warnings (``Route.warnings``), each with the outline entry it names: the
+    level, or in a compound the component whose route it is; the text names the full path."""
+    if scene.route is not None:
+        return [
+            (int(w[w.index("[") + 1 : w.index("]")]), "route." + w) for w in scene.route.warnings()
+        ]
+    return [
+        (k, f"{path_text(at)}.{w}")
+        for k, at, route, _ in component_routes(scene)
+        for w in route.warnings()
+    ]
+
+
 class Shown:
     """The scene drawn, its handles, warnings and clipped parts, for one scene and moment."""
 
@@ -32,7 +47,7 @@ class Shown:
         self._made_for: tuple[Scene, float] | None = None
         self.scene: Scene | None = None
         self.handles: list[Handle] = []
-        self.warnings: list[str] = []
+        self.warnings: list[tuple[int, str]] = []  # (outline entry, the warning)
         self.clipped: list[tuple[int, np.ndarray]] = []  # (level or component, world polyline)
 
     def follow(self, scene: Scene, t: float, posed: Callable[[Scene], Scene]) -> bool:
@@ -42,7 +57,6 @@ class Shown:
         self._made_for = (scene, t)
         self.scene = drawn(scene, posed)
         self.handles = handles(self.scene)
-        route = self.scene.route
-        self.warnings = route.warnings() if route is not None else []
+        self.warnings = warnings(self.scene)
         self.clipped = scene_clipped(self.scene)
         return True

@@ -113,7 +113,8 @@ class Editor(FileActions):
         return self.shown_now.handles
 
     @property
-    def warnings(self) -> list[str]:
+    def warnings(self) -> list[tuple[int, str]]:
+        """The route's warnings, each with the outline entry it names (shown.py)."""
         self._follow()
         return self.shown_now.warnings
 
