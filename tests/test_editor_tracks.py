@@ -133,3 +133,30 @@ def test_the_krs_panel_marks_a_keyed_fork(display, tmp_path):
             assert frame_colour(e, ("route", "levels", 20, "control"), mark) == 0
     finally:
         e.close()
+
+
+def test_a_linked_dial_drag_on_palm_curl_keys_every_curl_at_the_moment():
+    """The curl's dial dragged at 1 s (carry on): one edit of the animation, a key at 1 s in
+    each of the 30 linked tracks, the rest values kept. Negative control: carry off keys
+    level 58 alone."""
+    from krsview import load
+    from krsview.editor.dragging import drag_edits
+    from krsview.editor.handles import handles
+
+    s = load("palm-curl").at(1.0)
+    h = next(h for h in handles(s.posed()) if h.path == CURL)
+    a, r, turn = np.asarray(h.axis), h.position - h.pivot, np.radians(5.0)  # 5° on the ring
+    p = (
+        h.pivot
+        + r * np.cos(turn)
+        + np.cross(a, r) * np.sin(turn)
+        + a * (a @ r) * (1 - np.cos(turn))
+    )
+    edits = drag_edits(s, h, p, carry=True, t=1.0)
+    assert [path for path, _ in edits] == [("animation",)]
+    keyed = [tr for tr in edits[0][1].tracks if any(k.time == 1.0 for k in tr.keys)]
+    assert len(keyed) == 30 and len({tr.keys[1].value for tr in keyed}) == 1
+    drawn = get_at(s.posed(), CURL)
+    assert 4.0 < abs(keyed[0].keys[1].value - drawn) < 6.0, (keyed[0].keys[1].value, drawn)
+    alone = drag_edits(s, h, p, carry=False, t=1.0)
+    assert [path for path, _ in alone] == [CURL]  # keyed by Editor.edit: this level only
