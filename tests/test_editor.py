@@ -656,7 +656,8 @@ def test_the_clipped_part_of_a_warned_branch_is_drawn_red_in_the_view(editor):
     assert e.edit(("route", "levels", 21, "normal"), tuple(turned))
     settle(e)
     parts = clipped_parts(e.scene.route)
-    assert [level for level, _ in parts] == [20] and e.warnings[0].startswith("levels[20]")
+    assert [level for level, _ in parts] == [20] and e.warnings[0][0] == 20
+    assert e.warnings[0][1].startswith("route.levels[20]")
     points = parts[0][1][::4]
     assert red_at(points) > 0.8
     e.doc.commit(before, "back")

@@ -1,7 +1,7 @@
 """Keyframes in the editor (issue 29): K keys the selected value at the moment shown, a drag
 of a keyed value sets its key (auto-key), keys move in time between their neighbours and go
-with a right-click; in a real window, a fork keyed at two moments plays between them and the
-keys are saved."""
+with a right-click; in a real window, a fork keyed at two moments plays between them, its
+subtree with it, and the keys are saved."""
 
 from __future__ import annotations
 
@@ -80,6 +80,8 @@ def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(displa
         settle(e)
         h = handle(e, FORK)
         rest = np.array(h.position)
+        finer = ("route", "levels", 19, "fork")
+        finer_rest = np.array(handle(e, finer).position)
         click(e, screen_of(e, h.position))
         assert e.selected is not None and e.selected.path == FORK
         xdo("key", "k")  # a key at 0 s, holding the fork where it is
@@ -93,6 +95,9 @@ def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(displa
         keyed = np.array(track.keys[1].value)
         assert np.linalg.norm(keyed - rest) > 0.05
         assert np.allclose(handle(e, FORK).position, keyed), "the handle is not where drawn"
+        follows = handle(e, finer).position - finer_rest  # its subtree came along (a bone)
+        assert np.allclose(follows, keyed - rest, atol=1e-9), "the crown tore from the fork"
+        assert e.scene.route.levels[19].fork == tuple(finer_rest), "the finer rest moved"
         e.execute([SetTime(1.0)])
         pump(e, 2)
         between = handle(e, FORK).position  # the fork drawn half way: between its keys

@@ -2,7 +2,7 @@
 the negative side of each mirror, so the part of a child branch that reaches across the mirror
 of the fork it grows from is not drawn. Here that part is found exactly on the branch's centre
 line (a circular arc, or the chord when straight), for the editor to draw it in red where
-`Route.warnings` names the level."""
+`Route.warnings` names the level (in a compound, on each component's route, placed)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,10 @@ import math
 
 import numpy as np
 
-from ..scene import Route
+from ..scene import Route, Scene
 from ..scene.model import arc_of
 from ..scene.route import CLIP_TOLERANCE, arc_points
+from .handles import component_routes
 
 DRAW_STEP = 1.0 / 64  # the clipped arc is drawn in pieces of at most this fraction of the branch
 
@@ -72,3 +73,15 @@ def clipped_parts(route: Route) -> list[tuple[int, np.ndarray]]:
             pieces = max(2, math.ceil((s1 - s0) / DRAW_STEP) + 1)
             out.append((i - 1, centre_line(route, i - 1, np.linspace(s0, s1, pieces))))
     return out
+
+
+def scene_clipped(scene: Scene) -> list[tuple[int, np.ndarray]]:
+    """The clipped parts of the scene's route, or of each compound component's route placed
+    in the world (then numbered by component)."""
+    if scene.route is not None:
+        return clipped_parts(scene.route)
+    return [
+        (k, np.array([placement.point(p) for p in line]))
+        for k, _, route, placement in component_routes(scene)
+        for _, line in clipped_parts(route)
+    ]

@@ -1,7 +1,9 @@
 """Handles: the points of a scene a person can grab in the 3D view, each tied to the field it
 edits. A route shows its base, forks, control points and fork mirror normals [KRS17 §9.2];
 a plain KRS its kernels' points and its mirrors (a point on the plane and a normal arrow);
-a compound its components' placements. Pure NumPy: the window draws and drags them.
+a compound its components' placements, and the forks of a component's route placed by the
+component's placement (their edits go to ``compound[k].route``, in its own space). Pure NumPy:
+the window draws and drags them.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..scene import KRS, Capsule, Kernel, Mirror, Route, Scene, Sphere, ToroidalCapsule
+from ..scene.compound import Placement
 from ..scene.edits import Path, get_at
 from .mokrs_handles import mokrs_handles, mokrs_outline
 
@@ -27,6 +30,24 @@ class Handle:
     label: str
     owner: Path  # the table the selection panel shows (a level, a component)
     pivot: np.ndarray | None = None  # "normal": the arrow's foot (a fork, a point on a mirror)
+    placement: Placement | None = None  # a compound component's: world = placement(field's)
+
+    @property
+    def carries(self) -> bool:
+        """A route's fork or trunk foot: a drag can take its subtree along."""
+        return self.kind == "point" and "route" in self.path and self.path[-1] in ("fork", "base")
+
+    @property
+    def route_path(self) -> Path:
+        """The route a fork, control point or normal handle belongs to."""
+        return self.path[: self.path.index("route") + 1]
+
+    def local(self, p: np.ndarray, direction: bool = False) -> np.ndarray:
+        """World point (or ``direction``) ``p`` in the space of the field edited."""
+        if self.placement is None:
+            return np.asarray(p, dtype=np.float64)
+        origin = 0.0 if direction else np.array(self.placement.position)
+        return np.linalg.solve(self.placement.linear, np.asarray(p) - origin)
 
     def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
         """The edit (field path, new value) that puts the handle at ``p``. With ``carry``, a
@@ -34,19 +55,15 @@ class Handle:
         it, the branch's own control by half, so its bend stays) and the trunk's foot the
         whole tree: the mirrors at the moved forks move with them, so nothing that grew
         on the negative side of a mirror crosses it (a bone chain, as people expect)."""
-        if (
-            carry
-            and self.kind == "point"
-            and self.path[0] == "route"
-            and self.path[-1] in ("fork", "base")
-        ):
+        if carry and self.carries:
             return self._carry(scene, p)
         return self.path, self.value_at(scene, p)
 
     def _carry(self, scene: Scene, p: np.ndarray) -> tuple[Path, Any]:
-        route = scene.route
-        delta = p - self.position
-        i = len(route.levels) if self.path[-1] == "base" else self.path[2]
+        at = self.route_path
+        route = get_at(scene, at)
+        delta = self.local(p - self.position, direction=True)
+        i = len(route.levels) if self.path[-1] == "base" else self.path[-2]
 
         def moved(v: tuple, f: float = 1.0) -> tuple:
             return tuple(float(c) for c in np.array(v) + f * delta)
@@ -60,8 +77,8 @@ class Handle:
             for j, lv in enumerate(route.levels)
         ]
         if self.path[-1] == "base":
-            return ("route",), replace(route, base=moved(route.base), levels=levels)
-        return ("route", "levels"), levels
+            return at, replace(route, base=moved(route.base), levels=levels)
+        return (*at, "levels"), levels
 
     def value_at(self, scene: Scene, p: np.ndarray) -> Any:
         """The field's new value when the handle is dragged to ``p``."""
@@ -69,8 +86,8 @@ class Handle:
             m = get_at(scene, self.path)  # along its normal, by the drag's part along it
             return Mirror(m.normal, m.offset + float(np.array(m.normal) @ (p - self.position)))
         if self.kind == "point":
-            return tuple(float(c) for c in p)
-        d = p - self.pivot
+            return tuple(float(c) for c in self.local(p))
+        d = self.local(p - self.pivot, direction=True)
         n = float(np.linalg.norm(d))
         u = tuple(float(c) for c in (d / n if n > 0 else d))  # zero: the schema says why
         if self.path[-1] == "mirror":  # keep the plane on the pivot
@@ -88,7 +105,7 @@ def handles(scene: Scene) -> list[Handle]:
         return route_handles(scene.route, ("route",))
     if scene.krs is not None:
         return krs_handles(scene.krs, ("krs",))
-    return [
+    out = [
         Handle(
             ("compound", k, "position"),
             "point",
@@ -98,6 +115,29 @@ def handles(scene: Scene) -> list[Handle]:
             ("compound", k),
         )
         for k, c in enumerate(scene.compound)
+    ]
+    for k, at, route, placement in component_routes(scene):
+        out += [
+            replace(
+                h,
+                position=np.array(placement.point(h.position)),
+                pivot=None if h.pivot is None else np.array(placement.point(h.pivot)),
+                level=k,
+                label=f"C{k} {h.label}",
+                placement=placement,
+            )
+            for h in route_handles(route, at)
+        ]
+    return out
+
+
+def component_routes(scene: Scene) -> list[tuple[int, Path, Route, Placement]]:
+    """A compound's components given by a route: (component, the route's path, the route,
+    its placement in the world)."""
+    return [
+        (k, ("compound", k, "route"), c.route, Placement(c.position, c.axis, c.angle, c.scale))
+        for k, c in enumerate(scene.compound)
+        if c.route is not None
     ]
 
 
@@ -201,4 +241,18 @@ def polyline(scene: Scene) -> np.ndarray:
     """The route from the trunk's foot to the twig tip (empty for other scenes)."""
     if scene.route is None:
         return np.zeros((0, 3))
-    return np.array([scene.route.base] + [lv.fork for lv in scene.route.levels][::-1])
+    return _line(scene.route)
+
+
+def polylines(scene: Scene) -> list[np.ndarray]:
+    """The route's polyline, or each compound component's route's placed in the world."""
+    if scene.route is not None:
+        return [_line(scene.route)]
+    return [
+        np.array([placement.point(p) for p in _line(route)])
+        for _, _, route, placement in component_routes(scene)
+    ]
+
+
+def _line(route: Route) -> np.ndarray:
+    return np.array([route.base] + [lv.fork for lv in route.levels][::-1])

@@ -1,19 +1,25 @@
 """Keyframes in the editor (issue 29): K sets a key for the selected value at the moment shown;
 a drag of a value that has a track sets its key there (auto-key: the track would override the
-rest value); the timeline strip at the foot of the view plays, scrubs, and shows the
-selection's keys, which drag along it in time (right-click deletes one). Each change is one
-edit of the scene's ``[animation]`` table: validated, undoable, saved."""
+rest value). A keyed fork's subtree follows it as bones do (scene/animation.py's
+``bone_offsets``), so a key holds the value less what the keyed forks above it add. The
+timeline strip at the foot of the view plays, scrubs, and shows the selection's keys, which
+drag along it in time (right-click deletes one). Each change is one edit of the scene's
+``[animation]`` table: validated, undoable, saved."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
 from imgui_bundle import imgui
 
 from ..scene import Scene
-from ..scene.animation import Animation, Key, Track
-from ..scene.edits import get_at, path_text
+from ..scene.animation import Animation, Key, Track, bone_offset
+from ..scene.edits import Path, get_at, parse_path, path_text, replace_at
+from ..scene.mokrs import linked_edit, linked_levels
 from ..viewer import commands as vc
 from ..viewer.playback import Playback
 from . import commands as ec
@@ -23,6 +29,10 @@ KEY_GAP = 1e-3  # seconds kept between neighbouring keys when one is dragged in 
 STRIP_HEIGHT = 64.0  # pixels: the timeline strip at the window's foot
 DIAMOND = 6.0  # pixels: a key's half size on the strip
 KEY, KEY_HOT = 0xFF40C0FF, 0xFF40FFFF  # ImGui's packed ABGR: a key, the key under the pointer
+# A field a track moves, as Blender marks it: yellow with a key at the moment shown, green
+# between keys (its frame, and a diamond beside it: filled on a key, hollow between).
+ON_KEY, BETWEEN = imgui.ImVec4(0.55, 0.48, 0.08, 1.0), imgui.ImVec4(0.18, 0.42, 0.18, 1.0)
+MARK_ON_KEY, MARK_BETWEEN = 0xFF30D8F0, 0xFF50C050  # the diamond, ImGui's packed ABGR
 
 
 def track_index(scene: Scene, path: tuple) -> int | None:
@@ -48,17 +58,107 @@ def with_key(scene: Scene, path: tuple, t: float, value: Any) -> Animation:
     return replace(a, tracks=tracks, duration=max(a.duration, t))
 
 
+def held(scene: Scene, path: tuple, value: Any, t: float) -> Any:
+    """A value drawn at ``path`` at ``t`` as a key holds it: less what the keyed forks above
+    it add there (a route's fork or control point; any other value as it is)."""
+    off = bone_offset(scene.at(t), path)
+    return value if off is None else tuple(float(c) for c in np.subtract(value, off))
+
+
 def key_now(scene: Scene, path: tuple, t: float) -> Animation:
     """K: a key at ``t`` holding the value at ``path`` as drawn at ``t``."""
-    return with_key(scene, path, t, get_at(scene.at(t).posed(), path))
+    return with_key(scene, path, t, held(scene, path, get_at(scene.at(t).posed(), path), t))
 
 
 def keyed_edit(scene: Scene, path: tuple, value: Any, t: float) -> tuple[tuple, Any]:
     """A drag's edit: of the value itself, or, where a track moves that value, of its key
-    at ``t`` (auto-key)."""
+    at ``t`` (auto-key), ``value`` being where it is drawn."""
     if track_index(scene, path) is None:
         return path, value
-    return ("animation",), with_key(scene, path, t, value)
+    return ("animation",), with_key(scene, path, t, held(scene, path, value, t))
+
+
+def carried_tracks(scene: Scene, path: Path, delta: np.ndarray) -> Animation | None:
+    """A fork (or trunk foot) at ``path`` dragged by ``delta`` with its subtree: the tracks of
+    the subtree's forks and control points move along, every key by ``delta`` (level i's own
+    control point by half, as handles.py's carry moves it), so a keyed part of the subtree
+    stays on it; None where no track moves."""
+    a = scene.animation
+    if a is None or not a.tracks:
+        return None
+    at = path[:-1] if path[-1] == "base" else path[:-3]
+    i = len(get_at(scene, at).levels) if path[-1] == "base" else path[-2]
+    tracks, moved = list(a.tracks), False
+    for k, tr in enumerate(a.tracks):
+        p = parse_path(tr.path)
+        if p[:-2] != (*at, "levels") or p[-1] not in ("fork", "control"):
+            continue
+        f = 1.0 if p[-2] < i else 0.5 if (p[-2], p[-1]) == (i, "control") else 0.0
+        if f:
+            keys = [
+                Key(q.time, tuple(float(c) for c in np.add(q.value, f * delta))) for q in tr.keys
+            ]
+            tracks[k], moved = replace(tr, keys=keys), True
+    return replace(a, tracks=tracks) if moved else None
+
+
+def linked_edits(scene: Scene, path: Path, value: Any, t: float) -> list[tuple[Path, Any]]:
+    """A MöKRS step's field (``path``) set in its level and the linked finer levels
+    (``linked_levels``: palm's leaflets bend alike): keyed at ``t`` in the levels where a
+    track moves it (palm-curl's curl), the value itself in the others."""
+    m = scene.mokrs
+    paths = [(*path[:2], k, *path[3:]) for k in linked_levels(m, path[2])]
+    tracked = [q for q in paths if track_index(scene, q) is not None]
+    if not tracked:
+        return [linked_edit(m, path, value)]
+    keyed = scene
+    for q in tracked:
+        keyed = replace(keyed, animation=with_key(keyed, q, t, value))
+    out: list[tuple[Path, Any]] = [(("animation",), keyed.animation)]
+    if len(tracked) < len(paths):
+        levels = list(m.levels)
+        for q in paths:
+            if q not in tracked:
+                levels[q[2]] = replace_at(levels[q[2]], q[3:], value)
+        out.insert(0, (path[:2], levels))
+    return out
+
+
+def key_marks(scene: Scene, t: float) -> dict[Path, bool]:
+    """The values the scene's tracks move, by path: whether one of its keys is at ``t``."""
+    if scene.animation is None:
+        return {}
+    return {
+        parse_path(tr.path): any(abs(k.time - t) <= KEY_SNAP for k in tr.keys)
+        for tr in scene.animation.tracks
+    }
+
+
+@contextmanager
+def marked(on_key: bool | None) -> Iterator[None]:
+    """Around one field's widget: a tracked field (``on_key`` not None, from
+    :func:`key_marks`) framed and flagged by a diamond right of it, as Blender does."""
+    if on_key is None:
+        yield
+        return
+    imgui.push_style_color(imgui.Col_.frame_bg, ON_KEY if on_key else BETWEEN)
+    try:
+        yield
+    finally:
+        imgui.pop_style_color()
+    hi, lo = imgui.get_item_rect_max(), imgui.get_item_rect_min()
+    x, y, d = hi.x + DIAMOND + 2.0, 0.5 * (lo.y + hi.y), DIAMOND - 1.0
+    pts = [
+        imgui.ImVec2(x, y - d),
+        imgui.ImVec2(x + d, y),
+        imgui.ImVec2(x, y + d),
+        imgui.ImVec2(x - d, y),
+    ]
+    draw = imgui.get_window_draw_list()
+    if on_key:
+        draw.add_convex_poly_filled(pts, MARK_ON_KEY)
+    else:
+        draw.add_polyline(pts, MARK_BETWEEN, 1.5, imgui.ImDrawFlags_.closed.value)
 
 
 def moved_key(scene: Scene, track: int, key: int, t: float) -> Animation:

@@ -1,8 +1,10 @@
 """The edit panel's section for a MöKRS [KRS17 §7]: its levels (select, duplicate, insert,
 remove, reorder), the selected level's reflection, kernel and transform steps as fields from
 the schema (add, remove, reorder steps), and a refused value's message next to what it
-refused. Every change is an ``Edit`` of the scene (one undo step, validated by the schema);
-the panel returns commands and writes nothing."""
+refused. With keyframe tracks the fields show the values drawn at the moment shown (as the
+handles and the KRS panel do), a tracked field marked, and a change to one keys it there.
+Every change is an ``Edit`` of the scene (one undo step, validated by the schema); the panel
+returns commands and writes nothing."""
 
 from __future__ import annotations
 
@@ -13,10 +15,11 @@ from imgui_bundle import imgui
 
 from ..scene.edits import path_text
 from ..scene.model import Empty, Kernel
-from ..scene.mokrs import MobiusLevel, MobiusStep, linked_edit, linked_levels
+from ..scene.mokrs import MobiusLevel, MobiusStep, linked_levels
 from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions
 from . import commands as ec
+from .keys import key_marks, linked_edits, marked
 from .mokrs_handles import mokrs_outline
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
@@ -98,7 +101,10 @@ def mokrs_section(e: Any, out: list[Command], interactions: Interactions, fields
 
 
 def _level(e, levels: list, i: int, out: list, interactions: Interactions, fields) -> None:
+    """Level i: its structure buttons act on the rest ``levels``; its fields show the level
+    as drawn at the moment shown."""
     lv, lev = levels[i], (*LEVELS, i)
+    shown = e.handled_scene().mokrs.levels[i]
     error = e.viewer.error
     place = refusal_place(error, i, len(lv.transform))
     sel = e.selected.path if e.selected is not None else ()
@@ -119,7 +125,8 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
             imgui.set_tooltip(tip)
         imgui.same_line()
     imgui.new_line()
-    changed, on = imgui.checkbox("reflect (x = 0 of this level)", lv.reflect)
+    with marked(key_marks(e.scene, e.viewer.playback.time).get((*lev, "reflect"))):
+        changed, on = imgui.checkbox("reflect (x = 0 of this level)", shown.reflect)
     if changed:
         out.append(Edit((*lev, "reflect"), on))
     linked = len(linked_levels(e.scene.mokrs, i)) - 1
@@ -133,9 +140,9 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
     if changed and kinds[k] != lv.kernel.kind:
         out.append(Edit((*lev, "kernel"), Kernel.registry[kinds[k]]()))
-    fields(lv.kernel, (*lev, "kernel"), out, interactions)
+    fields(shown.kernel, (*lev, "kernel"), out, interactions)
     _message(error if place == "kernel" else "")
-    for j, s in enumerate(lv.transform):
+    for j, s in enumerate(shown.transform):  # as drawn now; reordered as the rest levels
         mine = step_selected and sel[len(lev) + 1] == j
         here = place == f"step {j}" or (place == "selection" and mine)
         _step(e, lv, i, j, s, mine, error if here else "", out, interactions, fields)
@@ -166,9 +173,13 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
     imgui.indent()
     first = len(out)
     fields(s, sp, out, interactions)
-    if e.carry:  # linked: the same change in the finer levels with the same steps
-        m = e.scene.mokrs
-        out[first:] = [Edit(*linked_edit(m, c.path, c.value), c.interaction) for c in out[first:]]
+    if e.carry:  # linked: the same change in the finer levels with the same steps (keyed
+        t = e.viewer.playback.time  # where a track moves it)
+        out[first:] = [
+            Edit(path, value, c.interaction)
+            for c in out[first:]
+            for path, value in linked_edits(e.scene, c.path, c.value, t)
+        ]
     imgui.unindent()
     _message(error)
 

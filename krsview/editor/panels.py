@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import fields
+from functools import partial
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -20,10 +21,11 @@ from ..viewer.window import Viewer
 from . import commands as ec
 from .gizmo import Snap
 from .handles import Handle, outline
+from .keys import key_marks, marked
 from .layout import MIN_WIDTH, Layout
 from .mokrs_panel import mokrs_section
 from .saving import copy_dialog
-from .structure import outline_menu, structure_section
+from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
@@ -37,7 +39,7 @@ class Edited(Protocol):
 
     viewer: Viewer
     selected: Handle | None
-    warnings: list[str]
+    warnings: list[tuple[int, str]]
     snap: Snap
     carry: bool
     save_as_text: str
@@ -53,6 +55,7 @@ class Edited(Protocol):
     def scene(self) -> Scene: ...
     @property
     def handles(self) -> list[Handle]: ...
+    def handled_scene(self) -> Scene: ...
 
 
 def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
@@ -75,6 +78,8 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         imgui.text_wrapped(e.viewer.error)
         imgui.pop_style_color()
     scene = e.scene
+    shown = e.handled_scene()  # as drawn at the moment shown (tracks), its tracked fields marked
+    fields_of = partial(_fields, marks=key_marks(scene, e.viewer.playback.time))
     if scene.tree is not None:
         imgui.text_wrapped(
             "This tree is grown from ratios. Bake it into a route to drag its "
@@ -83,20 +88,20 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         if imgui.button("bake into a route"):
             out.append(ec.Bake())
     elif scene.mokrs is not None:
-        mokrs_section(e, out, interactions, _fields)
+        mokrs_section(e, out, interactions, fields_of)
     else:
         _warnings(e, out)
         _outline(e, out)
         if imgui.collapsing_header("selection", imgui.TreeNodeFlags_.default_open):
-            _selection(e, out, interactions)
+            _selection(e, out, interactions, fields_of)
         out += structure_section(e, interactions)
     if imgui.collapsing_header("material"):
-        _fields(scene.material, ("material",), out, interactions)
+        fields_of(shown.material, ("material",), out, interactions)
     if imgui.collapsing_header("effect settings"):
         imgui.text_disabled(
             "effects: " + (", ".join(scene.effects) or "none") + " (switched in the krsview window)"
         )
-        _fields(scene.effect_settings, ("effect_settings",), out, interactions)
+        fields_of(shown.effect_settings, ("effect_settings",), out, interactions)
     if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
         if scene.route is not None:  # only a route's forks carry anything
             changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
@@ -105,7 +110,8 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
             if imgui.is_item_hovered():
                 imgui.set_tooltip(
                     "on: the finer forks, control points and mirrors move with a "
-                    "dragged fork, so the crown stays attached; off: only the fork"
+                    "dragged fork, so the crown stays attached; off: only the fork. "
+                    "A keyed fork always takes its subtree along, as a bone does"
                 )
         changed, on = imgui.checkbox("snap (or hold Shift while dragging)", e.snap.on)
         if changed:
@@ -130,15 +136,15 @@ def _dock(e: Edited, out: list, width: float) -> None:
 
 
 def _warnings(e: Edited, out: list) -> None:
-    """Each warning names its level; a click selects that level (the view shows the clipped
-    part in red)."""
-    for w in e.warnings:
+    """Each warning names its level (in a compound, its component's route's); a click
+    selects that level or component (the view shows the clipped part in red)."""
+    what = "component" if e.scene.compound else "level"
+    for k, (entry, text) in enumerate(e.warnings):
         imgui.push_style_color(imgui.Col_.text, YELLOW)
-        imgui.text_wrapped("route." + w)
+        imgui.text_wrapped(text)
         imgui.pop_style_color()
-        level = int(w[w.index("[") + 1 : w.index("]")])
-        if imgui.small_button(f"select level {level}##warn{level}"):
-            out.append(ec.SelectLevel(level))
+        if imgui.small_button(f"select {what} {entry}##warn{k}"):
+            out.append(ec.SelectLevel(entry))
 
 
 def _file(e: Edited, out: list) -> None:
@@ -199,23 +205,26 @@ def _outline(e: Edited, out: list) -> None:
     imgui.end_child()
 
 
-def _selection(e: Edited, out: list, interactions: Interactions) -> None:
+def _selection(e: Edited, out: list, interactions: Interactions, fields_of: Callable) -> None:
     h = e.selected
     if h is None:
         imgui.text_disabled("nothing selected")
         return
-    same_level = [k for k in e.handles if k.level == h.level]
+    same_level = [k for k in e.handles if k.owner == h.owner]  # a compound's: its level
     for k, other in enumerate(same_level):
         if imgui.radio_button(f"{other.label}##h{k}", other.same(h)):
             out.append(ec.Select(other))
         if k % 2 == 0 and k + 1 < len(same_level):
             imgui.same_line()
-    _fields(get_at(e.handled_scene(), h.owner), h.owner, out, interactions)  # as drawn
+    fields_of(get_at(e.handled_scene(), h.owner), h.owner, out, interactions)  # as drawn
 
 
-def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
+def _fields(
+    obj: Any, at: tuple, out: list, interactions: Interactions, marks: dict | None = None
+) -> None:
     """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse; the
-    fields the program keeps (BOOKKEEPING) as a line of text."""
+    fields the program keeps (BOOKKEEPING) as a line of text; a field a track moves marked
+    (``marks``: keys.key_marks)."""
     for f in fields(obj):
         value = getattr(obj, f.name)
         path = (*at, f.name)
@@ -228,12 +237,13 @@ def _fields(obj: Any, at: tuple, out: list, interactions: Interactions) -> None:
             imgui.separator_text(
                 f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else "")
             )
-            _fields(value, path, out, interactions)
+            _fields(value, path, out, interactions, marks)
             continue
         refused = interactions.refusal(path)
-        changed, new = field_widget(
-            f"{f.name}##{'.'.join(map(str, path))}", value, dict(f.metadata), refused
-        )
+        with marked((marks or {}).get(path)):
+            changed, new = field_widget(
+                f"{f.name}##{'.'.join(map(str, path))}", value, dict(f.metadata), refused
+            )
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))

@@ -1,7 +1,7 @@
-"""The editor's overlay, as shapes for gpu/overlay.py: the route, the handles shown (larger
-on the selected level, with its arrows and its mirror as a translucent disc), and in red the
-part of each branch that Alg. 1 clips (a warning of the route), all depth-composited with the
-traced image."""
+"""The editor's overlay, as shapes for gpu/overlay.py: the route (a compound's component
+routes, placed), the handles shown (larger on the selected level, with its arrows and its
+mirror as a translucent disc), and in red the part of each branch that Alg. 1 clips (a
+warning of the route), all depth-composited with the traced image."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 
 from ..gpu.overlay import Shapes
 from ..scene import Scene
-from .handles import Handle, polyline
+from .handles import Handle, polylines
 from .mokrs_handles import MobiusHandle, guide_lines
 
 FORK, CONTROL, NORMAL, SELECTED = (
@@ -32,9 +32,8 @@ def editor_shapes(
 ) -> Shapes:
     """``clipped``: the route's clipped parts (clipped.clipped_parts, made once per scene)."""
     s = Shapes()
-    route = polyline(scene)
-    for a, b in zip(route[:-1], route[1:]):
-        s.lines.append((a, b, ROUTE))
+    for route in polylines(scene):
+        s.lines += [(a, b, ROUTE) for a, b in zip(route[:-1], route[1:])]
     for h in shown:
         colour = {"normal": NORMAL}.get(h.kind, CONTROL if h.path[-1] == "control" else FORK)
         big = selected is not None and h.level == selected.level

@@ -1,6 +1,7 @@
 """The editor's structure tools [KRS17 §9.2]: insert, remove and duplicate a route's levels
-(keys, the outline's right-click menu and the panel's "structure" section), taper, scale the
-widths or the tree, move its foot, and grow a baked tree again from its growth parameters.
+(keys, the outline's right-click menu and the panel's "structure" section, drawn by
+structure_panel.py), taper, scale the widths or the tree, move its foot, and grow a baked
+tree again from its growth parameters.
 In a compound they act on the selected component's route (its level chosen in the section);
 a component grown from ratios is baked first, an explicit KRS has no route to act on.
 
@@ -12,10 +13,8 @@ in the status. Re-growing that would lose hand edits lists them and asks first."
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from typing import Any, Protocol
-
-from imgui_bundle import imgui
 
 from ..document.document import Document
 from ..scene import Route, Scene, SceneError
@@ -33,13 +32,9 @@ from ..scene.restructure import (
 )
 from ..scene.schema import Vec3, from_dict, to_dict
 from ..viewer.commands import Command
-from ..viewer.widgets import Interactions, field_widget
 from ..viewer.window import Viewer
 from . import commands as ec
-from .handles import Handle, route_outline
-
-RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
-MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
+from .handles import Handle
 
 # Insert / Delete / Ctrl+D act on the selected level (the viewer's keys are letters, F-keys
 # and Ctrl+Z/Y; Ctrl+D is free: D alone flies).
@@ -268,138 +263,3 @@ STRUCTURE_HANDLERS: dict[type[Command], Callable[[Any, Any], None]] = {
     ec.ConfirmRegrow: lambda e, c: confirm_regrow(e),
     ec.CancelRegrow: lambda e, c: setattr(e.structure, "pending", None),
 }
-
-
-# ------------------------------------------------------------------------------ drawing
-def outline_menu(k: int) -> list[Command]:
-    """The right-click menu of outline entry k (call right after its selectable)."""
-    out: list[Command] = []
-    if imgui.begin_popup_context_item(f"structure##{k}"):
-        for text, keys, command in (
-            ("insert a fork", "Insert", ec.InsertLevel(k)),
-            ("remove this fork", "Delete", ec.RemoveLevel(k)),
-            ("duplicate", "Ctrl+D", ec.DuplicateLevel(k)),
-        ):
-            if imgui.menu_item(text, keys, False)[0]:
-                out.append(command)
-        imgui.end_popup()
-    return out
-
-
-def structure_section(e: Structured, interactions: Interactions) -> list[Command]:
-    """The panel's "structure" section (a route only), and the re-grow dialog."""
-    out: list[Command] = []
-    t = e.structure
-    at, why = target(e)
-    if (at is None and not e.scene.compound) or not imgui.collapsing_header(
-        "structure", imgui.TreeNodeFlags_.default_open
-    ):
-        return out
-    imgui.push_text_wrap_pos(0.0)
-    if at is None:  # a compound's component without a route
-        imgui.text_disabled(why)
-        k = component(e)
-        tree = k is not None and e.scene.compound[k].tree is not None
-        if tree and imgui.button(f"bake component {k} into a route"):
-            out.append(ec.Bake(k))
-        imgui.pop_text_wrap_pos()
-        return out
-    route = get_at(e.scene, at)
-    if at == ("route",):
-        imgui.text_disabled(
-            ("on the selected level" if e.selected is not None else "select a level first")
-            + "; or right-click an outline entry"
-        )
-    else:
-        _component_level(t, route, out)
-    imgui.pop_text_wrap_pos()
-    imgui.set_next_item_width(120)
-    changed, s = imgui.slider_float("split at##structure", t.split_at, 0.05, 0.95, "%.2f")
-    if changed:
-        out.append(ec.SetToolValue("split_at", s))
-    for k, (text, command) in enumerate(
-        (
-            ("insert (Ins)", ec.InsertLevel()),
-            ("remove (Del)", ec.RemoveLevel()),
-            ("duplicate (Ctrl+D)", ec.DuplicateLevel()),
-        )
-    ):
-        if k:
-            imgui.same_line()
-        if imgui.button(text):
-            out.append(command)
-    imgui.separator_text("whole tree")
-    for name, op, lo, hi, button in (
-        ("taper", "taper", 0.05, 1.0, "taper"),
-        ("widths", "widths", 0.1, 10.0, "scale widths"),
-        ("scale", "scale", 0.1, 10.0, "scale tree"),
-    ):
-        imgui.set_next_item_width(120)
-        changed, v = imgui.slider_float(f"##{name}", getattr(t, name), lo, hi, "%.3g")
-        if changed:
-            out.append(ec.SetToolValue(name, v))
-        imgui.same_line()
-        if imgui.button(button):
-            out.append(ec.WholeTree(op))
-    imgui.set_next_item_width(180)
-    changed, b = imgui.drag_float3("##base", list(t.base or route.base), 0.01, 0.0, 0.0, "%.3g")
-    if changed:
-        out.append(ec.SetToolValue("base", tuple(float(c) for c in b)))
-    imgui.same_line()
-    if imgui.button("move foot"):
-        out.append(ec.WholeTree("base"))
-    if t.message:
-        (imgui.text_colored(RED, t.message) if t.refused else imgui.text_wrapped(t.message))
-    if route.growth is not None:
-        _growth(route.growth, out, interactions)
-    _regrow_dialog(t, out)
-    return out
-
-
-def _component_level(t: StructureTools, route: Route, out: list[Command]) -> None:
-    """In a compound: which level of the selected component's route the tools act on."""
-    n = len(route.levels)
-    names = route_outline(route)
-    level = min(t.level, n - 1)
-    imgui.text_disabled("on this level of the component's route:")
-    imgui.set_next_item_width(160)
-    changed, k = imgui.combo("##component level", n - 1 - level, names[::-1])  # trunk first
-    if changed or level != t.level:
-        out.append(ec.SetToolValue("level", n - 1 - k if changed else level))
-
-
-def _growth(growth: Growth, out: list[Command], interactions: Interactions) -> None:
-    if not imgui.tree_node("growth (edits kept where they can be)"):
-        return
-    for f in fields(Growth):
-        value = getattr(growth, f.name)
-        if value is None or isinstance(value, list):
-            continue
-        changed, new = field_widget(f"{f.name}##growth", value, dict(f.metadata))
-        key = interactions.key(("route", "growth", f.name))
-        if changed:
-            out.append(ec.SetGrowth(f.name, new, key))
-    if imgui.button("grow again"):
-        out.append(ec.Regrow())
-    imgui.tree_pop()
-
-
-def _regrow_dialog(t: StructureTools, out: list[Command]) -> None:
-    if t.pending is not None and not imgui.is_popup_open("grow again?"):
-        imgui.open_popup("grow again?")
-    if not imgui.begin_popup_modal("grow again?", None, imgui.WindowFlags_.always_auto_resize)[0]:
-        return
-    lost = t.pending[1] if t.pending else []
-    imgui.text("Growing the tree again loses these edits made by hand:")
-    for line in lost[:MAX_LISTED]:
-        imgui.bullet_text(line)
-    if len(lost) > MAX_LISTED:
-        imgui.text(f"... and {len(lost) - MAX_LISTED} more")
-    if imgui.button("grow again, losing them"):
-        out.append(ec.ConfirmRegrow())
-        imgui.close_current_popup()
-    imgui.same_line()
-    if imgui.button("cancel (keep the tree)"):
-        out.append(ec.CancelRegrow())
-        imgui.close_current_popup()
-    imgui.end_popup()

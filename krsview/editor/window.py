@@ -8,7 +8,8 @@ The editor composes a :class:`Viewer`: it turns the event loop itself, calling t
 parts (keys, camera, file watching, tracing, HUD) and adding its overlay (shapes.py), panels,
 gizmo, trackball and picking (picking.py). Commands of its own go to EDITOR_HANDLERS, and those
 the editor decides differently (bookmark, open, a file changed on disk, a field's edit, reset
-view); the rest to the viewer's.
+view); the rest to the viewer's. Its other jobs live beside it: the file (file_actions.py),
+what the view shows at the moment shown (shown.py) and a drag's edits (dragging.py).
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
@@ -27,9 +28,9 @@ from imgui_bundle import imgui
 
 from ..compile.camera import View, view_of
 from ..compile.geometry import scene_ball
-from ..document.document import ConflictError, Document
+from ..document.document import Document
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
-from ..scene import Bookmark, Scene, SceneError
+from ..scene import Scene, SceneError
 from ..scene.edits import apply_edit, path_text
 from ..scene.mokrs import check_view
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
@@ -39,15 +40,17 @@ from ..viewer.hud import draw_hud, draw_status
 from ..viewer.loop import run
 from ..viewer.window import Viewer
 from . import commands as ec
-from .clipped import clipped_parts
+from .dragging import manipulate
+from .file_actions import FileActions
 from .gizmo import Gizmo
-from .handles import Handle, handles
-from .keys import Timeline, key_now, keyed_edit, track_index
+from .handles import Handle
+from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
 from .panels import edit_panel
 from .picking import hover_label, pick, visible
-from .saving import SAVING_HANDLERS, CopyAsk, ask_copy, autosave, save_as_default
+from .saving import SAVING_HANDLERS, CopyAsk, autosave, save_as_default
 from .shapes import editor_shapes
+from .shown import Shown
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
 
@@ -61,7 +64,7 @@ EDITOR_KEYS = {
 }
 
 
-class Editor:
+class Editor(FileActions):
     def __init__(self, path: Path, settings: ViewerSettings | None = None, **options: Any):
         """``options``: ``visible``, ``shader_dir``, or fields of ViewerSettings."""
         window = {k: options.pop(k) for k in ("visible", "shader_dir") if k in options}
@@ -78,10 +81,7 @@ class Editor:
         self.timeline = Timeline()
         self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
-        self._handles_of: tuple | None = None  # the scene and moment the handles were made for
-        self._handles: list[Handle] = []
-        self.warnings: list[str] = []
-        self.clipped: list[tuple[int, np.ndarray]] = []  # what Alg. 1 clips (drawn red)
+        self.shown_now = Shown()  # the scene drawn now, its handles, warnings, clipped parts
         self.save_as_text = save_as_default(self.doc)
         self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
         self.recovered = self.doc.recovery()  # offered in a modal
@@ -107,30 +107,33 @@ class Editor:
 
     @property
     def handles(self) -> list[Handle]:
-        """The scene's handles, made again when the scene changed (an edit, undo, reload);
-        the selection and the route's warnings follow."""
+        """The scene's handles, made again when the scene changed (an edit, undo, reload)
+        or the moment shown; the selection and the route's warnings follow."""
         self._follow()
-        return self._handles
+        return self.shown_now.handles
+
+    @property
+    def warnings(self) -> list[tuple[int, str]]:
+        """The route's warnings, each with the outline entry it names (shown.py)."""
+        self._follow()
+        return self.shown_now.warnings
+
+    @property
+    def clipped(self) -> list[tuple[int, np.ndarray]]:
+        """What Alg. 1 clips of the route drawn (red in the view)."""
+        self._follow()
+        return self.shown_now.clipped
 
     def _follow(self) -> None:
-        made_for = (self.scene, self.viewer.playback.time)
-        if self._handles_of is None or any(a is not b for a, b in zip(self._handles_of, made_for)):
-            self._handles_of = made_for
-            self._handles = handles(self.handled_scene())
-            route = self.scene.route
-            self.warnings = route.warnings() if route else []
-            self.clipped = clipped_parts(route) if route else []
-            if self.selected is not None:  # keep the selection across edits, undo, reload
-                self.selected = next((h for h in self._handles if h.same(self.selected)), None)
+        now = self.shown_now
+        if now.follow(self.scene, self.viewer.playback.time, self.viewer.posed) and self.selected:
+            # keep the selection across edits, undo, reload
+            self.selected = next((h for h in now.handles if h.same(self.selected)), None)
 
     def handled_scene(self) -> Scene:
-        """The scene whose values the handles sit at: with keyframe tracks, as drawn at the
-        moment shown (a keyed handle is where its track puts it); else, and with sway (which
-        turns mirrors a drag must not write back), the scene's own values."""
-        a = self.scene.animation
-        if a is not None and a.tracks and a.sway is None:
-            return self.viewer.posed(self.scene)
-        return self.scene
+        """The scene whose values the handles and panels show (shown.py's ``drawn``)."""
+        self._follow()
+        return self.shown_now.scene
 
     def edit(self, path: tuple, value, interaction=None) -> bool:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
@@ -188,7 +191,7 @@ class Editor:
         if ui:
             v.platform.new_frame()
         if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
-            self._manipulate()
+            manipulate(self)
         v.draw_image()
         self._follow()
         if ui:
@@ -225,45 +228,6 @@ class Editor:
                 handler(self, command)
 
     # --------------------------------------------------------------------------- actions
-    def add_bookmark(self) -> None:
-        """In the editor a bookmark is an edit like any other (saved with the scene)."""
-        b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.viewer.camera.to_camera())
-        if self.edit(("bookmarks",), self.scene.bookmarks + [b]):
-            self.viewer.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
-
-    def reload_scene(self) -> None:
-        """Unsaved edits are never overwritten by the file's new contents: ask first."""
-        if not self.doc.changed_on_disk():
-            return
-        if self.doc.dirty:
-            self.conflict = True
-        else:
-            self.viewer.take_file()
-
-    def save(self, path: str | None = None, overwrite: bool = False) -> bool:
-        v = self.viewer
-        if not path and self.doc.template:
-            return ask_copy(self)
-        try:
-            saved = self.doc.save(path or None, overwrite=overwrite)
-        except ConflictError as e:
-            v.error, self.conflict = str(e), True
-            return False
-        except SceneError as e:
-            v.error = str(e)
-            return False
-        v.follow_file()
-        v.error, v.message, self.conflict = "", f"saved {saved.resolve()}", False
-        self.save_as_text = str(saved)
-        return True
-
-    def save_as(self, text: str) -> None:
-        target = Path(text.strip()).expanduser()
-        if target.suffix != ".toml" or target.is_dir():
-            self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
-            return
-        self.save(str(target))
-
     def bake(self, component: int | None = None) -> None:
         """Grown tree → route (one undo step): every fork becomes a handle; or the tree of a
         compound's ``component`` (the structure tools then act on its route)."""
@@ -282,60 +246,14 @@ class Editor:
             self.viewer.message = f"key at {t:.2f} s for {self.selected.label}"
 
     def select(self, h: Handle | None) -> None:
+        """Select ``h``; a compound component's fork also picks its level for the tools."""
         self.selected = h
         self.scroll_outline = True
+        if h is not None and self.scene.compound and "levels" in h.path:
+            self.structure.level = h.path[h.path.index("levels") + 1]
 
     def select_level(self, level: int) -> None:
         self.select(next((h for h in self.handles if h.level == level), None))
-
-    def take_file(self) -> None:
-        self.conflict = False
-        self.viewer.take_file()
-
-    def keep_mine(self) -> None:
-        self.conflict = False
-        self.viewer.message = "kept your edits; saving will ask to overwrite"
-
-    def restore(self) -> None:
-        self.doc.restore_recovery()
-        self.recovered = None
-        self.viewer.sync()
-        self.viewer.message = "restored the unsaved edits (Ctrl+Z undoes the restore)"
-
-    def discard_recovery(self) -> None:
-        self.doc.discard_recovery()
-        self.recovered = None
-
-    def answer_save(self) -> None:
-        if self.save():
-            self._answered()
-
-    def answer_discard(self) -> None:
-        self.doc.discard_recovery()
-        self._answered()
-
-    def answer_cancel(self) -> None:
-        self.asking = None
-
-    def _answered(self) -> None:
-        what, path = self.asking or (None, None)
-        self.asking = None
-        if what == "close":
-            self._quit = True
-        elif what == "open" and path is not None:
-            self._open(path)
-
-    def open_preset(self, path: Path) -> None:
-        if self.doc.dirty:
-            self.asking, self.viewer.hud = ("open", Path(path)), True
-        else:
-            self._open(path)
-
-    def _open(self, path: Path) -> None:
-        self.viewer.open_preset(path)
-        self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
-        self.save_as_text = save_as_default(self.doc)
-        self.frame()
 
     def place_panel(self, side: str, width: float) -> None:
         """Dock the panel on ``side`` at ``width``; what was in the middle of the view stays
@@ -387,14 +305,14 @@ class Editor:
     def _draw_ui(self) -> None:
         """Inside the ImGui frame, after the trace: the overlay over the image, the viewer's
         HUD (collapsed at first: the view stays free), the edit panel, and the name of the
-        handle under the pointer (the gizmo came before the trace: :meth:`_manipulate`)."""
+        handle under the pointer (the gizmo came before the trace: dragging.py)."""
         v = self.viewer
         view = self.window_view()
         shown = self.shown()
         if v.frames.image is not None:
             fb = glfw.get_framebuffer_size(v.window)
             view_matrix, proj = camera_matrices(view, NEAR, FAR)
-            shapes = editor_shapes(self.scene, shown, self.selected, self.clipped)
+            shapes = editor_shapes(self.handled_scene(), shown, self.selected, self.clipped)
             self.overlay.draw(
                 shapes, v.frames.image[0], v.ctx.screen, fb, proj @ view_matrix, view.origin
             )
@@ -406,19 +324,6 @@ class Editor:
             path = self.selected.path if self.selected is not None else None
             self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
         hover_label(shown, view)
-
-    def _manipulate(self) -> None:
-        """Inside the ImGui frame, before the turn's image is traced: the gizmo on a selected
-        point or the trackball on a selected normal; a drag's step is an edit at once."""
-        self.gizmo.begin_frame()
-        sel = self.selected
-        if sel is not None:
-            tool = self.trackball.update if sel.kind == "normal" else self.gizmo.manipulate
-            moved = tool(sel, self.window_view())
-            if moved is not None:  # a keyed value's drag sets its key (in edit)
-                p, drag = moved
-                keyed = track_index(self.scene, sel.path) is not None
-                self.edit(*sel.edit_to(self.scene, p, self.carry and not keyed), drag)
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an

@@ -6,7 +6,8 @@ take any other scene value. A scene without the table is drawn at time 0 and not
 Keyframe tracks (``[[animation.tracks]]``) move any value an edit can change: each is a
 path, as ``Scene.edit`` takes it, and keys [time, value]. :func:`pose` evaluates them at the
 scene's time, writes them by the edits' rule (replace, then validate) and turns the sway's
-mirrors (``sway.py``): the static scene drawn at that moment.
+mirrors (``sway.py``): the static scene drawn at that moment. A track on a route's fork (or
+its trunk's foot) moves its subtree with it, as a bone does (:func:`bone_offsets`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 
 from .edits import get_at, parse_path, replace_at, revalidated
 from .effects import EFFECTS
+from .route import Route
 from .schema import SceneError, param, to_dict
 from .sway import Sway, check_sway, swayed
 
@@ -270,23 +272,88 @@ def check_animation(scene: Any) -> None:
         check_sway(_sway_route(rest, "animation.sway"), a.sway, "animation.sway")
 
 
-def pose(scene: Any) -> Any:
-    """The static scene drawn at ``scene.time``: every track's value there written by the
-    edits' rule, then the sway's mirrors turned; without tracks or sway, time kept. A value
-    between keys that breaks its field's rule is a one-line error naming the track and time."""
+def _track_values(scene: Any) -> tuple[Any, list[tuple[tuple, Any]]]:
+    """The scene without tracks or sway (its rest values), and each track's path and value
+    at the scene's time."""
     a = scene.animation
-    t = a.time
     rest = replace(scene, animation=replace(a, tracks=[], sway=None))
     values = []
     for tr in a.tracks:
         path = parse_path(tr.path)
         unit = bool(_field_meta(rest, path).get("unit_vector"))
-        values.append((path, tr.value_at(t, _steps(rest, path, tr), unit)))
+        values.append((path, tr.value_at(a.time, _steps(rest, path, tr), unit)))
+    return rest, values
+
+
+def bone_offsets(rest: Any, values: list[tuple[tuple, Any]]) -> dict[tuple, np.ndarray]:
+    """Keyed forks pose their subtrees, as bones do (and as a fork drag carries them,
+    editor/handles.py): a track putting fork i at d from its rest value moves the finer
+    levels' forks and control points by d too, and level i's own control point by d/2 (its
+    bend stays); a track on the trunk's foot moves every level. The offsets of nested keyed
+    forks add up, so a finer fork's keys hold its value as if the coarser forks were at rest.
+    Per route path: an array (levels, 2, 3), each level's fork and control offsets."""
+    out: dict[tuple, np.ndarray] = {}
+    for path, value in values:
+        if path[-1:] == ("base",):
+            at, i = path[:-1], None
+        elif len(path) >= 3 and path[-1] == "fork" and path[-3] == "levels":
+            at, i = path[:-3], path[-2]
+        else:
+            continue
+        route = get_at(rest, at)
+        if not isinstance(route, Route):
+            continue
+        off = out.setdefault(at, np.zeros((len(route.levels), 2, 3)))
+        if i is None:
+            off += np.subtract(value, route.base)
+        else:
+            d = np.subtract(value, route.levels[i].fork)
+            off[:i] += d
+            off[i, 1] += d / 2
+    return out
+
+
+def bone_offset(scene: Any, path: tuple) -> np.ndarray | None:
+    """What :func:`pose` adds to the route fork or control point at ``path`` for the keyed
+    forks above it at the scene's time (None: nothing), so that a value drawn there can be
+    keyed as the track holds it."""
+    a = scene.animation
+    if a is None or not a.tracks or len(path) < 3 or path[-1] not in ("fork", "control"):
+        return None
+    off = bone_offsets(*_track_values(scene)).get(path[:-3])
+    return None if off is None else off[path[-2], int(path[-1] == "control")]
+
+
+def _posed_bones(out: Any, offsets: dict[tuple, np.ndarray]) -> Any:
+    """``out`` with each route's levels moved by its bone offsets."""
+    for at, off in offsets.items():
+        levels = [
+            replace(
+                lv,
+                fork=tuple(float(c) for c in np.add(lv.fork, o[0])),
+                control=tuple(float(c) for c in np.add(lv.control, o[1])),
+            )
+            for lv, o in zip(get_at(out, at).levels, off)
+        ]
+        out = replace_at(out, (*at, "levels"), levels)
+    return out
+
+
+def pose(scene: Any) -> Any:
+    """The static scene drawn at ``scene.time``: every track's value there written by the
+    edits' rule, the keyed forks' subtrees moved with them (:func:`bone_offsets`), then the
+    sway's mirrors turned; without tracks or sway, time kept. A value between keys that
+    breaks its field's rule is a one-line error naming the track and time."""
+    a = scene.animation
+    t = a.time
+    rest, values = _track_values(scene)
+    offsets = bone_offsets(rest, values)
     out = rest
     for path, value in values:
         out = replace_at(out, path, value)
     try:
-        out = revalidated(out, [path for path, _ in values])
+        out = _posed_bones(out, offsets)
+        out = revalidated(out, [path for path, _ in values] + [(*at, "levels") for at in offsets])
     except SceneError:
         out = rest
         for k, (path, value) in enumerate(values):  # which track broke it: edit one by one

@@ -1,0 +1,162 @@
+"""The panels under keyframe tracks (issue 28/29), in a real window: the MöKRS section shows
+the values drawn at the moment shown (as the KRS panel and the handles do), a tracked field
+is marked (yellow on a key, green between keys), and a value typed into it keys it at that
+moment, in every linked level a track moves."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from krsview.editor import panels
+from krsview.editor.keys import BETWEEN, ON_KEY
+from krsview.editor.mokrs_panel import LEVELS
+from krsview.scene.edits import get_at
+from krsview.scene.presets import resolve
+
+from .test_editor import pump, scroll_to, settle, window_xy, xdo
+
+CURL = (*LEVELS, 58, "transform", 1, "degrees")  # palm-curl's track: -2.5° at 0, 4 s; -7° at 2 s
+FACTOR = (*LEVELS, 58, "transform", 0, "factor")  # no track
+
+
+@pytest.fixture
+def palm(display, tmp_path, monkeypatch):
+    """palm-curl in an editor, with the values its panel's fields show recorded by path."""
+    from krsview.editor.window import Editor
+
+    shown: dict[str, object] = {}
+    widget = panels.field_widget
+
+    def recording(label, value, meta, refused=None):
+        shown[label.split("##", 1)[1]] = value
+        return widget(label, value, meta, refused)
+
+    monkeypatch.setattr(panels, "field_widget", recording)
+    path = tmp_path / "palm-curl.toml"
+    shutil.copy(resolve("palm-curl"), path)
+    e = Editor(path, size=(800, 500))
+    e.shown_values = shown
+    yield e
+    e.close()
+
+
+def type_at(e, at, *text: str) -> None:
+    """Ctrl+click the field at screen point ``at``, type ``text`` (xdotool's arguments: "--"
+    lets a value start with a minus) and press Return."""
+    xdo("mousemove", *map(round, at))
+    pump(e, 2)
+    xdo("keydown", "ctrl")
+    xdo("click", 1)
+    xdo("keyup", "ctrl")
+    pump(e, 2)
+    xdo("type", *text)
+    pump(e, 8)  # ImGui takes the typed characters one per frame
+    xdo("key", "Return")
+    pump(e, 3)
+
+
+def frame_colour(e, path, colour) -> int:
+    """Pixels of the field at ``path`` (its left half: the frame) in ``colour`` (an ImVec4)."""
+    x0, y0, x1, y1 = e.viewer.interactions.rects[path]
+    shot = e.viewer.read_window().astype(int)
+    field = shot[round(y0) + 2 : round(y1) - 2, round(x0) + 2 : round((x0 + x1) / 2)]
+    rgb = np.array([colour.x, colour.y, colour.z]) * 255
+    return int((np.abs(field - rgb) < 14).all(-1).sum())
+
+
+def test_the_mokrs_panel_shows_the_pose_marks_tracks_and_a_typed_value_keys_them(palm):
+    from krsview.viewer.commands import SetTime
+
+    e = palm
+    settle(e)
+    e.select(next(h for h in e.handles if h.path == CURL))
+    key = ".".join(map(str, CURL))
+    rest = get_at(e.scene, CURL)
+    for t, mark in ((1.0, BETWEEN), (2.0, ON_KEY)):
+        e.execute([SetTime(t)])
+        pump(e, 3)
+        scroll_to(e, CURL, 60, 0)
+        pump(e, 3)
+        posed = get_at(e.scene.at(t).posed(), CURL)
+        assert e.shown_values[key] == posed != rest, (t, e.shown_values[key], posed, rest)
+        assert frame_colour(e, CURL, mark) > 50, f"the tracked field is not marked at {t} s"
+        other = BETWEEN if mark is ON_KEY else ON_KEY
+        assert frame_colour(e, CURL, other) == 0
+        assert frame_colour(e, FACTOR, mark) == 0, "an untracked field is marked"
+    e.execute([SetTime(1.0)])
+    pump(e, 3)
+    x0, y0, x1, y1 = scroll_to(e, CURL, 60, 0)
+    type_at(e, window_xy(e, (x0 + x1) / 2 - 40, (y0 + y1) / 2), "--", "-6")
+    a = e.scene.animation
+    curls = [tr for tr in a.tracks if tr.path.endswith("transform[1].degrees")]
+    assert len(curls) == 30 and all([k.time for k in tr.keys] == [0, 1, 2, 4] for tr in curls)
+    assert all(tr.keys[1].value == -6.0 for tr in curls), "a linked track was not keyed"
+    assert get_at(e.scene, CURL) == rest, "typing moved the rest value"
+    assert get_at(e.scene.at(1.0).posed(), CURL) == -6.0
+    assert get_at(e.scene, (*LEVELS, 57, "transform")) == get_at(
+        e.doc.history.steps[0].before, (*LEVELS, 57, "transform")
+    )
+    assert len(e.doc.history.steps) == 1, "the typed value was not one undo step"
+    xdo("mousemove", *map(round, window_xy(e, 20, 250)))  # off the field: not hovered
+    pump(e, 3)
+    assert frame_colour(e, CURL, ON_KEY) > 50, "the new key is not marked"
+
+
+def test_the_krs_panel_marks_a_keyed_fork(display, tmp_path):
+    """A route's keyed fork: its field framed green between keys, yellow on one; its
+    neighbour's (no track) neither."""
+    from krsview.editor.keys import with_key
+    from krsview.editor.window import Editor
+    from krsview.viewer.commands import SetTime
+
+    path = tmp_path / "bent.toml"
+    shutil.copy(resolve("bent-tree"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        fork = ("route", "levels", 20, "fork")
+        rest = np.array(e.scene.route.levels[20].fork)
+        s = e.scene
+        for t, v in ((0.0, rest), (2.0, rest + 0.1)):
+            s = s.edit("animation", with_key(s, fork, t, tuple(v)))
+        e.doc.commit(s, "keys")
+        e.viewer.sync()
+        e.select(next(h for h in e.handles if h.path == fork))
+        for t, mark in ((1.0, BETWEEN), (2.0, ON_KEY)):
+            e.execute([SetTime(t)])
+            pump(e, 3)
+            scroll_to(e, fork, 60, 0)
+            pump(e, 3)
+            assert frame_colour(e, fork, mark) > 50, t
+            assert frame_colour(e, ("route", "levels", 20, "control"), mark) == 0
+    finally:
+        e.close()
+
+
+def test_a_linked_dial_drag_on_palm_curl_keys_every_curl_at_the_moment():
+    """The curl's dial dragged at 1 s (carry on): one edit of the animation, a key at 1 s in
+    each of the 30 linked tracks, the rest values kept. Negative control: carry off keys
+    level 58 alone."""
+    from krsview import load
+    from krsview.editor.dragging import drag_edits
+    from krsview.editor.handles import handles
+
+    s = load("palm-curl").at(1.0)
+    h = next(h for h in handles(s.posed()) if h.path == CURL)
+    a, r, turn = np.asarray(h.axis), h.position - h.pivot, np.radians(5.0)  # 5° on the ring
+    p = (
+        h.pivot
+        + r * np.cos(turn)
+        + np.cross(a, r) * np.sin(turn)
+        + a * (a @ r) * (1 - np.cos(turn))
+    )
+    edits = drag_edits(s, h, p, carry=True, t=1.0)
+    assert [path for path, _ in edits] == [("animation",)]
+    keyed = [tr for tr in edits[0][1].tracks if any(k.time == 1.0 for k in tr.keys)]
+    assert len(keyed) == 30 and len({tr.keys[1].value for tr in keyed}) == 1
+    drawn = get_at(s.posed(), CURL)
+    assert 4.0 < abs(keyed[0].keys[1].value - drawn) < 6.0, (keyed[0].keys[1].value, drawn)
+    alone = drag_edits(s, h, p, carry=False, t=1.0)
+    assert [path for path, _ in alone] == [CURL]  # keyed by Editor.edit: this level only
