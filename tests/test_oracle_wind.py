@@ -19,15 +19,15 @@ from krsview.api import exact_settings
 from krsview.compile.geometry import compile_geometry
 from krsview.gpu.renderer import Renderer
 from krsview.oracle.certify import UNCOVERED, count_errors
-from krsview.oracle.distance import Moved, in_box, on_segments, value
+from krsview.oracle.distance import Bounds, Moved, bounds, in_box, on_segments, value
 from krsview.oracle.numbers import Affine, Interval
-from krsview.oracle.wind import hit_stretch, unwind
+from krsview.oracle.wind import hit_stretch, unwind, wind_moved
 from krsview.reference.wind import Wind
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
 
 from .conftest import broken_shaders
-from .test_oracle import arb_mokrs
+from .test_oracle import arb_distance, arb_mokrs
 
 ctx.prec = 200
 W, H = 32, 18
@@ -125,46 +125,85 @@ def strong_wind(name: str, strength: float, t: float) -> Wind:
     return Wind.of(s)
 
 
-def map_outside(wind: Wind, boxes: int, seed: int, rate_scale: float = 1.0) -> int:
-    """Samples p of random boxes (interval) and segments (affine) in the crown whose arb
-    g(p) lies outside the enclosure of g over their box or segment (the enclosure made with
-    the rate × ``rate_scale``, for the negative control)."""
+def map_outside(wind: Wind, c: int, boxes: int, seed: int, rate_scale: float = 1.0) -> int:
+    """Samples p of random boxes (interval) and segments (affine) in component c's crown
+    whose arb g_c(p) lies outside the enclosure of g_c over their box or segment (the
+    enclosure made with the rate × ``rate_scale``, for the negative control)."""
     rng = np.random.default_rng(seed)
     wrong = replace(wind, rates=wind.rates * rate_scale)
-    centres = wind.bases[0] + rng.normal(size=(boxes, 3)) * 3.0 + np.array([0.0, 4.0, 0.0])
+    centres = wind.bases[c] + rng.normal(size=(boxes, 3)) * 3.0 + np.array([0.0, 4.0, 0.0])
     half = 10.0 ** rng.uniform(-4, 0, boxes)
     dirs = rng.normal(size=(boxes, 3))
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     bad = 0
     for shape in ("box", "segment"):
         if shape == "box":
-            g = unwind(wrong, 0)(in_box(centres, half))
+            g = unwind(wrong, c)(in_box(centres, half))
             pts = centres[:, None] + rng.uniform(-1, 1, (boxes, 6, 3)) * half[:, None, None]
             pts[:, 0] = centres + half[:, None]  # a corner
         else:
-            g = unwind(wrong, 0)(on_segments(centres, dirs, -half, half, "affine"))
+            g = unwind(wrong, c)(on_segments(centres, dirs, -half, half, "affine"))
             g = tuple(v.interval() for v in g)
             ts = np.linspace(-1, 1, 6)
             pts = centres[:, None] + (ts[None, :, None] * half[:, None, None]) * dirs[:, None]
         for i in range(boxes):
             for p in pts[i]:
-                q = arb_unwind(wind, 0, p)
+                q = arb_unwind(wind, c, p)
                 bad += any(
                     outside(q[k], arb(float(g[k].lo[i])), arb(float(g[k].hi[i]))) for k in range(3)
                 )
     return bad
 
 
-@pytest.mark.parametrize("name, strength, t", [("tree-wind", 4.0, 1.3), ("tree-wind", 20.0, 7.9)])
-def test_the_map_encloses_g_at_sampled_points(name, strength, t):
-    """Boxes and segments from 10⁻⁴ to 1 in size around the crown: g at sampled points (a
-    corner of each box among them), in arb, lies in the enclosure of g over the box."""
-    assert map_outside(strong_wind(name, strength, t), 40, seed=int(strength)) == 0
+@pytest.mark.parametrize(
+    "name, c, strength, t",
+    [("tree-wind", 0, 4.0, 1.3), ("tree-wind", 0, 20.0, 7.9), ("grove-wind", 3, 10.0, 0.4)],
+)
+def test_the_map_encloses_g_at_sampled_points(name, c, strength, t):
+    """Boxes and segments from 10⁻⁴ to 1 in size around a crown (a grove's fourth tree: its
+    own foot and phase): g at sampled points (a corner of each box among them), in arb, lies
+    in the enclosure of g over the box or segment."""
+    assert map_outside(strong_wind(name, strength, t), c, 40, seed=int(strength)) == 0
 
 
 def test_the_map_at_a_wrong_rate_misses_g():
     """Negative control: the enclosure made with the rate 5 % off misses g's true values."""
-    assert map_outside(strong_wind("tree-wind", 4.0, 1.3), 40, seed=4, rate_scale=1.05) > 20
+    assert map_outside(strong_wind("tree-wind", 4.0, 1.3), 0, 40, seed=4, rate_scale=1.05) > 20
+
+
+def balls_broken(geometry, wind: Wind, seed: int) -> tuple[int, Bounds]:
+    """Samples along random segments through the bent tree whose arb value at arb g(p)
+    breaks what the walk with balls certifies over the segment: v ≥ lower, v ≤ hi."""
+    c = geometry.geometry if isinstance(geometry, Moved) else geometry
+    rng = np.random.default_rng(seed)
+    starts = wind.bases[0] + np.array([0.0, 5.0, 0.0]) + rng.normal(size=(16, 3)) * 2.0
+    dirs = rng.normal(size=(16, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    a, b = np.zeros(16), np.full(16, 0.4)
+    e = bounds(geometry, on_segments(starts, dirs, a, b, "affine"), b - a)
+    broken = 0
+    for i in range(16):
+        for t in np.linspace(0.0, 0.4, 3):
+            q = arb_unwind(wind, 0, starts[i] + t * dirs[i])
+            v = arb_distance(c, [float(x) for x in q])
+            broken += bool(np.isfinite(e.lower[i]) and v < arb(float(e.lower[i])))
+            broken += bool(np.isfinite(e.hi[i]) and v > arb(float(e.hi[i])))
+    return broken, e
+
+
+def test_balls_tested_on_the_maps_enclosure_bound_the_bent_tree():
+    """The culling and level-of-detail balls live in rest space and are tested on the
+    enclosure of g(X): over segments through and around tree-wind's bent crown (20°), the
+    value at g(p) in arb keeps every bound the walk certifies, and both kinds of ball
+    ended walks. Negative control: the walk on X itself (the still tree, no map) breaks
+    bounds of the bent one."""
+    wind = strong_wind("tree-wind", 20.0, 7.9)
+    s = load_scene(resolve("tree-wind"))
+    c = compile_geometry(s.geometry(), s.material.albedo)
+    broken, e = balls_broken(wind_moved(wind, c), wind, seed=5)
+    assert broken == 0
+    assert np.isfinite(e.cut).any() and (e.lower > 0).any()
+    assert balls_broken(c, wind, seed=5)[0] > 0
 
 
 def test_a_mokrs_value_goes_through_the_same_map():
