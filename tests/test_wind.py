@@ -17,7 +17,6 @@ from krsview.compile.geometry import compile_geometry
 from krsview.compile.krs import compile_krs, grown, krs_ball
 from krsview.gpu.renderer import Renderer, read_buffers
 from krsview.gpu.uniforms import variant_defines
-from krsview.oracle.certify import count_errors
 from krsview.reference import render_reference
 from krsview.reference.distortion import Distortion, safe_step
 from krsview.reference.geometry import scene_distance
@@ -326,7 +325,7 @@ def test_every_path_follows_the_wind(renderer, name, knob, value):
 def test_the_prepass_follows_the_wind(renderer, name):
     """The pre-pass's cones ask the wind's bound (is_unbounding): with it, away from outlines
     every pixel has the same hit state as without it and a depth within about one ε
-    (tests/test_prepass.py's check; the oracle has no wind). Negative control: the still
+    (tests/test_prepass.py's check). Negative control: the still
     scene's image does not agree with the windy one."""
     s = replace(preset(name), render=replace(preset(name).render, prepass=0)).at(1.1)
     s = replace(s, effect_settings=replace(s.effect_settings, wind_strength=12.0))
@@ -370,15 +369,6 @@ def test_idle_wind_draws_the_still_scene(renderer):
     assert np.abs(wind.color - base.color).max() < 1e-6
     slight = replace(idle, effect_settings=replace(idle.effect_settings, wind_strength=0.5))
     assert not np.array_equal(renderer.render(slight, 64, 36).depth, base.depth)
-
-
-def test_the_oracle_refuses_wind(renderer):
-    """The oracle has no wind in it, so it refuses to certify a windy frame rather than
-    certify the still geometry; the still scene it takes (negative control)."""
-    s = small_tree(6)
-    with pytest.raises(ValueError, match="without twist, wind or empty zones"):
-        count_errors(s, renderer.render(s, 4, 3))
-    assert count_errors(still(s), renderer.render(still(s), 4, 3)).holes == 0
 
 
 @pytest.mark.parametrize("name", ["tree-wind", "grove-wind"])

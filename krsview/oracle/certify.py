@@ -19,6 +19,10 @@ A segment is walked with the levels' balls (``distance.bounds``): a ball it clea
 walk (culling), and a ball no larger than LOD_BALL × the segment stands for its levels, so a
 long segment costs a few levels and only short ones near the geometry walk deep — the
 level-of-detail oracle that decides trees at full depth.
+
+In the wind each bent component is walked from the enclosure of its world→rest map over the
+segment or box (``oracle/wind.py``), at the scene's time; a hit's reach widens by the map's
+stretch there (``wind.hit_stretch``).
 """
 
 from __future__ import annotations
@@ -31,8 +35,10 @@ import numpy as np
 from ..compile.camera import primary_rays, view_of
 from ..compile.geometry import compile_geometry
 from ..frame import Frame
+from ..reference.wind import Wind
 from ..scene import Scene
 from .distance import Bounds, bounds, in_box, on_segments
+from .wind import hit_stretch, wind_moved
 
 DELTA_PIXELS = 0.25  # a crossing is certified within a quarter pixel footprint
 REFINE = 1024  # a segment δ/REFINE long that touches 0 without a crossing: undecided
@@ -171,22 +177,24 @@ class Counts:
     work: dict = field(default_factory=dict)  # arithmetic → (segments, seconds)
 
 
-UNCOVERED = frozenset({"twist", "wind", "empty_zones"})  # distortions not in the oracle
+UNCOVERED = frozenset({"twist", "empty_zones"})  # distortions not in the oracle
 
 
 def count_errors(
     scene: Scene, image: Frame, arithmetics=ARITHMETICS, max_segments: int = MAX_SEGMENTS
 ) -> Counts:
     """Certified holes and false hits of a traced image (GPU or reference) of ``scene``: a
-    KRS, compound or MöKRS (the twist, wind and empty zones are not in the oracle)."""
+    KRS, compound or MöKRS, in the wind at the scene's time too (the twist and empty zones
+    are not in the oracle)."""
     if UNCOVERED & set(scene.effects):
-        raise ValueError(
-            f"{scene.name}: the oracle covers scenes without twist, wind or empty zones"
-        )
+        raise ValueError(f"{scene.name}: the oracle covers scenes without twist or empty zones")
     scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
     h, w = image.hit.shape
     view = view_of(scene.camera, w, h)
     c = compile_geometry(scene.geometry(), scene.material.albedo)
+    wind = Wind.of(scene) if "wind" in scene.effects else None
+    if wind is not None:
+        c = wind_moved(wind, c)
     dirs = primary_rays(view)
     hit, t = image.hit.ravel(), image.depth.ravel()
     eps = view.footprint * scene.render.epsilon_scale * t
@@ -205,8 +213,10 @@ def count_errors(
             else np.where(DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
         )
     centres = view.origin + t[hit, None] * dirs[hit]
-    reach = hit_reach(scene, view.footprint * scene.render.epsilon_scale)
-    false_hits = int(free_boxes(c, centres, reach * eps[hit]).sum())
+    reach = hit_reach(scene, view.footprint * scene.render.epsilon_scale) * eps[hit]
+    if wind is not None:
+        reach = reach * hit_stretch(scene, wind, centres, reach)
+    false_hits = int(free_boxes(c, centres, reach).sum())
     return Counts(
         len(hit),
         int(hit.sum()),

@@ -3,10 +3,13 @@
 they share). A fold is x − 2·max(0, u·x − w)·u, its conditional turned into a max as RAA09
 writes them; the toroidal capsule's wedge test takes the hull of both branches where the
 range cannot decide it. The result encloses the real-number value of the distance the tracer
-approximates, on the compiled scene's exact float64 constants."""
+approximates, on the compiled scene's exact float64 constants. A :class:`Moved` geometry
+looks each component up through a map from the world into its rest space (the wind's bend,
+``oracle/wind.py``): the walk and its balls then run on the map's enclosure, unchanged."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +19,24 @@ from ..compile.mokrs import CompiledMoKRS
 from .numbers import Affine, Interval, Number
 
 Vec = tuple  # three Numbers
+
+
+@dataclass(frozen=True)
+class Moved:
+    """A compiled geometry whose component i is drawn where ``maps[i]`` (world → its rest
+    space, over Numbers; None: it stands) takes a world point into it: the world geometry is
+    {x : maps[i](x) ∈ component i}, so an enclosure of maps[i](X) is all its walk needs."""
+
+    geometry: CompiledKRS | CompiledCompound | CompiledMoKRS
+    maps: tuple[Callable[[Vec], Vec] | None, ...]
+
+
+def placed(c) -> list[tuple[CompiledKRS | CompiledMoKRS, Callable[[Vec], Vec] | None]]:
+    """Each component of ``c`` with the map that takes world points into it (None: none)."""
+    moved = isinstance(c, Moved)
+    g = c.geometry if moved else c
+    parts = g.parts if isinstance(g, CompiledCompound) else (g,)
+    return list(zip(parts, c.maps if moved else (None,) * len(parts), strict=True))
 
 
 def dot(u, x: Vec) -> Number:
@@ -144,19 +165,19 @@ def inwards(H, reflect: bool, x: Vec) -> Vec:
     return x
 
 
-def value(c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec) -> Number:
+def value(c: CompiledKRS | CompiledCompound | CompiledMoKRS | Moved, x: Vec) -> Number:
     """The whole walk as one Number: Alg. 1's distance, or for a MöKRS min_i k_i(x_i), x_i
     the point followed inwards as Alg. 3 tests it — not a distance (the maps scale lengths)
     but continuous where the maps are defined (+∞ towards a pole), so its sign certifies
-    surfaces and empty space alike. A compound takes the least over its components."""
+    surfaces and empty space alike. A compound takes the least over its components; a
+    :class:`Moved` one walks each from its map's image of x (a sign, not a distance)."""
 
     def terms(part, x):
         for _, _, move, kind, rec in steps(part):
             x = move(x)
             yield kernel(kind, rec, x)
 
-    parts = c.parts if isinstance(c, CompiledCompound) else (c,)
-    return least(k for part in parts for k in terms(part, x))
+    return least(k for part, g in placed(c) for k in terms(part, x if g is None else g(x)))
 
 
 @dataclass
@@ -176,18 +197,21 @@ class Bounds:
 
 
 def bounds(
-    c: CompiledKRS | CompiledCompound | CompiledMoKRS, x: Vec, lod: np.ndarray | None = None
+    c: CompiledKRS | CompiledCompound | CompiledMoKRS | Moved,
+    x: Vec,
+    lod: np.ndarray | None = None,
 ) -> Bounds:
     """Bounds of the value over the batch ``x`` walked with the levels' balls: where a
     point's ball lies clear (its enclosure > 0) the levels below cannot reach 0 and its
     walk ends (culling, which for a MöKRS also steps around the poles); with ``lod`` (a
     length per element) a walk also ends at the first ball of radius ≤ lod, whose distance
-    then stands for the levels below — detail smaller than the level of detail asked for."""
+    then stands for the levels below — detail smaller than the level of detail asked for.
+    A :class:`Moved` component is walked from its map's enclosure of x, in its rest space,
+    where its balls are: a ball clear of that enclosure is clear of every mapped point."""
     n = x[0].size
     out = Bounds(np.full(n, np.inf), np.full(n, np.inf), np.full(n, np.inf))
-    parts = c.parts if isinstance(c, CompiledCompound) else (c,)
-    for part in parts:
-        rows, y = np.arange(n), x
+    for part, g in placed(c):
+        rows, y = np.arange(n), x if g is None else g(x)
         for ball, size, move, kind, rec in steps(part):
             if ball is not None:
                 blo = (norm(minus(y, ball[:3])) - float(ball[3])).range()[0]

@@ -5,12 +5,14 @@ batch of segments) and offer the same operations, so Alg. 1 is written once for 
 (``oracle/distance.py``). Every operation's result contains every value the real operation
 can take on its arguments (the inclusion property), float64 rounding included: intervals step
 one ulp outwards (+, −, ×, √ are correctly rounded to within half an ulp), affine forms add
-ROUNDING × their magnitude to e.
+ROUNDING × their magnitude to e. sin and cos come from the platform's libm, trusted to within
+TRIG_ROUNDING of their value (a few ulps; IEEE 754 leaves them unrounded), and widened by it.
 
 Non-affine operations of the affine forms use the min-range (√) and Chebyshev (|x|, max(0, x))
 approximations: f(x) ≈ αx + ζ ± δ over the argument's range [a, b], with f − αx monotone or
-bounded by hand on [a, b] [RAA09 §3.4, dS97]. Conditionals whose outcome the range cannot
-decide take the hull of both branches, as RAA09 does.
+bounded by hand on [a, b] [RAA09 §3.4, dS97]; sin and cos take their tangent at the centre,
+the remainder bounded by |f''| ≤ 1. Conditionals whose outcome the range cannot decide take
+the hull of both branches, as RAA09 does.
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 ROUNDING = 2.0**-49  # relative error added per affine operation (≥ a few ulps of float64)
+TRIG_ROUNDING = (2.0**-49, 2.0**-56)  # libm's sin/cos: within rel·|f| + abs of the true value
+TRIG_RANGE = 2.0**20  # |x| past this: sin and cos are only known to lie in [−1, 1]
 
 
 def _down(x):
@@ -26,6 +30,33 @@ def _down(x):
 
 def _up(x):
     return np.nextafter(x, np.inf)
+
+
+def _trig_slack(f):
+    """How far libm's sin or cos value ``f`` may be from the true one (TRIG_ROUNDING)."""
+    return np.abs(f) * TRIG_ROUNDING[0] + TRIG_ROUNDING[1]
+
+
+def _holds(lo, hi, at: float) -> np.ndarray:
+    """Whether [lo, hi] may hold a point at + 2πk (k an integer): the float64 test leans to
+    yes by a slack larger than its rounding, which only widens what uses it."""
+    slack = 1e-12 * (1.0 + np.abs(lo) + np.abs(hi))
+    k = np.ceil((lo - slack - at) / (2.0 * np.pi))
+    return at + 2.0 * np.pi * k <= hi + slack
+
+
+def _periodic(lo, hi, f, peak: float) -> tuple[np.ndarray, np.ndarray]:
+    """The range of f (sin or cos, 2π-periodic, f = 1 at ``peak``, −1 at peak + π) over
+    [lo, hi]: its ends' values, and ±1 where a peak or trough may lie inside."""
+    with np.errstate(invalid="ignore"):
+        fa, fb = f(lo), f(hi)
+        out_lo, out_hi = np.minimum(fa, fb), np.maximum(fa, fb)
+        out_lo = np.maximum(out_lo - _trig_slack(out_lo), -1.0)
+        out_hi = np.minimum(out_hi + _trig_slack(out_hi), 1.0)
+        wide = ~(np.maximum(np.abs(lo), np.abs(hi)) <= TRIG_RANGE) & ~np.isnan(lo + hi)
+        out_lo = np.where(_holds(lo, hi, peak + np.pi) | wide, -1.0, out_lo)
+        out_hi = np.where(_holds(lo, hi, peak) | wide, 1.0, out_hi)
+    return out_lo, out_hi
 
 
 class Interval:
@@ -100,6 +131,12 @@ class Interval:
         lo = np.where(safe, _down(1.0 / np.where(safe, self.hi, 1.0)), -np.inf)
         hi = np.where(safe, _up(1.0 / np.where(safe, self.lo, 1.0)), np.inf)
         return Interval(lo, hi)
+
+    def sin(self):
+        return Interval(*_periodic(self.lo, self.hi, np.sin, 0.5 * np.pi))
+
+    def cos(self):
+        return Interval(*_periodic(self.lo, self.hi, np.cos, 0.0))
 
     def minimum(self, o):
         o = Interval.lift(o)
@@ -222,6 +259,27 @@ class Affine:
         return Affine(
             np.where(safe, out.x0, 0.0), np.where(safe, out.x1, 0.0), np.where(safe, out.e, np.inf)
         )
+
+    def sin(self):
+        return self._trig(np.sin, np.cos, Interval.sin)
+
+    def cos(self):
+        return self._trig(np.cos, lambda x: -np.sin(x), Interval.cos)
+
+    def _trig(self, f, df, of_range) -> Affine:
+        """f(x) = f(x0) + f'(x0)(x − x0) ± r²/2 over x0 ± r (|f''| ≤ 1), where that is
+        narrower than the interval form of f over the range (wide ranges)."""
+        r = _up(np.abs(self.x1) + self.e)
+        fx, alpha = f(self.x0), df(self.x0)
+        slack = _trig_slack(fx) + _trig_slack(alpha) * r  # libm's f(x0) and f'(x0)
+        tangent = Affine.rounded(fx, alpha * self.x1, np.abs(alpha) * self.e + 0.5 * r * r + slack)
+        flat = Affine.of_interval(of_range(self.interval()))
+        narrow = np.abs(tangent.x1) + tangent.e <= flat.e
+
+        def pick(k: str) -> np.ndarray:
+            return np.where(narrow, getattr(tangent, k), getattr(flat, k))
+
+        return Affine(pick("x0"), pick("x1"), pick("e"))
 
     def relu(self):
         """Chebyshev: on a < 0 < b, max(0, x) − αx with α = b/(b − a) spans [0, −ab/(b − a)]."""
