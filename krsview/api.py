@@ -263,7 +263,7 @@ def certify(
         raise SceneError(
             scene.name,
             ", ".join(sorted(UNCOVERED & set(scene.effects))),
-            "the oracle covers scenes without twist, wind or empty zones "
+            "the oracle covers scenes without twist or empty zones "
             "(their distortions are not in it)",
         )
     scene = fast_settings(scene if tracer is None else configure(scene, tracer=tracer))
