@@ -292,8 +292,9 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_pa
     """Issue 29: the page poses tracks and sway at every 1/24 s (palm-curl: its Möbius steps;
     tree-growing: levels added, so the slots grow, and the camera's tracks moving the orbit;
     tree-sway in the wind: sway and u_time together). Held at T (#time=T) the page draws what
-    `krsview render --time T` draws, within the still pages' tolerance; held at T1 it is not
-    the render at T2 (the negative control)."""
+    `krsview render --time T` draws, within the still pages' tolerance, and half a pose
+    later it still shows that pose (a whole pose later, the next); held at T1 it is not the
+    render at T2 (the negative control)."""
     base, wind = name.split("+") if "+" in name else (name, None)
     scene = load_scene(resolve(base))
     if wind:
@@ -309,6 +310,10 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_pa
         assert np.abs(shots[t] - refs[t]).max(-1).mean() <= 2.0, t
     assert agreement(shots[t1], refs[t2], 16) < 0.97
     assert np.abs(shots[t1] - refs[t2]).max(-1).mean() > 2.0
+    if not wind:  # between two poses the page shows the one before, never a blend
+        between = screenshot(page, tmp_path / "between.png", f"bare&time={t1 + 0.5 / PAGE_RATE}")
+        after = screenshot(page, tmp_path / "after.png", f"bare&time={t1 + 1 / PAGE_RATE}")
+        assert np.array_equal(between, shots[t1]) and not np.array_equal(after, shots[t1])
 
 
 def test_the_moving_page_plays(tmp_path):

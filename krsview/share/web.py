@@ -216,7 +216,8 @@ def vertex_shader() -> str:
 
 
 def html_page(scene: Scene) -> str:
-    """One self-contained page: canvas, the two shaders, and a few lines of WebGL2."""
+    """One self-contained page: canvas, the two shaders, the poses of its tracks and sway
+    (page_shader), and a few lines of WebGL2."""
     template = resources.files("krsview.share").joinpath("page.html").read_text("utf-8")
     notes = export_notes(scene)
     fragment, poses = page_shader(scene)

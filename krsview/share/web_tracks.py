@@ -104,7 +104,7 @@ def sample(scene: Scene) -> Poses | str:
     for k, m in enumerate(moments):
         other = {**m.defines, "KRS_SLOTS": slots}
         if other != defines:
-            changed = min(k for k, _ in set(other.items()) ^ set(defines.items()))
+            changed = min(name for name, _ in set(other.items()) ^ set(defines.items()))
             return f"the variant changes at t = {k / rate:g} s ({changed})"
     blocks = [block_arrays(m.compiled, "float", slots) for m in moments]
     return Poses(rate, defines, [m.values for m in moments], blocks)
