@@ -22,7 +22,8 @@ from PIL import Image
 from krsview.bench.hard_cases import CASES
 from krsview.scene import Camera, SceneError, load_scene, save_scene
 from krsview.scene.presets import preset_names, resolve
-from krsview.share.web import html_page, shadertoy_source, web_shader
+from krsview.share.web import export_notes, html_page, page_shader, shadertoy_source, web_shader
+from krsview.share.web_tracks import PAGE_DATA_CAP, PAGE_RATE
 
 from .conftest import headless_render
 
@@ -34,7 +35,6 @@ BROWSER = [
     "--use-angle=swiftshader",
     "--enable-unsafe-swiftshader",
     "--hide-scrollbars",
-    "--virtual-time-budget=8000",
 ]
 # Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
 # main that calls mainImage (iMouse released, iTime 0).
@@ -46,12 +46,14 @@ TOY_PAGE_SHADER = (
 )
 
 
-def screenshot(page: Path, out: Path, fragment: str = "bare") -> np.ndarray:
-    """The page at SIZE in headless chromium (software WebGL2), rows top → bottom."""
+def screenshot(page: Path, out: Path, fragment: str = "bare", budget_ms: int = 8000) -> np.ndarray:
+    """The page at SIZE in headless chromium (software WebGL2), rows top → bottom, taken
+    once the page's clock has run ``budget_ms`` of virtual time."""
     assert shutil.which("chromium"), "chromium is missing: `make deps` installs it"
     r = subprocess.run(
         [
             *BROWSER,
+            f"--virtual-time-budget={budget_ms}",
             f"--window-size={SIZE[0]},{SIZE[1]}",
             f"--screenshot={out}",
             f"{page.resolve().as_uri()}#{fragment}",
@@ -214,6 +216,7 @@ def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
             refused += 1
             continue
         assert not glsl_es_errors(page, tmp_path), name
+        assert not glsl_es_errors(page_shader(scene)[0], tmp_path), name  # poses live
         assert not glsl_es_errors(TOY_PAGE_SHADER.format(body=toy), tmp_path), name
         exported += 1
     assert exported == len(scenes) - refused and exported > len(preset_names())
@@ -270,3 +273,119 @@ def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(tmp_path
     assert (still == ref).mean() < (held == ref).mean() - 0.002  # 0.9965 against 0.9999
     toy = shadertoy_source(scene)
     assert "u_time = mod(" in toy and "iTime" in toy
+
+
+def page_parts(page: Path) -> tuple[str, object]:
+    """The page's fragment stage and its poses, read back from the page's text."""
+    text = page.read_text(encoding="utf-8")
+    start = text.index("const FRAGMENT = ") + len("const FRAGMENT = ")
+    fragment = json.loads(text[start : text.index(";\nconst canvas")])
+    start = text.index("const POSES = ") + len("const POSES = ")
+    return fragment, json.loads(text[start : text.index(";\nlet rows")])
+
+
+@pytest.mark.parametrize(
+    "name, t1, t2",
+    [("palm-curl", 1.0, 2.0), ("tree-growing", 3.0, 7.5), ("tree-sway+wind", 1.25, 0.0)],
+)
+def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_path):
+    """Issue 29: the page poses tracks and sway at every 1/24 s (palm-curl: its Möbius steps;
+    tree-growing: levels added, so the slots grow, and the camera's tracks moving the orbit;
+    tree-sway in the wind: sway and u_time together). Held at T (#time=T) the page draws what
+    `krsview render --time T` draws, within the still pages' tolerance, and half a pose
+    later it still shows that pose (a whole pose later, the next); held at T1 it is not the
+    render at T2 (the negative control)."""
+    base, wind = name.split("+") if "+" in name else (name, None)
+    scene = load_scene(resolve(base))
+    if wind:
+        scene = scene.with_effects([*scene.effects, wind])
+    page = export_page(scene, tmp_path, base)
+    fragment, poses = page_parts(page)
+    assert poses["rate"] == PAGE_RATE and fragment != web_shader(scene)
+    assert ("u_time;" in fragment) == bool(wind)
+    shots = {t: screenshot(page, tmp_path / f"{t}.png", f"bare&time={t:g}") for t in (t1, t2)}
+    refs = {t: reference(scene.at(t), tmp_path, f"ref{t}") for t in (t1, t2)}
+    for t in (t1, t2):
+        assert agreement(shots[t], refs[t], 16) >= 0.97, t
+        assert np.abs(shots[t] - refs[t]).max(-1).mean() <= 2.0, t
+    assert agreement(shots[t1], refs[t2], 16) < 0.97
+    assert np.abs(shots[t1] - refs[t2]).max(-1).mean() > 2.0
+    if not wind:  # between two poses the page shows the one before, never a blend
+        between = screenshot(page, tmp_path / "between.png", f"bare&time={t1 + 0.5 / PAGE_RATE}")
+        after = screenshot(page, tmp_path / "after.png", f"bare&time={t1 + 1 / PAGE_RATE}")
+        assert np.array_equal(between, shots[t1]) and not np.array_equal(after, shots[t1])
+
+
+def test_the_moving_page_plays(tmp_path):
+    """Opened without #time, palm-curl's page plays its loop: after 0.5 s and 2 s of the
+    page's clock it shows other poses. Negative control: held (#time=1) it stands."""
+    page = export_page(load_scene(resolve("palm-curl")), tmp_path, "palm-curl")
+    a, b = (screenshot(page, tmp_path / f"p{ms}.png", "bare", ms) for ms in (500, 2000))
+    assert agreement(a, b, 16) < 0.97
+    c, d = (screenshot(page, tmp_path / f"h{ms}.png", "bare&time=1", ms) for ms in (500, 2000))
+    assert np.array_equal(c, d)
+
+
+@pytest.mark.parametrize("name", ["tree", "tree-wind", "palm"])
+def test_a_page_without_tracks_is_the_baked_page(name, tmp_path):
+    """A scene without tracks or sway exports the still page's shader, string for string
+    (web_shader: every value a constant, the path Shadertoy keeps), no poses and no uniform
+    but the page's own and the clock. Negative control: palm-curl's page is not its baked
+    shader, and uploads its Möbius records as a uniform block."""
+    scene = load_scene(resolve(name))
+    fragment, poses = page_parts(export_page(scene, tmp_path, name))
+    assert fragment == web_shader(scene) and poses is None
+    uniforms = {line.split()[2] for line in fragment.splitlines() if line.startswith("uniform")}
+    assert uniforms == {"u_orbit;", "u_canvas;"} | ({"u_time;"} if "wind" in name else set())
+    moving = load_scene(resolve("palm-curl"))
+    fragment, poses = page_parts(export_page(moving, tmp_path, "palm-curl"))
+    assert fragment != web_shader(moving) and poses["block"] > 0
+    assert "layout(std140) uniform KRSBlock {\n    vec4 u_mobius[" in fragment
+
+
+def test_every_moving_preset_fits_the_cap_and_a_long_loop_lowers_the_rate(tmp_path):
+    """Each moving preset's poses stay under PAGE_DATA_CAP at PAGE_RATE a second. A loop of
+    20 s of palm-curl would not (480 poses of 1440 floats: the negative control): it gets
+    every other pose, 12 a second, under the cap."""
+    moving = [n for n in preset_names() if load_scene(resolve(n)).animation is not None]
+    moving = [n for n in moving if load_scene(resolve(n)).animation.moves]
+    assert {"palm-curl", "tree-sway", "tree-growing"} <= set(moving)
+    for name in moving:
+        poses = page_parts(export_page(load_scene(resolve(name)), tmp_path, name))[1]
+        assert poses["rate"] == PAGE_RATE and len(poses["data"]) <= PAGE_DATA_CAP, name
+    long = load_scene(resolve("palm-curl")).edit("animation.duration", 20.0)
+    poses = page_parts(export_page(long, tmp_path, "long"))[1]
+    assert 4 * math.ceil(20 * PAGE_RATE * poses["row"] * 4 / 3) > PAGE_DATA_CAP
+    assert poses["rate"] == PAGE_RATE / 2 and poses["count"] == 240
+    assert len(poses["data"]) <= PAGE_DATA_CAP
+    assert any("play as 12 poses a second" in n for n in export_notes(long))
+
+
+def test_a_track_that_switches_the_variant_is_baked_and_said(tmp_path):
+    """A track that changes what is compiled (the tracer) cannot play in one variant: the
+    page draws the exported moment, with the still page's shader, and the note says why.
+    Negative control: a track on a value (the iteration cap) plays as a live uniform."""
+    tree = load_scene(resolve("tree"))
+    keyed = tree.edit(
+        "animation",
+        {
+            "duration": 1.0,
+            "tracks": [{"path": "render.tracer", "keys": [[0.0, "sphere"], [0.5, "binary"]]}],
+        },
+    )
+    fragment, poses = page_parts(export_page(keyed, tmp_path, "keyed"))
+    assert fragment == web_shader(keyed) and poses is None
+    (note,) = [n for n in export_notes(keyed) if "tracks" in n]
+    assert "drawn as at t = 0 s: the variant changes at t = 0.5 s (KRS_TRACER_BINARY)" in note
+    capped = tree.edit(
+        "animation",
+        {
+            "duration": 1.0,
+            "tracks": [{"path": "render.max_iterations", "keys": [[0.0, 64], [0.5, 256]]}],
+        },
+    )
+    fragment, poses = page_parts(export_page(capped, tmp_path, "capped"))
+    assert "uniform int u_max_iterations;" in fragment and poses["count"] == 24
+    assert [u[0] for u in poses["uniforms"]] == ["u_max_iterations"] and poses["block"] == 0
+    toy = shadertoy_source(capped)
+    assert "// note: keyframe tracks and sway are drawn as at t = 0 s (Shadertoy" in toy

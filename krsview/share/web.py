@@ -4,7 +4,9 @@ WebGL2 [issue 18 §1]. The fragment stage is assembled from the app's shader fil
 defines; then every uniform the renderer would upload is baked into a constant, relative to
 the exported camera's eye O, and the camera's uniforms become globals that
 ``orbit_camera`` sets from the mouse. The page is one file with no server or network; the
-Shadertoy file is one ``mainImage``.
+Shadertoy file is one ``mainImage``. Time: ``u_time`` stays live (the wind plays); keyframe
+tracks and sway play on the page as poses sampled over the loop (``web_tracks.py``), and
+Shadertoy, which runs no script, draws them as at the exported moment.
 
 What cannot be exported: double precision (GLSL ES has no fp64). The compute path and the
 pre-pass are speed-ups of the desktop renderer (a storage buffer, float render targets): the
@@ -14,19 +16,17 @@ from __future__ import annotations
 
 import html
 import json
-import math
 import re
-from dataclasses import replace
 from importlib import resources
 
 import numpy as np
 
-from ..compile.camera import view_of
-from ..compile.geometry import compile_geometry
 from ..gpu.program import ES_HEADER, Source
-from ..gpu.uniforms import block_arrays, variant_defines, view_uniforms
+from ..gpu.uniforms import block_arrays
 from ..scene import Scene, SceneError
-from ..scene.camera_path import horizontal_axes
+from ..scene.edits import parse_path
+from ..scene.schema import cached
+from .web_tracks import live_names, moment, page_poses, sample
 
 # Set per pixel by orbit_camera (web.frag): declared as plain globals.
 CAMERA = (
@@ -45,11 +45,9 @@ _BLOCK = re.compile(r"layout\(std140\) uniform KRSBlock \{.*?\};", re.S)
 _REAL = {"real": "float", "vec2r": "vec2", "vec3r": "vec3", "vec4r": "vec4", "mat3r": "mat3"}
 
 
-def export_notes(scene: Scene) -> list[str]:
-    """What the export leaves out, one line each; a scene that cannot be exported at all
-    is a SceneError naming the field."""
-    r = scene.render
-    if r.precision == "double":
+def refuse(scene: Scene) -> None:
+    """A scene that cannot be exported at all is a SceneError naming the field."""
+    if scene.render.precision == "double":
         raise SceneError(
             "render.precision",
             "double",
@@ -57,6 +55,13 @@ def export_notes(scene: Scene) -> list[str]:
             "it: GLSL ES 3.00 (WebGL2) has no fp64; export with precision = "
             '"float"',
         )
+
+
+def export_notes(scene: Scene, shadertoy: bool = False) -> list[str]:
+    """What the page (or, ``shadertoy``, the Shadertoy file) leaves out, one line each; a
+    scene that cannot be exported at all is a SceneError naming the field."""
+    refuse(scene)
+    r = scene.render
     notes = []
     if r.path == "compute":
         notes.append(
@@ -75,62 +80,98 @@ def export_notes(scene: Scene) -> list[str]:
         )
     a = scene.animation
     if a is not None and a.moves:
+        notes += _moving_notes(scene, shadertoy)
+    return notes
+
+
+def _moving_notes(scene: Scene, shadertoy: bool) -> list[str]:
+    """How the export carries keyframe tracks and sway (export_notes)."""
+    at = f"keyframe tracks and sway are drawn as at t = {scene.time:g} s"
+    if shadertoy:
+        return [
+            f"{at} (Shadertoy runs no script to change the baked geometry; only effects "
+            "that read time play)"
+        ]
+    poses = page_shader(scene)[1]
+    notes = []
+    if isinstance(poses, str):
         notes.append(
-            f"keyframe tracks and sway are drawn as at t = {scene.time:g} s (the page bakes "
-            "the geometry; only effects that read time play)"
+            f"{at}: {poses} (the page bakes the geometry; only effects that read time play)"
         )
+    elif poses is not None:
+        notes.append(
+            f"keyframe tracks and sway play as {poses['rate']:g} poses a second, each shown "
+            "until the next (exact poses, never blended)"
+        )
+    if isinstance(poses, str) and any(
+        parse_path(tr.path)[0] == "camera" for tr in scene.animation.tracks
+    ):
+        notes.append(f"the camera stays where its tracks put it at t = {scene.time:g} s")
     return notes
 
 
 def web_shader(scene: Scene, shadertoy: bool = False) -> str:
     """The fragment stage of the page (``#version 300 es``), or Shadertoy's body (Shadertoy
-    adds the version, precision and its uniforms)."""
-    export_notes(scene)
-    scene = scene.posed()  # tracks and sway baked at the scene's time (export_notes)
-    scene = replace(scene, render=replace(scene.render, prepass=0, path="fragment", lod=0.0))
-    view = view_of(scene.camera, 640, 360)  # only its eye O matters: the rest is live
-    c = compile_geometry(scene.geometry(), scene.material.albedo).relative_to(view.origin)
-    defines = variant_defines(scene, c)
-    defines["KRS_SLOTS"] = len(c.records)  # the slots in use, no more
+    adds the version, precision and its uniforms), with tracks and sway baked as at the
+    scene's time: a still scene's page, and Shadertoy's."""
+    refuse(scene)
+    m = moment(scene, np.array(scene.posed().camera.position, dtype=np.float64))
     if shadertoy:
-        defines["KRS_SHADERTOY"] = None
-    text = Source("web.frag", defines, header=() if shadertoy else ES_HEADER).text
-    values = {
-        **view_uniforms(scene, view, c),
-        **orbit_uniforms(scene, view.origin),
-        "u_epsilon_scale": scene.render.epsilon_scale,
+        m.defines["KRS_SHADERTOY"] = None
+    text = Source("web.frag", m.defines, header=() if shadertoy else ES_HEADER).text
+    blocks = block_arrays(m.compiled, "float", len(m.compiled.records))
+    return _specialise(text, m.values, blocks, shadertoy)
+
+
+def page_shader(scene: Scene) -> tuple[str, dict | str | None]:
+    """The page's fragment stage and its poses: the page's POSES (web_tracks.page_poses),
+    or why the page draws tracks and sway as at the scene's time, or None where nothing
+    moves. Made once per scene (html_page and export_notes both ask)."""
+    return cached(scene, "_web_page", lambda: _page_shader(scene))
+
+
+def _page_shader(scene: Scene) -> tuple[str, dict | str | None]:
+    refuse(scene)
+    if scene.animation is None or not scene.animation.moves:
+        return web_shader(scene), None
+    poses = sample(scene)
+    if isinstance(poses, str):
+        return web_shader(scene), poses
+    text = Source("web.frag", poses.defines, header=ES_HEADER).text
+    declared = {
+        m.group(2): _REAL.get(m.group(1), m.group(1))
+        for m in _UNIFORM.finditer(text)
+        if m.group(2) in poses.values[0] and m.group(2) not in (*CAMERA, CLOCK, *PAGE)
     }
-    blocks = block_arrays(c, "float", len(c.records))
-    text = _BLOCK.sub(
-        lambda m: "\n".join(const_array("vec4", k, v) for k, v in blocks.items()), text
-    )
-    return _UNIFORM.sub(lambda m: _bake(m, values, shadertoy), text)
+    block, live = live_names(poses, declared)
+    if not block and not live:
+        return web_shader(scene), None
+    data = page_poses(poses, block, {n: declared[n] for n in live})
+    if isinstance(data, str):
+        return web_shader(scene), data
+    return _specialise(text, poses.values[0], poses.blocks[0], False, block, live), data
 
 
-def orbit_uniforms(scene: Scene, origin: np.ndarray) -> dict[str, object]:
-    """The orbit of web.frag's orbit_camera: around the scene camera's target, starting at
-    its eye (relative to O, the eye itself)."""
-    cam = scene.camera
-    up = np.array(cam.up, dtype=np.float64)
-    up /= np.linalg.norm(up)
-    east, north = horizontal_axes(up)
-    target = np.array(cam.target, dtype=np.float64) - origin
-    away = -target / np.linalg.norm(target)
-    return {
-        "u_orbit_target": tuple(target),
-        "u_orbit_east": tuple(east),
-        "u_orbit_north": tuple(north),
-        "u_orbit_up": tuple(up),
-        "u_orbit_start": (
-            math.atan2(away @ east, away @ north),
-            math.asin(max(-1.0, min(1.0, away @ up))),
-            float(np.linalg.norm(target)),
-        ),
-    }
+def _specialise(text: str, values: dict, blocks: dict, shadertoy: bool, block=(), live=()) -> str:
+    """``text`` with every uniform and KRSBlock array baked into a constant, but the
+    camera's (globals), the clock and the page's own, and the ``block`` arrays and ``live``
+    uniforms the page uploads at each pose."""
+
+    def krs_block(m: re.Match) -> str:
+        out = [const_array("vec4", k, v) for k, v in blocks.items() if k not in block]
+        if block:
+            members = "".join(f"    vec4 {k}[{len(blocks[k])}];\n" for k in block)
+            out.append(f"layout(std140) uniform KRSBlock {{\n{members}}};")
+        return "\n".join(out)
+
+    text = _BLOCK.sub(krs_block, text)
+    return _UNIFORM.sub(lambda m: _bake(m, values, shadertoy, live), text)
 
 
-def _bake(m: re.Match, values: dict, shadertoy: bool) -> str:
+def _bake(m: re.Match, values: dict, shadertoy: bool, live=()) -> str:
     kind, name, count = _REAL.get(m.group(1), m.group(1)), m.group(2), m.group(4)
+    if name in live:
+        return f"uniform {kind} {name}{m.group(3) or ''};"
     if name in CAMERA or (name == CLOCK and shadertoy):
         return f"{kind} {name}{m.group(3) or ''};"
     if name == CLOCK:
@@ -175,16 +216,19 @@ def vertex_shader() -> str:
 
 
 def html_page(scene: Scene) -> str:
-    """One self-contained page: canvas, the two shaders, and a few lines of WebGL2."""
+    """One self-contained page: canvas, the two shaders, the poses of its tracks and sway
+    (page_shader), and a few lines of WebGL2."""
     template = resources.files("krsview.share").joinpath("page.html").read_text("utf-8")
     notes = export_notes(scene)
+    fragment, poses = page_shader(scene)
     return (
         template.replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
         .replace("{{NOTES}}", html.escape(" · ".join(notes)))
         .replace("{{TIME}}", json.dumps(scene.time))
         .replace("{{DURATION}}", json.dumps(scene.duration))
         .replace("{{VERTEX}}", json.dumps(vertex_shader()))
-        .replace("{{FRAGMENT}}", json.dumps(web_shader(scene)))
+        .replace("{{FRAGMENT}}", json.dumps(fragment))
+        .replace("{{POSES}}", json.dumps(poses if isinstance(poses, dict) else None))
     )
 
 
@@ -196,7 +240,7 @@ def shadertoy_source(scene: Scene) -> str:
         "`krsview export shadertoy` [KRS17].\n// Drag to orbit; the view turns slowly "
         "with time.\n"
     )
-    notes = "".join(f"// note: {n}\n" for n in export_notes(scene))
+    notes = "".join(f"// note: {n}\n" for n in export_notes(scene, shadertoy=True))
     body = web_shader(scene, shadertoy=True)
     clock = f"mod({_float(scene.time)} + iTime, {_float(scene.duration)})"
     plays = f"    {CLOCK} = {clock};  // the scene's time, round its loop\n"
