@@ -44,7 +44,7 @@ def shadertoy(scene: Scene, path: str | Path) -> list[str]:
     from .share.web import export_notes, shadertoy_source
 
     write_atomic(path, shadertoy_source(scene))
-    return export_notes(scene)
+    return export_notes(scene, shadertoy=True)
 
 
 def mesh(
