@@ -12,6 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from krsview.bench.truth import truth_scene
 from krsview.compile.geometry import compile_geometry, components
 from krsview.gpu.renderer import read_plane
 from krsview.gpu.uniforms import variant_defines
@@ -141,9 +142,10 @@ def test_the_cone_changes_the_shadows_by_less_than_a_level():
 
 def test_off_compiles_the_exact_shadows_and_a_mokrs_never_has_the_cone(renderer):
     """shadow_cone = off compiles today's shadow rays (no KRS_SHADOW_CONE), which the
-    reference without the cone matches; a MöKRS has no balls for it, so on and off draw
-    the same image there."""
+    reference without the cone matches, and the accuracy bench's truth has it off; a MöKRS
+    has no balls for it, so on and off draw the same image there."""
     off = grove("off")
+    assert truth_scene(grove("on")).render.shadow_cone == "off"  # the accuracy bench's truth
     assert "KRS_SHADOW_CONE" not in variant_defines(off, compiled(off))
     assert shadow_bounds(off, compiled(off), None) is None
     check_against_reference("grove-exact", renderer.render(off, W, H), render_reference(off, W, H))
