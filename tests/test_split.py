@@ -1,6 +1,7 @@
 """`krsview bench split` [issue 17]: where a frame's time goes, as differences of variants.
 What can be checked without asserting wall time: the tracing-only variant traces exactly as
-the frame does and shades nothing, and the report has every part, adding up to the frame."""
+the frame does and shades nothing, and the report has every part, adding up to the frame,
+with the shadow rays' work (steps, levels) on the frames with and without the shadow cone."""
 
 from __future__ import annotations
 
@@ -56,7 +57,8 @@ def test_bench_split_reports_every_part(tmp_path):
         timeout=300,
     )
     assert r.returncode == 0, r.stderr
-    rows = {row["part"]: float(row["ms"]) for row in csv.DictReader(out.open())}
+    table = list(csv.DictReader(out.open()))
+    rows = {row["part"]: float(row["ms"]) for row in table}
     parts = (
         "coarse passes",
         "tracing",
@@ -64,11 +66,16 @@ def test_bench_split_reports_every_part(tmp_path):
         "secondary effects (shadow rays, occlusion)",
     )
     per_pixel = ("secondary effects, a shadow ray per pixel", "frame, a shadow ray per pixel")
-    assert set(rows) == {*parts, "frame", "frame without secondary effects", *per_pixel}
+    cone_off = ("secondary effects, shadow cone off", "frame, shadow cone off")
+    assert set(rows) == {*parts, "frame", "frame without secondary effects", *per_pixel, *cone_off}
     assert sum(rows[p] for p in parts) == pytest.approx(rows["frame"])
-    assert rows["frame without secondary effects"] + rows[per_pixel[0]] == pytest.approx(
-        rows[per_pixel[1]]
-    )
+    for extra, whole in (per_pixel, cone_off):
+        assert rows["frame without secondary effects"] + rows[extra] == pytest.approx(rows[whole])
+    # the work measure on the two frames only; the tree's shadow rays start inside its one
+    # ball, so the cone spares them nothing (tests/test_shadows_cone.py: grove's it does)
+    work = {row["part"]: (row["shadow steps/px"], row["shadow levels/px"]) for row in table}
+    assert {p for p, w in work.items() if w != ("", "")} == {"frame", cone_off[1]}
+    assert work["frame"] == work[cone_off[1]] and float(work["frame"][0]) > 0
     assert rows["coarse passes"] > 0 and "| tracing |" in r.stdout
     assert "shadow rays per 2×2 px;" in r.stdout  # the tree's still frame shares them
     bad = subprocess.run(

@@ -4,17 +4,23 @@ tracing of the primary rays, the nearest kernel and shading, and the secondary e
 is the difference of two variants timed side by side, interleaved (bench/harness.py), each
 to the GPU's finish. GPU timer queries would split one frame instead, but llvmpipe's time
 only its command thread (a 138 ms draw read 29 ms), so each part is a variant of its own.
-Drawn on the fragment path, as the viewer draws."""
+Drawn on the fragment path, as the viewer draws. Beside the times, the shadow rays' work,
+which no machine load changes: steps and levels walked per pixel (a counting variant with a
+shadow ray per pixel); where the scene has the shadow cone, both again without it."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
+from ..compile.geometry import compile_geometry
 from ..gpu.passes import still_ratio
-from ..gpu.renderer import Renderer
+from ..gpu.renderer import Renderer, read_plane
+from ..gpu.uniforms import variant_defines
 from ..scene import EFFECTS, Scene
 from .harness import Variant, median_times
 from .report import Measured, markdown
+
+WORK = ("shadow steps/px", "shadow levels/px")  # the frames' rows' work (shadow_work)
 
 
 def split_variants(scene: Scene) -> dict[str, Variant]:
@@ -31,15 +37,36 @@ def split_variants(scene: Scene) -> dict[str, Variant]:
         out["coarse"] = Variant(scene, prepass_only=True)
     if still_ratio(scene):  # shadow rays shared by pixel blocks: and one per pixel beside
         out["per pixel"] = Variant(scene.edit(("render", "shadow_block"), 1))
+    if has_cone(scene):  # and the exact shadow rays beside (render.shadow_cone)
+        out["cone off"] = Variant(scene.edit(("render", "shadow_cone"), "off"))
     return out
+
+
+def has_cone(scene: Scene) -> bool:
+    """Whether ``scene``'s shadow rays meet its components through the shadow cone."""
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    return "KRS_SHADOW_CONE" in variant_defines(scene, c)
+
+
+def shadow_work(r: Renderer, scene: Scene, size: tuple[int, int]) -> tuple[float, float]:
+    """Shadow rays' steps and levels walked per pixel, a shadow ray per pixel (the counting
+    variant, render.frag); a measure of work that no machine load changes."""
+    with r.current():
+        prog = r.prepare(scene, *size, probes=("KRS_COUNT_LEVELS",))
+        counts = read_plane(r.draw(prog, *size), 2, *size)
+    return float(counts[..., 2].mean()), float(counts[..., 3].mean())
 
 
 def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
     """One row per part of the frame (coarse passes, tracing, nearest kernel and shading,
     secondary effects) and the frame and the moving frame whole: ms and share of the frame;
     where the frame shares shadow rays among pixel blocks, the secondary effects and the
-    frame with a shadow ray per pixel too (shares of that frame)."""
-    med = median_times(Renderer(), split_variants(scene), size, rounds, f"bench split {scene.name}")
+    frame with a shadow ray per pixel too (shares of that frame); where it has the shadow
+    cone, the frame without it too. The frames' rows carry the shadow rays' work
+    (:func:`shadow_work`), the others none."""
+    r = Renderer()
+    variants = split_variants(scene)
+    med = median_times(r, variants, size, rounds, f"bench split {scene.name}")
     coarse = med.get("coarse", 0.0)
     parts = [
         ("coarse passes", coarse),
@@ -50,15 +77,22 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
         ("frame without secondary effects", med["moving"]),
     ]
     rows = [dict(part=name, ms=t * 1e3, share=t / med["frame"]) for name, t in parts]
-    if "per pixel" in med:  # shares of that frame
-        whole = med["per pixel"]
-        rows += [
-            dict(part=name, ms=t * 1e3, share=t / whole)
-            for name, t in (
-                ("secondary effects, a shadow ray per pixel", whole - med["moving"]),
-                ("frame, a shadow ray per pixel", whole),
-            )
-        ]
+    for key, label in (("per pixel", "a shadow ray per pixel"), ("cone off", "shadow cone off")):
+        if key in med:  # shares of that frame
+            whole = med[key]
+            rows += [
+                dict(
+                    part=f"secondary effects, {label}",
+                    ms=(whole - med["moving"]) * 1e3,
+                    share=(whole - med["moving"]) / whole,
+                ),
+                dict(part=f"frame, {label}", ms=whole * 1e3, share=1.0),
+            ]
+    work = {"frame": variants["frame"], "frame, shadow cone off": variants.get("cone off")}
+    for row in rows:
+        v = work.get(row["part"])
+        steps, levels = shadow_work(r, v.scene, size) if v else ("", "")
+        row.update({"shadow steps/px": steps, "shadow levels/px": levels})
     return Measured(scene, size, rounds, rows)
 
 
@@ -72,7 +106,15 @@ def table(m: Measured) -> str:
         f"{r.culling}, lod {r.lod:g}{shared}; median of {m.rounds} interleaved rounds, each "
         "part the difference of two variants\n\n"
     ) + markdown(
-        ("part", "ms", "share of the frame"),
-        "lrr",
-        ((row["part"], f"{row['ms']:.1f}", f"{row['share']:.0%}") for row in m.rows),
+        ("part", "ms", "share of the frame", "shadow steps/px", "shadow levels/px"),
+        "lrrrr",
+        (
+            (
+                row["part"],
+                f"{row['ms']:.1f}",
+                f"{row['share']:.0%}",
+                *(f"{row[k]:.2f}" if row[k] != "" else "" for k in WORK),
+            )
+            for row in m.rows
+        ),
     )

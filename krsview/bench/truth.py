@@ -20,8 +20,8 @@ TRUTH_ITERATIONS = 4096
 
 def truth_scene(scene: Scene) -> Scene:
     """The scene at ground-truth accuracy: tight ε, generous cap, every level (no level of
-    detail), a shadow ray per pixel, its own tracer (a MöKRS keeps binary tracing: it has no
-    distance)."""
+    detail), a shadow ray per pixel stepping every component from the surface (no shadow
+    cone), its own tracer (a MöKRS keeps binary tracing: it has no distance)."""
     return replace(
         scene,
         render=replace(
@@ -30,6 +30,7 @@ def truth_scene(scene: Scene) -> Scene:
             max_iterations=TRUTH_ITERATIONS,
             lod=0.0,
             shadow_block=1,
+            shadow_cone="off",
         ),
     )
 

@@ -137,6 +137,12 @@ class CompiledKRS:
     def n(self) -> int:
         return len(self.mirrors)
 
+    @property
+    def half_space(self) -> np.ndarray | None:
+        """(u, w): the half-space u·x ≤ w that a KRS of one plane kernel is, which holds
+        everything it draws as ``ball`` does for a bounded KRS; None for any other KRS."""
+        return self.records[0, 1].copy() if self.n == 0 and self.types[0] == "plane" else None
+
     def relative_to(self, origin: np.ndarray | tuple) -> CompiledKRS:
         """The same KRS with every position taken relative to ``origin`` (float64): the
         per-frame step of camera-relative rendering; the rest is compiled once per scene."""

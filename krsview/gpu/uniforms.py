@@ -80,6 +80,12 @@ def variant_defines(
         and any(ball[3] >= 0 for ball in component_balls(c))
     ):
         defines["KRS_BALL_EXIT"] = None  # rays leave the components' balls (trace.glsl)
+    if (
+        "KRS_BALL_EXIT" in defines
+        and scene.render.shadow_cone == "on"
+        and {"shadows", "soft_shadows"} & set(scene.effects)
+    ):
+        defines["KRS_SHADOW_CONE"] = None  # shadow rays meet components late (shadows.glsl)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
     if isinstance(c, CompiledCompound):
@@ -140,6 +146,9 @@ def component_slots(c: Compiled) -> list[tuple]:
     return [(c, 0)]
 
 
+NO_HALF_SPACE = (0.0, 0.0, 0.0, 1.0)  # u = 0: no half-space (0·x ≤ 1 holds everywhere)
+
+
 def component_balls(c: Compiled) -> list[tuple[float, ...]]:
     """Each component's ball (CompiledKRS.ball), one per slot of a compound's component
     arrays (MAX_COMPONENTS); unbounded for a MöKRS and unused slots."""
@@ -151,6 +160,21 @@ def component_balls(c: Compiled) -> list[tuple[float, ...]]:
         if isinstance(c, CompiledCompound)
         else balls
     )
+
+
+def component_half_spaces(c: Compiled) -> list[tuple[float, ...]]:
+    """Each component's half-space u·x ≤ w (CompiledKRS.half_space), one per slot as in
+    component_balls; NO_HALF_SPACE (u = 0) where it has none. Shadow rays' cones read them
+    (shadows.glsl, cone_entry)."""
+    if isinstance(c, CompiledMoKRS):
+        return [NO_HALF_SPACE]
+    rows = [
+        NO_HALF_SPACE if part.half_space is None else tuple(float(v) for v in part.half_space)
+        for part, _ in component_slots(c)
+    ]
+    if isinstance(c, CompiledCompound):
+        rows += [NO_HALF_SPACE] * (MAX_COMPONENTS - len(rows))
+    return rows
 
 
 def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
@@ -227,6 +251,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_smooth_width": fx.smooth_width,
         "u_shadow_softness": fx.shadow_softness,
         "u_bounding_ball": per_component(c, component_balls(c)),
+        "u_half_space": per_component(c, component_half_spaces(c)),
         "u_ao_step": fx.ao_step,
         "u_ao_strength": fx.ao_strength,
         "u_texture_scale": fx.texture_scale,

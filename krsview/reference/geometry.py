@@ -11,6 +11,7 @@ import numpy as np
 
 from ..compile.geometry import Compiled, components
 from ..compile.krs import CompiledCompound, CompiledKRS
+from ..scene import Scene
 from . import krs, mokrs
 from .distortion import Distortion
 from .trace import Distance, Test
@@ -33,6 +34,37 @@ class Lod:
     def radius(self, x: np.ndarray, reach: np.ndarray | float = 0.0) -> np.ndarray:
         """ρ at the points x (N, 3), or at the far side of balls of radius ``reach``."""
         return self.per_t * (np.linalg.norm(x - self.eye, axis=1) + reach)
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Per component, what holds everything it draws: a ball (C, 4; radius < 0: none) and a
+    half-space u·x ≤ w (C, 4; u = 0: none), as the GPU's u_bounding_ball (the wind's swept
+    ball) and u_half_space; shadow rays' cones read them (occlusion.cone_entry)."""
+
+    balls: np.ndarray
+    half_spaces: np.ndarray
+
+
+NO_HALF_SPACE = (0.0, 0.0, 0.0, 1.0)  # u = 0: 0·x ≤ 1 holds everywhere
+
+
+def shadow_bounds(scene: Scene, c: Compiled, dist: Distortion | None) -> Bounds | None:
+    """The bounds the shadow cone meets (``[render] shadow_cone``), or None where the GPU
+    compiles none (uniforms.variant_defines): off, a MöKRS, a twist, no component's ball."""
+    if (
+        scene.render.shadow_cone != "on"
+        or isinstance(c, mokrs.CompiledMoKRS)
+        or "twist" in scene.effects
+    ):
+        return None
+    parts = components(c)
+    if all(p.ball[3] < 0 for p in parts):
+        return None
+    wind = dist is not None and dist.wind is not None
+    balls = dist.wind.balls if wind else np.array([p.ball for p in parts])  # type: ignore[union-attr]
+    half = [NO_HALF_SPACE if p.half_space is None else p.half_space for p in parts]
+    return Bounds(np.asarray(balls, dtype=np.float64), np.array(half, dtype=np.float64))
 
 
 def rho_at(lod: Lod | None, x: np.ndarray, reach: np.ndarray | float = 0.0):

@@ -13,7 +13,7 @@ from ..compile.mokrs import CompiledMoKRS
 from ..scene import Scene
 from . import atmosphere, mokrs, occlusion, texture
 from .distortion import Distortion
-from .geometry import Lod, component_distances, rho_at, scene_distance
+from .geometry import Lod, component_distances, rho_at, scene_distance, shadow_bounds
 
 
 def encode(scene: Scene, linear: np.ndarray) -> np.ndarray:
@@ -103,6 +103,7 @@ def shade(
                     scene.render,
                     k,
                     dist.lod_scale if dist is not None else None,
+                    shadow_bounds(scene, c, dist),
                 )
             cos[lit] *= vis
         light = light + lt.intensity * cos[:, None] * np.array(lt.color)

@@ -318,6 +318,14 @@ class Render:
         "[KRS17 §8.5: soft shadows at ¼ resolution] (1: a shadow ray per pixel, as on the "
         "compute path and in double precision, which always trace per pixel)",
     )
+    shadow_cone: str = param(
+        "on",
+        choices=SWITCH,
+        help="a shadow ray steps each component only from where the component's ball (or "
+        "a ground plane's half-space) meets its cone: the ray itself for hard shadows, the "
+        "penumbra's radius t/k for soft ones, inside which nothing can darken it (off: every "
+        "component from the surface on, as the reference's exact shadows)",
+    )
     path: str = param(
         "fragment",
         choices=PATHS,

@@ -64,6 +64,16 @@ real distort_distance(vec3r p, real D) {
     return D;
 }
 
+#ifdef KRS_BALL_EXIT  // bounded KRS components, not twisted (uniforms.variant_defines)
+#ifdef KRS_COMPOUND  // per component: centre (camera-relative), radius (< 0: none)
+uniform vec4 u_bounding_ball[COMPONENT_SLOTS];
+#define COMPONENT_BALL(c) u_bounding_ball[c]
+#else
+uniform vec4 u_bounding_ball;
+#define COMPONENT_BALL(c) u_bounding_ball
+#endif
+#endif
+
 // Component c's slots: (first, n).
 ivec2 component(int c) {
 #ifdef KRS_COMPOUND
@@ -133,13 +143,21 @@ bool is_unbounding(int c, vec3r center, real radius) {
 }
 
 // The component nearest to the world point p, each asked where it is undistorted (ties: the
-// first), without LOD.
+// first), without LOD. One whose ball (at rest, where q is) is no nearer than the best so far
+// is not walked: its distance is at least the ball's, so it could only tie, and ties go to
+// the first; the same winner, and a grove's hit walks one or two trees instead of seven.
 int nearest_component(vec3r p) {
     int win = 0;
 #ifdef KRS_COMPOUND
     real best = undistorted_distance(0, undistort(0, p), 0.0);
     for (int c = 1; c < COMPONENTS; ++c) {
-        real d = undistorted_distance(c, undistort(c, p), 0.0);
+        vec3r q = undistort(c, p);
+#ifdef KRS_BALL_EXIT
+        vec4 ball = COMPONENT_BALL(c);  // float: give up the rounding, as bound_ahead
+        float near = length(vec3(q) - ball.xyz) - ball.w - 1e-6 * (length(vec3(q)) + ball.w);
+        if (ball.w >= 0.0 && near >= best) continue;
+#endif
+        real d = undistorted_distance(c, q, 0.0);
         if (d < best) { best = d; win = c; }
     }
 #endif

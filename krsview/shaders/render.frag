@@ -25,5 +25,8 @@ void main() {
 #endif
 #ifdef KRS_COUNT_LEVELS
     out_iterations.y = float(levels);
+#if defined(KRS_SHADOWS) || defined(KRS_SOFT_SHADOWS)  // and its shadow rays' (shadows.glsl)
+    out_iterations.zw = vec2(float(g_shadow_steps), float(g_shadow_levels));
+#endif
 #endif
 }

@@ -2,8 +2,13 @@
 // met along the ray, as a fraction k·free/t of the distance travelled, sets the penumbra
 // (Fig. 11); twin of reference/occlusion.py. A KRS is sphere traced along the shadow ray
 // (a compound with one free distance per component), a MöKRS probed with unbounding balls
-// (its free distances are the free probe radii).
+// (its free distances are the free probe radii). With the shadow cone (render.shadow_cone),
+// a component is stepped only from where its bounds meet the ray's cone (cone_entry).
 uniform float u_shadow_softness;  // k
+#ifdef KRS_COUNT_LEVELS
+int g_shadow_steps = 0;    // steps of this invocation's shadow rays (bench split's measure)
+int g_shadow_levels = 0;   // and the levels Alg. 1 walked in them
+#endif
 
 bool soft_shadows_on() {
 #ifdef KRS_SOFT_SHADOWS
@@ -36,7 +41,46 @@ struct Shadow {
     int state;                  // SHADOW_LIVE or SHADOW_DONE
 };
 
-// The shadow ray from the hit point p with normal n towards the light l.
+#ifdef KRS_SHADOW_CONE  // bounded KRS components (uniforms.variant_defines)
+#ifdef KRS_COMPOUND  // per component: a half-space u·x ≤ w holding it (u = 0: none)
+uniform vec4 u_half_space[COMPONENT_SLOTS];
+#define COMPONENT_HALF_SPACE(c) u_half_space[c]
+#else
+uniform vec4 u_half_space;
+#define COMPONENT_HALF_SPACE(c) u_half_space
+#endif
+
+// Where the shadow ray o + t l first meets component c: the least t ≥ 0 at which c's ball or
+// half-space, grown by ε, meets the cone of radius slope·t about the ray (slope 1/k for a
+// soft shadow, 0 for a hard one); FAR_AWAY if neither does before the far limit. Before it
+// c's distance exceeds ε + slope·t, so c can neither block the ray (d ≤ ε) nor lower its
+// visibility (k·d/t > 1), and the ray need not step it from 0. Ball: |o + t l − C| ≤
+// R + slope·t, a quadratic in t whose smaller root is taken cancellation-free; half-space:
+// u·o − w + (u·l) t ≤ ε + slope·t. Each bound alone certifies the ray up to its own entry,
+// so the later of the two is taken. Float: both give up the rounding of o's offsets, as
+// bound_ahead's near does (twin: reference/occlusion.py, cone_entry).
+real cone_entry(int c, vec3 o, vec3 l, float eps, float slope) {
+    float t0 = 0.0, T = u_max_distance;
+    vec4 ball = COMPONENT_BALL(c);
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) ball = u_wind_ball[c];  // the swept ball, as bound_ahead
+#endif
+    vec3 v = o - ball.xyz;
+    float R = ball.w + eps + 1e-6 * (length(v) + length(o));
+    float a = 1.0 - slope * slope, b = dot(l, v) - R * slope, q = dot(v, v) - R * R;
+    float disc = b * b - a * q;
+    if (ball.w >= 0.0 && q > 0.0 && a > 0.0)  // o outside the grown ball, a cone under 45°
+        t0 = b >= 0.0 || disc < 0.0 ? FAR_AWAY : q / (sqrt(disc) - b);
+    vec4 h = COMPONENT_HALF_SPACE(c);
+    float s = dot(h.xyz, o) - h.w - eps - 1e-6 * (length(o) + abs(h.w)), g = dot(h.xyz, l) - slope;
+    if (s > 0.0) t0 = max(t0, g >= 0.0 ? FAR_AWAY : s / -g);
+    return t0 > T ? FAR_AWAY : real(t0);
+}
+#endif
+
+// The shadow ray from the hit point p with normal n towards the light l; with the shadow
+// cone each component's free distance starts at its cone_entry, and a ray that meets none
+// is done before its first step.
 Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
     Shadow sh;
     sh.o = vec4r(p + SHADOW_OFFSET * eps * n, 0.0);
@@ -46,6 +90,12 @@ Shadow shadow_begin(vec3r p, vec3 n, vec3 l, float eps) {
     sh.vis = 1.0;
     sh.iterations = 0;
     sh.state = SHADOW_LIVE;
+#ifdef KRS_SHADOW_CONE
+    float slope = soft_shadows_on() ? 1.0 / u_shadow_softness : 0.0;
+    for (int c = 0; c < COMPONENT_SLOTS; ++c)
+        sh.tc[c] = c < COMPONENTS ? cone_entry(c, vec3(sh.o.xyz), l, eps, slope) : FAR_AWAY;
+    if (sh.tc[front(sh.tc)] > u_max_distance) sh.state = SHADOW_DONE;
+#endif
     return sh;
 }
 
@@ -91,7 +141,14 @@ void shadow_step(inout Shadow sh) {
 // the primary ray stopped at threshold eps; the shadow ray stops at the same threshold.
 float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
     Shadow sh = shadow_begin(p, n, l, eps);
+#ifdef KRS_COUNT_LEVELS
+    int levels = g_levels;
+#endif
     while (sh.state == SHADOW_LIVE) shadow_step(sh);
+#ifdef KRS_COUNT_LEVELS
+    g_shadow_steps += sh.iterations;
+    g_shadow_levels += g_levels - levels;
+#endif
     return sh.vis;
 }
 

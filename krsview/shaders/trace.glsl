@@ -57,15 +57,7 @@ bool next_step(inout Ray r, out int c, out real t) {
     return true;
 }
 
-#ifdef KRS_BALL_EXIT  // bounded KRS components, not twisted (uniforms.variant_defines)
-#ifdef KRS_COMPOUND  // per component: centre (camera-relative), radius (< 0: none)
-uniform vec4 u_bounding_ball[COMPONENT_SLOTS];
-#define COMPONENT_BALL(c) u_bounding_ball[c]
-#else
-uniform vec4 u_bounding_ball;
-#define COMPONENT_BALL(c) u_bounding_ball
-#endif
-
+#ifdef KRS_BALL_EXIT  // COMPONENT_BALL: distance.glsl
 // What is left of component c ahead on a ray from o along dir, now at x = o + t dir with
 // c's distance d there: a component that can no longer stop the ray (nor, on a shadow ray,
 // lower its visibility) leaves it, and the ray is done once every one has left [issue 17].
