@@ -12,6 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from krsview import api
 from krsview.bench.truth import truth_scene
 from krsview.compile.geometry import compile_geometry, components
 from krsview.gpu.renderer import read_plane
@@ -146,6 +147,7 @@ def test_off_compiles_the_exact_shadows_and_a_mokrs_never_has_the_cone(renderer)
     has no balls for it, so on and off draw the same image there, the reference's."""
     off = grove("off")
     assert truth_scene(grove("on")).render.shadow_cone == "off"  # the accuracy bench's truth
+    assert api.exact_settings(grove("on")).render.shadow_cone == "off"  # --exact
     assert "KRS_SHADOW_CONE" not in variant_defines(off, compiled(off))
     assert shadow_bounds(off, compiled(off), None) is None
     check_against_reference("grove-exact", renderer.render(off, W, H), render_reference(off, W, H))

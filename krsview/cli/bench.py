@@ -73,9 +73,12 @@ BENCHES = {
         "tracing alone and the coarse passes alone, interleaved; each part of the frame is "
         "the difference of two of them. Where pixel blocks share shadow rays (the "
         "still frame's [render] shadow_block), the frame with a shadow ray per pixel beside "
-        "it. Example: krsview bench split tree "
+        "it. Where the scene's shadow rays meet its components through the shadow cone "
+        "([render] shadow_cone), the frame without it beside it; the frames' rows carry the "
+        "shadow rays' steps and levels per pixel (a counting variant, which no machine load "
+        "changes). Example: krsview bench split tree "
         f"--prepass {VIEW_PREPASS} (the viewer's pre-pass).",
-        knobs=("culling", "lod", "prepass", "prepass_levels", "shadow_block"),
+        knobs=("culling", "lod", "prepass", "prepass_levels", "shadow_block", "shadow_cone"),
     ),
     "tracers": Bench(
         "sphere vs binary sphere tracing, and a ξ sweep",

@@ -25,6 +25,7 @@ KNOBS = (
     "culling",
     "lod",
     "shadow_block",
+    "shadow_cone",
     "prepass",
     "prepass_levels",
     "path",
@@ -188,7 +189,7 @@ def settled(args: argparse.Namespace, scene: Scene) -> Scene:
     """The viewer's fast settings where neither the file nor an option sets them, or with
     --exact every level and no pre-pass (the reference's image)."""
     if args.exact:
-        for knob in ("prepass", "lod", "shadow_block"):
+        for knob in ("prepass", "lod", "shadow_block", "shadow_cone"):
             if getattr(args, knob) is not None:
                 flag = "--" + knob
                 raise SceneError(flag, getattr(args, knob), "cannot be combined with --exact")
