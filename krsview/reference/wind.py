@@ -34,6 +34,13 @@ in the basis (up, the unit e of x's part ⊥ up) is [[1 + α, 0], [γ, 1]], α =
 |a|(ρ + D), so ‖Dg‖ ≤ 1 + |a|(ρ' + δ) with ρ' = (ρ + (ŵ·r)⁺)/2 + |a|(ρ + D)²/8: the step's ρ is
 the smaller of ρ and ρ' (``wind_rho``), about half the distance to the axis above the foot.
 
+A MöKRS has no distance [KRS17 §7]: its binary tracer asks whether a world ball B(p, r) is
+free. g is L-Lipschitz on the ball, L = 1 + |a|(ρ' + r) (ρ' from ``wind_rho`` with D = r),
+so it maps the ball into B(g(p), L·r), and B(p, r) is free of the bent geometry when that
+ball is free of the rest geometry (``rest_ball``; mokrs.py, is_unbounding), or when it misses
+the swept ball. It is one component, its foot ``wind_base``, its reach from its outermost
+level bound (``rest_balls``); its normal is Dgᵀ of the rest normal at g(p), as for a KRS.
+
 Gusts: a_c(t) = radians(strength)/height · (1 + gust · n(t + c·WIND_PHASE/f)), with
 n = Σ w_k sin(2π r_k f t) (scene/effects.py). A compound bends each component about its own
 foot, with its own phase; an unbounded component (a ground plane) stands (a_c = 0).
