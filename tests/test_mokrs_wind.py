@@ -101,6 +101,27 @@ def test_without_the_lipschitz_factor_a_free_ball_holds_geometry():
     assert sum(held_free(seed, lipschitz=False)[1] for seed in SEEDS) > 0
 
 
+@pytest.mark.parametrize("seed", range(101, 105))
+def test_the_normal_is_the_gradient_of_the_bent_field(seed):
+    """At points of the bent palm the normal (the rest walk's at g(x), through Dgᵀ) is the
+    direction of the central differences of x ↦ estimate(g(x)) (the palm's maps are
+    similarities, so the first-order estimate's gradient is the kernel's); negative
+    control: the rest normal at g(x), not turned back, is off by degrees."""
+    rng = np.random.default_rng(seed)
+    scene = palm_in(rng)
+    wind, c = Wind.of(scene), compile_mokrs(scene.mokrs, ALBEDO)
+    x = bent_forward(wind, rest_samples(scene.mokrs, rng, 12, 6000))[:300]
+
+    def angle(n: np.ndarray) -> np.ndarray:
+        h, f = 1e-6, lambda y: mokrs.distance_estimate(c, wind.unwind(0, y))
+        fd = np.stack([(f(x + h * e) - f(x - h * e)) / (2 * h) for e in np.eye(3)], axis=1)
+        cos = (n * fd).sum(1) / np.linalg.norm(fd, axis=1)
+        return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+    assert angle(mokrs.nearest(c, x, wind)[1]).max() < 1e-3
+    assert angle(mokrs.nearest(c, wind.unwind(0, x))[1]).max() > 5.0
+
+
 # --------------------------------------------------------------------------- GPU
 def palm_wind(strength: float = 12.0):
     """The palm-wind preset drawn exactly (every level, a shadow ray per pixel), in a
