@@ -1,8 +1,9 @@
 """Wind on a MöKRS (issue 29 §1): the binary tracer's probes are mapped through the bend, a
 world ball B(p, r) free when B(g(p), L·r) is free at rest, so a ball declared free holds none
 of the bent geometry at random times (brute force over points of the bent, clipped
-geometry); the GPU draws what the float64 reference draws at sampled times, on every path,
-continuously in time; and a MöKRS without wind compiles and draws nothing of it."""
+geometry), and the normal is the bent field's gradient; the GPU draws what the float64
+reference draws at sampled times, on every path and MöKRS preset, continuously in time; and
+a MöKRS without wind compiles and draws nothing of it."""
 
 from __future__ import annotations
 
@@ -12,6 +13,14 @@ import numpy as np
 import pytest
 
 from krsview.algebra import mobius
+from krsview.bench.metrics import (
+    COLOR_TOL,
+    DEPTH_REL,
+    NORMAL_DEG,
+    agreement,
+    gpu_reference_agreement,
+    tolerance_failures,
+)
 from krsview.compile.camera import view_of
 from krsview.compile.geometry import compile_geometry
 from krsview.compile.krs import kernel_ball
@@ -141,6 +150,28 @@ def test_gpu_matches_the_reference_at_sampled_times(renderer, t):
     check_against_reference(f"palm-wind-t{t}", gpu, ref)
 
 
+def test_a_gpu_without_the_lipschitz_factor_fails_the_comparison(tmp_path):
+    """Negative control of the comparisons above: with the probe's radius not grown by L in
+    mokrs.glsl, rays pass leaflets and the image leaves the reference's tolerances."""
+    shaders = broken_shaders(tmp_path, "mokrs.glsl", "        radius *= L;\n", "\n")
+    s = palm_wind().at(1.7)
+    gpu = Renderer(shader_dir=shaders).render(s, 48, 32)
+    assert tolerance_failures(gpu_reference_agreement(gpu, render_reference(s, 48, 32)))
+
+
+@pytest.mark.parametrize("name", ["shell", "tree-mokrs", "inversion"])
+def test_every_mokrs_preset_bends(renderer, name):
+    """The shell, the tree as a MöKRS and the inversion (poles) in wind: the GPU draws the
+    reference's image, and the wind moves ≥ 3 % of the pixels."""
+    s = per_pixel(preset(name).edit("render.lod", 0.0))
+    s = replace(s, effects=[*s.effects, "wind"]).edit("effect_settings.wind_strength", 12.0)
+    s = s.at(2.3)
+    gpu, ref = renderer.render(s, 48, 32), render_reference(s, 48, 32)
+    assert_finite(gpu, s.render.max_iterations)
+    assert changed(ref, render_reference(still(s), 48, 32)) > 0.03
+    check_against_reference(f"{name}-wind", gpu, ref)
+
+
 @pytest.mark.parametrize("knob, value", [("precision", "double"), ("path", "compute")])
 def test_every_path_follows_the_wind(renderer, knob, value):
     """Double precision and the compute path (its shadow rays as tasks) probe through the
@@ -156,8 +187,6 @@ def test_the_prepass_follows_the_wind(renderer):
     pixel has the same hit state as without it, a depth within 2ε (binary tracing), and on
     outlines ≤ 1.5 % flip (tests/test_gpu_vs_reference.py's check). Negative control: the
     still palm's image is further off (the leaflets are thin, so it differs on outlines)."""
-    from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
-
     s = palm_wind().at(1.1)
     plain = renderer.render(s, 96, 54)
     img = renderer.render(s.edit("render.prepass", 4), 96, 54)
