@@ -177,6 +177,15 @@ def component_half_spaces(c: Compiled) -> list[tuple[float, ...]]:
     return rows
 
 
+def rest_balls(c: Compiled) -> list[np.ndarray]:
+    """The ball around each component at rest, camera-relative, which the wind's reach and
+    swept ball start from: CompiledKRS.ball, or a MöKRS's outermost bound in the world
+    (reference/wind.py, rest_balls)."""
+    if isinstance(c, CompiledMoKRS):
+        return [c.outer[-1]]
+    return [part.ball for part, _ in component_slots(c)]
+
+
 def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     """The wind's uniforms (wind.glsl; reference/wind.py derives them): time is ``u_time``
     alone, so an animated frame changes one value and compiles nothing."""
@@ -187,8 +196,8 @@ def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     axis = np.cross((0.0, 1.0, 0.0), w / np.linalg.norm(w))
     most = a0 * (1.0 + fx.wind_gust)
     feet, swept = [], []
-    if "wind" in scene.effects:  # not on a MöKRS
-        balls = [(*(part.ball[:3] + view.origin), part.ball[3]) for part, _ in component_slots(c)]
+    if "wind" in scene.effects:
+        balls = [(*(ball[:3] + view.origin), ball[3]) for ball in rest_balls(c)]
         for (b, r), ball in zip(wind_feet(scene, balls), balls):
             feet.append((*(np.array(b) - view.origin), r))
             held = swept_ball(b, r, ball, axis, most)

@@ -121,7 +121,8 @@ def component_distances(
 def component_tests(c: Compiled, dist: Distortion | None, lod: Lod | None = None) -> list[Test]:
     """One unbounding test per component, for the binary tracer's free distances."""
     if isinstance(c, mokrs.CompiledMoKRS):
-        return [lambda x, s: mokrs.is_unbounding(c, x, s, lod=rho_at(lod, x, s))]
+        wind = None if dist is None else dist.wind
+        return [lambda x, s: mokrs.is_unbounding(c, x, s, lod=rho_at(lod, x, s), wind=wind)]
     return [
         lambda x, s, p=p, k=k: component_distance(p, x, dist, lod, reach=s, k=k) >= s
         for k, p in enumerate(components(c))
@@ -136,7 +137,7 @@ def nearest(
     the component nearest to the point is asked (ties: the first), and its level is offset
     to the compound's slot."""
     if isinstance(c, mokrs.CompiledMoKRS):
-        level, g = mokrs.nearest(c, x)
+        level, g = mokrs.nearest(c, x, None if dist is None else dist.wind)
         return level, g, x
     q = x if dist is None else dist.undistort(x)
     win = np.zeros(len(x), dtype=int)

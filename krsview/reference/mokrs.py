@@ -16,6 +16,7 @@ import numpy as np
 from ..algebra import mobius
 from ..compile.mokrs import CompiledMoKRS
 from .kernels import kernel_distance, world_normal
+from .wind import Wind
 
 
 def is_unbounding(
@@ -24,6 +25,7 @@ def is_unbounding(
     radius: np.ndarray,
     pole_bounds: bool = True,
     lod: np.ndarray | float = 0.0,
+    wind: Wind | None = None,
 ) -> np.ndarray:
     """ISUNBOUNDING(κ_w, ρ_w) [KRS17 Alg. 3] for balls (N, 3), (N,): whether each ball is free
     of the MöKRS. A ball that holds a level's pole maps to a ball's exterior: it is free when
@@ -32,7 +34,14 @@ def is_unbounding(
     in the paper. Level of detail ``lod`` (world lengths per ball, 0: none): mapped into
     level i's space, a bound smaller than lod in the ball's own scale (lod / ρ_w per unit of
     its radius, the map's local scale to first order) stands for the levels below, and the
-    ball is free exactly when it misses that bound. Twin of mokrs.glsl."""
+    ball is free exactly when it misses that bound. In the ``wind`` (one component, c = 0)
+    the world ball is free when it misses the swept ball, or when the rest ball holding its
+    image under g (Wind.rest_ball) is free; lod stays the world's ρ, so a level is cut where
+    its bound is below ρ in the rest ball's scale. Twin of mokrs.glsl."""
+    if wind is not None:
+        far = wind.wind_ball_distance(0, center) >= radius
+        rest, reach = wind.rest_ball(0, center, radius)
+        return far | is_unbounding(c, rest, reach, pole_bounds, lod)
     free = np.ones(len(center), dtype=bool)
     live = np.arange(len(center))  # balls not yet decided (the shader returns early)
     kappa, rho = center, radius
@@ -63,11 +72,16 @@ def is_unbounding(
     return free
 
 
-def nearest(c: CompiledMoKRS, xw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def nearest(
+    c: CompiledMoKRS, xw: np.ndarray, wind: Wind | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """The level j whose kernel is nearest to world points xw (N, 3) and the world normal there.
-    The world gradient of k_j ∘ (world → level j) is Jᵀ ∇k_j [KRS17 §8.1]."""
-    _, level, xk, Jk = _walk(c, xw)
-    return level, world_normal(c.types, c.records, level, xk, np.swapaxes(Jk, 1, 2))
+    The world gradient of k_j ∘ (world → level j) is Jᵀ ∇k_j [KRS17 §8.1]; in the ``wind``, the
+    walk starts at the rest point q = g(xw) and the normal is Dgᵀ of that (Wind.wind_normal)."""
+    q = xw if wind is None else wind.unwind(0, xw)
+    _, level, xk, Jk = _walk(c, q)
+    g = world_normal(c.types, c.records, level, xk, np.swapaxes(Jk, 1, 2))
+    return level, g if wind is None else wind.wind_normal(0, xw, q, g)
 
 
 def distance_estimate(c: CompiledMoKRS, xw: np.ndarray) -> np.ndarray:

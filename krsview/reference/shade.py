@@ -87,7 +87,9 @@ def shade(
             k = fx.shadow_softness if soft else None
             if isinstance(c, CompiledMoKRS):
                 vis = occlusion.shadow_by_probes(
-                    lambda x, s: mokrs.is_unbounding(c, x, s, lod=rho_at(lod, x, s)),
+                    lambda x, s: mokrs.is_unbounding(
+                        c, x, s, lod=rho_at(lod, x, s), wind=None if dist is None else dist.wind
+                    ),
                     o,
                     l,
                     eps[lit],

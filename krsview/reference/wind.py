@@ -34,6 +34,13 @@ in the basis (up, the unit e of x's part ⊥ up) is [[1 + α, 0], [γ, 1]], α =
 |a|(ρ + D), so ‖Dg‖ ≤ 1 + |a|(ρ' + δ) with ρ' = (ρ + (ŵ·r)⁺)/2 + |a|(ρ + D)²/8: the step's ρ is
 the smaller of ρ and ρ' (``wind_rho``), about half the distance to the axis above the foot.
 
+A MöKRS has no distance [KRS17 §7]: its binary tracer asks whether a world ball B(p, r) is
+free. g is L-Lipschitz on the ball, L = 1 + |a|(ρ' + r) (ρ' from ``wind_rho`` with D = r),
+so it maps the ball into B(g(p), L·r), and B(p, r) is free of the bent geometry when that
+ball is free of the rest geometry (``rest_ball``; mokrs.py, is_unbounding), or when it misses
+the swept ball. It is one component, its foot ``wind_base``, its reach from its outermost
+level bound (``rest_balls``); its normal is Dgᵀ of the rest normal at g(p), as for a KRS.
+
 Gusts: a_c(t) = radians(strength)/height · (1 + gust · n(t + c·WIND_PHASE/f)), with
 n = Σ w_k sin(2π r_k f t) (scene/effects.py). A compound bends each component about its own
 foot, with its own phase; an unbounded component (a ground plane) stands (a_c = 0).
@@ -46,7 +53,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.krs import grown, krs_ball
-from ..scene import Compound, Scene
+from ..compile.mokrs import bounds_in_and_out
+from ..scene import Compound, MoKRS, Scene
 from ..scene.effects import (
     WIND_PHASE,
     WIND_RATIOS,
@@ -72,9 +80,7 @@ class Wind:
     def of(scene: Scene) -> Wind:
         fx = scene.effect_settings
         w = np.array([fx.wind_direction[0], 0.0, fx.wind_direction[2]])
-        geometry = scene.geometry()
-        parts = geometry.parts if isinstance(geometry, Compound) else (geometry,)
-        balls = [grown(krs_ball(krs)) for krs in parts]
+        balls = rest_balls(scene.geometry())
         feet = wind_feet(scene, balls)
         reach = np.array([r for _, r in feet])
         phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
@@ -98,6 +104,14 @@ class Wind:
         along = np.maximum(r @ np.cross(self.axis, UP), 0.0)
         far = rho + np.maximum(D, 0.0)
         return np.minimum(rho, 0.5 * (rho + along) + 0.125 * np.abs(self.rates[c]) * far**2)
+
+    def rest_ball(self, c, p: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A ball (centres, radii) holding g(B(p, r)) for the balls p (N, 3), r (N,) of
+        component c: B(g(p), L·r) with L = 1 + |a|(ρ + r) the bound of ‖Dg‖ over the ball (ρ
+        from ``wind_rho`` with D = r), so B(p, r) is free of the bent geometry when that ball
+        is free of the rest geometry: the MöKRS's unbounding test (mokrs.py) in the wind."""
+        L = 1.0 + np.abs(self.rates[c]) * (self.wind_rho(c, p, r) + r)
+        return self.unwind(c, p), L * r
 
     def stretch(self, c, p: np.ndarray) -> np.ndarray:
         """‖Dg‖ at the points p (N, 3), exactly: (β + √(4 + 4α + β²))/2 (module docstring)."""
@@ -135,6 +149,16 @@ class Wind:
         gets at any time and point, so ε shrinks with it (distortion.py, lod_scale) by one
         factor for the frame, which the shader reads without a loop over the components."""
         return np.full(len(p), 1.0 / (1.0 + self.most * self.reach.max()))
+
+
+def rest_balls(geometry) -> list[np.ndarray]:
+    """The ball around each component at rest (world; radius < 0: unbounded), which sets its
+    reach: a KRS's (CompiledKRS.ball), or a MöKRS's outermost level bound mapped out into the
+    world (compile/mokrs.py, bounds_in_and_out), which holds all of it."""
+    if isinstance(geometry, MoKRS):
+        return [bounds_in_and_out(geometry)[1][-1]]
+    parts = geometry.parts if isinstance(geometry, Compound) else (geometry,)
+    return [grown(krs_ball(krs)) for krs in parts]
 
 
 def wind_rate(fx: EffectSettings, t: np.ndarray) -> np.ndarray:

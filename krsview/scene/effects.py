@@ -66,8 +66,8 @@ _LIST = [
     Effect(
         "wind",
         "bend the geometry along the wind about its foot, swaying with gusts in time; "
-        "steps kept safe by the bend's Lipschitz bound at that time [KRS17 §5.2, §10]",
-        needs_distance=True,
+        "steps (a MöKRS's probes) kept safe by the bend's Lipschitz bound at that time "
+        "[KRS17 §5.2, §10]",
         reads_time=True,
     ),
     Effect(
@@ -234,11 +234,12 @@ def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> Non
 
 
 def wind_feet(scene, balls: list) -> list[tuple[Vec3, float]]:
-    """Per component of ``scene`` (a Scene with a KRS or a compound), given the ball around
-    it (``CompiledKRS.ball``, world; radius < 0: unbounded): its foot, ``wind_base`` moved by
-    the component's placement, and its reach, the farthest its geometry gets from the foot (a
-    turn about the foot keeps it), or 0 where it stands: an unbounded KRS (a ground plane)
-    would make the bend and its Lipschitz bound unbounded too."""
+    """Per component of ``scene`` (a Scene with a KRS, a compound or a MöKRS), given the ball
+    around it (``CompiledKRS.ball`` or a MöKRS's outermost bound, world; radius < 0:
+    unbounded): its foot, ``wind_base`` moved by the component's placement, and its reach,
+    the farthest its geometry gets from the foot (a turn about the foot keeps it), or 0 where
+    it stands: an unbounded KRS (a ground plane) would make the bend and its Lipschitz bound
+    unbounded too."""
     base = scene.effect_settings.wind_base
     feet = (
         [Placement(c.position, c.axis, c.angle, c.scale).point(base) for c in scene.compound]

@@ -3,6 +3,9 @@
 #include "kernels.glsl"
 #include "mobius.glsl"
 #include "lod.glsl"
+#ifdef KRS_WIND
+#include "wind.glsl"
+#endif
 
 bool reflects(int i) { return (int(mobius_rec(i, 4).w) & 2) != 0; }
 
@@ -14,15 +17,35 @@ bool exterior_is_free(int i, vec3r center, real radius) {
     return bound.w >= 0.0 && length(bound.xyz - center) + bound.w < radius;
 }
 
-real lod_scale(vec3r p) { return 1.0; }   // a MöKRS takes no distortion
+// The factor of the LOD threshold ε(t): 1, or in the wind one factor for the frame,
+// 1 / (1 + most·reach), as for a KRS in the wind (distance.glsl, lod_scale).
+real lod_scale(vec3r p) {
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) return 1.0 / (1.0 + u_wind.w);
+#endif
+    return 1.0;
+}
 
 // c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
 // Level of detail (lod.glsl): mapped into level i's space, the probe and the level's bound
 // share a unit; a bound smaller than ρ in the probe's own scale (ρ / radius world units per
 // unit of its radius: the map's local scale, to first order) stands for the levels below,
 // and the probe is free exactly when it misses that bound (which holds them all).
+// In the wind the world ball B(p, r) is free when it misses the swept ball, or when
+// B(g(p), L·r) is free at rest, L = 1 + |a|(ρ + r) ≥ ‖Dg‖ over the ball (wind_rho with D = r):
+// g maps the one into the other (reference/wind.py, rest_ball); ρ stays the world's.
 bool is_unbounding(int c, vec3r center, real radius) {
-    real lod_per_radius = lod_radius(length(center) + radius) / radius;
+    real lod = lod_radius(length(center) + radius);
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) {
+        if (wind_ball_distance(0, center) >= radius) return true;
+        float a = wind_rate(0);
+        real L = 1.0 + abs(a) * (wind_rho(0, center, radius, a) + radius);
+        center = unwind(0, center, a);
+        radius *= L;
+    }
+#endif
+    real lod_per_radius = lod / radius;
     for (int i = u_n - 1; i >= 0; --i) {
         if (!map_ball(i, center, radius)) return exterior_is_free(i, center, radius);
 #ifdef KRS_LOD
@@ -37,9 +60,15 @@ bool is_unbounding(int c, vec3r center, real radius) {
 }
 
 // Follow the point inwards accumulating J = d(world → level); k_i / |J e_x| is the world
-// distance to first order; the winner's world normal is Jᵀ ∇k_j.
+// distance to first order; the winner's world normal is Jᵀ ∇k_j. In the wind the walk
+// starts at the rest point g(xw), and the normal is the wind's Dgᵀ of that (wind_normal).
 void mokrs_nearest(vec3r xw, out int level, out vec3 normal) {
-    vec3r x = xw, xk = xw;
+    vec3r x = xw;
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) x = unwind(0, xw, wind_rate(0));
+    vec3r q = x;
+#endif
+    vec3r xk = x;
     mat3r J = mat3r(1.0), Jk = mat3r(1.0);
     const mat3r FLIP = mat3r(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
     real best = FAR_AWAY;
@@ -54,4 +83,7 @@ void mokrs_nearest(vec3r xw, out int level, out vec3 normal) {
     }
     vec3r g = kernel_gradient(level, xk), gw = transpose(Jk) * g;
     normal = vec3(length(gw) > 0.0 ? normalize(gw) : g);  // as krs_nearest where J degenerates
+#ifdef KRS_WIND
+    if (EFFECT_ON(KRS_WIND_BIT)) normal = wind_normal(0, vec3(xw), vec3(q), normal);
+#endif
 }

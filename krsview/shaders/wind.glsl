@@ -1,6 +1,8 @@
 // Wind: component c bends about the horizontal axis A through its foot b_c by a_c(t)·height,
 // a time-dependent Lipschitz distortion [KRS17 §5.2, §10]; twin of reference/wind.py (the
 // map, its bound ‖Dg‖ ≤ 1 + |a|ρ and its normal are derived there). Time is u_time only.
+// A KRS steps by it (distance.glsl); a MöKRS, component 0, maps its probes through it
+// (mokrs.glsl, is_unbounding).
 uniform float u_time;          // scene.time, seconds
 uniform vec3 u_wind_axis;      // A = normalize(up × wind), horizontal
 uniform vec4 u_wind;           // radians of lean per unit height, gust, phase step (s),
