@@ -79,12 +79,16 @@ def test_split_parts_add_up_to_the_frame_and_no_prepass_has_no_coarse_part():
     tree = krsview.load("tree")
     with_prepass = split.bench_split(tree.edit("render.prepass", 4), SIZE, rounds=1)
     ms = dict(zip(with_prepass.column("part"), with_prepass.column("ms")))
-    parts = [p for p in ms if not p.startswith(("frame", "moving")) and "per pixel" not in p]
+    alternatives = ("a shadow ray per pixel", "shadow cone off")  # other frames, not parts
+    parts = [
+        p
+        for p in ms
+        if not p.startswith(("frame", "moving")) and not any(a in p for a in alternatives)
+    ]
     assert len(parts) == 4 and sum(ms[p] for p in parts) == pytest.approx(ms["frame"])
-    per_pixel = (
-        ms["frame without secondary effects"] + ms["secondary effects, a shadow ray per pixel"]
-    )
-    assert per_pixel == pytest.approx(ms["frame, a shadow ray per pixel"])
+    for a in alternatives:  # each alternative frame is the frame without effects + its own
+        own = ms["frame without secondary effects"] + ms[f"secondary effects, {a}"]
+        assert own == pytest.approx(ms[f"frame, {a}"])
     assert ms["coarse passes"] > 0
     without = split.bench_split(tree.edit("render.prepass", 0), SIZE, rounds=1)
     assert dict(zip(without.column("part"), without.column("ms")))["coarse passes"] == 0.0
