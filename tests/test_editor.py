@@ -412,16 +412,17 @@ def scroll_to(e, path, margin: float, dx: float) -> tuple:
     return e.viewer.interactions.rects[path]
 
 
-def type_at(e, at, text: str) -> None:
-    """Ctrl+click the field at window point ``at``, type ``text`` and press Return."""
+def type_at(e, at, *text: str) -> None:
+    """Ctrl+click the field at window point ``at``, type ``text`` (xdotool's arguments: "--"
+    lets a value start with a minus) and press Return."""
     xdo("mousemove", *map(round, at))
     pump(e, 2)
     xdo("keydown", "ctrl")
     xdo("click", 1)
     xdo("keyup", "ctrl")
     pump(e, 2)
-    xdo("type", text)
-    pump(e, len(text) + 2)  # ImGui takes the typed characters one per frame
+    xdo("type", *text)
+    pump(e, sum(map(len, text)) + 2)  # ImGui takes the typed characters one per frame
     xdo("key", "Return")
     pump(e, 3)
 

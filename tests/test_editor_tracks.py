@@ -16,7 +16,7 @@ from krsview.editor.mokrs_panel import LEVELS
 from krsview.scene.edits import get_at
 from krsview.scene.presets import resolve
 
-from .test_editor import pump, scroll_to, settle, window_xy, xdo
+from .test_editor import pump, scroll_to, settle, type_at, window_xy, xdo
 
 CURL = (*LEVELS, 58, "transform", 1, "degrees")  # palm-curl's track: -2.5° at 0, 4 s; -7° at 2 s
 FACTOR = (*LEVELS, 58, "transform", 0, "factor")  # no track
@@ -41,21 +41,6 @@ def palm(display, tmp_path, monkeypatch):
     e.shown_values = shown
     yield e
     e.close()
-
-
-def type_at(e, at, *text: str) -> None:
-    """Ctrl+click the field at screen point ``at``, type ``text`` (xdotool's arguments: "--"
-    lets a value start with a minus) and press Return."""
-    xdo("mousemove", *map(round, at))
-    pump(e, 2)
-    xdo("keydown", "ctrl")
-    xdo("click", 1)
-    xdo("keyup", "ctrl")
-    pump(e, 2)
-    xdo("type", *text)
-    pump(e, 8)  # ImGui takes the typed characters one per frame
-    xdo("key", "Return")
-    pump(e, 3)
 
 
 def frame_colour(e, path, colour) -> int:

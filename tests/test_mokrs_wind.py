@@ -25,7 +25,7 @@ from krsview.compile.camera import view_of
 from krsview.compile.geometry import compile_geometry
 from krsview.compile.krs import kernel_ball
 from krsview.compile.mokrs import compile_mokrs
-from krsview.gpu.renderer import Renderer, read_buffers
+from krsview.gpu.renderer import Renderer
 from krsview.gpu.uniforms import variant_defines
 from krsview.reference import mokrs, render_reference
 from krsview.reference.kernels import kernel_distance
@@ -34,7 +34,7 @@ from krsview.scene import KRS, Level, SceneError, Sphere, scene_from_toml
 
 from .conftest import assert_finite, broken_shaders, check_against_reference, per_pixel
 from .test_distance_bound import ALBEDO
-from .test_wind import PRESETS, bent_forward, changed, preset, still, windy
+from .test_wind import PRESETS, all_effects_image, bent_forward, changed, preset, still, windy
 
 
 def palm_in(rng: np.random.Generator):
@@ -239,16 +239,8 @@ def test_the_all_effects_variant_switches_the_wind_by_its_bit(renderer):
     """A MöKRS's variant with every effect it allows (the wind now among them) draws the
     specialised images, windy and still; the two differ (the control)."""
     s = palm_wind().at(0.7)
-    images = []
-    for scene in (s, still(s)):
-        with renderer.current():
-            prog = renderer.prepare(scene, 64, 36, all_effects=True)
-            uber = read_buffers(renderer.draw(prog, 64, 36), 64, 36)
-        special = renderer.render(scene, 64, 36)
-        assert (np.abs(uber.color - special.color).max(-1) <= 1 / 255).mean() > 0.999
-        assert (uber.hit == special.hit).all()
-        images.append(special)
-    assert not np.array_equal(images[0].hit, images[1].hit)
+    moving, calm = (all_effects_image(renderer, scene) for scene in (s, still(s)))
+    assert not np.array_equal(moving.hit, calm.hit)
 
 
 # --------------------------------------------------------------------------- the scene
