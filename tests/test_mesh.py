@@ -175,3 +175,29 @@ def test_bad_mesh_options_are_one_line_errors(tmp_path, args, message):
     assert r.returncode == 2 and message in r.stderr, r.stderr
     assert len([line for line in r.stderr.splitlines() if "error" in line]) == 1
     assert "Traceback" not in r.stderr
+
+
+def test_a_mobius_scene_in_the_wind_meshes_bent():
+    """`export mesh palm-wind` bends the MöKRS as the tracer does (reference/wind.py): each
+    vertex x is certified on the bent field's zero set, the rest estimate at g(x), and the
+    forward bend (test_wind's bent_forward, by bisection, not the reference's g) takes g(x)
+    back to x. Negative control: the rest mesh's vertices are not on the bent surface."""
+    from krsview.reference.wind import Wind
+
+    from .test_wind import bent_forward
+
+    palm = load_scene(resolve("palm-wind"))
+    scene = palm.with_geometry(palm.geometry().truncated(12)).at(2.0)
+    scene = scene.edit("effect_settings.wind_strength", 30.0)
+    wind = Wind.of(scene)
+    bent, st = build_mesh(scene, 64)
+    assert bent.is_watertight
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    rest_point = lambda x: wind.unwind(0, np.asarray(x))  # noqa: E731
+    field = lambda x: distance_estimate(c, rest_point(x))  # noqa: E731
+    certified, _ = sign_change_near(bent.vertices, field, st.voxel, 2.0**-REFINE_STEPS)
+    assert certified.mean() > 0.99
+    back = bent_forward(wind, rest_point(bent.vertices))
+    assert np.abs(back - bent.vertices).max() < 1e-6 * st.voxel
+    rest, _ = build_mesh(scene.with_effects([e for e in scene.effects if e != "wind"]), 64)
+    assert sign_change_near(rest.vertices, field, st.voxel, 2.0**-REFINE_STEPS)[0].mean() < 0.5

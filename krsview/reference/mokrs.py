@@ -26,6 +26,7 @@ def is_unbounding(
     pole_bounds: bool = True,
     lod: np.ndarray | float = 0.0,
     wind: Wind | None = None,
+    bound_miss: bool = True,
 ) -> np.ndarray:
     """ISUNBOUNDING(κ_w, ρ_w) [KRS17 Alg. 3] for balls (N, 3), (N,): whether each ball is free
     of the MöKRS. A ball that holds a level's pole maps to a ball's exterior: it is free when
@@ -37,11 +38,16 @@ def is_unbounding(
     ball is free exactly when it misses that bound. In the ``wind`` (one component, c = 0)
     the world ball is free when it misses the swept ball, or when the rest ball holding its
     image under g (Wind.rest_ball) is free; lod stays the world's ρ, so a level is cut where
-    its bound is below ρ in the rest ball's scale. Twin of mokrs.glsl."""
+    its bound is below ρ in the rest ball's scale. A ball that misses level i's bound (in
+    level i's space, holding K_i and every level below) is free at once, the outermost first:
+    a Möbius map takes balls to balls, so the world ball misses all that is left to test.
+    Alg. 3 alone (``bound_miss=False``) walks on and may still call it blocked (a pole inside
+    it further in, the mirror decided on its centre, a kernel's lower bound). Twin of
+    mokrs.glsl."""
     if wind is not None:
         far = wind.wind_ball_distance(0, center) >= radius
         rest, reach = wind.rest_ball(0, center, radius)
-        return far | is_unbounding(c, rest, reach, pole_bounds, lod)
+        return far | is_unbounding(c, rest, reach, pole_bounds, lod, bound_miss=bound_miss)
     free = np.ones(len(center), dtype=bool)
     live = np.arange(len(center))  # balls not yet decided (the shader returns early)
     kappa, rho = center, radius
@@ -57,12 +63,11 @@ def is_unbounding(
                 live, kappa, rho = live[ok], kappa[ok], rho[ok]  # decided: leave the walk
                 per_radius = per_radius[ok]
             b = c.bounds[i]
-            cut = (b[3] >= 0) & (b[3] < per_radius * rho)
-            if cut.any():
-                miss = np.linalg.norm(kappa[cut] - b[:3], axis=1) - b[3] >= rho[cut]
-                free[live[cut][~miss]] = False
-                keep = ~cut
-                live, kappa, rho, per_radius = live[keep], kappa[keep], rho[keep], per_radius[keep]
+            miss = (b[3] >= 0) & (np.linalg.norm(kappa - b[:3], axis=1) - b[3] >= rho)
+            cut = (b[3] >= 0) & (b[3] < per_radius * rho)  # the bound stands for the levels
+            free[live[cut & ~miss]] = False
+            keep = ~((miss & bound_miss) | cut)
+            live, kappa, rho, per_radius = live[keep], kappa[keep], rho[keep], per_radius[keep]
             if c.reflect[i]:
                 kappa = kappa * np.where(kappa[:, :1] > 0.0, [-1.0, 1.0, 1.0], 1.0)
             if c.types[i] != "empty":

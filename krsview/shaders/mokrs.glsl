@@ -26,6 +26,10 @@ real lod_scale(vec3r p) {
     return 1.0;
 }
 
+#ifdef KRS_COUNT_LEVELS
+int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
+#endif
+
 // c: the component, always 0 (a MöKRS has no distance, so it joins no compound).
 // Level of detail (lod.glsl): mapped into level i's space, the probe and the level's bound
 // share a unit; a bound smaller than ρ in the probe's own scale (ρ / radius world units per
@@ -34,6 +38,11 @@ real lod_scale(vec3r p) {
 // In the wind the world ball B(p, r) is free when it misses the swept ball, or when
 // B(g(p), L·r) is free at rest, L = 1 + |a|(ρ + r) ≥ ‖Dg‖ over the ball (wind_rho with D = r):
 // g maps the one into the other (reference/wind.py, rest_ball); ρ stays the world's.
+// A probe that misses level i's bound (in level i's space it holds K_i and every level
+// below) is free at once, the outermost first: a Möbius map takes balls to balls, so the world
+// probe misses all that is left to test. Alg. 3 alone walks on and may still say "blocked"
+// (a pole inside the probe further in, the mirror decided on the centre, a kernel's lower
+// bound), so images may change, in the twin alike (reference/mokrs.py).
 bool is_unbounding(int c, vec3r center, real radius) {
     real lod = lod_radius(length(center) + radius);
 #ifdef KRS_WIND
@@ -47,11 +56,14 @@ bool is_unbounding(int c, vec3r center, real radius) {
 #endif
     real lod_per_radius = lod / radius;
     for (int i = u_n - 1; i >= 0; --i) {
+#ifdef KRS_COUNT_LEVELS
+        ++g_levels;
+#endif
         if (!map_ball(i, center, radius)) return exterior_is_free(i, center, radius);
-#ifdef KRS_LOD
         vec4r b = mobius_rec(i, 5);
-        if (b.w >= 0.0 && b.w < lod_per_radius * radius)
-            return length(b.xyz - center) - b.w >= radius;
+        if (b.w >= 0.0 && length(b.xyz - center) - b.w >= radius) return true;
+#ifdef KRS_LOD  // a bound below ρ that the probe reaches stands for the levels below
+        if (b.w >= 0.0 && b.w < lod_per_radius * radius) return false;
 #endif
         if (reflects(i)) center.x = -abs(center.x);      // mirror decision on the centre
         if (kernel_distance(i, center) < radius) return false;

@@ -16,6 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.geometry import compile_geometry, scene_ball
+from ..compile.krs import union_ball
+from ..compile.mokrs import CompiledMoKRS
+from ..reference import mokrs
 from ..reference.distortion import Distortion
 from ..reference.geometry import nearest, surface_field
 from ..scene import Scene, SceneError
@@ -38,14 +41,20 @@ class MeshStats:
     watertight: bool
 
 
-def box_of(scene: Scene, c, box: tuple[float, ...] | None) -> tuple[np.ndarray, float]:
+def box_of(
+    scene: Scene, c, box: tuple[float, ...] | None, dist: Distortion | None = None
+) -> tuple[np.ndarray, float]:
     """(lowest corner, side) of the cube sampled: around the given box (XMIN, YMIN, ZMIN,
-    XMAX, YMAX, ZMAX), or the scene's bounding ball."""
+    XMAX, YMAX, ZMAX), or the scene's bounding ball, grown in the wind to hold each bent
+    component's swept ball (the bend carries geometry out of its rest ball)."""
     if box is not None:
         lo, hi = np.array(box[:3], dtype=float), np.array(box[3:], dtype=float)
         side = float((hi - lo).max())
         return (lo + hi) / 2 - side / 2, side
     ball = scene_ball(c)
+    if ball is not None and dist is not None and dist.wind is not None:
+        for swept in dist.wind.balls:
+            ball = ball if swept[3] < 0 else union_ball(ball, swept)
     if ball is None:
         raise SceneError(
             "geometry",
@@ -77,9 +86,9 @@ def build_mesh(
     scene = scene.posed()  # the surface at the scene's time (tracks, sway)
     geometry = scene.geometry()
     c = compile_geometry(geometry, scene.material.albedo)
-    dist = Distortion.of(scene) if scene.mokrs is None else None
-    value, is_empty = surface_field(c, dist)
-    lo, side = box_of(scene, c, box)
+    dist = Distortion.of(scene)
+    value, is_empty = mesh_field(c, dist)
+    lo, side = box_of(scene, c, box, dist)
     bricks_per_side = 1 << max(0, math.ceil(math.log2(max(resolution, BRICK) / BRICK)))
     n = bricks_per_side * BRICK
     h = side / n
@@ -130,6 +139,20 @@ def build_mesh(
         bool(mesh.is_watertight),
     )
     return mesh, stats
+
+
+def mesh_field(c, dist: Distortion | None):
+    """(value, is_empty) of the surface sampled (reference/geometry.py, surface_field). A
+    MöKRS in the wind is bent as the tracer bends it: its estimate is looked up at the rest
+    point g(x) (zero exactly on the bent surface, same sign), and balls are certified free
+    through the bend (mokrs.is_unbounding with the wind); the twist is refused for a MöKRS."""
+    if not isinstance(c, CompiledMoKRS) or dist is None or dist.wind is None:
+        return surface_field(c, dist)
+    wind = dist.wind
+    return (
+        lambda x: mokrs.distance_estimate(c, wind.unwind(0, x)),
+        lambda x, r: mokrs.is_unbounding(c, x, r, wind=wind),
+    )
 
 
 def occupied_bricks(
