@@ -64,6 +64,7 @@ def variants() -> list[tuple[krsview.Scene, dict]]:
         (krsview.configure(grove, path="compute", component_tasks="on", prepass=4), {}),
         (krsview.configure(grove, tracer="binary", precision="double"), {}),
         (tree, {"probes": ("KRS_COUNT_LEVELS",)}),
+        (krsview.load("palm"), {"probes": ("KRS_COUNT_LEVELS",)}),  # a MöKRS counts too
         (tree, {"probes": ("KRS_TRACE_ONLY",)}),
     ]
     return out

@@ -134,7 +134,7 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
                     ms=t * 1e3,
                     speedup=base / t,
                     iterations=float(r.render(s, w, h).iterations.mean()),
-                    levels=float(r.levels(s, w, h).mean()) if not scene.mokrs else 0.0,
+                    levels=float(r.levels(s, w, h).mean()),
                     coarse_share=coarse.get(k[1:4], 0.0) / t,
                 )
             )
@@ -174,7 +174,7 @@ def table(m: Measured) -> str:
                 f"{r['ms']:.1f}",
                 f"{r['speedup']:.2f}×",
                 f"{r['iterations']:.1f}",
-                f"{r['levels']:.1f}" if r["levels"] else "—",  # not counted in a MöKRS
+                f"{r['levels']:.1f}",
                 f"{r['coarse_share']:.0%}",
             )
             for r in m.rows
