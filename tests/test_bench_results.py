@@ -126,11 +126,14 @@ def test_accuracy_returns_a_row_per_setting_and_error_images(tmp_path):
 
 
 def test_accuracy_runs_on_a_mokrs(tmp_path):
-    """A MöKRS has no level count probe: its work is its bound, and the bench still runs."""
+    """A MöKRS's walk is counted as a KRS's (the levels ISUNBOUNDING walks per probe): its
+    work lies between one kernel per step and the walk's bound, every level at every step,
+    well below that bound (a probe that misses a level's bound stops there)."""
     scene = krsview.load("palm")
     m = accuracy.bench_accuracy(scene, (12, 8), rounds=1, cache=tmp_path / "cache").measured
     n = scene.geometry().n
-    assert all(r["work"] == pytest.approx(r["iterations"] * (1 + n)) for r in m.rows[:3])
+    for r in m.rows[:3]:
+        assert r["iterations"] < r["work"] < 0.5 * r["iterations"] * (1 + n), r
 
 
 def test_markdown_and_csv_hold_the_rows(tmp_path):

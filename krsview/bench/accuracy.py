@@ -198,22 +198,16 @@ def bench_accuracy(
 
 
 def levels_walked(r: Renderer, s: Setting, size: tuple[int, int]) -> np.ndarray:
-    """Per pixel, the levels Alg. 1 walked tracing the ray (the KRS_COUNT_LEVELS probe of
-    :meth:`Renderer.levels`, here with the setting's own geometry, as a truncation needs);
-    zeros for a MöKRS, whose walk the probe does not count (see :func:`work`)."""
-    if s.scene.mokrs is not None:
-        return np.zeros((size[1], size[0]), dtype=np.int64)
+    """Per pixel, the levels walked tracing the ray (Alg. 1's, or a MöKRS's ISUNBOUNDING
+    walks: the KRS_COUNT_LEVELS probe of :meth:`Renderer.levels`), here with the setting's
+    own geometry, as a truncation needs."""
     return r.levels(s.scene, *size, s.geometry)
 
 
 def work(image: Frame, walked: np.ndarray, s: Setting) -> float:
     """Kernels evaluated per pixel while tracing, which no machine load changes: at each
-    step the top kernel, then one per level walked. A MöKRS, whose walk the probe does not
-    count, is given its bound: every level at every step."""
-    steps = float(image.iterations.mean())
-    if s.scene.mokrs is None:
-        return steps + float(walked.mean())
-    return steps * (1 + (s.geometry or s.scene.geometry()).n)
+    step the top kernel, then one per level walked."""
+    return float(image.iterations.mean()) + float(walked.mean())
 
 
 def same_work(

@@ -66,7 +66,7 @@ def _markdown(
         "work (same compiled variant, same colours, iterations and levels walked in every "
         "pixel) share one time, pooled over their rounds, and read '= setting'. Work: kernels "
         "evaluated per pixel while tracing, the top one at each step and one per level "
-        "walked (KRS_COUNT_LEVELS; a MöKRS: every level), which no machine load changes. "
+        "walked (KRS_COUNT_LEVELS), which no machine load changes. "
         "Depth error is "
         "in units of ε(t) = footprint × t; holes: the truth hits, the image misses; "
         "false: the image hits empty space; 'off sil.' counts only pixels away from "
