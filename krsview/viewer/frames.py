@@ -30,7 +30,8 @@ class FrameState:
     resolution), "refining" (image ``step`` = (k, n) of the refinement, k < n; the next one
     is being traced) or "still" (the last one: final); ``seconds`` is the time its tracing
     took (all its bands for a refinement's), ``shadows`` the side of the pixel blocks that
-    share a shadow ray (1: each pixel its own)."""
+    share a shadow ray (1: each pixel its own), ``blocks_of`` the size of the earlier image
+    whose blocks it took (a primary image: its own shadow rays come next), else (0, 0)."""
 
     state: str
     size: tuple[int, int]  # internal resolution of the image on screen
@@ -38,17 +39,21 @@ class FrameState:
     seconds: float
     step: tuple[int, int] = (0, 0)  # refining: (k, n)
     shadows: int = 1
+    blocks_of: tuple[int, int] = (0, 0)
 
     def text(self) -> str:
         w, h = self.size
         share = w / max(self.window[0], 1)
         k, n = self.step
         state = f"refining {k}/{n}" if self.state == "refining" else self.state
+        state += ", shadows next" if self.blocks_of[0] else ""
         return f"{state}: {w}×{h} ({share:.0%} of the window)"
 
     def timing(self) -> str:
         """How it was traced: time, and the shadow rays' blocks where they are shared."""
         rays = f", shadows per {self.shadows}×{self.shadows} px" if self.shadows > 1 else ""
+        if self.blocks_of[0]:
+            rays += " of the {}×{} image".format(*self.blocks_of)
         return f"traced in {self.seconds * 1e3:.1f} ms{rays}"
 
 
@@ -126,9 +131,10 @@ class Frames:
                 step = r.steps[r.k]
                 size = self.adaptive.size_at(step.scale)
                 shown = self._on_screen  # its tracing is reused where it has this size
-                traced = shown if step.ratio == 1 and shown and shown.has_trace(size) else None
+                traced = shown if step.ratio >= 1 and shown and shown.has_trace(size) else None
+                blocks = shown if step.primary else None  # its shadow blocks, for a primary step
                 self._tracing = PassImage(
-                    self.renderer, self.targets, scene, size, krs, step.ratio, traced
+                    self.renderer, self.targets, scene, size, krs, step.ratio, traced, blocks
                 )
                 r.begin(self._tracing.passes)
                 self._step_seconds = 0.0
@@ -150,6 +156,7 @@ class Frames:
                     self.adaptive.full,
                     self._step_seconds,
                     (k, n) if k < n else (0, 0),
+                    blocks_of=self._tracing.blocks[0] if r.steps[k - 1].primary else (0, 0),
                 )
                 self._show(self._tracing, state)
                 self._tracing = None
