@@ -12,6 +12,7 @@ from krsview.viewer.adaptive import (
     Refinement,
     Step,
     refinement_steps,
+    refining_budget,
 )
 
 
@@ -149,3 +150,11 @@ def test_costs_carry_over_to_the_next_refinement():
     r.begin(list(PASSES))
     assert r.next_band(0.02)[2] == int(0.02 / (COST["trace"] * 100))
     assert Refinement([Step(1.0, 2)]).cost == {}  # control: a fresh one knows none
+
+
+def test_a_refining_turn_traces_as_long_as_the_rest_of_the_turn_within_two_budgets():
+    budget = 1 / 30
+    assert refining_budget(budget, 0.05) == pytest.approx(0.05)  # a window drawn in 50 ms
+    assert refining_budget(budget, 1.0) == pytest.approx(2 * budget)  # after an idle wait
+    # control: a fast window leaves the turn's tracing at one frame budget
+    assert refining_budget(budget, 0.0) == refining_budget(budget, 0.01) == budget

@@ -12,6 +12,7 @@ SHADOW_RATIO = 2  # moving frames and refinement steps: a shadow ray per 2 × 2 
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
+REFINING_TURNS = 2.0  # a refining turn traces for at most this many frame budgets
 
 
 @dataclass
@@ -45,6 +46,14 @@ class AdaptiveResolution:
         factor = math.sqrt(self.budget / seconds)
         factor = min(1.25, max(0.7, factor))  # damped: a noisy frame moves scale a little
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
+
+
+def refining_budget(budget: float, rest: float) -> float:
+    """Seconds a turn of the refinement may trace: as long as the rest of the last turn took
+    (drawing the window, its UI) but at least one frame ``budget`` and at most REFINING_TURNS
+    of them, so a slow window (half of each turn under Xvfb) does not starve the refinement,
+    and a new move waits for at most that long."""
+    return budget * min(REFINING_TURNS, max(1.0, rest / budget))
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,7 @@
 """Scheduling the tracing: after a change of view one moving frame at the adaptive resolution;
 when the view stops, the refinement's images (adaptive.py), each traced in bands within the
-frame budget and shown when done, so input is never blocked by a slow frame. Moving frames
+frame budget (up to two while the rest of the turn takes as long: refining_budget) and shown
+when done, so input is never blocked by a slow frame. Moving frames
 light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py), or
 per the scene's larger blocks (``[render] shadow_block``), as the still image is."""
 
@@ -19,7 +20,13 @@ from ..gpu.program import ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.scene import Geometry
-from .adaptive import SHADOW_RATIO, AdaptiveResolution, Refinement, refinement_steps
+from .adaptive import (
+    SHADOW_RATIO,
+    AdaptiveResolution,
+    Refinement,
+    refinement_steps,
+    refining_budget,
+)
 
 KEPT_FRAME_TIMES = 240  # for the HUD's frame-time plot
 
@@ -72,6 +79,8 @@ class Frames:
         self._tracing: PassImage | None = None  # the refinement's next image
         self._cost: dict[str, float] = {}  # seconds per pixel of each pass, kept across
         self._step_seconds = 0.0
+        self._traced_at = 0.0  # when the last turn's tracing ended
+        self._rest = 0.0  # seconds of the last turn besides its tracing
 
     @property
     def refined(self) -> bool:
@@ -91,11 +100,16 @@ class Frames:
     def trace(self, scene: Scene, krs: Geometry) -> None:
         """One turn's tracing: a moving frame of ``scene`` after a change, else some bands of
         the refinement's next image. A ShaderError leaves the last image in place."""
-        if self.dirty:
-            self.dirty = False  # a shader error is not retried every turn
-            self._moving(scene, krs)
-        elif self.refinement is not None and not self.refinement.done:
-            self._refine(scene, krs)
+        now = time.perf_counter()
+        self._rest = now - self._traced_at if self._traced_at else 0.0
+        try:
+            if self.dirty:
+                self.dirty = False  # a shader error is not retried every turn
+                self._moving(scene, krs)
+            elif self.refinement is not None and not self.refinement.done:
+                self._refine(scene, krs)
+        finally:
+            self._traced_at = time.perf_counter()
 
     def _moving(self, scene: Scene, krs: Geometry) -> None:
         size = self.adaptive.moving_size()
@@ -124,7 +138,7 @@ class Frames:
 
     def _refine(self, scene: Scene, krs: Geometry) -> None:
         r = self.refinement
-        spent, budget = 0.0, self.adaptive.budget  # a turn no longer than a moving frame's
+        spent, budget = 0.0, refining_budget(self.adaptive.budget, self._rest)
         prepared = None
         while not r.done and spent < budget:
             if not r.started:
