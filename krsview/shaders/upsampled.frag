@@ -2,7 +2,7 @@
 // with KRS_SHADOW_UPSAMPLED each light's visibility comes from coarse_visibility.frag's
 // blocks around the pixel whose depth is within u_depth_slack footprints of its own
 // (bilinear weights); where none is, the pixel traces its own shadow ray (shadows.glsl). The
-// blocks may be an earlier, smaller image's of the same view (passes.py: its ``blocks``).
+// blocks may be an earlier, smaller image's of the same view (gpu/passes.py, ``blocks``).
 // Without it every pixel traces its own: render.frag's image, in two passes.
 #include "effects.glsl"
 #include "scene_block.glsl"
