@@ -12,6 +12,7 @@ from krsview.viewer.adaptive import (
     Refinement,
     Step,
     refinement_steps,
+    refining_budget,
 )
 
 
@@ -27,25 +28,33 @@ def test_the_scale_drops_when_slow_and_grows_back_when_fast():
     assert a.still_size() == (1280, 720) and a.size_at(0.5) == (320, 180)
 
 
+P = True  # a primary step (Step.primary)
+
+
 @pytest.mark.parametrize(
     "moving, seconds, supersample, ratio, still, steps",
     [
         # the still image with shadow rays per pixel: sharper images with shadow rays per 2 × 2
-        # pixels, then the still image adds them per pixel (reusing the window-size tracing)
-        (0.35, 0.03, 1, 2, 1, [(1.0, 2), (1.0, 1)]),
-        (0.2, 0.03, 1, 2, 1, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # 0.75 s at the window's size
-        (0.2, 0.01, 1, 2, 1, [(1.0, 2), (1.0, 1)]),  # 0.25 s: no step before it
-        (0.1, 0.03, 1, 2, 1, [(0.25, 2), (0.5, 2), (1.0, 2), (1.0, 1)]),
-        (0.1, 0.005, 1, 2, 1, [(0.5, 2), (1.0, 2), (1.0, 1)]),  # ½: 0.125 s
-        (0.8, 0.03, 1, 2, 1, [(1.0, 1)]),  # too close to the window for a step between
+        # pixels, then the window-size tracing alone (P: shaded with the blocks of the image
+        # before it), then the still image adds shadow rays per pixel to that tracing
+        (0.35, 0.03, 1, 2, 1, [(1.0, 2, P), (1.0, 1)]),
+        (0.2, 0.03, 1, 2, 1, [(0.5, 2), (1.0, 2, P), (1.0, 1)]),  # 0.75 s at the window's size
+        (0.2, 0.01, 1, 2, 1, [(1.0, 2, P), (1.0, 1)]),  # 0.25 s: no step before it
+        (0.1, 0.03, 1, 2, 1, [(0.25, 2), (0.5, 2), (1.0, 2, P), (1.0, 1)]),
+        (0.1, 0.005, 1, 2, 1, [(0.5, 2), (1.0, 2, P), (1.0, 1)]),  # ½: 0.125 s
+        (0.8, 0.03, 1, 2, 1, [(1.0, 2, P), (1.0, 1)]),  # too close to the window for a step
         (1.0, 0.03, 1, 2, 1, [(1.0, 1)]),  # the moving frame's tracing, shadowed per pixel
-        (0.35, 0.03, 2, 2, 1, [(1.0, 2), (2.0, 1)]),  # supersampled: traced anew, twice the side
+        # supersampled: the window-size image with its blocks, then traced anew at twice the side
+        (0.35, 0.03, 2, 2, 1, [(1.0, 2, P), (1.0, 2), (2.0, 1)]),
         # moving frames drawn as the still image (shadow rays per block, or every effect in
-        # one pass): the window-size image is the still one
-        (0.35, 0.03, 1, 2, 2, [(1.0, 2)]),
-        (0.2, 0.03, 1, 3, 3, [(0.5, 3), (1.0, 3)]),
+        # one pass): the window-size tracing, then the still image adds its blocks' shadow rays
+        (0.35, 0.03, 1, 2, 2, [(1.0, 2, P), (1.0, 2)]),
+        (0.2, 0.03, 1, 3, 3, [(0.5, 3), (1.0, 3, P), (1.0, 3)]),
         (1.0, 0.03, 1, 2, 2, []),
         (1.0, 0.03, 2, 2, 2, [(2.0, 2)]),
+        # no blocks before it (shadow rays per pixel throughout, or none in a pass of their
+        # own): no primary step
+        (0.35, 0.03, 1, 1, 1, [(1.0, 1)]),
         (0.35, 0.03, 1, 0, 0, [(1.0, 0)]),
         (0.2, 0.03, 1, 0, 0, [(0.5, 0), (1.0, 0)]),
         (0.8, 0.03, 1, 0, 0, [(1.0, 0)]),
@@ -60,7 +69,8 @@ def test_refinement_steps(moving, seconds, supersample, ratio, still, steps):
 def ladder_ok(moving: float, steps: list[Step]) -> bool:
     """Each image at least 1.5× the side of the one before, and all but the still image
     together costing at most 1/3 more pixels than the last of them."""
-    sides = [moving] + [s.scale for s in steps if s.ratio != 1]
+    traced = [s for s in steps if s.ratio != 1 and not (s.scale == 1.0 and not s.primary)]
+    sides = [moving] + [s.scale for s in traced]
     pixels = [s * s for s in sides[1:]]
     return all(b >= 1.5 * a for a, b in zip(sides, sides[1:])) and sum(pixels) <= (
         4 / 3 * pixels[-1] + 1e-12
@@ -71,12 +81,12 @@ def test_each_step_is_visibly_sharper_and_all_cost_at_most_a_third_more():
     for k in range(1, 100):
         moving = k / 100
         steps = refinement_steps(moving, 1.0, 1, 2, 1)  # slow: every step there can be
-        assert steps[-1] == Step(1.0, 1)
+        assert steps[-2:] == [Step(1.0, 2, primary=True), Step(1.0, 1)]
         if moving < 1 / 1.5:
             assert ladder_ok(moving, steps), moving
     # negative controls: a step too close to the one before, and a ladder too dense
-    assert not ladder_ok(0.4, [Step(0.5, 2), Step(1.0, 2)])
-    assert not ladder_ok(0.1, [Step(0.2, 2), Step(0.4, 2), Step(0.7, 2), Step(1.0, 2)])
+    assert not ladder_ok(0.4, [Step(0.5, 2), Step(1.0, 2, True)])
+    assert not ladder_ok(0.1, [Step(0.2, 2), Step(0.4, 2), Step(0.7, 2), Step(1.0, 2, True)])
 
 
 PASSES = [("trace", 100, 50), ("visibility", 50, 25), ("shade", 100, 50)]
@@ -140,3 +150,11 @@ def test_costs_carry_over_to_the_next_refinement():
     r.begin(list(PASSES))
     assert r.next_band(0.02)[2] == int(0.02 / (COST["trace"] * 100))
     assert Refinement([Step(1.0, 2)]).cost == {}  # control: a fresh one knows none
+
+
+def test_a_refining_turn_traces_as_long_as_the_rest_of_the_turn_within_two_budgets():
+    budget = 1 / 30
+    assert refining_budget(budget, 0.05) == pytest.approx(0.05)  # a window drawn in 50 ms
+    assert refining_budget(budget, 1.0) == pytest.approx(2 * budget)  # after an idle wait
+    # control: a fast window leaves the turn's tracing at one frame budget
+    assert refining_budget(budget, 0.0) == refining_budget(budget, 0.01) == budget

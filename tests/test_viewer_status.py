@@ -75,7 +75,7 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
     assert shown == [("refining", (k, n), sizes[k - 1]) for k in range(1, n)] + [
         ("still", (0, 0), SIZE)
     ]
-    assert n >= 2 and steps[-2] == Step(1.0, 2) and steps[-1] == Step(1.0, 1)
+    assert n >= 2 and steps[-2] == Step(1.0, 2, primary=True) and steps[-1] == Step(1.0, 1)
     # the HUD writes the state of the image on screen, for each state
     for s, drawn, _ in seen:
         assert drawn[0] == s.text() and drawn[1] == f"{s.timing()}; shaded view"
@@ -87,7 +87,14 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
     first = images[4][0]
     w1, h1 = sizes[0]
     assert first[1][0] == f"refining 1/{n}: {w1}×{h1} ({w1 / SIZE[0]:.0%} of the window)"
-    assert first[1][1].startswith("traced in ") and ", shadows per 2×2 px;" in first[1][1]
+    assert first[1][1].startswith("traced in ") and ", shadows per 2×2 px" in first[1][1]
+    # the window-size primary image: lit by the blocks of the image before it, its own next
+    primary, before = images[-2][0], images[-3][0]
+    bw, bh = before[0].size
+    assert primary[0].size == SIZE and primary[1][0].startswith(
+        f"refining {n - 1}/{n}, shadows next"
+    )
+    assert primary[1][1].endswith(f", shadows per 2×2 px of the {bw}×{bh} image; shaded view")
     still, lines, _ = seen[-1]
     assert still.size == SIZE == v.frames.image[1] and lines[0] == (
         f"still: {SIZE[0]}×{SIZE[1]} (100% of the window)"

@@ -7,7 +7,8 @@ steps, one per turn of the event loop, through the gizmo's own path: each step i
 reading by ImGuizmo is the only part left out). Every turn is time-stamped when its frame is
 on screen (after the buffer swap), so a step's latency is the time from the gizmo's edit to
 the end of the first turn that traced it. After the release: the first full-resolution
-image and the still one. Wall times on whatever else runs: median and p90, not a test."""
+image (where shadow rays are shared per block, the primary one, lit by the blocks of the
+image before it) and the still one. Wall times on whatever else runs: median and p90, not a test."""
 
 from __future__ import annotations
 

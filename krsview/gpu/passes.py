@@ -10,7 +10,12 @@ resolution]. ``ratio`` picks the passes:
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
   each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
-  its depth (an outline) traces its own."""
+  its depth (an outline) traces its own;
+- r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
+  one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
+  (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
+  at once, lit as the image before it, before its own shadow rays [issue 28 §5]; the image
+  after it at the same size reuses its tracing and adds them."""
 
 from __future__ import annotations
 
@@ -112,7 +117,9 @@ class Targets:
 
 class PassImage:
     """One image of ``scene`` at ``size`` in passes (the module's docstring); ``traced``: an
-    image of the same view and size whose trace pass this one reuses (it has none)."""
+    image of the same view and size whose trace pass this one reuses (it has none);
+    ``blocks``: an image of the same view whose shadow blocks this one's shading blends (it
+    traces no shadow rays but an outline's)."""
 
     def __init__(
         self,
@@ -123,6 +130,7 @@ class PassImage:
         geometry: Geometry,
         ratio: int,
         traced: PassImage | None = None,
+        blocks: PassImage | None = None,
     ):
         self.renderer, self.targets = renderer, targets
         self.scene, self.size, self.geometry, self.ratio = scene, size, geometry, ratio
@@ -132,10 +140,15 @@ class PassImage:
             self.passes = [("render", w, h)]
         else:
             self.passes = [] if traced else [("trace", w, h)]
-            if ratio > 1:
+            if ratio > 1 and blocks is None:
                 self.passes.append(("visibility", *self.coarse))
             self.passes.append(("shade" if ratio > 1 else "shadows+shade", w, h))
         self.traced = traced.traced if traced else None  # the trace pass's targets
+        if blocks is not None and (blocks.ratio < 2 or ratio < 2):
+            raise ValueError(f"shadow blocks of an image with ratio {blocks.ratio}: need ≥ 2")
+        source = blocks or self
+        # the blocks' images: their size, their coarse targets, and a block's side in pixels
+        self.blocks = source.size, source.coarse, max(source.ratio, 1)
         with renderer.current():
             self.output = targets.output(size) if ratio else None
         self._programs: dict[str, moderngl.Program] = {}
@@ -153,8 +166,9 @@ class PassImage:
         if self.ratio > 1:
             vis = self.renderer.companion(main, "coarse_visibility.frag")
             shade = self.renderer.companion(main, "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None})
-            for prog in (vis, shade):
-                prog["u_shadow_ratio"].value = self.ratio
+            vis["u_shadow_ratio"].value = self.ratio
+            (bw, bh), _, side = self.blocks
+            shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
             shade["u_depth_slack"].value = DEPTH_SLACK
             self._programs.update(visibility=vis, shade=shade)
         elif self.ratio == 1:
@@ -181,7 +195,7 @@ class PassImage:
             else:
                 target, size = self.output, self.size
                 if self.ratio > 1:
-                    coarse = self.targets.get(self.coarse, 2)
+                    coarse = self.targets.get(self.blocks[1], 2)
                     for k, tex in enumerate(coarse.color_attachments):
                         tex.use(len(TRACED) + k)
                         if COARSE[k] in prog:

@@ -28,7 +28,7 @@ from .model import (
     ToroidalCapsule,
 )
 from .route import Route
-from .schema import SceneError, Vec3, param
+from .schema import SceneError, Vec3, cached, param
 from .tree import Tree, as_vec3
 
 MAX_COMPONENTS = 8  # [KRS17 §8.3]: "compound of eight KRSs"
@@ -131,7 +131,11 @@ class Component:
             )
 
     def placed(self) -> KRS:
-        """The component's KRS in world space."""
+        """The component's KRS in world space, made once per component (a drag's edit keeps
+        the unchanged ones, whose trees would be grown again every frame)."""
+        return cached(self, "_placed", self._place)
+
+    def _place(self) -> KRS:
         source = self.tree or self.route
         krs = source.krs() if source is not None else self.krs
         assert krs is not None

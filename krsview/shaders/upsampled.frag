@@ -1,7 +1,8 @@
 // The trace-only pass (render.frag with KRS_TRACE_ONLY) shaded as render.frag shades it:
 // with KRS_SHADOW_UPSAMPLED each light's visibility comes from coarse_visibility.frag's
 // blocks around the pixel whose depth is within u_depth_slack footprints of its own
-// (bilinear weights); where none is, the pixel traces its own shadow ray (shadows.glsl).
+// (bilinear weights); where none is, the pixel traces its own shadow ray (shadows.glsl). The
+// blocks may be an earlier, smaller image's of the same view (gpu/passes.py, ``blocks``).
 // Without it every pixel traces its own: render.frag's image, in two passes.
 #include "effects.glsl"
 #include "scene_block.glsl"
@@ -15,16 +16,17 @@ uniform sampler2D u_traced_iterations;  // x
 #ifdef KRS_SHADOW_UPSAMPLED
 uniform sampler2D u_coarse_visibility;  // per light; < 0: none
 uniform sampler2D u_coarse_depth;       // x: t; < 0: no hit
-uniform int u_shadow_ratio;
-uniform float u_depth_slack;            // coarse pixel footprints of depth a block may differ
+uniform vec2 u_block;                   // a block's side in this image's pixels (an earlier,
+                                        // smaller image's blocks are wider than its ratio)
+uniform float u_depth_slack;            // block footprints of depth a block may differ
 
 // g_shadow: each light's visibility blended from the blocks near pixel px at depth t.
 void upsample_visibility(ivec2 px, float t) {
-    vec2 c = (vec2(px) + 0.5) / float(u_shadow_ratio) - 0.5;
+    vec2 c = (vec2(px) + 0.5) / u_block - 0.5;
     ivec2 c0 = ivec2(floor(c));
     vec2 f = c - vec2(c0);
     ivec2 last = textureSize(u_coarse_depth, 0) - 1;
-    float slack = u_depth_slack * u_footprint * float(u_shadow_ratio) * t;
+    float slack = u_depth_slack * u_footprint * u_block.x * t;
     vec4 sum = vec4(0.0), weight = vec4(0.0);
     for (int j = 0; j < 2; ++j) {
         for (int i = 0; i < 2; ++i) {

@@ -12,6 +12,7 @@ SHADOW_RATIO = 2  # moving frames and refinement steps: a shadow ray per 2 × 2 
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
+REFINING_TURNS = 2.0  # a refining turn traces for at most this many frame budgets
 
 
 @dataclass
@@ -47,14 +48,25 @@ class AdaptiveResolution:
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
 
 
+def refining_budget(budget: float, rest: float) -> float:
+    """Seconds a turn of the refinement may trace: as long as the rest of the last turn took
+    (drawing the window, its UI) but at least one frame ``budget`` and at most REFINING_TURNS
+    of them, so a slow window (half of each turn under Xvfb) does not starve the refinement,
+    and a new move waits for at most that long."""
+    return budget * min(REFINING_TURNS, max(1.0, rest / budget))
+
+
 @dataclass(frozen=True)
 class Step:
     """One image the view refines through: ``scale`` of the window's side, and its shadow
     rays (gpu/passes.py's ratio): 0 every effect in one pass, 1 a shadow ray per pixel in a
-    pass after the tracing, r ≥ 2 one per r × r pixels, blended along depth."""
+    pass after the tracing, r ≥ 2 one per r × r pixels, blended along depth. ``primary``:
+    the primary rays alone, shaded with the shadow blocks of the image before it (no lighting
+    jump, no shadow rays yet); the next step, at the same scale, adds its own to this tracing."""
 
     scale: float
     ratio: int
+    primary: bool = False
 
 
 def refinement_steps(
@@ -67,7 +79,9 @@ def refinement_steps(
     before the window-size one cost at most 1/3 of it. ``ratio``: the passes (gpu/passes.py)
     of the moving frames and these steps; ``still``: those of the still image. Where they
     differ (shadow rays per pixel in the still image only), the still image adds them to the
-    tracing of the window-size image before it; else that image is the still one."""
+    tracing of the window-size image before it; else that image is the still one. Where
+    shadow rays are shared per block, the window-size image comes first without its own
+    (:func:`primary_first`)."""
     scales = [1.0] if moving_scale * STEP_GAIN < 1.0 else []
     while (
         scales
@@ -77,10 +91,27 @@ def refinement_steps(
         scales.insert(0, scales[0] / 2)
     steps = [Step(s, ratio) for s in scales]
     if still != ratio:
-        return steps + [Step(float(supersample), still)]
-    if not steps and moving_scale < 1.0:
-        steps = [Step(1.0, ratio)]
-    return steps + ([Step(float(supersample), still)] if supersample > 1 else [])
+        steps.append(Step(float(supersample), still))
+    else:
+        if not steps and moving_scale < 1.0:
+            steps = [Step(1.0, ratio)]
+        steps += [Step(float(supersample), still)] if supersample > 1 else []
+    return primary_first(steps, ratio) if moving_scale < 1.0 else steps
+
+
+def primary_first(steps: list[Step], ratio: int) -> list[Step]:
+    """``steps`` with the window-size image first traced alone and shaded with the shadow
+    blocks of the image before it (issue 28 §5: a full-resolution primary image, then its
+    effects), where the images before it share shadow rays per block (``ratio`` ≥ 2) and it
+    has shadow rays of its own; the step after it reuses its tracing. Where the still image
+    follows at the window's size, it adds its shadow rays to that tracing directly."""
+    k = next((i for i, s in enumerate(steps) if s.scale == 1.0), None)
+    if ratio < 2 or k is None or steps[k].ratio == 0:
+        return steps
+    rest = steps[k:]
+    if len(rest) > 1 and rest[1].scale == 1.0:  # the still image at the window's size
+        rest = rest[1:]
+    return steps[:k] + [Step(1.0, ratio, primary=True)] + rest
 
 
 @dataclass

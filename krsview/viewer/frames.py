@@ -1,6 +1,7 @@
 """Scheduling the tracing: after a change of view one moving frame at the adaptive resolution;
 when the view stops, the refinement's images (adaptive.py), each traced in bands within the
-frame budget and shown when done, so input is never blocked by a slow frame. Moving frames
+frame budget (up to two while the rest of the turn takes as long: refining_budget) and shown
+when done, so input is never blocked by a slow frame. Moving frames
 light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py), or
 per the scene's larger blocks (``[render] shadow_block``), as the still image is."""
 
@@ -19,7 +20,13 @@ from ..gpu.program import ProgramCache, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.scene import Geometry
-from .adaptive import SHADOW_RATIO, AdaptiveResolution, Refinement, refinement_steps
+from .adaptive import (
+    SHADOW_RATIO,
+    AdaptiveResolution,
+    Refinement,
+    refinement_steps,
+    refining_budget,
+)
 
 KEPT_FRAME_TIMES = 240  # for the HUD's frame-time plot
 
@@ -30,7 +37,8 @@ class FrameState:
     resolution), "refining" (image ``step`` = (k, n) of the refinement, k < n; the next one
     is being traced) or "still" (the last one: final); ``seconds`` is the time its tracing
     took (all its bands for a refinement's), ``shadows`` the side of the pixel blocks that
-    share a shadow ray (1: each pixel its own)."""
+    share a shadow ray (1: each pixel its own), ``blocks_of`` the size of the earlier image
+    whose blocks it took (a primary image: its own shadow rays come next), else (0, 0)."""
 
     state: str
     size: tuple[int, int]  # internal resolution of the image on screen
@@ -38,17 +46,21 @@ class FrameState:
     seconds: float
     step: tuple[int, int] = (0, 0)  # refining: (k, n)
     shadows: int = 1
+    blocks_of: tuple[int, int] = (0, 0)
 
     def text(self) -> str:
         w, h = self.size
         share = w / max(self.window[0], 1)
         k, n = self.step
         state = f"refining {k}/{n}" if self.state == "refining" else self.state
+        state += ", shadows next" if self.blocks_of[0] else ""
         return f"{state}: {w}×{h} ({share:.0%} of the window)"
 
     def timing(self) -> str:
         """How it was traced: time, and the shadow rays' blocks where they are shared."""
         rays = f", shadows per {self.shadows}×{self.shadows} px" if self.shadows > 1 else ""
+        if self.blocks_of[0]:
+            rays += " of the {}×{} image".format(*self.blocks_of)
         return f"traced in {self.seconds * 1e3:.1f} ms{rays}"
 
 
@@ -67,6 +79,8 @@ class Frames:
         self._tracing: PassImage | None = None  # the refinement's next image
         self._cost: dict[str, float] = {}  # seconds per pixel of each pass, kept across
         self._step_seconds = 0.0
+        self._traced_at = 0.0  # when the last turn's tracing ended
+        self._rest = 0.0  # seconds of the last turn besides its tracing
 
     @property
     def refined(self) -> bool:
@@ -86,11 +100,16 @@ class Frames:
     def trace(self, scene: Scene, krs: Geometry) -> None:
         """One turn's tracing: a moving frame of ``scene`` after a change, else some bands of
         the refinement's next image. A ShaderError leaves the last image in place."""
-        if self.dirty:
-            self.dirty = False  # a shader error is not retried every turn
-            self._moving(scene, krs)
-        elif self.refinement is not None and not self.refinement.done:
-            self._refine(scene, krs)
+        now = time.perf_counter()
+        self._rest = now - self._traced_at if self._traced_at else 0.0
+        try:
+            if self.dirty:
+                self.dirty = False  # a shader error is not retried every turn
+                self._moving(scene, krs)
+            elif self.refinement is not None and not self.refinement.done:
+                self._refine(scene, krs)
+        finally:
+            self._traced_at = time.perf_counter()
 
     def _moving(self, scene: Scene, krs: Geometry) -> None:
         size = self.adaptive.moving_size()
@@ -119,16 +138,17 @@ class Frames:
 
     def _refine(self, scene: Scene, krs: Geometry) -> None:
         r = self.refinement
-        spent, budget = 0.0, self.adaptive.budget  # a turn no longer than a moving frame's
+        spent, budget = 0.0, refining_budget(self.adaptive.budget, self._rest)
         prepared = None
         while not r.done and spent < budget:
             if not r.started:
                 step = r.steps[r.k]
                 size = self.adaptive.size_at(step.scale)
                 shown = self._on_screen  # its tracing is reused where it has this size
-                traced = shown if step.ratio == 1 and shown and shown.has_trace(size) else None
+                traced = shown if step.ratio >= 1 and shown and shown.has_trace(size) else None
+                blocks = shown if step.primary else None  # its shadow blocks, for a primary step
                 self._tracing = PassImage(
-                    self.renderer, self.targets, scene, size, krs, step.ratio, traced
+                    self.renderer, self.targets, scene, size, krs, step.ratio, traced, blocks
                 )
                 r.begin(self._tracing.passes)
                 self._step_seconds = 0.0
@@ -150,6 +170,7 @@ class Frames:
                     self.adaptive.full,
                     self._step_seconds,
                     (k, n) if k < n else (0, 0),
+                    blocks_of=self._tracing.blocks[0] if r.steps[k - 1].primary else (0, 0),
                 )
                 self._show(self._tracing, state)
                 self._tracing = None
