@@ -1,0 +1,113 @@
+"""The shaping walk-through's saved files (docs/editing/, [issue 28]) are valid scene files and
+differ from the shipped presets exactly as the walk-through says: the tree gained two levels
+and lost one, is tapered and has a fork moved; the palm's leaflet steps shrink and curl more.
+Each check is run on the preset itself too, which must fail it, so the docs cannot rot."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from krsview.scene import Scene, load_scene
+from krsview.scene.presets import resolve
+
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "editing"
+TAPER = 0.75  # the structure section's taper the walk-through applies
+
+
+def baked(scene: Scene) -> Scene:
+    """A grown tree as its route (what the editor's "bake into a route" makes)."""
+    return replace(scene, tree=None, route=scene.tree.route()) if scene.tree else scene
+
+
+def tree_changes(shaped: Scene, original: Scene) -> list[str]:
+    """What the tree walk-through promises that ``shaped`` lacks (empty: all of it)."""
+    levels, start = shaped.route.levels, baked(original).route.levels
+    wrong = []
+    if len(levels) != len(start) + 1:
+        wrong.append(f"{len(levels)} levels, want {len(start)} + 2 inserted − 1 removed")
+    by_hand = [lv for lv in levels if lv.grown is None]
+    if len(by_hand) != 2:
+        wrong.append(f"{len(by_hand)} levels made by hand, want the 2 inserted")
+    kept = {lv.grown for lv in levels} - {None}
+    if len(kept) != len(start) - 1:
+        wrong.append(f"{len(start) - len(kept)} grown levels removed, want 1")
+    radii = np.array([lv.radius for lv in levels])
+    if not np.allclose(radii[:-1] / radii[1:], TAPER, rtol=1e-9):
+        wrong.append(f"widths not tapered by {TAPER} per level")
+    grown = {lv.grown: lv for lv in start}
+    moved = [
+        lv.grown
+        for lv in levels
+        if lv.grown is not None and np.abs(np.subtract(lv.fork, grown[lv.grown].fork)).max() > 0.1
+    ]
+    if not moved:
+        wrong.append("no fork moved by more than 0.1")
+    if shaped.route.base != baked(original).route.base:
+        wrong.append("the foot moved")
+    return wrong
+
+
+def palm_changes(shaped: Scene, original: Scene) -> list[str]:
+    """What the palm walk-through promises that ``shaped`` lacks: the same levels and kernels,
+    every leaflet level's scale below the preset's and its curl stronger, the rest unchanged."""
+    a, b = shaped.mokrs.levels, original.mokrs.levels
+    if len(a) != len(b):
+        return [f"{len(a)} levels, want {len(b)}"]
+    wrong = []
+    for i, (new, old) in enumerate(zip(a, b, strict=True)):
+        if (new.kernel, new.reflect) != (old.kernel, old.reflect):
+            wrong.append(f"level {i}: its kernel or reflection changed")
+        if [s.kind for s in new.transform] != [s.kind for s in old.transform]:
+            wrong.append(f"level {i}: its steps' kinds changed")
+            continue
+        for s, t in zip(new.transform, old.transform, strict=True):
+            if s.kind == "scale" and not s.factor < t.factor - 0.01:
+                wrong.append(f"level {i}: scale {s.factor:g}, want below {t.factor:g}")
+            if s.kind == "rotate" and not s.degrees < t.degrees - 1.0:
+                wrong.append(f"level {i}: rotate {s.degrees:g}°, want a stronger curl")
+            if s.kind == "translate" and s != t:
+                wrong.append(f"level {i}: the translate step changed")
+    return wrong
+
+
+@pytest.mark.parametrize(
+    ("name", "preset", "changes"),
+    [("tree-reshaped", "tree", tree_changes), ("palm-reshaped", "palm", palm_changes)],
+)
+def test_saved_walkthrough_differs_as_described(name, preset, changes):
+    original = load_scene(resolve(preset))
+    shaped = load_scene(DOCS / f"{name}.toml")  # validated by the scene schema on loading
+    assert changes(shaped, original) == []
+    # negative control: the preset itself fails every promise it can fail
+    assert changes(baked(original), original)
+    assert (DOCS / f"{name}.png").stat().st_size <= 200_000
+
+
+def test_each_promise_is_checked():
+    """Undoing one change of a saved file makes exactly that check fail."""
+    tree, palm = load_scene(resolve("tree")), load_scene(resolve("palm"))
+    shaped = load_scene(DOCS / "tree-reshaped.toml")
+    route = shaped.route
+    flat = replace(route, levels=[replace(lv, radius=0.1) for lv in route.levels])
+    assert tree_changes(replace(shaped, route=flat), tree) == [
+        "widths not tapered by 0.75 per level"
+    ]
+    regrown = [
+        replace(lv, grown=k) if lv.grown is None else lv for k, lv in enumerate(route.levels)
+    ]
+    wrong = tree_changes(replace(shaped, route=replace(route, levels=regrown)), tree)
+    assert wrong[0] == "0 levels made by hand, want the 2 inserted"
+    moved = replace(route, base=(0.0, 0.5, 0.0))
+    assert tree_changes(replace(shaped, route=moved), tree) == ["the foot moved"]
+    shaped = load_scene(DOCS / "palm-reshaped.toml")
+    levels = list(shaped.mokrs.levels)
+    levels[4] = palm.mokrs.levels[4]  # one leaflet level as shipped
+    wrong = palm_changes(replace(shaped, mokrs=replace(shaped.mokrs, levels=levels)), palm)
+    assert wrong == [
+        "level 4: scale 0.93, want below 0.93",
+        "level 4: rotate -2.5°, want a stronger curl",
+    ]
