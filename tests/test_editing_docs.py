@@ -1,7 +1,8 @@
 """The shaping walk-through's saved files (docs/editing/, [issue 28]) are valid scene files and
 differ from the shipped presets exactly as the walk-through says: the tree gained two levels
 and lost one, is tapered and has a fork moved; the palm's leaflet steps shrink and curl more.
-Each check is run on the preset itself too, which must fail it, so the docs cannot rot."""
+Each check is run on the preset itself too, which must fail it, so the docs cannot rot.
+Last, what the walk-through found wrong in the window, driven by real pointer events."""
 
 from __future__ import annotations
 
@@ -11,8 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from krsview.scene import Scene, load_scene
+from krsview.scene import Scene, load_scene, save_scene
 from krsview.scene.presets import resolve
+
+from .test_editor import pump, xdo
+from .test_structure import outline_row
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "editing"
 TAPER = 0.75  # the structure section's taper the walk-through applies
@@ -111,3 +115,29 @@ def test_each_promise_is_checked():
         "level 4: scale 0.93, want below 0.93",
         "level 4: rotate -2.5°, want a stronger curl",
     ]
+
+
+def test_the_outline_menu_acts_on_the_entry_it_marks(display, tmp_path):
+    """A right-click on an outline entry selects it, so the menu's "remove this fork" acts on
+    the marked entry (it used to act on the right-clicked one while another stayed marked).
+    Negative control: a left click on another entry moves the mark there."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.window import Editor
+
+    scene = load_scene(resolve("tree"))
+    path = tmp_path / "route.toml"
+    save_scene(baked(replace(scene, tree=replace(scene.tree, levels=8))), path)
+    e = Editor(path, size=(640, 400))
+    try:
+        pump(e)
+        n = len(e.scene.route.levels)
+        for button, row, popups in ((1, 1, 0), (3, 3, 1)):  # the top row is the trunk
+            xdo("mousemove", *map(round, outline_row(e, row)))
+            pump(e, 2)
+            xdo("click", button)
+            pump(e, 3)
+            assert imgui.get_current_context().open_popup_stack.size() == popups
+            assert e.selected is not None and e.selected.level == n - 1 - row, (button, row)
+    finally:
+        e.close()

@@ -198,7 +198,7 @@ def _outline(e: Edited, out: list) -> None:
             if clicked:
                 out.append(ec.SelectLevel(k))
             if e.scene.route is not None:  # entries are levels (a compound's: components)
-                out += outline_menu(k)
+                out += outline_menu(k, entries[k])
             if selected and e.scroll_outline:
                 imgui.set_scroll_here_y()
                 out.append(ec.OutlineScrolled())
