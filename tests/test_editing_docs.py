@@ -6,6 +6,7 @@ Last, what the walk-through found wrong in the window, driven by real pointer ev
 
 from __future__ import annotations
 
+import shutil
 from dataclasses import replace
 from pathlib import Path
 
@@ -52,6 +53,8 @@ def tree_changes(shaped: Scene, original: Scene) -> list[str]:
         wrong.append("no fork moved by more than 0.1")
     if shaped.route.base != baked(original).route.base:
         wrong.append("the foot moved")
+    if shaped.description == original.description:
+        wrong.append("the preset's description (22 forks)")
     return wrong
 
 
@@ -61,7 +64,7 @@ def palm_changes(shaped: Scene, original: Scene) -> list[str]:
     a, b = shaped.mokrs.levels, original.mokrs.levels
     if len(a) != len(b):
         return [f"{len(a)} levels, want {len(b)}"]
-    wrong = []
+    wrong = ["the preset's description"] if shaped.description == original.description else []
     for i, (new, old) in enumerate(zip(a, b, strict=True)):
         if (new.kernel, new.reflect) != (old.kernel, old.reflect):
             wrong.append(f"level {i}: its kernel or reflection changed")
@@ -139,5 +142,57 @@ def test_the_outline_menu_acts_on_the_entry_it_marks(display, tmp_path):
             pump(e, 3)
             assert imgui.get_current_context().open_popup_stack.size() == popups
             assert e.selected is not None and e.selected.level == n - 1 - row, (button, row)
+    finally:
+        e.close()
+
+
+def test_the_description_is_typed_in_the_panel_as_one_undo_step(display, tmp_path, monkeypatch):
+    """After a reshaping, the scene's description can be told (the shipped tree's counts its
+    forks): typed into its panel field with real keys, Enter makes it the scene's, one undo
+    step, and saved. Negative control: the shipped description before, and again after Ctrl+Z."""
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.editor import commands as ec
+    from krsview.editor.window import Editor
+
+    header = imgui.collapsing_header  # the section folds; open it from the start
+    monkeypatch.setattr(
+        imgui,
+        "collapsing_header",
+        lambda label, *a: (
+            header(label, imgui.TreeNodeFlags_.default_open)
+            if label == "name and description"
+            else header(label, *a)
+        ),
+    )
+    path, text = tmp_path / "palm.toml", "a palm leaf rolled in"
+    shutil.copy(resolve("palm"), path)
+    shipped = load_scene(path).description
+    e = Editor(path, size=(640, 400))
+    try:
+        pump(e, 4)
+        x0, y0, x1, y1 = e.viewer.interactions.rects[("description",)]
+        wx, wy = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", round(wx + x0 + 20), round(wy + (y0 + y1) / 2))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 2)
+        assert e.scene.description == shipped
+        xdo("key", "ctrl+a")
+        xdo("type", text)
+        pump(e, len(text) + 2)  # ImGui takes the typed characters one per frame
+        assert e.scene.description == shipped, "taken before Enter"
+        xdo("key", "Return")
+        pump(e, 3)
+        assert e.scene.description == text
+        assert len(e.doc.history.labels()[0]) == 1, e.doc.history.labels()
+        e.execute([ec.Save()])
+        assert load_scene(path).description == text
+        xdo("mousemove", round(wx + 100), round(wy + 300))  # the view: keys are the editor's
+        pump(e, 2)
+        xdo("key", "ctrl+z")
+        pump(e, 3)
+        assert e.scene.description == shipped
     finally:
         e.close()
