@@ -196,3 +196,31 @@ def test_the_description_is_typed_in_the_panel_as_one_undo_step(display, tmp_pat
         assert e.scene.description == shipped
     finally:
         e.close()
+
+
+def test_the_dragging_section_waits_for_something_to_drag(display, tmp_path, monkeypatch):
+    """A grown tree has no handles, so the panel shows no "dragging" section (snap, a fork
+    carries its subtree) until it is baked; then it does (the negative control)."""
+    from imgui_bundle import imgui
+
+    from krsview.editor import commands as ec
+    from krsview.editor.window import Editor
+
+    drawn: list[str] = []
+    header = imgui.collapsing_header
+    monkeypatch.setattr(
+        imgui, "collapsing_header", lambda label, *a: drawn.append(label) or header(label, *a)
+    )
+    scene = load_scene(resolve("tree"))
+    path = tmp_path / "tree.toml"
+    save_scene(replace(scene, tree=replace(scene.tree, levels=8)), path)
+    e = Editor(path, size=(640, 400))
+    try:
+        pump(e)
+        assert "material" in drawn and "dragging" not in drawn, drawn
+        e.execute([ec.Bake()])
+        drawn.clear()
+        pump(e)
+        assert "dragging" in drawn, drawn
+    finally:
+        e.close()

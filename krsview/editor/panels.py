@@ -104,7 +104,9 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
             "effects: " + (", ".join(scene.effects) or "none") + " (switched in the krsview window)"
         )
         fields_of(shown.effect_settings, ("effect_settings",), out, interactions)
-    if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
+    if scene.tree is None and imgui.collapsing_header(  # a grown tree has nothing to drag
+        "dragging", imgui.TreeNodeFlags_.default_open
+    ):
         if scene.route is not None:  # only a route's forks carry anything
             changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
             if changed:
