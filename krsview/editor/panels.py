@@ -95,6 +95,8 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         if imgui.collapsing_header("selection", imgui.TreeNodeFlags_.default_open):
             _selection(e, out, interactions, fields_of)
         out += structure_section(e, interactions)
+    if imgui.collapsing_header("name and description"):
+        _about(scene, out, interactions)
     if imgui.collapsing_header("material"):
         fields_of(shown.material, ("material",), out, interactions)
     if imgui.collapsing_header("effect settings"):
@@ -102,7 +104,9 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
             "effects: " + (", ".join(scene.effects) or "none") + " (switched in the krsview window)"
         )
         fields_of(shown.effect_settings, ("effect_settings",), out, interactions)
-    if imgui.collapsing_header("dragging", imgui.TreeNodeFlags_.default_open):
+    if scene.tree is None and imgui.collapsing_header(  # a grown tree has nothing to drag
+        "dragging", imgui.TreeNodeFlags_.default_open
+    ):
         if scene.route is not None:  # only a route's forks carry anything
             changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
             if changed:
@@ -133,6 +137,22 @@ def _dock(e: Edited, out: list, width: float) -> None:
         out.append(ec.PlacePanel(other, e.layout.width))
     if imgui.is_item_hovered():
         imgui.set_tooltip("drag the panel's edge to resize it; its title bar's arrow folds it")
+
+
+def _about(scene: Scene, out: list, interactions: Interactions) -> None:
+    """The scene's name and one-line description, to be told after a reshaping (the shipped
+    tree's says how many forks it has). Enter takes the typed text, as one undo step (the
+    view is not redrawn at every key)."""
+    for name in ("name", "description"):
+        imgui.set_next_item_width(-imgui.calc_text_size("description").x - 8)
+        changed, text = imgui.input_text(
+            f"{name}##scene", getattr(scene, name), imgui.InputTextFlags_.enter_returns_true
+        )
+        key = interactions.key((name,))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("Enter takes the text")
+        if changed and text != getattr(scene, name):
+            out.append(Edit((name,), text, key))
 
 
 def _warnings(e: Edited, out: list) -> None:
@@ -198,7 +218,7 @@ def _outline(e: Edited, out: list) -> None:
             if clicked:
                 out.append(ec.SelectLevel(k))
             if e.scene.route is not None:  # entries are levels (a compound's: components)
-                out += outline_menu(k)
+                out += outline_menu(k, entries[k])
             if selected and e.scroll_outline:
                 imgui.set_scroll_here_y()
                 out.append(ec.OutlineScrolled())

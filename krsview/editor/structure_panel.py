@@ -22,10 +22,15 @@ RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
 
 
-def outline_menu(k: int) -> list[Command]:
-    """The right-click menu of outline entry k (call right after its selectable)."""
+def outline_menu(k: int, name: str) -> list[Command]:
+    """The right-click menu of outline entry k, titled by its ``name`` (call right after its
+    selectable); opening it selects the entry, so what is marked is what the menu acts on."""
     out: list[Command] = []
     if imgui.begin_popup_context_item(f"structure##{k}"):
+        if imgui.is_window_appearing():
+            out.append(ec.SelectLevel(k))
+        imgui.text_disabled(name)
+        imgui.separator()
         for text, keys, command in (
             ("insert a fork", "Insert", ec.InsertLevel(k)),
             ("remove this fork", "Delete", ec.RemoveLevel(k)),
