@@ -12,8 +12,10 @@ import numpy as np
 import pytest
 
 from krsview.editor.commands import Bake, SaveAs
+from krsview.editor.layout import MARGIN, Layout
 from krsview.scene import load_scene
 from krsview.scene.presets import PRESET_DIR, resolve
+from krsview.viewer.hud import HUD_RIGHT
 
 from .test_editor import LEVEL, pump, scroll_to, window_xy, xdo
 from .test_editor import type_at as type_into
@@ -196,3 +198,17 @@ def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
         assert v.scene.render.max_iterations == 300
     finally:
         v.close()
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_the_panel_starts_below_the_hud_where_they_would_overlap(side):
+    """The viewer's HUD bar sits at the top left, HUD_RIGHT wide: a panel docked left, or
+    docked right in a window too narrow for both side by side (640×360), starts below it;
+    docked right in a wide window (the negative control) it starts at the top."""
+    bar = 20.0
+    layout = Layout(side=side)
+    x, y, width, _ = layout.panel((640, 360), bar, HUD_RIGHT)
+    assert y == MARGIN + bar + MARGIN and x < HUD_RIGHT
+    x, y, width, _ = layout.panel((1280, 720), bar, HUD_RIGHT)
+    overlaps = x < HUD_RIGHT + MARGIN
+    assert overlaps == (side == "left") and y == (MARGIN + bar + MARGIN if overlaps else MARGIN)

@@ -26,14 +26,15 @@ class Layout:
     folded: bool = False  # only the panel's title bar shows: the view has the whole width
 
     def panel(
-        self, size: tuple[float, float], hud: float = 0.0
+        self, size: tuple[float, float], hud: float = 0.0, hud_right: float = 0.0
     ) -> tuple[float, float, float, float]:
-        """The panel's window rectangle (x, y, width, height) in a window of ``size``; docked
-        left, it leaves the top ``hud`` pixels to the viewer's HUD (its title bar there)."""
+        """The panel's window rectangle (x, y, width, height) in a window of ``size``; where it
+        would overlap the viewer's HUD (its title bar ``hud`` pixels tall at the top left,
+        reaching ``hud_right``: docked left, or right in a narrow window), it starts below."""
         w, h = size
         width = self.clamped(w)
         x = MARGIN if self.side == "left" else w - width - MARGIN
-        y = MARGIN + (hud + MARGIN if self.side == "left" and hud else 0.0)
+        y = MARGIN + (hud + MARGIN if hud and x < hud_right + MARGIN else 0.0)
         return x, y, width, max(h - y - MARGIN, 1.0)
 
     def clamped(self, window_width: float) -> float:

@@ -16,6 +16,7 @@ from ..document.document import Document
 from ..scene import Scene
 from ..scene.edits import get_at
 from ..viewer.commands import Command, Edit, Redo, Undo
+from ..viewer.hud import HUD_RIGHT
 from ..viewer.widgets import Interactions, field_widget
 from ..viewer.window import Viewer
 from . import commands as ec
@@ -62,7 +63,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     out: list[Command] = []
     interactions.inline.clear()  # the fields drawn this frame show their own errors
     size = imgui.get_io().display_size
-    x, y, width, height = e.layout.panel((size.x, size.y), imgui.get_frame_height())
+    x, y, width, height = e.layout.panel((size.x, size.y), imgui.get_frame_height(), HUD_RIGHT)
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
     imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
     imgui.set_next_window_bg_alpha(0.8)

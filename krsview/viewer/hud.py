@@ -28,6 +28,8 @@ from .timeline import draw_time
 from .widgets import Interactions, field_widget
 
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
+HUD_AT = 8  # pixels from the window's top left corner, where the HUD first opens
+HUD_RIGHT = HUD_AT + HUD_WIDTH  # its right edge there
 PLOT_HEIGHT = 130  # the frame-time plot, tall enough for readable axis labels
 PLOTTED = 120  # moving frames in the plot
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
@@ -79,7 +81,7 @@ class Viewed(Protocol):
 def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
     out: list[c.Command] = []
     interactions.inline.clear()  # the fields drawn this frame show their own errors
-    imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
+    imgui.set_next_window_pos(imgui.ImVec2(HUD_AT, HUD_AT), imgui.Cond_.first_use_ever)
     tallest = imgui.get_io().display_size.y - 16
     imgui.set_next_window_size_constraints(
         imgui.ImVec2(HUD_WIDTH, 0), imgui.ImVec2(HUD_WIDTH, max(tallest, 100))
