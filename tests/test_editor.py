@@ -250,7 +250,8 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
 
     e = editor
     assert e.edit(("render", "epsilon_scale"), 2.0)
-    glfw.set_window_should_close(e.viewer.window, True)
+    assert not e.should_close()  # negative control: nothing asked to close yet
+    e.execute([e.viewer.input.keymap["ctrl+Q"]])  # Ctrl+Q, as the close button
     assert not e.should_close() and e.asking == ("close", None)
     pump(e)
     e.answer_cancel()

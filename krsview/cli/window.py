@@ -39,9 +39,8 @@ def add(sub) -> None:
         "looks, O orbits the point at the centre, R resets, B saves a "
         "bookmark in the preset, N cycles bookmarks, F5 records and F6 "
         "replays a camera path, F12 saves a screenshot beside the preset (NAME.screenshots/), "
-        "F1 hides the "
-        "HUD; Ctrl+Z / Ctrl+Shift+Z undo and redo the HUD's changes. Editing the preset or "
-        "a shader reloads it. "
+        "F1 hides the HUD, Ctrl+Q closes; Ctrl+Z / Ctrl+Shift+Z undo and redo the HUD's "
+        "changes. Editing the preset or a shader reloads it. "
         "Example: krsview view forest --fps 60 --prepass 8",
     )
     settings_options(v, [f.name for f in fields(ViewerSettings)])

@@ -111,6 +111,12 @@ class ToggleHud(Command):
 
 
 @dataclass(frozen=True)
+class Quit(Command):
+    """Close the window (Ctrl+Q), as its close button does: the editor asks first when
+    there are unsaved edits."""
+
+
+@dataclass(frozen=True)
 class AddBookmark(Command):
     """Keep the current camera as a bookmark of the scene (B)."""
 

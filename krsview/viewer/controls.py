@@ -10,6 +10,7 @@ from .commands import (
     AddBookmark,
     Command,
     NextBookmark,
+    Quit,
     Redo,
     Replay,
     ResetView,
@@ -44,6 +45,7 @@ VIEWER_KEYS: dict[str, Command] = {
     "ctrl+Z": Undo(),
     "ctrl+shift+Z": Redo(),
     "ctrl+Y": Redo(),
+    "ctrl+Q": Quit(),
 }
 LOOK_BUTTON = "right"  # hold to look around (fly) …
 ORBIT_BUTTON = "left"  # … or drag to orbit in orbit mode

@@ -457,6 +457,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.ToggleOrbit: lambda v, e: v.toggle_orbit(),
     c.Screenshot: lambda v, e: v.screenshot(),
     c.ToggleHud: lambda v, e: setattr(v, "hud", not v.hud),
+    c.Quit: lambda v, e: glfw.set_window_should_close(v.window, True),
     c.AddBookmark: lambda v, e: v.add_bookmark(),
     c.GoToBookmark: lambda v, e: v.go_to_bookmark(e.index),
     c.NextBookmark: lambda v, e: v.next_bookmark(),
