@@ -16,7 +16,7 @@ import pytest
 from krsview.scene import Scene, load_scene, save_scene
 from krsview.scene.presets import resolve
 
-from .test_editor import pump, xdo
+from .test_editor import open_from_start, pump, xdo
 from .test_structure import outline_row
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "editing"
@@ -151,21 +151,11 @@ def test_the_description_is_typed_in_the_panel_as_one_undo_step(display, tmp_pat
     forks): typed into its panel field with real keys, Enter makes it the scene's, one undo
     step, and saved. Negative control: the shipped description before, and again after Ctrl+Z."""
     import glfw
-    from imgui_bundle import imgui
 
     from krsview.editor import commands as ec
     from krsview.editor.window import Editor
 
-    header = imgui.collapsing_header  # the section folds; open it from the start
-    monkeypatch.setattr(
-        imgui,
-        "collapsing_header",
-        lambda label, *a: (
-            header(label, imgui.TreeNodeFlags_.default_open)
-            if label == "name and description"
-            else header(label, *a)
-        ),
-    )
+    open_from_start(monkeypatch, "name and description")
     path, text = tmp_path / "palm.toml", "a palm leaf rolled in"
     shutil.copy(resolve("palm"), path)
     shipped = load_scene(path).description

@@ -413,6 +413,22 @@ def scroll_to(e, path, margin: float, dx: float) -> tuple:
     return e.viewer.interactions.rects[path]
 
 
+def open_from_start(monkeypatch, section: str) -> None:
+    """Make the panel's folding ``section`` open from the start (a test's first frame)."""
+    from imgui_bundle import imgui
+
+    header = imgui.collapsing_header
+    monkeypatch.setattr(
+        imgui,
+        "collapsing_header",
+        lambda label, *a: (
+            header(label, imgui.TreeNodeFlags_.default_open)
+            if label == section
+            else header(label, *a)
+        ),
+    )
+
+
 def type_at(e, at, *text: str) -> None:
     """Ctrl+click the field at window point ``at``, type ``text`` (xdotool's arguments: "--"
     lets a value start with a minus) and press Return."""

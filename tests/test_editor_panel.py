@@ -17,7 +17,7 @@ from krsview.scene import load_scene
 from krsview.scene.presets import PRESET_DIR, resolve
 from krsview.viewer.hud import HUD_RIGHT
 
-from .test_editor import LEVEL, pump, scroll_to, window_xy, xdo
+from .test_editor import LEVEL, open_from_start, pump, scroll_to, window_xy, xdo
 from .test_editor import type_at as type_into
 
 SIZE = (640, 400)
@@ -129,20 +129,10 @@ def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
     line stays empty; a valid value clears it, Esc cancels a refused one. Negative control:
     no red there before."""
     import glfw
-    from imgui_bundle import imgui
 
     from krsview.viewer.window import Viewer
 
-    header = imgui.collapsing_header  # open the "accuracy and view" section from the start
-    monkeypatch.setattr(
-        imgui,
-        "collapsing_header",
-        lambda label, *a: (
-            header(label, imgui.TreeNodeFlags_.default_open)
-            if label == "accuracy and view"
-            else header(label, *a)
-        ),
-    )
+    open_from_start(monkeypatch, "accuracy and view")
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(640, 720))
