@@ -38,12 +38,12 @@ vec3r undistort(int c, vec3r p) {
 // The factor of the LOD threshold ε(t) at p: the twist's safe step is D / (1 + |k|ρ) to
 // first order, so ε shrinks by the same factor and rays converge where the undistorted
 // distance is within ε(t), not high above a twisted ground (reference/distortion.py, lod_scale).
-// The wind's is one factor for the frame, 1 / (1 + most·reach), the least its step shrink
-// 1 / (1 + |a|ρ) gets at any time and point (a loop over the components per step cost the
-// grove 12 %; a smaller ε where no bend shrinks the step costs it about 1 % of iterations).
+// The wind's is one factor for the frame (wind.glsl, wind_lod_scale: a loop over the
+// components per step cost the grove 12 %; a smaller ε where no bend shrinks the step costs
+// it about 1 % of iterations).
 real lod_scale(vec3r p) {
 #ifdef KRS_WIND
-    if (EFFECT_ON(KRS_WIND_BIT)) return 1.0 / (1.0 + u_wind.w);
+    if (EFFECT_ON(KRS_WIND_BIT)) return wind_lod_scale();
 #endif
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT))

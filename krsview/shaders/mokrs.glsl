@@ -17,11 +17,10 @@ bool exterior_is_free(int i, vec3r center, real radius) {
     return bound.w >= 0.0 && length(bound.xyz - center) + bound.w < radius;
 }
 
-// The factor of the LOD threshold ε(t): 1, or in the wind one factor for the frame,
-// 1 / (1 + most·reach), as for a KRS in the wind (distance.glsl, lod_scale).
+// The factor of the LOD threshold ε(t): 1, or in the wind its one factor for the frame.
 real lod_scale(vec3r p) {
 #ifdef KRS_WIND
-    if (EFFECT_ON(KRS_WIND_BIT)) return 1.0 / (1.0 + u_wind.w);
+    if (EFFECT_ON(KRS_WIND_BIT)) return wind_lod_scale();
 #endif
     return 1.0;
 }

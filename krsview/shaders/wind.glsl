@@ -22,6 +22,11 @@ float wind_rate(int c) {
     return float(u_wind_base[c].w > 0.0) * u_wind.x * (1.0 + u_wind.y * wind_gust(t));
 }
 
+// The factor of the LOD threshold ε(t) in the wind, one for the frame: 1 / (1 + most·reach),
+// the least the step's shrink 1 / (1 + |a|ρ) gets at any time and point (reference/wind.py,
+// lod_scale); a KRS's (distance.glsl) and a MöKRS's (mokrs.glsl) alike.
+real wind_lod_scale() { return 1.0 / (1.0 + u_wind.w); }
+
 // How far v moves when turned about A by `angle` (Rodrigues, with 1 − cos = 2 sin²(angle/2)
 // against cancellation): exactly 0 at angle 0, so an idle wind leaves every point as it is.
 vec3r wind_turn(vec3r v, float angle) {
