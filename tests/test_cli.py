@@ -380,6 +380,8 @@ def test_render_draws_fast_unless_exact(tmp_path, capsys):
     capsys.readouterr()
     assert main([*base, "--exact", "--lod", "1"]) == 2
     assert "--lod = 1.0: cannot be combined with --exact" in capsys.readouterr().err
+    assert main([*base, "--exact", "--shadow-cone", "on"]) == 2  # named as it is typed
+    assert "--shadow-cone = 'on': cannot be combined with --exact" in capsys.readouterr().err
     with pytest.raises(SystemExit) as bad:
         main([*base, "--lod", "-1"])
     assert bad.value.code == 2

@@ -191,7 +191,7 @@ def settled(args: argparse.Namespace, scene: Scene) -> Scene:
     if args.exact:
         for knob in ("prepass", "lod", "shadow_block", "shadow_cone"):
             if getattr(args, knob) is not None:
-                flag = "--" + knob
+                flag = "--" + knob.replace("_", "-")
                 raise SceneError(flag, getattr(args, knob), "cannot be combined with --exact")
         return api.exact_settings(scene)
     return scene if args.prepass is not None else api.fast_settings(scene)
