@@ -167,7 +167,8 @@ def test_twin_pointers_name_files_that_exist():
 # in the modules the shader's "twin of" names or ("module.py:name") elsewhere, and those
 # with no twin (None), with why.
 TWIN_NAMES: dict[str, str | None] = {
-    "mokrs.glsl:lod_scale": None,  # a MöKRS takes no distortion: the scale is 1
+    "mokrs.glsl:lod_scale": None,  # 1, or the wind's one factor (wind_lod_scale)
+    "wind_lod_scale": "lod_scale",  # reference/wind.py, Wind.lod_scale
     "capsule_core": "core_point",  # one core_point for every kind
     "toroidal_capsule_core": "core_point",
     "toroidal_capsule_distance": "kernel_distance",  # one kernel_distance for every kind
