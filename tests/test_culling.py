@@ -54,6 +54,55 @@ def test_every_culling_ball_holds_what_it_claims():
             assert reach.max() > 0.5 * c[3], (name, i)  # and not absurdly large
 
 
+def test_the_ball_around_a_whole_krs_holds_every_instance_and_is_tight():
+    """krs_ball holds all 2^n instances of every kernel's ball (brute force: a 12-level tree,
+    bent-tree at 11, sierpinski at 12: one sphere, empty kernels above it) and lies within
+    1.12× of the least ball that could, found here by 3,000 Bădoiu–Clarkson steps over all
+    the instances (tree 1.07×). Negative control: the ball from level_balls' one union per
+    level, which CompiledKRS.ball was before, is over 1.3× that (tree 1.59×)."""
+    from krsview.compile.krs import kernel_ball, krs_ball, level_balls, union_ball
+
+    slack = {}
+    for name, levels in (("tree", 12), ("bent-tree", 11), ("sierpinski", 12)):
+        g = load_scene(resolve(name)).geometry().truncated(levels)
+        top = kernel_ball(g.kernels[-1])
+        balls = expanded(g) if top is None else np.vstack([top, expanded(g)])
+        ball = krs_ball(g)
+        reach = np.linalg.norm(balls[:, :3] - ball[:3], axis=1) + balls[:, 3]
+        assert reach.max() <= ball[3] * (1 + 1e-12), name
+        least = least_radius(balls)
+        assert ball[3] <= 1.12 * least, name
+        slack[name] = union_ball(kernel_ball(g.kernels[-1]), level_balls(g)[-1])[3] / least
+    assert max(slack.values()) > 1.3, slack
+
+
+def least_radius(balls, steps=3000):
+    """The radius of a ball around ``balls`` close to the least: Bădoiu–Clarkson's steps
+    from the centroid toward the farthest ball, 1/(k + 2) of the way [converges as 1/√k]."""
+    c, best = balls[:, :3].mean(axis=0), np.inf
+    for k in range(steps):
+        reach = np.linalg.norm(balls[:, :3] - c, axis=1) + balls[:, 3]
+        best = min(best, reach.max())
+        c = c + (balls[reach.argmax(), :3] - c) / (k + 2)
+    return best
+
+
+def expanded(g):
+    """Every copy of every kernel's ball below the top under the reflection products."""
+    from krsview.compile.krs import kernel_ball
+
+    balls = np.zeros((0, 4))
+    for k, m in zip(g.kernels, g.mirrors):
+        b = kernel_ball(k)
+        if b is not None:
+            balls = np.vstack([balls, b])
+        u = np.array(m.normal)
+        mirrored = balls.copy()
+        mirrored[:, :3] -= 2.0 * (balls[:, :3] @ u - m.offset)[:, None] * u
+        balls = np.vstack([balls, mirrored])
+    return balls
+
+
 def test_a_ball_one_kernel_too_small_changes_the_distance():
     """Negative control: leaving K_i out of C_i (a ball one kernel too small) culls walks
     that still had a smaller value: the distance differs from the full walk somewhere."""

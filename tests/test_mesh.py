@@ -73,7 +73,7 @@ def test_the_narrow_band_finds_what_a_dense_grid_finds(monkeypatch):
     _, faces, _, _ = marching_cubes(vol, 0.0, allow_degenerate=False)
     assert len(faces) == st.triangles
     assert st.bricks < (n // BRICK) ** 3
-    # negative control: an octree test with balls a quarter too small drops bricks that hold
+    # negative control: an octree test with balls half too small drops bricks that hold
     # surface, and the dense grid sees the loss
     import krsview.share.mesh as module
 
@@ -81,7 +81,7 @@ def test_the_narrow_band_finds_what_a_dense_grid_finds(monkeypatch):
 
     def shrunk(c, dist):
         value, is_empty = field(c, dist)
-        return value, lambda x, r: is_empty(x, 0.75 * r)
+        return value, lambda x, r: is_empty(x, 0.5 * r)
 
     monkeypatch.setattr(module, "surface_field", shrunk)
     assert build_mesh(scene, 64)[1].triangles != len(faces)

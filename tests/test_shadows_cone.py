@@ -99,7 +99,8 @@ def shadow_work(renderer, scene) -> tuple[float, float]:
 
 def test_the_cone_spares_grove_most_of_its_shadow_steps(renderer):
     """Grove's shadow rays take under half the steps and levels with the cone; the tree's
-    start inside its one ball, so they take exactly the same (negative control)."""
+    start inside its one ball (but for a few on its outermost twigs), so they take about the
+    same: within 2 % (negative control)."""
     on, off = shadow_work(renderer, grove("on")), shadow_work(renderer, grove("off"))
     assert off[0] > 0 and on[0] < 0.5 * off[0] and on[1] < 0.5 * off[1], (on, off)
     tree = per_pixel(load_scene(resolve("tree")))
@@ -107,7 +108,7 @@ def test_the_cone_spares_grove_most_of_its_shadow_steps(renderer):
         shadow_work(renderer, replace(tree, render=replace(tree.render, shadow_cone=s)))
         for s in ("on", "off")
     ]
-    assert same[0] == same[1] and same[0][0] > 0
+    assert same[1][0] > 0 and 0.98 * same[1][0] <= same[0][0] <= same[1][0], same
 
 
 @pytest.mark.parametrize(
