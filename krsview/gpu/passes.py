@@ -10,7 +10,10 @@ resolution]. ``ratio`` picks the passes:
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
   each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
-  its depth (an outline) traces its own;
+  its depth (an outline) traces its own. ``shade`` draws twice: every pixel without any
+  shadow-ray code, outline pixels marked in a depth target, then the outline pixels alone,
+  redrawn with their own rays behind an early depth test (llvmpipe runs every branch's code
+  for every pixel, but skips pixel groups that fail that test);
 - r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
@@ -21,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from contextlib import AbstractContextManager
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import moderngl
 
@@ -30,8 +33,11 @@ from ..scene import Geometry, Scene
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
 MAX_KEPT = 6  # targets kept (least recently used released)
-TRACED = ("u_traced_color", "u_traced_depth", "u_traced_iterations")  # units 0, 1, 2
-COARSE = ("u_coarse_visibility", "u_coarse_depth")  # units 3, 4
+SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks',
+    # the image's normals (its own target) and its hits' kernel points (Views.points)
+    *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
+    *("u_coarse_visibility", "u_coarse_depth", "u_normals", "u_kernel_points"),
+)
 
 
 def splits_shadows(scene: Scene) -> bool:
@@ -79,6 +85,18 @@ class Tracer(Protocol):
     ) -> moderngl.Framebuffer: ...
 
 
+class Views(NamedTuple):
+    """Views of a finished image's targets for the passes after the trace, so that no pass
+    samples a texture it draws into: kernel_normals.frag draws ``kernels`` (the image's
+    normal and iterations targets and ``points``, each hit's kernel-space point and level);
+    upsampled.frag draws ``color`` (its colour target and the outline ``mask``)."""
+
+    kernels: moderngl.Framebuffer
+    color: moderngl.Framebuffer
+    points: moderngl.Texture
+    mask: moderngl.Renderbuffer
+
+
 class Targets:
     """The passes' float render targets by size, layers and slot, the MAX_KEPT most recently
     used kept. Finished images alternate between two slots, so the image on screen is never
@@ -87,6 +105,7 @@ class Targets:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
+        self._views: dict[moderngl.Framebuffer, Views] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -97,8 +116,9 @@ class Targets:
             return self._kept[key]
         while len(self._kept) >= MAX_KEPT:
             old = self._kept.pop(next(iter(self._kept)))
-            for tex in old.color_attachments:
-                tex.release()
+            views = self._views.pop(old, None)
+            for thing in (*(views or ()), *old.color_attachments):
+                thing.release()
             old.release()
         tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
         self._kept[key] = self.ctx.framebuffer(color_attachments=tex)
@@ -108,6 +128,20 @@ class Targets:
         """A finished image's three targets, the other slot than the last image's."""
         self.flip ^= 1
         return self.get(size, 3, self.flip)
+
+    def views(self, output: moderngl.Framebuffer) -> Views:
+        """The targets the passes after the trace draw ``output`` through (made once)."""
+        if output not in self._views:
+            color, normal, iterations = output.color_attachments
+            points = self.ctx.texture(output.size, 4, dtype="f4")
+            mask = self.ctx.depth_renderbuffer(output.size)
+            self._views[output] = Views(
+                self.ctx.framebuffer(color_attachments=[normal, iterations, points]),
+                self.ctx.framebuffer(color_attachments=[color], depth_attachment=mask),
+                points,
+                mask,
+            )
+        return self._views[output]
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -165,17 +199,28 @@ class PassImage:
         self._programs = {"render" if not self.ratio else "trace": main}
         if self.ratio > 1:
             vis = self.renderer.companion(main, "coarse_visibility.frag")
-            shade = self.renderer.companion(main, "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None})
             vis["u_shadow_ratio"].value = self.ratio
+            self._programs["kernels"] = self.renderer.companion(main, "kernel_normals.frag")
+            self._programs["visibility"] = vis
             (bw, bh), _, side = self.blocks
-            shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
-            shade["u_depth_slack"].value = DEPTH_SLACK
-            self._programs.update(visibility=vis, shade=shade)
+            for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
+                shade = self.renderer.companion(
+                    main, "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None, define: None}
+                )
+                shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
+                shade["u_depth_slack"].value = DEPTH_SLACK
+                self._programs[name] = shade
         elif self.ratio == 1:
             self._programs["shadows+shade"] = self.renderer.companion(main, "upsampled.frag")
+        for prog in self._programs.values():  # the samplers' units, as draw binds them
+            for unit, sampler in enumerate(SAMPLERS):
+                if sampler in prog:
+                    prog[sampler].value = unit
 
     def draw(self, name: str, y0: int, rows: int) -> None:
-        """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first."""
+        """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first. With
+        blocks, the hits' kernels are found first, in the visibility pass's rows or, where
+        this image has none (its blocks are an earlier image's), the shade pass's."""
         prog = self._programs[name]
         if name in ("render", "trace"):
             fbo = self.renderer.draw(prog, *self.size, (0, y0, self.size[0], rows))
@@ -184,27 +229,54 @@ class PassImage:
             else:
                 self.traced = fbo
             return
-        ctx = self.renderer.ctx
         with self.renderer.current():
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
-                if TRACED[unit] in prog:
-                    prog[TRACED[unit]].value = unit
+            if self.ratio == 1:
+                self._fill(prog, self.output, self.size, y0, rows)
+                return
+            views = self.targets.views(self.output)
             if name == "visibility":
-                target, size = self.targets.get(self.coarse, 2), self.coarse
-            else:
-                target, size = self.output, self.size
-                if self.ratio > 1:
-                    coarse = self.targets.get(self.blocks[1], 2)
-                    for k, tex in enumerate(coarse.color_attachments):
-                        tex.use(len(TRACED) + k)
-                        if COARSE[k] in prog:
-                            prog[COARSE[k]].value = len(TRACED) + k
-            target.use()
-            ctx.viewport = (0, 0, *size)
-            ctx.scissor = (0, y0, size[0], rows)
-            self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
-            ctx.scissor = None
+                r = self.ratio
+                self._fill(self._programs["kernels"], views.kernels, self.size, y0 * r, rows * r)
+            elif all(p[0] != "visibility" for p in self.passes):
+                self._fill(self._programs["kernels"], views.kernels, self.size, y0, rows)
+            self.output.color_attachments[1].use(SAMPLERS.index("u_normals"))
+            if name == "visibility":
+                self._fill(prog, self.targets.get(self.coarse, 2), self.coarse, y0, rows)
+                return
+            views.points.use(SAMPLERS.index("u_kernel_points"))
+            coarse = self.targets.get(self.blocks[1], 2)
+            for k, tex in enumerate(coarse.color_attachments):
+                tex.use(SAMPLERS.index("u_coarse_visibility") + k)
+            self._shade_and_outline(views.color, y0, rows)
+
+    def _fill(
+        self, prog: moderngl.Program, target: moderngl.Framebuffer, size, y0: int, rows: int
+    ) -> None:
+        """Draw ``prog`` over rows [y0, y0 + rows) of ``target`` (of ``size``)."""
+        ctx = self.renderer.ctx
+        target.use()
+        ctx.viewport = (0, 0, *size)
+        ctx.scissor = (0, y0, size[0], min(rows, size[1] - y0))
+        self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
+        ctx.scissor = None
+
+    def _shade_and_outline(self, target: moderngl.Framebuffer, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of ``target`` (the colour and the outline mask): every pixel
+        shaded without shadow-ray code, writing depth 0 where it lacks a light's visibility
+        (an outline) and 1 elsewhere; then the outline pass (the fragment's depth 0.5) only
+        where the depth is below it, each such pixel shaded anew with its own shadow rays."""
+        ctx = self.renderer.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        try:
+            ctx.depth_func = "1"  # always
+            self._fill(self._programs["shade"], target, self.size, y0, rows)
+            ctx.depth_func = ">"
+            self._fill(self._programs["outline"], target, self.size, y0, rows)
+        finally:
+            ctx.depth_func = "<"
+            ctx.disable(moderngl.DEPTH_TEST)
 
     def draw_all(
         self, bands: int = 1, progress: Callable[[int, int], None] | None = None

@@ -2,7 +2,8 @@
 // resolution]: for each u_shadow_ratio × u_shadow_ratio block of the trace-only pass
 // (render.frag with KRS_TRACE_ONLY), the block's nearest hit sends one shadow ray per light;
 // its visibilities and depth are what upsampled.frag blends along depth. The uniforms are
-// the full-resolution frame's, so the ray and its ε are those of that pixel.
+// the full-resolution frame's, so the ray and its ε are those of that pixel; the hit's
+// normal is kernel_normals.frag's.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
@@ -10,6 +11,7 @@
 
 uniform sampler2D u_traced_color;  // a: hit
 uniform sampler2D u_traced_depth;  // w: ray distance t
+uniform sampler2D u_normals;       // xyz: the hit's normal (kernel_normals.frag)
 uniform int u_shadow_ratio;
 
 layout(location = 0) out vec4 out_visibility;  // per light (MAX_LIGHTS is 4); < 0: faces
@@ -35,9 +37,7 @@ void main() {
     if (best.x < 0) return;
     real t = real(t_best);
     vec3r p = t * pixel_ray(vec2(best) + 0.5);
-    int level;
-    vec3 n, xk;
-    nearest_kernel(p, t, level, n, xk);
+    vec3 n = texelFetch(u_normals, best, 0).xyz;
     for (int k = 0; k < u_light_count; ++k)
         if (dot(n, u_light_dir[k]) > 0.0)
             out_visibility[k] = shadow_visibility(p, n, u_light_dir[k], u_eps_per_t * t_best);

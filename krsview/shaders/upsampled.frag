@@ -1,9 +1,16 @@
-// The trace-only pass (render.frag with KRS_TRACE_ONLY) shaded as render.frag shades it:
-// with KRS_SHADOW_UPSAMPLED each light's visibility comes from coarse_visibility.frag's
-// blocks around the pixel whose depth is within u_depth_slack footprints of its own
-// (bilinear weights); where none is, the pixel traces its own shadow ray (shadows.glsl). The
-// blocks may be an earlier, smaller image's of the same view (gpu/passes.py, ``blocks``).
-// Without it every pixel traces its own: render.frag's image, in two passes.
+// The trace-only pass (render.frag with KRS_TRACE_ONLY) shaded as render.frag shades it.
+// Without KRS_SHADOW_UPSAMPLED every pixel traces its own shadow rays: render.frag's image,
+// in two passes. With it each light's visibility comes from coarse_visibility.frag's blocks
+// around the pixel whose depth is within u_depth_slack footprints of its own (bilinear
+// weights), which may be an earlier, smaller image's of the same view (gpu/passes.py,
+// ``blocks``); the hit's kernel is kernel_normals.frag's, and only the colour is written.
+// Where no block is, the pixel traces its own ray, in a pass apart so that only those
+// pixels run shadow-ray code (llvmpipe runs every branch's code for every pixel):
+// KRS_SHADOW_MARK compiles none and gives such a pixel depth 0 (others 1); KRS_SHADOW_OUTLINE
+// traces them behind the early depth test, which skips groups of pixels that fail it.
+#ifdef KRS_SHADOW_OUTLINE
+layout(early_fragment_tests) in;
+#endif
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
@@ -14,6 +21,8 @@ uniform sampler2D u_traced_depth;       // w: ray distance t
 uniform sampler2D u_traced_iterations;  // x
 
 #ifdef KRS_SHADOW_UPSAMPLED
+uniform sampler2D u_normals;            // xyz: the hit's normal (kernel_normals.frag)
+uniform sampler2D u_kernel_points;      // xyz: its kernel-space point; w: its level
 uniform sampler2D u_coarse_visibility;  // per light; < 0: none
 uniform sampler2D u_coarse_depth;       // x: t; < 0: no hit
 uniform vec2 u_block;                   // a block's side in this image's pixels (an earlier,
@@ -49,8 +58,19 @@ void main() {
     bool hit = texelFetch(u_traced_color, px, 0).a > 0.5;
     float t = texelFetch(u_traced_depth, px, 0).w;
 #ifdef KRS_SHADOW_UPSAMPLED
-    if (hit) upsample_visibility(px, t);
+    vec3r dir = pixel_ray(gl_FragCoord.xy);
+    out_color = vec4(encode(background(vec3(dir))), 0.0);  // write_pixel's, from its kernel
+    if (hit) {
+        upsample_visibility(px, t);
+        vec4 xk = texelFetch(u_kernel_points, px, 0);
+        vec3 n = texelFetch(u_normals, px, 0).xyz;
+        out_color = vec4(encode(shade(real(t) * dir, vec3(dir), real(t), int(xk.w), n, xk.xyz)), 1.0);
+    }
+#ifdef KRS_SHADOW_MARK
+    gl_FragDepth = g_outline ? 0.0 : 1.0;
 #endif
+#else
     int iterations = int(texelFetch(u_traced_iterations, px, 0).x);
     write_pixel(pixel_ray(gl_FragCoord.xy), hit, real(t), iterations);
+#endif
 }
