@@ -22,6 +22,7 @@ resolution]. ``ratio`` picks the passes:
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from contextlib import AbstractContextManager
 from typing import NamedTuple, Protocol
@@ -32,6 +33,7 @@ from ..scene import Geometry, Scene
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
+BINDING_OUTLINE = 6  # the shade pass's list of outline pixels (after compile/constants.py's)
 MAX_KEPT = 6  # targets kept (least recently used released)
 SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks',
     # the image's normals (its own target) and its hits' kernel points (Views.points)
@@ -86,15 +88,19 @@ class Tracer(Protocol):
 
 
 class Views(NamedTuple):
-    """Views of a finished image's targets for the passes after the trace, so that no pass
-    samples a texture it draws into: kernel_normals.frag draws ``kernels`` (the image's
-    normal and iterations targets and ``points``, each hit's kernel-space point and level);
-    upsampled.frag draws ``color`` (its colour target and the outline ``mask``)."""
+    """What the passes after the trace draw a finished image through, so that no pass samples
+    a texture it draws into: kernel_normals.frag draws ``kernels`` (the image's normal and
+    iterations targets and ``points``, each hit's kernel-space point and level);
+    upsampled.frag's shade pass draws ``color`` (the colour target) and lists its outline
+    pixels in ``outline``; its outline pass draws ``scratch`` (no colour: it stores each
+    listed pixel's colour in the image's)."""
 
     kernels: moderngl.Framebuffer
     color: moderngl.Framebuffer
+    scratch: moderngl.Framebuffer
     points: moderngl.Texture
-    mask: moderngl.Renderbuffer
+    depth: moderngl.Renderbuffer
+    outline: moderngl.Buffer
 
 
 class Targets:
@@ -130,16 +136,18 @@ class Targets:
         return self.get(size, 3, self.flip)
 
     def views(self, output: moderngl.Framebuffer) -> Views:
-        """The targets the passes after the trace draw ``output`` through (made once)."""
+        """The views of ``output`` (made once)."""
         if output not in self._views:
             color, normal, iterations = output.color_attachments
-            points = self.ctx.texture(output.size, 4, dtype="f4")
-            mask = self.ctx.depth_renderbuffer(output.size)
+            (w, h), points = output.size, self.ctx.texture(output.size, 4, dtype="f4")
+            depth = self.ctx.depth_renderbuffer(output.size)
             self._views[output] = Views(
                 self.ctx.framebuffer(color_attachments=[normal, iterations, points]),
-                self.ctx.framebuffer(color_attachments=[color], depth_attachment=mask),
+                self.ctx.framebuffer(color_attachments=[color]),
+                self.ctx.framebuffer(depth_attachment=depth),
                 points,
-                mask,
+                depth,
+                self.ctx.buffer(reserve=4 * (w * h + 1)),  # Outline: a count, then pixels
             )
         return self._views[output]
 
@@ -205,7 +213,13 @@ class PassImage:
             (bw, bh), _, side = self.blocks
             for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
                 shade = self.renderer.companion(
-                    main, "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None, define: None}
+                    main,
+                    "upsampled.frag",
+                    {
+                        "KRS_SHADOW_UPSAMPLED": None,
+                        define: None,
+                        "BINDING_OUTLINE": BINDING_OUTLINE,
+                    },
                 )
                 shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
                 shade["u_depth_slack"].value = DEPTH_SLACK
@@ -249,7 +263,7 @@ class PassImage:
             coarse = self.targets.get(self.blocks[1], 2)
             for k, tex in enumerate(coarse.color_attachments):
                 tex.use(SAMPLERS.index("u_coarse_visibility") + k)
-            self._shade_and_outline(views.color, y0, rows)
+            self._shade_and_outline(views, y0, rows)
 
     def _fill(
         self, prog: moderngl.Program, target: moderngl.Framebuffer, size, y0: int, rows: int
@@ -262,21 +276,22 @@ class PassImage:
         self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
         ctx.scissor = None
 
-    def _shade_and_outline(self, target: moderngl.Framebuffer, y0: int, rows: int) -> None:
-        """Rows [y0, y0 + rows) of ``target`` (the colour and the outline mask): every pixel
-        shaded without shadow-ray code, writing depth 0 where it lacks a light's visibility
-        (an outline) and 1 elsewhere; then the outline pass (the fragment's depth 0.5) only
-        where the depth is below it, each such pixel shaded anew with its own shadow rays."""
+    def _shade_and_outline(self, views: Views, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of the image's colour: every pixel shaded without shadow-ray
+        code, except the outline pixels (those that lack a light's visibility), which are
+        listed instead; then the listed pixels shaded with their own shadow rays, packed
+        into the first rows of a pass of their own, their colours stored in the image's."""
         ctx = self.renderer.ctx
-        ctx.enable(moderngl.DEPTH_TEST)
-        try:
-            ctx.depth_func = "1"  # always
-            self._fill(self._programs["shade"], target, self.size, y0, rows)
-            ctx.depth_func = ">"
-            self._fill(self._programs["outline"], target, self.size, y0, rows)
-        finally:
-            ctx.depth_func = "<"
-            ctx.disable(moderngl.DEPTH_TEST)
+        views.outline.write(bytes(4))  # no pixel listed
+        views.outline.bind_to_storage_buffer(BINDING_OUTLINE)
+        self._fill(self._programs["shade"], views.color, self.size, y0, rows)
+        ctx.memory_barrier()  # the list complete before it is read
+        self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
+        listed = int.from_bytes(views.outline.read(4), sys.byteorder)
+        if listed:  # their pass over as many rows as they fill
+            w = self.size[0]
+            self._fill(self._programs["outline"], views.scratch, self.size, 0, -(-listed // w))
+        ctx.memory_barrier()  # the stored colours visible to whatever reads the image
 
     def draw_all(
         self, bands: int = 1, progress: Callable[[int, int], None] | None = None

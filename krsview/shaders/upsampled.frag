@@ -4,13 +4,12 @@
 // around the pixel whose depth is within u_depth_slack footprints of its own (bilinear
 // weights), which may be an earlier, smaller image's of the same view (gpu/passes.py,
 // ``blocks``); the hit's kernel is kernel_normals.frag's, and only the colour is written.
-// Where no block is, the pixel traces its own ray, in a pass apart so that only those
-// pixels run shadow-ray code (llvmpipe runs every branch's code for every pixel):
-// KRS_SHADOW_MARK compiles none and gives such a pixel depth 0 (others 1); KRS_SHADOW_OUTLINE
-// traces them behind the early depth test, which skips groups of pixels that fail it.
-#ifdef KRS_SHADOW_OUTLINE
-layout(early_fragment_tests) in;
-#endif
+// Where no block is (an outline), the pixel traces its own ray, in a pass apart so that
+// only those pixels run shadow-ray code (llvmpipe runs every branch's code for every
+// pixel): KRS_SHADOW_MARK compiles none and appends such a pixel to a list instead of
+// writing it; KRS_SHADOW_OUTLINE shades the listed pixels, the list's i-th at the i-th pixel
+// of its pass, so they fill whole groups of lanes (those past the list's end discard at
+// once, and llvmpipe skips a group that has discarded).
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
@@ -53,23 +52,48 @@ void upsample_visibility(ivec2 px, float t) {
 }
 #endif
 
+#if defined(KRS_SHADOW_MARK) || defined(KRS_SHADOW_OUTLINE)
+layout(std430, binding = BINDING_OUTLINE) buffer Outline {
+    uint outline_count;     // pixels listed
+    uint outline_pixels[];  // y · width + x
+};
+#endif
+#ifdef KRS_SHADOW_OUTLINE
+layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
+#endif
+
+#ifdef KRS_SHADOW_UPSAMPLED
+// Pixel px's colour (write_pixel's), its kernel kernel_normals.frag's.
+vec4 upsampled_color(ivec2 px) {
+    vec3r dir = pixel_ray(vec2(px) + 0.5);
+    if (texelFetch(u_traced_color, px, 0).a < 0.5) return vec4(encode(background(vec3(dir))), 0.0);
+    real t = real(texelFetch(u_traced_depth, px, 0).w);
+    upsample_visibility(px, float(t));
+    vec4 xk = texelFetch(u_kernel_points, px, 0);
+    vec3 n = texelFetch(u_normals, px, 0).xyz;
+    return vec4(encode(shade(t * dir, vec3(dir), t, int(xk.w), n, xk.xyz)), 1.0);
+}
+#endif
+
 void main() {
+#if defined(KRS_SHADOW_MARK)
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    out_color = upsampled_color(px);
+    if (g_outline) {
+        uint width = uint(textureSize(u_traced_color, 0).x);
+        outline_pixels[atomicAdd(outline_count, 1u)] = uint(px.y) * width + uint(px.x);
+        discard;
+    }
+#elif defined(KRS_SHADOW_OUTLINE)
+    uint width = uint(textureSize(u_traced_color, 0).x);
+    uint i = uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x);
+    if (i >= outline_count) discard;
+    ivec2 px = ivec2(outline_pixels[i] % width, outline_pixels[i] / width);
+    imageStore(u_color_image, px, upsampled_color(px));
+#else
     ivec2 px = ivec2(gl_FragCoord.xy);
     bool hit = texelFetch(u_traced_color, px, 0).a > 0.5;
     float t = texelFetch(u_traced_depth, px, 0).w;
-#ifdef KRS_SHADOW_UPSAMPLED
-    vec3r dir = pixel_ray(gl_FragCoord.xy);
-    out_color = vec4(encode(background(vec3(dir))), 0.0);  // write_pixel's, from its kernel
-    if (hit) {
-        upsample_visibility(px, t);
-        vec4 xk = texelFetch(u_kernel_points, px, 0);
-        vec3 n = texelFetch(u_normals, px, 0).xyz;
-        out_color = vec4(encode(shade(real(t) * dir, vec3(dir), real(t), int(xk.w), n, xk.xyz)), 1.0);
-    }
-#ifdef KRS_SHADOW_MARK
-    gl_FragDepth = g_outline ? 0.0 : 1.0;
-#endif
-#else
     int iterations = int(texelFetch(u_traced_iterations, px, 0).x);
     write_pixel(pixel_ray(gl_FragCoord.xy), hit, real(t), iterations);
 #endif
