@@ -35,10 +35,9 @@ SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
 BINDING_OUTLINE = 6  # the shade pass's list of outline pixels (after compile/constants.py's)
 MAX_KEPT = 6  # targets kept (least recently used released)
-SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks',
-    # the image's normals (its own target) and its hits' kernel points (Views.points)
+SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks'
     *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
-    *("u_coarse_visibility", "u_coarse_depth", "u_normals", "u_kernel_points"),
+    *("u_coarse_visibility", "u_coarse_depth"),
 )
 
 
@@ -87,20 +86,14 @@ class Tracer(Protocol):
     ) -> moderngl.Framebuffer: ...
 
 
-class Views(NamedTuple):
-    """What the passes after the trace draw a finished image through, so that no pass samples
-    a texture it draws into: kernel_normals.frag draws ``kernels`` (the image's normal and
-    iterations targets and ``points``, each hit's kernel-space point and level);
-    upsampled.frag's shade pass draws ``color`` (the colour target) and lists its outline
-    pixels in ``outline``; its outline pass draws ``scratch`` (no colour: it stores each
-    listed pixel's colour in the image's)."""
+class Outline(NamedTuple):
+    """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
+    the pixels) and the target their pass draws (no colour: it stores each listed pixel's
+    colour in the image's)."""
 
-    kernels: moderngl.Framebuffer
-    color: moderngl.Framebuffer
+    pixels: moderngl.Buffer
     scratch: moderngl.Framebuffer
-    points: moderngl.Texture
     depth: moderngl.Renderbuffer
-    outline: moderngl.Buffer
 
 
 class Targets:
@@ -111,7 +104,7 @@ class Targets:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
-        self._views: dict[moderngl.Framebuffer, Views] = {}
+        self._outlines: dict[moderngl.Framebuffer, Outline] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -122,8 +115,8 @@ class Targets:
             return self._kept[key]
         while len(self._kept) >= MAX_KEPT:
             old = self._kept.pop(next(iter(self._kept)))
-            views = self._views.pop(old, None)
-            for thing in (*(views or ()), *old.color_attachments):
+            outline = self._outlines.pop(old, None)
+            for thing in (*(outline or ()), *old.color_attachments):
                 thing.release()
             old.release()
         tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
@@ -135,21 +128,16 @@ class Targets:
         self.flip ^= 1
         return self.get(size, 3, self.flip)
 
-    def views(self, output: moderngl.Framebuffer) -> Views:
-        """The views of ``output`` (made once)."""
-        if output not in self._views:
-            color, normal, iterations = output.color_attachments
-            (w, h), points = output.size, self.ctx.texture(output.size, 4, dtype="f4")
-            depth = self.ctx.depth_renderbuffer(output.size)
-            self._views[output] = Views(
-                self.ctx.framebuffer(color_attachments=[normal, iterations, points]),
-                self.ctx.framebuffer(color_attachments=[color]),
+    def outline(self, output: moderngl.Framebuffer) -> Outline:
+        """The outline list of ``output`` (made once)."""
+        if output not in self._outlines:
+            (w, h), depth = output.size, self.ctx.depth_renderbuffer(output.size)
+            self._outlines[output] = Outline(
+                self.ctx.buffer(reserve=4 * (w * h + 1)),
                 self.ctx.framebuffer(depth_attachment=depth),
-                points,
                 depth,
-                self.ctx.buffer(reserve=4 * (w * h + 1)),  # Outline: a count, then pixels
             )
-        return self._views[output]
+        return self._outlines[output]
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -202,13 +190,12 @@ class PassImage:
     def prepare(self) -> None:
         """Compile or fetch the passes' programs and upload the uniforms: at each turn's
         start, since other drawing may have happened in between."""
-        probes = ("KRS_TRACE_ONLY",) if self.ratio else ()
+        probes = ("KRS_TRACE_ONLY", "KRS_TRACE_KERNELS") if self.ratio else ()
         main = self.renderer.prepare(self.scene, *self.size, self.geometry, probes=probes)
         self._programs = {"render" if not self.ratio else "trace": main}
         if self.ratio > 1:
             vis = self.renderer.companion(main, "coarse_visibility.frag")
             vis["u_shadow_ratio"].value = self.ratio
-            self._programs["kernels"] = self.renderer.companion(main, "kernel_normals.frag")
             self._programs["visibility"] = vis
             (bw, bh), _, side = self.blocks
             for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
@@ -232,9 +219,7 @@ class PassImage:
                     prog[sampler].value = unit
 
     def draw(self, name: str, y0: int, rows: int) -> None:
-        """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first. With
-        blocks, the hits' kernels are found first, in the visibility pass's rows or, where
-        this image has none (its blocks are an earlier image's), the shade pass's."""
+        """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first."""
         prog = self._programs[name]
         if name in ("render", "trace"):
             fbo = self.renderer.draw(prog, *self.size, (0, y0, self.size[0], rows))
@@ -246,24 +231,15 @@ class PassImage:
         with self.renderer.current():
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
-            if self.ratio == 1:
-                self._fill(prog, self.output, self.size, y0, rows)
-                return
-            views = self.targets.views(self.output)
-            if name == "visibility":
-                r = self.ratio
-                self._fill(self._programs["kernels"], views.kernels, self.size, y0 * r, rows * r)
-            elif all(p[0] != "visibility" for p in self.passes):
-                self._fill(self._programs["kernels"], views.kernels, self.size, y0, rows)
-            self.output.color_attachments[1].use(SAMPLERS.index("u_normals"))
             if name == "visibility":
                 self._fill(prog, self.targets.get(self.coarse, 2), self.coarse, y0, rows)
-                return
-            views.points.use(SAMPLERS.index("u_kernel_points"))
-            coarse = self.targets.get(self.blocks[1], 2)
-            for k, tex in enumerate(coarse.color_attachments):
-                tex.use(SAMPLERS.index("u_coarse_visibility") + k)
-            self._shade_and_outline(views, y0, rows)
+            elif name == "shade":
+                coarse = self.targets.get(self.blocks[1], 2)
+                for k, tex in enumerate(coarse.color_attachments):
+                    tex.use(len(self.traced.color_attachments) + k)
+                self._shade_and_outline(y0, rows)
+            else:
+                self._fill(prog, self.output, self.size, y0, rows)
 
     def _fill(
         self, prog: moderngl.Program, target: moderngl.Framebuffer, size, y0: int, rows: int
@@ -276,22 +252,22 @@ class PassImage:
         self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
         ctx.scissor = None
 
-    def _shade_and_outline(self, views: Views, y0: int, rows: int) -> None:
-        """Rows [y0, y0 + rows) of the image's colour: every pixel shaded without shadow-ray
-        code, except the outline pixels (those that lack a light's visibility), which are
-        listed instead; then the listed pixels shaded with their own shadow rays, packed
-        into the first rows of a pass of their own, their colours stored in the image's."""
-        ctx = self.renderer.ctx
-        views.outline.write(bytes(4))  # no pixel listed
-        views.outline.bind_to_storage_buffer(BINDING_OUTLINE)
-        self._fill(self._programs["shade"], views.color, self.size, y0, rows)
-        ctx.memory_barrier()  # the list complete before it is read
-        self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
-        listed = int.from_bytes(views.outline.read(4), sys.byteorder)
+    def _shade_and_outline(self, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
+        outline pixels (those that lack a light's visibility) listed; then the listed pixels
+        shaded anew with their own shadow rays, packed into the first rows of a pass of
+        their own, their colours stored over the image's."""
+        ctx, outline = self.renderer.ctx, self.targets.outline(self.output)
+        outline.pixels.write(bytes(4))  # none listed
+        outline.pixels.bind_to_storage_buffer(BINDING_OUTLINE)
+        self._fill(self._programs["shade"], self.output, self.size, y0, rows)
+        ctx.memory_barrier()  # the list and the shaded pixels complete
+        listed = int.from_bytes(outline.pixels.read(4), sys.byteorder)
         if listed:  # their pass over as many rows as they fill
-            w = self.size[0]
-            self._fill(self._programs["outline"], views.scratch, self.size, 0, -(-listed // w))
-        ctx.memory_barrier()  # the stored colours visible to whatever reads the image
+            self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
+            rows = -(-listed // self.size[0])
+            self._fill(self._programs["outline"], outline.scratch, self.size, 0, rows)
+            ctx.memory_barrier()  # the stored colours visible to whatever reads the image
 
     def draw_all(
         self, bands: int = 1, progress: Callable[[int, int], None] | None = None

@@ -1,27 +1,25 @@
-// The trace-only pass (render.frag with KRS_TRACE_ONLY) shaded as render.frag shades it.
-// Without KRS_SHADOW_UPSAMPLED every pixel traces its own shadow rays: render.frag's image,
-// in two passes. With it each light's visibility comes from coarse_visibility.frag's blocks
-// around the pixel whose depth is within u_depth_slack footprints of its own (bilinear
-// weights), which may be an earlier, smaller image's of the same view (gpu/passes.py,
-// ``blocks``); the hit's kernel is kernel_normals.frag's, and only the colour is written.
-// Where no block is (an outline), the pixel traces its own ray, in a pass apart so that
-// only those pixels run shadow-ray code (llvmpipe runs every branch's code for every
-// pixel): KRS_SHADOW_MARK compiles none and appends such a pixel to a list instead of
-// writing it; KRS_SHADOW_OUTLINE shades the listed pixels, the list's i-th at the i-th pixel
-// of its pass, so they fill whole groups of lanes (those past the list's end discard at
-// once, and llvmpipe skips a group that has discarded).
+// The trace-only pass (render.frag with KRS_TRACE_ONLY and KRS_TRACE_KERNELS: each hit's
+// kernel found there) shaded as render.frag shades it. Without KRS_SHADOW_UPSAMPLED every
+// pixel traces its own shadow rays: render.frag's image, in two passes. With it each
+// light's visibility comes from coarse_visibility.frag's blocks around the pixel whose depth
+// is within u_depth_slack footprints of its own (bilinear weights), which may be an
+// earlier, smaller image's of the same view (gpu/passes.py, ``blocks``). Where no block is
+// (an outline), the pixel traces its own ray, in a pass apart so that only those pixels
+// run shadow-ray code (llvmpipe runs every branch's code for every pixel): KRS_SHADOW_MARK
+// compiles none and lists such a pixel; KRS_SHADOW_OUTLINE shades the listed pixels, the
+// list's i-th at the i-th pixel of its pass, so that they fill whole groups of lanes, and
+// stores each one's colour in the image's.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
 #include "pixel.glsl"
 
-uniform sampler2D u_traced_color;       // a: hit
-uniform sampler2D u_traced_depth;       // w: ray distance t
+uniform sampler2D u_traced_color;       // rgb: the hit's kernel-space point; a: 1 + its
+                                        // level (< 0.5: no hit)
+uniform sampler2D u_traced_depth;       // xyz: the hit's normal; w: ray distance t
 uniform sampler2D u_traced_iterations;  // x
 
 #ifdef KRS_SHADOW_UPSAMPLED
-uniform sampler2D u_normals;            // xyz: the hit's normal (kernel_normals.frag)
-uniform sampler2D u_kernel_points;      // xyz: its kernel-space point; w: its level
 uniform sampler2D u_coarse_visibility;  // per light; < 0: none
 uniform sampler2D u_coarse_depth;       // x: t; < 0: no hit
 uniform vec2 u_block;                   // a block's side in this image's pixels (an earlier,
@@ -62,39 +60,37 @@ layout(std430, binding = BINDING_OUTLINE) buffer Outline {
 layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
 #endif
 
-#ifdef KRS_SHADOW_UPSAMPLED
-// Pixel px's colour (write_pixel's), its kernel kernel_normals.frag's.
-vec4 upsampled_color(ivec2 px) {
+// Pixel px's colour as write_pixel shades it, from the kernel the trace pass found.
+vec4 traced_color(ivec2 px) {
     vec3r dir = pixel_ray(vec2(px) + 0.5);
-    if (texelFetch(u_traced_color, px, 0).a < 0.5) return vec4(encode(background(vec3(dir))), 0.0);
-    real t = real(texelFetch(u_traced_depth, px, 0).w);
-    upsample_visibility(px, float(t));
-    vec4 xk = texelFetch(u_kernel_points, px, 0);
-    vec3 n = texelFetch(u_normals, px, 0).xyz;
-    return vec4(encode(shade(t * dir, vec3(dir), t, int(xk.w), n, xk.xyz)), 1.0);
-}
+    vec4 xk = texelFetch(u_traced_color, px, 0);
+    if (xk.a < 0.5) return vec4(encode(background(vec3(dir))), 0.0);
+    vec4 nt = texelFetch(u_traced_depth, px, 0);
+    real t = real(nt.w);
+#ifdef KRS_SHADOW_UPSAMPLED
+    upsample_visibility(px, nt.w);
 #endif
+    return vec4(encode(shade(t * dir, vec3(dir), t, int(xk.a) - 1, nt.xyz, xk.xyz)), 1.0);
+}
 
 void main() {
-#if defined(KRS_SHADOW_MARK)
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    out_color = upsampled_color(px);
-    if (g_outline) {
-        uint width = uint(textureSize(u_traced_color, 0).x);
-        outline_pixels[atomicAdd(outline_count, 1u)] = uint(px.y) * width + uint(px.x);
-        discard;
-    }
-#elif defined(KRS_SHADOW_OUTLINE)
+#ifdef KRS_SHADOW_OUTLINE
     uint width = uint(textureSize(u_traced_color, 0).x);
     uint i = uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x);
     if (i >= outline_count) discard;
     ivec2 px = ivec2(outline_pixels[i] % width, outline_pixels[i] / width);
-    imageStore(u_color_image, px, upsampled_color(px));
+    imageStore(u_color_image, px, traced_color(px));
 #else
     ivec2 px = ivec2(gl_FragCoord.xy);
-    bool hit = texelFetch(u_traced_color, px, 0).a > 0.5;
-    float t = texelFetch(u_traced_depth, px, 0).w;
-    int iterations = int(texelFetch(u_traced_iterations, px, 0).x);
-    write_pixel(pixel_ray(gl_FragCoord.xy), hit, real(t), iterations);
+    out_color = traced_color(px);  // an outline pixel's is stored over it by its own pass
+    vec4 nt = texelFetch(u_traced_depth, px, 0);
+    out_normal = out_color.a > 0.5 ? nt : vec4(0.0);
+    out_iterations = vec4(texelFetch(u_traced_iterations, px, 0).x, 0.0, 0.0, 0.0);
+#ifdef KRS_SHADOW_MARK
+    if (g_outline) {
+        uint width = uint(textureSize(u_traced_color, 0).x);
+        outline_pixels[atomicAdd(outline_count, 1u)] = uint(px.y) * width + uint(px.x);
+    }
+#endif
 #endif
 }
