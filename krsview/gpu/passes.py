@@ -3,17 +3,18 @@ turns and trace its shadow rays at reduced resolution [KRS17 §8.5 traces soft s
 resolution]. ``ratio`` picks the passes:
 
 - 0: ``render``, render.frag with every effect in one pass (the renderer's own image);
-- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY), then
-  ``shadows+shade``, upsampled.frag shading every pixel with its own shadow rays:
-  render.frag's image in two passes, so a later image of the same view and size can reuse
-  the tracing;
+- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY; with
+  KRS_TRACE_KERNELS it also finds each hit's kernel, which the passes after it read instead
+  of walking Alg. 1 again), then ``shadows+shade``, upsampled.frag shading every pixel with
+  its own shadow rays: render.frag's image in two passes, so a later image of the same view
+  and size can reuse the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
   each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
-  its depth (an outline) traces its own. ``shade`` draws twice: every pixel without any
-  shadow-ray code, outline pixels marked in a depth target, then the outline pixels alone,
-  redrawn with their own rays behind an early depth test (llvmpipe runs every branch's code
-  for every pixel, but skips pixel groups that fail that test);
+  its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
+  branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
+  outline pixels listed (an atomic counter), then the listed pixels alone, packed into the
+  first rows of a pass of their own, shaded with their own rays and stored into the image;
 - r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
