@@ -159,12 +159,12 @@ float g_shadow[MAX_LIGHTS];    // the compute path: each light's visibility, tra
 #endif
 #ifdef KRS_SHADOW_MARK
 bool g_outline = false;        // a lit light that no block gave a visibility: upsampled.frag
-                               // marks the pixel for the outline pass, which traces its ray
+                               // lists the pixel for the outline pass, which traces its ray
 #endif
 
 // The visibility of light k that shade() multiplies in. With KRS_SHADOW_MARK no shadow ray
 // is compiled in (llvmpipe runs every branch's code for every pixel): a light without a
-// block's visibility marks the pixel instead, and the colour it gets here is redrawn.
+// block's visibility marks the pixel instead, and the colour it gets here is replaced.
 float light_visibility(int k, vec3r p, vec3 n, float eps) {
 #ifdef KRS_SHADOW_TASKS
     return g_shadow[k];
