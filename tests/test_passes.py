@@ -119,7 +119,9 @@ def test_the_passes_are_valid_desktop_glsl(renderer, tmp_path, monkeypatch):
     build = program.build_program
 
     def recording(ctx, vertex, fragment, defines, shader_dir=program.SHADER_DIR):
-        if fragment in ("coarse_visibility.frag", "upsampled.frag"):
+        if fragment in ("coarse_visibility.frag", "upsampled.frag") or (
+            fragment == "render.frag" and "KRS_TRACE_KERNELS" in defines  # the trace pass
+        ):
             key = f"s{len(sources):02d}-{fragment.replace('.', '-')}.frag"
             sources[key] = program.Source(fragment, defines).text
         return build(ctx, vertex, fragment, defines, shader_dir)
@@ -130,7 +132,8 @@ def test_the_passes_are_valid_desktop_glsl(renderer, tmp_path, monkeypatch):
     for scene in (scene_of("tree"), scene_of("grove"), replace(mokrs, effects=["soft_shadows"])):
         for ratio in (1, 2):
             draw(renderer, Targets(renderer.ctx), scene, ratio, (16, 9))
-    assert len(sources) == 9
+    # per scene: the trace pass; ratio 1: the shading; 2: blocks, shading, outline pixels
+    assert len(sources) == 15
     for version in VERSIONS:
         assert validate(sources, tmp_path, version) == ""
     # negative control: a call the language does not have

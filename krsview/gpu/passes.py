@@ -3,14 +3,18 @@ turns and trace its shadow rays at reduced resolution [KRS17 §8.5 traces soft s
 resolution]. ``ratio`` picks the passes:
 
 - 0: ``render``, render.frag with every effect in one pass (the renderer's own image);
-- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY), then
-  ``shadows+shade``, upsampled.frag shading every pixel with its own shadow rays:
-  render.frag's image in two passes, so a later image of the same view and size can reuse
-  the tracing;
+- 1: ``trace``, the primary rays alone (render.frag with KRS_TRACE_ONLY; with
+  KRS_TRACE_KERNELS it also finds each hit's kernel, which the passes after it read instead
+  of walking Alg. 1 again), then ``shadows+shade``, upsampled.frag shading every pixel with
+  its own shadow rays: render.frag's image in two passes, so a later image of the same view
+  and size can reuse the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
   each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
-  its depth (an outline) traces its own;
+  its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
+  branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
+  outline pixels listed (an atomic counter), then the listed pixels alone, packed into the
+  first rows of a pass of their own, shaded with their own rays and stored into the image;
 - r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
@@ -19,9 +23,10 @@ resolution]. ``ratio`` picks the passes:
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from contextlib import AbstractContextManager
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import moderngl
 
@@ -29,9 +34,12 @@ from ..scene import Geometry, Scene
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
+BINDING_OUTLINE = 6  # the shade pass's list of outline pixels (after compile/constants.py's)
 MAX_KEPT = 6  # targets kept (least recently used released)
-TRACED = ("u_traced_color", "u_traced_depth", "u_traced_iterations")  # units 0, 1, 2
-COARSE = ("u_coarse_visibility", "u_coarse_depth")  # units 3, 4
+SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks'
+    *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
+    *("u_coarse_visibility", "u_coarse_depth"),
+)
 
 
 def splits_shadows(scene: Scene) -> bool:
@@ -79,6 +87,16 @@ class Tracer(Protocol):
     ) -> moderngl.Framebuffer: ...
 
 
+class Outline(NamedTuple):
+    """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
+    the pixels) and the target their pass draws (no colour: it stores each listed pixel's
+    colour in the image's)."""
+
+    pixels: moderngl.Buffer
+    scratch: moderngl.Framebuffer
+    depth: moderngl.Renderbuffer
+
+
 class Targets:
     """The passes' float render targets by size, layers and slot, the MAX_KEPT most recently
     used kept. Finished images alternate between two slots, so the image on screen is never
@@ -87,6 +105,7 @@ class Targets:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
+        self._outlines: dict[moderngl.Framebuffer, Outline] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -97,8 +116,9 @@ class Targets:
             return self._kept[key]
         while len(self._kept) >= MAX_KEPT:
             old = self._kept.pop(next(iter(self._kept)))
-            for tex in old.color_attachments:
-                tex.release()
+            outline = self._outlines.pop(old, None)
+            for thing in (*(outline or ()), *old.color_attachments):
+                thing.release()
             old.release()
         tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
         self._kept[key] = self.ctx.framebuffer(color_attachments=tex)
@@ -108,6 +128,17 @@ class Targets:
         """A finished image's three targets, the other slot than the last image's."""
         self.flip ^= 1
         return self.get(size, 3, self.flip)
+
+    def outline(self, output: moderngl.Framebuffer) -> Outline:
+        """The outline list of ``output`` (made once)."""
+        if output not in self._outlines:
+            (w, h), depth = output.size, self.ctx.depth_renderbuffer(output.size)
+            self._outlines[output] = Outline(
+                self.ctx.buffer(reserve=4 * (w * h + 1)),
+                self.ctx.framebuffer(depth_attachment=depth),
+                depth,
+            )
+        return self._outlines[output]
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -160,19 +191,33 @@ class PassImage:
     def prepare(self) -> None:
         """Compile or fetch the passes' programs and upload the uniforms: at each turn's
         start, since other drawing may have happened in between."""
-        probes = ("KRS_TRACE_ONLY",) if self.ratio else ()
+        probes = ("KRS_TRACE_ONLY", "KRS_TRACE_KERNELS") if self.ratio else ()
         main = self.renderer.prepare(self.scene, *self.size, self.geometry, probes=probes)
         self._programs = {"render" if not self.ratio else "trace": main}
         if self.ratio > 1:
             vis = self.renderer.companion(main, "coarse_visibility.frag")
-            shade = self.renderer.companion(main, "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None})
             vis["u_shadow_ratio"].value = self.ratio
+            self._programs["visibility"] = vis
             (bw, bh), _, side = self.blocks
-            shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
-            shade["u_depth_slack"].value = DEPTH_SLACK
-            self._programs.update(visibility=vis, shade=shade)
+            for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
+                shade = self.renderer.companion(
+                    main,
+                    "upsampled.frag",
+                    {
+                        "KRS_SHADOW_UPSAMPLED": None,
+                        define: None,
+                        "BINDING_OUTLINE": BINDING_OUTLINE,
+                    },
+                )
+                shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
+                shade["u_depth_slack"].value = DEPTH_SLACK
+                self._programs[name] = shade
         elif self.ratio == 1:
             self._programs["shadows+shade"] = self.renderer.companion(main, "upsampled.frag")
+        for prog in self._programs.values():  # the samplers' units, as draw binds them
+            for unit, sampler in enumerate(SAMPLERS):
+                if sampler in prog:
+                    prog[sampler].value = unit
 
     def draw(self, name: str, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first."""
@@ -184,27 +229,46 @@ class PassImage:
             else:
                 self.traced = fbo
             return
-        ctx = self.renderer.ctx
         with self.renderer.current():
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
-                if TRACED[unit] in prog:
-                    prog[TRACED[unit]].value = unit
             if name == "visibility":
-                target, size = self.targets.get(self.coarse, 2), self.coarse
+                self._fill(prog, self.targets.get(self.coarse, 2), self.coarse, y0, rows)
+            elif name == "shade":
+                coarse = self.targets.get(self.blocks[1], 2)
+                for k, tex in enumerate(coarse.color_attachments):
+                    tex.use(len(self.traced.color_attachments) + k)
+                self._shade_and_outline(y0, rows)
             else:
-                target, size = self.output, self.size
-                if self.ratio > 1:
-                    coarse = self.targets.get(self.blocks[1], 2)
-                    for k, tex in enumerate(coarse.color_attachments):
-                        tex.use(len(TRACED) + k)
-                        if COARSE[k] in prog:
-                            prog[COARSE[k]].value = len(TRACED) + k
-            target.use()
-            ctx.viewport = (0, 0, *size)
-            ctx.scissor = (0, y0, size[0], rows)
-            self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
-            ctx.scissor = None
+                self._fill(prog, self.output, self.size, y0, rows)
+
+    def _fill(
+        self, prog: moderngl.Program, target: moderngl.Framebuffer, size, y0: int, rows: int
+    ) -> None:
+        """Draw ``prog`` over rows [y0, y0 + rows) of ``target`` (of ``size``)."""
+        ctx = self.renderer.ctx
+        target.use()
+        ctx.viewport = (0, 0, *size)
+        ctx.scissor = (0, y0, size[0], min(rows, size[1] - y0))
+        self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
+        ctx.scissor = None
+
+    def _shade_and_outline(self, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
+        outline pixels (those that lack a light's visibility) listed; then the listed pixels
+        shaded anew with their own shadow rays, packed into the first rows of a pass of
+        their own, their colours stored over the image's."""
+        ctx, outline = self.renderer.ctx, self.targets.outline(self.output)
+        outline.pixels.write(bytes(4))  # none listed
+        outline.pixels.bind_to_storage_buffer(BINDING_OUTLINE)
+        self._fill(self._programs["shade"], self.output, self.size, y0, rows)
+        ctx.memory_barrier()  # the list and the shaded pixels complete
+        listed = int.from_bytes(outline.pixels.read(4), sys.byteorder)
+        if listed:  # their pass over as many rows as they fill
+            self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
+            rows = -(-listed // self.size[0])
+            self._fill(self._programs["outline"], outline.scratch, self.size, 0, rows)
+            ctx.memory_barrier()  # the stored colours visible to whatever reads the image
 
     def draw_all(
         self, bands: int = 1, progress: Callable[[int, int], None] | None = None

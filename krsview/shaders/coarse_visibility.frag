@@ -2,14 +2,15 @@
 // resolution]: for each u_shadow_ratio × u_shadow_ratio block of the trace-only pass
 // (render.frag with KRS_TRACE_ONLY), the block's nearest hit sends one shadow ray per light;
 // its visibilities and depth are what upsampled.frag blends along depth. The uniforms are
-// the full-resolution frame's, so the ray and its ε are those of that pixel.
+// the full-resolution frame's, so the ray and its ε are those of that pixel; the hit's
+// normal is the trace pass's (KRS_TRACE_KERNELS).
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
 #include "shadows.glsl"
 
 uniform sampler2D u_traced_color;  // a: hit
-uniform sampler2D u_traced_depth;  // w: ray distance t
+uniform sampler2D u_traced_depth;  // xyz: the hit's normal; w: ray distance t
 uniform int u_shadow_ratio;
 
 layout(location = 0) out vec4 out_visibility;  // per light (MAX_LIGHTS is 4); < 0: faces
@@ -21,13 +22,14 @@ void main() {
     ivec2 size = textureSize(u_traced_depth, 0);
     ivec2 best = ivec2(-1);
     float t_best = 0.0;
+    vec3 n = vec3(0.0);  // the best hit's normal
     for (int j = 0; j < u_shadow_ratio; ++j) {
         for (int i = 0; i < u_shadow_ratio; ++i) {
             ivec2 q = corner + ivec2(i, j);
             if (q.x >= size.x || q.y >= size.y || texelFetch(u_traced_color, q, 0).a < 0.5)
                 continue;
-            float t = texelFetch(u_traced_depth, q, 0).w;
-            if (best.x < 0 || t < t_best) { best = q; t_best = t; }
+            vec4 nt = texelFetch(u_traced_depth, q, 0);
+            if (best.x < 0 || nt.w < t_best) { best = q; t_best = nt.w; n = nt.xyz; }
         }
     }
     out_visibility = vec4(-1.0);
@@ -35,9 +37,6 @@ void main() {
     if (best.x < 0) return;
     real t = real(t_best);
     vec3r p = t * pixel_ray(vec2(best) + 0.5);
-    int level;
-    vec3 n, xk;
-    nearest_kernel(p, t, level, n, xk);
     for (int k = 0; k < u_light_count; ++k)
         if (dot(n, u_light_dir[k]) > 0.0)
             out_visibility[k] = shadow_visibility(p, n, u_light_dir[k], u_eps_per_t * t_best);

@@ -157,8 +157,14 @@ float g_shadow[MAX_LIGHTS];    // the compute path: each light's visibility, tra
                                // (compute.comp) and loaded by deferred.frag before shading;
                                // the viewer's: upsampled by upsampled.frag (< 0: none)
 #endif
+#ifdef KRS_SHADOW_MARK
+bool g_outline = false;        // a lit light that no block gave a visibility: upsampled.frag
+                               // lists the pixel for the outline pass, which traces its ray
+#endif
 
-// The visibility of light k that shade() multiplies in.
+// The visibility of light k that shade() multiplies in. With KRS_SHADOW_MARK no shadow ray
+// is compiled in (llvmpipe runs every branch's code for every pixel): a light without a
+// block's visibility marks the pixel instead, and the colour it gets here is replaced.
 float light_visibility(int k, vec3r p, vec3 n, float eps) {
 #ifdef KRS_SHADOW_TASKS
     return g_shadow[k];
@@ -166,6 +172,11 @@ float light_visibility(int k, vec3r p, vec3 n, float eps) {
 #ifdef KRS_SHADOW_UPSAMPLED
     if (g_shadow[k] >= 0.0) return g_shadow[k];
 #endif
+#ifdef KRS_SHADOW_MARK
+    g_outline = true;
+    return 1.0;
+#else
     return shadow_visibility(p, n, u_light_dir[k], eps);
+#endif
 #endif
 }

@@ -1,16 +1,22 @@
-// The trace-only pass (render.frag with KRS_TRACE_ONLY) shaded as render.frag shades it:
-// with KRS_SHADOW_UPSAMPLED each light's visibility comes from coarse_visibility.frag's
-// blocks around the pixel whose depth is within u_depth_slack footprints of its own
-// (bilinear weights); where none is, the pixel traces its own shadow ray (shadows.glsl). The
-// blocks may be an earlier, smaller image's of the same view (gpu/passes.py, ``blocks``).
-// Without it every pixel traces its own: render.frag's image, in two passes.
+// The trace-only pass (render.frag with KRS_TRACE_ONLY and KRS_TRACE_KERNELS: each hit's
+// kernel found there) shaded as render.frag shades it. Without KRS_SHADOW_UPSAMPLED every
+// pixel traces its own shadow rays: render.frag's image, in two passes. With it each
+// light's visibility comes from coarse_visibility.frag's blocks around the pixel whose depth
+// is within u_depth_slack footprints of its own (bilinear weights), which may be an
+// earlier, smaller image's of the same view (gpu/passes.py, ``blocks``). Where no block is
+// (an outline), the pixel traces its own ray, in a pass apart so that only those pixels
+// run shadow-ray code (llvmpipe runs every branch's code for every pixel): KRS_SHADOW_MARK
+// compiles none and lists such a pixel; KRS_SHADOW_OUTLINE shades the listed pixels, the
+// list's i-th at the i-th pixel of its pass, so that they fill whole groups of lanes, and
+// stores each one's colour in the image's.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
 #include "pixel.glsl"
 
-uniform sampler2D u_traced_color;       // a: hit
-uniform sampler2D u_traced_depth;       // w: ray distance t
+uniform sampler2D u_traced_color;       // rgb: the hit's kernel-space point; a: 1 + its
+                                        // level (< 0.5: no hit)
+uniform sampler2D u_traced_depth;       // xyz: the hit's normal; w: ray distance t
 uniform sampler2D u_traced_iterations;  // x
 
 #ifdef KRS_SHADOW_UPSAMPLED
@@ -44,13 +50,47 @@ void upsample_visibility(ivec2 px, float t) {
 }
 #endif
 
-void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    bool hit = texelFetch(u_traced_color, px, 0).a > 0.5;
-    float t = texelFetch(u_traced_depth, px, 0).w;
-#ifdef KRS_SHADOW_UPSAMPLED
-    if (hit) upsample_visibility(px, t);
+#if defined(KRS_SHADOW_MARK) || defined(KRS_SHADOW_OUTLINE)
+layout(std430, binding = BINDING_OUTLINE) buffer Outline {
+    uint outline_count;     // pixels listed
+    uint outline_pixels[];  // y · width + x
+};
 #endif
-    int iterations = int(texelFetch(u_traced_iterations, px, 0).x);
-    write_pixel(pixel_ray(gl_FragCoord.xy), hit, real(t), iterations);
+#ifdef KRS_SHADOW_OUTLINE
+layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
+#endif
+
+// Pixel px's colour as write_pixel shades it, from the kernel the trace pass found.
+vec4 traced_color(ivec2 px) {
+    vec3r dir = pixel_ray(vec2(px) + 0.5);
+    vec4 xk = texelFetch(u_traced_color, px, 0);
+    if (xk.a < 0.5) return vec4(encode(background(vec3(dir))), 0.0);
+    vec4 nt = texelFetch(u_traced_depth, px, 0);
+    real t = real(nt.w);
+#ifdef KRS_SHADOW_UPSAMPLED
+    upsample_visibility(px, nt.w);
+#endif
+    return vec4(encode(shade(t * dir, vec3(dir), t, int(xk.a) - 1, nt.xyz, xk.xyz)), 1.0);
+}
+
+void main() {
+#ifdef KRS_SHADOW_OUTLINE
+    uint width = uint(textureSize(u_traced_color, 0).x);
+    uint i = uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x);
+    if (i >= outline_count) discard;
+    ivec2 px = ivec2(outline_pixels[i] % width, outline_pixels[i] / width);
+    imageStore(u_color_image, px, traced_color(px));
+#else
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    out_color = traced_color(px);  // an outline pixel's is stored over it by its own pass
+    vec4 nt = texelFetch(u_traced_depth, px, 0);
+    out_normal = out_color.a > 0.5 ? nt : vec4(0.0);
+    out_iterations = vec4(texelFetch(u_traced_iterations, px, 0).x, 0.0, 0.0, 0.0);
+#ifdef KRS_SHADOW_MARK
+    if (g_outline) {
+        uint width = uint(textureSize(u_traced_color, 0).x);
+        outline_pixels[atomicAdd(outline_count, 1u)] = uint(px.y) * width + uint(px.x);
+    }
+#endif
+#endif
 }
