@@ -38,6 +38,7 @@ BINDING_QUEUES = 2  # two queues of ray (or task) indices
 BINDING_COUNTS = 3  # compute.comp's Counts: live rays per queue, the next dispatch's size
 BINDING_SHADOWS = 4  # shadows.glsl's Shadow per pixel and light (KRS_SHADOW_TASKS)
 BINDING_TASKS = 5  # a Ray per pixel and component (KRS_COMPONENT_TASKS)
+BINDING_OUTLINE = 6  # upsampled.frag's list of outline pixels (gpu/passes.py)
 # compute.comp's u_phase: what one dispatch does
 PHASE_START = 0  # start the rays (or component tasks) of the tile
 PHASE_ROUND = 1  # a round of the rays
@@ -77,6 +78,7 @@ def shared() -> dict[str, GlslValue]:
         "BINDING_COUNTS": BINDING_COUNTS,
         "BINDING_SHADOWS": BINDING_SHADOWS,
         "BINDING_TASKS": BINDING_TASKS,
+        "BINDING_OUTLINE": BINDING_OUTLINE,
         "PHASE_START": PHASE_START,
         "PHASE_ROUND": PHASE_ROUND,
         "PHASE_SIZE": PHASE_SIZE,

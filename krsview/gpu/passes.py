@@ -30,11 +30,11 @@ from typing import NamedTuple, Protocol
 
 import moderngl
 
+from ..compile.constants import BINDING_OUTLINE
 from ..scene import Geometry, Scene
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
-BINDING_OUTLINE = 6  # the shade pass's list of outline pixels (after compile/constants.py's)
 MAX_KEPT = 6  # targets kept (least recently used released)
 SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks'
     *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
@@ -203,11 +203,7 @@ class PassImage:
                 shade = self.renderer.companion(
                     main,
                     "upsampled.frag",
-                    {
-                        "KRS_SHADOW_UPSAMPLED": None,
-                        define: None,
-                        "BINDING_OUTLINE": BINDING_OUTLINE,
-                    },
+                    {"KRS_SHADOW_UPSAMPLED": None, define: None},
                 )
                 shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
                 shade["u_depth_slack"].value = DEPTH_SLACK
