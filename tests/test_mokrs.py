@@ -254,7 +254,7 @@ def test_level_bounds_hold_every_instance_below(preset, levels):
 
 
 def test_arc_bound_holds_the_arc():
-    from krsview.compile.krs import kernel_ball
+    from krsview.compile.balls import kernel_ball
     from krsview.scene.model import ToroidalCapsule, arc_of
 
     rng = np.random.default_rng(3)

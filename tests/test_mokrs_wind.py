@@ -21,9 +21,9 @@ from krsview.bench.metrics import (
     gpu_reference_agreement,
     tolerance_failures,
 )
+from krsview.compile.balls import kernel_ball
 from krsview.compile.camera import view_of
 from krsview.compile.geometry import compile_geometry
-from krsview.compile.krs import kernel_ball
 from krsview.compile.mokrs import compile_mokrs
 from krsview.gpu.renderer import Renderer
 from krsview.gpu.uniforms import variant_defines

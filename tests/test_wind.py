@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
+from krsview.compile.balls import grown, krs_ball
 from krsview.compile.camera import view_of
 from krsview.compile.geometry import compile_geometry
-from krsview.compile.krs import compile_krs, grown, krs_ball
+from krsview.compile.krs import compile_krs
 from krsview.gpu.renderer import Renderer, read_buffers
 from krsview.gpu.uniforms import variant_defines
 from krsview.reference import render_reference

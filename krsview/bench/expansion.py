@@ -10,8 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.balls import kernel_ball
 from ..compile.camera import View
-from ..compile.krs import CompiledKRS, compile_krs, kernel_ball
+from ..compile.krs import CompiledKRS, compile_krs
 from ..scene import KRS, Scene, SceneError
 from ..scene.model import Empty
 

@@ -11,7 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..compile.krs import kernel_ball
+from ..compile.balls import kernel_ball
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
 from .harness import Variant, median_times

@@ -8,13 +8,13 @@ keeps the camera in float64 (DESIGN.md, Precision).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
-from ..scene import KRS, Capsule, Empty, Kernel, Plane, Sphere, ToroidalCapsule, arc_of
+from ..scene import KRS, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
+from .balls import UNBOUNDED, grown, krs_ball, krs_bounds, union_ball
 
 # Kernel type codes, equal to the KERNEL_* defines in kernels.glsl.
 KERNEL_CODES = {"empty": 0, "sphere": 1, "capsule": 2, "toroidal_capsule": 3, "plane": 4}
@@ -27,162 +27,8 @@ RECORD_VEC4 = 6
 # record[5] = arc (e2: unit, in-plane ⟂ e1, sin phi)
 
 
-CULL_MARGIN = 1e-6  # relative growth of the culling balls, against rounding
-
 # Record slots holding a position (xyz), per kernel type: what moves when the origin moves.
 POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1, 2, 3)}
-
-
-UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])  # a bound record for "no bounding ball"
-
-
-def kernel_ball(k: Kernel) -> np.ndarray | None:
-    """(centre, radius) of a ball holding the kernel; None for an unbounded plane or empty.
-    An arc of at most π stays within the rectangle of its chord c and sagitta h, so within
-    √((c/2)² + h²) of the chord's midpoint; a longer arc within R of its circle's centre."""
-    if isinstance(k, Sphere):
-        return np.array([*k.center, k.radius])
-    if isinstance(k, Capsule):
-        a, b = np.array(k.a), np.array(k.b)
-        return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
-    if isinstance(k, ToroidalCapsule):
-        arc = arc_of(k)
-        a, b = np.array(k.start), np.array(k.end)
-        if arc is None:
-            return np.array([*(a + b) / 2, np.linalg.norm(b - a) / 2 + k.radius])
-        if arc.phi > math.pi:
-            return np.array([*arc.center, arc.R + k.radius])
-        half = np.linalg.norm(b - a) / 2
-        sagitta = arc.R * (1 - math.cos(arc.phi / 2))
-        return np.array([*(a + b) / 2, math.hypot(half, sagitta) + k.radius])
-    return None
-
-
-def union_ball(p: np.ndarray | None, q: np.ndarray | None) -> np.ndarray | None:
-    """The smallest ball holding balls p and q (None: nothing)."""
-    if p is None or q is None:
-        return q if p is None else p
-    d = float(np.linalg.norm(q[:3] - p[:3]))
-    if d + q[3] <= p[3]:
-        return p
-    if d + p[3] <= q[3]:
-        return q
-    r = (d + p[3] + q[3]) / 2
-    return np.array([*(p[:3] + (r - p[3]) / d * (q[:3] - p[:3])), r])
-
-
-def level_balls(krs: KRS) -> list[np.ndarray | None]:
-    """Per mirror slot i, the ball C_i = S ∪ R_i(S), S = ball(K_i) ∪ C_{i−1} (krs_bounds),
-    exactly; None where it is unbounded (a plane kernel at or below i) or holds nothing.
-    Each ball holds the finer ones and their mirror images, which the level of detail needs:
-    the ball it draws for the levels below slot c then lies inside every C_i above, so a walk
-    that culls at C_i gives the same value as one that goes on to the cut."""
-    out, below, unbounded = [], None, False
-    for k, m in zip(krs.kernels, krs.mirrors):
-        ball = kernel_ball(k)
-        unbounded |= ball is None and not isinstance(k, Empty)
-        if not unbounded:
-            S = union_ball(below, ball)
-            if S is not None:
-                below = union_ball(S, reflected(S[None], np.array(m.normal), m.offset)[0])
-        out.append(None if unbounded else below)
-    return out
-
-
-# Levels expanded exactly inside the ball around a whole KRS (2^(EXACT_LEVELS+2) kernel
-# balls); the levels below enter as balls of the same kind one step finer. level_balls' union
-# of two balls per level compounds its slack: on `tree` its outermost ball has 1.7× the
-# radius of the least one, this one's 1.01× [issue 27].
-EXACT_LEVELS = 4
-
-
-def enclosing_balls(sets: list[np.ndarray]) -> np.ndarray:
-    """(len(sets), 4): per (m, 4) array of balls, a small ball (centre, radius) holding them
-    all. The centre: a few Bădoiu–Clarkson steps from the box's centre, all sets at once (a
-    set is padded by repeating its last ball); the radius is exact for the centre chosen."""
-    m = max(len(s) for s in sets)
-    balls = np.stack([np.vstack([s, np.repeat(s[-1:], m - len(s), axis=0)]) for s in sets])
-    lo = (balls[..., :3] - balls[..., 3:]).min(axis=1)
-    hi = (balls[..., :3] + balls[..., 3:]).max(axis=1)
-    c = (lo + hi) / 2
-    best = np.full((len(sets), 4), np.inf)
-    rows = np.arange(len(sets))
-    for k in range(16):
-        v = balls[..., :3] - c[:, None]
-        reach = np.sqrt(np.einsum("smk,smk->sm", v, v)) + balls[..., 3]
-        far = reach.argmax(axis=1)
-        better = reach[rows, far] < best[:, 3]
-        best[better] = np.column_stack([c, reach[rows, far]])[better]
-        c = c + (balls[rows, far, :3] - c) / (k + 2)
-    return best
-
-
-def reflected(balls: np.ndarray, u: np.ndarray, w: float) -> np.ndarray:
-    """(m, 4) balls reflected in the plane u·x = w."""
-    out = balls.copy()
-    out[:, :3] -= 2.0 * (balls[:, :3] @ u - w)[:, None] * u
-    return out
-
-
-def krs_ball(krs: KRS) -> np.ndarray | None:
-    """A small ball (centre, radius) holding the whole KRS, all 2^n instances; None when a
-    plane kernel makes it unbounded. What slot i of Alg. 1 still tests, A_i = G_i ∪ R_i(G_i)
-    with G_i = K_i ∪ A_{i−1}, is expanded EXACT_LEVELS levels down into its kernels' balls
-    (kernel_ball) around the ball of A_{i−EXACT_LEVELS−1} found before, slots in batches of
-    EXACT_LEVELS + 1 that each need only earlier batches; the top kernel joins A_{n−1}."""
-    if any(kernel_ball(k) is None and not isinstance(k, Empty) for k in krs.kernels):
-        return None
-    n = len(krs.mirrors)
-    kb = [kernel_ball(k) for k in krs.kernels]
-    u = np.array([m.normal for m in krs.mirrors]).reshape(-1, 3)
-    w = np.array([m.offset for m in krs.mirrors])
-    held: list[np.ndarray | None] = [None] * (n + 1)  # held[i + 1]: the ball of A_i
-
-    def expanded(i: int) -> np.ndarray:  # A_i as balls; A_{−1} = ∅; slot n: K_n ∪ A_{n−1}
-        first = max(0, i - EXACT_LEVELS)
-        balls = np.zeros((0, 4)) if held[first] is None else held[first][None]
-        for j in range(first, min(i, n - 1) + 1):
-            if kb[j] is not None:
-                balls = np.vstack([kb[j][None], balls])
-            balls = np.vstack([balls, reflected(balls, u[j], w[j])])
-        return balls if i < n or kb[n] is None else np.vstack([kb[n][None], balls])
-
-    for first in range(0, n + 1, EXACT_LEVELS + 1):
-        sets = {i: expanded(i) for i in range(first, min(n + 1, first + EXACT_LEVELS + 1))}
-        sets = {i: s for i, s in sets.items() if len(s)}
-        if sets:
-            for i, ball in zip(sets, enclosing_balls(list(sets.values()))):
-                if i == n:
-                    return ball
-                held[i + 1] = ball
-    return None
-
-
-def grown(ball: np.ndarray | None) -> np.ndarray:
-    """A ball record for the GPU: ``ball`` grown by CULL_MARGIN against rounding, or
-    UNBOUNDED for None."""
-    if ball is None:
-        return UNBOUNDED.copy()
-    return np.array(
-        [*ball[:3], ball[3] * (1 + CULL_MARGIN) + CULL_MARGIN * float(np.abs(ball[:3]).max())]
-    )
-
-
-def krs_bounds(krs: KRS) -> np.ndarray:
-    """(n, 4): per mirror slot i, a ball C_i holding everything Alg. 1 still tests before
-    folding at level i — K_i and the levels below, doubled by R_i: C_i = S ∪ R_i(S),
-    S = ball(K_i) ∪ C_{i−1} (radius −1: unbounded, from a plane kernel on). A point x with
-    d ≤ dist(x, C_i) cannot lower d any more: the walk stops there with the same value
-    [issue 17, exact level culling]. Radii carry a margin of CULL_MARGIN against rounding.
-    Slots below only empty kernels get no ball (the walk's d is still ∞ there)."""
-    out = [grown(below) for below in level_balls(krs)]
-    # where every kernel above slot i is empty the walk still has d = ∞ there and can never
-    # stop: no ball, so the test is not paid for (sierpinski: all but K_0 empty)
-    solid = np.cumsum([not isinstance(k, Empty) for k in krs.kernels[::-1]])[::-1]
-    for i in range(len(out)):
-        if solid[i + 1] == 0:
-            out[i] = UNBOUNDED
-    return np.array(out, dtype=np.float64).reshape(-1, 4)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,8 @@ import numpy as np
 from ..algebra import mobius
 from ..scene import MoKRS
 from ..scene.model import Empty
-from .krs import CULL_MARGIN, UNBOUNDED, kernel_ball, kernel_records, union_ball
+from .balls import CULL_MARGIN, UNBOUNDED, kernel_ball, union_ball
+from .krs import kernel_records
 
 
 def level_bounds(m: MoKRS) -> np.ndarray:

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compile.balls import UNBOUNDED
 from ..compile.camera import View
 from ..compile.constants import MOBIUS_RECORD
 from ..compile.geometry import Compiled
-from ..compile.krs import KERNEL_CODES, RECORD_VEC4, UNBOUNDED, CompiledCompound
+from ..compile.krs import KERNEL_CODES, RECORD_VEC4, CompiledCompound
 from ..compile.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS

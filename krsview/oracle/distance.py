@@ -215,7 +215,8 @@ def bounds(
         for ball, size, move, kind, rec in steps(part):
             if ball is not None:
                 blo = (norm(minus(y, ball[:3])) - float(ball[3])).range()[0]
-                clear = blo > 0  # NaN: not clear
+                # with a level of detail, a ball cut below reaches up to 2·lod beyond this one
+                clear = blo > (0.0 if lod is None else 2.0 * lod[rows])  # NaN: not clear
                 cut = ~clear & (size <= lod[rows]) if lod is not None else np.zeros_like(clear)
                 out.lo[rows[clear]] = np.minimum(out.lo[rows[clear]], blo[clear])
                 out.cut[rows[cut]] = np.minimum(out.cut[rows[cut]], blo[cut])

@@ -33,7 +33,9 @@ def distance(
     solid ball C_i. It holds the KRS (C_i holds all below it),
     so the value stays a lower bound of the full walk's and no ray passes the KRS; and every
     point of C_i is within its diameter, 2·rho, of the geometry it holds. Culling and the
-    level of detail are independent switches, as in the shader."""
+    level of detail are independent switches, as in the shader; since such a ball reaches up
+    to 2·rho beyond the balls above it (they hold the KRS, not each other: compile/balls.py),
+    culling with the level of detail stops only once d ≤ dist(x, C_i) − 2·rho."""
     x = xw
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
     live = np.ones(len(x), dtype=bool)
@@ -44,7 +46,7 @@ def distance(
             db = np.linalg.norm(x - b[:3], axis=1) - b[3]
             cut = live & (b[3] < rho)
             d = np.where(cut, np.minimum(d, db), d)
-            live &= ~cut & ((db < d) | (not cull))
+            live &= ~cut & ((db - 2.0 * rho < d) | (not cull))
         x, _ = fold(c.mirrors[i], x)
         if c.types[i] != "empty":
             d = np.where(live, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..compile.krs import grown, krs_ball
+from ..compile.balls import grown, krs_ball
 from ..compile.mokrs import bounds_in_and_out
 from ..scene import Compound, MoKRS, Scene
 from ..scene.effects import (

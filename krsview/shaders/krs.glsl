@@ -17,13 +17,21 @@ real fold(int i, inout vec3r p) {
 // Level of detail [issue 27, KRS14 LOD]: at the first ball C_i whose radius is below rho,
 // the ball stands for levels i..0 (d = min(d, dist(x, C_i)), a lower bound of what they
 // would give) and the walk stops: detail smaller than rho costs nothing (distance.glsl,
-// lod_radius; reference/krs.py says which geometry that draws).
+// lod_radius; reference/krs.py says which geometry that draws). Such a ball holds its part
+// of the levels below and is less than 2·rho across, so it reaches at most 2·rho beyond the
+// ball of any slot above (compile/balls.py: the balls are not nested): culling then stops
+// once d ≤ dist(x, C_i) − 2·rho, still with the value the whole walk would give.
 #ifdef KRS_COUNT_LEVELS
 int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
 #endif
 real krs_distance(int first, int n, vec3r xw, real rho) {
     vec3r x = xw;
     real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
+#ifdef KRS_LOD
+    real reach = 2.0 * rho;  // how far a ball drawn below may reach beyond C_i (below)
+#else
+    real reach = 0.0;
+#endif
     for (int i = first + n - 1; i >= first; --i) {
 #ifdef KRS_COUNT_LEVELS
         ++g_levels;
@@ -32,7 +40,7 @@ real krs_distance(int first, int n, vec3r xw, real rho) {
         vec4r b = u_bounds[i];
 #endif
 #ifdef KRS_CULLING
-        if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
+        if (b.w >= 0.0 && length(x - b.xyz) - b.w - reach >= d) break;
 #endif
 #ifdef KRS_LOD  // the ball's distance only where it cuts: culling off pays no more
         if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); break; }

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.balls import union_ball
 from ..compile.geometry import compile_geometry, scene_ball
-from ..compile.krs import union_ball
 from ..compile.mokrs import CompiledMoKRS
 from ..reference import mokrs
 from ..reference.distortion import Distortion
