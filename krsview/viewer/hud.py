@@ -127,8 +127,10 @@ def _performance(v: Viewed, out: list) -> None:
     imgui.text(shown.text())
     imgui.text(f"{shown.timing()}; {v.view} view")
     times = np.array(v.frames.frame_seconds[-PLOTTED:] or [0.0], dtype=np.float32) * 1e3
-    budget = 1e3 / v.frames.adaptive.target_fps
+    a = v.frames.adaptive
+    budget, rest = 1e3 * a.trace_budget, 1e3 * a.rest
     imgui.text(f"moving frames: median {np.median(times):.1f} ms, budget {budget:.1f} ms")
+    imgui.text(f"a turn: {1e3 * a.budget:.1f} ms, of it {rest:.1f} ms besides the tracing")
     if implot.begin_plot("##frametime", imgui.ImVec2(-1, PLOT_HEIGHT), implot.Flags_.no_legend):
         implot.setup_axes("moving frames", "ms")
         implot.setup_axes_limits(
