@@ -1,5 +1,5 @@
 """Draws a traced image (the renderer's float buffers) into the current framebuffer, scaled to
-it, in one of the view modes of ``display.frag``: a variant per mode (``KRS_VIEW_<MODE>``), compiled
+it, in one of the view modes of ``display.frag``: a variant per mode (``KRS_VIEW``), compiled
 on first use, since this pass runs over every window pixel each turn and llvmpipe would run
 every mode's texture reads and maths if the mode were a uniform."""
 
@@ -13,11 +13,11 @@ from .program import ProgramCache
 UNITS = ("u_color", "u_normal", "u_iterations")  # the source's colour attachments, in order
 
 
-def view_defines(view: str) -> dict[str, None]:
+def view_defines(view: str) -> dict[str, str]:
     """``display.frag``'s defines for view mode ``view``: none for the shaded colour."""
     if view not in VIEW_MODES:
         raise ValueError(f"view mode {view!r}: allowed: {', '.join(VIEW_MODES)}")
-    return {} if view == "shaded" else {f"KRS_VIEW_{view.upper()}": None}
+    return {} if view == "shaded" else {"KRS_VIEW": f"VIEW_{view.upper()}"}
 
 
 class Display:
