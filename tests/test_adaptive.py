@@ -158,3 +158,50 @@ def test_a_refining_turn_traces_as_long_as_the_rest_of_the_turn_within_two_budge
     assert refining_budget(budget, 1.0) == pytest.approx(2 * budget)  # after an idle wait
     # control: a fast window leaves the turn's tracing at one frame budget
     assert refining_budget(budget, 0.0) == refining_budget(budget, 0.01) == budget
+
+
+def fly(a: AdaptiveResolution, rest, turns: int = 60, per_pixel: float = 1e-6) -> list[float]:
+    """Turns of a flight with tracing ∝ pixels and ``rest(k)`` seconds besides it (None: an
+    idle turn before): the turns' times."""
+    out = []
+    for k in range(turns):
+        w, h = a.moving_size()
+        seconds = per_pixel * w * h
+        r = rest(k)
+        a.frame_done(seconds, r)
+        out.append(seconds + (r or 0.0))
+    return out
+
+
+def test_the_controller_aims_the_whole_turn_at_the_frame_budget():
+    budget = 1 / 30
+    a = AdaptiveResolution((960, 540), target_fps=30)
+    turns = fly(a, lambda k: 0.008)  # display, HUD and swap: 8 ms a turn
+    assert turns[-1] == pytest.approx(budget, rel=0.05)
+    assert a.trace_budget == pytest.approx(budget - 0.008)
+    # negative control: a controller blind to the rest aims the tracing alone at the
+    # budget, and each turn overruns it by the rest
+    blind = AdaptiveResolution((960, 540), target_fps=30)
+    turns = fly(blind, lambda k: None)
+    assert turns[-1] == pytest.approx(budget, rel=0.05)  # the tracing alone
+    assert turns[-1] + 0.008 > 1.2 * budget
+
+
+def test_a_slow_turn_or_an_idle_wait_moves_the_aim_little():
+    a = AdaptiveResolution((960, 540), target_fps=30)
+    fly(a, lambda k: 0.008, turns=40)
+    steady = a.scale
+    # one turn with a file reloaded (0.3 s besides the tracing), one after an idle wait
+    fly(a, lambda k: {0: 0.3, 1: None}.get(k, 0.008), turns=3)
+    assert a.rest == pytest.approx(0.008) and a.scale == pytest.approx(steady, rel=0.02)
+    # control: a window that takes longer to draw every turn shrinks the image
+    fly(a, lambda k: 0.016, turns=40)
+    assert a.rest == pytest.approx(0.016) and a.scale < 0.9 * steady
+
+
+def test_the_tracing_keeps_half_the_budget_when_the_rest_takes_more():
+    a = AdaptiveResolution((960, 540), target_fps=30)
+    fly(a, lambda k: 0.05)  # a window slower than the whole budget
+    assert a.trace_budget == pytest.approx(0.5 * a.budget)
+    assert a.history[-1] == pytest.approx(0.5 * a.budget, rel=0.05)
+    assert a.moving_size()[0] > 0.1 * 960  # control: not driven to the floor

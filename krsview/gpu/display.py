@@ -1,5 +1,7 @@
 """Draws a traced image (the renderer's float buffers) into the current framebuffer, scaled to
-it, in one of the view modes of ``display.frag``."""
+it, in one of the view modes of ``display.frag``: a variant per mode (``KRS_VIEW``), compiled
+on first use, since this pass runs over every window pixel each turn and llvmpipe would run
+every mode's texture reads and maths if the mode were a uniform."""
 
 from __future__ import annotations
 
@@ -8,14 +10,34 @@ import moderngl
 from ..compile.constants import VIEW_MODES
 from .program import ProgramCache
 
+UNITS = ("u_color", "u_normal", "u_iterations")  # the source's colour attachments, in order
+
+
+def view_defines(view: str) -> dict[str, str]:
+    """``display.frag``'s defines for view mode ``view``: none for the shaded colour."""
+    if view not in VIEW_MODES:
+        raise ValueError(f"view mode {view!r}: allowed: {', '.join(VIEW_MODES)}")
+    return {} if view == "shaded" else {"KRS_VIEW": f"VIEW_{view.upper()}"}
+
 
 class Display:
-    def __init__(self, ctx: moderngl.Context, programs: ProgramCache):
-        self.ctx = ctx
-        self.prog = programs.get("fullscreen.vert", "display.frag", {})
-        self.vao = ctx.vertex_array(self.prog, [])
-        for unit, name in enumerate(("u_color", "u_normal", "u_iterations")):
-            self.prog[name].value = unit
+    """The display pass; ``views``: the modes compiled at once (a shader reload checks every
+    one), the others on first use."""
+
+    def __init__(self, ctx: moderngl.Context, programs: ProgramCache, views: tuple[str, ...] = ()):
+        self.ctx, self.programs = ctx, programs
+        self._vaos: dict[str, moderngl.VertexArray] = {}
+        for view in views:
+            self._vao(view)
+
+    def _vao(self, view: str) -> moderngl.VertexArray:
+        if view not in self._vaos:
+            prog = self.programs.get("fullscreen.vert", "display.frag", view_defines(view))
+            for unit, name in enumerate(UNITS):
+                if name in prog:
+                    prog[name].value = unit
+            self._vaos[view] = self.ctx.vertex_array(prog, [])
+        return self._vaos[view]
 
     def show(
         self,
@@ -26,13 +48,17 @@ class Display:
         iteration_cap: int,
         depth_scale: float,
     ) -> None:
+        vao = self._vao(view)
+        prog = vao.program
         for unit, tex in enumerate(source.color_attachments):
-            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            tex.use(location=unit)
+            if UNITS[unit] in prog:
+                tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+                tex.repeat_x = tex.repeat_y = False  # an edge pixel blends its own side only
+                tex.use(location=unit)
         target.use()
         self.ctx.viewport = (0, 0, *size)
-        self.prog["u_view"].value = VIEW_MODES.index(view)
-        self.prog["u_iteration_cap"].value = float(iteration_cap)
-        self.prog["u_depth_scale"].value = depth_scale
-        self.prog["u_window"].value = (float(size[0]), float(size[1]))
-        self.vao.render(moderngl.TRIANGLES, vertices=3)
+        for name, value in (("u_iteration_cap", iteration_cap), ("u_depth_scale", depth_scale)):
+            if name in prog:
+                prog[name].value = float(value)
+        prog["u_window"].value = (float(size[0]), float(size[1]))
+        vao.render(moderngl.TRIANGLES, vertices=3)

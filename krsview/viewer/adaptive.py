@@ -1,11 +1,13 @@
-"""Adaptive internal resolution: while the view moves, scale the image so a frame fits the
-target frame time; when it stops, refine through sharper images, each traced in bands of rows
-within a per-turn time budget (so input is never blocked by a slow frame) and shown when done.
-No GL here: frames.py draws what this schedules."""
+"""Adaptive internal resolution: while the view moves, scale the image so that a turn of the
+event loop (its tracing, and the rest: display, HUD, swap, input) fits the target frame time;
+when it stops, refine through sharper images, each traced in bands of rows within a per-turn
+time budget (so input is never blocked by a slow frame) and shown when done. No GL here:
+frames.py draws what this schedules."""
 
 from __future__ import annotations
 
 import math
+import statistics
 from dataclasses import dataclass, field
 
 SHADOW_RATIO = 2  # moving frames and refinement steps: a shadow ray per 2 × 2 pixels at least
@@ -13,6 +15,8 @@ STEP_GAIN = 1.5  # a refinement step's side is at least this many times the movi
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
 REFINING_TURNS = 2.0  # a refining turn traces for at most this many frame budgets
+REST_TURNS = 9  # the recent turns whose rest (display, HUD, swap, input) a moving frame counts
+MIN_TRACE_SHARE = 0.5  # a moving frame's tracing keeps at least this share of the budget
 
 
 @dataclass
@@ -23,10 +27,25 @@ class AdaptiveResolution:
     scale: float = 0.5  # start near 320×180 for a 640×360 window (DESIGN.md)
     supersample: int = 1  # still images: 1, or 2 for 2×2 supersampling
     history: list[float] = field(default_factory=list)
+    rests: list[float] = field(default_factory=list)  # the last REST_TURNS turns' rest
 
     @property
     def budget(self) -> float:
+        """Seconds a turn of the event loop may take at the target frame rate."""
         return 1.0 / self.target_fps
+
+    @property
+    def rest(self) -> float:
+        """Seconds of a turn besides its tracing: the median of the recent turns' (a slow
+        one, a file reloaded, moves it little)."""
+        return statistics.median(self.rests) if self.rests else 0.0
+
+    @property
+    def trace_budget(self) -> float:
+        """Seconds a moving frame's tracing may take so that the whole turn (display, HUD,
+        swap and input besides) fits the frame budget; at least MIN_TRACE_SHARE of it, so a
+        window slow to draw still gets an image of some size."""
+        return max(self.budget - self.rest, MIN_TRACE_SHARE * self.budget)
 
     def size_at(self, scale: float) -> tuple[int, int]:
         """The internal resolution at ``scale`` of the window's side."""
@@ -38,12 +57,16 @@ class AdaptiveResolution:
     def still_size(self) -> tuple[int, int]:
         return self.size_at(self.supersample)
 
-    def frame_done(self, seconds: float) -> None:
-        """After a moving frame: cost ∝ pixels ∝ scale², so aim scale at the budget, damped."""
+    def frame_done(self, seconds: float, rest: float | None = None) -> None:
+        """After a moving frame traced in ``seconds``, the turn before it having spent
+        ``rest`` besides its tracing (None: it traced nothing, its time is an idle wait):
+        cost ∝ pixels ∝ scale², so aim scale at the trace budget, damped."""
         self.history = (self.history + [seconds])[-120:]
+        if rest is not None:
+            self.rests = (self.rests + [rest])[-REST_TURNS:]
         if seconds <= 0:
             return
-        factor = math.sqrt(self.budget / seconds)
+        factor = math.sqrt(self.trace_budget / seconds)
         factor = min(1.25, max(0.7, factor))  # damped: a noisy frame moves scale a little
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
+from ..compile.constants import VIEW_MODES
 from ..gpu.display import Display
 from ..gpu.passes import PassImage, Targets, splits_shadows
 from ..gpu.program import ProgramCache, ShaderError
@@ -79,8 +80,7 @@ class Frames:
         self._tracing: PassImage | None = None  # the refinement's next image
         self._cost: dict[str, float] = {}  # seconds per pixel of each pass, kept across
         self._step_seconds = 0.0
-        self._traced_at = 0.0  # when the last turn's tracing ended
-        self._rest = 0.0  # seconds of the last turn besides its tracing
+        self._traced_at = 0.0  # when the last turn's tracing ended (0: it traced nothing)
 
     @property
     def refined(self) -> bool:
@@ -101,17 +101,22 @@ class Frames:
         """One turn's tracing: a moving frame of ``scene`` after a change, else some bands of
         the refinement's next image. A ShaderError leaves the last image in place."""
         now = time.perf_counter()
-        self._rest = now - self._traced_at if self._traced_at else 0.0
+        # the rest of the last turn, where it traced (else its time holds an idle wait)
+        rest = now - self._traced_at if self._traced_at else None
+        traced = self.dirty or not self.refined
         try:
             if self.dirty:
                 self.dirty = False  # a shader error is not retried every turn
-                self._moving(scene, krs)
-            elif self.refinement is not None and not self.refinement.done:
-                self._refine(scene, krs)
+                self._moving(scene, krs, rest)
+            elif traced:
+                self._refine(scene, krs, rest or 0.0)
         finally:
-            self._traced_at = time.perf_counter()
+            self._traced_at = time.perf_counter() if traced else 0.0
 
-    def _moving(self, scene: Scene, krs: Geometry) -> None:
+    def _moving(self, scene: Scene, krs: Geometry, rest: float | None) -> None:
+        """A moving frame at the adaptive resolution; ``rest``: the last turn's time besides
+        its tracing (None: it traced nothing), for the resolution's controller."""
+        t0 = time.perf_counter()
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
         # the still image's passes: 0 one pass, 1 shadow rays per pixel in a pass of their
@@ -119,11 +124,10 @@ class Frames:
         still = scene.render.shadow_block if splits_shadows(scene) else 0
         ratio = max(SHADOW_RATIO, still) if still and not self.full_shadows else still
         image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)
-        t0 = time.perf_counter()
         image.draw_all()
-        self.ctx.finish()
+        self.ctx.finish()  # the frame's time is read: the controller needs it
         seconds = time.perf_counter() - t0
-        self.adaptive.frame_done(seconds)
+        self.adaptive.frame_done(seconds, rest)
         self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
         steps = refinement_steps(scale, seconds, self.adaptive.supersample, ratio, still)
         self.refinement = Refinement(steps, self._cost) if steps else None
@@ -136,9 +140,11 @@ class Frames:
         self.image, self._on_screen = (image.output, image.size), image
         self.shown = replace(state, shadows=max(image.ratio, 1))
 
-    def _refine(self, scene: Scene, krs: Geometry) -> None:
+    def _refine(self, scene: Scene, krs: Geometry, rest: float) -> None:
+        """Bands of the refinement's next image for as long as ``rest``, the last turn's time
+        besides its tracing, within refining_budget."""
         r = self.refinement
-        spent, budget = 0.0, refining_budget(self.adaptive.budget, self._rest)
+        spent, budget = 0.0, refining_budget(self.adaptive.budget, rest)
         prepared = None
         while not r.done and spent < budget:
             if not r.started:
@@ -208,7 +214,7 @@ class Frames:
         try:
             self.renderer.programs = programs
             self.renderer.prepare(scene, 1, 1, krs)
-            display = Display(self.ctx, programs)
+            display = Display(self.ctx, programs, VIEW_MODES)  # every mode checked
         except ShaderError:
             self.renderer.programs = old
             raise

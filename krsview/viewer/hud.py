@@ -122,13 +122,15 @@ def draw_status(text: str) -> None:
 
 def _performance(v: Viewed, out: list) -> None:
     """The image on screen (state, resolution, time), then the moving frames' times against
-    the budget."""
+    their budget: the frame budget less the rest of a turn."""
     shown = v.frames.frame_state()
     imgui.text(shown.text())
     imgui.text(f"{shown.timing()}; {v.view} view")
     times = np.array(v.frames.frame_seconds[-PLOTTED:] or [0.0], dtype=np.float32) * 1e3
-    budget = 1e3 / v.frames.adaptive.target_fps
+    a = v.frames.adaptive
+    budget, rest = 1e3 * a.trace_budget, 1e3 * a.rest
     imgui.text(f"moving frames: median {np.median(times):.1f} ms, budget {budget:.1f} ms")
+    imgui.text(f"the rest of a turn (display, HUD, swap): {rest:.1f} ms")
     if implot.begin_plot("##frametime", imgui.ImVec2(-1, PLOT_HEIGHT), implot.Flags_.no_legend):
         implot.setup_axes("moving frames", "ms")
         implot.setup_axes_limits(

@@ -405,7 +405,8 @@ class Viewer:
         fb = glfw.get_framebuffer_size(self.window)
         self.frames.resize(fb)
         self.ctx.screen.use()
-        self.ctx.clear(*self.scene.material.background)
+        if self.frames.image is None:  # else the image covers every pixel: no clear to pay
+            self.ctx.clear(*self.scene.material.background)
         self.frames.show(self.ctx.screen, fb, self.view, self.scene, self._depth_scale())
 
     def _depth_scale(self) -> float:
