@@ -13,7 +13,9 @@ from pathlib import Path
 import pytest
 
 import krsview
+from krsview.compile.constants import VIEW_MODES
 from krsview.gpu import program
+from krsview.gpu.display import view_defines
 from krsview.gpu.renderer import Renderer
 
 SIZE = (32, 18)
@@ -102,6 +104,8 @@ def stage_sources() -> dict[str, str]:
     for vertex, fragment in (("fullscreen.vert", "display.frag"), ("overlay.vert", "overlay.frag")):
         record(vertex, {})
         record(fragment, {})
+    for view in VIEW_MODES[1:]:  # the display pass's other variants (gpu/display.py)
+        record("display.frag", view_defines(view))
     return {
         f"s{k:03d}-{entry.replace('.', '-')}.{entry.rsplit('.', 1)[1]}": text
         for k, (text, (entry, _)) in enumerate(seen.items())

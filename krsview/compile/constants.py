@@ -29,7 +29,8 @@ BARK_STRETCH = (0.25, 2.0)  # kernel texture: streaks long along a branch, fine 
 # The GPU's own (gpu/uniforms.py, gpu/renderer.py, gpu/display.py and their shaders)
 MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record, its bound
 COMPUTE_GROUP = 64  # compute.comp's local size
-VIEW_MODES = ("shaded", "iterations", "depth", "normals")  # display.frag's u_view, in order
+# display.frag's views, in order (KRS_VIEW = VIEW_<MODE>; shaded: no define)
+VIEW_MODES = ("shaded", "iterations", "depth", "normals")
 PREPASS_TARGETS = -(-MAX_COMPONENTS // 4)  # RGBA32F targets of a coarse pass: 4 components each
 # Storage buffer bindings: the scene block (KRS_DOUBLE) and the compute path's buffers.
 BINDING_KRS_BLOCK = 0  # also the uniform block binding of KRSBlock in float
