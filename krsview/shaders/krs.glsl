@@ -21,27 +21,89 @@ real fold(int i, inout vec3r p) {
 #ifdef KRS_COUNT_LEVELS
 int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
 #endif
+
+// Level slot i of Alg. 1 on the point x with the distance d found above it: culling, the level
+// of detail, the fold (its e returned) and the kernel; false where the walk ends here.
+bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e) {
+#ifdef KRS_COUNT_LEVELS
+    ++g_levels;
+#endif
+    e = 0.0;
+#if defined(KRS_CULLING) || defined(KRS_LOD)
+    vec4r b = u_bounds[i];
+#endif
+#ifdef KRS_CULLING
+    if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) return false;
+#endif
+#ifdef KRS_LOD  // the ball's distance only where it cuts: culling off pays no more
+    if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); return false; }
+#endif
+    e = fold(i, x);
+    d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
+    return true;
+}
+
 real krs_distance(int first, int n, vec3r xw, real rho) {
     vec3r x = xw;
     real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
-    for (int i = first + n - 1; i >= first; --i) {
-#ifdef KRS_COUNT_LEVELS
-        ++g_levels;
+    real e;
+    for (int i = first + n - 1; i >= first; --i) if (!krs_level(i, x, d, rho, e)) break;
+    return d;
+}
+
+#ifdef KRS_WALK_RESTART
+// The walk restarted below the levels whose folds cannot change [issue 27]. An anchor is the
+// walk's state before level slot j (aj; −1: none) at the ray distance where it was taken: x
+// folded by the mirrors above (ax), the ray's direction folded alike (ad), the least |e| of
+// those folds (am), the least distance of the levels above (adist) and the least radius of
+// the balls tested above (ar, for the level of detail). Each fold is an isometry on each side
+// of its mirror, so a point s < am further along the ray folds to ax + s·ad, and adist − s
+// bounds the levels above (1-Lipschitz); with rho ≤ ar no ball above cuts. A walk from j down
+// is then Alg. 1's own value where it ends below adist − s; where that bound is what limits,
+// the walk goes on from the top, so the value is always Alg. 1's (up to rounding).
+// The anchor moves to the deepest level whose min(margin, distance above) ≥ keep (κ times the
+// last step), so the next steps fit under it; `saved`: an anchor was taken at this point.
+real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real keep,
+                 inout int aj, inout vec3r ax, inout vec3r ad, inout real am,
+                 inout real adist, inout real ar, out bool saved) {
+    int top = first + n - 1;
+    real dtop = kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
+    bool again = aj >= 0 && s < am && rho <= ar;
+    int i = again ? aj : top;
+    vec3r x = again ? ax + s * ad : p, u = again ? ad : dir;
+    real bound = again ? adist - s : dtop;
+    real d = bound, m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
+    saved = false;
+    for (;;) {
+        if (i >= first) {
+            if (min(m, d) >= keep) {
+                aj = i; ax = x; ad = u; am = m; adist = d; ar = r;
+                saved = true;
+            }
+#ifdef KRS_LOD
+            real b = u_bounds[i].w;
+            r = b >= 0.0 ? min(r, b) : r;
 #endif
-#if defined(KRS_CULLING) || defined(KRS_LOD)
-        vec4r b = u_bounds[i];
-#endif
-#ifdef KRS_CULLING
-        if (b.w >= 0.0 && length(x - b.xyz) - b.w >= d) break;
-#endif
-#ifdef KRS_LOD  // the ball's distance only where it cuts: culling off pays no more
-        if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); break; }
-#endif
-        fold(i, x);
-        d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
+            real e;
+            bool on = krs_level(i, x, d, rho, e);
+            vec3r mu = u_mirrors[i].xyz;
+            u -= 2.0 * (e > 0.0 ? dot(u, mu) : 0.0) * mu;
+            m = min(m, abs(e));
+            i = on ? i - 1 : first - 1;
+            continue;
+        }
+        if (!(again && d >= bound)) break;
+        again = false;  // only the bound of the levels above: walk from the top
+        i = top;
+        x = p;
+        u = dir;
+        d = dtop;
+        m = FAR_AWAY;
+        r = FAR_AWAY;
     }
     return d;
 }
+#endif
 
 #ifdef KRS_SMOOTH_SHADING
 uniform float u_smooth_width;  // scene units
