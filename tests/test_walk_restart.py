@@ -1,0 +1,163 @@
+"""The walk restart [issue 27]: a sphere-traced ray's step restarts Alg. 1 below its anchor,
+the levels whose folds the ray cannot have changed since. Every fold is an isometry on each
+side of its mirror, so the restarted walk is Alg. 1's value (up to rounding): checked against
+the full walk along random rays, the GPU against itself without the restart and against the
+NumPy twin, the oracle on its image, and the levels it walks inside the crown."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
+from krsview.bench.zoom import stops
+from krsview.compile.constants import RESTART_KEEP
+from krsview.compile.geometry import compile_geometry
+from krsview.compile.krs import compile_krs
+from krsview.frame import Frame
+from krsview.gpu.uniforms import variant_defines
+from krsview.oracle.certify import count_errors
+from krsview.reference import krs
+from krsview.scene import load_scene
+from krsview.scene.presets import resolve
+
+from .conftest import per_pixel
+from .test_distance_bound import ALBEDO, arbitrary_krs
+
+W, H = 64, 36
+
+
+def geometry(name: str):
+    """(scene, compiled KRS) of a preset, or of a random KRS ("random")."""
+    scene = load_scene(resolve("tree"))
+    if name == "random":
+        return scene, compile_krs(arbitrary_krs(np.random.default_rng(7), 6), ALBEDO)
+    scene = load_scene(resolve(name))
+    return scene, compile_krs(scene.geometry(), ALBEDO)
+
+
+def walk_rays(c, n=400, steps=40, seed=0, lod=0.02, margin=True):
+    """Rays from random points towards the geometry's ball, stepped by random fractions of
+    the distance (each step carries its anchor, as trace.glsl's Ray does), the LOD growing
+    along the ray. Returns (restarted values, full walks' values, levels restarted, levels
+    of full walks, steps that walked fewer levels than the full walk). ``margin=False``
+    ignores the anchors' fold margins (negative control)."""
+    rng = np.random.default_rng(seed)
+    centre, radius = c.ball[:3], c.ball[3]
+    dirs = rng.normal(size=(n, 3))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    origin = centre - dirs * radius * rng.uniform(1.0, 2.0, (n, 1))
+    dirs = centre + rng.normal(size=(n, 3)) * radius * 0.3 - origin
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    t, last = np.zeros(n), np.full(n, np.inf)
+    anchor = krs.Anchor.none(n)
+    got, want, walked, full, fewer = [], [], 0, 0, 0
+    for _ in range(steps):
+        p = origin + t[:, None] * dirs
+        rho = lod * t
+        used = anchor if margin else replace(anchor, m=np.full(n, np.inf))
+        d, anchor, levels = krs.restart(c, p, dirs, t, rho, RESTART_KEEP * last, used)
+        _, _, plain = krs.restart(c, p, dirs, t, rho, np.full(n, np.inf), krs.Anchor.none(n))
+        got.append(d)
+        want.append(krs.distance(c, p, rho=rho))
+        walked, full = walked + levels.sum(), full + plain.sum()
+        fewer += (levels < plain).sum()
+        step = np.maximum(d, 1e-4 * radius) * rng.uniform(0.3, 1.0, n)
+        t, last = t + step, step
+    return np.concatenate(got), np.concatenate(want), walked, full, fewer
+
+
+def error(got, want, c) -> np.ndarray:
+    """Each value's error relative to its size and the geometry's."""
+    return np.abs(got - want) / (np.abs(want) + c.ball[3])
+
+
+@pytest.mark.parametrize("name", ["tree", "bent-tree", "random"])
+def test_restarted_walks_equal_the_full_walk(name):
+    """At every step of every ray the restarted walk gives Alg. 1's value (the levels below
+    the anchor decide, or it walks on from the top); it restarted at many steps, and on a
+    tree it walks fewer levels in all."""
+    _, c = geometry(name)
+    got, want, walked, full, fewer = walk_rays(c)
+    assert error(got, want, c).max() < 1e-12, error(got, want, c).max()
+    assert fewer > 0.1 * len(got), fewer
+    if name != "random":  # six levels: the fallbacks from the top cost about what it saves
+        assert walked < 0.9 * full, (walked, full)
+
+
+@pytest.mark.parametrize("name", ["tree", "random"])
+def test_a_restart_past_its_fold_margin_gives_a_wrong_value(name):
+    """Negative control: restarting below the anchor however far the ray moved (a fold above
+    it changed side) gives values that are not Alg. 1's."""
+    _, c = geometry(name)
+    got, want, *_ = walk_rays(c, margin=False)
+    assert error(got, want, c).max() > 1e-3
+
+
+def test_the_restart_is_compiled_only_where_folds_are_isometries_along_the_ray():
+    scene, c = geometry("tree")
+    assert scene.render.walk_restart == "on"
+    assert "KRS_WALK_RESTART" in variant_defines(scene, c)
+    for field, value in (("walk_restart", "off"), ("tracer", "binary")):
+        assert "KRS_WALK_RESTART" not in variant_defines(scene.edit(("render", field), value), c)
+    twisted = replace(scene, effects=(*scene.effects, "twist"))
+    assert "KRS_WALK_RESTART" not in variant_defines(twisted, c)
+    grove = load_scene(resolve("grove"))
+    grove_c = compile_geometry(grove.geometry(), ALBEDO)
+    assert "KRS_WALK_RESTART" not in variant_defines(grove, grove_c)
+
+
+def crown(stop: int = 4):
+    """tree seen from inside its crown (a stop of bench zoom), a shadow ray per pixel."""
+    return per_pixel(stops(load_scene(resolve("tree")), 12)[stop])
+
+
+def off(scene):
+    return scene.edit(("render", "walk_restart"), "off")
+
+
+@pytest.mark.parametrize("stop", [0, 4, 9])
+def test_gpu_images_with_and_without_the_restart_agree(renderer, stop):
+    """The same hits and depths up to rounding, the same iterations but where a rounding
+    flips a convergence test; negative control: the image at half ε differs in more hits."""
+    scene = crown(stop)
+    a, b = renderer.render(scene, W, H), renderer.render(off(scene), W, H)
+    agree = agreement(a, b, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
+    assert agree.hit >= 0.999 and agree.depth_close >= 0.999, agree
+    assert (a.iterations != b.iterations).mean() <= 0.002
+    assert a.iterations.sum() <= 1.001 * b.iterations.sum()
+    finer = renderer.render(off(scene).edit(("render", "epsilon_scale"), 0.5), W, H)
+    assert (finer.hit != b.hit).sum() > (a.hit != b.hit).sum()
+
+
+def test_gpu_matches_its_numpy_twin(renderer):
+    """GLSL and NumPy take the same restarted steps (float32 against float64)."""
+    from krsview.reference import render_reference
+
+    scene = crown()
+    gpu, ref = renderer.render(scene, W, H), render_reference(scene, W, H)
+    a = agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
+    assert a.hit >= 0.997 and a.color >= 0.99, a
+
+
+def test_the_oracle_finds_no_hole_in_the_restarted_image(renderer):
+    """No certified hole nor false hit; negative control: the same image with every ray
+    stopped 20 % further (as a walk that overshot) has holes."""
+    scene = crown()
+    img = renderer.render(scene, W, H)
+    counts = count_errors(scene, img, arithmetics=("affine",))
+    assert (counts.holes, counts.false_hits) == (0, 0), counts
+    past = Frame(img.color, img.depth * 1.2, img.normal, img.iterations, img.hit)
+    assert count_errors(scene, past, arithmetics=("affine",)).holes > 0
+
+
+def test_levels_walked_fall_inside_the_crown(renderer):
+    """The counting variant: inside the crown the restart walks at most 80 % of the levels
+    per iteration; the iterations stay the same (the control that the work is the same)."""
+    scene = crown()
+    on, plain = renderer.levels(scene, W, H), renderer.levels(off(scene), W, H)
+    a, b = renderer.render(scene, W, H), renderer.render(off(scene), W, H)
+    assert abs(int(a.iterations.sum()) - int(b.iterations.sum())) <= 0.001 * b.iterations.sum()
+    assert on.sum() < 0.8 * plain.sum(), (on.sum(), plain.sum())
