@@ -41,9 +41,8 @@ def geometry(name: str):
 def walk_rays(c, n=400, steps=40, seed=0, lod=0.02, margin=True):
     """Rays from random points towards the geometry's ball, stepped by random fractions of
     the distance (each step carries its anchor, as trace.glsl's Ray does), the LOD growing
-    along the ray. Returns (restarted values, full walks' values, levels restarted, levels
-    of full walks, steps that walked fewer levels than the full walk). ``margin=False``
-    ignores the anchors' fold margins (negative control)."""
+    along the ray. Returns (restarted values, bounded, full walks' values, levels restarted,
+    levels of full walks). ``margin=False`` ignores the anchors' fold margins."""
     rng = np.random.default_rng(seed)
     centre, radius = c.ball[:3], c.ball[3]
     dirs = rng.normal(size=(n, 3))
@@ -52,21 +51,21 @@ def walk_rays(c, n=400, steps=40, seed=0, lod=0.02, margin=True):
     dirs = centre + rng.normal(size=(n, 3)) * radius * 0.3 - origin
     dirs /= np.linalg.norm(dirs, axis=1)[:, None]
     t, last = np.zeros(n), np.full(n, np.inf)
-    anchor = krs.Anchor.none(n)
-    got, want, walked, full, fewer = [], [], 0, 0, 0
+    anchor, none = krs.Anchor.none(n), krs.Anchor.none(n)
+    got, bounds, want, walked, full = [], [], [], 0, 0
     for _ in range(steps):
         p = origin + t[:, None] * dirs
         rho = lod * t
-        used = anchor if margin else replace(anchor, m=np.full(n, np.inf))
-        d, anchor, levels = krs.restart(c, p, dirs, t, rho, RESTART_KEEP * last, used)
-        _, _, plain = krs.restart(c, p, dirs, t, rho, np.full(n, np.inf), krs.Anchor.none(n))
+        keep = RESTART_KEEP * last
+        d, bounded, anchor, levels = krs.restart(c, p, dirs, t, rho, keep, anchor, margin)
+        _, _, _, plain = krs.restart(c, p, dirs, t, rho, np.full(n, np.inf), none)
         got.append(d)
+        bounds.append(bounded)
         want.append(krs.distance(c, p, rho=rho))
         walked, full = walked + levels.sum(), full + plain.sum()
-        fewer += (levels < plain).sum()
         step = np.maximum(d, 1e-4 * radius) * rng.uniform(0.3, 1.0, n)
         t, last = t + step, step
-    return np.concatenate(got), np.concatenate(want), walked, full, fewer
+    return np.concatenate(got), np.concatenate(bounds), np.concatenate(want), walked, full
 
 
 def error(got, want, c) -> np.ndarray:
@@ -76,24 +75,26 @@ def error(got, want, c) -> np.ndarray:
 
 @pytest.mark.parametrize("name", ["tree", "bent-tree", "random"])
 def test_restarted_walks_equal_the_full_walk(name):
-    """At every step of every ray the restarted walk gives Alg. 1's value (the levels below
-    the anchor decide, or it walks on from the top); it restarted at many steps, and on a
-    tree it walks fewer levels in all."""
+    """At every step of every ray the restarted walk gives Alg. 1's value where the levels
+    below the anchor decide, and a lower bound of it where the bound of the levels above
+    limits (a step without a hit test); on a tree it walks fewer levels in all."""
     _, c = geometry(name)
-    got, want, walked, full, fewer = walk_rays(c)
-    assert error(got, want, c).max() < 1e-12, error(got, want, c).max()
-    assert fewer > 0.1 * len(got), fewer
-    if name != "random":  # six levels: the fallbacks from the top cost about what it saves
-        assert walked < 0.9 * full, (walked, full)
+    got, bounded, want, walked, full = walk_rays(c)
+    exact = ~bounded
+    assert error(got[exact], want[exact], c).max() < 1e-12, error(got, want, c)[exact].max()
+    assert np.all(got[bounded] <= want[bounded] + 1e-12 * (np.abs(want[bounded]) + c.ball[3]))
+    assert bounded.mean() < 0.2, bounded.mean()
+    if name != "random":  # six levels: little to restart below
+        assert walked < 0.8 * full, (walked, full)
 
 
 @pytest.mark.parametrize("name", ["tree", "random"])
 def test_a_restart_past_its_fold_margin_gives_a_wrong_value(name):
     """Negative control: restarting below the anchor however far the ray moved (a fold above
-    it changed side) gives values that are not Alg. 1's."""
+    it changed side) gives values, taken as exact, that are not Alg. 1's."""
     _, c = geometry(name)
-    got, want, *_ = walk_rays(c, margin=False)
-    assert error(got, want, c).max() > 1e-3
+    got, bounded, want, *_ = walk_rays(c, margin=False)
+    assert error(got[~bounded], want[~bounded], c).max() > 1e-3
 
 
 def test_the_restart_is_compiled_only_where_folds_are_isometries_along_the_ray():
@@ -120,14 +121,14 @@ def off(scene):
 
 @pytest.mark.parametrize("stop", [0, 4, 9])
 def test_gpu_images_with_and_without_the_restart_agree(renderer, stop):
-    """The same hits and depths up to rounding, the same iterations but where a rounding
-    flips a convergence test; negative control: the image at half ε differs in more hits."""
+    """The same hits and depths but where a bounded step (no hit test) sent a grazing ray
+    along other steps; a few more iterations for those steps. Negative control: the image
+    at half ε differs from the plain one in more hits."""
     scene = crown(stop)
     a, b = renderer.render(scene, W, H), renderer.render(off(scene), W, H)
     agree = agreement(a, b, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
-    assert agree.hit >= 0.999 and agree.depth_close >= 0.999, agree
-    assert (a.iterations != b.iterations).mean() <= 0.002
-    assert a.iterations.sum() <= 1.001 * b.iterations.sum()
+    assert agree.hit >= 0.998 and agree.depth_close >= 0.98, agree
+    assert b.iterations.sum() <= a.iterations.sum() <= 1.05 * b.iterations.sum()
     finer = renderer.render(off(scene).edit(("render", "epsilon_scale"), 0.5), W, H)
     assert (finer.hit != b.hit).sum() > (a.hit != b.hit).sum()
 
@@ -146,7 +147,7 @@ def test_the_oracle_finds_no_hole_in_the_restarted_image(renderer):
     """No certified hole nor false hit; negative control: the same image with every ray
     stopped 20 % further (as a walk that overshot) has holes."""
     scene = crown()
-    img = renderer.render(scene, W, H)
+    img = renderer.render(scene, 24, 14)  # the oracle's cost grows with every hit
     counts = count_errors(scene, img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
     past = Frame(img.color, img.depth * 1.2, img.normal, img.iterations, img.hit)
@@ -154,10 +155,25 @@ def test_the_oracle_finds_no_hole_in_the_restarted_image(renderer):
 
 
 def test_levels_walked_fall_inside_the_crown(renderer):
-    """The counting variant: inside the crown the restart walks at most 80 % of the levels
-    per iteration; the iterations stay the same (the control that the work is the same)."""
+    """The counting variant: inside the crown the restart walks at most 75 % of the levels
+    of the plain walk, its few added iterations included; negative control: the whole-tree
+    view, where few steps fit under an anchor, saves much less."""
     scene = crown()
     on, plain = renderer.levels(scene, W, H), renderer.levels(off(scene), W, H)
-    a, b = renderer.render(scene, W, H), renderer.render(off(scene), W, H)
-    assert abs(int(a.iterations.sum()) - int(b.iterations.sum())) <= 0.001 * b.iterations.sum()
-    assert on.sum() < 0.8 * plain.sum(), (on.sum(), plain.sum())
+    assert on.sum() < 0.75 * plain.sum(), (on.sum(), plain.sum())
+    far = crown(0)
+    assert renderer.levels(far, W, H).sum() > 0.85 * renderer.levels(off(far), W, H).sum()
+
+
+def test_bench_zoom_shows_the_other_walk_beside():
+    """bench zoom's rows carry the walk without the restart: more levels per iteration at the
+    stops inside the crown; negative control: the same column of a scene with the restart
+    off is the restarted walk, with fewer."""
+    from krsview.bench.zoom import bench_zoom
+
+    tree = load_scene(resolve("tree"))
+    m = bench_zoom(tree, (24, 14), rounds=1, stops_count=3)
+    inside = m.rows[1:]
+    assert all(r["levels_other_walk"] > r["levels_per_iteration"] for r in inside), inside
+    plain = bench_zoom(off(tree), (24, 14), rounds=1, stops_count=3)
+    assert all(r["levels_other_walk"] < r["levels_per_iteration"] for r in plain.rows[1:])

@@ -18,7 +18,7 @@ INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 
 MIN_PROBE = 1e-30
 # The walk restart's anchor sits at the deepest level whose fold margin and distance above are
 # this many last steps' lengths: the next few steps fit under it (krs.glsl, krs_restart).
-RESTART_KEEP = 4.0
+RESTART_KEEP = 8.0
 
 # Shading (reference/occlusion.py, shade.py, atmosphere.py, texture.py and their shaders)
 SHADOW_OFFSET = 2.0  # a shadow ray starts this many ε off the surface, along the normal

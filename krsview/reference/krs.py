@@ -97,58 +97,57 @@ def restart(
     rho: np.ndarray | float,
     keep: np.ndarray,
     a: Anchor,
-    cull: bool = True,
-) -> tuple[np.ndarray, Anchor, np.ndarray]:
-    """Alg. 1's value at the points p = origin + t·dirs, each walk restarted below its ray's
-    anchor ``a`` where the folds above cannot have changed (krs.glsl, krs_restart): a point
+    margin: bool = True,
+) -> tuple[np.ndarray, np.ndarray, Anchor, np.ndarray]:
+    """Alg. 1 at the points p = origin + t·dirs, each walk restarted below its ray's anchor
+    ``a`` where the folds above cannot have changed (krs.glsl, krs_restart): a point
     s = t − a.t < a.m further folds to a.x + s·a.u (every fold an isometry on its side of its
     mirror), a.d − s bounds the levels above (1-Lipschitz), and with rho ≤ a.r no ball above
-    cuts. Where the levels below end above that bound, the walk goes on from the top. The
-    anchor moves to the deepest level with min(margin, distance above) ≥ ``keep``.
-    Returns (distance, the new anchors, levels walked per point)."""
+    cuts. The value is Alg. 1's where the levels below end under that bound; where the bound
+    limits it is only a lower bound (``bounded``) and the anchor is dropped. The anchor moves
+    to the deepest level with min(margin, distance above) ≥ ``keep``. ``margin=False`` ignores
+    the fold margin (a negative control). Returns (distance, bounded, new anchors, levels
+    walked per point)."""
     N, n = len(p), c.n
     rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (N,))
     s = t - a.t
-    dtop = kernel_distance(c.types[n], c.records[n], p)
-    again = (a.j >= 0) & (s < a.m) & (rho <= a.r)
+    fits = s < np.minimum(a.m, a.d) if margin else s < a.d
+    again = (a.j >= 0) & fits & (rho <= a.r)
     start = np.where(again, a.j, n - 1)
     x = np.where(again[:, None], a.x + s[:, None] * a.u, p)
     u = np.where(again[:, None], a.u, dirs)
-    bound = np.where(again, a.d - s, dtop)
-    d = bound.copy()
+    bound = a.d - s
+    d = np.where(again, bound, kernel_distance(c.types[n], c.records[n], p))
     m = np.where(again, a.m - s, np.inf)
     r = np.where(again, a.r, np.inf)
     out, levels = a, np.zeros(N, dtype=np.int64)
-    for phase in (0, 1):
-        live = np.ones(N, dtype=bool) if phase == 0 else again & (d >= bound)
-        if phase == 1:  # only the bound of the levels above: from the top
-            start = np.full(N, n - 1)
-            x, u = np.where(live[:, None], p, x), np.where(live[:, None], dirs, u)
-            d, m, r = np.where(live, dtop, d), np.where(live, np.inf, m), np.where(live, np.inf, r)
-        for i in range(n - 1, -1, -1):
+    live = np.ones(N, dtype=bool)
+    for i in range(n - 1, -1, -1):
+        act = live & (i <= start)
+        sv = np.flatnonzero(act & (np.minimum(m, d) >= keep))
+        if sv.size:
+            j = np.full(sv.size, i)
+            out = out.put(sv, Anchor(j, x[sv], u[sv], t[sv], m[sv], d[sv], r[sv]))
+        levels += act
+        b = c.bounds[i]
+        if b[3] >= 0:
+            db = np.linalg.norm(x - b[:3], axis=1) - b[3]
+            r = np.where(act, np.minimum(r, b[3]), r)
+            cut = act & (b[3] < rho)
+            d = np.where(cut, np.minimum(d, db), d)
+            live &= ~(act & (cut | (db >= d)))
             act = live & (i <= start)
-            sv = np.flatnonzero(act & (np.minimum(m, d) >= keep))
-            if sv.size:
-                j = np.full(sv.size, i)
-                out = out.put(sv, Anchor(j, x[sv], u[sv], t[sv], m[sv], d[sv], r[sv]))
-            levels += act
-            b = c.bounds[i]
-            if b[3] >= 0:
-                db = np.linalg.norm(x - b[:3], axis=1) - b[3]
-                r = np.where(act, np.minimum(r, b[3]), r)
-                cut = act & (b[3] < rho)
-                d = np.where(cut, np.minimum(d, db), d)
-                live &= ~(act & (cut | (cull & (db >= d))))
-                act = live & (i <= start)
-            mu = c.mirrors[i]
-            xf, e = fold(mu, x)
-            x = np.where(act[:, None], xf, x)
-            flip = act & (e > 0)
-            u = np.where(flip[:, None], u - 2.0 * (u @ mu[:3])[:, None] * mu[:3], u)
-            m = np.where(act, np.minimum(m, np.abs(e)), m)
-            if c.types[i] != "empty":
-                d = np.where(act, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
-    return d, out, levels
+        mu = c.mirrors[i]
+        xf, e = fold(mu, x)
+        x = np.where(act[:, None], xf, x)
+        flip = act & (e > 0)
+        u = np.where(flip[:, None], u - 2.0 * (u @ mu[:3])[:, None] * mu[:3], u)
+        m = np.where(act, np.minimum(m, np.abs(e)), m)
+        if c.types[i] != "empty":
+            d = np.where(act, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
+    bounded = again & (d >= bound)
+    out = out.put(np.flatnonzero(bounded), Anchor.none(int(bounded.sum())))
+    return d, bounded, out, levels
 
 
 def mirror_weight(e: np.ndarray, width: np.ndarray | None) -> np.ndarray:

@@ -110,9 +110,10 @@ def restart_trace(
     rho: Callable[[np.ndarray], np.ndarray | float],
 ) -> tuple[Trace, np.ndarray]:
     """Sphere tracing of one undistorted KRS whose steps restart Alg. 1 below the ray's
-    anchor (krs.restart; trace.glsl's restart_distance): the same steps as
-    :func:`sphere_trace` up to rounding, fewer levels walked. ``rho``: the level of detail at
-    points (N, 3). Returns the trace and the levels walked per ray."""
+    anchor (krs.restart; trace.glsl's restart_distance): Alg. 1's value where the levels
+    below the anchor decide; where only the bound of the levels above is known, the ray steps
+    by it without a hit test and the next step walks from the top. ``rho``: the level of
+    detail at points (N, 3). Returns the trace and the levels walked per ray."""
     N = len(dirs)
     t = np.zeros(N)
     hit = np.zeros(N, dtype=bool)
@@ -127,13 +128,14 @@ def restart_trace(
             break
         ta = t[active]
         p = origin + ta[:, None] * dirs[active]
-        d, a, walked = krs.restart(
-            c, p, dirs[active], ta, rho(p), RESTART_KEEP * last[active], anchor.take(active)
+        keep = RESTART_KEEP * last[active]
+        d, bounded, a, walked = krs.restart(
+            c, p, dirs[active], ta, rho(p), keep, anchor.take(active)
         )
         anchor = anchor.put(active, a)
         levels[active] += walked
         iters[active] += 1
-        converged = d <= eps_per_t * ta
+        converged = ~bounded & (d <= eps_per_t * ta)
         hit[active[converged]] = True
         go = active[~converged]
         t[go] += d[~converged]

@@ -57,50 +57,42 @@ real krs_distance(int first, int n, vec3r xw, real rho) {
 // folded by the mirrors above (ax), the ray's direction folded alike (ad), the least |e| of
 // those folds (am), the least distance of the levels above (adist) and the least radius of
 // the balls tested above (ar, for the level of detail). Each fold is an isometry on each side
-// of its mirror, so a point s < am further along the ray folds to ax + s·ad, and adist − s
-// bounds the levels above (1-Lipschitz); with rho ≤ ar no ball above cuts. A walk from j down
+// of its mirror, so a point s < am further along the ray folds to ax + s·ad, adist − s bounds
+// the levels above (1-Lipschitz), and with rho ≤ ar no ball above cuts. The walk from j down
 // is then Alg. 1's own value where it ends below adist − s; where that bound is what limits,
-// the walk goes on from the top, so the value is always Alg. 1's (up to rounding).
-// The anchor moves to the deepest level whose min(margin, distance above) ≥ keep (κ times the
-// last step), so the next steps fit under it; `saved`: an anchor was taken at this point.
+// it is only a lower bound (`bounded`): the anchor is dropped, and the next step walks from
+// the top. (Walking on from the top in the same step cost more on llvmpipe, which runs a
+// group of 8 pixels as long as its slowest: docs/speed.md.) The anchor moves to the deepest
+// level whose min(margin, distance above) ≥ keep (κ times the last step), so the next steps
+// fit under it; `saved`: an anchor was taken at this point.
 real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real keep,
                  inout int aj, inout vec3r ax, inout vec3r ad, inout real am,
-                 inout real adist, inout real ar, out bool saved) {
-    int top = first + n - 1;
-    real dtop = kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
-    bool again = aj >= 0 && s < am && rho <= ar;
-    int i = again ? aj : top;
+                 inout real adist, inout real ar, out bool saved, out bool bounded) {
+    bool again = aj >= 0 && s < min(am, adist) && rho <= ar;
+    int i = again ? aj : first + n - 1;
     vec3r x = again ? ax + s * ad : p, u = again ? ad : dir;
-    real bound = again ? adist - s : dtop;
-    real d = bound, m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
+    real bound = adist - s;
+    real d = again ? bound : kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
+    real m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
     saved = false;
-    for (;;) {
-        if (i >= first) {
-            if (min(m, d) >= keep) {
-                aj = i; ax = x; ad = u; am = m; adist = d; ar = r;
-                saved = true;
-            }
-#ifdef KRS_LOD
-            real b = u_bounds[i].w;
-            r = b >= 0.0 ? min(r, b) : r;
-#endif
-            real e;
-            bool on = krs_level(i, x, d, rho, e);
-            vec3r mu = u_mirrors[i].xyz;
-            u -= 2.0 * (e > 0.0 ? dot(u, mu) : 0.0) * mu;
-            m = min(m, abs(e));
-            i = on ? i - 1 : first - 1;
-            continue;
+    for (; i >= first;) {
+        if (min(m, d) >= keep) {
+            aj = i; ax = x; ad = u; am = m; adist = d; ar = r;
+            saved = true;
         }
-        if (!(again && d >= bound)) break;
-        again = false;  // only the bound of the levels above: walk from the top
-        i = top;
-        x = p;
-        u = dir;
-        d = dtop;
-        m = FAR_AWAY;
-        r = FAR_AWAY;
+#ifdef KRS_LOD
+        real b = u_bounds[i].w;
+        r = b >= 0.0 ? min(r, b) : r;
+#endif
+        real e;
+        bool on = krs_level(i, x, d, rho, e);
+        vec3r mu = u_mirrors[i].xyz;
+        u -= 2.0 * (e > 0.0 ? dot(u, mu) : 0.0) * mu;
+        m = min(m, abs(e));
+        i = on ? i - 1 : first - 1;
     }
+    bounded = again && d >= bound;
+    if (bounded) aj = -1;
     return d;
 }
 #endif

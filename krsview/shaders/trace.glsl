@@ -152,11 +152,12 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
 #ifdef KRS_WALK_RESTART  // a single KRS, undistorted (uniforms.variant_defines)
 // Alg. 1's value at p = origin + t·dir, the walk restarted below the ray's anchor where its
 // folds cannot have changed (krs.glsl, krs_restart); `last`: the last step's length.
-real restart_distance(inout Ray r, vec3r p, vec3r dir, real t, real last) {
+// `bounded`: only a lower bound (the levels above the anchor limit it), no hit test.
+real restart_distance(inout Ray r, vec3r p, vec3r dir, real t, real last, out bool bounded) {
     ivec2 k = component(0);
     bool saved;
     real d = krs_restart(k.x, k.y, p, dir, t - r.wt, lod_radius(length(p)), RESTART_KEEP * last,
-                         r.wj, r.wx, r.wdir, r.wm, r.wd, r.wr, saved);
+                         r.wj, r.wx, r.wdir, r.wm, r.wd, r.wr, saved, bounded);
     if (saved) r.wt = t;
     return d;
 }
@@ -166,13 +167,20 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
     int c;
     real t, before = r.t;
     if (!next_step(r, c, t)) return;
-#ifdef KRS_WALK_RESTART
-    real d = restart_distance(r, origin + t * dir, dir, t, r.iterations > 0 ? t - before : FAR_AWAY);
+#ifdef KRS_WALK_RESTART  // a bounded step is no hit test: the next step walks from the top
+    bool bounded;
+    real d = restart_distance(r, origin + t * dir, dir, t, r.iterations > 0 ? t - before : FAR_AWAY,
+                              bounded);
+    ++r.iterations;
+    if (!bounded && d <= u_eps_per_t * t * lod_scale(origin + t * dir)) {
+        r.state = RAY_HIT;
+        return;
+    }
 #else
     real d = component_distance(c, origin + t * dir);
-#endif
     ++r.iterations;
     if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+#endif
     r.tc[c] = t + d;
 #if defined(KRS_BALL_EXIT) && !defined(KRS_COMPOUND)
     // c leaves once d(t') > ε(t') = ε_per_t t' all the way to T: a miss, found early (in a
