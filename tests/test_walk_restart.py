@@ -99,7 +99,9 @@ def test_a_restart_past_its_fold_margin_gives_a_wrong_value(name):
 
 def test_the_restart_is_compiled_only_where_folds_are_isometries_along_the_ray():
     scene, c = geometry("tree")
-    assert scene.render.walk_restart == "on"
+    assert scene.render.walk_restart == "off"  # the default: the plain walk
+    assert "KRS_WALK_RESTART" not in variant_defines(scene, c)
+    scene = on(scene)
     assert "KRS_WALK_RESTART" in variant_defines(scene, c)
     for field, value in (("walk_restart", "off"), ("tracer", "binary")):
         assert "KRS_WALK_RESTART" not in variant_defines(scene.edit(("render", field), value), c)
@@ -107,16 +109,21 @@ def test_the_restart_is_compiled_only_where_folds_are_isometries_along_the_ray()
     assert "KRS_WALK_RESTART" not in variant_defines(twisted, c)
     grove = load_scene(resolve("grove"))
     grove_c = compile_geometry(grove.geometry(), ALBEDO)
-    assert "KRS_WALK_RESTART" not in variant_defines(grove, grove_c)
+    assert "KRS_WALK_RESTART" not in variant_defines(on(grove), grove_c)
 
 
-def crown(stop: int = 4):
-    """tree seen from inside its crown (a stop of bench zoom), a shadow ray per pixel."""
-    return per_pixel(stops(load_scene(resolve("tree")), 12)[stop])
+def on(scene):
+    return scene.edit(("render", "walk_restart"), "on")
 
 
 def off(scene):
     return scene.edit(("render", "walk_restart"), "off")
+
+
+def crown(stop: int = 4):
+    """tree seen from inside its crown (a stop of bench zoom), a shadow ray per pixel, the
+    walk restarted."""
+    return on(per_pixel(stops(load_scene(resolve("tree")), 12)[stop]))
 
 
 @pytest.mark.parametrize("stop", [0, 4, 9])
@@ -166,12 +173,13 @@ def test_levels_walked_fall_inside_the_crown(renderer):
 
 
 def test_bench_zoom_shows_the_other_walk_beside():
-    """bench zoom's rows carry the walk without the restart: more levels per iteration at the
-    stops inside the crown; negative control: the same column of a scene with the restart
-    off is the restarted walk, with fewer."""
+    """bench zoom's rows carry the other walk beside: for a scene with the restart on, the
+    plain walk, with more levels per iteration at the stops inside the crown; negative
+    control: for a scene with it off (the default), the column is the restarted walk, with
+    fewer."""
     from krsview.bench.zoom import bench_zoom
 
-    tree = load_scene(resolve("tree"))
+    tree = on(load_scene(resolve("tree")))
     m = bench_zoom(tree, (24, 14), rounds=1, stops_count=3)
     inside = m.rows[1:]
     assert all(r["levels_other_walk"] > r["levels_per_iteration"] for r in inside), inside
