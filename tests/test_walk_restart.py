@@ -185,3 +185,16 @@ def test_bench_zoom_shows_the_other_walk_beside():
     assert all(r["levels_other_walk"] > r["levels_per_iteration"] for r in inside), inside
     plain = bench_zoom(off(tree), (24, 14), rounds=1, stops_count=3)
     assert all(r["levels_other_walk"] < r["levels_per_iteration"] for r in plain.rows[1:])
+
+
+@pytest.mark.parametrize("precision", ["float", "double"])
+def test_the_compute_path_takes_the_same_restarted_steps(renderer, precision):
+    """The anchor lives in the Ray between rounds (compile/std430.py): the compute path's
+    image equals the fragment path's, bit for bit; negative control: the image without the
+    restart is not that image."""
+    from .test_compute import on_path, same
+
+    scene = on_path(crown(), "fragment", precision=precision)
+    fragment = renderer.render(scene, W, H)
+    assert same(fragment, renderer.render(on_path(scene, "compute", steps=3), W, H))
+    assert not same(fragment, renderer.render(off(scene), W, H))
