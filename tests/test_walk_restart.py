@@ -98,6 +98,8 @@ def test_a_restart_past_its_fold_margin_gives_a_wrong_value(name):
 
 
 def test_the_restart_is_compiled_only_where_folds_are_isometries_along_the_ray():
+    """Off by default; on, for a sphere-traced single KRS, and not for the binary tracer,
+    under a twist, nor in a compound."""
     scene, c = geometry("tree")
     assert scene.render.walk_restart == "off"  # the default: the plain walk
     assert "KRS_WALK_RESTART" not in variant_defines(scene, c)
