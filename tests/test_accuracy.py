@@ -189,6 +189,7 @@ def test_every_knob_is_swept_and_a_mokrs_only_with_binary_tracing():
         "tracer",
         "precision",
         "culling",
+        "walk_restart",  # a single KRS, sphere-traced
         "lod",
         "shadow_block",  # its soft shadows: rays shared by pixel blocks or not
         "path",

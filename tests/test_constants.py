@@ -177,6 +177,9 @@ TWIN_NAMES: dict[str, str | None] = {
     "kernel_rec_float": None,
     "krs_distance": "distance",  # reference/krs.py is the KRS's module: no prefix
     "krs_nearest": "nearest",
+    "krs_level": "distance",  # one level of distance's loop
+    "krs_restart": "restart",
+    "restart_distance": "restart_trace",  # a restarted step, inside the tracer's loop
     "distort_distance": "distance",  # Distortion.distance
     "undistorted_distance": "reference/geometry.py:component_distances",
     "component_distance_at": "component_distance",  # ρ given: component_distance's lod, reach
@@ -306,7 +309,8 @@ def test_std430_rules():
     """Sizes and offsets by hand from OpenGL 4.6 §7.6.2.2, against the declared layouts."""
     assert base_type("vec3r", "double") == (24, 32) and base_type("vec2") == (8, 8)
     assert RAY.offsets("double", COMPONENT_SLOTS=2)["ts"] == 32
-    assert RAY.size("float", COMPONENT_SLOTS=1) == 32  # 6 floats + 2 ints
+    # 6 floats + 2 ints (32), two vec3 aligned to 16 (32 → 44, 48 → 60), 4 floats + 1 int → 80
+    assert RAY.size("float", COMPONENT_SLOTS=1) == 80
     assert SHADOW.size("float", COMPONENT_SLOTS=1) == 64  # 16 + 16 + 4 × 4 + 12 → 60 → 64
     assert SHADOW.size("double", COMPONENT_SLOTS=8) == 160  # 32 + 16 + 72 + 4 + 8 → 132 → 160
     assert COUNTS.offsets() == {"count": 0, "groups": 8} and COUNTS.size() == 20
@@ -389,5 +393,5 @@ def test_std430_sizes_are_the_drivers(renderer, preset, precision):
         )
         # negative control: a declaration that forgot the probe radii is caught
         wrong = Struct("Ray", tuple(f for f in RAY.fields if f.name != "sc"))
-        _, stride = driver_layout(glo, "rays", RAY)
-        assert wrong.size(precision, COMPONENT_SLOTS=slots) != stride
+        offsets, _ = driver_layout(glo, "rays", RAY)
+        assert wrong.offsets(precision, COMPONENT_SLOTS=slots)["ts"] != offsets["ts"]

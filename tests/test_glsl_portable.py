@@ -40,7 +40,7 @@ def variants() -> list[tuple[krsview.Scene, dict]]:
     """(scene, prepare's keywords) for every variant to check: each preset on both paths, in
     float and double, without and with the pre-pass; every hard case on both paths; the
     knobs that change the source (tracers, culling, the level of detail off, shadow and
-    component tasks, the variant
+    component tasks, the walk restart, the variant
     with every effect, the measuring probes)."""
     out = []
     for name in krsview.presets():
@@ -68,6 +68,9 @@ def variants() -> list[tuple[krsview.Scene, dict]]:
         (tree, {"probes": ("KRS_COUNT_LEVELS",)}),
         (krsview.load("palm"), {"probes": ("KRS_COUNT_LEVELS",)}),  # a MöKRS counts too
         (tree, {"probes": ("KRS_TRACE_ONLY",)}),
+        (krsview.configure(tree, walk_restart="on"), {"probes": ("KRS_COUNT_LEVELS",)}),
+        (krsview.configure(tree, walk_restart="on", lod=0.0, culling="off"), {}),
+        (krsview.configure(tree, walk_restart="on", path="compute", precision="double"), {}),
     ]
     return out
 

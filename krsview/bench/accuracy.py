@@ -7,9 +7,10 @@ shows each trade-off as no machine load changes it.
 
 Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / over-relaxed
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
-float64 shader), exact level culling, the level of detail in the walk (render.lod), the
-pixel blocks sharing a soft shadow ray (render.shadow_block: colour only), the pre-pass
-tile, the path (fragment or compute) and level count (LOD by truncation). One run
+float64 shader), exact level culling, the walk restart (render.walk_restart), the level of
+detail in the walk (render.lod), the pixel blocks sharing a soft shadow ray
+(render.shadow_block: colour only), the pre-pass tile, the path (fragment or compute) and
+level count (LOD by truncation). One run
 writes a CSV, a Markdown report, plots (error against time and against work per knob, the
 Pareto fronts over all settings) and error images (holes red, false hits blue)."""
 
@@ -23,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..compile.camera import view_of
+from ..compile.geometry import compile_geometry, walk_restarts
 from ..frame import Frame
 from ..gpu.passes import splits_shadows
 from ..gpu.renderer import Renderer
@@ -98,6 +100,12 @@ def settings(scene: Scene) -> list[Setting]:
     if scene.mokrs is None:  # Alg. 1's culling; not in a MöKRS
         other = "off" if r.culling == "on" else "on"
         out.append(Setting("culling", other, replace(scene, render=replace(r, culling=other))))
+    restarted = replace(scene, render=replace(r, walk_restart="on"))
+    if walk_restarts(restarted, compile_geometry(scene.geometry(), scene.material.albedo)):
+        other = "off" if r.walk_restart == "on" else "on"  # a single, undistorted KRS
+        out.append(
+            Setting("walk_restart", other, replace(scene, render=replace(r, walk_restart=other)))
+        )
     for lod in LODS:  # Alg. 1's balls, or a MöKRS's levels' bounds
         if lod != r.lod:
             out.append(Setting("lod", f"{lod:g}", replace(scene, render=replace(r, lod=lod))))

@@ -54,7 +54,8 @@ def bench_zoom(
     scene: Scene, size: tuple[int, int], rounds: int = 5, stops_count: int = 12, plot=None
 ) -> Measured:
     """One row per stop: distance to the kernel, median ms per frame (interleaved rounds),
-    iterations per pixel, levels walked per iteration, hit fraction; ``plot``: a PNG path
+    iterations per pixel, levels walked per iteration, hit fraction, and beside them every
+    level (lod 0) and the other walk (``[render] walk_restart`` switched); ``plot``: a PNG path
     for the plot of time and work along the flight."""
     w, h = size
     views = stops(scene, stops_count)
@@ -62,14 +63,18 @@ def bench_zoom(
     centre = finest_kernel_ball(scene)[:3]
     names = [f"stop {k}" for k in range(len(views))]
     every = [replace(v, render=replace(v.render, lod=0.0)) for v in views]
+    walk = "off" if scene.render.walk_restart == "on" else "on"  # the other walk, beside it
+    other = [replace(v, render=replace(v.render, walk_restart=walk)) for v in views]
     variants = {n: Variant(v) for n, v in zip(names, views)}
     variants |= {f"{n}, every level": Variant(v) for n, v in zip(names, every)}
+    variants |= {f"{n}, restart {walk}": Variant(v) for n, v in zip(names, other)}
     med = median_times(r, variants, size, rounds, f"bench zoom {scene.name}")
     rows = []
-    for name, v, e in zip(names, views, every):
+    for name, v, e, o in zip(names, views, every, other):
         frame = r.render(v, w, h)
         walked = r.levels(v, w, h)
         iterations = float(frame.iterations.mean())
+        other_frame = r.render(o, w, h)
         rows.append(
             dict(
                 stop=name,
@@ -82,6 +87,10 @@ def bench_zoom(
                     r.levels(e, w, h).sum() / max(r.render(e, w, h).iterations.sum(), 1)
                 ),
                 hit=float(frame.hit.mean()),
+                ms_other_walk=med[f"{name}, restart {walk}"] * 1e3,
+                levels_other_walk=float(
+                    r.levels(o, w, h).sum() / max(other_frame.iterations.sum(), 1)
+                ),
             )
         )
     m = Measured(scene, size, rounds, rows)
@@ -101,6 +110,7 @@ def table(m: Measured) -> str:
         f"{m.rounds} interleaved rounds\n\n"
     )
     lod = m.scene.render.lod
+    walk = "off" if m.scene.render.walk_restart == "on" else "on"
     text += markdown(
         (
             "stop",
@@ -111,8 +121,10 @@ def table(m: Measured) -> str:
             "levels/iteration",
             "levels/iteration, every level",
             "hit",
+            f"ms, walk restart {walk}",
+            f"levels/iteration, walk restart {walk}",
         ),
-        "lrrrrrrr",
+        "lrrrrrrrrr",
         (
             (
                 r["stop"],
@@ -123,13 +135,16 @@ def table(m: Measured) -> str:
                 f"{r['levels_per_iteration']:.1f}",
                 f"{r['levels_every_level']:.1f}",
                 f"{r['hit']:.0%}",
+                f"{r['ms_other_walk']:.1f}",
+                f"{r['levels_other_walk']:.1f}",
             )
             for r in m.rows
         ),
     )
     return (
         text + f"\n\nslowest frame / fastest: {spread(m):.2f}× (lod {lod:g}), "
-        f"{spread(m, 'ms_every_level'):.2f}× (every level)"
+        f"{spread(m, 'ms_every_level'):.2f}× (every level), "
+        f"{spread(m, 'ms_other_walk'):.2f}× (walk restart {walk})"
     )
 
 
@@ -144,11 +159,14 @@ def write_plot(m: Measured, path) -> None:
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     a.plot(d, m.column("ms"), "o-", color="C0", label=f"lod {m.scene.render.lod:g}")
     a.plot(d, m.column("ms_every_level"), "o--", color="C3", label="every level (lod 0)")
+    walk = "off" if m.scene.render.walk_restart == "on" else "on"
+    a.plot(d, m.column("ms_other_walk"), "s:", color="C4", label=f"walk restart {walk}")
     a.set_ylabel("ms per frame")
     a.legend()
     a.set_title(f"{m.scene.name}: zoom into the finest kernel, {m.size[0]}×{m.size[1]}")
     b.plot(d, m.column("iterations"), "o-", color="C1", label="iterations per pixel")
     b.plot(d, m.column("levels_per_iteration"), "s-", color="C2", label="levels per iteration")
+    b.plot(d, m.column("levels_other_walk"), "s:", color="C4", label=f"… walk restart {walk}")
     b.set_xscale("log")
     b.invert_xaxis()
     b.set_xlabel("distance to the kernel (scene units; the flight goes right)")

@@ -16,6 +16,9 @@ INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 
 # A blocked probe this small has converged even where ε(t) = 0 (an eye inside a solid): in
 # exact arithmetic it would shrink forever; in float32 it underflowed to 0 within 100 probes.
 MIN_PROBE = 1e-30
+# The walk restart's anchor sits at the deepest level whose fold margin and distance above are
+# this many last steps' lengths: the next few steps fit under it (krs.glsl, krs_restart).
+RESTART_KEEP = 8.0
 
 # Shading (reference/occlusion.py, shade.py, atmosphere.py, texture.py and their shaders)
 SHADOW_OFFSET = 2.0  # a shadow ray starts this many ε off the surface, along the normal
@@ -64,6 +67,7 @@ def shared() -> dict[str, GlslValue]:
         "MAX_EMPTY_ZONES": MAX_EMPTY_ZONES,
         "INITIAL_PROBE": INITIAL_PROBE,
         "MIN_PROBE": MIN_PROBE,
+        "RESTART_KEEP": RESTART_KEEP,
         "SHADOW_OFFSET": SHADOW_OFFSET,
         "AO_SAMPLES": AO_SAMPLES,
         "GAMMA": GAMMA,

@@ -7,7 +7,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..scene import KRS, Compound, Geometry, MoKRS
+from ..scene import KRS, Compound, Geometry, MoKRS, Scene
 from .krs import CompiledCompound, CompiledKRS, compile_krs
 from .mokrs import CompiledMoKRS, compile_mokrs
 
@@ -62,3 +62,15 @@ def scene_ball(c: Compiled) -> np.ndarray | None:
         top = c.outer[-1]
         return top.copy() if top[3] >= 0 and np.isfinite(top).all() else None
     return c.ball.copy() if c.ball[3] >= 0 else None
+
+
+def walk_restarts(scene: Scene, c: Compiled) -> bool:
+    """The sphere tracer's steps restart Alg. 1 below the ray's anchor (``[render]
+    walk_restart``; krs.glsl, reference/krs.py restart): one KRS, whose folds are isometries
+    along the ray, so not under a distortion (twist, wind, empty zones) nor in a compound."""
+    return (
+        scene.render.walk_restart == "on"
+        and scene.render.tracer == "sphere"
+        and isinstance(c, CompiledKRS)
+        and not {"twist", "wind", "empty_zones"} & set(scene.effects)
+    )

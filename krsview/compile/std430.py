@@ -83,6 +83,13 @@ RAY = Struct(
         Field("real", "t"),
         Field("int", "iterations"),
         Field("int", "state"),
+        Field("vec3r", "wx"),
+        Field("vec3r", "wdir"),
+        Field("real", "wt"),
+        Field("real", "wm"),
+        Field("real", "wd"),
+        Field("real", "wr"),
+        Field("int", "wj"),
     ),
 )
 # shadows.glsl's Shadow: a shadow ray between rounds (KRS_SHADOW_TASKS).

@@ -8,7 +8,7 @@ import numpy as np
 from ..compile.balls import UNBOUNDED
 from ..compile.camera import View
 from ..compile.constants import MOBIUS_RECORD
-from ..compile.geometry import Compiled
+from ..compile.geometry import Compiled, walk_restarts
 from ..compile.krs import KERNEL_CODES, RECORD_VEC4, CompiledCompound
 from ..compile.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
@@ -87,6 +87,8 @@ def variant_defines(
         and {"shadows", "soft_shadows"} & set(scene.effects)
     ):
         defines["KRS_SHADOW_CONE"] = None  # shadow rays meet components late (shadows.glsl)
+    if walk_restarts(scene, c) and not all_effects:
+        defines["KRS_WALK_RESTART"] = None  # steps restart Alg. 1 below their anchor (krs.glsl)
     if isinstance(c, CompiledMoKRS):
         defines["KRS_MOBIUS"] = None
     if isinstance(c, CompiledCompound):

@@ -7,6 +7,8 @@ exact when kernels are separated. Mirrors ``shaders/krs.glsl``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..compile.krs import CompiledKRS
@@ -51,6 +53,103 @@ def distance(
         if c.types[i] != "empty":
             d = np.where(live, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
     return d
+
+
+@dataclass(frozen=True)
+class Anchor:
+    """Per ray, Alg. 1's state before level slot ``j`` (−1: none) at ray distance ``t``: the
+    point folded by the mirrors above (``x``), the ray's direction folded alike (``u``), the
+    least |e| of those folds (``m``), the least distance of the levels above (``d``) and the
+    least radius of the balls tested above (``r``). Twin of trace.glsl's Ray fields w*."""
+
+    j: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    t: np.ndarray
+    m: np.ndarray
+    d: np.ndarray
+    r: np.ndarray
+
+    @staticmethod
+    def none(n: int) -> Anchor:
+        z = np.zeros(n)
+        return Anchor(np.full(n, -1), np.zeros((n, 3)), np.zeros((n, 3)), z, z, z, z)
+
+    def take(self, rows: np.ndarray) -> Anchor:
+        return Anchor(*(getattr(self, f)[rows] for f in FIELDS))
+
+    def put(self, rows: np.ndarray, other: Anchor) -> Anchor:
+        """This anchor with ``rows`` replaced by ``other``'s (one row each)."""
+        out = {}
+        for f in FIELDS:
+            v = getattr(self, f).copy()
+            v[rows] = getattr(other, f)
+            out[f] = v
+        return Anchor(**out)
+
+
+FIELDS = ("j", "x", "u", "t", "m", "d", "r")
+
+
+def restart(
+    c: CompiledKRS,
+    p: np.ndarray,
+    dirs: np.ndarray,
+    t: np.ndarray,
+    rho: np.ndarray | float,
+    keep: np.ndarray,
+    a: Anchor,
+    margin: bool = True,
+) -> tuple[np.ndarray, np.ndarray, Anchor, np.ndarray]:
+    """Alg. 1 at the points p = origin + t·dirs, each walk restarted below its ray's anchor
+    ``a`` where the folds above cannot have changed (krs.glsl, krs_restart): a point
+    s = t − a.t < a.m further folds to a.x + s·a.u (every fold an isometry on its side of its
+    mirror), a.d − s bounds the levels above (1-Lipschitz), and with rho ≤ a.r no ball above
+    cuts. The value is Alg. 1's where the levels below end under that bound; where the bound
+    limits it is only a lower bound (``bounded``) and the anchor is dropped. The anchor moves
+    to the deepest level with min(margin, distance above) ≥ ``keep``. ``margin=False`` ignores
+    the fold margin (a negative control). Returns (distance, bounded, new anchors, levels
+    walked per point)."""
+    N, n = len(p), c.n
+    rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (N,))
+    s = t - a.t
+    fits = s < np.minimum(a.m, a.d) if margin else s < a.d
+    again = (a.j >= 0) & fits & (rho <= a.r)
+    start = np.where(again, a.j, n - 1)
+    x = np.where(again[:, None], a.x + s[:, None] * a.u, p)
+    u = np.where(again[:, None], a.u, dirs)
+    bound = a.d - s
+    d = np.where(again, bound, kernel_distance(c.types[n], c.records[n], p))
+    m = np.where(again, a.m - s, np.inf)
+    r = np.where(again, a.r, np.inf)
+    out, levels = a, np.zeros(N, dtype=np.int64)
+    live = np.ones(N, dtype=bool)
+    for i in range(n - 1, -1, -1):
+        act = live & (i <= start)
+        sv = np.flatnonzero(act & (np.minimum(m, d) >= keep))
+        if sv.size:
+            j = np.full(sv.size, i)
+            out = out.put(sv, Anchor(j, x[sv], u[sv], t[sv], m[sv], d[sv], r[sv]))
+        levels += act
+        b = c.bounds[i]
+        if b[3] >= 0:
+            db = np.linalg.norm(x - b[:3], axis=1) - b[3]
+            r = np.where(act, np.minimum(r, b[3]), r)
+            cut = act & (b[3] < rho)
+            d = np.where(cut, np.minimum(d, db), d)
+            live &= ~(act & (cut | (db - 2.0 * rho >= d)))  # 2ρ: what is cut below reaches
+            act = live & (i <= start)
+        mu = c.mirrors[i]
+        xf, e = fold(mu, x)
+        x = np.where(act[:, None], xf, x)
+        flip = act & (e > 0)
+        u = np.where(flip[:, None], u - 2.0 * (u @ mu[:3])[:, None] * mu[:3], u)
+        m = np.where(act, np.minimum(m, np.abs(e)), m)
+        if c.types[i] != "empty":
+            d = np.where(act, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
+    bounded = again & (d >= bound)
+    out = out.put(np.flatnonzero(bounded), Anchor.none(int(bounded.sum())))
+    return d, bounded, out, levels
 
 
 def mirror_weight(e: np.ndarray, width: np.ndarray | None) -> np.ndarray:

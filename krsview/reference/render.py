@@ -7,14 +7,14 @@ from collections.abc import Callable
 import numpy as np
 
 from ..compile.camera import View, primary_rays, view_of
-from ..compile.geometry import compile_geometry
+from ..compile.geometry import compile_geometry, walk_restarts
 from ..frame import Frame
 from ..scene import Geometry, Scene
 from .atmosphere import background
 from .distortion import Distortion
-from .geometry import Lod, component_distances, component_tests, nearest
+from .geometry import Lod, component_distances, component_tests, nearest, rho_at
 from .shade import Hits, encode, shade
-from .trace import binary_trace, relaxed_trace, sphere_trace
+from .trace import binary_trace, relaxed_trace, restart_trace, sphere_trace
 
 PROGRESS_CHUNK = 8192  # rays per chunk when progress is reported
 
@@ -75,6 +75,10 @@ def _trace_and_shade(
         (d,) = component_distances(c, dist, lod)  # a single KRS (Scene.check_tracer)
         tr = relaxed_trace(
             d, view.origin, dirs, eps, r.max_iterations, r.max_distance, r.relaxation, scale
+        )
+    elif walk_restarts(scene, c):
+        tr, _ = restart_trace(
+            c, view.origin, dirs, eps, r.max_iterations, r.max_distance, lambda p: rho_at(lod, p)
         )
     else:
         tr = sphere_trace(

@@ -12,7 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..compile.constants import INITIAL_PROBE, MIN_PROBE
+from ..compile.constants import INITIAL_PROBE, MIN_PROBE, RESTART_KEEP
+from ..compile.krs import CompiledKRS
+from . import krs
 
 
 @dataclass
@@ -96,6 +98,50 @@ def sphere_trace(
         tc[active, c] = ta + d
         active = active[~converged]
     return Trace(hit, t, iters)
+
+
+def restart_trace(
+    c: CompiledKRS,
+    origin: np.ndarray,
+    dirs: np.ndarray,
+    eps_per_t: float,
+    max_iterations: int,
+    max_distance: float,
+    rho: Callable[[np.ndarray], np.ndarray | float],
+) -> tuple[Trace, np.ndarray]:
+    """Sphere tracing of one undistorted KRS whose steps restart Alg. 1 below the ray's
+    anchor (krs.restart; trace.glsl's restart_distance): Alg. 1's value where the levels
+    below the anchor decide; where only the bound of the levels above is known, the ray steps
+    by it without a hit test and the next step walks from the top. ``rho``: the level of
+    detail at points (N, 3). Returns the trace and the levels walked per ray."""
+    N = len(dirs)
+    t = np.zeros(N)
+    hit = np.zeros(N, dtype=bool)
+    iters = np.zeros(N, dtype=np.int64)
+    levels = np.zeros(N, dtype=np.int64)
+    anchor = krs.Anchor.none(N)
+    last = np.full(N, np.inf)  # the last step's length (none before the first)
+    active = np.arange(N)
+    for _ in range(max_iterations):
+        active = active[t[active] <= max_distance]
+        if active.size == 0:
+            break
+        ta = t[active]
+        p = origin + ta[:, None] * dirs[active]
+        keep = RESTART_KEEP * last[active]
+        d, bounded, a, walked = krs.restart(
+            c, p, dirs[active], ta, rho(p), keep, anchor.take(active)
+        )
+        anchor = anchor.put(active, a)
+        levels[active] += walked
+        iters[active] += 1
+        converged = ~bounded & (d <= eps_per_t * ta)
+        hit[active[converged]] = True
+        go = active[~converged]
+        t[go] += d[~converged]
+        last[go] = d[~converged]
+        active = go
+    return Trace(hit, t, iters), levels
 
 
 def relaxed_trace(

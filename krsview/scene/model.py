@@ -308,6 +308,14 @@ class Render:
         "the levels below (0: off, every level; hit points move by at most "
         "2·lod·ε, never a hole)",
     )
+    walk_restart: str = param(
+        "off",
+        choices=SWITCH,
+        help="sphere tracer of one undistorted KRS: each step restarts Alg. 1 below the "
+        "levels whose folds the ray cannot have changed since an earlier step (fewer levels "
+        "walked inside a crown; a step whose value is only a bound takes no hit test, so "
+        "grazing rays may converge a step apart)",
+    )
     shadow_block: int = param(
         DEFAULT_SHADOW_BLOCK,
         lo=1,

@@ -24,32 +24,86 @@ real fold(int i, inout vec3r p) {
 #ifdef KRS_COUNT_LEVELS
 int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
 #endif
-real krs_distance(int first, int n, vec3r xw, real rho) {
-    vec3r x = xw;
-    real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
+
+// Level slot i of Alg. 1 on the point x with the distance d found above it: culling, the level
+// of detail, the fold (its e returned) and the kernel; false where the walk ends here.
+bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e) {
+#ifdef KRS_COUNT_LEVELS
+    ++g_levels;
+#endif
+    e = 0.0;
+#if defined(KRS_CULLING) || defined(KRS_LOD)
+    vec4r b = u_bounds[i];
+#endif
+#ifdef KRS_CULLING
 #ifdef KRS_LOD
-    real reach = 2.0 * rho;  // how far a ball drawn below may reach beyond C_i (below)
+    real reach = 2.0 * rho;  // how far a ball drawn below may reach beyond C_i (above)
 #else
     real reach = 0.0;
 #endif
-    for (int i = first + n - 1; i >= first; --i) {
-#ifdef KRS_COUNT_LEVELS
-        ++g_levels;
-#endif
-#if defined(KRS_CULLING) || defined(KRS_LOD)
-        vec4r b = u_bounds[i];
-#endif
-#ifdef KRS_CULLING
-        if (b.w >= 0.0 && length(x - b.xyz) - b.w - reach >= d) break;
+    if (b.w >= 0.0 && length(x - b.xyz) - b.w - reach >= d) return false;
 #endif
 #ifdef KRS_LOD  // the ball's distance only where it cuts: culling off pays no more
-        if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); break; }
+    if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); return false; }
 #endif
-        fold(i, x);
-        d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
-    }
+    e = fold(i, x);
+    d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
+    return true;
+}
+
+real krs_distance(int first, int n, vec3r xw, real rho) {
+    vec3r x = xw;
+    real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
+    real e;
+    for (int i = first + n - 1; i >= first; --i) if (!krs_level(i, x, d, rho, e)) break;
     return d;
 }
+
+#ifdef KRS_WALK_RESTART
+// The walk restarted below the levels whose folds cannot change [issue 27]. An anchor is the
+// walk's state before level slot j (aj; −1: none) at the ray distance where it was taken: x
+// folded by the mirrors above (ax), the ray's direction folded alike (ad), the least |e| of
+// those folds (am), the least distance of the levels above (adist) and the least radius of
+// the balls tested above (ar, for the level of detail). Each fold is an isometry on each side
+// of its mirror, so a point s < am further along the ray folds to ax + s·ad, adist − s bounds
+// the levels above (1-Lipschitz), and with rho ≤ ar no ball above cuts. The walk from j down
+// is then Alg. 1's own value where it ends below adist − s; where that bound is what limits,
+// it is only a lower bound (`bounded`): the anchor is dropped, and the next step walks from
+// the top. (Walking on from the top in the same step cost more on llvmpipe, which runs a
+// group of 8 pixels as long as its slowest: docs/speed.md.) The anchor moves to the deepest
+// level whose min(margin, distance above) ≥ keep (κ times the last step), so the next steps
+// fit under it; `saved`: an anchor was taken at this point.
+real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real keep,
+                 inout int aj, inout vec3r ax, inout vec3r ad, inout real am,
+                 inout real adist, inout real ar, out bool saved, out bool bounded) {
+    bool again = aj >= 0 && s < min(am, adist) && rho <= ar;
+    int i = again ? aj : first + n - 1;
+    vec3r x = again ? ax + s * ad : p, u = again ? ad : dir;
+    real bound = adist - s;
+    real d = again ? bound : kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
+    real m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
+    saved = false;
+    for (; i >= first;) {
+        if (min(m, d) >= keep) {
+            aj = i; ax = x; ad = u; am = m; adist = d; ar = r;
+            saved = true;
+        }
+#ifdef KRS_LOD
+        real b = u_bounds[i].w;
+        r = b >= 0.0 ? min(r, b) : r;
+#endif
+        real e;
+        bool on = krs_level(i, x, d, rho, e);
+        vec3r mu = u_mirrors[i].xyz;
+        u -= 2.0 * (e > 0.0 ? dot(u, mu) : 0.0) * mu;
+        m = min(m, abs(e));
+        i = on ? i - 1 : first - 1;
+    }
+    bounded = again && d >= bound;
+    if (bounded) aj = -1;
+    return d;
+}
+#endif
 
 #ifdef KRS_SMOOTH_SHADING
 uniform float u_smooth_width;  // scene units

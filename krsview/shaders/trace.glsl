@@ -31,6 +31,9 @@ struct Ray {
     real t;                     // the ray distance of the last step (the hit's, once hit)
     int iterations;
     int state;                  // RAY_LIVE, RAY_HIT or RAY_MISS
+    vec3r wx, wdir;             // walk restart: the anchor's folded point and direction,
+    real wt, wm, wd, wr;        // its ray distance, fold margin, distance above, least ball
+    int wj;                     // and its level slot (−1: none; krs.glsl, krs_restart)
 };
 
 Ray ray_begin(real start[COMPONENT_SLOTS]) {
@@ -43,6 +46,9 @@ Ray ray_begin(real start[COMPONENT_SLOTS]) {
     r.t = start[0];
     r.iterations = 0;
     r.state = RAY_LIVE;
+    r.wx = r.wdir = vec3r(0.0);
+    r.wt = r.wm = r.wd = r.wr = 0.0;
+    r.wj = -1;
     return r;
 }
 
@@ -143,13 +149,38 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
     r.t = t + r.w * d;
 }
 #else
+#ifdef KRS_WALK_RESTART  // a single KRS, undistorted (uniforms.variant_defines)
+// Alg. 1's value at p = origin + t·dir, the walk restarted below the ray's anchor where its
+// folds cannot have changed (krs.glsl, krs_restart); `last`: the last step's length.
+// `bounded`: only a lower bound (the levels above the anchor limit it), no hit test.
+real restart_distance(inout Ray r, vec3r p, vec3r dir, real t, real last, out bool bounded) {
+    ivec2 k = component(0);
+    bool saved;
+    real d = krs_restart(k.x, k.y, p, dir, t - r.wt, lod_radius(length(p)), RESTART_KEEP * last,
+                         r.wj, r.wx, r.wdir, r.wm, r.wd, r.wr, saved, bounded);
+    if (saved) r.wt = t;
+    return d;
+}
+#endif
+
 void ray_step(inout Ray r, vec3r origin, vec3r dir) {
     int c;
-    real t;
+    real t, before = r.t;
     if (!next_step(r, c, t)) return;
+#ifdef KRS_WALK_RESTART  // a bounded step is no hit test: the next step walks from the top
+    bool bounded;
+    real d = restart_distance(r, origin + t * dir, dir, t, r.iterations > 0 ? t - before : FAR_AWAY,
+                              bounded);
+    ++r.iterations;
+    if (!bounded && d <= u_eps_per_t * t * lod_scale(origin + t * dir)) {
+        r.state = RAY_HIT;
+        return;
+    }
+#else
     real d = component_distance(c, origin + t * dir);
     ++r.iterations;
     if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+#endif
     r.tc[c] = t + d;
 #if defined(KRS_BALL_EXIT) && !defined(KRS_COMPOUND)
     // c leaves once d(t') > ε(t') = ε_per_t t' all the way to T: a miss, found early (in a
