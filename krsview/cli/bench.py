@@ -45,7 +45,7 @@ BENCHES = {
         "Render the same view with the coarsest 4, 8, … levels, interleaved, median of "
         "several frames; print time relative to the smallest level count beside the kernel "
         "instances. Example: krsview bench levels tree --step 4",
-        knobs=("epsilon_scale", "max_iterations", "lod", "prepass"),
+        knobs=("epsilon_scale", "max_iterations", "lod", "prepass", "walk_restart"),
         own=(
             (
                 "--step",
@@ -112,7 +112,7 @@ BENCHES = {
         "(interleaved rounds), iterations per pixel and levels walked per iteration at each "
         "stop, and the slowest frame against the fastest. Example: krsview bench zoom tree "
         "--stops 12 --plot out/zoom.png",
-        knobs=("prepass", "culling", "lod"),
+        knobs=("prepass", "culling", "lod", "walk_restart"),
         own=(
             (
                 "--stops",

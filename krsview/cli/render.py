@@ -24,6 +24,7 @@ KNOBS = (
     "precision",
     "culling",
     "lod",
+    "walk_restart",
     "shadow_block",
     "shadow_cone",
     "prepass",
@@ -189,7 +190,7 @@ def settled(args: argparse.Namespace, scene: Scene) -> Scene:
     """The viewer's fast settings where neither the file nor an option sets them, or with
     --exact every level and no pre-pass (the reference's image)."""
     if args.exact:
-        for knob in ("prepass", "lod", "shadow_block", "shadow_cone"):
+        for knob in ("prepass", "lod", "shadow_block", "shadow_cone", "walk_restart"):
             if getattr(args, knob) is not None:
                 flag = "--" + knob.replace("_", "-")
                 raise SceneError(flag, getattr(args, knob), "cannot be combined with --exact")

@@ -135,7 +135,7 @@ def steps(c: CompiledKRS | CompiledMoKRS):
     its radius in world lengths (∞ where the frame's scale varies).
 
     KRS [KRS17 Alg. 1]: the top kernel, then per level i a fold and k_i; the ball is the
-    culling ball C_i (``compile/krs.krs_bounds``). MöKRS [KRS17 Alg. 3]: per level
+    culling ball C_i (``compile/balls.krs_bounds``). MöKRS [KRS17 Alg. 3]: per level
     x ← H_i(x), folded to x ≤ 0 where it reflects, then k_i; the ball is the level's bound
     mapped out by G_i = H_i⁻¹ (``reference/mokrs.bounds_in_and_out``), so it is tested before
     H_i, where a pole of H_i is not."""

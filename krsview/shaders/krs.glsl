@@ -12,7 +12,7 @@ real fold(int i, inout vec3r p) {
 
 // The KRS whose kernels K_0..K_n and mirrors R_0..R_{n−1} sit in slots first..first + n.
 // Exact level culling [issue 17]: once d ≤ dist(x, C_i), the ball of everything levels i..0
-// would still test (compile/krs.py, krs_bounds; r < 0: none), the walk stops with the
+// would still test (compile/balls.py, krs_bounds; r < 0: none), the walk stops with the
 // same value. Most rays far from the finer levels pay for a few levels instead of n.
 // Level of detail [issue 27, KRS14 LOD]: at the first ball C_i whose radius is below rho,
 // the ball stands for levels i..0 (d = min(d, dist(x, C_i)), a lower bound of what they
