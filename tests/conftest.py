@@ -30,6 +30,14 @@ def renderer():
     return Renderer()
 
 
+@pytest.fixture(scope="module")
+def targets(renderer):
+    """The passes' targets (gpu/passes.py) on the session's renderer."""
+    from krsview.gpu.passes import Targets
+
+    return Targets(renderer.ctx)
+
+
 def per_pixel(scene):
     """``scene`` with a shadow ray per pixel: as the NumPy reference shades it (the GPU's
     shared shadow rays, ``[render] shadow_block`` > 1, are held to per-pixel ones by

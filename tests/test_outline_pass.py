@@ -10,21 +10,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import krsview
 from krsview.gpu import passes, program
-from krsview.gpu.passes import SAMPLERS, PassImage, Targets
+from krsview.gpu.passes import SAMPLERS, PassImage
 from krsview.gpu.renderer import read_buffers
 
-SIZE = (160, 90)
-
-
-@pytest.fixture(scope="module")
-def targets(renderer):
-    return Targets(renderer.ctx)
-
-
-def scene_of(name: str) -> krsview.Scene:
-    return krsview.configure(krsview.load(name), prepass=4)
+from .test_passes import SIZE, scene_of
 
 
 def image_of(renderer, targets, scene, one_pass=False, blocks=None, size=SIZE) -> PassImage:

@@ -23,11 +23,6 @@ from .test_glsl_portable import VERSIONS, validate
 SIZE = (160, 90)
 
 
-@pytest.fixture(scope="module")
-def targets(renderer):
-    return Targets(renderer.ctx)
-
-
 def scene_of(name: str) -> krsview.Scene:
     return krsview.configure(krsview.load(name), prepass=4)
 

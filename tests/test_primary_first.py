@@ -10,7 +10,7 @@ import pytest
 
 import krsview
 from krsview.frame import Frame
-from krsview.gpu.passes import PassImage, Targets
+from krsview.gpu.passes import PassImage
 from krsview.gpu.renderer import read_buffers
 from krsview.viewer.adaptive import AdaptiveResolution
 from krsview.viewer.frames import Frames
@@ -25,11 +25,6 @@ def scene_of(name: str) -> krsview.Scene:
 
 def luminance(frame: Frame) -> np.ndarray:
     return frame.color.mean(-1)
-
-
-@pytest.fixture(scope="module")
-def targets(renderer):
-    return Targets(renderer.ctx)
 
 
 def first_and_final(renderer, targets, scene, visibility: float | None = None):
