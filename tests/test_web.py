@@ -1,6 +1,7 @@
 """Web page and Shadertoy export [issue 18 §1], checked in a real browser: Debian's chromium,
-headless, WebGL2 on its SwiftShader rasteriser. Each screenshot is compared with `krsview
-render` (EGL, llvmpipe) of the same view; the orbit is checked against cameras computed here
+headless, WebGL2 on its SwiftShader rasteriser (one browser for the module, each page in a
+fresh tab: tests/browser.py). Each screenshot is compared with `krsview render` (EGL,
+llvmpipe) of the same view; the orbit is checked against cameras computed here
 from the orbit formula, and every preset and hard case compiles as GLSL ES 3.00
 (glslangValidator)."""
 
@@ -17,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from krsview.bench.hard_cases import CASES
 from krsview.scene import Camera, SceneError, load_scene, save_scene
@@ -26,17 +26,10 @@ from krsview.share import web_tracks
 from krsview.share.web import export_notes, html_page, page_shader, shadertoy_source, web_shader
 from krsview.share.web_tracks import PAGE_DATA_CAP, PAGE_RATE
 
+from .browser import Browser
 from .conftest import headless_render
 
 SIZE = (160, 90)
-BROWSER = [
-    "chromium",
-    "--headless=new",
-    "--no-sandbox",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--hide-scrollbars",
-]
 # Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
 # main that calls mainImage (iMouse released, iTime 0).
 TOY_PAGE_SHADER = (
@@ -47,24 +40,12 @@ TOY_PAGE_SHADER = (
 )
 
 
-def screenshot(page: Path, out: Path, fragment: str = "bare", budget_ms: int = 8000) -> np.ndarray:
-    """The page at SIZE in headless chromium (software WebGL2), rows top → bottom, taken
-    once the page's clock has run ``budget_ms`` of virtual time."""
-    assert shutil.which("chromium"), "chromium is missing: `make deps` installs it"
-    r = subprocess.run(
-        [
-            *BROWSER,
-            f"--virtual-time-budget={budget_ms}",
-            f"--window-size={SIZE[0]},{SIZE[1]}",
-            f"--screenshot={out}",
-            f"{page.resolve().as_uri()}#{fragment}",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert r.returncode == 0 and out.exists(), r.stderr[-2000:]
-    return np.asarray(Image.open(out).convert("RGB")).astype(int)
+@pytest.fixture(scope="module")
+def browser():
+    """One headless chromium for the module's screenshots (tests/browser.py)."""
+    b = Browser(SIZE)
+    yield b
+    b.close()
 
 
 def reference(scene, tmp_path: Path, name: str) -> np.ndarray:
@@ -83,15 +64,15 @@ def export_page(scene, tmp_path: Path, name: str) -> Path:
 
 
 @pytest.mark.parametrize("name", ["tree", "palm", "grove", "sierpinski", "grass"])
-def test_the_page_draws_what_krsview_render_draws(name, tmp_path):
+def test_the_page_draws_what_krsview_render_draws(browser, name, tmp_path):
     """Colour within 16 of 255 on ≥ 97 % of pixels and a mean difference ≤ 2: two different
     software rasterisers round differently, which shows on sub-pixel leaves and blades."""
     scene = load_scene(resolve(name))
-    shot = screenshot(export_page(scene, tmp_path, name), tmp_path / "shot.png")
+    shot = browser.shot(export_page(scene, tmp_path, name))
     ref = reference(scene, tmp_path, "ref")
     assert agreement(shot, ref, 16) >= 0.97 and np.abs(shot - ref).max(-1).mean() <= 2.0
     # negative control: the view a little turned is another picture
-    turned = screenshot(tmp_path / f"{name}.html", tmp_path / "turned.png", "bare&orbit=0.1,0,1")
+    turned = browser.shot(tmp_path / f"{name}.html", "bare&orbit=0.1,0,1")
     assert agreement(turned, ref, 16) < 0.95
 
 
@@ -103,9 +84,9 @@ def silhouette(scene):
 
 
 @pytest.mark.parametrize("name", ["tree", "palm"])
-def test_the_page_hits_what_krsview_render_hits(name, tmp_path):
+def test_the_page_hits_what_krsview_render_hits(browser, name, tmp_path):
     scene = silhouette(load_scene(resolve(name)))
-    shot = screenshot(export_page(scene, tmp_path, name), tmp_path / "shot.png")
+    shot = browser.shot(export_page(scene, tmp_path, name))
     ref = reference(scene, tmp_path, "ref")
     hit_page, hit_ref = shot.max(-1) > 10, ref.max(-1) > 10
     assert 0.05 < hit_ref.mean() < 0.6
@@ -128,17 +109,17 @@ def orbit_camera(scene, yaw: float, pitch: float, zoom: float) -> Camera:
     return Camera(tuple(new_eye), cam.target, cam.up, cam.fov_y)
 
 
-def test_the_orbit_moves_the_camera_as_the_formula_says(tmp_path):
+def test_the_orbit_moves_the_camera_as_the_formula_says(browser, tmp_path):
     scene = load_scene(resolve("tree"))
     assert scene.camera.up == (0.0, 1.0, 0.0)
     page = export_page(scene, tmp_path, "tree")
-    shot = screenshot(page, tmp_path / "shot.png", "bare&orbit=0.7,0.25,0.8")
+    shot = browser.shot(page, "bare&orbit=0.7,0.25,0.8")
     ref = reference(replace(scene, camera=orbit_camera(scene, 0.7, 0.25, 0.8)), tmp_path, "r")
     assert agreement(shot, ref, 16) >= 0.97
     assert agreement(shot, reference(scene, tmp_path, "still"), 16) < 0.8
 
 
-def test_dragging_and_scrolling_orbit_and_zoom(tmp_path):
+def test_dragging_and_scrolling_orbit_and_zoom(browser, tmp_path):
     """The page's own pointer and wheel handlers, driven by events dispatched in the page:
     a drag of (−50, 20) pixels turns by 0.006 rad per pixel, a wheel of 223 zooms by
     e^(0.001·223) ≈ 1.25."""
@@ -154,7 +135,7 @@ canvas.dispatchEvent(new WheelEvent("wheel", {deltaY: 223, bubbles: true, cancel
 </script>
 </body>"""
     page.write_text(page.read_text(encoding="utf-8").replace("</body>", events), encoding="utf-8")
-    shot = screenshot(page, tmp_path / "shot.png")
+    shot = browser.shot(page)
     yaw, pitch, zoom = 0.006 * 50, 0.006 * 20, math.exp(0.001 * 223)
     ref = reference(replace(scene, camera=orbit_camera(scene, yaw, pitch, zoom)), tmp_path, "r")
     assert agreement(shot, ref, 16) >= 0.97
@@ -163,7 +144,7 @@ canvas.dispatchEvent(new WheelEvent("wheel", {deltaY: 223, bubbles: true, cancel
     assert agreement(shot, near, 16) < 0.95
 
 
-def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
+def test_the_shadertoy_shader_draws_the_same_picture(browser, tmp_path):
     """The .glsl file inside Shadertoy's wrapper (version, iResolution, iTime 0, iMouse 0)."""
     scene = load_scene(resolve("palm"))
     page = export_page(scene, tmp_path, "palm")
@@ -190,7 +171,7 @@ def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
         .replace("gl.uniform2f(uCanvas, w, h);", "gl.uniform3f(uCanvas, w, h, 1);"),
         encoding="utf-8",
     )
-    shot = screenshot(toy, tmp_path / "toy.png")
+    shot = browser.shot(toy)
     ref = reference(scene, tmp_path, "ref")
     assert agreement(shot, ref, 16) >= 0.97
 
@@ -259,7 +240,7 @@ def test_export_on_the_command_line_and_its_refusals(tmp_path):
     assert r.returncode == 0 and "note: render.prepass = 8" in r.stdout
 
 
-def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(tmp_path):
+def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(browser, tmp_path):
     """Issue 29: the page keeps the scene's time live (u_time, not baked): held at 1.5 s
     (#time=1.5) it hits what `krsview render --time 1.5` hits; held at 0 s, the crown stands
     elsewhere (the negative control)."""
@@ -268,8 +249,8 @@ def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(tmp_path
     text = page.read_text(encoding="utf-8")
     assert "uniform float u_time;" in text and "const float u_time" not in text
     ref = reference(scene.at(1.5), tmp_path, "ref").max(-1) > 10
-    held = screenshot(page, tmp_path / "held.png", "bare&time=1.5").max(-1) > 10
-    still = screenshot(page, tmp_path / "still.png", "bare&time=0").max(-1) > 10
+    held = browser.shot(page, "bare&time=1.5").max(-1) > 10
+    still = browser.shot(page, "bare&time=0").max(-1) > 10
     assert (held == ref).mean() >= 0.99
     assert (still == ref).mean() < (held == ref).mean() - 0.002  # 0.9965 against 0.9999
     toy = shadertoy_source(scene)
@@ -289,7 +270,7 @@ def page_parts(page: Path) -> tuple[str, object]:
     "name, t1, t2",
     [("palm-curl", 1.0, 2.0), ("tree-growing", 3.0, 7.5), ("tree-sway+wind", 1.25, 0.0)],
 )
-def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_path):
+def test_a_moving_page_holds_each_moment_as_render_draws_it(browser, name, t1, t2, tmp_path):
     """Issue 29: the page poses tracks and sway at every 1/24 s (palm-curl: its Möbius steps;
     tree-growing: levels added, so the slots grow, and the camera's tracks moving the orbit;
     tree-sway in the wind: sway and u_time together). Held at T (#time=T) the page draws what
@@ -304,7 +285,7 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_pa
     fragment, poses = page_parts(page)
     assert poses["rate"] == PAGE_RATE and fragment != web_shader(scene)
     assert ("u_time;" in fragment) == bool(wind)
-    shots = {t: screenshot(page, tmp_path / f"{t}.png", f"bare&time={t:g}") for t in (t1, t2)}
+    shots = {t: browser.shot(page, f"bare&time={t:g}") for t in (t1, t2)}
     refs = {t: reference(scene.at(t), tmp_path, f"ref{t}") for t in (t1, t2)}
     for t in (t1, t2):
         assert agreement(shots[t], refs[t], 16) >= 0.97, t
@@ -312,18 +293,18 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_pa
     assert agreement(shots[t1], refs[t2], 16) < 0.97
     assert np.abs(shots[t1] - refs[t2]).max(-1).mean() > 2.0
     if base == "palm-curl":  # between two poses the page shows the one before, never a blend
-        between = screenshot(page, tmp_path / "between.png", f"bare&time={t1 + 0.5 / PAGE_RATE}")
-        after = screenshot(page, tmp_path / "after.png", f"bare&time={t1 + 1 / PAGE_RATE}")
+        between = browser.shot(page, f"bare&time={t1 + 0.5 / PAGE_RATE}")
+        after = browser.shot(page, f"bare&time={t1 + 1 / PAGE_RATE}")
         assert np.array_equal(between, shots[t1]) and not np.array_equal(after, shots[t1])
 
 
-def test_the_moving_page_plays(tmp_path):
+def test_the_moving_page_plays(browser, tmp_path):
     """Opened without #time, palm-curl's page plays its loop: after 0.5 s and 2 s of the
     page's clock it shows other poses. Negative control: held (#time=1) it stands."""
     page = export_page(load_scene(resolve("palm-curl")), tmp_path, "palm-curl")
-    a, b = (screenshot(page, tmp_path / f"p{ms}.png", "bare", ms) for ms in (500, 2000))
+    a, b = (browser.shot(page, "bare", ms) for ms in (500, 2000))
     assert agreement(a, b, 16) < 0.97
-    c, d = (screenshot(page, tmp_path / f"h{ms}.png", "bare&time=1", ms) for ms in (500, 2000))
+    c, d = (browser.shot(page, "bare&time=1", ms) for ms in (500, 2000))
     assert np.array_equal(c, d)
 
 
