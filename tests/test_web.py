@@ -7,6 +7,7 @@ from the orbit formula, and every preset and hard case compiles as GLSL ES 3.00
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -60,6 +61,18 @@ def agreement(a: np.ndarray, b: np.ndarray, tolerance: int) -> float:
 def export_page(scene, tmp_path: Path, name: str) -> Path:
     page = tmp_path / f"{name}.html"
     page.write_text(html_page(scene), encoding="utf-8")
+    return page
+
+
+@functools.cache
+def preset_html(name: str) -> str:
+    """A preset's page, built once for the module (a moving preset's poses take seconds)."""
+    return html_page(load_scene(resolve(name)))
+
+
+def preset_page(name: str, tmp_path: Path) -> Path:
+    page = tmp_path / f"{name}.html"
+    page.write_text(preset_html(name), encoding="utf-8")
     return page
 
 
@@ -285,7 +298,7 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(browser, name, t1, t
     scene = load_scene(resolve(base))
     if wind:
         scene = scene.with_effects([*scene.effects, wind])
-    page = export_page(scene, tmp_path, base)
+    page = export_page(scene, tmp_path, base) if wind else preset_page(base, tmp_path)
     fragment, poses = page_parts(page)
     assert poses["rate"] == PAGE_RATE and fragment != web_shader(scene)
     assert ("u_time;" in fragment) == bool(wind)
@@ -305,7 +318,7 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(browser, name, t1, t
 def test_the_moving_page_plays(browser, tmp_path):
     """Opened without #time, palm-curl's page plays its loop: after 0.5 s and 2 s of the
     page's clock it shows other poses. Negative control: held (#time=1) it stands."""
-    page = export_page(load_scene(resolve("palm-curl")), tmp_path, "palm-curl")
+    page = preset_page("palm-curl", tmp_path)
     a, b = (browser.shot(page, "bare", ms) for ms in (500, 2000))
     assert agreement(a, b, 16) < 0.97
     c, d = (browser.shot(page, "bare&time=1", ms) for ms in (500, 2000))
@@ -324,7 +337,7 @@ def test_a_page_without_tracks_is_the_baked_page(name, tmp_path):
     uniforms = {line.split()[2] for line in fragment.splitlines() if line.startswith("uniform")}
     assert uniforms == {"u_orbit;", "u_canvas;"} | ({"u_time;"} if "wind" in name else set())
     moving = load_scene(resolve("palm-curl"))
-    fragment, poses = page_parts(export_page(moving, tmp_path, "palm-curl"))
+    fragment, poses = page_parts(preset_page("palm-curl", tmp_path))
     assert fragment != web_shader(moving) and poses["block"] > 0
     assert "layout(std140) uniform KRSBlock {\n    vec4 u_mobius[" in fragment
 
@@ -338,7 +351,7 @@ def test_every_moving_preset_fits_the_cap_and_a_lower_cap_lowers_the_rate(tmp_pa
     assert {"palm-curl", "tree-sway", "tree-growing"} <= set(moving)
     full = {}
     for name in moving:
-        full[name] = page_parts(export_page(load_scene(resolve(name)), tmp_path, name))[1]
+        full[name] = page_parts(preset_page(name, tmp_path))[1]
         assert full[name]["rate"] == PAGE_RATE and len(full[name]["data"]) <= PAGE_DATA_CAP, name
     cap = len(full["palm-curl"]["data"]) * 2 // 3
     monkeypatch.setattr(web_tracks, "PAGE_DATA_CAP", cap)
