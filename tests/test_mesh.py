@@ -190,7 +190,7 @@ def test_a_mobius_scene_in_the_wind_meshes_bent():
     scene = palm.with_geometry(palm.geometry().truncated(12)).at(2.0)
     scene = scene.edit("effect_settings.wind_strength", 30.0)
     wind = Wind.of(scene)
-    bent, st = build_mesh(scene, 64)
+    bent, st = build_mesh(scene, 32)  # the bend is per vertex (the MöKRS at 64: above)
     assert bent.is_watertight
     c = compile_geometry(scene.geometry(), scene.material.albedo)
     rest_point = lambda x: wind.unwind(0, np.asarray(x))  # noqa: E731
@@ -199,5 +199,5 @@ def test_a_mobius_scene_in_the_wind_meshes_bent():
     assert certified.mean() > 0.99
     back = bent_forward(wind, rest_point(bent.vertices))
     assert np.abs(back - bent.vertices).max() < 1e-6 * st.voxel
-    rest, _ = build_mesh(scene.with_effects([e for e in scene.effects if e != "wind"]), 64)
+    rest, _ = build_mesh(scene.with_effects([e for e in scene.effects if e != "wind"]), 32)
     assert sign_change_near(rest.vertices, field, st.voxel, 2.0**-REFINE_STEPS)[0].mean() < 0.5

@@ -325,10 +325,10 @@ def test_the_oracle_certifies_a_swaying_frame_and_finds_the_rest_pose_wrong(rend
     from krsview.api import exact_settings
 
     s = exact_settings(load_scene(resolve("tree-sway"))).at(0.9)
-    img = renderer.render(s, 48, 27)
+    img = renderer.render(s, 32, 18)  # as the wind's frames (tests/test_oracle_wind.py)
     counts = count_errors(s, img, arithmetics=("affine",))
     assert (counts.holes, counts.false_hits) == (0, 0), counts
     assert counts.hits > 20
-    rest = renderer.render(s.at(0.0), 48, 27)  # the negative control: another moment
+    rest = renderer.render(s.at(0.0), 32, 18)  # the negative control: another moment
     wrong = count_errors(s, rest, arithmetics=("affine",))
     assert wrong.holes + wrong.false_hits > 0, wrong

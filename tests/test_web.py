@@ -1,11 +1,13 @@
 """Web page and Shadertoy export [issue 18 §1], checked in a real browser: Debian's chromium,
-headless, WebGL2 on its SwiftShader rasteriser. Each screenshot is compared with `krsview
-render` (EGL, llvmpipe) of the same view; the orbit is checked against cameras computed here
+headless, WebGL2 on its SwiftShader rasteriser (one browser for the module, each page in a
+fresh tab: tests/browser.py). Each screenshot is compared with `krsview render` (EGL,
+llvmpipe) of the same view; the orbit is checked against cameras computed here
 from the orbit formula, and every preset and hard case compiles as GLSL ES 3.00
 (glslangValidator)."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -17,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from krsview.bench.hard_cases import CASES
 from krsview.scene import Camera, SceneError, load_scene, save_scene
@@ -26,17 +27,10 @@ from krsview.share import web_tracks
 from krsview.share.web import export_notes, html_page, page_shader, shadertoy_source, web_shader
 from krsview.share.web_tracks import PAGE_DATA_CAP, PAGE_RATE
 
+from .browser import Browser
 from .conftest import headless_render
 
 SIZE = (160, 90)
-BROWSER = [
-    "chromium",
-    "--headless=new",
-    "--no-sandbox",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--hide-scrollbars",
-]
 # Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
 # main that calls mainImage (iMouse released, iTime 0).
 TOY_PAGE_SHADER = (
@@ -47,24 +41,12 @@ TOY_PAGE_SHADER = (
 )
 
 
-def screenshot(page: Path, out: Path, fragment: str = "bare", budget_ms: int = 8000) -> np.ndarray:
-    """The page at SIZE in headless chromium (software WebGL2), rows top → bottom, taken
-    once the page's clock has run ``budget_ms`` of virtual time."""
-    assert shutil.which("chromium"), "chromium is missing: `make deps` installs it"
-    r = subprocess.run(
-        [
-            *BROWSER,
-            f"--virtual-time-budget={budget_ms}",
-            f"--window-size={SIZE[0]},{SIZE[1]}",
-            f"--screenshot={out}",
-            f"{page.resolve().as_uri()}#{fragment}",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert r.returncode == 0 and out.exists(), r.stderr[-2000:]
-    return np.asarray(Image.open(out).convert("RGB")).astype(int)
+@pytest.fixture(scope="module")
+def browser():
+    """One headless chromium for the module's screenshots (tests/browser.py)."""
+    b = Browser(SIZE)
+    yield b
+    b.close()
 
 
 def reference(scene, tmp_path: Path, name: str) -> np.ndarray:
@@ -82,16 +64,28 @@ def export_page(scene, tmp_path: Path, name: str) -> Path:
     return page
 
 
+@functools.cache
+def preset_html(name: str) -> str:
+    """A preset's page, built once for the module (a moving preset's poses take seconds)."""
+    return html_page(load_scene(resolve(name)))
+
+
+def preset_page(name: str, tmp_path: Path) -> Path:
+    page = tmp_path / f"{name}.html"
+    page.write_text(preset_html(name), encoding="utf-8")
+    return page
+
+
 @pytest.mark.parametrize("name", ["tree", "palm", "grove", "sierpinski", "grass"])
-def test_the_page_draws_what_krsview_render_draws(name, tmp_path):
+def test_the_page_draws_what_krsview_render_draws(browser, name, tmp_path):
     """Colour within 16 of 255 on ≥ 97 % of pixels and a mean difference ≤ 2: two different
     software rasterisers round differently, which shows on sub-pixel leaves and blades."""
     scene = load_scene(resolve(name))
-    shot = screenshot(export_page(scene, tmp_path, name), tmp_path / "shot.png")
+    shot = browser.shot(export_page(scene, tmp_path, name))
     ref = reference(scene, tmp_path, "ref")
     assert agreement(shot, ref, 16) >= 0.97 and np.abs(shot - ref).max(-1).mean() <= 2.0
     # negative control: the view a little turned is another picture
-    turned = screenshot(tmp_path / f"{name}.html", tmp_path / "turned.png", "bare&orbit=0.1,0,1")
+    turned = browser.shot(tmp_path / f"{name}.html", "bare&orbit=0.1,0,1")
     assert agreement(turned, ref, 16) < 0.95
 
 
@@ -103,9 +97,9 @@ def silhouette(scene):
 
 
 @pytest.mark.parametrize("name", ["tree", "palm"])
-def test_the_page_hits_what_krsview_render_hits(name, tmp_path):
+def test_the_page_hits_what_krsview_render_hits(browser, name, tmp_path):
     scene = silhouette(load_scene(resolve(name)))
-    shot = screenshot(export_page(scene, tmp_path, name), tmp_path / "shot.png")
+    shot = browser.shot(export_page(scene, tmp_path, name))
     ref = reference(scene, tmp_path, "ref")
     hit_page, hit_ref = shot.max(-1) > 10, ref.max(-1) > 10
     assert 0.05 < hit_ref.mean() < 0.6
@@ -128,17 +122,17 @@ def orbit_camera(scene, yaw: float, pitch: float, zoom: float) -> Camera:
     return Camera(tuple(new_eye), cam.target, cam.up, cam.fov_y)
 
 
-def test_the_orbit_moves_the_camera_as_the_formula_says(tmp_path):
+def test_the_orbit_moves_the_camera_as_the_formula_says(browser, tmp_path):
     scene = load_scene(resolve("tree"))
     assert scene.camera.up == (0.0, 1.0, 0.0)
     page = export_page(scene, tmp_path, "tree")
-    shot = screenshot(page, tmp_path / "shot.png", "bare&orbit=0.7,0.25,0.8")
+    shot = browser.shot(page, "bare&orbit=0.7,0.25,0.8")
     ref = reference(replace(scene, camera=orbit_camera(scene, 0.7, 0.25, 0.8)), tmp_path, "r")
     assert agreement(shot, ref, 16) >= 0.97
     assert agreement(shot, reference(scene, tmp_path, "still"), 16) < 0.8
 
 
-def test_dragging_and_scrolling_orbit_and_zoom(tmp_path):
+def test_dragging_and_scrolling_orbit_and_zoom(browser, tmp_path):
     """The page's own pointer and wheel handlers, driven by events dispatched in the page:
     a drag of (−50, 20) pixels turns by 0.006 rad per pixel, a wheel of 223 zooms by
     e^(0.001·223) ≈ 1.25."""
@@ -154,7 +148,7 @@ canvas.dispatchEvent(new WheelEvent("wheel", {deltaY: 223, bubbles: true, cancel
 </script>
 </body>"""
     page.write_text(page.read_text(encoding="utf-8").replace("</body>", events), encoding="utf-8")
-    shot = screenshot(page, tmp_path / "shot.png")
+    shot = browser.shot(page)
     yaw, pitch, zoom = 0.006 * 50, 0.006 * 20, math.exp(0.001 * 223)
     ref = reference(replace(scene, camera=orbit_camera(scene, yaw, pitch, zoom)), tmp_path, "r")
     assert agreement(shot, ref, 16) >= 0.97
@@ -163,7 +157,7 @@ canvas.dispatchEvent(new WheelEvent("wheel", {deltaY: 223, bubbles: true, cancel
     assert agreement(shot, near, 16) < 0.95
 
 
-def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
+def test_the_shadertoy_shader_draws_the_same_picture(browser, tmp_path):
     """The .glsl file inside Shadertoy's wrapper (version, iResolution, iTime 0, iMouse 0)."""
     scene = load_scene(resolve("palm"))
     page = export_page(scene, tmp_path, "palm")
@@ -190,16 +184,21 @@ def test_the_shadertoy_shader_draws_the_same_picture(tmp_path):
         .replace("gl.uniform2f(uCanvas, w, h);", "gl.uniform3f(uCanvas, w, h, 1);"),
         encoding="utf-8",
     )
-    shot = screenshot(toy, tmp_path / "toy.png")
+    shot = browser.shot(toy)
     ref = reference(scene, tmp_path, "ref")
     assert agreement(shot, ref, 16) >= 0.97
 
 
-def glsl_es_errors(text: str, tmp_path: Path) -> str:
-    f = tmp_path / "stage.frag"
-    f.write_text(text, encoding="utf-8")
+def glsl_es_errors(stages: dict[str, str], tmp_path: Path) -> str:
+    """glslangValidator's complaints about fragment stages (file name → text), all in one
+    run (each file compiled on its own; a complaint names its file); '' if all are valid."""
+    for name, text in stages.items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
     r = subprocess.run(
-        ["glslangValidator", "-S", "frag", str(f)], capture_output=True, text=True, timeout=60
+        ["glslangValidator", "-S", "frag", *(str(tmp_path / name) for name in stages)],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     return "" if r.returncode == 0 else r.stdout + r.stderr
 
@@ -207,8 +206,8 @@ def glsl_es_errors(text: str, tmp_path: Path) -> str:
 def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
     assert shutil.which("glslangValidator"), "glslang-tools is missing: `make deps`"
     scenes = [(n, load_scene(resolve(n))) for n in preset_names()]
-    scenes += [(f"hard:{c.name}", c.build()) for c in CASES.values()]
-    exported = refused = 0
+    scenes += [(f"hard-{c.name}", c.build()) for c in CASES.values()]
+    stages, refused = {}, 0
     for name, scene in scenes:
         try:
             page, toy = web_shader(scene), shadertoy_source(scene)
@@ -216,17 +215,16 @@ def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
             assert scene.render.precision == "double" and "no fp64" in str(e), name
             refused += 1
             continue
-        assert not glsl_es_errors(page, tmp_path), name
-        assert not glsl_es_errors(page_shader(scene)[0], tmp_path), name  # poses live
-        assert not glsl_es_errors(TOY_PAGE_SHADER.format(body=toy), tmp_path), name
-        exported += 1
+        stages[f"{name}.page.frag"] = page
+        stages[f"{name}.posed.frag"] = page_shader(scene)[0]  # poses live
+        stages[f"{name}.toy.frag"] = TOY_PAGE_SHADER.format(body=toy)
+    exported = len(stages) // 3
     assert exported == len(scenes) - refused and exported > len(preset_names())
-    # negative control: the validator does reject what GLSL ES forbids
-    assert glsl_es_errors(
-        web_shader(load_scene(resolve("tree"))).replace("precision highp float;", "")
-        + "\ndouble x;",
-        tmp_path,
-    )
+    assert glsl_es_errors(stages, tmp_path) == ""
+    # negative control: the validator does reject what GLSL ES forbids, named by its file
+    broken = web_shader(load_scene(resolve("tree"))).replace("precision highp float;", "")
+    complaints = glsl_es_errors({**stages, "broken.frag": broken + "\ndouble x;"}, tmp_path)
+    assert complaints.split("broken.frag\n", 1)[1].startswith("ERROR"), complaints[-2000:]
 
 
 def test_export_on_the_command_line_and_its_refusals(tmp_path):
@@ -259,7 +257,7 @@ def test_export_on_the_command_line_and_its_refusals(tmp_path):
     assert r.returncode == 0 and "note: render.prepass = 8" in r.stdout
 
 
-def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(tmp_path):
+def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(browser, tmp_path):
     """Issue 29: the page keeps the scene's time live (u_time, not baked): held at 1.5 s
     (#time=1.5) it hits what `krsview render --time 1.5` hits; held at 0 s, the crown stands
     elsewhere (the negative control)."""
@@ -268,8 +266,8 @@ def test_the_wind_tree_page_plays_and_holds_a_moment_as_render_draws_it(tmp_path
     text = page.read_text(encoding="utf-8")
     assert "uniform float u_time;" in text and "const float u_time" not in text
     ref = reference(scene.at(1.5), tmp_path, "ref").max(-1) > 10
-    held = screenshot(page, tmp_path / "held.png", "bare&time=1.5").max(-1) > 10
-    still = screenshot(page, tmp_path / "still.png", "bare&time=0").max(-1) > 10
+    held = browser.shot(page, "bare&time=1.5").max(-1) > 10
+    still = browser.shot(page, "bare&time=0").max(-1) > 10
     assert (held == ref).mean() >= 0.99
     assert (still == ref).mean() < (held == ref).mean() - 0.002  # 0.9965 against 0.9999
     toy = shadertoy_source(scene)
@@ -289,7 +287,7 @@ def page_parts(page: Path) -> tuple[str, object]:
     "name, t1, t2",
     [("palm-curl", 1.0, 2.0), ("tree-growing", 3.0, 7.5), ("tree-sway+wind", 1.25, 0.0)],
 )
-def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_path):
+def test_a_moving_page_holds_each_moment_as_render_draws_it(browser, name, t1, t2, tmp_path):
     """Issue 29: the page poses tracks and sway at every 1/24 s (palm-curl: its Möbius steps;
     tree-growing: levels added, so the slots grow, and the camera's tracks moving the orbit;
     tree-sway in the wind: sway and u_time together). Held at T (#time=T) the page draws what
@@ -300,11 +298,11 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_pa
     scene = load_scene(resolve(base))
     if wind:
         scene = scene.with_effects([*scene.effects, wind])
-    page = export_page(scene, tmp_path, base)
+    page = export_page(scene, tmp_path, base) if wind else preset_page(base, tmp_path)
     fragment, poses = page_parts(page)
     assert poses["rate"] == PAGE_RATE and fragment != web_shader(scene)
     assert ("u_time;" in fragment) == bool(wind)
-    shots = {t: screenshot(page, tmp_path / f"{t}.png", f"bare&time={t:g}") for t in (t1, t2)}
+    shots = {t: browser.shot(page, f"bare&time={t:g}") for t in (t1, t2)}
     refs = {t: reference(scene.at(t), tmp_path, f"ref{t}") for t in (t1, t2)}
     for t in (t1, t2):
         assert agreement(shots[t], refs[t], 16) >= 0.97, t
@@ -312,18 +310,18 @@ def test_a_moving_page_holds_each_moment_as_render_draws_it(name, t1, t2, tmp_pa
     assert agreement(shots[t1], refs[t2], 16) < 0.97
     assert np.abs(shots[t1] - refs[t2]).max(-1).mean() > 2.0
     if base == "palm-curl":  # between two poses the page shows the one before, never a blend
-        between = screenshot(page, tmp_path / "between.png", f"bare&time={t1 + 0.5 / PAGE_RATE}")
-        after = screenshot(page, tmp_path / "after.png", f"bare&time={t1 + 1 / PAGE_RATE}")
+        between = browser.shot(page, f"bare&time={t1 + 0.5 / PAGE_RATE}")
+        after = browser.shot(page, f"bare&time={t1 + 1 / PAGE_RATE}")
         assert np.array_equal(between, shots[t1]) and not np.array_equal(after, shots[t1])
 
 
-def test_the_moving_page_plays(tmp_path):
+def test_the_moving_page_plays(browser, tmp_path):
     """Opened without #time, palm-curl's page plays its loop: after 0.5 s and 2 s of the
     page's clock it shows other poses. Negative control: held (#time=1) it stands."""
-    page = export_page(load_scene(resolve("palm-curl")), tmp_path, "palm-curl")
-    a, b = (screenshot(page, tmp_path / f"p{ms}.png", "bare", ms) for ms in (500, 2000))
+    page = preset_page("palm-curl", tmp_path)
+    a, b = (browser.shot(page, "bare", ms) for ms in (500, 2000))
     assert agreement(a, b, 16) < 0.97
-    c, d = (screenshot(page, tmp_path / f"h{ms}.png", "bare&time=1", ms) for ms in (500, 2000))
+    c, d = (browser.shot(page, "bare&time=1", ms) for ms in (500, 2000))
     assert np.array_equal(c, d)
 
 
@@ -339,7 +337,7 @@ def test_a_page_without_tracks_is_the_baked_page(name, tmp_path):
     uniforms = {line.split()[2] for line in fragment.splitlines() if line.startswith("uniform")}
     assert uniforms == {"u_orbit;", "u_canvas;"} | ({"u_time;"} if "wind" in name else set())
     moving = load_scene(resolve("palm-curl"))
-    fragment, poses = page_parts(export_page(moving, tmp_path, "palm-curl"))
+    fragment, poses = page_parts(preset_page("palm-curl", tmp_path))
     assert fragment != web_shader(moving) and poses["block"] > 0
     assert "layout(std140) uniform KRSBlock {\n    vec4 u_mobius[" in fragment
 
@@ -353,7 +351,7 @@ def test_every_moving_preset_fits_the_cap_and_a_lower_cap_lowers_the_rate(tmp_pa
     assert {"palm-curl", "tree-sway", "tree-growing"} <= set(moving)
     full = {}
     for name in moving:
-        full[name] = page_parts(export_page(load_scene(resolve(name)), tmp_path, name))[1]
+        full[name] = page_parts(preset_page(name, tmp_path))[1]
         assert full[name]["rate"] == PAGE_RATE and len(full[name]["data"]) <= PAGE_DATA_CAP, name
     cap = len(full["palm-curl"]["data"]) * 2 // 3
     monkeypatch.setattr(web_tracks, "PAGE_DATA_CAP", cap)
