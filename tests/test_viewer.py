@@ -340,6 +340,7 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
         "scene,as saved,100,100,50,0.02\nepsilon_scale,0.5,100,100,80,0.01\n"
         "epsilon_scale,4,100,100,20,0.09\nlevels,12,100,100,10,0.2\n"
         "tracer,binary 2/0.3,100,100,90,0.015\nprecision,double,100,100,70,0.019\n"
+        "walk_restart,on,100,100,55,0.02\n"
     )
     monkeypatch.setattr(measured, "REPORT_DIRS", (tmp_path,))
     rows = load_measured("tree")
@@ -365,6 +366,11 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     assert [
         r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
     ] == ["double"]
+    v.execute(apply_row(rows[6], v.doc.saved))
+    assert v.scene.render.walk_restart == "on" and v.scene.render.precision == "float"
+    assert [
+        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+    ] == ["on"]
     v.execute(apply_row(rows[3], v.doc.saved))
     assert v.levels == 12 and v.scene.render == v.doc.saved.render
     # the panel itself draws inside an ImGui frame and returns commands, not changes

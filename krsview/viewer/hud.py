@@ -43,6 +43,7 @@ KNOBS = (
     "precision",
     "culling",
     "lod",
+    "walk_restart",
     "path",
     "steps",
     "shadow_tasks",

@@ -14,6 +14,7 @@ from .commands import Command, Edit, SetLevels, SetPrepass
 # A report made here by `krsview bench accuracy` (OUT/PRESET/accuracy.csv) wins over the
 # measurements shipped beside the presets (PRESET.accuracy.csv, in the wheel too).
 REPORT_DIRS = (Path("out") / "accuracy",)
+SWITCHES = ("precision", "culling", "path", "walk_restart")  # knobs whose value is a word
 
 
 def report_files(stem: str) -> list[Path]:
@@ -65,7 +66,7 @@ def matches(
         return same_but(lod=float(value))
     if knob == "tracer":
         return same_but(**_tracer(value))
-    if knob in ("precision", "culling", "path"):
+    if knob in SWITCHES:
         return same_but(**{knob: value})
     if knob == "prepass":  # the scene's own pre-pass may differ: the view draws ``prepass``
         return replace(s, prepass=r.prepass) == r and full and prepass == int(value)
@@ -99,9 +100,7 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
         "max_iterations": lambda: replace(base, max_iterations=int(value)),
         "lod": lambda: replace(base, lod=float(value)),
         "tracer": lambda: replace(base, **_tracer(value)),
-        "precision": lambda: replace(base, precision=value),
-        "culling": lambda: replace(base, culling=value),
-        "path": lambda: replace(base, path=value),
+        **{k: lambda k=k: replace(base, **{k: value}) for k in SWITCHES},
     }.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
     out: list[Command] = [Edit(("render",), render), SetLevels(levels)]
