@@ -215,8 +215,10 @@ def bounds(
         for ball, size, move, kind, rec in steps(part):
             if ball is not None:
                 blo = (norm(minus(y, ball[:3])) - float(ball[3])).range()[0]
-                # with a level of detail, a ball cut below reaches up to 2·lod beyond this one
-                clear = blo > (0.0 if lod is None else 2.0 * lod[rows])  # NaN: not clear
+                # a KRS's balls are not nested (compile/balls.py): with a level of detail, a
+                # ball cut below reaches up to 2·lod beyond this one; a MöKRS's are nested
+                reach = 0.0 if lod is None or isinstance(part, CompiledMoKRS) else 2 * lod[rows]
+                clear = blo > reach  # NaN: not clear
                 cut = ~clear & (size <= lod[rows]) if lod is not None else np.zeros_like(clear)
                 out.lo[rows[clear]] = np.minimum(out.lo[rows[clear]], blo[clear])
                 out.cut[rows[cut]] = np.minimum(out.cut[rows[cut]], blo[cut])
