@@ -132,11 +132,14 @@ SPARSE = {  # two small spheres 2 apart (one and its mirror image) under a large
 
 
 @pytest.mark.parametrize("name", ["tree", "tree-mokrs", "sparse"])
-def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, name):
+def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, tmp_path, name):
     """Certified: the LOD image passes no surface, and every hit lies within hit_reach (ε
-    plus the cut ball's diameter). Negative control: held to plain ε, the two small spheres'
+    plus the cut ball's diameter). Negative controls: held to plain ε, the two small spheres'
     ball drawn whole makes hits that are certified false — the level of detail does draw
-    something else, and the oracle sees it."""
+    something else, and the oracle sees it; and a tree whose cut balls are drawn at a quarter
+    of their radius (so no longer holding the levels below) shows certified holes. (In the
+    crown a ball drawn too large is not caught at this size: a hit's reach, 9ε at lod 4,
+    always holds a twig; the sparse spheres catch that.)"""
     scene = load_dict(SPARSE, "sparse") if name == "sparse" else load_scene(resolve(name))
     scene = with_lod(scene, 4.0)
     # the oracle's cost grows with the rays (a MöKRS's the most); the sparse spheres' whole
@@ -148,6 +151,15 @@ def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, na
     if name == "sparse":
         plain_reach = replace(scene, render=replace(scene.render, lod=0.0))
         assert count_errors(plain_reach, img, arithmetics=("affine",)).false_hits > 0
+    if name == "tree":
+        from krsview.gpu.renderer import Renderer
+
+        from .conftest import broken_shaders
+
+        cut = "d = min(d, length(x - b.xyz) - b.w); return false;"
+        quarter = "d = min(d, length(x - b.xyz) - 0.25 * b.w); return false;"
+        shrunk = Renderer(shader_dir=broken_shaders(tmp_path, "krs.glsl", cut, quarter))
+        assert count_errors(scene, shrunk.render(scene, w, h), arithmetics=("affine",)).holes > 0
 
 
 def test_levels_below_the_pixel_are_not_walked(renderer):
