@@ -65,6 +65,27 @@ def lod(scale: Scale | None, points: np.ndarray) -> np.ndarray | float:
     return 1.0 if scale is None else scale(points)
 
 
+# A step of a tracer that keeps one t per ray: it moves ``t`` of the rays ``active`` and
+# returns (the rays that converged, the rays going on).
+Step = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def march(n: int, max_iterations: int, max_distance: float, step: Step) -> Trace:
+    """The loop of the tracers that keep one t per ray (restart_trace, relaxed_trace): each
+    round the rays not past max_distance take ``step`` and count an iteration; a converged
+    ray is a hit, one that passes max_distance or spends the iteration cap a miss."""
+    trace = Trace(np.zeros(n, dtype=bool), np.zeros(n), np.zeros(n, dtype=np.int64))
+    active = np.arange(n)
+    for _ in range(max_iterations):
+        active = active[trace.t[active] <= max_distance]
+        if active.size == 0:
+            break
+        trace.iterations[active] += 1
+        converged, active = step(trace.t, active)
+        trace.hit[converged] = True
+    return trace
+
+
 def sphere_trace(
     distances: list[Distance],
     origin: np.ndarray,
@@ -115,17 +136,12 @@ def restart_trace(
     by it without a hit test and the next step walks from the top. ``rho``: the level of
     detail at points (N, 3). Returns the trace and the levels walked per ray."""
     N = len(dirs)
-    t = np.zeros(N)
-    hit = np.zeros(N, dtype=bool)
-    iters = np.zeros(N, dtype=np.int64)
     levels = np.zeros(N, dtype=np.int64)
     anchor = krs.Anchor.none(N)
     last = np.full(N, np.inf)  # the last step's length (none before the first)
-    active = np.arange(N)
-    for _ in range(max_iterations):
-        active = active[t[active] <= max_distance]
-        if active.size == 0:
-            break
+
+    def step(t: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        nonlocal anchor
         ta = t[active]
         p = origin + ta[:, None] * dirs[active]
         keep = RESTART_KEEP * last[active]
@@ -134,14 +150,13 @@ def restart_trace(
         )
         anchor = anchor.put(active, a)
         levels[active] += walked
-        iters[active] += 1
         converged = ~bounded & (d <= eps_per_t * ta)
-        hit[active[converged]] = True
         go = active[~converged]
         t[go] += d[~converged]
         last[go] = d[~converged]
-        active = go
-    return Trace(hit, t, iters), levels
+        return active[converged], go
+
+    return march(N, max_iterations, max_distance, step), levels
 
 
 def relaxed_trace(
@@ -162,31 +177,24 @@ def relaxed_trace(
     covered point. Once ω = 1 the steps are plain sphere tracing, covered by construction, so
     the test is skipped (rounding of t_s + d_s − t_s must not send a ray back forever)."""
     N = len(dirs)
-    t = np.zeros(N)
     ts, ds = np.zeros(N), np.zeros(N)  # last verified point and its free radius
     w = np.full(N, omega)
-    hit = np.zeros(N, dtype=bool)
-    iters = np.zeros(N, dtype=np.int64)
-    active = np.arange(N)
-    for _ in range(max_iterations):
-        active = active[t[active] <= max_distance]
-        if active.size == 0:
-            break
+
+    def step(t: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ta = t[active]
         d = distance(origin + ta[:, None] * dirs[active])
-        iters[active] += 1
         gap = (w[active] > 1.0) & (ds[active] + d < ta - ts[active])  # ω = 1: always covered
         back = active[gap]
         t[back], w[back] = ts[back] + ds[back], 1.0
         ok = active[~gap]
         dk = d[~gap]
         converged = dk <= eps_per_t * t[ok] * lod(lod_scale, origin + t[ok, None] * dirs[ok])
-        hit[ok[converged]] = True
         go = ok[~converged]
         ts[go], ds[go] = t[go], dk[~converged]
         t[go] = t[go] + w[go] * dk[~converged]
-        active = np.concatenate([back, go])
-    return Trace(hit, t, iters)
+        return ok[converged], np.concatenate([back, go])
+
+    return march(N, max_iterations, max_distance, step)
 
 
 def binary_trace(
