@@ -10,7 +10,7 @@ import numpy as np
 
 from krsview.compile.camera import project, view_of
 from krsview.editor.dial import distance_to, plane_basis, pointer_angle, rotation
-from krsview.scene.model import Camera
+from krsview.scene.render import Camera
 
 
 class Dial:

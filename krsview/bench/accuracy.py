@@ -29,7 +29,7 @@ from ..frame import Frame
 from ..gpu.passes import splits_shadows
 from ..gpu.renderer import Renderer
 from ..scene import Geometry, Scene, SceneError
-from ..scene.model import PRECISIONS
+from ..scene.render import PRECISIONS
 from .harness import Variant, noise_floor, round_times
 from .metrics import compare, error_image
 from .paths import TILES as PREPASS_TILES

@@ -19,7 +19,7 @@ from ..compile.constants import BINDING_KRS_BLOCK, PREPASS_TARGETS
 from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
 from ..scene import Geometry, Scene, SceneError
-from ..scene.model import PREPASS_RATIO
+from ..scene.render import PREPASS_RATIO
 from .compute import ComputePath, Rounds
 from .context import headless_context
 from .passes import PassImage, Targets, still_ratio

@@ -5,23 +5,19 @@ from .effects import EFFECTS, EffectSettings, EmptyZone
 from .model import (
     KRS,
     MAX_LEVELS,
-    TRACERS,
     Arc,
-    Camera,
     Capsule,
     Empty,
     Kernel,
     Level,
-    Light,
-    Material,
     Mirror,
     Plane,
-    Render,
     Sphere,
     ToroidalCapsule,
     arc_of,
 )
 from .mokrs import Invert, MobiusLevel, MobiusStep, MoKRS, Rotate, Scale, Translate
+from .render import TRACERS, Camera, Light, Material, Render
 from .route import Route, RouteLevel
 from .scene import Bookmark, Geometry, Scene, load_scene, save_scene, scene_from_toml, scene_to_toml
 from .schema import SceneError

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .model import Camera
+from .render import Camera
 from .schema import SceneError
 
 FORMAT = '{"poses": [{"t": seconds, "position": [x, y, z], "yaw": radians, "pitch": radians}, …]}'

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .compound import Placement
-from .schema import SceneError, Vec3, param
+from .schema import COLOR, SceneError, Vec3, param
 
 
 @dataclass(frozen=True)
@@ -87,8 +87,6 @@ MIN_HORIZONTAL = 1e-3  # the least horizontal part of wind_direction (sine of it
 WIND_RATIOS = (1.0, math.sqrt(5.0), math.sqrt(15.0))
 WIND_WEIGHTS = (0.5, 0.3, 0.2)
 WIND_PHASE = (math.sqrt(5.0) - 1.0) / 2.0
-
-_COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")
 
 
 @dataclass(frozen=True)
@@ -176,7 +174,7 @@ class EffectSettings:
         help="wind: the foot that stays put (in a compound, in each component's own frame)",
     )
     empty_zones: list[EmptyZone] = param([], help=f"empty_zones: at most {MAX_EMPTY_ZONES} balls")
-    sky_zenith: Vec3 = param((0.22, 0.42, 0.82), **_COLOR)
+    sky_zenith: Vec3 = param((0.22, 0.42, 0.82), **COLOR)
     fog_density: float = param(
         0.03,
         lo=0.0,

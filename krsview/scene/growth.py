@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
-from .model import _COLOR, Mirror
-from .schema import SceneError, Vec3, param
+from .model import Mirror
+from .schema import COLOR, SceneError, Vec3, param
 
 
 @dataclass(frozen=True)
@@ -36,8 +36,8 @@ class Growth:
         help="turn of successive fork planes around the branch",
     )
     bend: float = param(0.08, lo=-0.5, hi=0.5, help="upward bow of a branch, × its length")
-    bark: Vec3 = param((0.30, 0.20, 0.12), **_COLOR)
-    leaf: Vec3 = param((0.20, 0.45, 0.10), **_COLOR)
+    bark: Vec3 = param((0.30, 0.20, 0.12), **COLOR)
+    leaf: Vec3 = param((0.20, 0.45, 0.10), **COLOR)
     leaf_levels: int = param(5, lo=0, hi=63, help="finest levels coloured as leaves")
     forest: list[Mirror] = param(
         [],

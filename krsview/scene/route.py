@@ -21,7 +21,6 @@ import numpy as np
 
 from .growth import Growth
 from .model import (
-    _COLOR,
     KRS,
     MAX_LEVELS,
     Empty,
@@ -32,7 +31,7 @@ from .model import (
     arc_of,
     check_mirror_per_level,
 )
-from .schema import SceneError, Vec3, param
+from .schema import COLOR, SceneError, Vec3, param
 
 FORK_SEPARATION = 1e-9  # forks closer than this × the route's size are "on top of each other"
 CLIP_TOLERANCE = 0.5  # × a child's radius: a shallower crossing stays inside the fork joint
@@ -51,7 +50,7 @@ class RouteLevel:
         help="point the branch's arc passes through (on the chord: a straight branch)",
     )
     radius: float = param(0.05, lo=0.0, lo_open=True, hi=1e6, help="branch section radius")
-    color: Vec3 | None = param(None, **_COLOR)
+    color: Vec3 | None = param(None, **COLOR)
     normal: Vec3 | None = param(
         None,
         unit_vector="normalise",

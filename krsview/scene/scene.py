@@ -22,8 +22,9 @@ from .animation import (
 from .compound import Component, Compound, check_compound
 from .edits import apply_edit, parse_path
 from .effects import EffectSettings, check_effects
-from .model import KRS, Camera, Light, Material, Render
+from .model import KRS
 from .mokrs import MoKRS, check_view
+from .render import Camera, Light, Material, Render
 from .route import Route
 from .schema import SceneError, from_dict, param, to_dict
 from .toml_writer import dumps

@@ -86,6 +86,8 @@ def param(
     return field(default=default, metadata=meta)
 
 
+COLOR = dict(lo=0.0, hi=1.0, help="linear RGB")  # a colour field's range: param(..., **COLOR)
+
 MAX_ITEMS = 1024  # any list in a scene file (the fields' own limits are far lower)
 
 # Scene lengths and coordinates without a range of their own: the GPU squares them in
