@@ -131,15 +131,36 @@ SPARSE = {  # two small spheres 2 apart (one and its mirror image) under a large
 }
 
 
+# Negative controls: the cut drawn with each ball shrunk, so that it no longer holds the
+# levels below (shader, the cut, the shrunk cut). A KRS's walk takes the distance to a ball at
+# a quarter of its radius. A MöKRS's probe that reaches its bound is blocked; shrunk, it is
+# free unless it reaches a tenth of the bound: the bounds are loose (hits at lod 4: 295 with
+# the bound, 188 at half its radius, 145 at a quarter, and the rays lost pass no surface, so
+# no hole), and at a tenth 112 hits are left and 5 rays pass a certified surface.
+SHRUNK_CUT = {
+    "tree": (
+        "krs.glsl",
+        "d = min(d, length(x - b.xyz) - b.w); return false;",
+        "d = min(d, length(x - b.xyz) - 0.25 * b.w); return false;",
+    ),
+    "tree-mokrs": (
+        "mokrs.glsl",
+        "if (b.w >= 0.0 && b.w < lod_per_radius * radius) return false;",
+        "if (b.w >= 0.0 && b.w < lod_per_radius * radius)\n"
+        "            return length(b.xyz - center) - 0.1 * b.w >= radius;",
+    ),
+}
+
+
 @pytest.mark.parametrize("name", ["tree", "tree-mokrs", "sparse"])
 def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, tmp_path, name):
     """Certified: the LOD image passes no surface, and every hit lies within hit_reach (ε
     plus the cut ball's diameter). Negative controls: held to plain ε, the two small spheres'
     ball drawn whole makes hits that are certified false — the level of detail does draw
-    something else, and the oracle sees it; and a tree whose cut balls are drawn at a quarter
-    of their radius (so no longer holding the levels below) shows certified holes. (In the
-    crown a ball drawn too large is not caught at this size: a hit's reach, 9ε at lod 4,
-    always holds a twig; the sparse spheres catch that.)"""
+    something else, and the oracle sees it; and a tree, or a MöKRS tree, whose cut balls are
+    drawn shrunk (SHRUNK_CUT: no longer holding the levels below) shows certified holes.
+    (In the crown a ball drawn too large is not caught at this size: a hit's reach, 9ε at
+    lod 4, always holds a twig; the sparse spheres catch that.)"""
     scene = load_dict(SPARSE, "sparse") if name == "sparse" else load_scene(resolve(name))
     scene = with_lod(scene, 4.0)
     # the oracle's cost grows with the rays (a MöKRS's the most); the sparse spheres' whole
@@ -151,14 +172,12 @@ def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, tm
     if name == "sparse":
         plain_reach = replace(scene, render=replace(scene.render, lod=0.0))
         assert count_errors(plain_reach, img, arithmetics=("affine",)).false_hits > 0
-    if name == "tree":
+    if name in SHRUNK_CUT:
         from krsview.gpu.renderer import Renderer
 
         from .conftest import broken_shaders
 
-        cut = "d = min(d, length(x - b.xyz) - b.w); return false;"
-        quarter = "d = min(d, length(x - b.xyz) - 0.25 * b.w); return false;"
-        shrunk = Renderer(shader_dir=broken_shaders(tmp_path, "krs.glsl", cut, quarter))
+        shrunk = Renderer(shader_dir=broken_shaders(tmp_path, *SHRUNK_CUT[name]))
         assert count_errors(scene, shrunk.render(scene, w, h), arithmetics=("affine",)).holes > 0
 
 
