@@ -127,6 +127,21 @@ def broken_shaders(tmp_path: Path, name: str, old: str, new: str) -> Path:
     return shaders
 
 
+def krsview_cli(
+    *args: str, timeout: float = 300, cwd: Path | None = None, **env: str
+) -> subprocess.CompletedProcess:
+    """`krsview ARGS` in its own process, as a user runs it, headless (DISPLAY empty: EGL, no
+    window; ``env``: more variables), its output as text."""
+    return subprocess.run(
+        [sys.executable, "-m", "krsview", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=cwd,
+        env={**os.environ, "DISPLAY": "", **env},
+    )
+
+
 def headless_render(scene, path: Path, size: tuple[int, int], *options: str) -> np.ndarray:
     """`krsview render [options]` in its own process (EGL, no window) of ``scene`` saved at
     ``path``.toml: what a user gets from the command line, for comparing with a window."""
@@ -136,25 +151,17 @@ def headless_render(scene, path: Path, size: tuple[int, int], *options: str) -> 
 
     save_scene(scene, path.with_suffix(".toml"))
     out = path.with_suffix(".png")
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "krsview",
-            "render",
-            str(path.with_suffix(".toml")),
-            "-o",
-            str(out),
-            "--size",
-            f"{size[0]}x{size[1]}",
-            "--repeats",
-            "1",
-            *options,
-        ],
-        capture_output=True,
-        text=True,
+    r = krsview_cli(
+        "render",
+        str(path.with_suffix(".toml")),
+        "-o",
+        str(out),
+        "--size",
+        f"{size[0]}x{size[1]}",
+        "--repeats",
+        "1",
+        *options,
         timeout=120,
-        env={**os.environ, "DISPLAY": ""},
     )
     assert r.returncode == 0, r.stderr
     return np.asarray(Image.open(out).convert("RGB"))

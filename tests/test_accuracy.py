@@ -5,9 +5,6 @@ ground-truth cache, and the report a run writes."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -23,6 +20,8 @@ from krsview.gpu.renderer import Renderer
 from krsview.reference import render_reference
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
+
+from .conftest import krsview_cli
 
 W, H = 48, 27
 
@@ -237,19 +236,9 @@ def test_ground_truth_draws_every_level():
     )
 
 
-def run(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "krsview", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "DISPLAY": ""},
-    )
-
-
 def test_bench_accuracy_writes_a_readable_report(tmp_path):
     out = tmp_path / "report"
-    r = run(
+    r = krsview_cli(
         "bench",
         "accuracy",
         "sierpinski",
@@ -281,6 +270,6 @@ def test_bench_accuracy_writes_a_readable_report(tmp_path):
 def test_bench_accuracy_refuses_a_file_as_its_folder_before_any_work(tmp_path):
     f = tmp_path / "x.txt"
     f.write_text("")
-    r = run("bench", "accuracy", "sierpinski", "--out", str(f))
+    r = krsview_cli("bench", "accuracy", "sierpinski", "--out", str(f))
     assert r.returncode == 2 and "is a file; give a folder" in r.stderr
     assert "Traceback" not in r.stderr and "ground truth" not in r.stdout

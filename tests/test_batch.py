@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -20,6 +19,8 @@ from krsview.scene.camera_path import load_camera_path
 from krsview.scene.presets import resolve
 from krsview.share.batch import FrameWorker, run_batch
 from krsview.share.frames import FrameJob, frame_file, render_frames
+
+from .conftest import krsview_cli
 
 SIZE = (64, 36)
 POSES = [
@@ -43,12 +44,17 @@ def cluster():
 
 
 @pytest.fixture
-def job(tmp_path):
+def path_file(tmp_path):
     path = tmp_path / "tree.path.json"
     path.write_text(json.dumps({"poses": POSES}))
+    return path
+
+
+@pytest.fixture
+def job(tmp_path, path_file):
     folder = tmp_path / "frames"
     folder.mkdir()
-    return FrameJob(load_scene(resolve("tree")), load_camera_path(path), 8.0, SIZE, folder)
+    return FrameJob(load_scene(resolve("tree")), load_camera_path(path_file), 8.0, SIZE, folder)
 
 
 def read(path: Path) -> np.ndarray:
@@ -122,31 +128,13 @@ def test_a_chunk_out_of_retries_is_reported_and_the_rest_is_written(cluster, job
     assert job.missing(range(job.count)) == [6, 7]
 
 
-def test_batch_on_the_command_line(tmp_path):
+def test_batch_on_the_command_line(tmp_path, path_file):
     """`krsview batch` with a local Ray of two workers, then a resumed run."""
-    path = tmp_path / "tree.path.json"
-    path.write_text(json.dumps({"poses": POSES}))
-    args = [
-        sys.executable,
-        "-m",
-        "krsview",
-        "batch",
-        "tree",
-        "--camera-path",
-        str(path),
-        "--fps",
-        "4",
-        "--size",
-        "64x36",
-        "-o",
-        str(tmp_path / "f"),
-        "--workers",
-        "2",
-    ]
-    env = {**os.environ, "DISPLAY": ""}
-    r = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
+    args = ["batch", "tree", "--camera-path", str(path_file), "--fps", "4", "--size", "64x36"]
+    args += ["-o", str(tmp_path / "f"), "--workers", "2"]
+    r = krsview_cli(*args)
     assert r.returncode == 0 and "0 already there, 5 rendered" in r.stdout, r.stderr[-3000:]
-    r = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
+    r = krsview_cli(*args)
     assert r.returncode == 0 and "5 already there, 0 rendered" in r.stdout
 
 
@@ -195,29 +183,21 @@ def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster
         (["--workers", "0"], "--workers '0': allowed 1 ≤ value"),
     ],
 )
-def test_bad_cluster_options_are_one_line_errors(tmp_path, args, message):
+def test_bad_cluster_options_are_one_line_errors(tmp_path, path_file, args, message):
     """An address where nothing listens is refused at once (Ray alone waits 30 s, or for
     ever). ('auto' with no cluster running is one line too, but whether one runs depends on
     the machine: this module's own fixture starts one.)"""
-    path = tmp_path / "tree.path.json"
-    path.write_text(json.dumps({"poses": POSES}))
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "krsview",
-            "batch",
-            "tree",
-            "--camera-path",
-            str(path),
-            "-o",
-            str(tmp_path / "f"),
-            *args,
-        ],
-        capture_output=True,
-        text=True,
+    out = str(tmp_path / "f")
+    r = krsview_cli(
+        "batch",
+        "tree",
+        "--camera-path",
+        str(path_file),
+        "-o",
+        out,
+        *args,
         timeout=120,
-        env={**os.environ, "DISPLAY": "", "RAY_ADDRESS": ""},
+        RAY_ADDRESS="",
     )
     assert r.returncode in (2, 3) and message in r.stderr, r.stderr
     assert "Traceback" not in r.stderr

@@ -13,16 +13,12 @@ from PIL import Image
 import krsview
 from krsview.cli import main
 
-
-def run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "krsview", *args], capture_output=True, text=True, timeout=300
-    )
+from .conftest import krsview_cli
 
 
 def test_render_writes_png_of_requested_size_and_buffers(tmp_path):
     out, npz = tmp_path / "a.png", tmp_path / "a.npz"
-    r = run(
+    r = krsview_cli(
         "render",
         "sierpinski",
         "-o",
@@ -100,7 +96,7 @@ def test_reference_render_matches_size(tmp_path):
     ],
 )
 def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):
-    r = run(*args)
+    r = krsview_cli(*args)
     assert r.returncode != 0
     assert message in r.stderr, r.stderr
     assert "Traceback" not in r.stderr
@@ -108,14 +104,14 @@ def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):
 
 
 def test_version():
-    r = run("--version")
+    r = krsview_cli("--version")
     assert r.returncode == 0 and r.stdout.strip().startswith("krsview 0.")
 
 
 def test_bad_scene_file_gets_file_field_value(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text("[tree]\nlevels = 12\nbranch_angle = -5.0\n")
-    r = run("check", str(bad))
+    r = krsview_cli("check", str(bad))
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert f"{bad}: tree.branch_angle = -5.0: allowed: 0 ≤ value ≤ 89 degrees" in r.stderr
 
@@ -168,7 +164,7 @@ def test_iterations_view_writes_a_heat_map_with_legend(tmp_path, tracer):
     from krsview.heatmap import LEGEND_HEIGHT, heat
 
     out, npz = tmp_path / "it.png", tmp_path / "b.npz"
-    r = run(
+    r = krsview_cli(
         "render",
         "tree",
         "--view",
@@ -207,7 +203,7 @@ def test_heat_ramp_runs_from_black_to_white_and_brightens():
 
 
 def test_sphere_tracer_on_a_mokrs_is_refused():
-    r = run("render", "palm", "--tracer", "sphere", "-o", "/tmp/never.png")
+    r = krsview_cli("render", "palm", "--tracer", "sphere", "-o", "/tmp/never.png")
     assert r.returncode == 2
     assert "--tracer = 'sphere': this scene is a MöKRS" in r.stderr
 

@@ -6,9 +6,7 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -21,7 +19,7 @@ from krsview.scene.camera_path import CameraPath, Pose, load_camera_path
 from krsview.scene.presets import resolve
 from krsview.share.frames import FrameJob, frame_file, parse_frames, render_frames
 
-from .conftest import headless_render
+from .conftest import headless_render, krsview_cli
 
 SIZE = (64, 36)
 FPS = 4.0
@@ -40,14 +38,11 @@ def path_file(tmp_path):
     return f
 
 
-def krsview(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "krsview", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "DISPLAY": ""},
-    )
+def render_path(path_file: Path, out: Path, *options: str) -> subprocess.CompletedProcess:
+    """`krsview render tree` of the frames along ``path_file`` at SIZE and FPS into ``out``."""
+    size = f"{SIZE[0]}x{SIZE[1]}"
+    args = ("--camera-path", str(path_file), "--size", size, "--fps", str(FPS), "-o", str(out))
+    return krsview_cli("render", "tree", *args, *options)
 
 
 def read(path: Path) -> np.ndarray:
@@ -87,18 +82,7 @@ def test_scene_time_advances_with_the_frames_from_the_scenes_own(path_file, tmp_
 
 
 def test_each_frame_is_the_headless_render_of_its_camera(path_file, tmp_path):
-    r = krsview(
-        "render",
-        "tree",
-        "--camera-path",
-        str(path_file),
-        "--size",
-        "64x36",
-        "--fps",
-        str(FPS),
-        "-o",
-        str(tmp_path / "frames"),
-    )
+    r = render_path(path_file, tmp_path / "frames")
     assert r.returncode == 0, r.stderr
     assert "frames 0-4 of 5" in r.stdout and "0 already there, 5 to render" in r.stdout
     scene = load_scene(resolve("tree"))
@@ -139,37 +123,10 @@ def test_chunks_and_an_interrupted_run_give_the_same_files(path_file, tmp_path, 
 
 def test_a_resumed_run_skips_the_frames_already_written(path_file, tmp_path):
     out = tmp_path / "frames"
-    assert (
-        krsview(
-            "render",
-            "tree",
-            "--camera-path",
-            str(path_file),
-            "--size",
-            "64x36",
-            "--fps",
-            "4",
-            "-o",
-            str(out),
-            "--frames",
-            "1-3",
-        ).returncode
-        == 0
-    )
+    assert render_path(path_file, out, "--frames", "1-3").returncode == 0
     assert sorted(p.name for p in out.iterdir()) == [f"frame_0000{k}.png" for k in (1, 2, 3)]
     stamps = {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)}
-    r = krsview(
-        "render",
-        "tree",
-        "--camera-path",
-        str(path_file),
-        "--size",
-        "64x36",
-        "--fps",
-        "4",
-        "-o",
-        str(out),
-    )
+    r = render_path(path_file, out)
     assert "3 already there, 2 to render" in r.stdout
     assert {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)} == stamps
     assert len(list(out.iterdir())) == 5
@@ -179,20 +136,7 @@ def test_the_video_holds_the_frames(path_file, tmp_path):
     import imageio_ffmpeg
 
     out, video = tmp_path / "frames", tmp_path / "fly.mp4"
-    r = krsview(
-        "render",
-        "tree",
-        "--camera-path",
-        str(path_file),
-        "--size",
-        "64x36",
-        "--fps",
-        "4",
-        "-o",
-        str(out),
-        "--video",
-        str(video),
-    )
+    r = render_path(path_file, out, "--video", str(video))
     assert r.returncode == 0, r.stderr
     reader = imageio_ffmpeg.read_frames(str(video))
     meta = next(reader)
@@ -217,7 +161,7 @@ def test_the_video_holds_the_frames(path_file, tmp_path):
     ],
 )
 def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, message):
-    r = krsview(
+    r = krsview_cli(
         "render",
         "tree",
         "--camera-path",
@@ -253,7 +197,7 @@ def test_a_damaged_path_file_names_the_file_and_the_pose(tmp_path, text, message
     with pytest.raises(SceneError) as e:
         load_camera_path(f)
     assert message in str(e.value) and str(f) in str(e.value)
-    r = krsview("render", "tree", "--camera-path", str(f), "-o", str(tmp_path / "out"))
+    r = krsview_cli("render", "tree", "--camera-path", str(f), "-o", str(tmp_path / "out"))
     assert r.returncode == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1
 
 

@@ -5,9 +5,7 @@ and the files trimesh writes."""
 from __future__ import annotations
 
 import math
-import os
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -20,6 +18,8 @@ from krsview.reference.mokrs import distance_estimate
 from krsview.scene import KRS, Empty, Level, Mirror, Sphere, load_scene
 from krsview.scene.presets import resolve
 from krsview.share.mesh import BRICK, REFINE_STEPS, box_of, build_mesh
+
+from .conftest import krsview_cli
 
 BASE = load_scene(resolve("tree"))
 CENTER, RADIUS = (0.3, 1.0, -0.2), 1.3
@@ -129,13 +129,7 @@ def test_a_mobius_scene_meshes_on_its_zero_set():
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "krsview", "export", "mesh", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "DISPLAY": ""},
-    )
+    return krsview_cli("export", "mesh", *args)
 
 
 @pytest.mark.parametrize("suffix", [".glb", ".ply", ".stl", ".obj"])
@@ -164,14 +158,7 @@ def test_each_format_loads_back_with_the_same_triangles(tmp_path, suffix):
     ],
 )
 def test_bad_mesh_options_are_one_line_errors(tmp_path, args, message):
-    r = subprocess.run(
-        [sys.executable, "-m", "krsview", "export", "mesh", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        cwd=tmp_path,
-        env={**os.environ, "DISPLAY": ""},
-    )
+    r = krsview_cli("export", "mesh", *args, timeout=120, cwd=tmp_path)
     assert r.returncode == 2 and message in r.stderr, r.stderr
     assert len([line for line in r.stderr.splitlines() if "error" in line]) == 1
     assert "Traceback" not in r.stderr

@@ -18,7 +18,7 @@ from krsview.oracle.certify import count_errors
 from krsview.scene import load_scene
 from krsview.scene.presets import preset_names, resolve
 
-from .conftest import broken_shaders
+from .conftest import broken_shaders, krsview_cli
 
 W, H = 48, 27
 GRID = (32, 18)  # the grid's images: the oracle's cost grows with the rays, the skips are per ray
@@ -154,28 +154,10 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
     plain frame as the unit, and fewer full-pass iterations with the pre-pass (no wall-time
     assertion: only what the rows must contain)."""
     import csv
-    import subprocess
-    import sys
 
     out = tmp_path / "paths.csv"
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "krsview",
-            "bench",
-            "paths",
-            "sierpinski",
-            "--size",
-            "32x18",
-            "--rounds",
-            "1",
-            "--csv",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
+    r = krsview_cli(
+        "bench", "paths", "sierpinski", "--size", "32x18", "--rounds", "1", "--csv", str(out)
     )
     assert r.returncode == 0, r.stderr
     rows = list(csv.DictReader(out.open()))

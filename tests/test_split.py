@@ -6,8 +6,6 @@ with the shadow rays' work (steps, levels) on the frames with and without the sh
 from __future__ import annotations
 
 import csv
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -16,6 +14,8 @@ import pytest
 from krsview.gpu.renderer import read_buffers
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
+
+from .conftest import krsview_cli
 
 
 def test_the_tracing_only_variant_traces_as_the_frame_and_shades_nothing(renderer):
@@ -35,26 +35,18 @@ def test_the_tracing_only_variant_traces_as_the_frame_and_shades_nothing(rendere
 
 def test_bench_split_reports_every_part(tmp_path):
     out = tmp_path / "split.csv"
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "krsview",
-            "bench",
-            "split",
-            "tree",
-            "--size",
-            "32x18",
-            "--rounds",
-            "1",
-            "--prepass",
-            "4",
-            "--csv",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
+    r = krsview_cli(
+        "bench",
+        "split",
+        "tree",
+        "--size",
+        "32x18",
+        "--rounds",
+        "1",
+        "--prepass",
+        "4",
+        "--csv",
+        str(out),
     )
     assert r.returncode == 0, r.stderr
     table = list(csv.DictReader(out.open()))
@@ -79,11 +71,6 @@ def test_bench_split_reports_every_part(tmp_path):
     assert 0 < steps["frame"] <= steps[cone_off[1]], steps
     assert rows["coarse passes"] > 0 and "| tracing |" in r.stdout
     assert "shadow rays per 2×2 px;" in r.stdout  # the tree's still frame shares them
-    bad = subprocess.run(
-        [sys.executable, "-m", "krsview", "bench", "split", "tree", "--prepass-levels", "9"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    bad = krsview_cli("bench", "split", "tree", "--prepass-levels", "9", timeout=60)
     assert bad.returncode == 2 and "--prepass-levels" in bad.stderr
     assert "Traceback" not in bad.stderr

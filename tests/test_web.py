@@ -10,10 +10,8 @@ from __future__ import annotations
 import functools
 import json
 import math
-import os
 import shutil
 import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -28,7 +26,7 @@ from krsview.share.web import export_notes, html_page, page_shader, shadertoy_so
 from krsview.share.web_tracks import PAGE_DATA_CAP, PAGE_RATE
 
 from .browser import Browser
-from .conftest import headless_render
+from .conftest import headless_render, krsview_cli
 
 SIZE = (160, 90)
 # Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
@@ -229,13 +227,7 @@ def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
 
 def test_export_on_the_command_line_and_its_refusals(tmp_path):
     def run(*a):
-        return subprocess.run(
-            [sys.executable, "-m", "krsview", "export", *a],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            env={**os.environ, "DISPLAY": ""},
-        )
+        return krsview_cli("export", *a, timeout=120)
 
     r = run("html", "tree", "-o", str(tmp_path / "t.html"), "--levels", "8")
     assert r.returncode == 0 and "wrote" in r.stdout, r.stderr
