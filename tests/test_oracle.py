@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from flint import arb, ctx
 
+from krsview.algebra.quaternion import mul
 from krsview.compile.geometry import compile_geometry
 from krsview.oracle.certify import count_errors, free_boxes, surfaces_before
 from krsview.oracle.distance import on_segments, value
@@ -79,14 +80,8 @@ def arb_distance(c, point):
 
 
 def aqmul(p, q):
-    pw, px, py, pz = p
-    qw, qx, qy, qz = q
-    return (
-        pw * qw - px * qx - py * qy - pz * qz,
-        pw * qx + px * qw + py * qz - pz * qy,
-        pw * qy - px * qz + py * qw + pz * qx,
-        pw * qz + px * qy - py * qx + pz * qw,
-    )
+    """The reference's Hamilton product (algebra/quaternion.py, not the oracle's) on arb balls."""
+    return tuple(mul(np.array(p, dtype=object), np.array(q, dtype=object)))
 
 
 def arb_mokrs(c, point):
