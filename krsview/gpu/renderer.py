@@ -1,7 +1,10 @@
 """Fragment-shader path: one full-screen pass writes colour, normal+depth and iterations to
 float32 render targets, read back as :class:`Frame` in image order (rows top → bottom).
 With ``[render] prepass`` a coarse pass over tiles first writes each tile's free distances
-(prepass.glsl), which the full pass starts its rays from."""
+(prepass.glsl), which the full pass starts its rays from; the pixels of tiles free past the
+far limit are written by a small pass of their own and skipped by the full pass's early
+depth test (llvmpipe runs every branch's code for every pixel it shades, so a sky pixel cost
+as much as a traced one)."""
 
 from __future__ import annotations
 
@@ -37,6 +40,7 @@ class Renderer:
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
         self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int, int]] = {}  # pre-pass
+        self._free: dict[moderngl.Program, moderngl.Program] = {}  # its free tiles' pass
         self._blank: moderngl.Texture | None = None  # bound where the coarsest pass's parent is
         self._compute: dict[moderngl.Program, Rounds] = {}  # deferred → its compute pass
         self._rays = ComputePath(self.ctx)  # the compute path's buffers
@@ -63,18 +67,19 @@ class Renderer:
     def _framebuffer(self, width: int, height: int, layers: int = 3) -> moderngl.Framebuffer:
         """Render targets per size, the most recently used MAX_TARGETS kept: the viewer's
         adaptive resolution and window resizes visit many sizes, and each holds 3 textures
-        (a pre-pass's: PREPASS_TARGETS)."""
+        (a pre-pass's: PREPASS_TARGETS) and a depth buffer (which marks the free tiles)."""
         key = (width, height, layers)
         if key in self._targets:
             self._targets[key] = self._targets.pop(key)  # most recent last
         else:
             while len(self._targets) >= MAX_TARGETS:
                 old = self._targets.pop(next(iter(self._targets)))
-                for tex in old.color_attachments:
-                    tex.release()
+                for part in (*old.color_attachments, old.depth_attachment):
+                    part.release()
                 old.release()
             tex = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(layers)]
-            self._targets[key] = self.ctx.framebuffer(color_attachments=tex)
+            depth = self.ctx.depth_renderbuffer((width, height))
+            self._targets[key] = self.ctx.framebuffer(color_attachments=tex, depth_attachment=depth)
         return self._targets[key]
 
     def prepare(
@@ -136,6 +141,10 @@ class Renderer:
             coarse = self.programs.get("fullscreen.vert", "prepass.frag", defines)
             self._coarse[prog] = (coarse, scene.render.prepass, scene.render.prepass_levels)
             progs.append(coarse)
+            if prog not in self._compute:  # render.frag: its free tiles written apart
+                free = {**defines, "KRS_FREE_TILES": None}
+                self._free[prog] = self.programs.get("fullscreen.vert", "render.frag", free)
+                progs.append(self._free[prog])
             for p in progs:  # the finest coarse pass's output, and the coarser one's before it
                 for k, name in enumerate(("u_free", "u_parent")):
                     if name in p:  # unused: compiled away; only its first elements used
@@ -153,9 +162,7 @@ class Renderer:
         for p in progs:
             if not storage and "KRSBlock" in p:
                 p["KRSBlock"].binding = BINDING_KRS_BLOCK
-            for name, value in uniforms.items():
-                if name in p:
-                    p[name].value = value
+            set_uniforms(p, uniforms)
         self._variant[prog] = (variant, uniforms)
         return prog
 
@@ -170,9 +177,7 @@ class Renderer:
             p = self.programs.get("fullscreen.vert", fragment, {**variant, **(defines or {})})
             if "KRS_DOUBLE" not in variant and "KRSBlock" in p:
                 p["KRSBlock"].binding = BINDING_KRS_BLOCK
-            for name, value in uniforms.items():
-                if name in p:
-                    p[name].value = value
+            set_uniforms(p, uniforms)
             return p
 
     def world(self, geometry: Geometry, albedo: tuple) -> Compiled:
@@ -205,9 +210,25 @@ class Renderer:
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
             self.ctx.scissor = tile
-            self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
+            if prog in self._free:
+                self._skipping_free_tiles(prog)
+            else:
+                self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
             self.ctx.scissor = None
             return fbo
+
+    def _skipping_free_tiles(self, prog: moderngl.Program) -> None:
+        """``prog``'s pass over the bound target, less the pixels whose tile the pre-pass
+        found free past the far limit: its KRS_FREE_TILES variant writes those (as ``prog``
+        would: a miss before any step) with depth 0 and the others with 1, then ``prog``'s
+        fragments, at depth 0.5, pass a less-than test only on the others, before their
+        shader runs (it writes no depth and no memory, so the test is early)."""
+        self.ctx.enable(moderngl.DEPTH_TEST)
+        self.ctx.depth_func = "1"  # always: every pixel marked
+        self._vao(self._free[prog]).render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.depth_func = "<"
+        self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.disable(moderngl.DEPTH_TEST)
 
     def _prepass(
         self,
@@ -358,6 +379,18 @@ class Renderer:
                 self.ctx.finish()
                 times.append(time.perf_counter() - t0)
             return times
+
+
+def set_uniforms(prog: moderngl.Program, uniforms: dict[str, object]) -> None:
+    """Give ``prog`` the values of ``uniforms`` it declares; of an array, only the first
+    elements that it uses (the compiler drops the rest: a pass that reads only the first
+    light's colour declares an array of one)."""
+    for name, value in uniforms.items():
+        if name in prog:
+            n = prog[name].array_length
+            if isinstance(value, list) and n < len(value):
+                value = value[0] if n == 1 else value[:n]
+            prog[name].value = value
 
 
 def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:

@@ -1,5 +1,8 @@
 // Primary rays through pixel centres, traced and shaded (the fragment path); writes the
-// reference's buffers.
+// reference's buffers. KRS_FREE_TILES (with a pre-pass): the variant that writes only the
+// pixels whose tile the pre-pass found free past the far limit, as the tracing variant
+// would (a miss before the first step), and marks them with depth 0 so the tracing variant,
+// drawn behind a depth test, skips them (gpu/renderer.py); the other pixels get depth 1.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
@@ -12,7 +15,18 @@ void main() {
     ray_start(ivec2(gl_FragCoord.xy), start);
     real t;
     int iterations;
+#ifdef KRS_FREE_TILES
+    Ray r = ray_begin(start);
+    int c;
+    real first;
+    bool traced = next_step(r, c, first);  // false: done before a step, as trace_ray is
+    gl_FragDepth = traced ? 1.0 : 0.0;
+    t = r.t;
+    iterations = r.iterations;
+    const bool hit = false;  // the shading's code compiled away
+#else
     bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);
+#endif
 #ifdef KRS_COUNT_LEVELS
     int levels = g_levels;   // the tracing's, before shading walks more
 #endif
