@@ -47,6 +47,7 @@ class Renderer:
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self._depth = 0
         self._compiled: tuple[Geometry, tuple, Compiled] | None = None  # last geometry
+        self._expanded: tuple[Scene, Geometry] | None = None  # last scene's geometry()
         self._variant: dict[moderngl.Program, tuple[dict, dict]] = {}  # defines, uniforms
         self._pass_targets: Targets | None = None  # images drawn in passes (passes.py)
 
@@ -110,7 +111,8 @@ class Renderer:
     ) -> moderngl.Program:
         scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
         view = view_of(scene.camera, width, height)
-        c = self.world(geometry or scene.geometry(), scene.material.albedo).relative_to(view.origin)
+        geometry = geometry or self.geometry_of(scene)
+        c = self.world(geometry, scene.material.albedo).relative_to(view.origin)
         block = krs_block(c, scene.render.precision)
         storage = scene.render.precision == "double"  # scene_block.glsl: a storage buffer
         limit = self.ctx.info[
@@ -179,6 +181,13 @@ class Renderer:
                 p["KRSBlock"].binding = BINDING_KRS_BLOCK
             set_uniforms(p, uniforms)
             return p
+
+    def geometry_of(self, scene: Scene) -> Geometry:
+        """``scene.geometry()``, made once per scene (scenes are frozen): a tree is expanded
+        anew by each call, which frames of the same scene need not pay."""
+        if self._expanded is None or self._expanded[0] is not scene:
+            self._expanded = (scene, scene.geometry())
+        return self._expanded[1]
 
     def world(self, geometry: Geometry, albedo: tuple) -> Compiled:
         """The geometry compiled in world coordinates, redone only when it or the albedo
@@ -317,7 +326,8 @@ class Renderer:
         if self._pass_targets is None:
             self._pass_targets = Targets(self.ctx)
         scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
-        return PassImage(self, self._pass_targets, scene, size, geometry or scene.geometry(), ratio)
+        geometry = geometry or self.geometry_of(scene)
+        return PassImage(self, self._pass_targets, scene, size, geometry, ratio)
 
     def levels(
         self, scene: Scene, width: int, height: int, geometry: Geometry | None = None
@@ -386,11 +396,12 @@ def set_uniforms(prog: moderngl.Program, uniforms: dict[str, object]) -> None:
     elements that it uses (the compiler drops the rest: a pass that reads only the first
     light's colour declares an array of one)."""
     for name, value in uniforms.items():
-        if name in prog:
-            n = prog[name].array_length
+        uniform = prog.get(name, None)  # not `name in prog`, which walks all its members
+        if uniform is not None:
+            n = uniform.array_length
             if isinstance(value, list) and n < len(value):
                 value = value[0] if n == 1 else value[:n]
-            prog[name].value = value
+            uniform.value = value
 
 
 def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:
