@@ -1,6 +1,10 @@
-"""OpenGL contexts: headless through EGL (tests, CI, `krsview render`)."""
+"""OpenGL contexts: headless through EGL (tests, CI, `krsview render`); what the passes do
+on one: give a program its uniforms, draw a pass behind a mark of the pixels it has nothing
+to do on."""
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import moderngl
 
@@ -28,3 +32,30 @@ def headless_context() -> moderngl.Context:
         ) from None
     ctx.__exit__(None, None, None)  # release it: nothing is current on this thread now
     return ctx
+
+
+def behind_mark(ctx: moderngl.Context, mark: Callable[[], None], draw: Callable[[], None]) -> None:
+    """Draw ``mark``, whose shader writes depth 0 on the pixels ``draw`` has nothing to do on
+    (and draws them) and 1 elsewhere, then ``draw`` (fragments at depth 0.5, writing no depth)
+    behind a less-than test, which llvmpipe makes before the fragment shader: llvmpipe runs
+    every branch's code for every pixel it shades, so a sky pixel otherwise costs as much as
+    a traced one. A shader that writes memory declares ``early_fragment_tests``."""
+    ctx.enable(moderngl.DEPTH_TEST)
+    ctx.depth_func = "1"  # always: every pixel marked
+    mark()
+    ctx.depth_func = "<"
+    draw()
+    ctx.disable(moderngl.DEPTH_TEST)
+
+
+def set_uniforms(prog: moderngl.Program, uniforms: dict[str, object]) -> None:
+    """Give ``prog`` the values of ``uniforms`` it declares; of an array, only the first
+    elements that it uses (the compiler drops the rest: a pass that reads only the first
+    light's colour declares an array of one)."""
+    for name, value in uniforms.items():
+        uniform = prog.get(name, None)  # not `name in prog`, which walks all its members
+        if uniform is not None:
+            n = uniform.array_length
+            if isinstance(value, list) and n < len(value):
+                value = value[0] if n == 1 else value[:n]
+            uniform.value = value

@@ -2,9 +2,8 @@
 float32 render targets, read back as :class:`Frame` in image order (rows top → bottom).
 With ``[render] prepass`` a coarse pass over tiles first writes each tile's free distances
 (prepass.glsl), which the full pass starts its rays from; the pixels of tiles free past the
-far limit are written by a small pass of their own and skipped by the full pass's early
-depth test (llvmpipe runs every branch's code for every pixel it shades, so a sky pixel cost
-as much as a traced one)."""
+far limit are written by a small pass of their own, and the full pass skips them
+(context.behind_mark)."""
 
 from __future__ import annotations
 
@@ -24,7 +23,7 @@ from ..frame import Frame
 from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
 from .compute import ComputePath, Rounds
-from .context import headless_context
+from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
 from .uniforms import krs_block, variant_defines, view_uniforms
@@ -219,25 +218,14 @@ class Renderer:
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
             self.ctx.scissor = tile
-            if prog in self._free:
-                self._skipping_free_tiles(prog)
+            if prog in self._free:  # its KRS_FREE_TILES variant marks the pixels to skip
+                behind_mark(
+                    self.ctx, lambda: self._full(self._free[prog]), lambda: self._full(prog)
+                )
             else:
-                self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
+                self._full(prog)
             self.ctx.scissor = None
             return fbo
-
-    def _skipping_free_tiles(self, prog: moderngl.Program) -> None:
-        """``prog``'s pass over the bound target, less the pixels whose tile the pre-pass
-        found free past the far limit: its KRS_FREE_TILES variant writes those (as ``prog``
-        would: a miss before any step) with depth 0 and the others with 1, then ``prog``'s
-        fragments, at depth 0.5, pass a less-than test only on the others, before their
-        shader runs (it writes no depth and no memory, so the test is early)."""
-        self.ctx.enable(moderngl.DEPTH_TEST)
-        self.ctx.depth_func = "1"  # always: every pixel marked
-        self._vao(self._free[prog]).render(moderngl.TRIANGLES, vertices=3)
-        self.ctx.depth_func = "<"
-        self._vao(prog).render(moderngl.TRIANGLES, vertices=3)
-        self.ctx.disable(moderngl.DEPTH_TEST)
 
     def _prepass(
         self,
@@ -275,7 +263,7 @@ class Renderer:
                 x, y, w, h = tile
                 x0, y0 = x // t, y // t
                 self.ctx.scissor = (x0, y0, -(-(x + w) // t) - x0, -(-(y + h) // t) - y0)
-            self._vao(coarse).render(moderngl.TRIANGLES, vertices=3)
+            self._full(coarse)
             self.ctx.scissor = None
             parent = fbo
         for unit, tex in enumerate(parent.color_attachments):
@@ -286,10 +274,11 @@ class Renderer:
             self._blank = self.ctx.texture((1, 1), 4, bytes(16), dtype="f4")
         return self._blank
 
-    def _vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
+    def _full(self, prog: moderngl.Program) -> None:
+        """Draw ``prog`` over the viewport (one triangle, no vertex buffer)."""
         if prog not in self._vaos:
             self._vaos[prog] = self.ctx.vertex_array(prog, [])
-        return self._vaos[prog]
+        self._vaos[prog].render(moderngl.TRIANGLES, vertices=3)
 
     def render(
         self,
@@ -389,19 +378,6 @@ class Renderer:
                 self.ctx.finish()
                 times.append(time.perf_counter() - t0)
             return times
-
-
-def set_uniforms(prog: moderngl.Program, uniforms: dict[str, object]) -> None:
-    """Give ``prog`` the values of ``uniforms`` it declares; of an array, only the first
-    elements that it uses (the compiler drops the rest: a pass that reads only the first
-    light's colour declares an array of one)."""
-    for name, value in uniforms.items():
-        uniform = prog.get(name, None)  # not `name in prog`, which walks all its members
-        if uniform is not None:
-            n = uniform.array_length
-            if isinstance(value, list) and n < len(value):
-                value = value[0] if n == 1 else value[:n]
-            uniform.value = value
 
 
 def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:
