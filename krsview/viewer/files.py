@@ -1,6 +1,6 @@
-"""The viewer's scene file and what follows it: the watcher of the file and the shaders, the
-camera path kept beside it; opening another file, taking the file's new contents when it
-changes on disk, and a bookmark saved into it (a shipped preset's go to its copy)."""
+"""The files the viewer follows: the scene file (opening another, taking its new contents
+when it changes on disk, a bookmark saved into it: a shipped preset's go to its copy), the
+shaders (compiled again when one changes), and the camera path kept beside the scene."""
 
 from __future__ import annotations
 
@@ -8,8 +8,11 @@ from pathlib import Path
 from typing import Protocol
 
 from ..document.document import Document
-from ..scene import SceneError
+from ..gpu.program import ShaderError
+from ..scene import Scene, SceneError
+from ..scene.scene import Geometry
 from .camera import FlyCamera
+from .frames import Frames
 from .recording import Recorder, path_file
 from .watch import FileWatcher
 
@@ -21,14 +24,17 @@ class Shows(Protocol):
     camera: FlyCamera
     message: str
     error: str
+    frames: Frames  # the programs it draws with
+    krs: Geometry  # the geometry drawn
 
     def sync(self) -> None: ...  # redraw when the document changed
     def opened(self) -> None: ...  # a new document: its camera, pre-pass and moment
+    def view_scene(self) -> Scene: ...  # the scene as drawn now
 
 
 class ViewerFile:
-    """The file the viewer shows: its document is the viewer's, its watcher and camera path
-    follow the file's name (a save as, a shipped preset's copy)."""
+    """The files the viewer follows: the document is the viewer's; the watcher and the
+    camera path follow the scene file's name (a save as, a shipped preset's copy)."""
 
     def __init__(self, viewer: Shows, shader_dir: Path):
         self.viewer = viewer
@@ -100,6 +106,16 @@ class ViewerFile:
         v.sync()
         self.follow()  # our own save is not an outside edit
         v.message = f"saved bookmark {name!r} in {saved}"
+
+    def reload_shaders(self) -> None:
+        """Compile the current variant from the edited files; on failure keep the old ones."""
+        v = self.viewer
+        try:
+            v.frames.reload_programs(self.shader_dir, v.view_scene(), v.krs)
+        except ShaderError as e:
+            v.error = str(e)
+            return
+        v.error, v.message = "", "shaders reloaded"
 
     def toggle_recording(self) -> None:
         self.recorder.toggle()

@@ -1,6 +1,7 @@
 """`krsview view`: a GLFW window to fly through a scene, with adaptive resolution, an ImGui HUD
-and hot reload of the preset and the shaders. The window owns its state; keys, the HUD and the
-file watcher return commands, which :meth:`Viewer.execute` applies through its HANDLERS."""
+and hot reload of the preset and the shaders (files.py). The window owns its state; keys, the
+HUD and the file watcher return commands, which :meth:`Viewer.execute` applies through its
+HANDLERS."""
 
 from __future__ import annotations
 
@@ -55,13 +56,12 @@ class Viewer:
         """``options``: fields of ViewerSettings (size, target_fps, prepass, hud,
         moving_effects) replacing those of ``settings``."""
         self.settings = make_settings(settings or ViewerSettings(), **options)
-        self.shader_dir = Path(shader_dir)
         self.doc = Document(path)  # a bad file is a SceneError before any window
         self.moving_effects = self.settings.moving_effects  # True: shadow rays per pixel
         self.platform = Platform(self.settings.size, f"krsview — {self.scene.name}", visible)
         self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
-        self.renderer = Renderer(self.ctx, self.shader_dir)
+        self.renderer = Renderer(self.ctx, Path(shader_dir))
         self.input = Input()
         self.interactions = Interactions()
         self.hud = self.settings.hud
@@ -80,7 +80,7 @@ class Viewer:
         self.frames.full_shadows = self.moving_effects
         self._measured_for: str | None = None
         self.opened()
-        self.file = ViewerFile(self, self.shader_dir)  # watches the file, its camera path
+        self.file = ViewerFile(self, Path(shader_dir))  # the files watched, the camera path
         self.platform.route_events(self.input)
 
     # ------------------------------------------------------------------------- scene state
@@ -275,15 +275,6 @@ class Viewer:
         if self.scene.bookmarks:
             self.go_to_bookmark((self.nav.bookmark_index + 1) % len(self.scene.bookmarks))
 
-    def reload_shaders(self) -> None:
-        """Compile the current variant from the edited files; on failure keep the old ones."""
-        try:
-            self.frames.reload_programs(self.shader_dir, self.view_scene(), self.krs)
-        except ShaderError as e:
-            self.error = str(e)
-            return
-        self.error, self.message = "", "shaders reloaded"
-
     # --------------------------------------------------------------------------- the loop
     def run(self) -> None:
         run(self)
@@ -411,7 +402,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.ToggleRecording: lambda v, e: v.file.toggle_recording(),
     c.Replay: lambda v, e: v.file.recorder.replay(v.clock),
     c.ReloadScene: lambda v, e: v.file.reload(),
-    c.ReloadShaders: lambda v, e: v.reload_shaders(),
+    c.ReloadShaders: lambda v, e: v.file.reload_shaders(),
     c.TogglePlay: lambda v, e: v.toggle_play(),
     c.SetTime: lambda v, e: v.set_time(e.time),
     c.SetSpeed: lambda v, e: v.playback.set_speed(e.speed),
