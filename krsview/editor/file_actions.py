@@ -2,8 +2,9 @@
 preset asks where its copy goes), a bookmark as an edit saved with the scene, the file
 changed on disk (never overwriting unsaved edits: a conflict to answer), the recovery of a
 session that did not end cleanly, and the unsaved-edits question before closing or opening
-another scene. It knows the editor only through the few things it is given, so it can be
-read and tested alone (tests/test_file_actions.py)."""
+another scene. It knows the viewer only as a ``Window`` and the editor only by two functions
+(its edit, and what it does once another scene is opened), so it can be read and tested
+alone (tests/test_file_actions.py)."""
 
 from __future__ import annotations
 
