@@ -268,6 +268,28 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
     assert load_scene(e.path).render.epsilon_scale == 1.0, "discard wrote the file"
 
 
+def test_the_unsaved_edits_question_is_answered_by_clicking_its_button(editor):
+    """The question drawn in the real window; its first answer, "save", clicked with the
+    mouse, saves the edits and closes (editor/modals.py's answers)."""
+    import glfw
+    from imgui_bundle import imgui
+
+    e = editor
+    assert e.edit(("render", "epsilon_scale"), 2.0)
+    glfw.set_window_should_close(e.viewer.window, True)
+    assert not e.should_close() and e.file.asking == ("close", None)
+    pump(e)
+    w = imgui.internal.find_window_by_name("unsaved changes")
+    pad, frame = imgui.get_style().window_padding, imgui.get_style().frame_padding
+    x = w.pos.x + pad.x + 4
+    y = w.pos.y + w.size.y - pad.y - frame.y - imgui.get_font_size() / 2
+    pump(e)  # negative control: drawn again, not clicked, nothing answered
+    assert not e.should_close() and load_scene(e.path).render.epsilon_scale == 1.0
+    click(e, window_xy(e, x, y))
+    assert e.file.asking is None and e.should_close()
+    assert load_scene(e.path).render.epsilon_scale == 2.0 and not e.doc.dirty
+
+
 def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor):
     from krsview.scene import save_scene
 
