@@ -179,7 +179,7 @@ def test_record_and_replay_a_camera_path(viewer):
     v.execute([Replay()])
     for _ in range(20):
         v.step(0.05)
-    assert v.recorder.replay_start is None and np.allclose(v.camera.position, end)
+    assert v.file.recorder.replay_start is None and np.allclose(v.camera.position, end)
 
 
 def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
@@ -187,18 +187,18 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
     v.execute([ToggleRecording()])
     hold(v, "W", 4)
     v.execute([ToggleRecording()])
-    end, recorded = v.camera.position.copy(), len(v.recorder.path.poses)
-    assert v.recorder.file.exists() and v.recorder.file.name == "tree.path.json"
-    v.recorder.path = None
-    v.open_preset(v.path)  # as a new session would: the path comes from the file
-    assert len(v.recorder.path.poses) == recorded > 0
+    end, recorded = v.camera.position.copy(), len(v.file.recorder.path.poses)
+    assert v.file.recorder.file.exists() and v.file.recorder.file.name == "tree.path.json"
+    v.file.recorder.path = None
+    v.file.open(v.path)  # as a new session would: the path comes from the file
+    assert len(v.file.recorder.path.poses) == recorded > 0
     v.execute([Replay()])
     for _ in range(20):
         v.step(0.05)
     assert np.allclose(v.camera.position, end)
-    v.recorder.file.write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
-    v.open_preset(v.path)
-    assert v.recorder.path is None and "tree.path.json: poses[0]" in v.error
+    v.file.recorder.file.write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
+    v.file.open(v.path)
+    assert v.file.recorder.path is None and "tree.path.json: poses[0]" in v.error
 
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
@@ -245,7 +245,7 @@ def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
 def test_mokrs_presets_fly_in_the_viewer(viewer):
     v = viewer
     for name in ("palm", "shell", "inversion"):
-        v.open_preset(resolve(name))
+        v.file.open(resolve(name))
         assert v.error == "" and v.scene.mokrs is not None
         settle(v)
         img = v.read_window()
@@ -271,11 +271,11 @@ def test_preset_picker_and_levels_slider(viewer):
     assert (np.abs(v.read_window().astype(int) - full).max(-1) > 30).mean() > 0.01  # fewer twigs
     v.set_levels(len(v.geometry.levels))
     assert v.krs is v.geometry
-    v.open_preset(resolve("sierpinski"))
+    v.file.open(resolve("sierpinski"))
     assert v.scene.name == "sierpinski" and v.path == resolve("sierpinski") and not v.error
     assert v.camera.to_camera().position == v.scene.camera.position
     settle(v)
-    v.open_preset(v.path.with_name("missing.toml"))
+    v.file.open(v.path.with_name("missing.toml"))
     assert "cannot read" in v.error and v.scene.name == "sierpinski"  # kept the last good one
 
 
@@ -285,7 +285,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     2 × 2 pixels, the shading with them and its outline pixels', gpu/passes.py); switching back
     and forth again compiles nothing."""
     v = viewer
-    v.open_preset(resolve("sierpinski"))
+    v.file.open(resolve("sierpinski"))
     settle(v)
     programs = v.renderer.programs
     before = programs.compiles
@@ -303,14 +303,14 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     v.set_effect("shadows", True)
     settle(v)
     assert programs.compiles == before + 10
-    v.open_preset(resolve("palm"))
+    v.file.open(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error
 
 
 def test_compound_preset_flies_and_the_levels_slider_cuts_every_component(viewer):
     v = viewer
-    v.open_preset(resolve("grove"))
+    v.file.open(resolve("grove"))
     assert v.error == "" and len(v.geometry.parts) == 8
     settle(v)
     full = v.read_window()
