@@ -393,7 +393,7 @@ def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(view
     HUD's knob sets the scene's render.prepass through the document (validated by the
     schema's range, one undo step), and the view then draws with it. Off or on, the window
     shows the same tree (pixels change only on outlines, where grazing rays may flip)."""
-    from krsview.scene.model import VIEW_PREPASS
+    from krsview.scene.render import VIEW_PREPASS
 
     v = viewer
     settle(v)

@@ -22,7 +22,7 @@ from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
 from ..scene.effects import EXCLUSIVE
-from ..scene.model import VIEW_PREPASS
+from ..scene.render import VIEW_PREPASS
 from ..scene.settings import ViewerSettings, make_settings
 from . import commands as c
 from .adaptive import AdaptiveResolution
