@@ -156,8 +156,8 @@ def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, tm
 
         from .conftest import broken_shaders
 
-        cut = "d = min(d, length(x - b.xyz) - b.w); return false;"
-        quarter = "d = min(d, length(x - b.xyz) - 0.25 * b.w); return false;"
+        cut = "d = min(d, length(x - b.xyz) - b.w);"
+        quarter = "d = min(d, length(x - b.xyz) - 0.25 * b.w);"
         shrunk = Renderer(shader_dir=broken_shaders(tmp_path, "krs.glsl", cut, quarter))
         assert count_errors(scene, shrunk.render(scene, w, h), arithmetics=("affine",)).holes > 0
 
