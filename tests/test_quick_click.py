@@ -1,0 +1,104 @@
+"""A quick click (the pointer moved and clicked before the window drew a frame with it there,
+a touchpad's tap) in the editor's real window under Xvfb: on the panel it is the panel's
+alone, and in the view it picks. ImGui's own ``want_capture_mouse`` answers for where the
+pointer was at its last frame, so each was taken by the wrong side."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from krsview.editor.commands import Bake
+
+from .test_editor import (
+    LEVEL,
+    SIZE,
+    click,
+    editor_on_a_copy,
+    handle,
+    pump,
+    screen_of,
+    settle,
+    window_xy,
+    xdo,
+)
+
+FORK = ("route", "levels", LEVEL, "fork")
+RADIUS = ("route", "levels", LEVEL, "radius")
+
+
+@pytest.fixture
+def baked(display, tmp_path):
+    """The tree baked, its fork LEVEL selected by a click (its fields shown in the panel)."""
+    for e in editor_on_a_copy(tmp_path, "tree", SIZE):
+        settle(e)
+        e.execute([Bake()])
+        settle(e)
+        click(e, screen_of(e, handle(e, FORK).position))
+        assert e.selected is not None and e.selected.path == FORK
+        yield e
+
+
+def quick_click(e, at) -> None:
+    """Move to ``at`` and click in one go: no frame sees the pointer there before the press."""
+    xdo("mousemove", round(at[0]), round(at[1]), "click", 1)
+    pump(e, 3)
+
+
+def rest(e, at) -> None:
+    """The pointer at ``at`` for two frames: ImGui knows where it is."""
+    xdo("mousemove", round(at[0]), round(at[1]))
+    pump(e, 2)
+
+
+def middle(rect) -> tuple[float, float]:
+    x0, y0, x1, y1 = rect
+    return (x0 + x1) / 2, (y0 + y1) / 2
+
+
+def test_a_quick_click_on_the_panel_keeps_the_selection(baked):
+    """From the view straight onto the fork's radius field: the field takes the click (a new
+    interaction; a click without a drag keeps its value) and the selection stays."""
+    e = baked
+    radius = e.scene.route.levels[LEVEL].radius
+    field = window_xy(e, *middle(e.viewer.interactions.rects[RADIUS]))
+    off_tree = window_xy(e, 30, 480)  # the view, off the tree and its handles
+    rest(e, off_tree)
+    count = e.viewer.interactions.count
+    quick_click(e, field)
+    assert e.selected is not None and e.selected.path == FORK, "the click picked in the view"
+    assert e.viewer.interactions.count == count + 1, "the panel's field missed the click"
+    assert e.scene.route.levels[LEVEL].radius == radius
+    # negative control: the same quick click off the tree in the view clears the selection
+    rest(e, field)
+    quick_click(e, off_tree)
+    assert e.selected is None
+
+
+def test_a_quick_click_in_the_view_from_the_panel_still_picks(baked):
+    """From the panel straight onto the trunk: the trunk's level is picked, and the panel's
+    fields take nothing."""
+    e = baked
+    depth = e.viewer.geometry.depth
+    rest(e, window_xy(e, *middle(e.viewer.interactions.rects[RADIUS])))
+    count = e.viewer.interactions.count
+    quick_click(e, screen_of(e, (0.0, 0.4, -0.2)))
+    assert e.selected is not None and e.selected.level == depth - 1
+    assert e.viewer.interactions.count == count
+
+
+def test_a_quick_tap_on_the_gizmo_keeps_the_selection(baked):
+    """From the view straight onto the gizmo's X arrow: the gizmo's, not a pick of what lies
+    under the arrow."""
+
+    e = baked
+    at = np.array(screen_of(e, handle(e, FORK).position))
+    along = np.array(screen_of(e, handle(e, FORK).position + np.array([0.01, 0.0, 0.0]))) - at
+    arrow = at + 30 * along / np.linalg.norm(along)
+    rest(e, window_xy(e, 30, 480))
+    quick_click(e, arrow)
+    assert e.selected is not None and e.selected.path == FORK
+    # negative control: as far off the other way, no gizmo there, the tap picks
+    rest(e, window_xy(e, 30, 480))
+    quick_click(e, at - 30 * along / np.linalg.norm(along))
+    assert e.selected is None or e.selected.path != FORK
