@@ -1,7 +1,8 @@
-"""A quick click (the pointer moved and clicked before the window drew a frame with it there,
+"""A quick click (the pointer moved and pressed before the window drew a frame with it there,
 a touchpad's tap) in the editor's real window under Xvfb: on the panel it is the panel's
-alone, and in the view it picks. ImGui's own ``want_capture_mouse`` answers for where the
-pointer was at its last frame, so each was taken by the wrong side."""
+alone, in the view it picks, on the gizmo it is the gizmo's (no pick, no orbit), and a wheel
+notch scrolls the side under the pointer. ImGui's own ``want_capture_mouse`` and the gizmo's
+hover answer for where the pointer was at the last frame, so each went to the wrong side."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import numpy as np
 import pytest
 
 from krsview.editor.commands import Bake
+from krsview.viewer.commands import ToggleOrbit
 
 from .test_editor import (
     LEVEL,
@@ -87,18 +89,71 @@ def test_a_quick_click_in_the_view_from_the_panel_still_picks(baked):
     assert e.viewer.interactions.count == count
 
 
+def x_arrow(e) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Screen points on the selected fork's gizmo X arrow and as far off the other way (no
+    gizmo there), 30 pixels from the fork; the arrow's unit direction on screen."""
+    at = np.array(screen_of(e, handle(e, FORK).position))
+    along = np.array(screen_of(e, handle(e, FORK).position + np.array([0.01, 0.0, 0.0]))) - at
+    along /= np.linalg.norm(along)
+    return at + 30 * along, at - 30 * along, along
+
+
 def test_a_quick_tap_on_the_gizmo_keeps_the_selection(baked):
     """From the view straight onto the gizmo's X arrow: the gizmo's, not a pick of what lies
     under the arrow."""
-
     e = baked
-    at = np.array(screen_of(e, handle(e, FORK).position))
-    along = np.array(screen_of(e, handle(e, FORK).position + np.array([0.01, 0.0, 0.0]))) - at
-    arrow = at + 30 * along / np.linalg.norm(along)
+    arrow, off, _ = x_arrow(e)
     rest(e, window_xy(e, 30, 480))
     quick_click(e, arrow)
     assert e.selected is not None and e.selected.path == FORK
     # negative control: as far off the other way, no gizmo there, the tap picks
     rest(e, window_xy(e, 30, 480))
-    quick_click(e, at - 30 * along / np.linalg.norm(along))
+    quick_click(e, off)
     assert e.selected is None or e.selected.path != FORK
+
+
+def test_a_quick_press_and_drag_on_the_gizmo_moves_the_fork_not_the_orbiting_camera(baked):
+    """Orbiting (a left drag turns the camera): a press straight onto the gizmo's X arrow
+    and a drag move the fork and leave the camera; the same press off the gizmo orbits."""
+    e = baked
+    e.execute([ToggleOrbit()])
+    arrow, off, along = x_arrow(e)
+
+    def press_and_drag(start) -> tuple[float, float]:
+        """How far the camera and the fork moved."""
+        eye, fork = e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
+        rest(e, window_xy(e, 30, 480))
+        xdo("mousemove", *map(round, start), "mousedown", 1)
+        pump(e, 2)
+        for k in range(1, 7):
+            xdo("mousemove", *map(round, start + 5 * k * along))
+            pump(e, 1)
+        xdo("mouseup", 1)
+        pump(e, 2)
+        return (
+            float(np.linalg.norm(e.viewer.camera.position - eye)),
+            float(np.linalg.norm(np.array(e.scene.route.levels[LEVEL].fork) - fork)),
+        )
+
+    eye_moved, fork_moved = press_and_drag(arrow)
+    assert eye_moved == 0.0 and fork_moved > 0.0, (eye_moved, fork_moved)
+    eye_moved, fork_moved = press_and_drag(off)  # negative control
+    assert eye_moved > 0.0 and fork_moved == 0.0, (eye_moved, fork_moved)
+
+
+def test_a_quick_wheel_turn_on_the_panel_scrolls_it_and_not_the_flying_speed(baked):
+    """From the view straight onto the panel, a wheel notch: the panel scrolls (its fields
+    move up), the flying speed stays; the same notch straight into the view changes the
+    speed and scrolls nothing."""
+    e = baked
+    speed = e.viewer.nav.speed_factor
+    field = window_xy(e, *middle(e.viewer.interactions.rects[RADIUS]))
+    rest(e, window_xy(e, 30, 480))
+    y = e.viewer.interactions.rects[RADIUS][1]
+    xdo("mousemove", *map(round, field), "click", 5)
+    pump(e, 3)
+    assert e.viewer.interactions.rects[RADIUS][1] < y and e.viewer.nav.speed_factor == speed
+    y = e.viewer.interactions.rects[RADIUS][1]
+    xdo("mousemove", *map(round, window_xy(e, 30, 480)), "click", 5)  # negative control
+    pump(e, 3)
+    assert e.viewer.interactions.rects[RADIUS][1] == y and e.viewer.nav.speed_factor != speed

@@ -85,6 +85,7 @@ class Editor:
         self.file = FileActions(self.viewer, self.edit, self._opened)
         self.scroll_outline = False
         self._again = False  # a turn at once: a pick's gizmo
+        self._held: set[str] = set()  # the view's buttons held at the last turn's end
         self._title = ""
         self._update_title()
         self.frame()
@@ -175,8 +176,9 @@ class Editor:
     def step(self, dt: float) -> None:
         """The viewer's turn with the editor's parts: the gizmo, picking by a click, the
         overlay and the panels; then the autosave. A click picks after the gizmo has seen the
-        pointer where it clicked (a tap straight onto the gizmo is the gizmo's), still before
-        the overlay is drawn; the gizmo of what it picked comes the turn after, at once."""
+        pointer where it clicked, still before the overlay is drawn (the gizmo of what it
+        picked comes the turn after, at once); a press straight onto the gizmo (a tap, no
+        frame saw the pointer there) is the gizmo's, and the view lets go of it."""
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
@@ -191,9 +193,12 @@ class Editor:
         self._again = False
         if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
             manipulate(self)
-            if click is not None and not self._claimed():
-                self.pick(*click)
-                self._again = True
+            if not self._claimed():
+                if click is not None:
+                    self.pick(*click)
+                    self._again = True
+            elif "left" in v.input.buttons - self._held:  # pressed onto the gizmo
+                v.input.let_go("left")
         v.draw_image()
         self._follow()
         if ui:
@@ -202,6 +207,7 @@ class Editor:
             draw_status(status)
             v.platform.render()
         v.input.claimed = v.hud and self._claimed()
+        self._held = set(v.input.buttons)
         glfw.swap_buffers(v.window)
         autosave(self.file, time.monotonic())
         self._update_title()
