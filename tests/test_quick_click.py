@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from krsview.editor.commands import Bake
-from krsview.viewer.commands import ToggleOrbit
+from krsview.viewer.commands import ToggleHud, ToggleOrbit
 
 from .test_editor import (
     LEVEL,
@@ -112,33 +112,48 @@ def test_a_quick_tap_on_the_gizmo_keeps_the_selection(baked):
     assert e.selected is None or e.selected.path != FORK
 
 
+def press_and_drag(e, start, along) -> tuple[float, float]:
+    """From the view, a press straight at ``start`` and a 30-pixel drag along ``along``; how
+    far the camera and the fork moved."""
+    eye, fork = e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
+    rest(e, window_xy(e, 30, 480))
+    xdo("mousemove", *map(round, start), "mousedown", 1)
+    pump(e, 2)
+    for k in range(1, 7):
+        xdo("mousemove", *map(round, start + 5 * k * along))
+        pump(e, 1)
+    xdo("mouseup", 1)
+    pump(e, 2)
+    return (
+        float(np.linalg.norm(e.viewer.camera.position - eye)),
+        float(np.linalg.norm(np.array(e.scene.route.levels[LEVEL].fork) - fork)),
+    )
+
+
 def test_a_quick_press_and_drag_on_the_gizmo_moves_the_fork_not_the_orbiting_camera(baked):
     """Orbiting (a left drag turns the camera): a press straight onto the gizmo's X arrow
     and a drag move the fork and leave the camera; the same press off the gizmo orbits."""
     e = baked
     e.execute([ToggleOrbit()])
     arrow, off, along = x_arrow(e)
-
-    def press_and_drag(start) -> tuple[float, float]:
-        """How far the camera and the fork moved."""
-        eye, fork = e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
-        rest(e, window_xy(e, 30, 480))
-        xdo("mousemove", *map(round, start), "mousedown", 1)
-        pump(e, 2)
-        for k in range(1, 7):
-            xdo("mousemove", *map(round, start + 5 * k * along))
-            pump(e, 1)
-        xdo("mouseup", 1)
-        pump(e, 2)
-        return (
-            float(np.linalg.norm(e.viewer.camera.position - eye)),
-            float(np.linalg.norm(np.array(e.scene.route.levels[LEVEL].fork) - fork)),
-        )
-
-    eye_moved, fork_moved = press_and_drag(arrow)
+    eye_moved, fork_moved = press_and_drag(e, arrow, along)
     assert eye_moved == 0.0 and fork_moved > 0.0, (eye_moved, fork_moved)
-    eye_moved, fork_moved = press_and_drag(off)  # negative control
+    eye_moved, fork_moved = press_and_drag(e, off, along)  # negative control
     assert eye_moved > 0.0 and fork_moved == 0.0, (eye_moved, fork_moved)
+
+
+def test_with_the_hud_hidden_a_drag_where_the_panel_was_orbits(baked):
+    """F1 hides the panel, whose windows stay in ImGui's context: a press where it was is the
+    view's (orbiting, the camera turns); shown again, the same press is the panel's."""
+    e = baked
+    e.execute([ToggleOrbit(), ToggleHud()])
+    pump(e, 2)
+    field = np.array(window_xy(e, *middle(e.viewer.interactions.rects[RADIUS])))
+    down = np.array([0.0, 1.0])
+    assert press_and_drag(e, field, down)[0] > 0.0
+    e.execute([ToggleHud()])  # negative control
+    pump(e, 2)
+    assert press_and_drag(e, field, down)[0] == 0.0
 
 
 def test_a_quick_wheel_turn_on_the_panel_scrolls_it_and_not_the_flying_speed(baked):

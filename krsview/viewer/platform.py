@@ -40,6 +40,13 @@ class Platform:
         self.addr = ctypes.cast(self.window, ctypes.c_void_p).value
         imgui.backends.glfw_init_for_opengl(self.addr, False)
         imgui.backends.opengl3_init("#version 430")
+        self.drawn = False  # this turn drew an ImGui frame: its windows are on screen
+
+    def begin_turn(self) -> None:
+        """A turn of the event loop begins: ImGui's windows are on screen for the events
+        after it only if it draws a frame (a hidden HUD draws none; its windows stay in
+        ImGui's context, not on screen)."""
+        self.drawn = False
 
     def close(self) -> None:
         imgui.backends.opengl3_shutdown()
@@ -66,7 +73,7 @@ class Platform:
 
         def on_button(_w, button, action, mods):
             b.glfw_mouse_button_callback(a, button, action, mods)
-            if action == glfw.PRESS and (imgui_under(to) or to.claimed):
+            if action == glfw.PRESS and (self.drawn and imgui_under(to) or to.claimed):
                 return  # the HUD's or a gizmo's press, not the camera's
             if button in GLFW_BUTTONS:
                 to.button(GLFW_BUTTONS[button], action == glfw.PRESS)
@@ -81,7 +88,7 @@ class Platform:
 
         def on_scroll(_w, dx, dy):
             b.glfw_scroll_callback(a, dx, dy)
-            if not imgui_under(to):
+            if not (self.drawn and imgui_under(to)):
                 to.wheel(dy)
 
         def on_char(_w, c):
@@ -100,6 +107,7 @@ class Platform:
         imgui.new_frame()
 
     def render(self) -> None:
+        self.drawn = True
         imgui.render()
         imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
 
