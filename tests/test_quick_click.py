@@ -1,7 +1,8 @@
 """A quick click (the pointer moved and pressed before the window drew a frame with it there,
 a touchpad's tap) in the editor's real window under Xvfb: on the panel it is the panel's
 alone, in the view it picks, on the gizmo it is the gizmo's (no pick, no orbit), and a wheel
-notch scrolls the side under the pointer. ImGui's own ``want_capture_mouse`` and the gizmo's
+notch scrolls the side under the pointer; a hidden panel takes nothing, and a field held
+takes the other buttons too. ImGui's own ``want_capture_mouse`` and the gizmo's
 hover answer for where the pointer was at the last frame, so each went to the wrong side."""
 
 from __future__ import annotations
@@ -172,3 +173,25 @@ def test_a_quick_wheel_turn_on_the_panel_scrolls_it_and_not_the_flying_speed(bak
     xdo("mousemove", *map(round, window_xy(e, 30, 480)), "click", 5)  # negative control
     pump(e, 3)
     assert e.viewer.interactions.rects[RADIUS][1] == y and e.viewer.nav.speed_factor != speed
+
+
+def test_while_a_panel_field_is_dragged_a_right_press_in_the_view_does_not_look(baked):
+    """ImGui holds the pointer while it holds a button pressed on it: a right press in the
+    view then is not the look button's; with no field held, it is."""
+    e = baked
+    field = window_xy(e, *middle(e.viewer.interactions.rects[RADIUS]))
+    view = window_xy(e, 30, 480)
+    rest(e, field)
+    xdo("mousedown", 1)
+    pump(e, 2)
+    xdo("mousemove", *map(round, view), "mousedown", 3)
+    pump(e, 2)
+    assert "right" not in e.viewer.input.buttons
+    xdo("mouseup", 3, "mouseup", 1)
+    pump(e, 2)
+    rest(e, view)  # negative control
+    xdo("mousedown", 3)
+    pump(e, 2)
+    assert "right" in e.viewer.input.buttons
+    xdo("mouseup", 3)
+    pump(e, 2)

@@ -58,6 +58,10 @@ class Platform:
     def route_events(self, to: Input) -> None:
         """GLFW events go to ImGui first, then to ``to`` unless ImGui or a gizmo takes them."""
         b, a, window = imgui.backends, self.addr, self.window
+        taken: set[int] = set()  # the buttons whose press was not the view's, until released
+
+        def ui() -> bool:
+            return self.drawn and imgui_under(to, taken)
 
         def on_key(_w, key, scancode, action, mods):
             b.glfw_key_callback(a, key, scancode, action, mods)
@@ -73,8 +77,10 @@ class Platform:
 
         def on_button(_w, button, action, mods):
             b.glfw_mouse_button_callback(a, button, action, mods)
-            if action == glfw.PRESS and (self.drawn and imgui_under(to) or to.claimed):
+            if action == glfw.PRESS and (ui() or to.claimed):
+                taken.add(button)
                 return  # the HUD's or a gizmo's press, not the camera's
+            taken.discard(button)
             if button in GLFW_BUTTONS:
                 to.button(GLFW_BUTTONS[button], action == glfw.PRESS)
                 look = GLFW_BUTTONS[button] == LOOK_BUTTON
@@ -88,7 +94,7 @@ class Platform:
 
         def on_scroll(_w, dx, dy):
             b.glfw_scroll_callback(a, dx, dy)
-            if not (self.drawn and imgui_under(to)):
+            if not ui():
                 to.wheel(dy)
 
         def on_char(_w, c):
@@ -112,15 +118,16 @@ class Platform:
         imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
 
 
-def imgui_under(to: Input) -> bool:
+def imgui_under(to: Input, taken: set[int]) -> bool:
     """Whether ImGui takes a press or a wheel turn of the pointer at ``to.cursor``, between
     two frames: ImGui's rule (``UpdateHoveredWindowAndCaptureFlags``) for the pointer there,
     not where its last frame saw it. A button the view holds keeps the pointer the view's;
-    else ImGui takes it while it holds a button or a popup is open (a click anywhere closes
-    it), or where a window of its last frame lies."""
+    else ImGui takes it while it holds a button (``taken``, in the events' order: its own
+    state lags a frame) or a popup is open (a click anywhere closes it), or where a window
+    of its last frame lies."""
     if to.buttons:
         return False
-    if imgui.is_any_mouse_down() or imgui.is_popup_open("", imgui.PopupFlags_.any_popup):
+    if taken or imgui.is_popup_open("", imgui.PopupFlags_.any_popup):
         return True
     return window_at(*to.cursor)
 
