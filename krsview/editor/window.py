@@ -84,6 +84,8 @@ class Editor:
         self.shown_now = Shown()  # the scene drawn now, its handles, warnings, clipped parts
         self.file = FileActions(self.viewer, self.edit, self._opened)
         self.scroll_outline = False
+        self._again = False  # a turn at once: a pick's gizmo
+        self._held: set[str] = set()  # the view's buttons held at the last turn's end
         self._title = ""
         self._update_title()
         self.frame()
@@ -165,20 +167,22 @@ class Editor:
         run(self)
 
     def is_idle(self) -> bool:
-        return self.viewer.is_idle()
+        """The viewer's idle, but never right after a pick (its gizmo is drawn next turn)."""
+        return not self._again and self.viewer.is_idle()
 
     def close(self) -> None:
         self.viewer.close()
 
     def step(self, dt: float) -> None:
-        """The viewer's turn with the editor's parts: picking by a click, the overlay, the
-        panels and the gizmo; then the autosave."""
+        """The viewer's turn with the editor's parts: the gizmo, picking by a click, the
+        overlay and the panels; then the autosave. A click picks after the gizmo has seen the
+        pointer where it clicked, still before the overlay is drawn (the gizmo of what it
+        picked comes the turn after, at once); a press straight onto the gizmo (a tap, no
+        frame saw the pointer there) is the gizmo's, and the view lets go of it."""
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
         click = v.input.take_click()
-        if click is not None and v.hud:
-            self.pick(*click)
         v.move(dt)
         self.execute(v.file.watcher.poll())
         self._follow()
@@ -186,8 +190,15 @@ class Editor:
         ui = v.hud or bool(status)
         if ui:
             v.platform.new_frame()
+        self._again = False
         if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
             manipulate(self)
+            if not self._claimed():
+                if click is not None:
+                    self.pick(*click)
+                    self._again = True
+            elif "left" in v.input.buttons - self._held:  # pressed onto the gizmo
+                v.input.let_go("left")
         v.draw_image()
         self._follow()
         if ui:
@@ -195,10 +206,8 @@ class Editor:
                 self._draw_ui()
             draw_status(status)
             v.platform.render()
-        turning = self.selected is not None and self.selected.kind == "normal"
-        v.input.claimed = v.hud and (
-            self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
-        )
+        v.input.claimed = v.hud and self._claimed()
+        self._held = set(v.input.buttons)
         glfw.swap_buffers(v.window)
         autosave(self.file, time.monotonic())
         self._update_title()
@@ -301,6 +310,12 @@ class Editor:
         best = pick(self, self.window_view(), x, y)
         self.select(best)
         return best
+
+    def _claimed(self) -> bool:
+        """The gizmo, or the trackball on a selected normal, is under the pointer or dragged:
+        a press there is neither the camera's nor a pick."""
+        turning = self.selected is not None and self.selected.kind == "normal"
+        return self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
 
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:

@@ -311,6 +311,7 @@ class Viewer:
     def begin_step(self, dt: float) -> None:
         self.clock += dt
         glfw.make_context_current(self.window)
+        self.platform.begin_turn()
 
     def close(self) -> None:
         if self.window is not None:
