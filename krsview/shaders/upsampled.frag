@@ -60,7 +60,7 @@ layout(std430, binding = BINDING_OUTLINE) buffer Outline {
 layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
 #endif
 
-#if defined(KRS_SHADE_SKY) || defined(KRS_SHADOW_MARK)
+#ifndef KRS_HIT_DEPTH  // (which writes the depth the others are tested against)
 layout(early_fragment_tests) in;  // groups of pixels the depth test leaves out never run
 #endif
 
