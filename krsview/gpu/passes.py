@@ -19,7 +19,12 @@ resolution]. ``ratio`` picks the passes:
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
   at once, lit as the image before it, before its own shadow rays [issue 28 §5]; the image
-  after it at the same size reuses its tracing and adds them."""
+  after it at the same size reuses its tracing and adds them.
+
+The shading after ``trace`` (``shadows+shade``, ``shade``) is drawn by depth: the hits into a
+depth buffer, then the sky's pixels with the sky's code alone and the hits with the
+shading's, so that llvmpipe, which skips a group of pixels only where an early depth test
+fails for all of it, never runs the shading over groups of sky (0.95× tree's frame)."""
 
 from __future__ import annotations
 
