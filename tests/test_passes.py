@@ -127,8 +127,9 @@ def test_the_passes_are_valid_desktop_glsl(renderer, tmp_path, monkeypatch):
     for scene in (scene_of("tree"), scene_of("grove"), replace(mokrs, effects=["soft_shadows"])):
         for ratio in (1, 2):
             draw(renderer, Targets(renderer.ctx), scene, ratio, (16, 9))
-    # per scene: the trace pass; ratio 1: the shading; 2: blocks, shading, outline pixels
-    assert len(sources) == 15
+    # per scene: the trace pass; ratio 1: the shading; 2: blocks, hits' depth, sky, shading,
+    # outline pixels
+    assert len(sources) == 21
     for version in VERSIONS:
         assert validate(sources, tmp_path, version) == ""
     # negative control: a call the language does not have

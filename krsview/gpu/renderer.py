@@ -171,8 +171,9 @@ class Renderer:
             if "KRS_DOUBLE" not in variant and "KRSBlock" in p:
                 p["KRSBlock"].binding = BINDING_KRS_BLOCK
             for name, value in uniforms.items():
-                if name in p:
-                    p[name].value = value
+                if name in p:  # an array the pass reads the first of alone (the sky's sun)
+                    one = p[name].array_length == 1 and isinstance(value, list)
+                    p[name].value = value[0] if one else value
             return p
 
     def world(self, geometry: Geometry, albedo: tuple) -> Compiled:
