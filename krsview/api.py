@@ -26,8 +26,8 @@ from typing import Any
 from .frame import Frame
 from .scene import Render, Scene, SceneError, load_scene
 from .scene.info import SceneInfo, describe
-from .scene.model import VIEW_PREPASS
 from .scene.presets import preset_names, resolve
+from .scene.render import VIEW_PREPASS
 from .scene.schema import from_dict
 from .scene.settings import MAX_SIDE
 

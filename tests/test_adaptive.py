@@ -8,9 +8,13 @@ import pytest
 
 from krsview.viewer.adaptive import (
     FIRST_BAND,
+    MIN_BLOCKS_ACROSS,
+    MOVING_RATIO,
+    SHADOW_RATIO,
     AdaptiveResolution,
     Refinement,
     Step,
+    moving_ratio,
     refinement_steps,
     refining_budget,
 )
@@ -205,3 +209,29 @@ def test_the_tracing_keeps_half_the_budget_when_the_rest_takes_more():
     assert a.trace_budget == pytest.approx(0.5 * a.budget)
     assert a.history[-1] == pytest.approx(0.5 * a.budget, rel=0.05)
     assert a.moving_size()[0] > 0.1 * 960  # control: not driven to the floor
+
+
+def blocks_rule_broken(rule) -> list[tuple[int, int]]:
+    """(width, still) where ``rule`` differs from the block side counted for each width: the
+    largest side from SHADOW_RATIO to MOVING_RATIO that leaves at least MIN_BLOCKS_ACROSS
+    blocks across the frame (SHADOW_RATIO where none does), never below the still image's
+    ``still``."""
+    broken = []
+    for still in (2, 3, 4):
+        for width in range(1, 1500):
+            r = rule(width, still)
+            fits = [
+                q for q in range(SHADOW_RATIO, MOVING_RATIO + 1) if width / q >= MIN_BLOCKS_ACROSS
+            ]
+            if r != max([still, SHADOW_RATIO, *fits]):
+                broken.append((width, still))
+    return broken
+
+
+def test_moving_frames_share_shadow_rays_in_blocks_as_wide_as_keep_enough_across():
+    """moving_ratio against a count of the blocks across each width; negative controls: 3 × 3
+    blocks in every frame, or the still image's side alone, break the count."""
+    assert blocks_rule_broken(moving_ratio) == []
+    assert moving_ratio(239, 2) == 2 and moving_ratio(240, 2) == 3 and moving_ratio(960, 4) == 4
+    assert blocks_rule_broken(lambda w, still: max(still, 3))
+    assert blocks_rule_broken(lambda w, still: still)

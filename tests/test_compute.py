@@ -14,8 +14,8 @@ import pytest
 
 from krsview.gpu.renderer import Renderer
 from krsview.scene import load_scene
-from krsview.scene.model import VIEW_PREPASS
 from krsview.scene.presets import preset_names, resolve
+from krsview.scene.render import VIEW_PREPASS
 
 from .conftest import broken_shaders
 

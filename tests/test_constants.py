@@ -178,6 +178,7 @@ TWIN_NAMES: dict[str, str | None] = {
     "krs_distance": "distance",  # reference/krs.py is the KRS's module: no prefix
     "krs_nearest": "nearest",
     "krs_level": "distance",  # one level of distance's loop
+    "krs_lod_cut": "distance",  # the level-of-detail ball of distance's loop, after the walk
     "krs_restart": "restart",
     "restart_distance": "restart_trace",  # a restarted step, inside the tracer's loop
     "distort_distance": "distance",  # Distortion.distance

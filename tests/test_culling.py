@@ -169,3 +169,30 @@ def test_culling_that_ignores_the_reach_of_the_balls_below_changes_the_image(ren
     on, off = (replace(scene, render=replace(scene.render, culling=v)) for v in ("on", "off"))
     assert np.array_equal(renderer.render(on, 96, 54).depth, renderer.render(off, 96, 54).depth)
     assert not np.array_equal(naive.render(on, 96, 54).depth, naive.render(off, 96, 54).depth)
+
+
+@pytest.mark.parametrize("culling", ["on", "off"])
+def test_the_cut_ball_drawn_after_the_walk_equals_the_cut_in_place(renderer, tmp_path, culling):
+    """The level of detail's cut notes its slot and draws the ball once the walk is over
+    (krs.glsl, krs_lod_cut), so that a level reads only the ball's radius where culling does
+    not read its centre; the image is the cut's in place (the ball's distance taken at the
+    level, as Alg. 1 reads, before a shader that defers it), bit for bit, with and without
+    culling. Negative control: deferring the ball of the slot above draws another image."""
+    from krsview.gpu.renderer import Renderer
+
+    from .conftest import broken_shaders
+
+    deferred = "if (r >= 0.0 && r < rho) { cut = i; return false; }"
+    in_place = (
+        "if (r >= 0.0 && r < rho) { d = min(d, length(x - u_bounds[i].xyz) - r); return false; }"
+    )
+    inline = Renderer(shader_dir=broken_shaders(tmp_path / "a", "krs.glsl", deferred, in_place))
+    above = "if (r >= 0.0 && r < rho) { cut = i + 1; return false; }"
+    wrong = Renderer(shader_dir=broken_shaders(tmp_path / "b", "krs.glsl", deferred, above))
+    scene = load_scene(resolve("tree"))
+    scene = replace(scene, render=replace(scene.render, culling=culling, lod=2.0))
+    img = renderer.render(scene, 96, 54)
+    ref = inline.render(scene, 96, 54)
+    for field in ("color", "depth", "normal", "iterations", "hit"):
+        assert np.array_equal(getattr(img, field), getattr(ref, field)), field
+    assert not np.array_equal(wrong.render(scene, 96, 54).depth, img.depth)

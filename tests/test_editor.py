@@ -32,15 +32,20 @@ LEVEL = 19  # a fork near the top of the shipped tree, clear of the panels
 ROCK_SIZE = (640, 400)  # small: the rock's test draws some 200 frames
 
 
-@pytest.fixture
-def editor(display, tmp_path):
+def editor_on_a_copy(tmp_path, preset: str, size: tuple[int, int]):
+    """An editor on a copy of a shipped preset in ``tmp_path``, closed afterwards."""
     from krsview.editor.window import Editor
 
-    path = tmp_path / "tree.toml"
-    shutil.copy(resolve("tree"), path)
-    e = Editor(path, size=SIZE)
+    path = tmp_path / f"{preset}.toml"
+    shutil.copy(resolve(preset), path)
+    e = Editor(path, size=size)
     yield e
     e.close()
+
+
+@pytest.fixture
+def editor(display, tmp_path):
+    yield from editor_on_a_copy(tmp_path, "tree", SIZE)
 
 
 def pump(e, turns: int = 3) -> None:
@@ -236,11 +241,11 @@ def test_killed_mid_edit_the_reopened_editor_offers_the_recovery(display, tmp_pa
 
     e = Editor(path, size=(320, 200))
     try:
-        assert e.recovered is not None
+        assert e.file.recovered is not None
         pump(e)  # the modal is drawn (panels run)
-        e.restore()
+        e.file.restore()
         assert e.scene.route.levels[5].radius == 0.123 and e.doc.dirty
-        assert e.recovered is None
+        assert e.file.recovered is None
     finally:
         e.close()
 
@@ -252,15 +257,37 @@ def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(editor):
     assert e.edit(("render", "epsilon_scale"), 2.0)
     assert not e.should_close()  # negative control: nothing asked to close yet
     e.execute([e.viewer.input.keymap["ctrl+Q"]])  # Ctrl+Q, as the close button
-    assert not e.should_close() and e.asking == ("close", None)
+    assert not e.should_close() and e.file.asking == ("close", None)
     pump(e)
-    e.answer_cancel()
+    e.file.answer_cancel()
     assert not e.should_close() and e.doc.dirty
     glfw.set_window_should_close(e.viewer.window, True)
     e.should_close()
-    e.answer_discard()
+    e.file.answer_discard()
     assert e.should_close()
     assert load_scene(e.path).render.epsilon_scale == 1.0, "discard wrote the file"
+
+
+def test_the_unsaved_edits_question_is_answered_by_clicking_its_button(editor):
+    """The question drawn in the real window; its first answer, "save", clicked with the
+    mouse, saves the edits and closes (editor/modals.py's answers)."""
+    import glfw
+    from imgui_bundle import imgui
+
+    e = editor
+    assert e.edit(("render", "epsilon_scale"), 2.0)
+    glfw.set_window_should_close(e.viewer.window, True)
+    assert not e.should_close() and e.file.asking == ("close", None)
+    pump(e)
+    w = imgui.internal.find_window_by_name("unsaved changes")
+    pad, frame = imgui.get_style().window_padding, imgui.get_style().frame_padding
+    x = w.pos.x + pad.x + 4
+    y = w.pos.y + w.size.y - pad.y - frame.y - imgui.get_font_size() / 2
+    pump(e)  # negative control: drawn again, not clicked, nothing answered
+    assert not e.should_close() and load_scene(e.path).render.epsilon_scale == 1.0
+    click(e, window_xy(e, x, y))
+    assert e.file.asking is None and e.should_close()
+    assert load_scene(e.path).render.epsilon_scale == 2.0 and not e.doc.dirty
 
 
 def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor):
@@ -274,10 +301,10 @@ def test_a_disk_change_with_unsaved_edits_is_a_conflict_never_overwritten(editor
     os.utime(e.path, ns=(e.doc.stamp.mtime_ns + 10**9,) * 2)
     time.sleep(0.6)
     pump(e)
-    assert e.conflict and e.scene.render.epsilon_scale == 2.0
-    assert not e.save() and "changed on disk" in e.viewer.error
+    assert e.file.conflict and e.scene.render.epsilon_scale == 2.0
+    assert not e.file.save() and "changed on disk" in e.viewer.error
     assert load_scene(e.path).name == "changed elsewhere"
-    e.take_file()
+    e.file.take_file()
     assert e.scene.name == "changed elsewhere" and not e.doc.dirty
     e.viewer.undo()
     assert e.scene.render.epsilon_scale == 2.0, "the edits were lost on reload"
@@ -296,9 +323,9 @@ def test_a_bad_panel_value_keeps_the_last_valid_scene(editor):
 
 def test_save_as_a_bad_name_is_a_clear_error(editor, tmp_path):
     e = editor
-    e.save_as(str(tmp_path / "x.png"))
+    e.file.save_as(str(tmp_path / "x.png"))
     assert "ends in .toml" in e.viewer.error or "ending in .toml" in e.viewer.error
-    e.save_as(str(tmp_path / "copy.toml"))
+    e.file.save_as(str(tmp_path / "copy.toml"))
     assert e.path == tmp_path / "copy.toml" and load_scene(tmp_path / "copy.toml") == e.scene
 
 
@@ -309,11 +336,11 @@ def test_opening_another_scene_with_unsaved_edits_asks_first(editor):
     e.doc.autosave(10.0)
     recovery = e.doc.recovery_path
     assert recovery.exists()
-    e.open_preset(resolve("sierpinski"))
-    assert e.asking == ("open", resolve("sierpinski")) and e.scene.name == "tree"
+    e.file.open_preset(resolve("sierpinski"))
+    assert e.file.asking == ("open", resolve("sierpinski")) and e.scene.name == "tree"
     pump(e)  # the question is drawn as a modal
-    e.answer_discard()
-    assert e.scene.name == "sierpinski" and e.asking is None and not e.doc.dirty
+    e.file.answer_discard()
+    assert e.scene.name == "sierpinski" and e.file.asking is None and not e.doc.dirty
     assert not recovery.exists(), "discarded edits left a recovery file to be offered later"
 
 
@@ -458,13 +485,7 @@ def angle(a, b) -> float:
 
 @pytest.fixture
 def rock_editor(display, tmp_path):
-    from krsview.editor.window import Editor
-
-    path = tmp_path / "rock.toml"
-    shutil.copy(resolve("rock"), path)
-    e = Editor(path, size=ROCK_SIZE)
-    yield e
-    e.close()
+    yield from editor_on_a_copy(tmp_path, "rock", ROCK_SIZE)
 
 
 def test_the_rocks_twelve_normals_are_each_picked_and_turned_by_small_drags(rock_editor):
@@ -724,10 +745,10 @@ def test_nothing_is_cut_off_and_the_scene_is_framed_beside_the_panel(display, tm
         w = imgui.internal.find_window_by_name("edit")
         assert abs(w.pos.x + w.size.x - (size[0] - 8)) <= 1
         inside("edit")
-        e.asking = ("close", None)
+        e.file.asking = ("close", None)
         pump(e, 3)
         inside("unsaved changes")
-        e.answer_cancel()
+        e.file.answer_cancel()
         for side in ("left", "right"):  # each a new side: framed again
             e.execute([PlacePanel(side, e.layout.width)])
             pump(e, 2)

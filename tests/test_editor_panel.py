@@ -104,7 +104,7 @@ def test_a_shipped_presets_save_as_field_starts_at_its_copy(display, tmp_path, m
     before = {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()}
     e = Editor(resolve("tree"), size=SIZE)
     try:
-        assert e.save_as_text == str(tmp_path / "tree.toml")
+        assert e.file.save_as_text == str(tmp_path / "tree.toml")
         e.execute([Bake()])
         pump(e)
         e.execute([SaveAs()])
@@ -116,7 +116,7 @@ def test_a_shipped_presets_save_as_field_starts_at_its_copy(display, tmp_path, m
     shutil.copy(resolve("tree"), mine)
     e = Editor(mine, size=SIZE)
     try:
-        assert e.save_as_text == str(mine)
+        assert e.file.save_as_text == str(mine)
     finally:
         e.close()
 

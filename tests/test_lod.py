@@ -20,8 +20,8 @@ from krsview.gpu.uniforms import variant_defines
 from krsview.oracle.certify import count_errors
 from krsview.reference import krs
 from krsview.scene import load_scene
-from krsview.scene.model import DEFAULT_LOD
 from krsview.scene.presets import resolve
+from krsview.scene.render import DEFAULT_LOD
 
 from .conftest import per_pixel
 from .test_culling import points
@@ -140,8 +140,8 @@ SPARSE = {  # two small spheres 2 apart (one and its mirror image) under a large
 SHRUNK_CUT = {
     "tree": (
         "krs.glsl",
-        "d = min(d, length(x - b.xyz) - b.w); return false;",
-        "d = min(d, length(x - b.xyz) - 0.25 * b.w); return false;",
+        "d = min(d, length(x - b.xyz) - b.w);",
+        "d = min(d, length(x - b.xyz) - 0.25 * b.w);",
     ),
     "tree-mokrs": (
         "mokrs.glsl",

@@ -125,8 +125,9 @@ def test_the_listed_pixels_are_those_no_block_lights(renderer, targets, monkeypa
 
 
 def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch):
-    """Fragments kept by each of the shading passes (an occlusion query): the shade pass
-    every pixel of its rows, the outline pass one per listed pixel, in the rows they fill."""
+    """Fragments kept by each of the shading passes (an occlusion query): the hits' depth
+    every pixel of its rows, the sky's pass and the shade pass the two parts of them, the
+    outline pass one per listed pixel, in the rows they fill."""
     tree = scene_of("tree")
     drawn: list[tuple[str, int, int]] = []
     fill = PassImage._fill
@@ -143,9 +144,9 @@ def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch)
         image = image_of(renderer, targets, tree)
         count = int(listed(targets, image).sum())
     w, h = SIZE
-    assert [d[0] for d in drawn] == ["visibility", "shade", "outline"]
-    assert drawn[1] == ("shade", h, w * h)
-    assert 0 < count < w * h / 20 and drawn[2] == ("outline", -(-count // w), count)
+    assert [d[0] for d in drawn] == ["visibility", "hits", "sky", "shade", "outline"]
+    assert drawn[1] == ("hits", h, w * h) and drawn[2][2] + drawn[3][2] == w * h
+    assert 0 < count < w * h / 20 and drawn[4] == ("outline", -(-count // w), count)
 
 
 def test_the_shade_pass_compiles_no_shadow_ray(renderer, targets, monkeypatch):

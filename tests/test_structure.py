@@ -444,14 +444,14 @@ def test_saving_a_shipped_preset_asks_for_a_copy_and_never_writes_the_package(
     e = Editor(resolve("tree"), size=WINDOW)
     try:
         e.execute([ec.Bake()])
-        assert e.save() is False and e.copy_to.text == str(tmp_path / "tree.toml")
+        assert e.file.save() is False and e.file.copy_to.text == str(tmp_path / "tree.toml")
         assert copy_target(e.path) == tmp_path / "tree.toml"
         pump(e)  # the dialog is drawn
         e.execute([ec.SetCopyText(str(tmp_path / "mine.toml")), ec.SaveCopy()])
-        assert e.copy_to is None and e.path == tmp_path / "mine.toml" and not e.doc.dirty
+        assert e.file.copy_to is None and e.path == tmp_path / "mine.toml" and not e.doc.dirty
         assert load_scene(tmp_path / "mine.toml").route is not None
         e.execute([ec.InsertLevel(2)])
-        assert e.save() is True, "the copy is an ordinary file: Ctrl+S saves it"
+        assert e.file.save() is True, "the copy is an ordinary file: Ctrl+S saves it"
     finally:
         e.close()
     assert {p.name: p.stat().st_mtime_ns for p in PRESET_DIR.iterdir()} == before
@@ -479,13 +479,13 @@ def test_a_viewer_bookmark_of_a_shipped_preset_goes_to_its_copy(display, tmp_pat
     before = {p.name: p.read_bytes() for p in PRESET_DIR.iterdir() if p.is_file()}
     v = Viewer(resolve("sierpinski"), size=WINDOW, hud=False)
     try:
-        v.add_bookmark()
+        v.file.add_bookmark()
         assert v.path == tmp_path / "sierpinski.toml" and not v.doc.dirty, v.error
         assert (
             len(load_scene(v.path).bookmarks)
             == len(load_scene(resolve("sierpinski")).bookmarks) + 1
         )
-        v.add_bookmark()  # the copy is an ordinary file now: the next one goes there too
+        v.file.add_bookmark()  # the copy is an ordinary file now: the next one goes there too
         assert (
             len(load_scene(v.path).bookmarks)
             == len(load_scene(resolve("sierpinski")).bookmarks) + 2
@@ -508,11 +508,11 @@ def test_closing_a_shipped_preset_with_edits_saves_the_copy_then_closes(
     try:
         e.edit(("render", "epsilon_scale"), 2.0)
         glfw.set_window_should_close(e.viewer.window, True)
-        assert not e.should_close() and e.asking == ("close", None)
+        assert not e.should_close() and e.file.asking == ("close", None)
         pump(e)
         e.execute([ec.AnswerSave()])
         pump(e)
-        assert e.asking is None and e.copy_to.then == ("close", None)
+        assert e.file.asking is None and e.file.copy_to.then == ("close", None)
         assert not e.should_close(), "nothing saved yet: the window stays"
         e.execute([ec.SaveCopy()])
         assert e.should_close() and e.path == tmp_path / "sierpinski.toml"

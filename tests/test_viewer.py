@@ -179,7 +179,7 @@ def test_record_and_replay_a_camera_path(viewer):
     v.execute([Replay()])
     for _ in range(20):
         v.step(0.05)
-    assert v.recorder.replay_start is None and np.allclose(v.camera.position, end)
+    assert v.file.recorder.replay_start is None and np.allclose(v.camera.position, end)
 
 
 def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
@@ -187,26 +187,26 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
     v.execute([ToggleRecording()])
     hold(v, "W", 4)
     v.execute([ToggleRecording()])
-    end, recorded = v.camera.position.copy(), len(v.recorder.path.poses)
-    assert v.recorder.file.exists() and v.recorder.file.name == "tree.path.json"
-    v.recorder.path = None
-    v.open_preset(v.path)  # as a new session would: the path comes from the file
-    assert len(v.recorder.path.poses) == recorded > 0
+    end, recorded = v.camera.position.copy(), len(v.file.recorder.path.poses)
+    assert v.file.recorder.file.exists() and v.file.recorder.file.name == "tree.path.json"
+    v.file.recorder.path = None
+    v.file.open(v.path)  # as a new session would: the path comes from the file
+    assert len(v.file.recorder.path.poses) == recorded > 0
     v.execute([Replay()])
     for _ in range(20):
         v.step(0.05)
     assert np.allclose(v.camera.position, end)
-    v.recorder.file.write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
-    v.open_preset(v.path)
-    assert v.recorder.path is None and "tree.path.json: poses[0]" in v.error
+    v.file.recorder.file.write_text('{"poses": [{"t": 0, "position": [1, "x"]}]}')
+    v.file.open(v.path)
+    assert v.file.recorder.path is None and "tree.path.json: poses[0]" in v.error
 
 
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once
     (its tracing program, its pre-pass and its free tiles' pass (gpu/renderer.py), the tree's
-    shadow rays per 2 × 2 pixels, and the shading with those, and its outline pixels':
-    gpu/passes.py; the still image shares them, [render] shadow_block); switching back, and
-    moving accuracy knobs, compile nothing."""
+    shadow rays per block of pixels, the hits' depth, the sky's and the shading with those,
+    and its outline pixels': gpu/passes.py; the still image shares them, [render]
+    shadow_block); switching back, and moving accuracy knobs, compile nothing."""
     v = viewer
     settle(v)
     programs = v.renderer.programs
@@ -214,7 +214,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     sphere_image = v.read_window()
     v.set_render(tracer="binary")
     settle(v)
-    assert v.prepass and programs.compiles == before + 6
+    assert v.prepass and programs.compiles == before + 8
     assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
     binary_image = v.read_window()
     assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
@@ -222,7 +222,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     settle(v)
     v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
     settle(v)
-    assert programs.compiles == before + 6
+    assert programs.compiles == before + 8
 
 
 def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
@@ -246,7 +246,7 @@ def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
 def test_mokrs_presets_fly_in_the_viewer(viewer):
     v = viewer
     for name in ("palm", "shell", "inversion"):
-        v.open_preset(resolve(name))
+        v.file.open(resolve(name))
         assert v.error == "" and v.scene.mokrs is not None
         settle(v)
         img = v.read_window()
@@ -272,28 +272,29 @@ def test_preset_picker_and_levels_slider(viewer):
     assert (np.abs(v.read_window().astype(int) - full).max(-1) > 30).mean() > 0.01  # fewer twigs
     v.set_levels(len(v.geometry.levels))
     assert v.krs is v.geometry
-    v.open_preset(resolve("sierpinski"))
+    v.file.open(resolve("sierpinski"))
     assert v.scene.name == "sierpinski" and v.path == resolve("sierpinski") and not v.error
     assert v.camera.to_camera().position == v.scene.camera.position
     settle(v)
-    v.open_preset(v.path.with_name("missing.toml"))
+    v.file.open(v.path.with_name("missing.toml"))
     assert "cannot read" in v.error and v.scene.name == "sierpinski"  # kept the last good one
 
 
 def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     """The HUD's effect checkboxes go through Viewer.set_effect: a new effect set compiles one
-    variant with its define (with shadows: the tracing, its pre-pass and its free tiles' pass,
-    the shadow rays per 2 × 2 pixels, the shading with them and its outline pixels',
-    gpu/passes.py); switching back and forth again compiles nothing."""
+    variant with its define (with shadows: the tracing, its pre-pass and its free tiles'
+    pass, the shadow rays per block of pixels, the hits' depth, the sky's and the shading
+    with them and its outline pixels', gpu/passes.py); switching back and forth again
+    compiles nothing."""
     v = viewer
-    v.open_preset(resolve("sierpinski"))
+    v.file.open(resolve("sierpinski"))
     settle(v)
     programs = v.renderer.programs
     before = programs.compiles
     plain = v.read_window()
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 6
+    assert programs.compiles == before + 8
     assert any(("KRS_SHADOWS", None) in key[2] for key in programs._programs)
     assert np.abs(v.read_window().astype(int) - plain).max() > 0
     v.set_effect("soft_shadows", True)  # replaces the hard shadows: they exclude each other
@@ -303,15 +304,15 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     settle(v)
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 12
-    v.open_preset(resolve("palm"))
+    assert programs.compiles == before + 16
+    v.file.open(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error
 
 
 def test_compound_preset_flies_and_the_levels_slider_cuts_every_component(viewer):
     v = viewer
-    v.open_preset(resolve("grove"))
+    v.file.open(resolve("grove"))
     assert v.error == "" and len(v.geometry.parts) == 8
     settle(v)
     full = v.read_window()
@@ -394,7 +395,7 @@ def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(view
     HUD's knob sets the scene's render.prepass through the document (validated by the
     schema's range, one undo step), and the view then draws with it. Off or on, the window
     shows the same tree (pixels change only on outlines, where grazing rays may flip)."""
-    from krsview.scene.model import VIEW_PREPASS
+    from krsview.scene.render import VIEW_PREPASS
 
     v = viewer
     settle(v)

@@ -167,6 +167,17 @@ def test_screenshot_of_a_read_only_scene_goes_to_the_pictures_folder(tmp_path, m
     assert np.array_equal(np.asarray(Image.open(out)), RGB)
 
 
+def test_screenshot_of_a_shipped_preset_goes_to_the_pictures_folder(tmp_path, monkeypatch):
+    home = tmp_path / "home"
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.delenv("XDG_CONFIG_HOME", raising=False)
+    preset = resolve("tree")
+    out = save_screenshot(RGB, preset, "20260101-000000")
+    assert out == home / "Pictures" / "krsview" / "tree-20260101-000000.png"
+    assert np.array_equal(np.asarray(Image.open(out)), RGB)
+    assert not (preset.parent / "tree.screenshots").exists()  # the package's folder is left alone
+
+
 @pytest.mark.skipif(not shutil.which("xdg-user-dir"), reason="xdg-user-dir is not installed")
 def test_the_pictures_folder_is_the_users_xdg_one(tmp_path, monkeypatch):
     home = tmp_path / "home"

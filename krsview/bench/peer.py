@@ -20,7 +20,7 @@ import numpy as np
 from ..compile.camera import View, primary_rays, view_of
 from ..gpu.renderer import Renderer
 from ..scene import KRS, Scene, SceneError
-from ..scene.model import DEFAULT_LOD, VIEW_PREPASS
+from ..scene.render import DEFAULT_LOD, VIEW_PREPASS
 from .expansion import TOLERANCE, Mesh, expand, single_krs
 from .harness import Variant, frame_timer, interleaved
 from .report import Measured, markdown

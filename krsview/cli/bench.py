@@ -14,8 +14,8 @@ from .. import app
 from ..bench.expansion import TOLERANCE
 from ..bench.report import markdown, write_csv
 from ..scene import MAX_LEVELS, SceneError
-from ..scene.model import VIEW_PREPASS
 from ..scene.presets import DEFAULT_PRESET, resolve
+from ..scene.render import VIEW_PREPASS
 from . import options
 from .options import check_output_dir, check_output_file, render_option
 

@@ -13,7 +13,7 @@ from .. import api, export
 from ..frame import Frame
 from ..progress import Progress
 from ..scene import Scene, SceneError
-from ..scene.model import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, VIEW_PREPASS
+from ..scene.render import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, VIEW_PREPASS
 from ..share.frames import DEFAULT_FPS
 from . import options
 from .options import SILENT_SECONDS, check_output_dir, check_output_file, render_option

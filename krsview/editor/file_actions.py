@@ -1,36 +1,82 @@
-"""The editor's file, one job of the editor window (a mixin of ``Editor``): save and save
-as (a shipped preset asks where its copy goes, saving.py), a bookmark as an edit saved with
-the scene, the file changed on disk (never overwriting unsaved edits: a conflict to answer),
-the recovery of a session that did not end cleanly, and the unsaved-edits question before
-closing or opening another scene."""
+"""The editor's file, a part the editor holds (``Editor.file``): save and save as (a shipped
+preset asks where its copy goes), a bookmark as an edit saved with the scene, the file
+changed on disk (never overwriting unsaved edits: a conflict to answer), the recovery of a
+session that did not end cleanly, and the unsaved-edits question before closing or opening
+another scene. It knows the viewer only as a ``Window`` and the editor only by two functions
+(its edit, and what it does once another scene is opened), so it can be read and tested
+alone (tests/test_file_actions.py)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any, Protocol
 
-from ..document.document import ConflictError
-from ..scene import Bookmark, Scene, SceneError
-from ..viewer.window import Viewer
-from .saving import ask_copy, save_as_default
+from ..document.document import ConflictError, Document, copy_target
+from ..scene import Bookmark, SceneError
+from ..viewer import commands as vc
+from ..viewer.camera import FlyCamera
+from ..viewer.files import ViewerFile
+from . import commands as ec
+
+
+class Window(Protocol):
+    """What the file part reads and calls of the viewer."""
+
+    doc: Document
+    file: ViewerFile  # the file's watcher and camera path; taking it, opening another
+    camera: FlyCamera  # a bookmark's view
+    message: str
+    error: str
+    hud: bool  # shown for a question
+
+    def sync(self) -> None: ...
+    def say(self, text: str) -> None: ...  # in the status line, for a while
+
+
+@dataclass(frozen=True)
+class CopyAsk:
+    """The copy dialog: where the copy goes, and the question that wanted the save (closing
+    or opening another scene with unsaved edits), answered once the copy is saved."""
+
+    text: str
+    then: tuple[str, Path | None] | None = None
+
+
+def save_as_default(doc: Document) -> str:
+    """What the save-as field starts with: the file itself, or for a shipped preset the
+    copy's default (``./NAME.toml``, else the user's folder), never the package's folder."""
+    return str(copy_target(doc.path) if doc.template else doc.path)
 
 
 class FileActions:
-    """What the editor does with its file. Mixed into ``Editor``, which gives it the state
-    below, its ``doc`` and ``scene``, ``edit`` (an edit through the document) and ``frame``
-    (the camera framing the scene beside the panel)."""
+    """What the editor does with its file. ``edit`` is the editor's edit through the
+    document (a bookmark is one); ``opened`` is told when another scene was opened (the
+    editor drops its selection and frames the scene)."""
 
-    viewer: Viewer
-    asking: tuple[str, Path | None] | None  # unsaved edits: close / open?
-    recovered: Scene | None  # a recovery file's scene, offered in a modal
-    conflict: bool  # the file changed on disk while there are unsaved edits
-    save_as_text: str
-    selected: object
-    _quit: bool
+    def __init__(
+        self, viewer: Window, edit: Callable[[tuple, Any], bool], opened: Callable[[], None]
+    ):
+        self.viewer = viewer
+        self._edit = edit
+        self._opened = opened
+        self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
+        self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
+        self.recovered = self.doc.recovery()  # a recovery file's scene, offered in a modal
+        self.conflict = False  # the file changed on disk while there are unsaved edits
+        self.save_as_text = save_as_default(self.doc)
+        self.quit = False  # the question was answered: the window closes
+
+    @property
+    def doc(self) -> Document:
+        return self.viewer.doc
 
     def add_bookmark(self) -> None:
         """In the editor a bookmark is an edit like any other (saved with the scene)."""
-        b = Bookmark(f"view {len(self.scene.bookmarks) + 1}", self.viewer.camera.to_camera())
-        if self.edit(("bookmarks",), self.scene.bookmarks + [b]):
+        scene = self.doc.scene
+        b = Bookmark(f"view {len(scene.bookmarks) + 1}", self.viewer.camera.to_camera())
+        if self._edit(("bookmarks",), scene.bookmarks + [b]):
             self.viewer.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
 
     def reload_scene(self) -> None:
@@ -40,12 +86,15 @@ class FileActions:
         if self.doc.dirty:
             self.conflict = True
         else:
-            self.viewer.take_file()
+            self.viewer.file.take()
 
     def save(self, path: str | None = None, overwrite: bool = False) -> bool:
+        """Save (atomic); a shipped preset first asks where its copy goes, taking over the
+        unsaved-edits question if that is what asked; nothing is saved yet then."""
         v = self.viewer
         if not path and self.doc.template:
-            return ask_copy(self)
+            self.copy_to, self.asking = CopyAsk(str(copy_target(self.doc.path)), self.asking), None
+            return False
         try:
             saved = self.doc.save(path or None, overwrite=overwrite)
         except ConflictError as e:
@@ -54,7 +103,7 @@ class FileActions:
         except SceneError as e:
             v.error = str(e)
             return False
-        v.follow_file()
+        v.file.follow()
         v.error, v.message, self.conflict = "", f"saved {saved.resolve()}", False
         self.save_as_text = str(saved)
         return True
@@ -66,9 +115,22 @@ class FileActions:
             return
         self.save(str(target))
 
+    def save_copy(self) -> None:
+        """Save to the copy named in the dialog; then go on with the question that asked."""
+        ask = self.copy_to
+        if ask is None:
+            return
+        self.save_as(ask.text)
+        if self.doc.template:
+            return  # refused: the dialog stays, with the error
+        self.copy_to = None
+        if ask.then is not None:
+            self.asking = ask.then
+            self.answer_save()
+
     def take_file(self) -> None:
         self.conflict = False
-        self.viewer.take_file()
+        self.viewer.file.take()
 
     def keep_mine(self) -> None:
         self.conflict = False
@@ -83,6 +145,13 @@ class FileActions:
     def discard_recovery(self) -> None:
         self.doc.discard_recovery()
         self.recovered = None
+
+    def may_close(self) -> bool:
+        """The window's close button: close at once, or first ask about unsaved edits."""
+        if not self.doc.dirty:
+            return True
+        self.asking, self.viewer.hud = ("close", None), True
+        return False
 
     def answer_save(self) -> None:
         if self.save():
@@ -99,7 +168,7 @@ class FileActions:
         what, path = self.asking or (None, None)
         self.asking = None
         if what == "close":
-            self._quit = True
+            self.quit = True
         elif what == "open" and path is not None:
             self._open(path)
 
@@ -110,7 +179,29 @@ class FileActions:
             self._open(path)
 
     def _open(self, path: Path) -> None:
-        self.viewer.open_preset(path)
-        self.selected, self.recovered, self.conflict = None, self.doc.recovery(), False
+        self.viewer.file.open(path)
+        self.recovered, self.conflict = self.doc.recovery(), False
         self.save_as_text = save_as_default(self.doc)
-        self.frame()
+        self._opened()
+
+
+# The commands about the file, each applied to the file part (the editor's EDITOR_HANDLERS
+# hands them over); tests/test_commands.py checks every command class is handled.
+FILE_HANDLERS: dict[type[vc.Command], Callable[[FileActions, Any], None]] = {
+    ec.Save: lambda f, c: f.save(),
+    ec.SaveAs: lambda f, c: f.save_as(f.save_as_text),
+    ec.SetSaveAsText: lambda f, c: setattr(f, "save_as_text", c.text),
+    ec.SetCopyText: lambda f, c: setattr(f, "copy_to", replace(f.copy_to, text=c.text)),
+    ec.SaveCopy: lambda f, c: f.save_copy(),
+    ec.CancelCopy: lambda f, c: setattr(f, "copy_to", None),
+    ec.TakeFile: lambda f, c: f.take_file(),
+    ec.KeepMine: lambda f, c: f.keep_mine(),
+    ec.Restore: lambda f, c: f.restore(),
+    ec.DiscardRecovery: lambda f, c: f.discard_recovery(),
+    ec.AnswerSave: lambda f, c: f.answer_save(),
+    ec.AnswerDiscard: lambda f, c: f.answer_discard(),
+    ec.AnswerCancel: lambda f, c: f.answer_cancel(),
+    vc.AddBookmark: lambda f, c: f.add_bookmark(),
+    vc.OpenPreset: lambda f, c: f.open_preset(c.path),
+    vc.ReloadScene: lambda f, c: f.reload_scene(),
+}

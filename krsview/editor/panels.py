@@ -7,7 +7,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import fields
 from functools import partial
-from pathlib import Path
 from typing import Any, Protocol
 
 from imgui_bundle import imgui
@@ -20,10 +19,12 @@ from ..viewer.hud import HUD_RIGHT
 from ..viewer.widgets import Interactions, field_widget
 from ..viewer.window import Viewer
 from . import commands as ec
+from .file_actions import FileActions
 from .gizmo import Snap
 from .handles import Handle, outline
 from .keys import key_marks, marked
 from .layout import MIN_WIDTH, Layout
+from .modals import answer_buttons, begin_modal
 from .mokrs_panel import mokrs_section
 from .saving import copy_dialog
 from .structure_panel import outline_menu, structure_section
@@ -31,7 +32,6 @@ from .structure_panel import outline_menu, structure_section
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
-MODAL_WIDTH = 420.0  # pixels, or the window's width where it is narrower
 TIP_EMS = 22.0  # a bookkeeping field's tooltip wraps at this many font sizes
 
 
@@ -43,11 +43,8 @@ class Edited(Protocol):
     warnings: list[tuple[int, str]]
     snap: Snap
     carry: bool
-    save_as_text: str
-    conflict: bool
+    file: FileActions  # save as, a conflict, the unsaved-edits and recovery questions
     scroll_outline: bool
-    asking: tuple[str, Path | None] | None
-    recovered: Scene | None
     layout: Layout
 
     @property
@@ -124,7 +121,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
     imgui.end()
     _modals(e, out)
-    out += copy_dialog(e)
+    out += copy_dialog(e.file)
     return out
 
 
@@ -178,7 +175,7 @@ def _file(e: Edited, out: list) -> None:
         out.append(ec.SaveAs())
     imgui.same_line()
     imgui.set_next_item_width(-1)  # the rest of the line, however wide the panel
-    changed, text = imgui.input_text("##saveas", e.save_as_text)
+    changed, text = imgui.input_text("##saveas", e.file.save_as_text)
     if changed:
         out.append(ec.SetSaveAsText(text))
     done, undone = doc.history.labels()
@@ -195,7 +192,7 @@ def _file(e: Edited, out: list) -> None:
     imgui.end_disabled()
     if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
         imgui.set_tooltip("redo: " + undone[0])
-    if e.conflict:
+    if e.file.conflict:
         imgui.push_style_color(imgui.Col_.text, RED)
         imgui.text_wrapped(f"{doc.path.name} changed on disk, and you have unsaved edits.")
         imgui.pop_style_color()
@@ -300,44 +297,22 @@ BOOKKEEPING: dict[str, Callable[[Any], tuple[str, str]]] = {"grown": _grown}
 
 
 def _modals(e: Edited, out: list) -> None:
-    if e.asking is not None and not imgui.is_popup_open("unsaved changes"):
+    if e.file.asking is not None and not imgui.is_popup_open("unsaved changes"):
         imgui.open_popup("unsaved changes")
-    if _begin_modal("unsaved changes"):
-        what = "closing" if e.asking == ("close", None) else "opening another scene"
+    if begin_modal("unsaved changes"):
+        what = "closing" if e.file.asking == ("close", None) else "opening another scene"
         imgui.text_wrapped(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
-        for label, command in (
-            ("save", ec.AnswerSave()),
-            ("discard", ec.AnswerDiscard()),
-            ("cancel", ec.AnswerCancel()),
-        ):
-            if imgui.button(label):
-                out.append(command)
-                imgui.close_current_popup()
-            imgui.same_line()
+        answers = [("save", ec.AnswerSave()), ("discard", ec.AnswerDiscard())]
+        answer_buttons([*answers, ("cancel", ec.AnswerCancel())], out)
         imgui.end_popup()
-    if e.recovered is not None and not imgui.is_popup_open("recover"):
+    if e.file.recovered is not None and not imgui.is_popup_open("recover"):
         imgui.open_popup("recover")
-    if _begin_modal("recover"):
+    if begin_modal("recover"):
         imgui.text_wrapped(
             f"{e.doc.recovery_path.name} holds unsaved edits from a session that "
             "did not end cleanly."
         )
-        if imgui.button("restore them"):
-            out.append(ec.Restore())
-            imgui.close_current_popup()
-        imgui.same_line()
-        if imgui.button("discard them"):
-            out.append(ec.DiscardRecovery())
-            imgui.close_current_popup()
+        answer_buttons(
+            [("restore them", ec.Restore()), ("discard them", ec.DiscardRecovery())], out
+        )
         imgui.end_popup()
-
-
-def _begin_modal(name: str) -> bool:
-    """A modal dialog in the middle of the window, never wider than it (its text wraps)."""
-    size = imgui.get_io().display_size
-    width = min(MODAL_WIDTH, size.x - 16)
-    imgui.set_next_window_pos(
-        imgui.ImVec2(size.x / 2, size.y / 2), imgui.Cond_.always, imgui.ImVec2(0.5, 0.5)
-    )
-    imgui.set_next_window_size(imgui.ImVec2(width, 0))
-    return imgui.begin_popup_modal(name, None, imgui.WindowFlags_.no_resize)[0]

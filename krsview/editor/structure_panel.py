@@ -16,6 +16,7 @@ from ..viewer.commands import Command
 from ..viewer.widgets import Interactions, field_widget
 from . import commands as ec
 from .handles import route_outline
+from .modals import answer_buttons
 from .structure import Structured, StructureTools, component, target
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
@@ -151,11 +152,6 @@ def _regrow_dialog(t: StructureTools, out: list[Command]) -> None:
         imgui.bullet_text(line)
     if len(lost) > MAX_LISTED:
         imgui.text(f"... and {len(lost) - MAX_LISTED} more")
-    if imgui.button("grow again, losing them"):
-        out.append(ec.ConfirmRegrow())
-        imgui.close_current_popup()
-    imgui.same_line()
-    if imgui.button("cancel (keep the tree)"):
-        out.append(ec.CancelRegrow())
-        imgui.close_current_popup()
+    answers = [("grow again, losing them", ec.ConfirmRegrow())]
+    answer_buttons([*answers, ("cancel (keep the tree)", ec.CancelRegrow())], out)
     imgui.end_popup()

@@ -8,8 +8,9 @@ The editor composes a :class:`Viewer`: it turns the event loop itself, calling t
 parts (keys, camera, file watching, tracing, HUD) and adding its overlay (shapes.py), panels,
 gizmo, trackball and picking (picking.py). Commands of its own go to EDITOR_HANDLERS, and those
 the editor decides differently (bookmark, open, a file changed on disk, a field's edit, reset
-view); the rest to the viewer's. Its other jobs live beside it: the file (file_actions.py),
-what the view shows at the moment shown (shown.py) and a drag's edits (dragging.py).
+view); the rest to the viewer's. Its other jobs live beside it: the file, a part it holds
+(``self.file``, file_actions.py), what the view shows at the moment shown (shown.py) and a
+drag's edits (dragging.py).
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
@@ -41,14 +42,14 @@ from ..viewer.loop import run
 from ..viewer.window import Viewer
 from . import commands as ec
 from .dragging import manipulate
-from .file_actions import FileActions
+from .file_actions import FILE_HANDLERS, FileActions
 from .gizmo import Gizmo
 from .handles import Handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
 from .panels import edit_panel
 from .picking import hover_label, pick, visible
-from .saving import SAVING_HANDLERS, CopyAsk, autosave, save_as_default
+from .saving import autosave
 from .shapes import editor_shapes
 from .shown import Shown
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
@@ -64,7 +65,7 @@ EDITOR_KEYS = {
 }
 
 
-class Editor(FileActions):
+class Editor:
     def __init__(self, path: Path, settings: ViewerSettings | None = None, **options: Any):
         """``options``: ``visible``, ``shader_dir``, or fields of ViewerSettings."""
         window = {k: options.pop(k) for k in ("visible", "shader_dir") if k in options}
@@ -79,15 +80,12 @@ class Editor(FileActions):
         self.carry = True  # a fork drag takes its subtree along
         self.structure = StructureTools()
         self.timeline = Timeline()
-        self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.selected: Handle | None = None
         self.shown_now = Shown()  # the scene drawn now, its handles, warnings, clipped parts
-        self.save_as_text = save_as_default(self.doc)
-        self.asking: tuple[str, Path | None] | None = None  # unsaved edits: close / open?
-        self.recovered = self.doc.recovery()  # offered in a modal
-        self.conflict = False
+        self.file = FileActions(self.viewer, self.edit, self._opened)
         self.scroll_outline = False
-        self._quit = False
+        self._again = False  # a turn at once: a pick's gizmo
+        self._held: set[str] = set()  # the view's buttons held at the last turn's end
         self._title = ""
         self._update_title()
         self.frame()
@@ -169,29 +167,38 @@ class Editor(FileActions):
         run(self)
 
     def is_idle(self) -> bool:
-        return self.viewer.is_idle()
+        """The viewer's idle, but never right after a pick (its gizmo is drawn next turn)."""
+        return not self._again and self.viewer.is_idle()
 
     def close(self) -> None:
         self.viewer.close()
 
     def step(self, dt: float) -> None:
-        """The viewer's turn with the editor's parts: picking by a click, the overlay, the
-        panels and the gizmo; then the autosave."""
+        """The viewer's turn with the editor's parts: the gizmo, picking by a click, the
+        overlay and the panels; then the autosave. A click picks after the gizmo has seen the
+        pointer where it clicked, still before the overlay is drawn (the gizmo of what it
+        picked comes the turn after, at once); a press straight onto the gizmo (a tap, no
+        frame saw the pointer there) is the gizmo's, and the view lets go of it."""
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
         click = v.input.take_click()
-        if click is not None and v.hud:
-            self.pick(*click)
         v.move(dt)
-        self.execute(v.watcher.poll())
+        self.execute(v.file.watcher.poll())
         self._follow()
         status = v.status_line()
         ui = v.hud or bool(status)
         if ui:
             v.platform.new_frame()
+        self._again = False
         if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
             manipulate(self)
+            if not self._claimed():
+                if click is not None:
+                    self.pick(*click)
+                    self._again = True
+            elif "left" in v.input.buttons - self._held:  # pressed onto the gizmo
+                v.input.let_go("left")
         v.draw_image()
         self._follow()
         if ui:
@@ -199,22 +206,20 @@ class Editor(FileActions):
                 self._draw_ui()
             draw_status(status)
             v.platform.render()
-        turning = self.selected is not None and self.selected.kind == "normal"
-        v.input.claimed = v.hud and (
-            self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
-        )
+        v.input.claimed = v.hud and self._claimed()
+        self._held = set(v.input.buttons)
         glfw.swap_buffers(v.window)
-        autosave(self, time.monotonic())
+        autosave(self.file, time.monotonic())
         self._update_title()
 
     def should_close(self) -> bool:
-        if self._quit:
+        """The question about unsaved edits answered, or the close button pressed with none
+        (with some, the file part asks first)."""
+        if self.file.quit:
             return True
         if glfw.window_should_close(self.viewer.window):
             glfw.set_window_should_close(self.viewer.window, False)
-            if not self.doc.dirty:
-                return True
-            self.asking, self.viewer.hud = ("close", None), True
+            return self.file.may_close()
         return False
 
     def execute(self, commands: list[vc.Command]) -> None:
@@ -275,6 +280,11 @@ class Editor(FileActions):
         self.viewer.reset_view()
         self.frame()
 
+    def _opened(self) -> None:
+        """Another scene was opened (file_actions.py): nothing selected, the scene framed."""
+        self.selected = None
+        self.frame()
+
     def frame(self) -> None:
         """Turn the camera so the scene camera's target sits in the middle of the part of the
         window the panel leaves."""
@@ -300,6 +310,12 @@ class Editor(FileActions):
         best = pick(self, self.window_view(), x, y)
         self.select(best)
         return best
+
+    def _claimed(self) -> bool:
+        """The gizmo, or the trackball on a selected normal, is under the pointer or dragged:
+        a press there is neither the camera's nor a pick."""
+        turning = self.selected is not None and self.selected.kind == "normal"
+        return self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
 
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:
@@ -327,7 +343,8 @@ class Editor(FileActions):
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
-# edit, opening or reloading asks about unsaved edits); tests/test_commands.py checks them.
+# edit, opening or reloading asks about unsaved edits: the file part's, FILE_HANDLERS);
+# tests/test_commands.py checks them.
 EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.Bake: lambda e, c: e.bake(c.component),
     ec.SetKey: lambda e, c: e.set_key(),
@@ -336,23 +353,10 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),
     ec.SetSnap: lambda e, c: setattr(e.snap, "on", c.on),
     ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),
-    ec.Save: lambda e, c: e.save(),
-    ec.SaveAs: lambda e, c: e.save_as(e.save_as_text),
-    ec.SetSaveAsText: lambda e, c: setattr(e, "save_as_text", c.text),
-    ec.TakeFile: lambda e, c: e.take_file(),
-    ec.KeepMine: lambda e, c: e.keep_mine(),
-    ec.Restore: lambda e, c: e.restore(),
-    ec.DiscardRecovery: lambda e, c: e.discard_recovery(),
-    ec.AnswerSave: lambda e, c: e.answer_save(),
-    ec.AnswerDiscard: lambda e, c: e.answer_discard(),
-    ec.AnswerCancel: lambda e, c: e.answer_cancel(),
-    vc.AddBookmark: lambda e, c: e.add_bookmark(),
-    vc.OpenPreset: lambda e, c: e.open_preset(c.path),
-    vc.ReloadScene: lambda e, c: e.reload_scene(),
     vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction),
     vc.ResetView: lambda e, c: e.reset_view(),
     ec.PlacePanel: lambda e, c: e.place_panel(c.side, c.width),
     ec.FoldPanel: lambda e, c: e.fold_panel(c.folded),
     **STRUCTURE_HANDLERS,
-    **SAVING_HANDLERS,
+    **{kind: (lambda e, c, h=h: h(e.file, c)) for kind, h in FILE_HANDLERS.items()},
 }

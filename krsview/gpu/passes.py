@@ -19,7 +19,12 @@ resolution]. ``ratio`` picks the passes:
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
   at once, lit as the image before it, before its own shadow rays [issue 28 §5]; the image
-  after it at the same size reuses its tracing and adds them."""
+  after it at the same size reuses its tracing and adds them.
+
+The shading after ``trace`` (``shadows+shade``, ``shade``) is drawn by depth: the hits into a
+depth buffer, then the sky's pixels with the sky's code alone and the hits with the
+shading's, so that llvmpipe, which skips a group of pixels only where an early depth test
+fails for all of it, never runs the shading over groups of sky (0.95× tree's frame)."""
 
 from __future__ import annotations
 
@@ -36,6 +41,10 @@ from ..scene import Geometry, Scene
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
 MAX_KEPT = 6  # targets kept (least recently used released)
+# the shading after the trace pass, pass and depth test: the hits' depth (0, the sky 1) into
+# every pixel, then the sky's pixels and the hits ("shade": the image's shading pass), each
+# against the triangle's depth 0.5
+SHADE_PASSES = (("hits", "1"), ("sky", "<"), ("shade", ">"))
 SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks'
     *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
     *("u_coarse_visibility", "u_coarse_depth"),
@@ -89,11 +98,13 @@ class Tracer(Protocol):
 
 class Outline(NamedTuple):
     """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
-    the pixels) and the target their pass draws (no colour: it stores each listed pixel's
-    colour in the image's)."""
+    the pixels), the target their pass draws (no colour: it stores each listed pixel's
+    colour in the image's) and the image's colour with the depth that tells the shading
+    passes hits from the sky (``shaded``)."""
 
     pixels: moderngl.Buffer
     scratch: moderngl.Framebuffer
+    shaded: moderngl.Framebuffer
     depth: moderngl.Renderbuffer
 
 
@@ -136,6 +147,7 @@ class Targets:
             self._outlines[output] = Outline(
                 self.ctx.buffer(reserve=4 * (w * h + 1)),
                 self.ctx.framebuffer(depth_attachment=depth),
+                self.ctx.framebuffer(output.color_attachments, depth),
                 depth,
             )
         return self._outlines[output]
@@ -210,6 +222,11 @@ class PassImage:
                 self._programs[name] = shade
         elif self.ratio == 1:
             self._programs["shadows+shade"] = self.renderer.companion(main, "upsampled.frag")
+        if self.ratio:  # the shading's passes by depth (_shade_by_depth)
+            for name, define in (("hits", "KRS_HIT_DEPTH"), ("sky", "KRS_SHADE_SKY")):
+                self._programs[name] = self.renderer.companion(
+                    main, "upsampled.frag", {define: None}
+                )
         for prog in self._programs.values():  # the samplers' units, as draw binds them
             for unit, sampler in enumerate(SAMPLERS):
                 if sampler in prog:
@@ -236,7 +253,7 @@ class PassImage:
                     tex.use(len(self.traced.color_attachments) + k)
                 self._shade_and_outline(y0, rows)
             else:
-                self._fill(prog, self.output, self.size, y0, rows)
+                self._shade_by_depth(self.targets.outline(self.output), y0, rows, name)
 
     def _fill(
         self, prog: moderngl.Program, target: moderngl.Framebuffer, size, y0: int, rows: int
@@ -257,7 +274,7 @@ class PassImage:
         ctx, outline = self.renderer.ctx, self.targets.outline(self.output)
         outline.pixels.write(bytes(4))  # none listed
         outline.pixels.bind_to_storage_buffer(BINDING_OUTLINE)
-        self._fill(self._programs["shade"], self.output, self.size, y0, rows)
+        self._shade_by_depth(outline, y0, rows, "shade")
         ctx.memory_barrier()  # the list and the shaded pixels complete
         listed = int.from_bytes(outline.pixels.read(4), sys.byteorder)
         if listed:  # their pass over as many rows as they fill
@@ -265,6 +282,23 @@ class PassImage:
             rows = -(-listed // self.size[0])
             self._fill(self._programs["outline"], outline.scratch, self.size, 0, rows)
             ctx.memory_barrier()  # the stored colours visible to whatever reads the image
+
+    def _shade_by_depth(self, outline: Outline, y0: int, rows: int, shading: str) -> None:
+        """Rows [y0, y0 + rows) shaded by pass ``shading`` so that groups of pixels with no
+        hit never run its code (llvmpipe runs a shader's every branch for each group it
+        draws): the hits written into the depth buffer (0, the sky 1), then the sky's pixels
+        with the sky's code alone and the hits with the shading's, each pass kept to its own
+        pixels by an early depth test against the full-screen triangle's depth (0.5)."""
+        ctx = self.renderer.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        try:
+            for name, test in SHADE_PASSES:
+                ctx.depth_func = test
+                target = outline.scratch if name == "hits" else outline.shaded
+                prog = self._programs[shading if name == "shade" else name]
+                self._fill(prog, target, self.size, y0, rows)
+        finally:
+            ctx.disable(moderngl.DEPTH_TEST)
 
     def draw_all(
         self, bands: int = 1, progress: Callable[[int, int], None] | None = None

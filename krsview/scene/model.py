@@ -15,14 +15,6 @@ import numpy as np
 from .schema import COLOR, SceneError, Tagged, Vec3, cached, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
-# Defaults of the render knobs (scene/render.py) that the windows and the command line share.
-VIEW_PREPASS = 4  # the viewer's pre-pass tile where the file has none (docs/speed.md)
-# render.lod where the file has none: at most +0.2 % hit-mask error against the ground truth
-# on every preset, no hole (docs/speed.md, docs/accuracy/); 0 draws every level
-DEFAULT_LOD = 0.5
-# render.shadow_block where the file has none: soft shadows within 1/255 of per-pixel ones in
-# mean colour, for 14–26 % of a still frame on tree and grove (docs/speed.md); 1: per pixel
-DEFAULT_SHADOW_BLOCK = 2
 
 
 # ----------------------------------------------------------------------------------- kernels

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .model import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK
 from .schema import COLOR, SceneError, Vec3, param
 
 TRACERS = ("sphere", "binary", "relaxed")
@@ -15,6 +14,14 @@ SWITCH = ("on", "off")
 PATHS = ("fragment", "compute")
 PREPASS_RATIO = 4  # pre-pass: a coarse pass's tiles are this many times as wide as the next's
 TARGET_DISTANCE = 1e-9  # below this the view direction is lost to rounding
+# Defaults of the render knobs that the windows and the command line share.
+VIEW_PREPASS = 4  # the viewer's pre-pass tile where the file has none (docs/speed.md)
+# render.lod where the file has none: at most +0.2 % hit-mask error against the ground truth
+# on every preset, no hole (docs/speed.md, docs/accuracy/); 0 draws every level
+DEFAULT_LOD = 0.5
+# render.shadow_block where the file has none: soft shadows within 1/255 of per-pixel ones in
+# mean colour, for 14–26 % of a still frame on tree and grove (docs/speed.md); 1: per pixel
+DEFAULT_SHADOW_BLOCK = 2
 
 
 @dataclass(frozen=True)

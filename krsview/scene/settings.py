@@ -8,7 +8,7 @@ import typing
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from .model import VIEW_PREPASS
+from .render import VIEW_PREPASS
 from .schema import SceneError, check_value, param
 
 MAX_SIDE = 8192  # pixels, each side of a window

@@ -26,37 +26,55 @@ int g_levels = 0;   // levels walked so far by this invocation (bench paths' mea
 #endif
 
 // Level slot i of Alg. 1 on the point x with the distance d found above it: culling, the level
-// of detail, the fold (its e returned) and the kernel; false where the walk ends here.
-bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e) {
+// of detail, the fold (its e returned) and the kernel; false where the walk ends here. A
+// level-of-detail cut only notes its slot in `cut` and leaves x as it is: krs_lod_cut adds
+// the ball's distance once, after the walk. On llvmpipe each read of the uniform block is a
+// gather per component that costs far more than the arithmetic around it, and a branch's
+// reads run whether any pixel takes it or not; read in the cut's branch, the ball's centre
+// was read at every level, which without culling doubled what the level of detail cost
+// (docs/speed.md).
+bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e, inout int cut) {
 #ifdef KRS_COUNT_LEVELS
     ++g_levels;
 #endif
     e = 0.0;
-#if defined(KRS_CULLING) || defined(KRS_LOD)
-    vec4r b = u_bounds[i];
-#endif
 #ifdef KRS_CULLING
 #ifdef KRS_LOD
     real reach = 2.0 * rho;  // how far a ball drawn below may reach beyond C_i (above)
 #else
     real reach = 0.0;
 #endif
+    vec4r b = u_bounds[i];
     if (b.w >= 0.0 && length(x - b.xyz) - b.w - reach >= d) return false;
 #endif
-#ifdef KRS_LOD  // the ball's distance only where it cuts: culling off pays no more
-    if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); return false; }
+#ifdef KRS_LOD
+    real r = u_bounds[i].w;
+    if (r >= 0.0 && r < rho) { cut = i; return false; }
 #endif
     e = fold(i, x);
     d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
     return true;
 }
 
+// The walk's value: d, with the level-of-detail ball of slot `cut` (−1: none) drawn at the
+// point x where the walk stopped, d = min(d, dist(x, C_cut)).
+real krs_lod_cut(int cut, vec3r x, real d) {
+#ifdef KRS_LOD
+    if (cut >= 0) {
+        vec4r b = u_bounds[cut];
+        d = min(d, length(x - b.xyz) - b.w);
+    }
+#endif
+    return d;
+}
+
 real krs_distance(int first, int n, vec3r xw, real rho) {
     vec3r x = xw;
     real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
     real e;
-    for (int i = first + n - 1; i >= first; --i) if (!krs_level(i, x, d, rho, e)) break;
-    return d;
+    int cut = -1;
+    for (int i = first + n - 1; i >= first; --i) if (!krs_level(i, x, d, rho, e, cut)) break;
+    return krs_lod_cut(cut, x, d);
 }
 
 #ifdef KRS_WALK_RESTART
@@ -83,6 +101,7 @@ real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real ke
     real d = again ? bound : kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
     real m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
     saved = false;
+    int cut = -1;
     for (; i >= first;) {
         if (min(m, d) >= keep) {
             aj = i; ax = x; ad = u; am = m; adist = d; ar = r;
@@ -93,12 +112,13 @@ real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real ke
         r = b >= 0.0 ? min(r, b) : r;
 #endif
         real e;
-        bool on = krs_level(i, x, d, rho, e);
+        bool on = krs_level(i, x, d, rho, e, cut);
         vec3r mu = u_mirrors[i].xyz;
         u -= 2.0 * (e > 0.0 ? dot(u, mu) : 0.0) * mu;
         m = min(m, abs(e));
         i = on ? i - 1 : first - 1;
     }
+    d = krs_lod_cut(cut, x, d);
     bounded = again && d >= bound;
     if (bounded) aj = -1;
     return d;

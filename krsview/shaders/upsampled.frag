@@ -60,9 +60,16 @@ layout(std430, binding = BINDING_OUTLINE) buffer Outline {
 layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
 #endif
 
+#ifndef KRS_HIT_DEPTH  // (which writes the depth the others are tested against)
+layout(early_fragment_tests) in;  // groups of pixels the depth test leaves out never run
+#endif
+
 // Pixel px's colour as write_pixel shades it, from the kernel the trace pass found.
 vec4 traced_color(ivec2 px) {
     vec3r dir = pixel_ray(vec2(px) + 0.5);
+#ifdef KRS_SHADE_SKY  // the depth test passes the pixels without a hit alone
+    return vec4(encode(background(vec3(dir))), 0.0);
+#else
     vec4 xk = texelFetch(u_traced_color, px, 0);
     if (xk.a < 0.5) return vec4(encode(background(vec3(dir))), 0.0);
     vec4 nt = texelFetch(u_traced_depth, px, 0);
@@ -71,10 +78,13 @@ vec4 traced_color(ivec2 px) {
     upsample_visibility(px, nt.w);
 #endif
     return vec4(encode(shade(t * dir, vec3(dir), t, int(xk.a) - 1, nt.xyz, xk.xyz)), 1.0);
+#endif
 }
 
 void main() {
-#ifdef KRS_SHADOW_OUTLINE
+#if defined(KRS_HIT_DEPTH)
+    gl_FragDepth = texelFetch(u_traced_color, ivec2(gl_FragCoord.xy), 0).a < 0.5 ? 1.0 : 0.0;
+#elif defined(KRS_SHADOW_OUTLINE)
     uint width = uint(textureSize(u_traced_color, 0).x);
     uint i = uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x);
     if (i >= outline_count) discard;

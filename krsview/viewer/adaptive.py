@@ -11,6 +11,8 @@ import statistics
 from dataclasses import dataclass, field
 
 SHADOW_RATIO = 2  # moving frames and refinement steps: a shadow ray per 2 × 2 pixels at least
+MOVING_RATIO = 3  # ... and per 3 × 3 in one wide enough to keep MIN_BLOCKS_ACROSS blocks
+MIN_BLOCKS_ACROSS = 80  # (docs/speed.md: 0.83× the frame inside tree's crown, 0.94× outside)
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
@@ -69,6 +71,15 @@ class AdaptiveResolution:
         factor = math.sqrt(self.trace_budget / seconds)
         factor = min(1.25, max(0.7, factor))  # damped: a noisy frame moves scale a little
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
+
+
+def moving_ratio(width: int, still: int) -> int:
+    """The side of the pixel blocks that share a shadow ray in a moving frame ``width`` pixels
+    wide whose still image's is ``still``: MOVING_RATIO where that leaves MIN_BLOCKS_ACROSS
+    blocks across it (the mean colour of its hits within 1/255 of one with a ray per pixel
+    on tree and grove), else SHADOW_RATIO; never below ``still``."""
+    wide = width >= MOVING_RATIO * MIN_BLOCKS_ACROSS
+    return max(still, MOVING_RATIO if wide else SHADOW_RATIO)
 
 
 def refining_budget(budget: float, rest: float) -> float:

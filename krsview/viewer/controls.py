@@ -94,6 +94,13 @@ class Input:
             if moved <= CLICK_PIXELS:
                 self.click = self.cursor
 
+    def let_go(self, name: str) -> None:
+        """The press of button ``name`` was not the view's after all (a frame that saw the
+        pointer there found a gizmo under it): no drag and no click from it."""
+        self.buttons.discard(name)
+        if name == "left":
+            self.press = None
+
     def move_cursor(self, x: float, y: float) -> None:
         if self.buttons:
             self.drag = (self.drag[0] + x - self.cursor[0], self.drag[1] + y - self.cursor[1])

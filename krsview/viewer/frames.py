@@ -2,8 +2,9 @@
 when the view stops, the refinement's images (adaptive.py), each traced in bands within the
 frame budget (up to two while the rest of the turn takes as long: refining_budget) and shown
 when done, so input is never blocked by a slow frame. Moving frames
-light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py), or
-per the scene's larger blocks (``[render] shadow_block``), as the still image is."""
+light like still ones: their shadow rays are traced per 2 × 2 pixels (gpu/passes.py), per
+3 × 3 in frames at least 240 pixels wide (adaptive.moving_ratio), or per the scene's larger
+blocks (``[render] shadow_block``), and blended as the still image's."""
 
 from __future__ import annotations
 
@@ -22,9 +23,9 @@ from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.scene import Geometry
 from .adaptive import (
-    SHADOW_RATIO,
     AdaptiveResolution,
     Refinement,
+    moving_ratio,
     refinement_steps,
     refining_budget,
 )
@@ -122,7 +123,7 @@ class Frames:
         # the still image's passes: 0 one pass, 1 shadow rays per pixel in a pass of their
         # own, ≥ 2 per block; moving frames share a shadow ray per 2 × 2 pixels at least
         still = scene.render.shadow_block if splits_shadows(scene) else 0
-        ratio = max(SHADOW_RATIO, still) if still and not self.full_shadows else still
+        ratio = moving_ratio(size[0], still) if still and not self.full_shadows else still
         image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)
         image.draw_all()
         self.ctx.finish()  # the frame's time is read: the controller needs it

@@ -19,11 +19,11 @@ from ..scene.presets import preset_names, resolve
 from ..scene.scene import Geometry
 from ..scene.settings import settings_meta
 from . import commands as c
+from .files import ViewerFile
 from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .playback import Playback
-from .recording import Recorder
 from .timeline import draw_time
 from .widgets import Interactions, field_widget
 
@@ -59,7 +59,7 @@ class Viewed(Protocol):
 
     doc: Document
     frames: Frames
-    recorder: Recorder
+    file: ViewerFile  # its camera path's recorder
     geometry: Geometry
     view: str
     levels: int
@@ -215,7 +215,7 @@ def _scene(v: Viewed, out: list) -> None:
         imgui.same_line()
         if imgui.button(f"{b.name}##{i}"):
             out.append(c.GoToBookmark(i))
-    recording = v.recorder.recording is not None
+    recording = v.file.recorder.recording is not None
     if imgui.button("stop recording (F5)" if recording else "record path (F5)"):
         out.append(c.ToggleRecording())
     imgui.same_line()

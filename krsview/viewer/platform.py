@@ -1,6 +1,11 @@
 """The platform layer: a GLFW window with an OpenGL 4.3+ core context, Dear ImGui's GLFW and
 OpenGL3 backends, and the routing of GLFW events to ImGui first, then to the window's own
-input (keys, buttons, cursor, wheel) unless ImGui or a gizmo wants them."""
+input (keys, buttons, cursor, wheel) unless ImGui or a gizmo wants them.
+
+A press or a wheel turn is ImGui's when ImGui's windows, as the last frame drew them, lie
+under the pointer where the event happened (``imgui_under``). ImGui's own
+``want_capture_mouse`` answers for the pointer where its last frame saw it, so a pointer
+moved and pressed before the next frame (a touchpad's tap) went to the wrong side."""
 
 from __future__ import annotations
 
@@ -35,6 +40,13 @@ class Platform:
         self.addr = ctypes.cast(self.window, ctypes.c_void_p).value
         imgui.backends.glfw_init_for_opengl(self.addr, False)
         imgui.backends.opengl3_init("#version 430")
+        self.drawn = False  # this turn drew an ImGui frame: its windows are on screen
+
+    def begin_turn(self) -> None:
+        """A turn of the event loop begins: ImGui's windows are on screen for the events
+        after it only if it draws a frame (a hidden HUD draws none; its windows stay in
+        ImGui's context, not on screen)."""
+        self.drawn = False
 
     def close(self) -> None:
         imgui.backends.opengl3_shutdown()
@@ -46,6 +58,10 @@ class Platform:
     def route_events(self, to: Input) -> None:
         """GLFW events go to ImGui first, then to ``to`` unless ImGui or a gizmo takes them."""
         b, a, window = imgui.backends, self.addr, self.window
+        taken: set[int] = set()  # the buttons whose press was not the view's, until released
+
+        def ui() -> bool:
+            return self.drawn and imgui_under(to, taken)
 
         def on_key(_w, key, scancode, action, mods):
             b.glfw_key_callback(a, key, scancode, action, mods)
@@ -61,8 +77,10 @@ class Platform:
 
         def on_button(_w, button, action, mods):
             b.glfw_mouse_button_callback(a, button, action, mods)
-            if action == glfw.PRESS and (imgui.get_io().want_capture_mouse or to.claimed):
+            if action == glfw.PRESS and (ui() or to.claimed):
+                taken.add(button)
                 return  # the HUD's or a gizmo's press, not the camera's
+            taken.discard(button)
             if button in GLFW_BUTTONS:
                 to.button(GLFW_BUTTONS[button], action == glfw.PRESS)
                 look = GLFW_BUTTONS[button] == LOOK_BUTTON
@@ -76,7 +94,7 @@ class Platform:
 
         def on_scroll(_w, dx, dy):
             b.glfw_scroll_callback(a, dx, dy)
-            if not imgui.get_io().want_capture_mouse:
+            if not ui():
                 to.wheel(dy)
 
         def on_char(_w, c):
@@ -95,8 +113,41 @@ class Platform:
         imgui.new_frame()
 
     def render(self) -> None:
+        self.drawn = True
         imgui.render()
         imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+
+def imgui_under(to: Input, taken: set[int]) -> bool:
+    """Whether ImGui takes a press or a wheel turn of the pointer at ``to.cursor``, between
+    two frames: ImGui's rule (``UpdateHoveredWindowAndCaptureFlags``) for the pointer there,
+    not where its last frame saw it. A button the view holds keeps the pointer the view's;
+    else ImGui takes it while it holds a button (``taken``, in the events' order: its own
+    state lags a frame) or a popup is open (a click anywhere closes it), or where a window
+    of its last frame lies."""
+    if to.buttons:
+        return False
+    if taken or imgui.is_popup_open("", imgui.PopupFlags_.any_popup):
+        return True
+    return window_at(*to.cursor)
+
+
+def window_at(x: float, y: float) -> bool:
+    """An ImGui window drawn in the last frame covers window point (x, y), as ImGui's next
+    frame finds it (``FindHoveredWindowEx``: windows taking mouse input, each grown by its
+    hover padding, more where it can be resized by its border)."""
+    style = imgui.get_style()
+    touch = style.touch_extra_padding
+    border = style.window_border_hover_padding
+    fixed = imgui.WindowFlags_.no_resize | imgui.WindowFlags_.always_auto_resize
+    point = imgui.ImVec2(x, y)
+    for w in imgui.get_current_context().windows:
+        if not w.active or w.hidden or w.flags & imgui.WindowFlags_.no_mouse_inputs:
+            continue
+        pad = touch if w.flags & fixed else imgui.ImVec2(max(touch.x, border), max(touch.y, border))
+        if w.outer_rect_clipped.contains_with_pad(point, pad):
+            return True
+    return False
 
 
 def open_window(size: tuple[int, int], title: str, visible: bool):

@@ -1,6 +1,7 @@
-"""Where F12 writes: a folder beside the scene, ``NAME.screenshots/``, where the user finds it
-again; the user's pictures folder when the scene's folder cannot be written (a preset inside
-an installed package)."""
+"""Where F12 writes: a folder beside the user's scene, ``NAME.screenshots/``, where the user
+finds it again; the user's pictures folder for a shipped preset (its folder is the package's,
+read-only when installed, a checkout's source folder otherwise) and when the scene's folder
+cannot be written."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from ..scene.presets import PRESET_DIR
 from ..scene.scene import write_atomic
 
 
@@ -32,8 +34,11 @@ def pictures_folder() -> Path:
     return home / "Pictures" / "krsview"
 
 
-def screenshot_folders(scene: Path) -> tuple[Path, Path]:
-    """The folders tried in turn: beside the scene, then the pictures folder."""
+def screenshot_folders(scene: Path) -> tuple[Path, ...]:
+    """The folders tried in turn: beside the scene (not a shipped preset's), then the
+    pictures folder."""
+    if scene.resolve().parent == PRESET_DIR.resolve():
+        return (pictures_folder(),)
     return scene.parent / f"{scene.stem}.screenshots", pictures_folder()
 
 

@@ -1,6 +1,7 @@
 """`krsview view`: a GLFW window to fly through a scene, with adaptive resolution, an ImGui HUD
-and hot reload of the preset and the shaders. The window owns its state; keys, the HUD and the
-file watcher return commands, which :meth:`Viewer.execute` applies through its HANDLERS."""
+and hot reload of the preset and the shaders (files.py). The window owns its state; keys, the
+HUD and the file watcher return commands, which :meth:`Viewer.execute` applies through its
+HANDLERS."""
 
 from __future__ import annotations
 
@@ -21,12 +22,13 @@ from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
 from ..scene.effects import EXCLUSIVE
-from ..scene.model import VIEW_PREPASS
+from ..scene.render import VIEW_PREPASS
 from ..scene.settings import ViewerSettings, make_settings
 from . import commands as c
 from .adaptive import AdaptiveResolution
 from .camera import FlyCamera
 from .controls import Input
+from .files import ViewerFile
 from .frames import Frames
 from .hud import draw_hud, draw_status
 from .loop import run
@@ -35,9 +37,7 @@ from .navigation import Navigation
 from .picking import pick_center
 from .platform import Platform
 from .playback import Playback, Posing
-from .recording import Recorder, path_file
 from .screenshots import save_screenshot
-from .watch import FileWatcher
 from .widgets import Interactions
 
 STATUS_SECONDS = 6.0  # how long the status line stays
@@ -56,13 +56,12 @@ class Viewer:
         """``options``: fields of ViewerSettings (size, target_fps, prepass, hud,
         moving_effects) replacing those of ``settings``."""
         self.settings = make_settings(settings or ViewerSettings(), **options)
-        self.shader_dir = Path(shader_dir)
         self.doc = Document(path)  # a bad file is a SceneError before any window
         self.moving_effects = self.settings.moving_effects  # True: shadow rays per pixel
         self.platform = Platform(self.settings.size, f"krsview — {self.scene.name}", visible)
         self.window = self.platform.window
         self.ctx = moderngl.create_context(require=GL_VERSION)
-        self.renderer = Renderer(self.ctx, self.shader_dir)
+        self.renderer = Renderer(self.ctx, Path(shader_dir))
         self.input = Input()
         self.interactions = Interactions()
         self.hud = self.settings.hud
@@ -80,7 +79,8 @@ class Viewer:
         )
         self.frames.full_shadows = self.moving_effects
         self._measured_for: str | None = None
-        self._opened()
+        self.opened()
+        self.file = ViewerFile(self, Path(shader_dir))  # the files watched, the camera path
         self.platform.route_events(self.input)
 
     # ------------------------------------------------------------------------- scene state
@@ -102,17 +102,14 @@ class Viewer:
         until then the command line's, else the file's, else VIEW_PREPASS."""
         return self._view_prepass if self._view_prepass is not None else self.scene.render.prepass
 
-    def _opened(self) -> None:
-        """A document was opened: its camera, camera path, watched files and pre-pass."""
+    def opened(self) -> None:
+        """A document was opened: its pre-pass, moment and camera (files.py watches it)."""
         p = self.settings.prepass
         self._view_prepass = (
             p if p is not None else (None if self.scene.render.prepass else VIEW_PREPASS)
         )
         self.playback = Playback(self.scene.time)
         self._set_scene(self.scene, reset_camera=True)
-        self.watcher = FileWatcher(self.path, self.shader_dir)
-        self.recorder = Recorder(self.path)
-        self._report(self.recorder)
 
     def _set_scene(self, scene: Scene, reset_camera: bool = False) -> None:
         """Follow the document: a new scene version redraws (and recompiles only if its
@@ -179,13 +176,6 @@ class Viewer:
             self.levels, self.krs, self.error = 0, self.geometry, f"{e}; drawing every level"
         self.world = self.renderer.world(self.krs, self.scene.material.albedo)  # speed, picking
         self.frames.dirty = True
-
-    def _report(self, part: Any) -> None:
-        """Show what a part (the camera-path recorder) has to say, once."""
-        if part.message:
-            self.message, part.message = part.message, ""
-        if part.error:
-            self.error, part.error = part.error, ""
 
     def view_scene(self) -> Scene:
         """The scene as drawn now: at the moment shown, with the viewer's camera and pre-pass.
@@ -268,16 +258,6 @@ class Viewer:
         if self.doc.redo():
             self.sync()
 
-    def open_preset(self, path: Path) -> None:
-        """Show another scene file from its own camera; it becomes the one watched for edits."""
-        try:
-            self.doc = Document(path)
-        except SceneError as e:
-            self.error = str(e)
-            return
-        self.error = ""
-        self._opened()
-
     def reset_view(self) -> None:
         self.nav.reset(self.scene.camera)
         self.frames.dirty = True
@@ -295,53 +275,6 @@ class Viewer:
         if self.scene.bookmarks:
             self.go_to_bookmark((self.nav.bookmark_index + 1) % len(self.scene.bookmarks))
 
-    def add_bookmark(self) -> None:
-        """Append the current camera to the scene file's bookmarks (Document.add_bookmark: a
-        shipped preset's go to its copy, which the viewer shows and watches from then on)."""
-        try:
-            name, saved = self.doc.add_bookmark(self.camera.to_camera())
-        except SceneError as e:
-            self.error = f"bookmark not saved: {e}"
-            return
-        self.sync()
-        self.follow_file()  # our own save is not an outside edit
-        self.message = f"saved bookmark {name!r} in {saved}"
-
-    def follow_file(self) -> None:
-        """The document was saved, perhaps under a new name: watch that file, and keep the
-        camera path beside it."""
-        self.watcher.watch(self.path)
-        self.recorder.file = path_file(self.path)
-
-    def toggle_recording(self) -> None:
-        self.recorder.toggle()
-        self._report(self.recorder)
-
-    def reload_scene(self) -> None:
-        """The scene file changed on disk: take it. A viewer has no edits of its own to lose
-        (the editor asks first when it has unsaved ones)."""
-        if self.doc.changed_on_disk():
-            self.take_file()
-
-    def take_file(self) -> None:
-        """The file's contents become the scene (an undoable step); a bad file keeps the last
-        good scene and shows why."""
-        try:
-            self.doc.reload()
-            self.error, self.message = "", f"reloaded {self.path.name}"
-        except SceneError as e:
-            self.error = str(e)  # keep the last good scene and image
-        self.sync()
-
-    def reload_shaders(self) -> None:
-        """Compile the current variant from the edited files; on failure keep the old ones."""
-        try:
-            self.frames.reload_programs(self.shader_dir, self.view_scene(), self.krs)
-        except ShaderError as e:
-            self.error = str(e)
-            return
-        self.error, self.message = "", "shaders reloaded"
-
     # --------------------------------------------------------------------------- the loop
     def run(self) -> None:
         run(self)
@@ -354,7 +287,7 @@ class Viewer:
             self.frames.refined
             and not self.input.held
             and not self.input.buttons
-            and self.recorder.replay_start is None
+            and self.file.recorder.replay_start is None
             and not (self.playback.playing and self.scene.animated)
         )
 
@@ -364,7 +297,7 @@ class Viewer:
         self.begin_step(dt)
         self.execute(self.input.commands())
         self.move(dt)
-        self.execute(self.watcher.poll())
+        self.execute(self.file.watcher.poll())
         self.draw_image()
         status = self.status_line()
         if self.hud or status:
@@ -378,6 +311,7 @@ class Viewer:
     def begin_step(self, dt: float) -> None:
         self.clock += dt
         glfw.make_context_current(self.window)
+        self.platform.begin_turn()
 
     def close(self) -> None:
         if self.window is not None:
@@ -391,9 +325,9 @@ class Viewer:
             self._time_moved()
         if self.nav.move(dt, self.nearest_distance):
             self.frames.dirty = True
-        if self.recorder.tick(self.clock, self.camera):
+        if self.file.recorder.tick(self.clock, self.camera):
             self.frames.dirty = True
-        self._report(self.recorder)
+        self.file.report()
 
     def draw_image(self) -> None:
         """Follow the document, trace within the frame budget and show the image."""
@@ -425,9 +359,13 @@ class Viewer:
             self.error = str(e)
             return None
         self.message = f"screenshot: {out}"
-        self.status = (self.message, self.clock + STATUS_SECONDS)
+        self.say(self.message)
         print(self.message, flush=True)
         return out
+
+    def say(self, text: str) -> None:
+        """Show ``text`` in the status line at the window's foot for STATUS_SECONDS."""
+        self.status = (text, self.clock + STATUS_SECONDS)
 
     def status_line(self) -> str:
         """The status line shown at the window's foot (a screenshot's path), while it lasts."""
@@ -453,19 +391,19 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.SetTargetFps: lambda v, e: v.set_target_fps(e.fps),
     c.SetSupersample: lambda v, e: v.set_supersample(e.factor),
     c.SetMovingEffects: lambda v, e: v.set_moving_effects(e.on),
-    c.OpenPreset: lambda v, e: v.open_preset(e.path),
+    c.OpenPreset: lambda v, e: v.file.open(e.path),
     c.ResetView: lambda v, e: v.reset_view(),
     c.ToggleOrbit: lambda v, e: v.toggle_orbit(),
     c.Screenshot: lambda v, e: v.screenshot(),
     c.ToggleHud: lambda v, e: setattr(v, "hud", not v.hud),
     c.Quit: lambda v, e: glfw.set_window_should_close(v.window, True),
-    c.AddBookmark: lambda v, e: v.add_bookmark(),
+    c.AddBookmark: lambda v, e: v.file.add_bookmark(),
     c.GoToBookmark: lambda v, e: v.go_to_bookmark(e.index),
     c.NextBookmark: lambda v, e: v.next_bookmark(),
-    c.ToggleRecording: lambda v, e: v.toggle_recording(),
-    c.Replay: lambda v, e: v.recorder.replay(v.clock),
-    c.ReloadScene: lambda v, e: v.reload_scene(),
-    c.ReloadShaders: lambda v, e: v.reload_shaders(),
+    c.ToggleRecording: lambda v, e: v.file.toggle_recording(),
+    c.Replay: lambda v, e: v.file.recorder.replay(v.clock),
+    c.ReloadScene: lambda v, e: v.file.reload(),
+    c.ReloadShaders: lambda v, e: v.file.reload_shaders(),
     c.TogglePlay: lambda v, e: v.toggle_play(),
     c.SetTime: lambda v, e: v.set_time(e.time),
     c.SetSpeed: lambda v, e: v.playback.set_speed(e.speed),

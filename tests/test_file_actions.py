@@ -1,0 +1,171 @@
+"""The editor's file part alone (editor/file_actions.py), without a window: it is given a
+stand-in for the viewer (a document, a camera, the message lines, and the viewer's real file
+part, viewer/files.py) and the editor's edit as a function. Each answer is checked against
+the file on disk, read back independently; the window tests (test_editor.py) drive the
+same part through the editor."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from dataclasses import replace
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from krsview.document.document import Document
+from krsview.editor import commands as ec
+from krsview.editor.file_actions import FileActions
+from krsview.editor.saving import autosave
+from krsview.editor.window import EDITOR_HANDLERS
+from krsview.gpu.program import SHADER_DIR
+from krsview.scene import SceneError, load_scene, save_scene
+from krsview.scene.presets import resolve
+from krsview.viewer import commands as vc
+from krsview.viewer.camera import FlyCamera
+from krsview.viewer.files import ViewerFile
+
+
+class Window:
+    """What the file part reads and calls of the viewer, with no window behind it."""
+
+    def __init__(self, path: Path):
+        self.doc = Document(path)
+        self.camera = FlyCamera.from_camera(self.doc.scene.camera)
+        self.message = self.error = ""
+        self.hud = False
+        self.said: list[str] = []  # the status line's texts
+        self.opened_count = 0
+        self.file = ViewerFile(self, SHADER_DIR)
+
+    def sync(self) -> None:
+        pass  # nothing drawn
+
+    def say(self, text: str) -> None:
+        self.said.append(text)
+
+    def opened(self) -> None:
+        self.opened_count += 1
+
+
+def part(path: Path) -> tuple[FileActions, Window, list[str]]:
+    """The file part over a stand-in window; the editor's ``opened`` calls are listed."""
+    w, told = Window(path), []
+
+    def edit(at: tuple, value) -> bool:
+        try:
+            w.doc.apply(at, value)
+        except SceneError as e:
+            w.error = str(e)
+            return False
+        return True
+
+    return FileActions(w, edit, lambda: told.append("opened")), w, told
+
+
+@pytest.fixture
+def tree(tmp_path) -> Path:
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    return path
+
+
+def change_on_disk(path: Path, doc: Document, name: str) -> None:
+    save_scene(replace(load_scene(path), name=name), path)
+    os.utime(path, ns=(doc.stamp.mtime_ns + 10**9,) * 2)  # a later stamp, however fast
+
+
+def test_a_disk_change_is_taken_unless_there_are_unsaved_edits(tree):
+    f, w, _ = part(tree)
+    change_on_disk(tree, w.doc, "first")
+    f.reload_scene()  # negative control: no edits, so the file's contents are taken
+    assert not f.conflict and w.doc.scene.name == "first" and "reloaded" in w.message
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    assert w.doc.dirty
+    change_on_disk(tree, w.doc, "second")
+    f.reload_scene()
+    assert f.conflict and w.doc.scene.name == "first", "unsaved edits were overwritten"
+    assert not f.save() and "changed on disk" in w.error
+    assert load_scene(tree).name == "second" and load_scene(tree).render.epsilon_scale == 1.0
+    f.take_file()
+    assert not f.conflict and w.doc.scene.name == "second" and not w.doc.dirty
+
+
+def test_closing_asks_only_with_unsaved_edits_and_discard_writes_nothing(tree):
+    f, w, _ = part(tree)
+    assert f.may_close() and f.asking is None, "a clean scene closes at once"
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    assert not f.may_close() and f.asking == ("close", None) and w.hud
+    f.answer_cancel()
+    assert f.asking is None and not f.quit
+    f.may_close()
+    f.answer_discard()
+    assert f.quit and load_scene(tree).render.epsilon_scale == 1.0
+
+
+def test_opening_another_scene_with_edits_asks_then_tells_the_editor(tree):
+    f, w, told = part(tree)
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    f.open_preset(resolve("sierpinski"))
+    assert f.asking == ("open", resolve("sierpinski")) and w.doc.scene.name == "tree" and not told
+    f.answer_discard()
+    assert w.doc.scene.name == "sierpinski" and told == ["opened"] and w.opened_count == 1
+    assert w.file.watcher.scene_file == resolve("sierpinski"), "the new file is not watched"
+
+
+def test_a_bookmark_is_an_edit_saved_with_the_scene_not_written_at_once(tree):
+    f, w, _ = part(tree)
+    before = len(load_scene(tree).bookmarks)
+    f.add_bookmark()
+    assert w.doc.dirty and len(w.doc.scene.bookmarks) == before + 1 and "added" in w.message
+    assert len(load_scene(tree).bookmarks) == before, "the editor's bookmark skipped the save"
+    # the viewer's own bookmark (negative control) is appended to the file on disk at once
+    w.file.add_bookmark()
+    assert len(load_scene(tree).bookmarks) == before + 1
+
+
+def test_a_shipped_preset_asks_for_its_copy_then_saves_and_follows_it(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    f, w, _ = part(resolve("tree"))
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    assert f.may_close() is False
+    assert f.save() is False and f.asking is None, "the copy dialog takes over the question"
+    assert f.copy_to.text == str(tmp_path / "tree.toml") and f.copy_to.then == ("close", None)
+    assert not (tmp_path / "tree.toml").exists(), "saved before the copy was named"
+    f.copy_to = replace(f.copy_to, text=str(tmp_path / "mine.toml"))
+    f.save_copy()
+    assert f.copy_to is None and f.quit, "the question that asked was not answered"
+    assert load_scene(tmp_path / "mine.toml").render.epsilon_scale == 2.0
+    assert w.file.watcher.scene_file == tmp_path / "mine.toml" and f.save_as_text.endswith(
+        "mine.toml"
+    )
+
+
+def test_the_editors_handlers_reach_the_file_part(tree, tmp_path):
+    """Commands the editor takes go to its ``file``: save as under the typed name, and a
+    bookmark as an edit (the viewer's handler would write the file)."""
+    f, w, _ = part(tree)
+    editor = SimpleNamespace(file=f)
+    target = tmp_path / "other.toml"
+    for command in (ec.SetSaveAsText(str(target)), ec.SaveAs(), vc.AddBookmark()):
+        EDITOR_HANDLERS[type(command)](editor, command)
+    assert load_scene(target) == load_scene(tree) and w.doc.path == target
+    assert w.doc.dirty and len(load_scene(target).bookmarks) == len(w.doc.scene.bookmarks) - 1
+
+
+def test_an_autosave_that_cannot_write_is_said_once_in_the_status_line(tree):
+    from krsview.document.document import AUTOSAVE_SECONDS
+
+    f, w, _ = part(tree)
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    autosave(f, 0.0)  # the interval starts
+    autosave(f, AUTOSAVE_SECONDS + 1)
+    assert w.said == [] and w.doc.recovery_path.exists(), "a working autosave said something"
+    w.doc.recovery_path.unlink()
+    w.doc.recovery_path.mkdir()  # no one may write there, root neither
+    w.doc.apply(("render", "epsilon_scale"), 3.0)
+    for k in (2, 3):
+        autosave(f, k * (AUTOSAVE_SECONDS + 1))
+    assert w.said == [w.error] and "autosave cannot write" in w.error
