@@ -41,8 +41,8 @@ class ViewerSettings:
         False,
         help="trace shadow rays in moving frames and refinement steps as in the still image "
         "(the scene's [render] shadow_block; a lower resolution at the target FPS); off: "
-        "one per 2×2 pixels at least, blended along depth, for the same lighting at a "
-        "higher resolution",
+        "one per 2×2 pixels at least (3×3 from 240 pixels wide), blended along depth, for "
+        "the same lighting at a higher resolution",
     )
 
 

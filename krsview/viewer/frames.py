@@ -121,7 +121,7 @@ class Frames:
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
         # the still image's passes: 0 one pass, 1 shadow rays per pixel in a pass of their
-        # own, ≥ 2 per block; moving frames share a shadow ray per 2 × 2 pixels at least
+        # own, ≥ 2 per block; moving frames share a shadow ray per 2 × 2 or 3 × 3 pixels
         still = scene.render.shadow_block if splits_shadows(scene) else 0
         ratio = moving_ratio(size[0], still) if still and not self.full_shadows else still
         image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)

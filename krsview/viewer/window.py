@@ -180,7 +180,7 @@ class Viewer:
     def view_scene(self) -> Scene:
         """The scene as drawn now: at the moment shown, with the viewer's camera and pre-pass.
         Moving frames have every effect too; unless ``moving_effects``, their shadow rays are
-        shared by 2 × 2 pixels at least (frames.py)."""
+        shared by 2 × 2 pixels at least, 3 × 3 from 240 pixels wide (frames.py)."""
         scene = self.posed(self.scene)
         return replace(
             scene,
