@@ -93,9 +93,9 @@ def test_a_long_session_keeps_gl_objects_and_memory_flat(long_viewer):
     from krsview.gpu.renderer import MAX_TARGETS
 
     assert len(r._targets) <= MAX_TARGETS
-    assert len(r.programs._programs) <= 17  # sphere/binary × fog on/off × moving (no
-    # soft shadows) / still, each with its
-    # pre-pass, + the display program
+    # sphere/binary × fog on/off, each: the trace, its pre-pass, the pre-pass's free tiles,
+    # the hits' depth, the sky's and the hits' shading; + the display program
+    assert len(r.programs._programs) <= 2 * 2 * 6 + 1
     assert grown < 60, f"resident memory grew by {grown:.0f} MB"
     assert not v.error
 
