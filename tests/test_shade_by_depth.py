@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from krsview.gpu import passes
+from krsview.gpu.context import behind_mark
 from krsview.gpu.passes import PassImage
 from krsview.gpu.renderer import read_buffers, read_plane
 
@@ -74,8 +75,10 @@ def test_each_pixel_is_shaded_by_one_pass(renderer, targets, monkeypatch, ratio,
     w, h = SIZE
     for swapped in (False, True):
         if swapped:
-            monkeypatch.setattr(
-                passes, "SHADE_PASSES", (("hits", "1"), ("sky", ">"), ("shade", "<"))
+            monkeypatch.setattr(  # the sky's and the shading's depth tests swapped
+                passes,
+                "behind_mark",
+                lambda ctx, mark, draw, marked: behind_mark(ctx, mark, marked, draw),
             )
         image = drawn(renderer, targets, tree, ratio)
         with renderer.current():

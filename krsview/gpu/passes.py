@@ -37,14 +37,11 @@ import moderngl
 
 from ..compile.constants import BINDING_OUTLINE
 from ..scene import Geometry, Scene
+from .context import behind_mark
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
 MAX_KEPT = 6  # targets kept (least recently used released)
-# the shading after the trace pass, pass and depth test: the hits' depth (0, the sky 1) into
-# every pixel, then the sky's pixels and the hits ("shade": the image's shading pass), each
-# against the triangle's depth 0.5
-SHADE_PASSES = (("hits", "1"), ("sky", "<"), ("shade", ">"))
 SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks'
     *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
     *("u_coarse_visibility", "u_coarse_depth"),
@@ -286,19 +283,18 @@ class PassImage:
     def _shade_by_depth(self, outline: Outline, y0: int, rows: int, shading: str) -> None:
         """Rows [y0, y0 + rows) shaded by pass ``shading`` so that groups of pixels with no
         hit never run its code (llvmpipe runs a shader's every branch for each group it
-        draws): the hits written into the depth buffer (0, the sky 1), then the sky's pixels
-        with the sky's code alone and the hits with the shading's, each pass kept to its own
-        pixels by an early depth test against the full-screen triangle's depth (0.5)."""
-        ctx = self.renderer.ctx
-        ctx.enable(moderngl.DEPTH_TEST)
-        try:
-            for name, test in SHADE_PASSES:
-                ctx.depth_func = test
-                target = outline.scratch if name == "hits" else outline.shaded
-                prog = self._programs[shading if name == "shade" else name]
-                self._fill(prog, target, self.size, y0, rows)
-        finally:
-            ctx.disable(moderngl.DEPTH_TEST)
+        draws): the hits marked in the depth buffer (``hits``), then the sky's pixels with
+        the sky's code alone and the hits with the shading's (context.behind_mark)."""
+
+        def fill(name: str, target: moderngl.Framebuffer) -> Callable[[], None]:
+            return lambda: self._fill(self._programs[name], target, self.size, y0, rows)
+
+        behind_mark(
+            self.renderer.ctx,
+            fill("hits", outline.scratch),
+            fill("sky", outline.shaded),
+            fill(shading, outline.shaded),
+        )
 
     def draw_all(
         self, bands: int = 1, progress: Callable[[int, int], None] | None = None
