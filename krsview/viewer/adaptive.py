@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 SHADOW_RATIO = 2  # moving frames and refinement steps: a shadow ray per 2 × 2 pixels at least
 MOVING_RATIO = 3  # ... and per 3 × 3 in one wide enough to keep MIN_BLOCKS_ACROSS blocks
-MIN_BLOCKS_ACROSS = 80  # (docs/speed.md: 0.83× the frame inside tree's crown, 0.94× outside)
+MIN_BLOCKS_ACROSS = 80  # (docs/speed.md, "Moving frames": the colour and the time measured)
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
