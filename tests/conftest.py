@@ -75,13 +75,43 @@ def save_diff(name: str, gpu: Frame, ref: Frame) -> Path:
     return path
 
 
-def check_against_reference(name: str, gpu: Frame, ref: Frame) -> Agreement:
-    a = agreement(gpu, ref)
+def check_against_reference(
+    name: str, gpu: Frame, ref: Frame, ties: np.ndarray | None = None
+) -> Agreement:
+    a = agreement(gpu, ref, ties)
     problems = failures(a)
     if problems:
         path = save_diff(name, gpu, ref)
         pytest.fail(f"{name}: " + "; ".join(problems) + f" (images: {path})")
     return a
+
+
+def fold_ties(scene, ref: Frame, ulps: float = 4.0) -> np.ndarray:
+    """Hit pixels whose reference hit point lies within ``ulps`` float32 roundings (of its
+    distance from the eye) of a mirror plane that a component's walk meets: which side the
+    GPU's float32 folds it to is chance, and the two sides' normals are each other's mirror
+    images (a crease). Left out of the pixel comparison, as outlines are."""
+    from krsview.compile.camera import primary_rays, view_of
+    from krsview.compile.geometry import compile_geometry
+    from krsview.compile.krs import CompiledKRS
+    from krsview.reference.distortion import Distortion
+    from krsview.reference.krs import fold
+
+    scene = scene.posed()
+    h, w = ref.hit.shape
+    view = view_of(scene.camera, w, h)
+    t = ref.depth.reshape(-1)
+    p = view.origin + t[:, None] * primary_rays(view)
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    dist = Distortion.of(scene)
+    ties = np.zeros(len(p), dtype=bool)
+    for k, part in enumerate(getattr(c, "parts", (c,))):
+        if isinstance(part, CompiledKRS):  # a MöKRS has no mirror planes
+            x = p if dist is None else dist.undistort(p, k)
+            for i in range(part.n - 1, -1, -1):
+                x, e = fold(part.mirrors[i], x)
+                ties |= np.abs(e) < ulps * 2.0**-23 * t
+    return ties.reshape(h, w) & ref.hit
 
 
 @pytest.fixture(scope="session")

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from krsview.compile.krs import compile_krs
 from krsview.reference import distance
 from krsview.reference.kernels import kernel_distance
-from krsview.scene import KRS, Capsule, Empty, Level, Mirror, Plane, Sphere, ToroidalCapsule
+from krsview.scene import KRS, Capsule, Empty, Level, Mirror, Plane, Sphere, ToroidalCapsule, arc_of
 
 ALBEDO = (0.5, 0.5, 0.5)
 seeds = st.integers(0, 2**32 - 1)
@@ -55,9 +55,10 @@ def core_samples(k) -> np.ndarray:
         a = np.array(k.a if isinstance(k, Capsule) else k.start)
         b = np.array(k.b if isinstance(k, Capsule) else k.end)
         return a + s * (b - a)
-    rec = c.records[0]
-    angle = s * (np.arctan2(rec[5, 3], rec[4, 3]) % (2 * np.pi))
-    return rec[3, :3] + rec[3, 3] * (np.cos(angle) * rec[4, :3] + np.sin(angle) * rec[5, :3])
+    arc = arc_of(k)  # the scene's arc through start, control and end, not the record
+    angle = s * arc.phi
+    e1, e2 = np.array(arc.e1), np.array(arc.e2)
+    return np.array(arc.center) + arc.R * (np.cos(angle) * e1 + np.sin(angle) * e2)
 
 
 def extent(k, center: np.ndarray) -> float:
@@ -200,7 +201,7 @@ def test_kernel_distance_matches_dense_core_samples(seed):
     core = core_samples(k)
     if c.types[0] == "toroidal_capsule":  # the arc really passes through all three points
         for pt in (k.start, k.control, k.end):
-            assert np.min(np.linalg.norm(core - np.array(pt), axis=1)) < 1e-3 * c.records[0, 3, 3]
+            assert np.min(np.linalg.norm(core - np.array(pt), axis=1)) < 1e-3 * arc_of(k).R
     x = rng.normal(size=(200, 3)) * 2.0
     brute = np.min(np.linalg.norm(x[:, None] - core[None], axis=2), axis=1) - k.radius
     got = kernel_distance(c.types[0], c.records[0], x)

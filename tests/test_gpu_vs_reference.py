@@ -11,7 +11,7 @@ from krsview.compile.camera import view_of
 from krsview.reference import render_reference
 from krsview.scene import load_scene
 
-from .conftest import assert_finite, check_against_reference, per_pixel, preset_paths
+from .conftest import assert_finite, check_against_reference, fold_ties, per_pixel, preset_paths
 
 W, H = 160, 120
 
@@ -32,7 +32,9 @@ def test_preset_matches_reference(renderer, path):
     assert ref.hit.mean() > 0.02, "the preset's camera sees (almost) nothing"
     gpu = renderer.render(scene, W, H)
     assert_finite(gpu, scene.render.max_iterations)
-    check_against_reference(path.stem, gpu, ref)
+    ties = fold_ties(scene, ref)  # tree at 160×120: one pixel within an ulp of a mirror
+    assert ties.sum() <= 0.002 * ties.size
+    check_against_reference(path.stem, gpu, ref, ties)
     fast = renderer.render(replace(scene, render=replace(scene.render, prepass=8)), W, H)
     assert_finite(fast, scene.render.max_iterations, prepass=True)
     a = gpu_reference_agreement(fast, ref)

@@ -41,26 +41,27 @@ def akernel(kind, rec, p):
     r = arb(float(rec[1, 3]))
     if kind == "sphere":
         return anorm([p[k] - arb(float(rec[1, k])) for k in range(3)]) - r
-    A, B = rec[1, :3], rec[2, :3]
     if kind == "capsule":
+        A, B = rec[1, :3], rec[2, :3]
         ab = [arb(float(B[k])) - arb(float(A[k])) for k in range(3)]
         pa = [p[k] - arb(float(A[k])) for k in range(3)]
         h = sum((pa[k] * ab[k] for k in range(3)), arb(0)) / sum((v * v for v in ab), arb(0))
         h = relu(h) - relu(h - 1)
         return anorm([pa[k] - h * ab[k] for k in range(3)]) - r
-    q = [p[k] - arb(float(rec[3, k])) for k in range(3)]
-    x, y = adot(rec[4, :3], q), adot(rec[5, :3], q)
-    cos_phi, sin_phi = float(rec[4, 3]), float(rec[5, 3])
-    s = x * arb(sin_phi) - y * arb(cos_phi)
-    yy, ss = float(y.mid()), float(s.mid())
-    inside = (yy >= 0 and ss >= 0) if sin_phi >= 0 else (yy >= 0 or ss >= 0)
-    if inside:
-        planar = x * x + y * y
-        z2 = relu(sum((v * v for v in q), arb(0)) - planar)
-        return ((planar.sqrt() - arb(float(rec[3, 3]))) ** 2 + z2).sqrt() - r
-    ca = anorm([p[k] - arb(float(A[k])) for k in range(3)])
-    cb = anorm([p[k] - arb(float(B[k])) for k in range(3)])
-    return (ca + cb - abs(ca - cb)) / 2 - r
+    # toroidal capsule (compile/krs.py): centre O, the frame's quaternion P with |P|² = 1/R
+    # (P̄ q P by Hamilton products), t = tan(phi/4); the ends at angles ±phi/2 from e1
+    P = [arb(float(v)) for v in rec[2]]
+    q = (arb(0), *(p[k] - arb(float(rec[1, k])) for k in range(3)))
+    x, y, z = aqmul(aqmul((P[0], -P[1], -P[2], -P[3]), q), P)[1:]
+    t = arb(float(rec[3, 0]))
+    c, s = (1 - t * t) / (1 + t * t), 2 * t / (1 + t * t)
+    rho = (x * x + y * y).sqrt()
+    if float((x - rho * c).mid()) >= 0:
+        w = (rho - 1) ** 2
+    else:
+        wa, wb = (x - c) ** 2 + (y - s) ** 2, (x - c) ** 2 + (y + s) ** 2
+        w = (wa + wb - abs(wa - wb)) / 2
+    return (w + z * z).sqrt() / sum((v * v for v in P), arb(0)) - r
 
 
 def arb_distance(c, point):

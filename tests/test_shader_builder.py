@@ -27,7 +27,7 @@ def shader_copy(tmp_path):
 def test_compile_error_is_mapped_to_file_and_line(renderer, shader_copy):
     path = shader_copy / "kernels.glsl"
     lines = path.read_text().splitlines()
-    target = "return sqrt(w + z * z) - kernel_rec(i, 1).w;"
+    target = "return sqrt(w + a.z * a.z) / dot(P, P) - o.w;"
     k = next(i for i, line in enumerate(lines) if target in line)
     lines[k] = lines[k].replace(";", " + undefined_thing;")
     path.write_text("\n".join(lines) + "\n")

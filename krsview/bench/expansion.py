@@ -13,6 +13,7 @@ import numpy as np
 from ..compile.balls import kernel_ball
 from ..compile.camera import View
 from ..compile.krs import CompiledKRS, compile_krs
+from ..reference.kernels import arc_world
 from ..scene import KRS, Scene, SceneError
 from ..scene.model import Empty
 
@@ -77,12 +78,13 @@ def kernel_mesh(kind: str, rec: np.ndarray, tol: float) -> tuple[np.ndarray, np.
         core, tangent = np.stack([a, b]), np.stack([axis, axis])
         n1, n2 = np.stack([side, side]), np.stack([np.cross(axis, side)] * 2)
     elif kind == "toroidal_capsule":
-        O, R, e1, e2 = rec[3, :3], rec[3, 3], rec[4, :3], rec[5, :3]
-        phi = math.atan2(rec[5, 3], rec[4, 3]) % (2.0 * math.pi)
-        a = np.linspace(0.0, phi, pieces(phi, R + r, tol / 2, 1) + 1)[:, None]
+        R = 1.0 / float(rec[2] @ rec[2])
+        e1, e2, n = arc_world(rec[2], np.eye(3)) / R  # the arc's frame (compile/krs.py)
+        half = 2.0 * math.atan(rec[3, 0])  # half the arc's angle: t = tan(phi/4)
+        a = np.linspace(-half, half, pieces(2.0 * half, R + r, tol / 2, 1) + 1)[:, None]
         n1 = np.cos(a) * e1 + np.sin(a) * e2
-        core, tangent = O + R * n1, -np.sin(a) * e1 + np.cos(a) * e2
-        n2 = np.broadcast_to(np.cross(e1, e2), n1.shape)
+        core, tangent = rec[1, :3] + R * n1, -np.sin(a) * e1 + np.cos(a) * e2
+        n2 = np.broadcast_to(n, n1.shape)
     else:
         raise ValueError(f"kernel_mesh: a {kind} kernel has no closed surface")
     sides = pieces(2.0 * math.pi, r, tol / 2, 3)

@@ -153,15 +153,21 @@ class Agreement:
 
 
 def agreement(
-    a: Frame, b: Frame, depth_rel: float, normal_deg: float, color_tol: float
+    a: Frame,
+    b: Frame,
+    depth_rel: float,
+    normal_deg: float,
+    color_tol: float,
+    ties: np.ndarray | None = None,
 ) -> Agreement:
+    """How a and b agree; ``ties`` (a pixel mask) are left out with the occlusion edges."""
     both = a.hit & b.hit
     t = b.depth[both]
     dt = np.abs(a.depth[both] - t)
     cos = np.clip((a.normal * b.normal).sum(-1)[both], -1.0, 1.0)
     angle = np.degrees(np.arccos(cos))
     n = max(int(both.sum()), 1)
-    off = ~(edges(a) | edges(b))
+    off = ~(edges(a) | edges(b) | (False if ties is None else ties))
     rel = np.abs(a.depth - b.depth) / np.maximum(b.depth, 1e-300)
     both_off = both & off
     return Agreement(
@@ -194,8 +200,8 @@ OFF_EDGE_DEPTH = 0.02
 OFF_EDGE_COLOR = 5.0 / 255.0
 
 
-def gpu_reference_agreement(gpu: Frame, ref: Frame) -> Agreement:
-    return agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
+def gpu_reference_agreement(gpu: Frame, ref: Frame, ties: np.ndarray | None = None) -> Agreement:
+    return agreement(gpu, ref, DEPTH_REL, NORMAL_DEG, COLOR_TOL, ties)
 
 
 def tolerance_failures(a: Agreement) -> list[str]:

@@ -13,22 +13,27 @@ from functools import cached_property
 
 import numpy as np
 
-from ..scene import KRS, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
+from ..scene import KRS, Arc, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
 from .balls import UNBOUNDED, grown, krs_ball, krs_bounds, union_ball
 
 # Kernel type codes, equal to the KERNEL_* defines in kernels.glsl.
 KERNEL_CODES = {"empty": 0, "sphere": 1, "capsule": 2, "toroidal_capsule": 3, "plane": 4}
-RECORD_VEC4 = 6
+RECORD_VEC4 = 4
 # record[0] = (colour rgb, type code)
-# record[1] = sphere (centre, r) | capsule/arc (start A, r) | plane (normal u, offset w)
-# record[2] = capsule/arc (end B, 0)
-# record[3] = arc (centre O, major radius R)
-# record[4] = arc (e1: unit O→A, cos phi)     phi: arc angle from A to B, in (0, 2π)
-# record[5] = arc (e2: unit, in-plane ⟂ e1, sin phi)
+# record[1] = sphere (centre, r) | capsule (start A, r) | arc (centre O, r) | plane (u, w)
+# record[2] = capsule (end B, 0) | arc (quaternion P = (real, i, j, k) of the arc's frame)
+# record[3] = arc (t = tan(phi/4), 0, 0, 0)   phi: arc angle from start to end, in (0, 2π)
+# The arc's frame [e1 e2 n]: e1 the bisector of the arc, e2 in its plane, n = e1 × e2 its
+# normal; P is that rotation's unit quaternion divided by √R, so P̄ q P is q in the frame in
+# units of R, and R = 1/|P|². The arc is then the unit circle's points at angles within ±phi/2
+# of e1, its ends (cos, ±sin)(phi/2) = ((1 − t²), ±2t)/(1 + t²): 9 numbers where Alg. 1's
+# level reads the arc (kernels.glsl), against 13 for O, R, e1, e2, cos and sin phi; and the
+# rational half angle stays accurate in float32 for the shortest arcs (STRAIGHT_RATIO), where
+# sin(phi/2) = √(1 − cos²) would not.
 
 
 # Record slots holding a position (xyz), per kernel type: what moves when the origin moves.
-POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1, 2, 3)}
+POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1,)}
 
 
 @dataclass(frozen=True)
@@ -92,15 +97,15 @@ def kernel_records(
             r[1] = [*k.a, k.radius]
             r[2, :3] = k.b
         elif isinstance(k, ToroidalCapsule):
-            r[1] = [*k.start, k.radius]
-            r[2, :3] = k.end
             arc = arc_of(k)
             if arc is None:
                 kind = "capsule"
+                r[1] = [*k.start, k.radius]
+                r[2, :3] = k.end
             else:
-                r[3] = [*arc.center, arc.R]
-                r[4] = [*arc.e1, np.cos(arc.phi)]
-                r[5] = [*arc.e2, np.sin(arc.phi)]
+                r[1] = [*arc.center, k.radius]
+                r[2] = arc_quaternion(arc)
+                r[3, 0] = np.tan(arc.phi / 4.0)
         elif isinstance(k, Plane):
             r[1] = [*k.normal, k.offset]
         else:
@@ -108,6 +113,29 @@ def kernel_records(
         r[0] = [*color, KERNEL_CODES[kind]]
         types.append(kind)
     return records, tuple(types)
+
+
+def arc_quaternion(arc: Arc) -> np.ndarray:
+    """P of the arc's record (layout above): the unit quaternion of the rotation whose columns
+    are the bisector e1, e2 and n, divided by √R (Shepperd's choice of the largest term, so
+    no square root of a small difference)."""
+    half = arc.phi / 2.0
+    e1, e2 = np.array(arc.e1), np.array(arc.e2)
+    F = np.stack([np.cos(half) * e1 + np.sin(half) * e2, -np.sin(half) * e1 + np.cos(half) * e2])
+    F = np.stack([F[0], F[1], np.cross(F[0], F[1])], axis=1)  # columns e1, e2, n
+    trace = np.trace(F)
+    k = int(np.argmax([trace, *np.diag(F)]))
+    if k == 0:
+        q = [1.0 + trace, F[2, 1] - F[1, 2], F[0, 2] - F[2, 0], F[1, 0] - F[0, 1]]
+    else:
+        a, b, c = k - 1, k % 3, (k + 1) % 3
+        q = np.zeros(4)
+        q[0] = F[c, b] - F[b, c]
+        q[1 + a] = 1.0 + 2.0 * F[a, a] - trace
+        q[1 + b] = F[b, a] + F[a, b]
+        q[1 + c] = F[c, a] + F[a, c]
+    q = np.asarray(q, dtype=np.float64)
+    return q / (np.linalg.norm(q) * np.sqrt(arc.R))
 
 
 @dataclass(frozen=True)

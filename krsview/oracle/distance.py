@@ -3,7 +3,8 @@
 they share). A fold is x − 2·max(0, u·x − w)·u, its conditional turned into a max as RAA09
 writes them; the toroidal capsule's wedge test takes the hull of both branches where the
 range cannot decide it. The result encloses the real-number value of the distance the tracer
-approximates, on the compiled scene's exact float64 constants. A :class:`Moved` geometry
+approximates, on the compiled scene's exact float64 constants (an arc's frame taken as the
+float64 matrix of its record's quaternion). A :class:`Moved` geometry
 looks each component up through a map from the world into its rest space (the wind's bend,
 ``oracle/wind.py``): the walk and its balls then run on the map's enclosure, unchanged."""
 
@@ -16,6 +17,7 @@ import numpy as np
 
 from ..compile.krs import CompiledCompound, CompiledKRS
 from ..compile.mokrs import CompiledMoKRS
+from ..reference.kernels import arc_half_angle, arc_local
 from .numbers import Affine, Interval, Number
 
 Vec = tuple  # three Numbers
@@ -70,28 +72,25 @@ def kernel(kind: str, rec, p: Vec) -> Number | None:
     r = float(rec[1, 3])
     if kind == "sphere":
         return norm(minus(p, rec[1, :3])) - r
-    A, B = rec[1, :3], rec[2, :3]
     if kind == "capsule":
+        A, B = rec[1, :3], rec[2, :3]
         ab = B - A
         h = dot(ab, minus(p, A)) * (1.0 / max(float(ab @ ab), 1e-300))
         h = h.relu() - (h - 1.0).relu()  # clamp to [0, 1]
         return norm(tuple(p[k] - float(A[k]) - h * float(ab[k]) for k in range(3))) - r
-    # toroidal capsule: torus formula inside the wedge, else the nearer cap
-    q = minus(p, rec[3, :3])
-    x, y = dot(rec[4, :3], q), dot(rec[5, :3], q)
-    cos_phi, sin_phi = float(rec[4, 3]), float(rec[5, 3])
-    s = x * sin_phi - y * cos_phi
-    planar = x.sqr() + y.sqr()
-    z2 = (dot_self(q) - planar).relu()
-    ring = ((planar.sqrt() - float(rec[3, 3])).sqr() + z2).sqrt()
-    cap = norm(minus(p, A)).minimum(norm(minus(p, B)))
-    ylo, yhi = y.range()
-    slo, shi = s.range()
-    if sin_phi >= 0.0:
-        yes, no = (ylo >= 0) & (slo >= 0), (yhi < 0) | (shi < 0)
-    else:
-        yes, no = (ylo >= 0) | (slo >= 0), (yhi < 0) & (shi < 0)
-    return ring.select(yes, no, cap) - r
+    # toroidal capsule, in the arc's frame in units of R (reference/kernels.py): the circle
+    # inside the wedge x ≥ ρ·cos(phi/2), else the nearer end
+    L = arc_local(rec[2], np.eye(3))  # rows: the frame's coordinates of the world's axes
+    q = minus(p, rec[1, :3])
+    x, y, z = (dot(L[:, k], q) for k in range(3))
+    c, s = arc_half_angle(rec)
+    rho = (x.sqr() + y.sqr()).sqrt()
+    z2 = z.sqr()
+    ring = ((rho - 1.0).sqr() + z2).sqrt()
+    dx2 = (x - c).sqr() + z2
+    cap = (dx2 + (y - s).sqr()).sqrt().minimum((dx2 + (y + s).sqr()).sqrt())
+    lo, hi = (x - rho * c).range()
+    return ring.select(lo >= 0, hi < 0, cap) * (1.0 / float(rec[2] @ rec[2])) - r
 
 
 def least(values) -> Number:

@@ -14,41 +14,51 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
 
 
-def in_wedge(rec: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Whether the angle a of (x, y) from e1 towards e2 lies in [0, phi], without trigonometry:
-    y = ρ sin a and s = x sin phi − y cos phi = ρ sin(phi − a) are both ≥ 0 inside an arc of at
-    most π; a longer arc excludes only the points where both are negative."""
-    cos_phi, sin_phi = rec[4, 3], rec[5, 3]
-    s = x * sin_phi - y * cos_phi
-    if sin_phi >= 0.0:
-        return (y >= 0.0) & (s >= 0.0)
-    return (y >= 0.0) | (s >= 0.0)
+def arc_local(P: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """P̄ q P for offsets q (N, 3) from the arc's centre: q in the arc's frame (x along the
+    bisector e1, y along e2, z along n), in units of R = 1/|P|² (compile/krs.py's layout)."""
+    w, u = P[0], P[1:]
+    return (w * w - u @ u) * q + 2.0 * (q @ u)[:, None] * u + 2.0 * w * np.cross(q, u)
 
 
-def _arc_frame(rec: np.ndarray, p: np.ndarray):
-    O, e1, e2 = rec[3, :3], rec[4, :3], rec[5, :3]
-    q = p - O
-    return q, _dot(q, e1), _dot(q, e2)
+def arc_world(P: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The inverse of arc_local: frame coordinates v (N, 3), in units of R, as a world offset
+    R·F v from the arc's centre (P v P̄ = F v / R, divided by |P|⁴)."""
+    w, u = P[0], P[1:]
+    out = (w * w - u @ u) * v + 2.0 * (v @ u)[:, None] * u + 2.0 * w * np.cross(u, v)
+    return out / float(P @ P) ** 2
+
+
+def arc_half_angle(rec: np.ndarray) -> tuple[float, float]:
+    """cos and sin of half the arc's angle, from t = tan(phi/4): exact rational functions, so
+    accurate in float32 for every arc (kernels.glsl)."""
+    t = rec[3, 0]
+    return (1.0 - t * t) / (1.0 + t * t), 2.0 * t / (1.0 + t * t)
+
+
+def in_wedge(x: np.ndarray, rho: np.ndarray, c: float) -> np.ndarray:
+    """Whether the point (x, y) at ρ = |(x, y)| of the arc's frame lies within half the arc's
+    angle of its bisector e1: cos a = x/ρ ≥ c = cos(phi/2), one test for every arc angle."""
+    return x >= rho * c
 
 
 def core_point(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Nearest point of the kernel's core (point, segment or arc) to each p."""
     if kind == "sphere":
         return np.broadcast_to(rec[1, :3], p.shape)
-    A, B = rec[1, :3], rec[2, :3]
     if kind == "capsule":
+        A, B = rec[1, :3], rec[2, :3]
         ab = B - A
         h = np.clip(_dot(p - A, ab) / max(float(ab @ ab), 1e-300), 0.0, 1.0)
         return A + h[:, None] * ab
-    # toroidal capsule: inside the wedge the arc point at p's angle, else the nearer end
-    q, x, y = _arc_frame(rec, p)
-    rho = np.hypot(x, y)
-    radial = (x[:, None] * rec[4, :3] + y[:, None] * rec[5, :3]) / np.where(rho > 0, rho, 1)[
-        :, None
-    ]
-    on_arc = rec[3, :3] + rec[3, 3] * np.where((rho > 0)[:, None], radial, rec[4, :3])
-    end = np.where((_dot(p - A, p - A) <= _dot(p - B, p - B))[:, None], A, B)
-    return np.where(in_wedge(rec, x, y)[:, None], on_arc, end)
+    # toroidal capsule: inside the wedge the arc point at p's angle, else the end on p's side
+    a = arc_local(rec[2], p - rec[1, :3])
+    rho = np.hypot(a[:, 0], a[:, 1])
+    c, s = arc_half_angle(rec)
+    radial = np.where((rho > 0)[:, None], a[:, :2] / np.where(rho > 0, rho, 1)[:, None], [1, 0])
+    end = np.stack([np.full(len(a), c), np.where(a[:, 1] >= 0.0, s, -s)], axis=1)
+    on = np.where(in_wedge(a[:, 0], rho, c)[:, None], radial, end)
+    return rec[1, :3] + arc_world(rec[2], np.concatenate([on, np.zeros((len(a), 1))], axis=1))
 
 
 def kernel_distance(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -58,12 +68,13 @@ def kernel_distance(kind: str, rec: np.ndarray, p: np.ndarray) -> np.ndarray:
     if kind == "plane":
         return p @ rec[1, :3] - rec[1, 3]
     if kind == "toroidal_capsule":  # see kernels.glsl: |p − core(p)|² = z² + w, in the arc's frame
-        q, x, y = _arc_frame(rec, p)
-        z = _dot(q, np.cross(rec[4, :3], rec[5, :3]))
-        R, cos_phi, sin_phi = rec[3, 3], rec[4, 3], rec[5, 3]
-        ring = (np.hypot(x, y) - R) ** 2
-        cap = np.minimum((x - R) ** 2 + y**2, (x - R * cos_phi) ** 2 + (y - R * sin_phi) ** 2)
-        return np.sqrt(np.where(in_wedge(rec, x, y), ring, cap) + z * z) - rec[1, 3]
+        P = rec[2]
+        a = arc_local(P, p - rec[1, :3])
+        x, y, z = a[:, 0], a[:, 1], a[:, 2]
+        c, s = arc_half_angle(rec)
+        rho = np.hypot(x, y)
+        w = np.where(in_wedge(x, rho, c), (rho - 1.0) ** 2, (x - c) ** 2 + (np.abs(y) - s) ** 2)
+        return np.sqrt(w + z * z) / float(P @ P) - rec[1, 3]
     return np.linalg.norm(p - core_point(kind, rec, p), axis=1) - rec[1, 3]
 
 

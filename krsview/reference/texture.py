@@ -10,6 +10,7 @@ import numpy as np
 
 from ..compile.constants import BARK_STRETCH, TEXTURE_OCTAVE_SHIFT, TEXTURE_OCTAVES
 from ..scene.tree import perpendicular
+from .kernels import arc_local
 
 
 def lattice(cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
@@ -81,15 +82,10 @@ def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
         e2 = np.cross(d, e1)
         q = xk - a
         return np.stack([q @ d, r * np.arctan2(q @ e2, q @ e1)], axis=1)
-    if kind == "toroidal_capsule":
-        O, R, e1, e2 = rec[3, :3], rec[3, 3], rec[4, :3], rec[5, :3]
-        q = xk - O
-        x, y = q @ e1, q @ e2
-        rho = np.maximum(np.hypot(x, y), 1e-30)
-        radial = (x[:, None] * e1 + y[:, None] * e2) / rho[:, None]
-        tube = q - R * radial
-        around = np.arctan2(tube @ np.cross(e1, e2), np.sum(tube * radial, axis=1))
-        return np.stack([R * np.arctan2(y, x), r * around], axis=1)
+    if kind == "toroidal_capsule":  # the arc's frame in units of R: angles from its bisector
+        a = arc_local(rec[2], xk - rec[1, :3])  # along, from its plane around the tube
+        along = np.arctan2(a[:, 1], a[:, 0]) / float(rec[2] @ rec[2])
+        return np.stack([along, r * np.arctan2(a[:, 2], np.hypot(a[:, 0], a[:, 1]) - 1.0)], axis=1)
     u = rec[1, :3]  # plane
     e1 = perpendicular(u)
     return np.stack([xk @ e1, xk @ np.cross(u, e1)], axis=1)

@@ -13,41 +13,59 @@ vec3r capsule_core(int i, vec3r p) {
 #endif
 
 #ifdef KRS_KERNEL_TOROIDAL_CAPSULE
-// Is the angle of (x, y) from e1 towards e2 within [0, phi]? y = ρ sin a and
-// s = x sin phi − y cos phi = ρ sin(phi − a); no trigonometry (twin of in_wedge).
-bool in_wedge(int i, real x, real y) {
-    real cos_phi = kernel_rec(i, 4).w, sin_phi = kernel_rec(i, 5).w;
-    real s = x * sin_phi - y * cos_phi;
-    return sin_phi >= 0.0 ? (y >= 0.0 && s >= 0.0) : (y >= 0.0 || s >= 0.0);
+// The arc's record (compile/krs.py): O and r, the quaternion P of its frame [e1 e2 n] (e1 the
+// arc's bisector) scaled to |P|² = 1/R, and t = tan(phi/4). Alg. 1's level reads these 9
+// numbers: on llvmpipe each is a gather that costs more than all the arithmetic here.
+
+// P̄ q P: the offset q from O in the arc's frame, in units of R (twin of arc_local).
+vec3r arc_local(vec4r P, vec3r q) {
+    return (P.x * P.x - dot(P.yzw, P.yzw)) * q + 2.0 * dot(P.yzw, q) * P.yzw
+           + 2.0 * P.x * cross(q, P.yzw);
 }
 
-// In the arc's frame (x, y along e1, e2, z along their normal n), |p − core(p)|² = z² + w,
-// where w is the squared distance in the arc's plane: to the circle inside the wedge (the arc
-// is nearer than its ends there), else to the nearer end A = (R, 0), B = R (cos phi, sin phi).
-// Two square roots in all; z comes from n, not from |q|² − x² − y², so no cancellation.
+// Its inverse: frame coordinates v in units of R as a world offset R·F v from O.
+vec3r arc_world(vec4r P, vec3r v) {
+    vec3r f = (P.x * P.x - dot(P.yzw, P.yzw)) * v + 2.0 * dot(P.yzw, v) * P.yzw
+              + 2.0 * P.x * cross(P.yzw, v);
+    real k = dot(P, P);
+    return f / (k * k);
+}
+
+// cos and sin of phi/2 from t = tan(phi/4), rational and so accurate for every arc.
+vec2r arc_half_angle(int i) {
+    real t = kernel_rec(i, 3).x;
+    return vec2r(1.0 - t * t, 2.0 * t) / (1.0 + t * t);
+}
+
+// Within phi/2 of the bisector: cos a = x/ρ ≥ cos(phi/2), one test for every arc angle.
+bool in_wedge(real x, real rho, real c) { return x >= rho * c; }
+
+// In the arc's frame (units of R) |p − core(p)|² = z² + w, w the squared distance in the
+// arc's plane: to the unit circle inside the wedge (the arc is nearer than its ends there),
+// else to the end on p's side, (c, ±s). Two square roots; z comes from the frame, not from
+// |q|² − x² − y², so no cancellation.
 real toroidal_capsule_distance(int i, vec3r p) {
-    vec4r c = kernel_rec(i, 3), f1 = kernel_rec(i, 4), f2 = kernel_rec(i, 5);
-    vec3r q = p - c.xyz;
-    real x = dot(q, f1.xyz), y = dot(q, f2.xyz), z = dot(q, cross(f1.xyz, f2.xyz));
-    real w;
-    if (in_wedge(i, x, y)) {
-        real ring = length(vec2r(x, y)) - c.w;
-        w = ring * ring;
+    vec4r o = kernel_rec(i, 1), P = kernel_rec(i, 2);
+    vec3r a = arc_local(P, p - o.xyz);
+    vec2r cs = arc_half_angle(i);
+    real rho = length(a.xy), w;
+    if (in_wedge(a.x, rho, cs.x)) {
+        w = (rho - 1.0) * (rho - 1.0);
     } else {
-        vec2r a = vec2r(x - c.w, y), b = vec2r(x, y) - c.w * vec2r(f1.w, f2.w);
-        w = min(dot(a, a), dot(b, b));
+        vec2r e = vec2r(a.x, abs(a.y)) - cs;
+        w = dot(e, e);
     }
-    return sqrt(w + z * z) - kernel_rec(i, 1).w;
+    return sqrt(w + a.z * a.z) / dot(P, P) - o.w;
 }
 
 vec3r toroidal_capsule_core(int i, vec3r p) {
-    vec4r c = kernel_rec(i, 3);
-    vec3r e1 = kernel_rec(i, 4).xyz, e2 = kernel_rec(i, 5).xyz, q = p - c.xyz;
-    real x = dot(q, e1), y = dot(q, e2), rho = length(vec2r(x, y));
-    if (in_wedge(i, x, y))
-        return c.xyz + c.w * (rho > 0.0 ? (x * e1 + y * e2) / rho : e1);
-    vec3r A = kernel_rec(i, 1).xyz, B = kernel_rec(i, 2).xyz;
-    return dot(p - A, p - A) <= dot(p - B, p - B) ? A : B;
+    vec4r o = kernel_rec(i, 1), P = kernel_rec(i, 2);
+    vec3r a = arc_local(P, p - o.xyz);
+    vec2r cs = arc_half_angle(i);
+    real rho = length(a.xy);
+    vec2r on = in_wedge(a.x, rho, cs.x) ? (rho > 0.0 ? a.xy / rho : vec2r(1.0, 0.0))
+                                        : vec2r(cs.x, a.y >= 0.0 ? cs.y : -cs.y);
+    return o.xyz + arc_world(P, vec3r(on, 0.0));
 }
 #endif
 

@@ -69,13 +69,13 @@ vec2 kernel_uv(int level, vec3 xk, vec3 eye) {
         vec3 e1 = perpendicular(d), e2 = cross(d, e1), q = xk - a;
         return vec2(dot(q, d), r * atan(dot(q, e2), dot(q, e1)));
     }
-    if (type == KERNEL_TOROIDAL_CAPSULE) {
-        vec4 c = kernel_rec_float(level, 3);
-        vec3 e1 = kernel_rec_float(level, 4).xyz, e2 = kernel_rec_float(level, 5).xyz, q = xk - c.xyz;
-        float x = dot(q, e1), y = dot(q, e2), rho = max(length(vec2(x, y)), 1e-30);
-        vec3 radial = (x * e1 + y * e2) / rho, tube = q - c.w * radial;
-        return vec2(c.w * atan(y, x), r * atan(dot(tube, cross(e1, e2)), dot(tube, radial)));
+#ifdef KRS_KERNEL_TOROIDAL_CAPSULE
+    if (type == KERNEL_TOROIDAL_CAPSULE) {  // the arc's frame in units of R: angles from the
+        vec4 P = kernel_rec_float(level, 2);  // bisector along, from the arc's plane around
+        vec3 a = vec3(arc_local(vec4r(P), vec3r(xk - kernel_rec_float(level, 1).xyz)));
+        return vec2(atan(a.y, a.x) / dot(P, P), r * atan(a.z, length(a.xy) - 1.0));
     }
+#endif
     vec3 u = kernel_rec_float(level, 1).xyz, e1 = perpendicular(u), q = xk + eye;  // plane
     return vec2(dot(q, e1), dot(q, cross(u, e1)));
 }
