@@ -82,7 +82,7 @@ def test_a_quick_click_in_the_view_from_the_panel_still_picks(baked):
     """From the panel straight onto the trunk: the trunk's level is picked, and the panel's
     fields take nothing."""
     e = baked
-    depth = e.viewer.geometry.depth
+    depth = e.viewer.drawn.geometry.depth
     rest(e, window_xy(e, *middle(e.viewer.interactions.rects[RADIUS])))
     count = e.viewer.interactions.count
     quick_click(e, screen_of(e, (0.0, 0.4, -0.2)))

@@ -123,8 +123,8 @@ class Editor:
         return self.shown_now.clipped
 
     def _follow(self) -> None:
-        now = self.shown_now
-        if now.follow(self.scene, self.viewer.playback.time, self.viewer.posed) and self.selected:
+        now, drawn = self.shown_now, self.viewer.drawn
+        if now.follow(self.scene, drawn.playback.time, drawn.posed) and self.selected:
             # keep the selection across edits, undo, reload
             self.selected = next((h for h in now.handles if h.same(self.selected)), None)
 
@@ -140,7 +140,7 @@ class Editor:
         field (viewer/widgets.py), any other in the panel's error line. A value a track
         moves is keyed at the moment shown instead (keys.py), as a drag or a typed value."""
         v = self.viewer
-        path, value = keyed_edit(self.scene, path, value, v.playback.time)
+        path, value = keyed_edit(self.scene, path, value, v.drawn.playback.time)
         try:
             scene = apply_edit(self.scene, path, value)
             if scene.mokrs is not None:
@@ -246,7 +246,7 @@ class Editor:
         if self.selected is None:
             self.viewer.message = "select a handle to key its value (K)"
             return
-        t = self.viewer.playback.time
+        t = self.viewer.drawn.playback.time
         if self.edit(("animation",), key_now(self.scene, self.selected.path, t)):
             self.viewer.message = f"key at {t:.2f} s for {self.selected.label}"
 
@@ -288,12 +288,10 @@ class Editor:
     def frame(self) -> None:
         """Turn the camera so the scene camera's target sits in the middle of the part of the
         window the panel leaves."""
-        size = glfw.get_window_size(self.viewer.window)
+        v, size = self.viewer, glfw.get_window_size(self.viewer.window)
         target = np.array(self.scene.camera.target)
-        frame(
-            self.viewer.camera, target, size, self.layout.free(size), scene_ball(self.viewer.world)
-        )
-        self.viewer.frames.dirty = True
+        frame(v.camera, target, size, self.layout.free(size), scene_ball(v.drawn.world))
+        v.frames.dirty = True
 
     # ------------------------------------------------------------------- mouse and picking
     def window_view(self) -> View:
@@ -336,9 +334,9 @@ class Editor:
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))
         if self.scene.animated:  # a still scene keeps the whole view (K starts a track)
-            size = glfw.get_window_size(v.window)
+            free = self.layout.free(glfw.get_window_size(v.window))
             path = self.selected.path if self.selected is not None else None
-            self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
+            self.execute(self.timeline.draw(self.scene, v.drawn.playback, path, free))
         hover_label(shown, view)
 
 
