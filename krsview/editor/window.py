@@ -72,6 +72,7 @@ class Editor:
         settings = make_settings(settings or EDITOR_SETTINGS, **options)
         self.viewer = Viewer(path, settings, **window)
         self.viewer.input.keymap = dict(EDITOR_KEYS)
+        self.viewer.input.judged_by_frame = True  # a press on the gizmo shows in the frame
         self.overlay = Overlay(self.viewer.ctx, self.viewer.renderer.programs)
         self.gizmo = Gizmo()
         self.snap = self.gizmo.snap
@@ -177,8 +178,9 @@ class Editor:
         """The viewer's turn with the editor's parts: the gizmo, picking by a click, the
         overlay and the panels; then the autosave. A click picks after the gizmo has seen the
         pointer where it clicked, still before the overlay is drawn (the gizmo of what it
-        picked comes the turn after, at once); a press straight onto the gizmo (a tap, no
-        frame saw the pointer there) is the gizmo's, and the view lets go of it."""
+        picked comes the turn after, at once); a press onto the gizmo, as this frame finds
+        it, is the gizmo's, and the view lets go of it; the motion since the press waits for
+        that finding (Input.judged), so neither orbits the camera by a poll's motion first."""
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
@@ -199,6 +201,7 @@ class Editor:
                     self._again = True
             elif "left" in v.input.buttons - self._held:  # pressed onto the gizmo
                 v.input.let_go("left")
+        v.input.judged()  # else the press is the view's, and so is its motion
         v.draw_image()
         self._follow()
         if ui:
@@ -206,7 +209,7 @@ class Editor:
                 self._draw_ui()
             draw_status(status)
             v.platform.render()
-        v.input.claimed = v.hud and self._claimed()
+        v.input.claimed = v.hud and self._dragging()
         self._held = set(v.input.buttons)
         glfw.swap_buffers(v.window)
         autosave(self.file, time.monotonic())
@@ -314,6 +317,12 @@ class Editor:
         a press there is neither the camera's nor a pick."""
         turning = self.selected is not None and self.selected.kind == "normal"
         return self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
+
+    def _dragging(self) -> bool:
+        """The gizmo, the dial or the trackball is dragged: a press of another button is not
+        the camera's. (Whether a press lands on one, only the frame after it can tell: the
+        pointer may have moved since this frame.)"""
+        return self.gizmo.dragging() or self.trackball.active
 
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:
