@@ -265,7 +265,10 @@ def test_the_motion_of_a_press_a_frame_judges_waits_for_the_frame():
         i.button("left", True)
         i.move_cursor(13.0, 14.0)
         assert i.take_drag() == (0.0, 0.0)
-        i.judged() if judged else i.let_go("left")
+        if judged:
+            i.judged()
+        else:
+            i.let_go("left")
         i.move_cursor(15.0, 14.0)
         assert i.take_drag() == ((5.0, 4.0) if judged else (0.0, 0.0))
     i = Input()  # the control: no frame judges
