@@ -394,10 +394,10 @@ def test_picking_the_geometry_with_fewer_levels_drawn_selects_the_right_level(ed
     e = editor
     e.execute([Bake()])
     settle(e)
-    depth = e.viewer.geometry.depth
+    depth = e.viewer.drawn.geometry.depth
     click(e, screen_of(e, (0.0, 0.4, -0.2)))
     assert e.selected.level == depth - 1
-    e.viewer.set_levels(6)
+    e.viewer.drawn.set_levels(6)
     settle(e)
     e.select(None)
     click(e, screen_of(e, (0.0, 0.4, -0.2)))

@@ -330,13 +330,13 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
         assert refusal_place(refused.message, 58, 3) == "step 0", refused.message
         # the outermost level without a kernel: one level cannot be drawn, two can
         e.execute([Edit((*LEVELS, 59, "kernel"), Empty())])
-        e.viewer.set_levels(1)
+        e.viewer.drawn.set_levels(1)
         pump(e)
-        assert e.viewer.levels == 0 and "cannot be carried" in e.viewer.error
+        assert e.viewer.drawn.levels == 0 and "cannot be carried" in e.viewer.error
         assert refusal_place(e.viewer.error, 59, 0) == "selection"  # shown in the panel
-        e.viewer.set_levels(2)
+        e.viewer.drawn.set_levels(2)
         pump(e)
-        assert e.viewer.levels == 2 and e.viewer.krs.n == 2
+        assert e.viewer.drawn.levels == 2 and e.viewer.drawn.krs.n == 2
     finally:
         e.close()
 

@@ -62,10 +62,10 @@ def test_space_plays_the_sway_in_a_window_and_the_paused_frame_is_render_at_that
             v.step(0.02)
             if v.frames.refined:
                 break
-        assert v.is_idle() and v.playback.time == 0.0
+        assert v.is_idle() and v.drawn.playback.time == 0.0
         rest = v.read_window()
         press(v, "Space")
-        assert v.playback.playing
+        assert v.drawn.playback.playing
         changed, last = 0, rest
         for _ in range(6):
             v.step(0.25)
@@ -73,15 +73,15 @@ def test_space_plays_the_sway_in_a_window_and_the_paused_frame_is_render_at_that
             changed += int(np.abs(now.astype(int) - last).max() > 40)
             last = now
             assert not v.is_idle(), "a playing scene let the loop wait for events"
-        assert v.playback.time == pytest.approx(1.5)
+        assert v.drawn.playback.time == pytest.approx(1.5)
         assert changed >= 5, f"the tree moved in {changed} of 6 turns"
         press(v, "Space")
-        assert not v.playback.playing
+        assert not v.drawn.playback.playing
         for _ in range(400):
             v.step(0.02)
             if v.frames.refined:
                 break
-        t = v.playback.time
+        t = v.drawn.playback.time
         shot = v.read_window().astype(int)
         scene = replace(load_scene(path), camera=v.camera.to_camera())
         ref = headless_render(scene, tmp_path / "at", (160, 120), "--time", str(t)).astype(int)
@@ -104,7 +104,7 @@ def test_space_on_a_scene_that_does_not_move_says_so(display, tmp_path):
     v = Viewer(path, size=(64, 48), hud=False)
     try:
         press(v, "Space")
-        assert not v.playback.playing and "nothing in this scene moves" in v.message
+        assert not v.drawn.playback.playing and "nothing in this scene moves" in v.message
     finally:
         v.close()
 
@@ -163,7 +163,7 @@ def test_a_keyed_camera_is_followed_while_playing_and_flown_when_paused(display,
         press(v, "Space")
         for _ in range(8):
             v.step(0.5)
-        t = v.playback.time
+        t = v.drawn.playback.time
         keyed = load_scene(path).at(t).posed().camera.position
         assert np.allclose(v.camera.position, keyed, atol=1e-9)
         assert not np.allclose(keyed, load_scene(path).camera.position, atol=0.1)  # it moved
@@ -196,9 +196,9 @@ def test_playing_past_the_last_key_redraws_nothing_and_the_image_refines(display
             v.move(0.05)  # the clock advances here; a new image is asked for by `dirty`
             asked += v.frames.dirty
             v.step(0.0)
-        assert v.playback.playing and asked == 0, f"{asked} new images past the last key"
+        assert v.drawn.playback.playing and asked == 0, f"{asked} new images past the last key"
         assert v.frames.refined
-        v.set_time(3.0)  # the control: between keys each turn asks
+        v.drawn.set_time(3.0)  # the control: between keys each turn asks
         v.step(0.0)
         asked = 0
         for _ in range(5):

@@ -2,8 +2,10 @@
 a touchpad's tap) in the editor's real window under Xvfb: on the panel it is the panel's
 alone, in the view it picks, on the gizmo it is the gizmo's (no pick, no orbit), and a wheel
 notch scrolls the side under the pointer; a hidden panel takes nothing, and a field held
-takes the other buttons too. ImGui's own ``want_capture_mouse`` and the gizmo's
-hover answer for where the pointer was at the last frame, so each went to the wrong side."""
+takes the other buttons too; a tap-drag whose first motion comes with its press (one
+poll) moves either the gizmo or, orbiting, the camera, never both. ImGui's own
+``want_capture_mouse`` and the gizmo's hover answer for where the pointer was at the last
+frame, so each went to the wrong side."""
 
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ import numpy as np
 import pytest
 
 from krsview.editor.commands import Bake
-from krsview.viewer.commands import ToggleHud, ToggleOrbit
+from krsview.viewer.commands import ToggleHud, ToggleOrbit, Undo
 
 from .test_editor import (
     LEVEL,
@@ -82,7 +84,7 @@ def test_a_quick_click_in_the_view_from_the_panel_still_picks(baked):
     """From the panel straight onto the trunk: the trunk's level is picked, and the panel's
     fields take nothing."""
     e = baked
-    depth = e.viewer.geometry.depth
+    depth = e.viewer.drawn.geometry.depth
     rest(e, window_xy(e, *middle(e.viewer.interactions.rects[RADIUS])))
     count = e.viewer.interactions.count
     quick_click(e, screen_of(e, (0.0, 0.4, -0.2)))
@@ -195,3 +197,81 @@ def test_while_a_panel_field_is_dragged_a_right_press_in_the_view_does_not_look(
     assert "right" in e.viewer.input.buttons
     xdo("mouseup", 3)
     pump(e, 2)
+
+
+def in_one_poll(e, rest_at, *events) -> tuple[float, float]:
+    """The pointer resting at ``rest_at`` (frames see it there), then ``events`` (a move,
+    a press and a move) delivered together, before any frame; how far the camera and the
+    fork moved once the button is up."""
+    rest(e, rest_at)
+    eye, fork = e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
+    xdo(*events)
+    pump(e, 2)
+    xdo("mouseup", 1)
+    pump(e, 2)
+    return (
+        float(np.linalg.norm(e.viewer.camera.position - eye)),
+        float(np.linalg.norm(np.array(e.scene.route.levels[LEVEL].fork) - fork)),
+    )
+
+
+def xy(p) -> tuple[int, int]:
+    return round(p[0]), round(p[1])
+
+
+def test_a_tap_drag_in_one_poll_onto_the_gizmo_never_orbits_by_its_motion(baked):
+    """Orbiting: a press onto the gizmo's X arrow with the drag's first motion in the same
+    poll is the gizmo's alone (the view used to orbit by that motion before the frame found
+    the gizmo). A press in the view whose motion reaches the gizmo in that poll orbits, and
+    the gizmo, moved under the pointer by that orbit, used to take the press too."""
+    e = baked
+    e.execute([ToggleOrbit()])
+    arrow, off, along = x_arrow(e)
+    view = window_xy(e, 30, 480)
+    press = ("mousemove", *xy(arrow), "mousedown", 1, "mousemove", *xy(arrow + 30 * along))
+    eye_moved, fork_moved = in_one_poll(e, view, *press)
+    assert eye_moved == 0.0 and fork_moved > 0.0, (eye_moved, fork_moved)
+    e.execute([Undo()])
+    eye_moved, fork_moved = in_one_poll(e, off, "mousedown", 1, "mousemove", *xy(arrow))
+    assert eye_moved > 0.0 and fork_moved == 0.0, (eye_moved, fork_moved)
+
+
+def test_a_tap_drag_in_one_poll_off_the_gizmo_orbits(baked):
+    """Orbiting, the pointer resting on the gizmo: moved off it, pressed and dragged in one
+    poll, the press is the view's and orbits (it used to be nobody's: the gizmo had been
+    under the pointer at the last frame); pressed and dragged where it rests, it is the
+    gizmo's (the control)."""
+    e = baked
+    e.execute([ToggleOrbit()])
+    arrow, off, along = x_arrow(e)
+    away = ("mousemove", *xy(off), "mousedown", 1, "mousemove", *xy(off - 30 * along))
+    eye_moved, fork_moved = in_one_poll(e, arrow, *away)
+    assert eye_moved > 0.0 and fork_moved == 0.0, (eye_moved, fork_moved)
+    arrow, off, along = x_arrow(e)  # where the orbit put them
+    on = ("mousedown", 1, "mousemove", *xy(arrow + 30 * along))
+    eye_moved, fork_moved = in_one_poll(e, arrow, *on)
+    assert eye_moved == 0.0 and fork_moved > 0.0, (eye_moved, fork_moved)
+
+
+def test_the_motion_of_a_press_a_frame_judges_waits_for_the_frame():
+    """Input alone: with ``judged_by_frame`` a left press's motion reaches the drag only once
+    judged, and none of it once let go (a gizmo's press); without it (the viewer, whose
+    presses are judged as they come) the motion is the drag at once."""
+    from krsview.viewer.controls import Input
+
+    for judged in (True, False):
+        i = Input(judged_by_frame=True)
+        i.move_cursor(10.0, 10.0)
+        i.button("left", True)
+        i.move_cursor(13.0, 14.0)
+        assert i.take_drag() == (0.0, 0.0)
+        if judged:
+            i.judged()
+        else:
+            i.let_go("left")
+        i.move_cursor(15.0, 14.0)
+        assert i.take_drag() == ((5.0, 4.0) if judged else (0.0, 0.0))
+    i = Input()  # the control: no frame judges
+    i.button("left", True)
+    i.move_cursor(3.0, 4.0)
+    assert i.take_drag() == (3.0, 4.0)

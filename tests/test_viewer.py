@@ -69,7 +69,7 @@ def test_flying_and_looking_then_screenshot_matches_headless_render(viewer, tmp_
     assert np.linalg.norm(v.camera.position - p0) > 0.1, "W did not move the camera"
     shot = v.read_window()
     assert np.abs(shot.astype(int) - start).max() > 50, "the view did not change"
-    ref = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "headless", SIZE)
+    ref = headless_render(v.view_scene().with_geometry(v.drawn.krs), tmp_path / "headless", SIZE)
     close = np.abs(shot.astype(int) - ref.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99, f"window and headless render agree on {close.mean():.2%}"
 
@@ -266,12 +266,12 @@ def test_preset_picker_and_levels_slider(viewer):
     v = viewer
     settle(v)
     full = v.read_window()
-    v.set_levels(6)
-    assert len(v.krs.levels) == 6 and v.krs.kernels[-1] == v.geometry.kernels[-1]
+    v.drawn.set_levels(6)
+    assert len(v.drawn.krs.levels) == 6 and v.drawn.krs.kernels[-1] == v.drawn.geometry.kernels[-1]
     settle(v)
     assert (np.abs(v.read_window().astype(int) - full).max(-1) > 30).mean() > 0.01  # fewer twigs
-    v.set_levels(len(v.geometry.levels))
-    assert v.krs is v.geometry
+    v.drawn.set_levels(len(v.drawn.geometry.levels))
+    assert v.drawn.krs is v.drawn.geometry
     v.file.open(resolve("sierpinski"))
     assert v.scene.name == "sierpinski" and v.path == resolve("sierpinski") and not v.error
     assert v.camera.to_camera().position == v.scene.camera.position
@@ -313,13 +313,13 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
 def test_compound_preset_flies_and_the_levels_slider_cuts_every_component(viewer):
     v = viewer
     v.file.open(resolve("grove"))
-    assert v.error == "" and len(v.geometry.parts) == 8
+    assert v.error == "" and len(v.drawn.geometry.parts) == 8
     settle(v)
     full = v.read_window()
     background = np.round(np.array(v.scene.material.background) ** (1 / 2.2) * 255)
     assert (np.abs(full - background).max(-1) > 8).mean() > 0.02, "nothing drawn"
-    v.set_levels(4)
-    assert [p.depth for p in v.krs.parts] == [4] * 7 + [1]
+    v.drawn.set_levels(4)
+    assert [p.depth for p in v.drawn.krs.parts] == [4] * 7 + [1]
     settle(v)
     assert (np.abs(v.read_window().astype(int) - full).max(-1) > 30).mean() > 0.01
     assert 0 < v.nearest_distance() < 1e3
@@ -348,7 +348,9 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     rows = load_measured("tree")
     v = viewer
     assert [
-        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+        r["value"]
+        for r in rows
+        if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth)
     ] == ["as saved"]
     assert best_within(rows, 60.0, 100 * 100)["value"] == "as saved"
     assert best_within(rows, 100.0, 100 * 100)["value"] == "0.5"
@@ -357,26 +359,32 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     v.execute(apply_row(rows[1], v.doc.saved))
     assert v.scene.render.epsilon_scale == 0.5
     assert [
-        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+        r["value"]
+        for r in rows
+        if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth)
     ] == ["0.5"]
     v.execute(apply_row(rows[4], v.doc.saved))
     assert v.scene.render.tracer == "binary" and matches(
-        rows[4], v.scene, v.doc.saved, v.levels, v.geometry.depth
+        rows[4], v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth
     )
     v.execute(apply_row(rows[5], v.doc.saved))
     assert v.scene.render.precision == "double" and v.scene.render.tracer == "sphere"
     assert [
-        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+        r["value"]
+        for r in rows
+        if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth)
     ] == ["double"]
     v.execute(apply_row(rows[6], v.doc.saved))
     assert v.scene.render.walk_restart == "on" and v.scene.render.precision == "float"
     assert [
-        r["value"] for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth)
+        r["value"]
+        for r in rows
+        if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth)
     ] == ["on"]
     v.execute(apply_row(rows[3], v.doc.saved))
-    assert v.levels == 12 and v.scene.render == v.doc.saved.render
+    assert v.drawn.levels == 12 and v.scene.render == v.doc.saved.render
     # the panel itself draws inside an ImGui frame and returns commands, not changes
-    v.measured = rows
+    v._measured = (v.path.stem, rows)  # as read for this file name
     v.platform.new_frame()
     from imgui_bundle import imgui
 
@@ -385,7 +393,7 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     hud._measured(v, commands)
     imgui.end()
     v.platform.render()
-    assert commands == [] and v.levels == 12
+    assert commands == [] and v.drawn.levels == 12
     (tmp_path / "tree" / "accuracy.csv").write_text("knob,value,ms\nscene,x,notanumber\n")
     assert load_measured("tree") is None
 
@@ -465,12 +473,14 @@ def test_moving_frames_light_like_the_still_image(viewer, tmp_path):
     still = buffers()
     assert still.color.shape[:2] == (SIZE[1], SIZE[0]) and v.frames.frame_state().shadows == 1
     plain = replace(v.view_scene(), effects=[e for e in v.scene.effects if e != "soft_shadows"])
-    unshadowed = headless_render(plain.with_geometry(v.krs), tmp_path / "plain", (80, 60)) / 255
+    unshadowed = (
+        headless_render(plain.with_geometry(v.drawn.krs), tmp_path / "plain", (80, 60)) / 255
+    )
 
     def lit(color, hit):
         return color[hit].mean(0)
 
-    exact = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "exact", (80, 60))
+    exact = headless_render(v.view_scene().with_geometry(v.drawn.krs), tmp_path / "exact", (80, 60))
     target = lit(exact / 255, moving.hit)
     assert np.abs(lit(moving.color, moving.hit) - target).max() < 2 / 255
     assert np.abs(lit(unshadowed, moving.hit) - target).max() > 8 / 255
@@ -478,6 +488,6 @@ def test_moving_frames_light_like_the_still_image(viewer, tmp_path):
     a.scale = 1.0
     hold(v, "S", 1)
     assert v.frames.frame_state().state == "still" and v.frames.refined  # no step to follow
-    full = headless_render(v.view_scene().with_geometry(v.krs), tmp_path / "full", SIZE)
+    full = headless_render(v.view_scene().with_geometry(v.drawn.krs), tmp_path / "full", SIZE)
     close = np.abs(v.read_window().astype(int) - full.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99

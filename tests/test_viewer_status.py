@@ -22,7 +22,7 @@ RGB = np.arange(4 * 6 * 3, dtype=np.uint8).reshape(4, 6, 3)
 
 @pytest.fixture
 def hud_viewer(display, tmp_path, monkeypatch):
-    """A viewer with its HUD on; every line the HUD writes is kept in ``v.drawn``."""
+    """A viewer with its HUD on; every line the HUD writes is kept in ``v.written``."""
     from krsview.viewer.window import Viewer
 
     path = tmp_path / "tree.toml"
@@ -31,16 +31,16 @@ def hud_viewer(display, tmp_path, monkeypatch):
     text = imgui.text
     monkeypatch.setattr(imgui, "text", lambda s: (drawn.append(s), text(s))[1])
     v = Viewer(path, size=SIZE, hud=True)
-    v.drawn = drawn
+    v.written = drawn
     yield v
     v.close()
 
 
 def turn(v) -> tuple:
     """One event-loop turn: the state the HUD drew from, the lines it drew, the window."""
-    v.drawn.clear()
+    v.written.clear()
     v.step(0.05)
-    return v.frames.frame_state(), list(v.drawn), v.read_window()
+    return v.frames.frame_state(), list(v.written), v.read_window()
 
 
 def groups(seen: list[tuple]) -> list[list[tuple]]:

@@ -69,5 +69,5 @@ def manipulate(e: Dragged) -> None:
     moved = tool(sel, e.window_view())
     if moved is not None:
         p, drag = moved
-        for path, value in drag_edits(e.scene, sel, p, e.carry, e.viewer.playback.time):
+        for path, value in drag_edits(e.scene, sel, p, e.carry, e.viewer.drawn.playback.time):
             e.edit(path, value, drag)

@@ -45,7 +45,11 @@ class Gizmo:
         """The pointer is on the gizmo drawn this frame, or drags it: a press there is not
         the camera's. (ImGuizmo's own ``is_over`` answers for the frame before, so a pointer
         just moved onto or off a ring was claimed wrongly for one frame.)"""
-        return self._over or self.dial.active or bool(gizmo.is_using())
+        return self._over or self.dragging()
+
+    def dragging(self) -> bool:
+        """The gizmo or the dial is being dragged (wherever the pointer is now)."""
+        return self.dial.active or bool(gizmo.is_using())
 
     def manipulate(self, h: Handle, v: View) -> tuple[np.ndarray, tuple] | None:
         """Draw the gizmo on ``h``; while it is dragged, where ``h`` goes (world) and the

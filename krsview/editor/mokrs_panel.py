@@ -125,7 +125,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
             imgui.set_tooltip(tip)
         imgui.same_line()
     imgui.new_line()
-    with marked(key_marks(e.scene, e.viewer.playback.time).get((*lev, "reflect"))):
+    with marked(key_marks(e.scene, e.viewer.drawn.playback.time).get((*lev, "reflect"))):
         changed, on = imgui.checkbox("reflect (x = 0 of this level)", shown.reflect)
     if changed:
         out.append(Edit((*lev, "reflect"), on))
@@ -174,7 +174,7 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
     first = len(out)
     fields(s, sp, out, interactions)
     if e.carry:  # linked: the same change in the finer levels with the same steps (keyed
-        t = e.viewer.playback.time  # where a track moves it)
+        t = e.viewer.drawn.playback.time  # where a track moves it)
         out[first:] = [
             Edit(path, value, c.interaction)
             for c in out[first:]

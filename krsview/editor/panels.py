@@ -77,7 +77,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         imgui.pop_style_color()
     scene = e.scene
     shown = e.handled_scene()  # as drawn at the moment shown (tracks), its tracked fields marked
-    fields_of = partial(_fields, marks=key_marks(scene, e.viewer.playback.time))
+    fields_of = partial(_fields, marks=key_marks(scene, e.viewer.drawn.playback.time))
     if scene.tree is not None:
         imgui.text_wrapped(
             "This tree is grown from ratios. Bake it into a route to drag its "

@@ -82,7 +82,7 @@ def _surface(e: Picked, v: View, x: float, y: float) -> Handle | None:
     if not t > 0:
         return None
     point = v.origin + t * pixel_ray(v, x, y)
-    slot = int(nearest(e.viewer.world, point[None])[0][0])
+    slot = int(nearest(e.viewer.drawn.world, point[None])[0][0])
     level = _entry_of_slot(e, slot)
     return next((h for h in e.handles if h.level == level), None)
 
@@ -92,8 +92,8 @@ def _entry_of_slot(e: Picked, slot: int) -> int:
     levels the levels slider cut away), or a compound's component (slots are numbered
     component after component)."""
     if not e.scene.compound:
-        return slot + e.viewer.geometry.depth - e.viewer.krs.depth
-    bases = list(getattr(e.viewer.world, "bases", (0,)))
+        return slot + e.viewer.drawn.geometry.depth - e.viewer.drawn.krs.depth
+    bases = list(getattr(e.viewer.drawn.world, "bases", (0,)))
     return max(k for k, b in enumerate(bases) if b <= slot)
 
 

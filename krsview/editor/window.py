@@ -72,6 +72,7 @@ class Editor:
         settings = make_settings(settings or EDITOR_SETTINGS, **options)
         self.viewer = Viewer(path, settings, **window)
         self.viewer.input.keymap = dict(EDITOR_KEYS)
+        self.viewer.input.judged_by_frame = True  # a press on the gizmo shows in the frame
         self.overlay = Overlay(self.viewer.ctx, self.viewer.renderer.programs)
         self.gizmo = Gizmo()
         self.snap = self.gizmo.snap
@@ -123,8 +124,8 @@ class Editor:
         return self.shown_now.clipped
 
     def _follow(self) -> None:
-        now = self.shown_now
-        if now.follow(self.scene, self.viewer.playback.time, self.viewer.posed) and self.selected:
+        now, drawn = self.shown_now, self.viewer.drawn
+        if now.follow(self.scene, drawn.playback.time, drawn.posed) and self.selected:
             # keep the selection across edits, undo, reload
             self.selected = next((h for h in now.handles if h.same(self.selected)), None)
 
@@ -140,7 +141,7 @@ class Editor:
         field (viewer/widgets.py), any other in the panel's error line. A value a track
         moves is keyed at the moment shown instead (keys.py), as a drag or a typed value."""
         v = self.viewer
-        path, value = keyed_edit(self.scene, path, value, v.playback.time)
+        path, value = keyed_edit(self.scene, path, value, v.drawn.playback.time)
         try:
             scene = apply_edit(self.scene, path, value)
             if scene.mokrs is not None:
@@ -177,8 +178,9 @@ class Editor:
         """The viewer's turn with the editor's parts: the gizmo, picking by a click, the
         overlay and the panels; then the autosave. A click picks after the gizmo has seen the
         pointer where it clicked, still before the overlay is drawn (the gizmo of what it
-        picked comes the turn after, at once); a press straight onto the gizmo (a tap, no
-        frame saw the pointer there) is the gizmo's, and the view lets go of it."""
+        picked comes the turn after, at once); a press onto the gizmo, as this frame finds
+        it, is the gizmo's, and the view lets go of it; the motion since the press waits for
+        that finding (Input.judged), so neither orbits the camera by a poll's motion first."""
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
@@ -199,6 +201,7 @@ class Editor:
                     self._again = True
             elif "left" in v.input.buttons - self._held:  # pressed onto the gizmo
                 v.input.let_go("left")
+        v.input.judged()  # else the press is the view's, and so is its motion
         v.draw_image()
         self._follow()
         if ui:
@@ -206,7 +209,7 @@ class Editor:
                 self._draw_ui()
             draw_status(status)
             v.platform.render()
-        v.input.claimed = v.hud and self._claimed()
+        v.input.claimed = v.hud and self._dragging()
         self._held = set(v.input.buttons)
         glfw.swap_buffers(v.window)
         autosave(self.file, time.monotonic())
@@ -246,7 +249,7 @@ class Editor:
         if self.selected is None:
             self.viewer.message = "select a handle to key its value (K)"
             return
-        t = self.viewer.playback.time
+        t = self.viewer.drawn.playback.time
         if self.edit(("animation",), key_now(self.scene, self.selected.path, t)):
             self.viewer.message = f"key at {t:.2f} s for {self.selected.label}"
 
@@ -288,12 +291,10 @@ class Editor:
     def frame(self) -> None:
         """Turn the camera so the scene camera's target sits in the middle of the part of the
         window the panel leaves."""
-        size = glfw.get_window_size(self.viewer.window)
+        v, size = self.viewer, glfw.get_window_size(self.viewer.window)
         target = np.array(self.scene.camera.target)
-        frame(
-            self.viewer.camera, target, size, self.layout.free(size), scene_ball(self.viewer.world)
-        )
-        self.viewer.frames.dirty = True
+        frame(v.camera, target, size, self.layout.free(size), scene_ball(v.drawn.world))
+        v.frames.dirty = True
 
     # ------------------------------------------------------------------- mouse and picking
     def window_view(self) -> View:
@@ -317,6 +318,12 @@ class Editor:
         turning = self.selected is not None and self.selected.kind == "normal"
         return self.gizmo.claims_mouse() or (turning and self.trackball.claims_mouse())
 
+    def _dragging(self) -> bool:
+        """The gizmo, the dial or the trackball is dragged: a press of another button is not
+        the camera's. (Whether a press lands on one, only the frame after it can tell: the
+        pointer may have moved since this frame.)"""
+        return self.gizmo.dragging() or self.trackball.active
+
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:
         """Inside the ImGui frame, after the trace: the overlay over the image, the viewer's
@@ -336,9 +343,9 @@ class Editor:
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))
         if self.scene.animated:  # a still scene keeps the whole view (K starts a track)
-            size = glfw.get_window_size(v.window)
+            free = self.layout.free(glfw.get_window_size(v.window))
             path = self.selected.path if self.selected is not None else None
-            self.execute(self.timeline.draw(self.scene, v.playback, path, self.layout.free(size)))
+            self.execute(self.timeline.draw(self.scene, v.drawn.playback, path, free))
         hover_label(shown, view)
 
 

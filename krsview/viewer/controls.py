@@ -63,8 +63,12 @@ class Input:
     scroll: float = 0.0
     press: tuple[float, float] | None = None  # where the left button went down
     click: tuple[float, float] | None = None  # the last left click not yet taken
-    claimed: bool = False  # a press now is not the camera's (a gizmo is under the cursor)
+    claimed: bool = False  # a press now is not the camera's (a gizmo is being dragged)
     look_hides_cursor: bool = True  # flying: the look button captures the cursor
+    # The editor: a left press may be a gizmo's, which only the next frame tells (judged);
+    # the motion since such a press waits for it, so the camera never moves by a gizmo's.
+    judged_by_frame: bool = False
+    unjudged: tuple[float, float] | None = None  # that motion, until the frame
 
     def key(self, name: str, down: bool) -> None:
         """A key named as in MOVES and the keymap went down or up (others are ignored)."""
@@ -88,6 +92,8 @@ class Input:
             return
         if down:
             self.press = self.cursor
+            if self.judged_by_frame:
+                self.unjudged = (0.0, 0.0)
         elif self.press is not None:
             moved = math.dist(self.cursor, self.press)
             self.press = None
@@ -99,11 +105,22 @@ class Input:
         pointer there found a gizmo under it): no drag and no click from it."""
         self.buttons.discard(name)
         if name == "left":
-            self.press = None
+            self.press, self.unjudged = None, None
+
+    def judged(self) -> None:
+        """A frame has seen the last left press (``judged_by_frame``): what the view still
+        holds of it is the view's, with the motion held since."""
+        if self.unjudged is not None:
+            self.drag = (self.drag[0] + self.unjudged[0], self.drag[1] + self.unjudged[1])
+            self.unjudged = None
 
     def move_cursor(self, x: float, y: float) -> None:
         if self.buttons:
-            self.drag = (self.drag[0] + x - self.cursor[0], self.drag[1] + y - self.cursor[1])
+            d = (x - self.cursor[0], y - self.cursor[1])
+            if self.unjudged is not None:
+                self.unjudged = (self.unjudged[0] + d[0], self.unjudged[1] + d[1])
+            else:
+                self.drag = (self.drag[0] + d[0], self.drag[1] + d[1])
         self.cursor = (x, y)
 
     def wheel(self, dy: float) -> None:

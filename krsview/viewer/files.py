@@ -10,8 +10,8 @@ from typing import Protocol
 from ..document.document import Document
 from ..gpu.program import ShaderError
 from ..scene import Scene, SceneError
-from ..scene.scene import Geometry
 from .camera import FlyCamera
+from .drawn import Drawn
 from .frames import Frames
 from .recording import Recorder, path_file
 from .watch import FileWatcher
@@ -25,7 +25,7 @@ class Shows(Protocol):
     message: str
     error: str
     frames: Frames  # the programs it draws with
-    krs: Geometry  # the geometry drawn
+    drawn: Drawn  # the geometry drawn
 
     def sync(self) -> None: ...  # redraw when the document changed
     def opened(self) -> None: ...  # a new document: its camera, pre-pass and moment
@@ -111,7 +111,7 @@ class ViewerFile:
         """Compile the current variant from the edited files; on failure keep the old ones."""
         v = self.viewer
         try:
-            v.frames.reload_programs(self.shader_dir, v.view_scene(), v.krs)
+            v.frames.reload_programs(self.shader_dir, v.view_scene(), v.drawn.krs)
         except ShaderError as e:
             v.error = str(e)
             return

@@ -16,14 +16,13 @@ from ..document.document import Document
 from ..scene import EFFECTS, Render, Scene
 from ..scene.effects import allowed_effects
 from ..scene.presets import preset_names, resolve
-from ..scene.scene import Geometry
 from ..scene.settings import settings_meta
 from . import commands as c
+from .drawn import Drawn
 from .files import ViewerFile
 from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
-from .playback import Playback
 from .timeline import draw_time
 from .widgets import Interactions, field_widget
 
@@ -60,13 +59,10 @@ class Viewed(Protocol):
     doc: Document
     frames: Frames
     file: ViewerFile  # its camera path's recorder
-    geometry: Geometry
+    drawn: Drawn  # the moment shown, the levels kept
     view: str
-    levels: int
     nav: Navigation
     moving_effects: bool
-    playback: Playback
-    measured: list[dict] | None
     message: str
     error: str
 
@@ -76,6 +72,8 @@ class Viewed(Protocol):
     def path(self) -> Path: ...
     @property
     def prepass(self) -> int: ...
+    @property
+    def measured(self) -> list[dict] | None: ...
     def nearest_distance(self) -> float: ...
 
 
@@ -91,7 +89,7 @@ def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
     imgui.begin("krsview (F1 hides)", None, imgui.WindowFlags_.always_auto_resize)
     _performance(v, out)
     if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
-        draw_time(v.playback, out)
+        draw_time(v.drawn.playback, out)
     if imgui.collapsing_header("accuracy and view"):
         _accuracy(v, out, interactions)
     if imgui.collapsing_header("measured accuracy"):
@@ -175,8 +173,8 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
     key = interactions.key(("render", "prepass"))
     if changed:
         out.append(c.SetPrepass(tile, key))
-    total = v.geometry.depth
-    changed, levels = imgui.slider_int("levels", v.levels or total, 1, total)
+    total = v.drawn.geometry.depth
+    changed, levels = imgui.slider_int("levels", v.drawn.levels or total, 1, total)
     if changed:
         out.append(c.SetLevels(levels))
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))
@@ -233,7 +231,9 @@ def _measured(v: Viewed, out: list) -> None:
         )
         return
     now = [
-        r for r in rows if matches(r, v.scene, v.doc.saved, v.levels, v.geometry.depth, v.prepass)
+        r
+        for r in rows
+        if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth, v.prepass)
     ]
     w, h = v.frames.adaptive.moving_size()
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):

@@ -1,6 +1,7 @@
 """`krsview view`: a GLFW window to fly through a scene, with adaptive resolution, an ImGui HUD
-and hot reload of the preset and the shaders (files.py). The window owns its state; keys, the
-HUD and the file watcher return commands, which :meth:`Viewer.execute` applies through its
+and hot reload of the preset and the shaders (files.py). The window owns its state, and holds
+what it draws (the moment shown, the pose there, the levels kept: drawn.py) as a part; keys,
+the HUD and the file watcher return commands, which :meth:`Viewer.execute` applies through its
 HANDLERS."""
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from . import commands as c
 from .adaptive import AdaptiveResolution
 from .camera import FlyCamera
 from .controls import Input
+from .drawn import Drawn
 from .files import ViewerFile
 from .frames import Frames
 from .hud import draw_hud, draw_status
@@ -36,7 +38,6 @@ from .measured import load_measured
 from .navigation import Navigation
 from .picking import pick_center
 from .platform import Platform
-from .playback import Playback, Posing
 from .screenshots import save_screenshot
 from .widgets import Interactions
 
@@ -66,19 +67,17 @@ class Viewer:
         self.interactions = Interactions()
         self.hud = self.settings.hud
         self.view = "shaded"
-        self.levels = 0  # 0: all of the scene's levels
         self.nav = Navigation(self.input, self.scene.camera)
         self.message, self.error = "", ""
         self.clock = 0.0
         self.status = ("", 0.0)  # text, and the clock it goes at
-        self.playback = Playback()
-        self.posing = Posing()
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
         )
         self.frames.full_shadows = self.moving_effects
-        self._measured_for: str | None = None
+        self._measured: tuple[str | None, list[dict] | None] = (None, None)  # file name, rows
+        self.drawn = Drawn(self)  # the moment shown, its pose, the levels kept
         self.opened()
         self.file = ViewerFile(self, Path(shader_dir))  # the files watched, the camera path
         self.platform.route_events(self.input)
@@ -108,80 +107,26 @@ class Viewer:
         self._view_prepass = (
             p if p is not None else (None if self.scene.render.prepass else VIEW_PREPASS)
         )
-        self.playback = Playback(self.scene.time)
-        self._set_scene(self.scene, reset_camera=True)
+        self.drawn.open()
+        self.nav.reset(self.scene.camera)
 
-    def _set_scene(self, scene: Scene, reset_camera: bool = False) -> None:
-        """Follow the document: a new scene version redraws (and recompiles only if its
-        variant changed: effects, tracer, geometry family)."""
-        self._seen_version = self.doc.version
-        self.playback.duration = scene.duration  # new keys move its end
-        self.playback.seek(self.playback.time)
-        if self._measured_for != self.path.stem:  # per preset, not per edit
-            self.measured, self._measured_for = load_measured(self.path.stem), self.path.stem
-        pose = self.posed(scene)
-        self.posing.changed(pose)
-        self.geometry = pose.geometry()
-        self.levels = min(self.levels, self.geometry.depth)
-        self._apply_levels()
-        if reset_camera:
-            self.nav.reset(scene.camera)
-
-    def posed(self, scene: Scene) -> Scene:
-        """``scene`` as drawn at the moment shown (``Posing``); a moment that cannot be posed
-        shows why until one poses again."""
-        said = self.posing.error
-        pose = self.posing.pose(scene, self.playback.time)
-        if self.posing.error:
-            self.error = self.posing.error
-        elif said and self.error == said:
-            self.error = ""
-        return pose
-
-    def _time_moved(self) -> None:
-        """The moment shown changed: a new image (a moving one while playing, so the
-        adaptive resolution counts time as motion), new geometry if tracks or sway move it,
-        and the keyed camera where a track moves the camera (between moments, one flies)."""
-        pose = self.posed(self.scene)
-        a = self.scene.animation
-        if a is not None and any(t.path.startswith("camera") for t in a.tracks):
-            self.nav.reset(pose.camera)
-        geometry = pose.geometry()
-        if geometry != self.geometry:
-            self.geometry = geometry
-            self.levels = min(self.levels, geometry.depth)
-            self._apply_levels()
-        if self.posing.changed(pose):
-            self.frames.dirty = True
-
-    def toggle_play(self) -> None:
-        if not self.scene.animated:
-            self.message = "nothing in this scene moves (no wind, keyframe tracks or sway)"
-            return
-        self.playback.playing = not self.playback.playing
-
-    def set_time(self, t: float) -> None:
-        self.playback.seek(t)
-        self._time_moved()
+    @property
+    def measured(self) -> list[dict] | None:
+        """The preset's measured accuracy (the HUD's section), read once per file name."""
+        if self._measured[0] != self.path.stem:
+            self._measured = (self.path.stem, load_measured(self.path.stem))
+        return self._measured[1]
 
     def sync(self) -> None:
-        """Redraw when the document changed (an edit, undo, redo, reload)."""
-        if self.doc.version != self._seen_version:
-            self._set_scene(self.doc.scene)
-
-    def _apply_levels(self) -> None:
-        try:
-            self.krs = self.geometry.truncated(self.levels) if self.levels else self.geometry
-        except SceneError as e:  # a MöKRS whose kept levels cannot carry a kernel up
-            self.levels, self.krs, self.error = 0, self.geometry, f"{e}; drawing every level"
-        self.world = self.renderer.world(self.krs, self.scene.material.albedo)  # speed, picking
-        self.frames.dirty = True
+        """Redraw when the document changed (an edit, undo, redo, reload): what is drawn
+        follows it (drawn.py)."""
+        self.drawn.sync()
 
     def view_scene(self) -> Scene:
         """The scene as drawn now: at the moment shown, with the viewer's camera and pre-pass.
         Moving frames have every effect too; unless ``moving_effects``, their shadow rays are
         shared by 2 × 2 pixels at least, 3 × 3 from 240 pixels wide (frames.py)."""
-        scene = self.posed(self.scene)
+        scene = self.drawn.posed(self.scene)
         return replace(
             scene,
             camera=self.camera.to_camera(),
@@ -190,7 +135,7 @@ class Viewer:
 
     def nearest_distance(self) -> float:
         """Radius of an empty ball around the eye (the flying speed follows it)."""
-        return self.nav.free_distance(self.world)
+        return self.nav.free_distance(self.drawn.world)
 
     # ------------------------------------------------------------------------ the changes
     def execute(self, commands: list[c.Command]) -> None:
@@ -234,11 +179,6 @@ class Viewer:
         editor); from then on the view draws with the scene's."""
         if self.edit(("render", "prepass"), tile, interaction):
             self._view_prepass, self.frames.dirty = None, True
-
-    def set_levels(self, levels: int) -> None:
-        """Draw only the coarsest ``levels`` levels (0 or all: the whole scene)."""
-        self.levels = 0 if levels >= self.geometry.depth else levels
-        self._apply_levels()
 
     def set_target_fps(self, fps: float) -> None:
         self.frames.adaptive.target_fps = fps
@@ -288,7 +228,7 @@ class Viewer:
             and not self.input.held
             and not self.input.buttons
             and self.file.recorder.replay_start is None
-            and not (self.playback.playing and self.scene.animated)
+            and not (self.drawn.playback.playing and self.scene.animated)
         )
 
     def step(self, dt: float) -> None:
@@ -321,8 +261,7 @@ class Viewer:
     def move(self, dt: float) -> None:
         """Move the camera by the input (a recording takes the pose, a replay sets it) and
         the clock while playing."""
-        if self.scene.animated and self.playback.advance(dt):
-            self._time_moved()
+        self.drawn.advance(dt)
         if self.nav.move(dt, self.nearest_distance):
             self.frames.dirty = True
         if self.file.recorder.tick(self.clock, self.camera):
@@ -333,7 +272,7 @@ class Viewer:
         """Follow the document, trace within the frame budget and show the image."""
         self.sync()
         try:
-            self.frames.trace(self.view_scene(), self.krs)
+            self.frames.trace(self.view_scene(), self.drawn.krs)
         except ShaderError as e:
             self.error = str(e)
         fb = glfw.get_framebuffer_size(self.window)
@@ -352,7 +291,7 @@ class Viewer:
     def screenshot(self) -> Path | None:
         """A full-resolution PNG of the current view and view mode, beside the scene (else in
         the pictures folder); its full path is printed and shown for STATUS_SECONDS."""
-        rgb = self.frames.still(self.view_scene(), self.krs, self.view, self._depth_scale())
+        rgb = self.frames.still(self.view_scene(), self.drawn.krs, self.view, self._depth_scale())
         try:
             out = save_screenshot(rgb, self.path, time.strftime("%Y%m%d-%H%M%S"))
         except OSError as e:
@@ -386,7 +325,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.SetPrepass: lambda v, e: v.set_prepass(e.tile, e.interaction),
     c.Undo: lambda v, e: v.undo(),
     c.Redo: lambda v, e: v.redo(),
-    c.SetLevels: lambda v, e: v.set_levels(e.levels),
+    c.SetLevels: lambda v, e: v.drawn.set_levels(e.levels),
     c.SetViewMode: lambda v, e: setattr(v, "view", e.mode),
     c.SetTargetFps: lambda v, e: v.set_target_fps(e.fps),
     c.SetSupersample: lambda v, e: v.set_supersample(e.factor),
@@ -404,7 +343,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.Replay: lambda v, e: v.file.recorder.replay(v.clock),
     c.ReloadScene: lambda v, e: v.file.reload(),
     c.ReloadShaders: lambda v, e: v.file.reload_shaders(),
-    c.TogglePlay: lambda v, e: v.toggle_play(),
-    c.SetTime: lambda v, e: v.set_time(e.time),
-    c.SetSpeed: lambda v, e: v.playback.set_speed(e.speed),
+    c.TogglePlay: lambda v, e: v.drawn.toggle_play(),
+    c.SetTime: lambda v, e: v.drawn.set_time(e.time),
+    c.SetSpeed: lambda v, e: v.drawn.playback.set_speed(e.speed),
 }
