@@ -17,6 +17,7 @@ from ..compile.constants import (
     BINDING_SHADOWS,
     BINDING_TASKS,
     COMPUTE_GROUP,
+    PHASE_LANES,
     PHASE_NEAREST,
     PHASE_ROUND,
     PHASE_SHADOW_ROUND,
@@ -75,7 +76,7 @@ class ComputePath:
     def trace(
         self,
         r: Rounds,
-        prog: moderngl.Program,
+        readers: tuple[moderngl.Program, ...],
         width: int,
         height: int,
         tile: tuple[int, int, int, int] | None,
@@ -88,6 +89,28 @@ class ComputePath:
         comp = r.comp
         x, y, w, h = tile or (0, 0, width, height)
         area = w * h
+        if r.steps == 0:
+            import os
+            self._bind({BINDING_RAYS: area * r.ray_bytes, BINDING_COUNTS: COUNTS.size(),
+                        BINDING_QUEUES: 2 * area * 4})
+            self.buffers[BINDING_COUNTS].write(counts(0, 0))
+            for prog in readers:
+                prog["u_tile_rect"].value = (x, y, w, h)
+            lanes = -(-area * int(os.environ.get("KRS_LANE_IT", "16")) // (COMPUTE_GROUP * r.cap))
+            for name, value in (("u_tile_rect", (x, y, w, h)), ("u_area", area), ("u_queue", area),
+                                ("u_tasks", area), ("u_steps", r.cap), ("u_lanes", lanes * COMPUTE_GROUP),
+                                ("u_refill", int(os.environ.get("KRS_REFILL", "1"))),
+                                ("u_phase", PHASE_LANES)):
+                if name in comp:
+                    comp[name].value = value
+            comp.run(lanes)
+            self.ctx.memory_barrier()
+            if os.environ.get("KRS_DEBUG"):
+                print("counts", area, lanes, np.frombuffer(self.buffers[BINDING_COUNTS].read(), np.uint32))
+            comp["u_phase"].value = PHASE_ROUND
+            comp.run_indirect(self.buffers[BINDING_COUNTS], offset=COUNTS.offsets()["groups"])
+            self.ctx.memory_barrier()
+            return
         traced = area * max(r.per_pixel, 1)  # rays traced in rounds
         queue = max(traced, area * MAX_LIGHTS if r.shadow_bytes else area)  # the longest queue
         self._bind(
@@ -101,7 +124,8 @@ class ComputePath:
         )
         groups = -(-area // COMPUTE_GROUP)
         self.buffers[BINDING_COUNTS].write(counts(traced, -(-traced // COMPUTE_GROUP)))
-        prog["u_tile_rect"].value = (x, y, w, h)
+        for prog in readers:
+            prog["u_tile_rect"].value = (x, y, w, h)
         for name, value in (
             ("u_tile_rect", (x, y, w, h)),
             ("u_area", area),

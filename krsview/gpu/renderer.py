@@ -131,10 +131,14 @@ class Renderer:
             defines.update(dict.fromkeys(probes))
             scene = replace(scene, render=replace(scene.render, path="fragment"))
         if scene.render.path == "compute":  # trace in rounds, then a shading pass
+            if scene.render.steps == 0:
+                defines["KRS_LANES"] = None
             prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
             comp = self.programs.compute("compute.comp", defines)
             self._compute[prog] = Rounds.of(comp, scene.render, defines)
-            progs = [prog, comp]
+            mark = {**defines, "KRS_MISS_MARK": None}
+            self._free[prog] = self.programs.get("fullscreen.vert", "deferred.frag", mark)
+            progs = [prog, comp, self._free[prog]]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
             progs = [prog]
@@ -213,7 +217,9 @@ class Renderer:
             if prog in self._coarse:
                 self._prepass(prog, width, height, tile)
             if prog in self._compute:
-                self._rays.trace(self._compute[prog], prog, width, height, tile)
+                self._rays.trace(
+                    self._compute[prog], (prog, self._free[prog]), width, height, tile
+                )
             fbo = self._framebuffer(width, height)
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)

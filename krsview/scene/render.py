@@ -163,7 +163,7 @@ class Render:
         "shaded in a deferred pass (the same image)",
     )
     steps: int = param(
-        16, lo=1, hi=1024, help="compute path: iterations per ray per round (dispatch)"
+        16, lo=0, hi=1024, help="compute path: iterations per ray per round (dispatch)"
     )
     shadow_tasks: str = param(
         "on",

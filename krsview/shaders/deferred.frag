@@ -14,8 +14,13 @@ layout(std430, binding = BINDING_SHADOWS) readonly buffer Shadows { Shadow shado
 void main() {
     int index = ray_index(ivec2(gl_FragCoord.xy));
     Ray r = rays[index];
+#ifdef KRS_MISS_MARK
+    gl_FragDepth = r.state == RAY_HIT ? 1.0 : 0.0;
+    write_pixel(pixel_ray(gl_FragCoord.xy), false, r.t, r.iterations);
+#else
 #ifdef KRS_SHADOW_TASKS
     for (int j = 0; j < MAX_LIGHTS; ++j) g_shadow[j] = shadows[index * MAX_LIGHTS + j].vis;
 #endif
     write_pixel(pixel_ray(gl_FragCoord.xy), r.state == RAY_HIT, r.t, r.iterations);
+#endif
 }
