@@ -109,5 +109,10 @@ SHADOW = Struct(
 # persistent lanes that have finished (PHASE_LANES).
 COUNTS = Struct(
     "Counts",
-    (Field("uint", "count", 2), Field("uint", "groups", 3), Field("uint", "lanes_done")),
+    (
+        Field("uint", "count", 2),
+        Field("uint", "groups", 3),
+        Field("uint", "taken"),
+        Field("uint", "lanes_done"),
+    ),
 )

@@ -22,7 +22,7 @@ from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
 from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
-from .compute import ComputePath, Rounds
+from .compute import ComputePath, Rounds, path_defines
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
@@ -39,7 +39,8 @@ class Renderer:
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
         self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int, int]] = {}  # pre-pass
-        self._free: dict[moderngl.Program, moderngl.Program] = {}  # its free tiles' pass
+        # its marking pass: the free tiles' (render.frag) or the misses' (deferred.frag)
+        self._free: dict[moderngl.Program, moderngl.Program] = {}
         self._blank: moderngl.Texture | None = None  # bound where the coarsest pass's parent is
         self._compute: dict[moderngl.Program, Rounds] = {}  # deferred → its compute pass
         self._rays = ComputePath(self.ctx)  # the compute path's buffers
@@ -130,9 +131,8 @@ class Renderer:
         if probes:
             defines.update(dict.fromkeys(probes))
             scene = replace(scene, render=replace(scene.render, path="fragment"))
-        if scene.render.path == "compute":  # trace in rounds, then a shading pass
-            if scene.render.steps == 0:
-                defines["KRS_LANES"] = None
+        if scene.render.path == "compute":  # trace, then shade (misses written apart)
+            defines = path_defines(defines, scene.render)
             prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
             comp = self.programs.compute("compute.comp", defines)
             self._compute[prog] = Rounds.of(comp, scene.render, defines)
@@ -217,14 +217,12 @@ class Renderer:
             if prog in self._coarse:
                 self._prepass(prog, width, height, tile)
             if prog in self._compute:
-                self._rays.trace(
-                    self._compute[prog], (prog, self._free[prog]), width, height, tile
-                )
+                self._rays.trace(self._compute[prog], (prog, self._free[prog]), width, height, tile)
             fbo = self._framebuffer(width, height)
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
             self.ctx.scissor = tile
-            if prog in self._free:  # its KRS_FREE_TILES variant marks the pixels to skip
+            if prog in self._free:  # its marking variant marks the pixels to skip
                 behind_mark(
                     self.ctx, lambda: self._full(self._free[prog]), lambda: self._full(prog)
                 )

@@ -163,7 +163,13 @@ class Render:
         "shaded in a deferred pass (the same image)",
     )
     steps: int = param(
-        16, lo=0, hi=1024, help="compute path: iterations per ray per round (dispatch)"
+        16,
+        lo=0,
+        hi=1024,
+        help="compute path: iterations per ray per round (dispatch); 0: persistent lanes, "
+        "each taking the next pixel as soon as its ray is done, so 8 lanes in lockstep wait "
+        "for their slowest ray only at the end (one ray per pixel: no shadow or component "
+        "tasks)",
     )
     shadow_tasks: str = param(
         "on",

@@ -12,12 +12,11 @@
 // A compound keeps a task per component (KRS_COMPONENT_TASKS): PHASE_START starts one ray per
 // pixel and component that steps that component alone (the others start past the far
 // limit), the rounds run them, and PHASE_NEAREST keeps each pixel's nearest hit [KRS17 §5.1].
+// With KRS_LANES (`steps = 0`), persistent lanes trace the primary rays instead (lanes.glsl).
 // The phases, bindings and COMPUTE_GROUP are compile/constants.py's; Counts is declared for
 // Python in compile/std430.py (COUNTS).
 #ifdef KRS_LANES
 #extension GL_ARB_shader_group_vote : require
-#extension GL_ARB_shader_ballot : require
-#extension GL_ARB_gpu_shader_int64 : require
 #endif
 #include "effects.glsl"
 #include "scene_block.glsl"
@@ -43,7 +42,8 @@ layout(std430, binding = BINDING_QUEUES) buffer Queues { uint queue[]; };  // tw
 layout(std430, binding = BINDING_COUNTS) buffer Counts {
     uint count[2];       // live rays in each queue
     uint groups[3];      // the next dispatch's size (glDispatchComputeIndirect)
-    uint lanes_done;     // PHASE_LANES: invocations finished
+    uint taken;          // lanes.glsl: pixels the lanes took
+    uint lanes_done;     // lanes.glsl: lanes that have finished
 };
 
 uniform int u_phase;     // PHASE_*: what this dispatch does
@@ -63,6 +63,10 @@ ivec2 tile_pixel(uint p) {
 void requeue(uint k) {
     queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = k;
 }
+
+#ifdef KRS_LANES
+#include "lanes.glsl"
+#endif
 
 // PHASE_SIZE: one invocation sizes the next round from the rays this one left live.
 void size_next_round(uint k) {
@@ -161,97 +165,11 @@ void shadow_round(uint k) {
 }
 #endif
 
-#ifdef KRS_LANES
-uniform int u_refill;    // a lane's chunk refills once this many of its 8 lanes are done
-uniform uint u_lanes;    // invocations of the lanes' dispatch
-
-// How many of this invocation's subgroup (llvmpipe: 8 lanes in lockstep) have b.
-int lanes_with(bool b) {
-    uvec2 m = unpackUint2x32(ballotARB(b));
-    return bitCount(m.x) + bitCount(m.y);
-}
-
-// Pixel p of the tile (in the order lanes take them) begins its ray, done already where it
-// is done before its first step (a tile free past the far limit: no step is spent on it);
-// past the tile, an idle lane (a finished miss that is never stored).
-void lane_begin(uint p, out Ray r, out vec3r dir) {
-    ivec2 pixel = tile_pixel(min(p, u_area - 1u));
-    real start[COMPONENT_SLOTS];
-    ray_start(pixel, start);
-    r = ray_begin(start);
-    dir = pixel_ray(vec2(pixel) + 0.5);
-    Ray first = r;
-    int c;
-    real t;
-    if (!next_step(first, c, t)) r = first;  // as ray_step would find it
-    if (p >= u_area) r.state = RAY_MISS;
-}
-
-// PHASE_LANES: persistent lanes [Aila & Laine 2009]. Each takes the next pixel from a counter
-// (count[0]) and steps its ray; once u_refill lanes of its subgroup are done, those store
-// their rays and take the next pixels, so a subgroup waits for its slowest ray only at the
-// end. A subgroup takes at most u_steps steps (the iteration cap: the fragment path's own
-// bound, which llvmpipe's limit on a shader's loop iterations, 65535, must allow); rays still
-// live then are saved and queued (queue 1, count[1]), and the last lane to finish sizes the
-// round that finishes them and the pixels never taken (lanes_rest).
-void lanes() {
-    uint p = atomicAdd(count[0], 1u);
-    Ray r;
-    vec3r dir;
-    lane_begin(p, r, dir);
-    int budget = u_steps;
-    bool done = r.state != RAY_LIVE && p < u_area;  // done, not stored yet
-    while (lanes_with(p < u_area) > 0 && budget > 0) {
-        while (lanes_with(done) > 0 && budget > 0) {  // store, and take the next pixels
-            uint next = atomicAdd(count[0], done ? 1u : 0u);  // atomics outside branches
-            if (done) {
-                uint index = uint(ray_index(tile_pixel(p)));
-                rays[index].t = r.t;           // what deferred.frag reads
-                rays[index].iterations = r.iterations;
-                rays[index].state = r.state;
-                p = next;
-                lane_begin(p, r, dir);
-                done = r.state != RAY_LIVE && p < u_area;
-            }
-            --budget;
-        }
-        while (lanes_with(r.state == RAY_LIVE) > 0 && lanes_with(done) < u_refill && budget > 0) {
-            if (r.state == RAY_LIVE) ray_step(r, vec3r(0.0), dir);
-            done = r.state != RAY_LIVE && p < u_area;
-            --budget;
-        }
-    }
-    bool left = r.state == RAY_LIVE;    // p < u_area: not stored yet
-    uint slot = atomicAdd(count[1], left ? 1u : 0u);
-    if (left) queue[u_queue + slot] = p;
-    if (p < u_area) rays[p] = r;
-    memoryBarrierBuffer();
-    if (atomicAdd(lanes_done, 1u) == u_lanes - 1u) {  // the last lane: size lanes_rest
-        uint rest = count[1] + u_area - min(count[0], u_area);
-        groups[0] = (rest + uint(COMPUTE_GROUP) - 1u) / uint(COMPUTE_GROUP);
-        groups[1] = 1u;
-        groups[2] = 1u;
-    }
-}
-
-// PHASE_ROUND after the lanes: the rays they left live, then the pixels they never took,
-// each traced to its end.
-void lanes_rest(uint k) {
-    uint left = count[1], p = k < left ? queue[u_queue + k] : min(count[0], u_area) + k - left;
-    if (p >= u_area) return;
-    vec3r dir = pixel_ray(vec2(tile_pixel(p)) + 0.5);
-    Ray r;
-    if (k < left) r = rays[p];
-    else lane_begin(p, r, dir);
-    while (r.state == RAY_LIVE) ray_step(r, vec3r(0.0), dir);
-    rays[p] = r;
-}
-#endif
-
 void main() {
     uint k = gl_GlobalInvocationID.x;
 #ifdef KRS_LANES
     if (u_phase == PHASE_LANES) lanes();
+    else if (u_phase == PHASE_START) list_block(k);
     else if (u_phase == PHASE_ROUND) lanes_rest(k);
     else
 #endif

@@ -1,9 +1,13 @@
 // The compute path's shading pass: each pixel's ray as compute.comp left it in the ray
 // buffer (and its shadow rays' visibilities, with KRS_SHADOW_TASKS), shaded and written as
-// render.frag writes it.
+// render.frag writes it. KRS_MISS_MARK: the variant that writes the misses (no shading code)
+// and marks them with depth 0, so the shading variant, drawn behind a depth test, runs on the
+// hits alone (gpu/renderer.py, context.behind_mark); with persistent lanes it also writes
+// the rays they skip, done before their first step (rays.glsl, starts_live).
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
+#include "prepass.glsl"
 #include "rays.glsl"
 #include "pixel.glsl"
 
@@ -15,6 +19,10 @@ void main() {
     int index = ray_index(ivec2(gl_FragCoord.xy));
     Ray r = rays[index];
 #ifdef KRS_MISS_MARK
+#ifdef KRS_LANES  // the lanes skip the rays that are done before a step: written here
+    Ray first;
+    if (!starts_live(ivec2(gl_FragCoord.xy), first)) r = first;
+#endif
     gl_FragDepth = r.state == RAY_HIT ? 1.0 : 0.0;
     write_pixel(pixel_ray(gl_FragCoord.xy), false, r.t, r.iterations);
 #else
