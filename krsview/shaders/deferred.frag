@@ -2,7 +2,7 @@
 // buffer (and its shadow rays' visibilities, with KRS_SHADOW_TASKS), shaded and written as
 // render.frag writes it. KRS_MISS_MARK: the variant that writes the misses (no shading code)
 // and marks them with depth 0, so the shading variant, drawn behind a depth test, runs on the
-// hits alone (gpu/renderer.py, context.behind_mark); with persistent lanes it also writes
+// hits alone (gpu/context.py, behind_mark); with persistent lanes it also writes
 // the rays they skip, done before their first step (rays.glsl, starts_live).
 #include "effects.glsl"
 #include "scene_block.glsl"
