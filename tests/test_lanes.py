@@ -18,7 +18,7 @@ from krsview.bench.zoom import stops
 from krsview.compile.constants import BINDING_COUNTS, COMPUTE_GROUP
 from krsview.compile.geometry import compile_geometry
 from krsview.compile.std430 import COUNTS, Struct
-from krsview.gpu import compute, program
+from krsview.gpu import compute, passes, program
 from krsview.gpu.compute import LANE_STEPS_PER_PIXEL, path_defines
 from krsview.gpu.renderer import Renderer
 from krsview.gpu.uniforms import variant_defines
@@ -35,9 +35,9 @@ FIELDS = ("color", "depth", "normal", "iterations", "hit")
 
 
 def on_path(scene, path, **render):
-    """``scene`` on ``path`` with ``render`` knobs and a shadow ray per pixel (the compute
-    path traces no other, passes.still_ratio), so the two paths draw the same image."""
-    return replace(scene, render=replace(scene.render, path=path, shadow_block=1, **render))
+    """``scene`` on ``path`` with ``render`` knobs, by default a shadow ray per pixel (as the
+    shading pass after the lanes traces them), so the two paths draw the same image."""
+    return replace(scene, render=replace(scene.render, **{"shadow_block": 1, **render}, path=path))
 
 
 def lanes(scene, **render):
@@ -101,6 +101,46 @@ def test_lanes_in_bands_in_double_and_short_of_budget(renderer, monkeypatch):
     assert same(fragment, traced) and (fragment.iterations == 12).any()
 
 
+def in_passes(monkeypatch) -> None:
+    """Let gpu/passes.py draw a lanes scene's still image in passes where it does not yet:
+    its trace pass drawn by the lanes (deferred.frag with KRS_TRACE_ONLY, KRS_TRACE_KERNELS)."""
+    scene = lanes(load_scene(resolve("tree")), shadow_block=2)
+    if not passes.splits_shadows(scene):
+        fragment_only = passes.splits_shadows
+        monkeypatch.setattr(
+            passes,
+            "splits_shadows",
+            lambda s: (
+                fragment_only(replace(s, render=replace(s.render, path="fragment")))
+                and (s.render.path == "fragment" or s.render.steps == 0)
+            ),
+        )
+    assert passes.still_ratio(scene) == 2
+
+
+@pytest.mark.parametrize("name", ["tree", "grove"])
+def test_lanes_trace_the_passes_image(renderer, monkeypatch, name):
+    """The still image in passes (shadow rays shared by 2×2 blocks, the scene's effects),
+    its primary rays traced by the lanes: the fragment path's image, bit for bit."""
+    in_passes(monkeypatch)
+    scene = replace(
+        load_scene(resolve(name)), render=replace(load_scene(resolve(name)).render, prepass=4)
+    )
+    fragment = renderer.render(scene, W, H)
+    assert same(fragment, renderer.render(lanes(scene, shadow_block=2), W, H))
+
+
+def test_a_trace_pass_that_shades_fails(tmp_path, renderer, monkeypatch):
+    """Negative control: a lanes trace pass that writes the shaded pixel instead of the
+    tracing (the hits' kernels) gives the passes after it wrong kernels."""
+    in_passes(monkeypatch)
+    shaders = broken_shaders(
+        tmp_path, "deferred.frag", "write_trace(pixel_ray", "write_pixel(pixel_ray"
+    )
+    scene = lanes(load_scene(resolve("tree")), shadow_block=2)
+    assert not same(renderer.render(scene, W, H), Renderer(shader_dir=shaders).render(scene, W, H))
+
+
 def test_a_lane_that_skips_a_pixel_fails(tmp_path, renderer):
     """Negative control: lanes that skip the pixel after each one they finish leave pixels
     untraced."""
@@ -140,7 +180,8 @@ def test_without_the_budget_llvmpipe_cuts_the_walk(tmp_path, renderer):
 
 
 def test_lanes_sources_are_valid_desktop_glsl(tmp_path):
-    """The lanes' compute stage and the shading and marking passes, for a KRS, a compound and
+    """The lanes' compute stage and the shading and marking passes (shading, or the tracing
+    alone for gpu/passes.py), for a KRS, a compound and
     a MöKRS, in float and double, with and without the pre-pass, pass glslangValidator as
     the driver sees them and as GLSL 4.50; without the group-vote extension (negative
     control) the compute stage is refused."""
@@ -156,7 +197,9 @@ def test_lanes_sources_are_valid_desktop_glsl(tmp_path):
             assert "KRS_LANES" in defines and "KRS_SHADOW_TASKS" not in defines
             key = f"{name}-{precision}-{prepass}"
             sources[f"{key}.comp"] = program.Source("compute.comp", defines).text
-            for k, extra in enumerate(({}, {"KRS_MISS_MARK": None})):
+            trace = {"KRS_TRACE_ONLY": None, "KRS_TRACE_KERNELS": None}
+            marks = ({}, {"KRS_MISS_MARK": None}, trace, {**trace, "KRS_MISS_MARK": None})
+            for k, extra in enumerate(marks):
                 sources[f"{key}-{k}.frag"] = program.Source(
                     "deferred.frag", {**defines, **extra}
                 ).text

@@ -35,6 +35,9 @@ from ..scene.scene import MAX_LIGHTS
 # A subgroup with nothing left to take costs a few microseconds (docs/speed.md).
 LANE_STEPS_PER_PIXEL = 16
 LANE_BLOCK = 4  # without a pre-pass, the side of the pixel blocks the lanes take
+# The measuring probes a lanes variant draws too (deferred.frag): the tracing alone, with the
+# hits' kernels, as gpu/passes.py's trace pass asks for it.
+LANE_PROBES = frozenset({"KRS_TRACE_ONLY", "KRS_TRACE_KERNELS"})
 
 
 @dataclass(frozen=True)

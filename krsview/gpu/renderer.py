@@ -20,9 +20,9 @@ from ..compile.camera import view_of
 from ..compile.constants import BINDING_KRS_BLOCK, PREPASS_TARGETS
 from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
-from ..scene import Geometry, Scene, SceneError
+from ..scene import Geometry, Render, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
-from .compute import ComputePath, Rounds, path_defines
+from .compute import LANE_PROBES, ComputePath, Rounds, path_defines
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
@@ -94,9 +94,10 @@ class Renderer:
     ) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms,
-        ``probes`` the defines of a measuring variant, drawn on the fragment path:
-        KRS_COUNT_LEVELS counts the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY
-        traces without shading (bench split)."""
+        ``probes`` the defines of a measuring variant, drawn on the fragment path (the
+        tracing alone by persistent lanes too, compute.LANE_PROBES): KRS_COUNT_LEVELS counts
+        the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY traces without shading
+        (bench split, the passes' trace pass)."""
         with self.current():
             return self._prepare(scene, width, height, geometry, all_effects, probes)
 
@@ -127,18 +128,17 @@ class Renderer:
                 "separate scenes",
             )
         defines = variant_defines(scene, c, all_effects)
-        variant = dict(defines)  # before the probes: what companion passes compile with
+        if scene.render.path == "compute":  # persistent lanes: one ray per pixel, no tasks
+            defines = path_defines(defines, scene.render)
+        # before the probes: what companion passes compile with
+        variant = {k: v for k, v in defines.items() if k != "KRS_LANES"}
         if probes:
             defines.update(dict.fromkeys(probes))
-            scene = replace(scene, render=replace(scene.render, path="fragment"))
+            if "KRS_LANES" not in defines or not LANE_PROBES.issuperset(probes):
+                defines.pop("KRS_LANES", None)
+                scene = replace(scene, render=replace(scene.render, path="fragment"))
         if scene.render.path == "compute":  # trace, then shade (misses written apart)
-            defines = path_defines(defines, scene.render)
-            prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
-            comp = self.programs.compute("compute.comp", defines)
-            self._compute[prog] = Rounds.of(comp, scene.render, defines)
-            mark = {**defines, "KRS_MISS_MARK": None}
-            self._free[prog] = self.programs.get("fullscreen.vert", "deferred.frag", mark)
-            progs = [prog, comp, self._free[prog]]
+            prog, progs = self._compute_passes(scene.render, defines)
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
             progs = [prog]
@@ -170,6 +170,19 @@ class Renderer:
             set_uniforms(p, uniforms)
         self._variant[prog] = (variant, uniforms)
         return prog
+
+    def _compute_passes(
+        self, render: Render, defines: dict
+    ) -> tuple[moderngl.Program, list[moderngl.Program]]:
+        """The compute path's shading pass (deferred.frag), and with it its tracing
+        (compute.comp) and its marking variant, which writes the misses so that the shading
+        runs on the hits alone: (the shading pass, all three)."""
+        prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
+        comp = self.programs.compute("compute.comp", defines)
+        self._compute[prog] = Rounds.of(comp, render, defines)
+        mark = {**defines, "KRS_MISS_MARK": None}
+        self._free[prog] = self.programs.get("fullscreen.vert", "deferred.frag", mark)
+        return prog, [prog, comp, self._free[prog]]
 
     def companion(
         self, prog: moderngl.Program, fragment: str, defines: dict | None = None

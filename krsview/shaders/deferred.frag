@@ -15,6 +15,16 @@
 layout(std430, binding = BINDING_SHADOWS) readonly buffer Shadows { Shadow shadows[]; };
 #endif
 
+// The pixel written: shaded, or its tracing alone (KRS_TRACE_ONLY: gpu/passes.py's trace
+// pass, whose shading passes follow).
+void write_ray(bool hit, real t, int iterations) {
+#ifdef KRS_TRACE_ONLY
+    write_trace(pixel_ray(gl_FragCoord.xy), hit, t, iterations);
+#else
+    write_pixel(pixel_ray(gl_FragCoord.xy), hit, t, iterations);
+#endif
+}
+
 void main() {
     int index = ray_index(ivec2(gl_FragCoord.xy));
     Ray r = rays[index];
@@ -24,11 +34,11 @@ void main() {
     if (!starts_live(ivec2(gl_FragCoord.xy), first)) r = first;
 #endif
     gl_FragDepth = r.state == RAY_HIT ? 1.0 : 0.0;
-    write_pixel(pixel_ray(gl_FragCoord.xy), false, r.t, r.iterations);
+    write_ray(false, r.t, r.iterations);
 #else
 #ifdef KRS_SHADOW_TASKS
     for (int j = 0; j < MAX_LIGHTS; ++j) g_shadow[j] = shadows[index * MAX_LIGHTS + j].vis;
 #endif
-    write_pixel(pixel_ray(gl_FragCoord.xy), r.state == RAY_HIT, r.t, r.iterations);
+    write_ray(r.state == RAY_HIT, r.t, r.iterations);
 #endif
 }
