@@ -159,8 +159,9 @@ class Render:
         choices=PATHS,
         help="fragment: one full-screen pass traces and shades each pixel; "
         "compute: rays in a storage buffer traced in rounds of "
-        "--steps iterations, finished rays leaving the queue, then "
-        "shaded in a deferred pass (the same image)",
+        "--steps iterations, finished rays leaving the queue (or by "
+        "persistent lanes: --steps 0), then shaded in a deferred pass "
+        "(the same image)",
     )
     steps: int = param(
         16,

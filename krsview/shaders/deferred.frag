@@ -15,8 +15,8 @@
 layout(std430, binding = BINDING_SHADOWS) readonly buffer Shadows { Shadow shadows[]; };
 #endif
 
-// The pixel written: shaded, or its tracing alone (KRS_TRACE_ONLY: gpu/passes.py's trace
-// pass, whose shading passes follow).
+// The pixel written: shaded, or its tracing alone (KRS_TRACE_ONLY: the trace pass in
+// gpu/passes.py; its shading passes follow).
 void write_ray(bool hit, real t, int iterations) {
 #ifdef KRS_TRACE_ONLY
     write_trace(pixel_ray(gl_FragCoord.xy), hit, t, iterations);

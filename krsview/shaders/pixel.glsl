@@ -21,9 +21,9 @@ void write_pixel(vec3r dir, bool hit, real t, int iterations) {
     out_normal = vec4(n, float(t));
 }
 
-// The tracing alone (KRS_TRACE_ONLY: bench split, gpu/passes.py's trace pass): hit and depth,
-// and with KRS_TRACE_KERNELS the hit's kernel point, level and normal, which the passes after
-// it read instead of walking Alg. 1 again.
+// The tracing alone (KRS_TRACE_ONLY: bench split, the trace pass in gpu/passes.py): hit and
+// depth, and with KRS_TRACE_KERNELS the hit's kernel point, level and normal, which the
+// passes after it read instead of walking Alg. 1 again.
 void write_trace(vec3r dir, bool hit, real t, int iterations) {
     out_color = vec4(0.0, 0.0, 0.0, hit ? 1.0 : 0.0);
     out_normal = vec4(0.0, 0.0, 0.0, float(t));
