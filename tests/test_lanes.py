@@ -2,9 +2,10 @@
 as soon as its ray is done. They take the fragment path's steps (trace.glsl's ray_step), so the
 image is the fragment path's bit for bit: colour, depth, normal, iterations and hits, on a KRS,
 a compound and a MöKRS (binary tracer), with and without the pre-pass, in bands, in double
-precision, with every preset's effects. Negative controls: a lane that skips a pixel, a round
-that does not finish the rays the lanes left, and lanes without their step budget (llvmpipe
-cuts every loop of an invocation after 65535 loop iterations in all)."""
+precision, with every preset's effects, and as the trace pass of the image in passes.
+Negative controls: a lane that skips a pixel, a round that does not finish the rays the lanes
+left, lanes without their step budget (llvmpipe cuts every loop of an invocation after 65535
+loop iterations in all), and a trace pass that shades."""
 
 from __future__ import annotations
 

@@ -29,6 +29,7 @@ from ..compile.constants import (
 from ..compile.std430 import COUNTS, RAY, SHADOW, base_type
 from ..scene import MAX_COMPONENTS, Render
 from ..scene.scene import MAX_LIGHTS
+from .program import ProgramCache
 
 # Persistent lanes: their dispatch holds subgroups enough for this many steps per pixel, each
 # subgroup taking at most the iteration cap (lanes.glsl); what they leave, a round finishes
@@ -192,6 +193,17 @@ class ComputePath:
             self.ctx.memory_barrier()
             comp["u_phase"].value = PHASE_SIZE
             comp.run(1)
+
+
+def compute_passes(
+    programs: ProgramCache, render: Render, defines: dict
+) -> tuple[moderngl.Program, moderngl.Program, Rounds]:
+    """The compute path's shading pass (deferred.frag), its marking variant, which writes the
+    misses so that the shading runs on the hits alone, and its tracing (compute.comp)."""
+    prog = programs.get("fullscreen.vert", "deferred.frag", defines)
+    mark = programs.get("fullscreen.vert", "deferred.frag", {**defines, "KRS_MISS_MARK": None})
+    comp = programs.compute("compute.comp", defines)
+    return prog, mark, Rounds.of(comp, render, defines)
 
 
 def path_defines(defines: dict, render: Render) -> dict:

@@ -20,9 +20,9 @@ from ..compile.camera import view_of
 from ..compile.constants import BINDING_KRS_BLOCK, PREPASS_TARGETS
 from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
-from ..scene import Geometry, Render, Scene, SceneError
+from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
-from .compute import LANE_PROBES, ComputePath, Rounds, path_defines
+from .compute import LANE_PROBES, ComputePath, Rounds, compute_passes, path_defines
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
@@ -137,8 +137,10 @@ class Renderer:
             if "KRS_LANES" not in defines or not LANE_PROBES.issuperset(probes):
                 defines.pop("KRS_LANES", None)
                 scene = replace(scene, render=replace(scene.render, path="fragment"))
-        if scene.render.path == "compute":  # trace, then shade (misses written apart)
-            prog, progs = self._compute_passes(scene.render, defines)
+        if scene.render.path == "compute":  # trace, then shade (the misses written apart)
+            prog, mark, rounds = compute_passes(self.programs, scene.render, defines)
+            self._compute[prog], self._free[prog] = rounds, mark
+            progs = [prog, mark, rounds.comp]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
             progs = [prog]
@@ -170,19 +172,6 @@ class Renderer:
             set_uniforms(p, uniforms)
         self._variant[prog] = (variant, uniforms)
         return prog
-
-    def _compute_passes(
-        self, render: Render, defines: dict
-    ) -> tuple[moderngl.Program, list[moderngl.Program]]:
-        """The compute path's shading pass (deferred.frag), and with it its tracing
-        (compute.comp) and its marking variant, which writes the misses so that the shading
-        runs on the hits alone: (the shading pass, all three)."""
-        prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
-        comp = self.programs.compute("compute.comp", defines)
-        self._compute[prog] = Rounds.of(comp, render, defines)
-        mark = {**defines, "KRS_MISS_MARK": None}
-        self._free[prog] = self.programs.get("fullscreen.vert", "deferred.frag", mark)
-        return prog, [prog, comp, self._free[prog]]
 
     def companion(
         self, prog: moderngl.Program, fragment: str, defines: dict | None = None
