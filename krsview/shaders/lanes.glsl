@@ -5,8 +5,8 @@
 // done stores it and takes the next pixel at once, and its 8 lanes wait for their slowest only
 // at the end. Three dispatches:
 // - PHASE_START (list_block): the tile's blocks of u_block × u_block pixels (the pre-pass's
-//   tiles) are listed in queue 0 (count[0] of them), but for those whose rays are done before a
-//   step (free past the far limit: deferred.frag writes those);
+//   tiles, 4 × 4 without one) are listed in queue 0 (count[0] of them), but for those whose rays
+//   are done before a step (free past the far limit: deferred.frag writes those);
 // - PHASE_LANES (lanes): the lanes take the listed blocks' pixels from a counter (`taken`),
 //   block by block, and trace them with trace.glsl's ray_step, the fragment path's steps;
 // - PHASE_ROUND (lanes_rest): the rays the lanes left live, then the pixels they never took,
@@ -18,7 +18,7 @@
 // count[1]), and the last lane to finish sizes lanes_rest's dispatch.
 
 uniform uint u_lanes;    // invocations of the lanes' dispatch
-uniform int u_block;     // the side of the blocks: the pre-pass's tile
+uniform int u_block;     // the side of the blocks: the pre-pass's tile (4 without one)
 uniform uint u_blocks;   // blocks over u_tile_rect (u_block_grid.x × .y)
 uniform ivec2 u_block_grid;  // blocks across and down
 
