@@ -314,7 +314,8 @@ def test_std430_rules():
     assert RAY.size("float", COMPONENT_SLOTS=1) == 80
     assert SHADOW.size("float", COMPONENT_SLOTS=1) == 64  # 16 + 16 + 4 × 4 + 12 → 60 → 64
     assert SHADOW.size("double", COMPONENT_SLOTS=8) == 160  # 32 + 16 + 72 + 4 + 8 → 132 → 160
-    assert COUNTS.offsets() == {"count": 0, "groups": 8} and COUNTS.size() == 20
+    assert COUNTS.offsets() == {"count": 0, "groups": 8, "taken": 20, "lanes_done": 24}
+    assert COUNTS.size() == 28
     with pytest.raises(KeyError, match="COMPONENT_SLOTS"):
         RAY.size("float")
 
@@ -389,9 +390,10 @@ def test_std430_sizes_are_the_drivers(renderer, preset, precision):
             want = (struct.offsets(precision, COMPONENT_SLOTS=slots),)
             want += (struct.size(precision, COMPONENT_SLOTS=slots),)
             assert driver_layout(glo, array, struct) == want, (array, struct.name)
-        assert {f: resource(glo, f"{f}[0]", GL_OFFSET) for f in ("count", "groups")} == (
-            COUNTS.offsets()
-        )
+        counts = ("count", "groups")  # the lanes' fields: tests/test_lanes.py
+        assert {f: resource(glo, f"{f}[0]", GL_OFFSET) for f in counts} == {
+            f: COUNTS.offsets()[f] for f in counts
+        }
         # negative control: a declaration that forgot the probe radii is caught
         wrong = Struct("Ray", tuple(f for f in RAY.fields if f.name != "sc"))
         offsets, _ = driver_layout(glo, "rays", RAY)

@@ -50,6 +50,7 @@ PHASE_SIZE = 2  # size the next round from the rays the last one left live
 PHASE_SHADOW_START = 3  # start the shadow tasks
 PHASE_SHADOW_ROUND = 4  # a round of the shadow tasks
 PHASE_NEAREST = 5  # each pixel's nearest component task (KRS_COMPONENT_TASKS)
+PHASE_LANES = 6  # persistent lanes: each takes the next pixel when its ray is done
 
 GlslValue = int | float | tuple[float, ...]
 
@@ -90,6 +91,7 @@ def shared() -> dict[str, GlslValue]:
         "PHASE_SHADOW_START": PHASE_SHADOW_START,
         "PHASE_SHADOW_ROUND": PHASE_SHADOW_ROUND,
         "PHASE_NEAREST": PHASE_NEAREST,
+        "PHASE_LANES": PHASE_LANES,
     }
 
 

@@ -105,5 +105,14 @@ SHADOW = Struct(
         Field("int", "state"),
     ),
 )
-# compute.comp's Counts: live rays per queue, then the next dispatch's size (indirect).
-COUNTS = Struct("Counts", (Field("uint", "count", 2), Field("uint", "groups", 3)))
+# compute.comp's Counts: live rays per queue, the next dispatch's size (indirect), and the
+# persistent lanes that have finished (PHASE_LANES).
+COUNTS = Struct(
+    "Counts",
+    (
+        Field("uint", "count", 2),
+        Field("uint", "groups", 3),
+        Field("uint", "taken"),
+        Field("uint", "lanes_done"),
+    ),
+)

@@ -1,7 +1,8 @@
 """The compute path [issue 17 §3]: ``compute.comp`` traces a tile's rays in rounds, sized by
-the GPU, into storage buffers that the shading pass (``deferred.frag``) reads. The buffers'
-element sizes come from the structs declared in ``compile/std430.py``; the bindings and the
-phases of a dispatch from ``compile/constants.py``."""
+the GPU, or with persistent lanes (``steps = 0``, ``lanes.glsl``), into storage buffers that
+the shading pass (``deferred.frag``) reads. The buffers' element sizes come from the structs
+declared in ``compile/std430.py``; the bindings and the phases of a dispatch from
+``compile/constants.py``."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from ..compile.constants import (
     BINDING_SHADOWS,
     BINDING_TASKS,
     COMPUTE_GROUP,
+    PHASE_LANES,
     PHASE_NEAREST,
     PHASE_ROUND,
     PHASE_SHADOW_ROUND,
@@ -27,6 +29,17 @@ from ..compile.constants import (
 from ..compile.std430 import COUNTS, RAY, SHADOW, base_type
 from ..scene import MAX_COMPONENTS, Render
 from ..scene.scene import MAX_LIGHTS
+from .program import ProgramCache
+
+# Persistent lanes: their dispatch holds subgroups enough for this many steps per pixel, each
+# subgroup taking at most the iteration cap (lanes.glsl); what they leave, a round finishes
+# (8 left more to it: 0.89× the fragment path's frame inside the crown against 0.78×), and a
+# subgroup with nothing left to take runs one masked step.
+LANE_STEPS_PER_PIXEL = 16
+LANE_BLOCK = 4  # without a pre-pass, the side of the pixel blocks the lanes take
+# The measuring probes a lanes variant draws too (deferred.frag): the tracing alone, with the
+# hits' kernels, as gpu/passes.py's trace pass asks for it.
+LANE_PROBES = frozenset({"KRS_TRACE_ONLY", "KRS_TRACE_KERNELS"})
 
 
 @dataclass(frozen=True)
@@ -34,11 +47,12 @@ class Rounds:
     """One variant's compute pass and what its buffers hold per ray."""
 
     comp: moderngl.ComputeShader
-    steps: int  # iterations per ray per round
+    steps: int  # iterations per ray per round; 0: persistent lanes
     cap: int  # the iteration cap: rounds enough for it are issued
     ray_bytes: int  # trace.glsl's Ray
     shadow_bytes: int  # shadows.glsl's Shadow; 0: no shadow tasks
     per_pixel: int  # tasks per pixel (KRS_COMPONENT_TASKS); 0: one ray per pixel
+    block: int  # the side of the pixel blocks persistent lanes take: the pre-pass's tile
 
     @staticmethod
     def of(comp: moderngl.ComputeShader, render: Render, defines: dict) -> Rounds:
@@ -51,6 +65,7 @@ class Rounds:
             RAY.size(real, COMPONENT_SLOTS=components),
             SHADOW.size(real, COMPONENT_SLOTS=components) if "KRS_SHADOW_TASKS" in defines else 0,
             components if "KRS_COMPONENT_TASKS" in defines else 0,
+            render.prepass or LANE_BLOCK,
         )
 
 
@@ -75,16 +90,17 @@ class ComputePath:
     def trace(
         self,
         r: Rounds,
-        prog: moderngl.Program,
+        readers: tuple[moderngl.Program, ...],
         width: int,
         height: int,
         tile: tuple[int, int, int, int] | None,
     ) -> None:
-        """Start the rays of ``tile`` (or all), run rounds of at most ``r.steps`` iterations,
-        each sized by the GPU from the rays still live, and leave the ray buffer bound for
-        the shading pass ``prog`` (deferred.frag). Rounds enough for the iteration cap are
-        issued without reading anything back. With a task per pixel and component, those
-        are traced instead, and a last pass keeps each pixel's nearest hit in its ray."""
+        """Trace the rays of ``tile`` (or all) and leave the ray buffer bound for the passes
+        ``readers`` (deferred.frag's), in rounds or with persistent lanes (:meth:`_lanes`).
+        Rounds: start the rays, run rounds of at most ``r.steps`` iterations, each sized by
+        the GPU from the rays still live, enough for the iteration cap, without reading
+        anything back. With a task per pixel and component, those are traced instead, and a
+        last pass keeps each pixel's nearest hit in its ray."""
         comp = r.comp
         x, y, w, h = tile or (0, 0, width, height)
         area = w * h
@@ -99,19 +115,22 @@ class ComputePath:
                 BINDING_TASKS: traced * r.ray_bytes if r.per_pixel else 0,
             }
         )
+        for prog in readers:
+            prog["u_tile_rect"].value = (x, y, w, h)
+        self._set(
+            comp,
+            u_tile_rect=(x, y, w, h),
+            u_area=area,
+            u_queue=queue,
+            u_tasks=traced,
+            u_steps=r.steps or r.cap,
+        )
+        if not r.steps:
+            self._lanes(r, (x, y, w, h))
+            return
         groups = -(-area // COMPUTE_GROUP)
         self.buffers[BINDING_COUNTS].write(counts(traced, -(-traced // COMPUTE_GROUP)))
-        prog["u_tile_rect"].value = (x, y, w, h)
-        for name, value in (
-            ("u_tile_rect", (x, y, w, h)),
-            ("u_area", area),
-            ("u_queue", queue),
-            ("u_tasks", traced),
-            ("u_steps", r.steps),
-            ("u_phase", PHASE_START),
-        ):
-            if name in comp:
-                comp[name].value = value
+        comp["u_phase"].value = PHASE_START
         comp.run(-(-traced // COMPUTE_GROUP))
         rounds = -(-r.cap // r.steps) + 1
         self._rounds(comp, PHASE_ROUND, rounds)
@@ -131,6 +150,39 @@ class ComputePath:
             self._rounds(comp, PHASE_SHADOW_ROUND, rounds)
         self.ctx.memory_barrier()
 
+    def _lanes(self, r: Rounds, rect: tuple[int, int, int, int]) -> None:
+        """Persistent lanes (lanes.glsl) over ``rect``: list the blocks with rays to trace,
+        let the lanes trace their pixels, then a round finishes what they left, sized by the
+        last lane; nothing is read back."""
+        comp, (x, y, w, h), b = r.comp, rect, r.block
+        grid = ((x + w - 1) // b - x // b + 1, (y + h - 1) // b - y // b + 1)
+        blocks = grid[0] * grid[1]
+        lanes = -(-w * h * LANE_STEPS_PER_PIXEL // (COMPUTE_GROUP * r.cap))
+        self.buffers[BINDING_COUNTS].write(counts(0, 0))
+        self._set(
+            comp,
+            u_block=b,
+            u_block_grid=grid,
+            u_blocks=blocks,
+            u_lanes=lanes * COMPUTE_GROUP,
+            u_phase=PHASE_START,
+        )
+        comp.run(-(-blocks // COMPUTE_GROUP))
+        self.ctx.memory_barrier()
+        comp["u_phase"].value = PHASE_LANES
+        comp.run(lanes)
+        self.ctx.memory_barrier()
+        comp["u_phase"].value = PHASE_ROUND
+        comp.run_indirect(self.buffers[BINDING_COUNTS], offset=COUNTS.offsets()["groups"])
+        self.ctx.memory_barrier()
+
+    @staticmethod
+    def _set(comp: moderngl.ComputeShader, **uniforms: object) -> None:
+        """Give ``comp`` those of ``uniforms`` it uses (the compiler drops the others)."""
+        for name, value in uniforms.items():
+            if name in comp:
+                comp[name].value = value
+
     def _rounds(self, comp: moderngl.ComputeShader, phase: int, rounds: int) -> None:
         """``rounds`` rounds of ``phase`` (PHASE_ROUND or PHASE_SHADOW_ROUND), each sized by
         the GPU from what the last one left live, with no read-back."""
@@ -143,9 +195,29 @@ class ComputePath:
             comp.run(1)
 
 
+def compute_passes(
+    programs: ProgramCache, render: Render, defines: dict
+) -> tuple[moderngl.Program, moderngl.Program, Rounds]:
+    """The compute path's shading pass (deferred.frag), its marking variant, which writes the
+    misses so that the shading runs on the hits alone, and its tracing (compute.comp)."""
+    prog = programs.get("fullscreen.vert", "deferred.frag", defines)
+    mark = programs.get("fullscreen.vert", "deferred.frag", {**defines, "KRS_MISS_MARK": None})
+    comp = programs.compute("compute.comp", defines)
+    return prog, mark, Rounds.of(comp, render, defines)
+
+
+def path_defines(defines: dict, render: Render) -> dict:
+    """The compute variant's defines: with ``steps = 0``, persistent lanes (KRS_LANES) and no
+    tasks, since the lanes trace one ray per pixel and the shading pass its shadow rays."""
+    if render.steps:
+        return defines
+    tasks = ("KRS_SHADOW_TASKS", "KRS_COMPONENT_TASKS")
+    return {**{k: v for k, v in defines.items() if k not in tasks}, "KRS_LANES": None}
+
+
 def counts(live: int, groups: int) -> bytes:
     """compute.comp's Counts (compile/std430.py): ``live`` entries in queue 0, none in queue
-    1, and an indirect dispatch of ``groups`` × 1 × 1."""
+    1, an indirect dispatch of ``groups`` × 1 × 1, and the lanes' counters at 0."""
     out = np.zeros(COUNTS.size() // 4, dtype=np.uint32)
     at = {name: offset // 4 for name, offset in COUNTS.offsets().items()}
     out[at["count"] : at["count"] + 2] = live, 0

@@ -22,7 +22,7 @@ from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
 from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
-from .compute import ComputePath, Rounds
+from .compute import LANE_PROBES, ComputePath, Rounds, compute_passes, path_defines
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
@@ -39,7 +39,8 @@ class Renderer:
         self._ubo: moderngl.Buffer | None = None
         self._targets: dict[tuple[int, int, int], moderngl.Framebuffer] = {}
         self._coarse: dict[moderngl.Program, tuple[moderngl.Program, int, int]] = {}  # pre-pass
-        self._free: dict[moderngl.Program, moderngl.Program] = {}  # its free tiles' pass
+        # its marking pass: the free tiles' (render.frag) or the misses' (deferred.frag)
+        self._free: dict[moderngl.Program, moderngl.Program] = {}
         self._blank: moderngl.Texture | None = None  # bound where the coarsest pass's parent is
         self._compute: dict[moderngl.Program, Rounds] = {}  # deferred → its compute pass
         self._rays = ComputePath(self.ctx)  # the compute path's buffers
@@ -93,9 +94,10 @@ class Renderer:
     ) -> moderngl.Program:
         """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms,
-        ``probes`` the defines of a measuring variant, drawn on the fragment path:
-        KRS_COUNT_LEVELS counts the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY
-        traces without shading (bench split)."""
+        ``probes`` the defines of a measuring variant, drawn on the fragment path (the
+        tracing alone by persistent lanes too, compute.LANE_PROBES): KRS_COUNT_LEVELS counts
+        the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY traces without shading
+        (bench split, the passes' trace pass)."""
         with self.current():
             return self._prepare(scene, width, height, geometry, all_effects, probes)
 
@@ -126,15 +128,19 @@ class Renderer:
                 "separate scenes",
             )
         defines = variant_defines(scene, c, all_effects)
-        variant = dict(defines)  # before the probes: what companion passes compile with
+        if scene.render.path == "compute":  # persistent lanes: one ray per pixel, no tasks
+            defines = path_defines(defines, scene.render)
+        # before the probes: what companion passes compile with
+        variant = {k: v for k, v in defines.items() if k != "KRS_LANES"}
         if probes:
             defines.update(dict.fromkeys(probes))
-            scene = replace(scene, render=replace(scene.render, path="fragment"))
-        if scene.render.path == "compute":  # trace in rounds, then a shading pass
-            prog = self.programs.get("fullscreen.vert", "deferred.frag", defines)
-            comp = self.programs.compute("compute.comp", defines)
-            self._compute[prog] = Rounds.of(comp, scene.render, defines)
-            progs = [prog, comp]
+            if "KRS_LANES" not in defines or not LANE_PROBES.issuperset(probes):
+                defines.pop("KRS_LANES", None)
+                scene = replace(scene, render=replace(scene.render, path="fragment"))
+        if scene.render.path == "compute":  # trace, then shade (the misses written apart)
+            prog, mark, rounds = compute_passes(self.programs, scene.render, defines)
+            self._compute[prog], self._free[prog] = rounds, mark
+            progs = [prog, mark, rounds.comp]
         else:
             prog = self.programs.get("fullscreen.vert", "render.frag", defines)
             progs = [prog]
@@ -213,12 +219,12 @@ class Renderer:
             if prog in self._coarse:
                 self._prepass(prog, width, height, tile)
             if prog in self._compute:
-                self._rays.trace(self._compute[prog], prog, width, height, tile)
+                self._rays.trace(self._compute[prog], (prog, self._free[prog]), width, height, tile)
             fbo = self._framebuffer(width, height)
             fbo.use()
             self.ctx.viewport = (0, 0, width, height)
             self.ctx.scissor = tile
-            if prog in self._free:  # its KRS_FREE_TILES variant marks the pixels to skip
+            if prog in self._free:  # its marking variant marks the pixels to skip
                 behind_mark(
                     self.ctx, lambda: self._full(self._free[prog]), lambda: self._full(prog)
                 )

@@ -159,11 +159,18 @@ class Render:
         choices=PATHS,
         help="fragment: one full-screen pass traces and shades each pixel; "
         "compute: rays in a storage buffer traced in rounds of "
-        "--steps iterations, finished rays leaving the queue, then "
-        "shaded in a deferred pass (the same image)",
+        "--steps iterations, finished rays leaving the queue (or by "
+        "persistent lanes: --steps 0), then shaded in a deferred pass "
+        "(the same image)",
     )
     steps: int = param(
-        16, lo=1, hi=1024, help="compute path: iterations per ray per round (dispatch)"
+        16,
+        lo=0,
+        hi=1024,
+        help="compute path: iterations per ray per round (dispatch); 0: persistent lanes, "
+        "each taking the next pixel as soon as its ray is done, so 8 lanes in lockstep wait "
+        "for their slowest ray only at the end (one ray per pixel: no shadow or component "
+        "tasks)",
     )
     shadow_tasks: str = param(
         "on",

@@ -12,8 +12,12 @@
 // A compound keeps a task per component (KRS_COMPONENT_TASKS): PHASE_START starts one ray per
 // pixel and component that steps that component alone (the others start past the far
 // limit), the rounds run them, and PHASE_NEAREST keeps each pixel's nearest hit [KRS17 §5.1].
+// With KRS_LANES (`steps = 0`), persistent lanes trace the primary rays instead (lanes.glsl).
 // The phases, bindings and COMPUTE_GROUP are compile/constants.py's; Counts is declared for
 // Python in compile/std430.py (COUNTS).
+#ifdef KRS_LANES
+#extension GL_ARB_shader_group_vote : require
+#endif
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
@@ -38,6 +42,8 @@ layout(std430, binding = BINDING_QUEUES) buffer Queues { uint queue[]; };  // tw
 layout(std430, binding = BINDING_COUNTS) buffer Counts {
     uint count[2];       // live rays in each queue
     uint groups[3];      // the next dispatch's size (glDispatchComputeIndirect)
+    uint taken;          // lanes.glsl: pixels the lanes took
+    uint lanes_done;     // lanes.glsl: lanes that have finished
 };
 
 uniform int u_phase;     // PHASE_*: what this dispatch does
@@ -57,6 +63,10 @@ ivec2 tile_pixel(uint p) {
 void requeue(uint k) {
     queue[uint(1 - u_parity) * u_queue + atomicAdd(count[1 - u_parity], 1u)] = k;
 }
+
+#ifdef KRS_LANES
+#include "lanes.glsl"
+#endif
 
 // PHASE_SIZE: one invocation sizes the next round from the rays this one left live.
 void size_next_round(uint k) {
@@ -157,6 +167,12 @@ void shadow_round(uint k) {
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
+#ifdef KRS_LANES
+    if (u_phase == PHASE_LANES) lanes();
+    else if (u_phase == PHASE_START) list_block(k);
+    else if (u_phase == PHASE_ROUND) lanes_rest(k);
+    else
+#endif
     if (u_phase == PHASE_SIZE) size_next_round(k);
     else if (u_phase == PHASE_START) start_ray(k);
 #ifdef KRS_COMPONENT_TASKS

@@ -7,3 +7,17 @@ int ray_index(ivec2 pixel) {
     ivec2 q = pixel - u_tile_rect.xy;
     return q.y * u_tile_rect.z + q.x;
 }
+
+#ifdef KRS_LANES
+// Pixel's ray as it starts, and false where it is done before its first step (its pre-pass
+// tile is free past the far limit), left as ray_step would leave it: persistent lanes skip
+// such pixels (lanes.glsl) and deferred.frag writes them.
+bool starts_live(ivec2 pixel, out Ray r) {
+    real start[COMPONENT_SLOTS];
+    ray_start(pixel, start);
+    r = ray_begin(start);
+    int c;
+    real t;
+    return next_step(r, c, t);
+}
+#endif

@@ -30,19 +30,8 @@ void main() {
 #ifdef KRS_COUNT_LEVELS
     int levels = g_levels;   // the tracing's, before shading walks more
 #endif
-#ifdef KRS_TRACE_ONLY   // bench split: the tracing alone, its result kept, nothing shaded
-    out_color = vec4(0.0, 0.0, 0.0, hit ? 1.0 : 0.0);
-    out_normal = vec4(0.0, 0.0, 0.0, float(t));
-    out_iterations = vec4(float(iterations), 0.0, 0.0, 0.0);
-#ifdef KRS_TRACE_KERNELS  // and the hit's kernel, for the passes after it (gpu/passes.py)
-    if (hit) {
-        int level;
-        vec3 n, xk;
-        nearest_kernel(t * dir, t, level, n, xk);
-        out_color = vec4(xk, 1.0 + float(level));  // a > 0.5: a hit
-        out_normal.xyz = n;
-    }
-#endif
+#ifdef KRS_TRACE_ONLY   // the tracing alone, its result kept, nothing shaded
+    write_trace(dir, hit, t, iterations);
 #else
     write_pixel(dir, hit, t, iterations);
 #endif
