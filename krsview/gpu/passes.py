@@ -50,10 +50,11 @@ SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, 
 
 def splits_shadows(scene: Scene) -> bool:
     """Whether ``scene``'s shadow rays can be a pass of their own: it has shadows, on the
-    fragment path, in float (the trace pass hands each ray's distance on as a float)."""
+    fragment path or with persistent lanes (``steps = 0``, whose trace pass is deferred.frag's),
+    in float (the trace pass hands each ray's distance on as a float)."""
     return (
         bool(SHADOW_EFFECTS & set(scene.effects))
-        and scene.render.path == "fragment"
+        and (scene.render.path == "fragment" or scene.render.steps == 0)
         and scene.render.precision == "float"
     )
 

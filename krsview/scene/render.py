@@ -144,7 +144,7 @@ class Render:
         help="side of the pixel blocks that share a shadow ray: the nearest hit of each "
         "block traces one per light, and each pixel blends the blocks near its depth "
         "[KRS17 §8.5: soft shadows at ¼ resolution] (1: a shadow ray per pixel, as on the "
-        "compute path and in double precision, which always trace per pixel)",
+        "compute path's rounds and in double precision, which always trace per pixel)",
     )
     shadow_cone: str = param(
         "on",
