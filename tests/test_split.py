@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from krsview.gpu.renderer import read_buffers
+from krsview.gpu.readback import read_buffers
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
 

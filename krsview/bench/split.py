@@ -14,7 +14,8 @@ from dataclasses import replace
 
 from ..compile.geometry import compile_geometry
 from ..gpu.passes import still_ratio
-from ..gpu.renderer import Renderer, read_plane
+from ..gpu.readback import read_plane
+from ..gpu.renderer import Renderer
 from ..gpu.uniforms import variant_defines
 from ..scene import EFFECTS, Scene
 from .harness import Variant, median_times

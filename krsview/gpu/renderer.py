@@ -26,6 +26,7 @@ from .compute import LANE_PROBES, ComputePath, Rounds, compute_passes, path_defi
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
+from .readback import read_buffers, read_plane
 from .uniforms import krs_block, variant_defines, view_uniforms
 
 PROGRESS_BANDS = 16  # bands of rows of a first frame drawn with progress
@@ -384,21 +385,3 @@ class Renderer:
                 self.ctx.finish()
                 times.append(time.perf_counter() - t0)
             return times
-
-
-def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:
-    """Colour attachment k as (rows top → bottom, columns, 4) float32."""
-    raw = fbo.read(attachment=k, components=4, dtype="f4")
-    return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)[::-1]
-
-
-def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Frame:
-    c, nd, it = (read_plane(fbo, k, width, height) for k in range(3))
-    hit = c[..., 3] > 0.5
-    return Frame(
-        c[..., :3].astype(np.float64),
-        nd[..., 3].astype(np.float64),
-        nd[..., :3].astype(np.float64),
-        it[..., 0].astype(np.int64),
-        hit,
-    )
