@@ -40,7 +40,7 @@ def variants() -> list[tuple[krsview.Scene, dict]]:
     """(scene, prepare's keywords) for every variant to check: each preset on both paths, in
     float and double, without and with the pre-pass; every hard case on both paths; the
     knobs that change the source (tracers, culling, the level of detail off, shadow and
-    component tasks, the walk restart, the variant
+    component tasks, persistent lanes, the walk restart, the variant
     with every effect, the measuring probes)."""
     out = []
     for name in krsview.presets():
@@ -63,6 +63,7 @@ def variants() -> list[tuple[krsview.Scene, dict]]:
         (krsview.configure(krsview.load("palm"), lod=0.0, prepass=4), {}),
         (krsview.configure(tree, lod=0.0, path="compute", precision="double"), {}),
         (krsview.configure(tree, path="compute", shadow_tasks="off"), {}),
+        (krsview.configure(tree, path="compute", steps=0, prepass=4), {}),  # persistent lanes
         (krsview.configure(grove, path="compute", component_tasks="on", prepass=4), {}),
         (krsview.configure(grove, tracer="binary", precision="double"), {}),
         (tree, {"probes": ("KRS_COUNT_LEVELS",)}),
