@@ -18,7 +18,8 @@ from .kernels import kernel_distance, world_normal
 def fold(u: np.ndarray, c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reflect the points behind the mirror of normal u through c (its slot's ball centre,
     which compile/balls.py puts on the plane); returns (x', e) with e = u·(x − c), the signed
-    distance before folding (e > 0: reflected)."""
+    distance before folding (e > 0: reflected). The shader folds so where it compiles the
+    level of detail, else with e = u·x − w: the same plane, in float64 the same to rounding."""
     e = (x - c) @ u
     return np.where((e > 0.0)[:, None], x - 2.0 * e[:, None] * u, x), e
 

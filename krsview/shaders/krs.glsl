@@ -2,12 +2,18 @@
 // twin of reference/krs.py. Folding clips each level to its mirror's negative side.
 #include "kernels.glsl"
 
-// Reflect p if it lies behind mirror i, the plane u·(p − c) = 0 through its slot's ball centre
-// c (compile/balls.py centres every C_i on its mirror, so the walk reads c, r and u: 7 scalars
-// a level, not 8 with the offset w); returns that signed distance u·(p − c).
+// Reflect p if it lies behind mirror i, the plane u·p = w; returns that signed distance e.
+// With the level of detail the walk reads slot i's ball (c, r) at every level, and
+// compile/balls.py centres it on the mirror's plane, so e = u·(p − c) needs no w: 7 scalars a
+// level, not 8. Without it e = u·p − w reads the mirror alone (4 scalars, not 6 with c).
+// Culling on or off, a variant folds alike, so culling changes no value, bit for bit.
 real fold(int i, vec3r c, inout vec3r p) {
     vec3r u = u_mirrors[i].xyz;
+#ifdef KRS_LOD
     real e = dot(p - c, u);
+#else
+    real e = dot(p, u) - u_mirrors[i].w;
+#endif
     p -= 2.0 * max(e, 0.0) * u;  // no branch: llvmpipe would run it anyway
     return e;
 }
@@ -33,7 +39,7 @@ int g_levels = 0;   // levels walked so far by this invocation (bench paths' mea
 // the ball's distance once, after the walk. On llvmpipe each read of the uniform block is a
 // gather per component that costs far more than the arithmetic around it, and a branch's
 // reads run whether any pixel takes it or not (docs/speed.md): the ball (c, r) is read once,
-// and its centre c serves culling and the fold alike.
+// and its centre c serves culling, the level of detail and the fold alike.
 bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e, inout int cut) {
 #ifdef KRS_COUNT_LEVELS
     ++g_levels;

@@ -32,7 +32,7 @@ layout(std140) uniform KRSBlock {
 #ifdef KRS_MOBIUS
     vec4r u_mobius[KRS_SLOTS * MOBIUS_RECORD];   // per level: H_i = G_i⁻¹ (mobius.glsl)
 #else
-    vec4r u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w (w unread)
+    vec4r u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
     vec4r u_bounds[KRS_SLOTS];                   // culling ball (c, r) before fold i, c on
                                                  // mirror i's plane (krs.glsl, fold)
 #endif
