@@ -145,8 +145,9 @@ def krs_bounds(krs: KRS) -> np.ndarray:
     its part of A_i) reaches at most 2ρ beyond A_i ⊂ C_i (krs.glsl). Slots below only empty
     kernels get no ball (the walk's d is still ∞ there).
 
-    Every centre lies on its slot's mirror plane, so that the walk folds with it, u·(x − c),
-    and never reads the plane's offset (krs.glsl, fold). That costs no radius: A_i is
+    Every centre lies on its slot's mirror plane, so that a walk that reads the ball at every
+    level anyway (the level of detail) folds about it, u·(x − c), and need not read the
+    plane's offset w (krs.glsl, fold). That costs no radius: A_i is
     symmetric under R_i, so if (c, r) holds it so does (R_i c, r), and so does (m, r) with m
     their midpoint, on the plane: |x − m| ≤ (|x − c| + |x − R_i c|)/2 ≤ r. A slot without a
     ball keeps radius −1 about the plane's point nearest the origin."""
