@@ -127,14 +127,16 @@ def test_every_ball_is_centred_on_its_mirror_and_still_holds_its_slot(name, leve
 
 
 def test_folding_about_the_centres_is_folding_in_the_mirrors():
-    """Alg. 1 folding about the balls' centres (reference/krs.py, as the shader) gives the
-    value of Alg. 1 folding in the planes u·x = w, written out here, to rounding; negative
-    control: folding about the centres as enclosed, before projection, does not."""
+    """Alg. 1 folding about the balls' centres (reference/krs.py, as the shader where it
+    compiles the level of detail) gives the value of Alg. 1 folding in the planes u·x = w,
+    written out here, to rounding; negative control: folding about the centres as enclosed,
+    before projection, does not."""
     from krsview.compile.balls import UNBOUNDED, grown, held_balls
     from krsview.reference.kernels import kernel_distance
 
     scene = load_scene(resolve("tree"))
-    c = compile_krs(scene.geometry().truncated(12), (1.0, 1.0, 1.0))
+    g = scene.geometry().truncated(12)
+    c = compile_krs(g, (1.0, 1.0, 1.0))
     x = points(scene)
     y, planes = x, kernel_distance(c.types[c.n], c.records[c.n], x)
     for i in range(c.n - 1, -1, -1):
@@ -143,10 +145,7 @@ def test_folding_about_the_centres_is_folding_in_the_mirrors():
         planes = np.minimum(planes, kernel_distance(c.types[i], c.records[i], y))
     walk = krs.distance(c, x, cull=False)
     assert np.allclose(walk, planes, rtol=0.0, atol=1e-12)
-    enclosed = [
-        UNBOUNDED if b is None else grown(b)
-        for b in held_balls(scene.geometry().truncated(12))[:-1]
-    ]
+    enclosed = [UNBOUNDED if b is None else grown(b) for b in held_balls(g)[:-1]]
     loose = replace(c, bounds=np.array(enclosed))
     assert np.abs(krs.distance(loose, x, cull=False) - planes).max() > 1e-3
 
