@@ -109,7 +109,7 @@ def fold_ties(scene, ref: Frame, ulps: float = 4.0) -> np.ndarray:
         if isinstance(part, CompiledKRS):  # a MöKRS has no mirror planes
             x = p if dist is None else dist.undistort(p, k)
             for i in range(part.n - 1, -1, -1):
-                x, e = fold(part.mirrors[i], x)
+                x, e = fold(part.mirrors[i, :3], part.bounds[i, :3], x)
                 ties |= np.abs(e) < ulps * 2.0**-23 * t
     return ties.reshape(h, w) & ref.hit
 

@@ -96,6 +96,60 @@ def test_every_ball_holds_what_it_claims_and_is_tight(name, levels):
     assert slack and (name == "rock" or max(slack) > 1.3), slack
 
 
+@pytest.mark.parametrize(
+    "name, levels", [("tree", 12), ("bent-tree", 11), ("rock", None), ("grass", None)]
+)
+def test_every_ball_is_centred_on_its_mirror_and_still_holds_its_slot(name, levels):
+    """The walk folds about each slot's ball centre, u·(x − c) (krs.glsl, fold), so every
+    centre lies on its slot's mirror plane, and the ball still holds every copy of every
+    kernel's ball the slot tests (brute force). Negative controls: the centres as enclosed
+    (held_balls, before projection) lie off their planes, and a centre projected onto the
+    plane of the slot below instead no longer holds its slot somewhere."""
+    from krsview.compile.balls import held_balls, on_plane
+
+    g = load_scene(resolve(name)).geometry()
+    g = g.truncated(levels) if levels else g
+    bounds, enclosed = krs_bounds(g), held_balls(g)
+    off, elsewhere = [], []
+    for i, (ball, m) in enumerate(zip(bounds, g.mirrors)):
+        u = np.array(m.normal)
+        assert abs(ball[:3] @ u - m.offset) <= 1e-12 * (1.0 + np.abs(ball[:3]).max()), (name, i)
+        if ball[3] < 0:
+            continue
+        held = expanded(g, i)
+        assert (np.linalg.norm(held[:, :3] - ball[:3], axis=1) + held[:, 3]).max() <= ball[3]
+        off.append(abs(enclosed[i][:3] @ u - m.offset) / ball[3])
+        if i > 0:
+            below = g.mirrors[i - 1]
+            c = on_plane(ball[:3], np.array(below.normal), below.offset)
+            elsewhere.append((np.linalg.norm(held[:, :3] - c, axis=1) + held[:, 3]).max() / ball[3])
+    assert max(off) > 1e-3 and max(elsewhere) > 1.0, (off, elsewhere)
+
+
+def test_folding_about_the_centres_is_folding_in_the_mirrors():
+    """Alg. 1 folding about the balls' centres (reference/krs.py, as the shader where it
+    compiles the level of detail) gives the value of Alg. 1 folding in the planes u·x = w,
+    written out here, to rounding; negative control: folding about the centres as enclosed,
+    before projection, does not."""
+    from krsview.compile.balls import UNBOUNDED, grown, held_balls
+    from krsview.reference.kernels import kernel_distance
+
+    scene = load_scene(resolve("tree"))
+    g = scene.geometry().truncated(12)
+    c = compile_krs(g, (1.0, 1.0, 1.0))
+    x = points(scene)
+    y, planes = x, kernel_distance(c.types[c.n], c.records[c.n], x)
+    for i in range(c.n - 1, -1, -1):
+        e = y @ c.mirrors[i, :3] - c.mirrors[i, 3]
+        y = y - 2.0 * np.maximum(e, 0.0)[:, None] * c.mirrors[i, :3]
+        planes = np.minimum(planes, kernel_distance(c.types[i], c.records[i], y))
+    walk = krs.distance(c, x, cull=False)
+    assert np.allclose(walk, planes, rtol=0.0, atol=1e-12)
+    enclosed = [UNBOUNDED if b is None else grown(b) for b in held_balls(g)[:-1]]
+    loose = replace(c, bounds=np.array(enclosed))
+    assert np.abs(krs.distance(loose, x, cull=False) - planes).max() > 1e-3
+
+
 def test_a_ball_one_kernel_too_small_changes_the_distance():
     """Negative control: leaving K_i out of C_i (a ball one kernel too small) culls walks
     that still had a smaller value: the distance differs from the full walk somewhere."""
@@ -174,20 +228,17 @@ def test_culling_that_ignores_the_reach_of_the_balls_below_changes_the_image(ren
 @pytest.mark.parametrize("culling", ["on", "off"])
 def test_the_cut_ball_drawn_after_the_walk_equals_the_cut_in_place(renderer, tmp_path, culling):
     """The level of detail's cut notes its slot and draws the ball once the walk is over
-    (krs.glsl, krs_lod_cut), so that a level reads only the ball's radius where culling does
-    not read its centre; the image is the cut's in place (the ball's distance taken at the
-    level, as Alg. 1 reads, before a shader that defers it), bit for bit, with and without
-    culling. Negative control: deferring the ball of the slot above draws another image."""
+    (krs.glsl, krs_lod_cut); the image is the cut's in place (the ball's distance taken at the
+    level, as Alg. 1 reads), bit for bit, with and without culling. Negative control:
+    deferring the ball of the slot above draws another image."""
     from krsview.gpu.renderer import Renderer
 
     from .conftest import broken_shaders
 
-    deferred = "if (r >= 0.0 && r < rho) { cut = i; return false; }"
-    in_place = (
-        "if (r >= 0.0 && r < rho) { d = min(d, length(x - u_bounds[i].xyz) - r); return false; }"
-    )
+    deferred = "if (b.w >= 0.0 && b.w < rho) { cut = i; return false; }"
+    in_place = "if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); return false; }"
     inline = Renderer(shader_dir=broken_shaders(tmp_path / "a", "krs.glsl", deferred, in_place))
-    above = "if (r >= 0.0 && r < rho) { cut = i + 1; return false; }"
+    above = "if (b.w >= 0.0 && b.w < rho) { cut = i + 1; return false; }"
     wrong = Renderer(shader_dir=broken_shaders(tmp_path / "b", "krs.glsl", deferred, above))
     scene = load_scene(resolve("tree"))
     scene = replace(scene, render=replace(scene.render, culling=culling, lod=2.0))

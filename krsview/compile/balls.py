@@ -131,6 +131,11 @@ def grown(ball: np.ndarray | None) -> np.ndarray:
     )
 
 
+def on_plane(c: np.ndarray, u: np.ndarray, w: float) -> np.ndarray:
+    """The point c projected onto the plane u·x = w (u a unit normal)."""
+    return c - (c @ u - w) * u
+
+
 def krs_bounds(krs: KRS) -> np.ndarray:
     """(n, 4): per mirror slot i, the ball C_i of A_i, everything Alg. 1 still tests before
     folding at level i (radius −1: unbounded, from a plane kernel on), grown by CULL_MARGIN
@@ -138,12 +143,23 @@ def krs_bounds(krs: KRS) -> np.ndarray:
     there with the same value [issue 17, exact level culling]; with the level of detail at ρ,
     once d ≤ dist(x, C_i) − 2ρ, since a ball drawn for the levels below (radius < ρ, holding
     its part of A_i) reaches at most 2ρ beyond A_i ⊂ C_i (krs.glsl). Slots below only empty
-    kernels get no ball (the walk's d is still ∞ there)."""
-    out = [grown(b) for b in held_balls(krs)[:-1]]
+    kernels get no ball (the walk's d is still ∞ there).
+
+    Every centre lies on its slot's mirror plane, so that a walk that reads the ball at every
+    level anyway (the level of detail) folds about it, u·(x − c), and need not read the
+    plane's offset w (krs.glsl, fold). That costs no radius: A_i is
+    symmetric under R_i, so if (c, r) holds it so does (R_i c, r), and so does (m, r) with m
+    their midpoint, on the plane: |x − m| ≤ (|x − c| + |x − R_i c|)/2 ≤ r. A slot without a
+    ball keeps radius −1 about the plane's point nearest the origin."""
+    held = held_balls(krs)
     # where every kernel above slot i is empty the walk still has d = ∞ there and can never
     # stop: no ball, so the test is not paid for (sierpinski: all but K_0 empty)
     solid = np.cumsum([not isinstance(k, Empty) for k in krs.kernels[::-1]])[::-1]
-    for i in range(len(out)):
-        if solid[i + 1] == 0:
-            out[i] = UNBOUNDED
-    return np.array(out, dtype=np.float64).reshape(-1, 4)
+    out = np.zeros((len(krs.mirrors), 4))
+    for i, m in enumerate(krs.mirrors):
+        u, ball = np.array(m.normal, dtype=np.float64), held[i] if solid[i + 1] else None
+        if ball is None:
+            out[i] = [*on_plane(np.zeros(3), u, m.offset), -1.0]
+        else:
+            out[i] = grown(np.array([*on_plane(ball[:3], u, m.offset), ball[3]]))
+    return out

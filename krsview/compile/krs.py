@@ -39,7 +39,8 @@ POSITION_SLOTS = {"sphere": (1,), "capsule": (1, 2), "toroidal_capsule": (1,)}
 @dataclass(frozen=True)
 class CompiledKRS:
     mirrors: np.ndarray  # (n, 4): u.xyz, w  (the plane u·x = w)
-    bounds: np.ndarray  # (n, 4): krs_bounds, the culling ball before fold i (r < 0: none)
+    bounds: np.ndarray  # (n, 4): krs_bounds, the culling ball before fold i (r < 0: none),
+    # centred on mirror i's plane (the walk folds about that centre)
     records: np.ndarray  # (n+1, RECORD_VEC4, 4) float64
     types: tuple[str, ...]  # kernel type per level (after arc → capsule degeneration)
     ball: np.ndarray  # (4,): grown(krs_ball), everything drawn (r < 0: unbounded)
@@ -67,7 +68,7 @@ class CompiledKRS:
             if kind == "plane":
                 records[i, 1, 3] -= records[i, 1, :3] @ o
         bounds = self.bounds.copy()
-        bounds[:, :3] -= np.where(bounds[:, 3:] >= 0, o, 0.0)
+        bounds[:, :3] -= o  # every centre, with or without a ball: it stays on its plane
         ball = self.ball - np.array([*o, 0.0]) if self.ball[3] >= 0 else self.ball
         return CompiledKRS(mirrors, bounds, records, self.types, ball)
 

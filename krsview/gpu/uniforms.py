@@ -117,8 +117,9 @@ def slots(c: Compiled) -> int:
 
 
 def krs_block(c: Compiled, precision: str = "float") -> bytes:
-    """The std140 KRSBlock: mirrors and culling balls (or Möbius records), then kernel
-    records, as float32 or, for ``precision = "double"`` (dvec4 arrays), float64."""
+    """The std140 KRSBlock: mirrors and culling balls, each centred on its mirror (the walk
+    folds about it), or Möbius records; then kernel records, as float32 or, for
+    ``precision = "double"`` (dvec4 arrays), float64."""
     return b"".join(a.tobytes() for a in block_arrays(c, precision, slots(c)).values())
 
 

@@ -15,11 +15,13 @@ from ..compile.krs import CompiledKRS
 from .kernels import kernel_distance, world_normal
 
 
-def fold(m: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Reflect the points behind mirror m = (u, w); returns (x', e) with e = u·x − w, the
-    signed distance before folding (e > 0: reflected)."""
-    e = x @ m[:3] - m[3]
-    return np.where((e > 0.0)[:, None], x - 2.0 * e[:, None] * m[:3], x), e
+def fold(u: np.ndarray, c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reflect the points behind the mirror of normal u through c (its slot's ball centre,
+    which compile/balls.py puts on the plane); returns (x', e) with e = u·(x − c), the signed
+    distance before folding (e > 0: reflected). The shader folds so where it compiles the
+    level of detail, else with e = u·x − w: the same plane, in float64 the same to rounding."""
+    e = (x - c) @ u
+    return np.where((e > 0.0)[:, None], x - 2.0 * e[:, None] * u, x), e
 
 
 def distance(
@@ -49,7 +51,7 @@ def distance(
             cut = live & (b[3] < rho)
             d = np.where(cut, np.minimum(d, db), d)
             live &= ~cut & ((db - 2.0 * rho < d) | (not cull))
-        x, _ = fold(c.mirrors[i], x)
+        x, _ = fold(c.mirrors[i, :3], c.bounds[i, :3], x)
         if c.types[i] != "empty":
             d = np.where(live, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
     return d
@@ -139,11 +141,11 @@ def restart(
             d = np.where(cut, np.minimum(d, db), d)
             live &= ~(act & (cut | (db - 2.0 * rho >= d)))  # 2ρ: what is cut below reaches
             act = live & (i <= start)
-        mu = c.mirrors[i]
-        xf, e = fold(mu, x)
+        mu = c.mirrors[i, :3]
+        xf, e = fold(mu, c.bounds[i, :3], x)
         x = np.where(act[:, None], xf, x)
         flip = act & (e > 0)
-        u = np.where(flip[:, None], u - 2.0 * (u @ mu[:3])[:, None] * mu[:3], u)
+        u = np.where(flip[:, None], u - 2.0 * (u @ mu)[:, None] * mu, u)
         m = np.where(act, np.minimum(m, np.abs(e)), m)
         if c.types[i] != "empty":
             d = np.where(act, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
@@ -176,7 +178,7 @@ def nearest(
     Mk = M.copy()
     for i in range(c.n - 1, -1, -1):
         u = c.mirrors[i, :3]
-        x, e = fold(c.mirrors[i], x)
+        x, e = fold(u, c.bounds[i, :3], x)
         w = mirror_weight(e, width)
         M = M - 2.0 * w[:, None, None] * np.einsum("ni,j->nij", M @ u, u)
         if c.types[i] == "empty":

@@ -2,11 +2,19 @@
 // twin of reference/krs.py. Folding clips each level to its mirror's negative side.
 #include "kernels.glsl"
 
-// Reflect p if it lies behind mirror i (u·p − w > 0); returns that signed distance u·p − w.
-real fold(int i, inout vec3r p) {
-    vec4r m = u_mirrors[i];
-    real e = dot(p, m.xyz) - m.w;
-    p -= 2.0 * max(e, 0.0) * m.xyz;  // no branch: llvmpipe would run it anyway
+// Reflect p if it lies behind mirror i, the plane u·p = w; returns that signed distance e.
+// With the level of detail the walk reads slot i's ball (c, r) at every level, and
+// compile/balls.py centres it on the mirror's plane, so e = u·(p − c) needs no w: 7 scalars a
+// level, not 8. Without it e = u·p − w reads the mirror alone (4 scalars, not 6 with c).
+// Culling on or off, a variant folds alike, so culling changes no value, bit for bit.
+real fold(int i, vec3r c, inout vec3r p) {
+    vec3r u = u_mirrors[i].xyz;
+#ifdef KRS_LOD
+    real e = dot(p - c, u);
+#else
+    real e = dot(p, u) - u_mirrors[i].w;
+#endif
+    p -= 2.0 * max(e, 0.0) * u;  // no branch: llvmpipe would run it anyway
     return e;
 }
 
@@ -30,28 +38,26 @@ int g_levels = 0;   // levels walked so far by this invocation (bench paths' mea
 // level-of-detail cut only notes its slot in `cut` and leaves x as it is: krs_lod_cut adds
 // the ball's distance once, after the walk. On llvmpipe each read of the uniform block is a
 // gather per component that costs far more than the arithmetic around it, and a branch's
-// reads run whether any pixel takes it or not; read in the cut's branch, the ball's centre
-// was read at every level, which without culling doubled what the level of detail cost
-// (docs/speed.md).
+// reads run whether any pixel takes it or not (docs/speed.md): the ball (c, r) is read once,
+// and its centre c serves culling, the level of detail and the fold alike.
 bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e, inout int cut) {
 #ifdef KRS_COUNT_LEVELS
     ++g_levels;
 #endif
     e = 0.0;
+    vec4r b = u_bounds[i];
 #ifdef KRS_CULLING
 #ifdef KRS_LOD
     real reach = 2.0 * rho;  // how far a ball drawn below may reach beyond C_i (above)
 #else
     real reach = 0.0;
 #endif
-    vec4r b = u_bounds[i];
     if (b.w >= 0.0 && length(x - b.xyz) - b.w - reach >= d) return false;
 #endif
 #ifdef KRS_LOD
-    real r = u_bounds[i].w;
-    if (r >= 0.0 && r < rho) { cut = i; return false; }
+    if (b.w >= 0.0 && b.w < rho) { cut = i; return false; }
 #endif
-    e = fold(i, x);
+    e = fold(i, b.xyz, x);
     d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
     return true;
 }
@@ -150,7 +156,7 @@ real krs_nearest(int first, int n, vec3r xw, float width, out int level, out vec
     mat3r M = mat3r(1.0), Mk = mat3r(1.0);
     for (int i = first + n - 1; i >= first; --i) {
         vec3r u = u_mirrors[i].xyz;
-        real e = fold(i, x);
+        real e = fold(i, u_bounds[i].xyz, x);
         M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
         real di = kernel_distance_of(i, x, KRS_LEVEL_KERNELS);
         if (di < d) { d = di; level = i; xk = x; Mk = M; }

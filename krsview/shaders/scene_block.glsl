@@ -33,7 +33,8 @@ layout(std140) uniform KRSBlock {
     vec4r u_mobius[KRS_SLOTS * MOBIUS_RECORD];   // per level: H_i = G_i⁻¹ (mobius.glsl)
 #else
     vec4r u_mirrors[KRS_SLOTS];                  // u.xyz, w: the plane u·x = w
-    vec4r u_bounds[KRS_SLOTS];                   // culling ball before fold i (krs.glsl)
+    vec4r u_bounds[KRS_SLOTS];                   // culling ball (c, r) before fold i, c on
+                                                 // mirror i's plane (krs.glsl, fold)
 #endif
     vec4r u_kernels[KRS_SLOTS * RECORD_VEC4];    // per level: RECORD_VEC4 vec4s
 };
