@@ -149,10 +149,10 @@ def test_culling_changes_no_pixel(renderer, name):
 
 
 def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
-    """`krsview bench paths` times culling × pre-pass tiles on the fragment path and the
-    compute path's round sizes, at --size and twice it; its CSV has every combination, the
-    plain frame as the unit, and fewer full-pass iterations with the pre-pass (no wall-time
-    assertion: only what the rows must contain)."""
+    """`krsview bench paths` times culling × pre-pass tiles on the fragment path, the
+    compute path's round sizes and its persistent lanes, at --size and twice it; its CSV has
+    every combination, the plain frame as the unit, and fewer full-pass iterations with the
+    pre-pass (no wall-time assertion: only what the rows must contain)."""
     import csv
 
     out = tmp_path / "paths.csv"
@@ -170,7 +170,7 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
         for t in (0, 4, 8, 16)
     } | {(size, "fragment", "on", str(t), "1", "0") for size in sizes for t in (4, 8)} | {
         (size, "compute", "on", "8", "2", str(s)) for size in sizes for s in (4, 8, 16, 32)
-    }
+    } | {(size, "compute", "on", "4", "2", "0") for size in sizes}  # persistent lanes
     n = len(load_scene(resolve("sierpinski")).geometry().mirrors)
     for row in rows:
         if (row["path"], row["culling"], row["prepass"]) == ("fragment", "off", "0"):
@@ -191,8 +191,14 @@ def test_bench_paths_reports_every_lever_at_two_sizes(tmp_path):
         iters[("64x36", "compute", "on", "8", "2", "4")]
         == iters[("64x36", "fragment", "on", "8", "2", "0")]
     )
+    assert (  # persistent lanes take the fragment path's steps
+        iters[("64x36", "compute", "on", "4", "2", "0")]
+        == iters[("64x36", "fragment", "on", "4", "2", "0")]
+    )
     assert {row["shadow_rays"] for row in rows} == {""}  # sierpinski has no shadows
     from krsview.bench.paths import levers
 
     shadowed = {k[4:] for k in levers(load_scene(resolve("tree"))) if k[0] == "compute"}
-    assert shadowed == {(s, kind) for s in (4, 8, 16, 32) for kind in ("tasks", "inline")}
+    assert shadowed == {(s, kind) for s in (4, 8, 16, 32) for kind in ("tasks", "inline")} | {
+        (0, "")  # persistent lanes: shadow rays as the fragment path traces them
+    }

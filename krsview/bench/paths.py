@@ -1,11 +1,11 @@
 """`krsview bench paths`: what each speed lever of issue 17 buys, measured side by side —
 exact level culling on and off and the low-resolution pre-pass off and at several tile sizes
-(with the default coarse passes, and with one) on the fragment path, and the compute path
-at several iterations per round (shadow rays as tasks and inline, where the scene has
-shadows), at two resolutions; frame-time ratios against the plain frame (fragment path, no
-culling, no pre-pass), iterations and levels of Alg. 1 walked per pixel in the full pass (a
-KRS), and the coarse passes' share of the frame. Variants are interleaved round by round
-(bench/harness.py)."""
+(with the default coarse passes, and with one) on the fragment path, the compute path at
+several iterations per round (shadow rays as tasks and inline, where the scene has shadows)
+and with persistent lanes (steps 0, at the viewer's pre-pass), at two resolutions;
+frame-time ratios against the plain frame (fragment path, no culling, no pre-pass),
+iterations and levels of Alg. 1 walked per pixel in the full pass (a KRS), and the coarse
+passes' share of the frame. Variants are interleaved round by round (bench/harness.py)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from dataclasses import replace
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene
+from ..scene.render import VIEW_PREPASS
 from .harness import Variant, median_times
 from .report import Measured, markdown
 
@@ -48,8 +49,9 @@ def lever(
 
 def levers(scene: Scene) -> dict[tuple, Scene]:
     """(path, culling, tile, coarse passes, steps, shadow rays) → the scene drawn so; coarse
-    passes 0 without a pre-pass; steps 0 on the fragment path; shadow rays "tasks" or
-    "inline" on the compute path of a scene with shadows, else ""."""
+    passes 0 without a pre-pass; steps 0 on the fragment path, and on the compute path its
+    persistent lanes; shadow rays "tasks" or "inline" on the compute path's rounds of a scene
+    with shadows, else ""."""
     shadowed = bool({"shadows", "soft_shadows"} & set(scene.effects))
     passes = scene.render.prepass_levels
     out = {
@@ -76,6 +78,9 @@ def levers(scene: Scene) -> dict[tuple, Scene]:
             for s in STEPS
         }
     )
+    out[("compute", "on", VIEW_PREPASS, passes, 0, "")] = lever(  # persistent lanes
+        scene, "compute", "on", VIEW_PREPASS, 0
+    )
     if shadowed:
         out.update(
             {
@@ -93,7 +98,7 @@ def lever_name(k: tuple) -> str:
     return (
         f"{k[0]}, culling {k[1]}, pre-pass {k[2] or 'off'}"
         + (f" × {k[3]}" if k[3] else "")
-        + (f", {k[4]} per round" if k[4] else "")
+        + (f", {k[4]} per round" if k[4] else ", persistent lanes" if k[0] == "compute" else "")
         + (f", shadow rays {k[5]}" if k[5] else "")
     )
 
