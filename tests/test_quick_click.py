@@ -115,10 +115,21 @@ def test_a_quick_tap_on_the_gizmo_keeps_the_selection(baked):
     assert e.selected is None or e.selected.path != FORK
 
 
+def pose(e) -> tuple[np.ndarray, np.ndarray]:
+    """The camera's position and the watched fork's, as they are now."""
+    return e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
+
+
+def moved(e, before: tuple[np.ndarray, np.ndarray]) -> tuple[float, float]:
+    """How far the camera and the fork moved since ``before`` (:func:`pose`)."""
+    (eye, fork), (eye2, fork2) = before, pose(e)
+    return float(np.linalg.norm(eye2 - eye)), float(np.linalg.norm(fork2 - fork))
+
+
 def press_and_drag(e, start, along) -> tuple[float, float]:
     """From the view, a press straight at ``start`` and a 30-pixel drag along ``along``; how
     far the camera and the fork moved."""
-    eye, fork = e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
+    before = pose(e)
     rest(e, window_xy(e, 30, 480))
     xdo("mousemove", *map(round, start), "mousedown", 1)
     pump(e, 2)
@@ -127,10 +138,7 @@ def press_and_drag(e, start, along) -> tuple[float, float]:
         pump(e, 1)
     xdo("mouseup", 1)
     pump(e, 2)
-    return (
-        float(np.linalg.norm(e.viewer.camera.position - eye)),
-        float(np.linalg.norm(np.array(e.scene.route.levels[LEVEL].fork) - fork)),
-    )
+    return moved(e, before)
 
 
 def test_a_quick_press_and_drag_on_the_gizmo_moves_the_fork_not_the_orbiting_camera(baked):
@@ -204,15 +212,12 @@ def in_one_poll(e, rest_at, *events) -> tuple[float, float]:
     a press and a move) delivered together, before any frame; how far the camera and the
     fork moved once the button is up."""
     rest(e, rest_at)
-    eye, fork = e.viewer.camera.position.copy(), np.array(e.scene.route.levels[LEVEL].fork)
+    before = pose(e)
     xdo(*events)
     pump(e, 2)
     xdo("mouseup", 1)
     pump(e, 2)
-    return (
-        float(np.linalg.norm(e.viewer.camera.position - eye)),
-        float(np.linalg.norm(np.array(e.scene.route.levels[LEVEL].fork) - fork)),
-    )
+    return moved(e, before)
 
 
 def xy(p) -> tuple[int, int]:
