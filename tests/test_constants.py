@@ -211,6 +211,7 @@ TWIN_NAMES: dict[str, str | None] = {
     "next_step": "front",  # a tracer's steps: one loop per tracer in NumPy
     "ray_begin": "sphere_trace",
     "ray_step": "sphere_trace",
+    "ray_starts_live": "sphere_trace",
     "trace_ray": "sphere_trace",
     "bound_ahead": None,  # the balls' exits change no value: compared without them instead
     "leave": None,

@@ -87,6 +87,6 @@ def test_the_pixels_skipped_are_the_free_tiles(renderer, tmp_path, case):
 def test_a_mark_that_skips_rays_short_of_the_far_limit_loses_hits(renderer, tmp_path):
     """Negative control: free tiles taken as every tile whose cone moved at all."""
     scene = CASES["tree in one pass"]
-    wrong = broken_shaders(tmp_path, "render.frag", MARK, "gl_FragDepth = first > 0.0 ? 0.0 : 1.0;")
+    wrong = broken_shaders(tmp_path, "render.frag", MARK, "gl_FragDepth = r.t > 0.0 ? 0.0 : 1.0;")
     img, ref = Renderer(shader_dir=wrong).render(scene, W, H), renderer.render(scene, W, H)
     assert img.hit.sum() < ref.hit.sum()

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algebra.quaternion import conj
+
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
@@ -24,9 +26,7 @@ def arc_local(P: np.ndarray, q: np.ndarray) -> np.ndarray:
 def arc_world(P: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The inverse of arc_local: frame coordinates v (N, 3), in units of R, as a world offset
     R·F v from the arc's centre (P v P̄ = F v / R, divided by |P|⁴)."""
-    w, u = P[0], P[1:]
-    out = (w * w - u @ u) * v + 2.0 * (v @ u)[:, None] * u + 2.0 * w * np.cross(u, v)
-    return out / float(P @ P) ** 2
+    return arc_local(conj(P), v) / float(P @ P) ** 2  # P v P̄: the sandwich by P̄
 
 
 def arc_half_angle(rec: np.ndarray) -> tuple[float, float]:

@@ -25,10 +25,8 @@ vec3r arc_local(vec4r P, vec3r q) {
 
 // Its inverse: frame coordinates v in units of R as a world offset R·F v from O.
 vec3r arc_world(vec4r P, vec3r v) {
-    vec3r f = (P.x * P.x - dot(P.yzw, P.yzw)) * v + 2.0 * dot(P.yzw, v) * P.yzw
-              + 2.0 * P.x * cross(P.yzw, v);
     real k = dot(P, P);
-    return f / (k * k);
+    return arc_local(vec4r(P.x, -P.yzw), v) / (k * k);  // P v P̄: the sandwich by P̄
 }
 
 // cos and sin of phi/2 from t = tan(phi/4), rational and so accurate for every arc.

@@ -15,9 +15,6 @@ int ray_index(ivec2 pixel) {
 bool starts_live(ivec2 pixel, out Ray r) {
     real start[COMPONENT_SLOTS];
     ray_start(pixel, start);
-    r = ray_begin(start);
-    int c;
-    real t;
-    return next_step(r, c, t);
+    return ray_starts_live(start, r);
 }
 #endif

@@ -16,10 +16,8 @@ void main() {
     real t;
     int iterations;
 #ifdef KRS_FREE_TILES
-    Ray r = ray_begin(start);
-    int c;
-    real first;
-    bool traced = next_step(r, c, first);  // false: done before a step, as trace_ray is
+    Ray r;
+    bool traced = ray_starts_live(start, r);  // false: done before a step, as trace_ray is
     gl_FragDepth = traced ? 1.0 : 0.0;
     t = r.t;
     iterations = r.iterations;

@@ -63,6 +63,16 @@ bool next_step(inout Ray r, out int c, out real t) {
     return true;
 }
 
+// The ray starting at `start`, and false where it is done before its first step (its
+// pre-pass tile free past the far limit), left as ray_step would leave it: the pixels the
+// free tiles' variant of render.frag writes, and persistent lanes skip (rays.glsl).
+bool ray_starts_live(real start[COMPONENT_SLOTS], out Ray r) {
+    r = ray_begin(start);
+    int c;
+    real t;
+    return next_step(r, c, t);
+}
+
 #ifdef KRS_BALL_EXIT  // COMPONENT_BALL: distance.glsl
 // What is left of component c ahead on a ray from o along dir, now at x = o + t dir with
 // c's distance d there: a component that can no longer stop the ray (nor, on a shadow ray,
