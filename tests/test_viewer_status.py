@@ -1,16 +1,18 @@
 """What the viewer says about itself: the HUD's state of the image on screen (moving, refining
-k/n, still) and where F12 wrote its screenshot."""
+k/n, still), where F12 wrote its screenshot, and only the knobs that act on the setting."""
 
 from __future__ import annotations
 
 import os
 import shutil
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from imgui_bundle import imgui
 from PIL import Image
 
+from krsview import load
 from krsview.scene.presets import resolve
 from krsview.viewer.adaptive import Step
 from krsview.viewer.screenshots import pictures_folder, save_screenshot
@@ -198,3 +200,19 @@ def test_a_screenshot_nowhere_writable_says_where_it_tried(tmp_path, monkeypatch
     (tmp_path / "fern.screenshots").write_text("")
     with pytest.raises(OSError, match=r"screenshot not written: .*fern\.screenshots: .*Pictures"):
         save_screenshot(RGB, scene, "20260101-000000")
+
+
+def test_the_hud_offers_only_the_knobs_that_act_on_the_setting():
+    from krsview.viewer.hud import knobs_shown
+
+    render = load("tree").render
+    tasks = {"shadow_tasks", "component_tasks"}
+    fragment = set(knobs_shown(render))
+    rounds = set(knobs_shown(replace(render, path="compute", steps=16)))
+    lanes = set(knobs_shown(replace(render, path="compute", steps=0)))
+    assert not fragment & (tasks | {"steps"}), "the compute path's knobs on the fragment path"
+    assert rounds - fragment == tasks | {"steps"}, "the rounds' knobs are missing"
+    assert lanes - fragment == {"steps"}, "persistent lanes trace no tasks"
+    binary = set(knobs_shown(replace(render, tracer="binary")))
+    assert {"xi_bonus", "xi_penalty"} <= binary and "relaxation" not in binary
+    assert not {"xi_bonus", "xi_penalty"} & fragment

@@ -50,6 +50,7 @@ KNOBS = (
     "prepass_levels",
 )
 COMPUTE_KNOBS = ("steps", "shadow_tasks", "component_tasks")  # on the compute path only
+TASK_KNOBS = ("shadow_tasks", "component_tasks")  # rounds of tasks: not with lanes (steps 0)
 RENDER_META = {f.name: dict(f.metadata) for f in fields(Render)}
 
 
@@ -153,13 +154,22 @@ def _performance(v: Viewed, out: list) -> None:
         out.append(c.SetMovingEffects(on))
 
 
+def knobs_shown(r: Render) -> tuple[str, ...]:
+    """The render knobs that act on this setting: another tracer's, the compute path's
+    on the fragment path and the tasks' with persistent lanes change nothing, so the HUD
+    does not offer them."""
+    return tuple(
+        name
+        for name in KNOBS
+        if TRACER_KNOBS.get(name, r.tracer) == r.tracer
+        and (name not in COMPUTE_KNOBS or r.path == "compute")
+        and (name not in TASK_KNOBS or r.steps > 0)
+    )
+
+
 def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
     r = v.scene.render
-    for name in KNOBS:
-        if TRACER_KNOBS.get(name, r.tracer) != r.tracer:  # another tracer's knob
-            continue
-        if name in COMPUTE_KNOBS and r.path != "compute":
-            continue
+    for name in knobs_shown(r):
         meta = RENDER_META[name]
         if name == "tracer" and v.scene.mokrs is not None:
             meta = {**meta, "choices": ("binary",)}  # a MöKRS has only unbounding tests
