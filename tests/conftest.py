@@ -7,7 +7,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -122,18 +121,19 @@ def display():
         return
     xvfb = shutil.which("Xvfb")
     assert xvfb, "Xvfb is needed for the window tests (`make deps` installs it)"
-    for n in range(90, 110):
-        if not Path(f"/tmp/.X{n}-lock").exists():
-            break
+    # Xvfb picks a free display itself and writes its number once it accepts clients, so
+    # test processes running side by side never share or race for one.
+    read, write = os.pipe()
     proc = subprocess.Popen(
-        [xvfb, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        [xvfb, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
+        pass_fds=(write,),
     )
-    for _ in range(100):
-        if Path(f"/tmp/.X11-unix/X{n}").exists():
-            break
-        time.sleep(0.05)
+    os.close(write)
+    with os.fdopen(read) as number:
+        n = number.readline().strip()
+    assert n.isdigit(), f"Xvfb did not start (exit {proc.poll()})"
     os.environ["DISPLAY"] = f":{n}"
     yield f":{n}"
     del os.environ["DISPLAY"]

@@ -22,6 +22,8 @@ from krsview.share.frames import FrameJob, frame_file, render_frames
 
 from .conftest import krsview_cli
 
+# one local Ray for the module: under `pytest -n` its tests run in the same worker
+pytestmark = pytest.mark.xdist_group("ray")
 SIZE = (64, 36)
 POSES = [
     dict(t=0.0, position=[0.0, 2.0, -9.0], yaw=0.0, pitch=0.0),
