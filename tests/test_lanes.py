@@ -65,15 +65,18 @@ def lane_counts(renderer) -> dict[str, np.ndarray]:
 def test_lanes_draw_the_fragment_paths_image(renderer, name, tracer, prepass):
     """A KRS, a compound and a MöKRS: the same image, bit for bit; the lanes took more pixels
     than there are lanes (they refilled), and every lane finished (the last sized the round
-    after them)."""
+    after them): as many as hold LANE_STEPS_PER_PIXEL steps per listed pixel at the cap's
+    steps each, fewer with the pre-pass, which lists only the tiles with rays to trace."""
     scene = on_path(load_scene(resolve(name)), "fragment", tracer=tracer, prepass=prepass)
     fragment = renderer.render(scene, W, H)
     traced = renderer.render(lanes(scene), W, H)
     assert same(fragment, traced)
     assert fragment.hit.any() and (fragment.iterations > 1).any()
     c = lane_counts(renderer)
-    cap = scene.render.max_iterations
-    lanes_n = -(-W * H * LANE_STEPS_PER_PIXEL // (COMPUTE_GROUP * cap)) * COMPUTE_GROUP
+    cap, block = scene.render.max_iterations, prepass or compute.LANE_BLOCK
+    listed = int(c["count"][0]) * block**2
+    assert (listed < W * H) == (prepass > 0) and listed >= W * H * (prepass == 0)
+    lanes_n = -(-listed * LANE_STEPS_PER_PIXEL // (COMPUTE_GROUP * cap)) * COMPUTE_GROUP
     assert c["lanes_done"][0] == lanes_n < c["taken"][0]
 
 
@@ -306,3 +309,19 @@ def test_a_wrong_anchor_in_the_lanes_gives_wrong_hits(tmp_path, renderer, broken
     wrong = Renderer(shader_dir=broken_shaders(tmp_path, *broken)).render(scene, W, H)
     agree = agreement(right, wrong, DEPTH_REL, NORMAL_DEG, COLOR_TOL)
     assert agree.depth_close < 0.9, agree
+
+
+def test_the_lanes_dispatch_is_sized_by_the_listed_pixels(renderer):
+    """At the whole-tree view (stop 0 of bench zoom) most pre-pass tiles are free past the far
+    limit: the GPU sizes the lanes' dispatch from the pixels it listed, a quarter of those a
+    dispatch sized by every pixel would hold, and the image is still the fragment path's."""
+    scene = on_path(crown_stops()["tree stop 0"], "fragment", prepass=VIEW_PREPASS)
+    size = (160, 90)
+    fragment = renderer.render(scene, *size)
+    assert same(fragment, renderer.render(lanes(scene), *size))
+    c = lane_counts(renderer)
+    listed, cap = int(c["count"][0]) * VIEW_PREPASS**2, scene.render.max_iterations
+    per_group = COMPUTE_GROUP * cap
+    every = -(-size[0] * size[1] * LANE_STEPS_PER_PIXEL // per_group) * COMPUTE_GROUP
+    assert c["lanes_done"][0] == -(-listed * LANE_STEPS_PER_PIXEL // per_group) * COMPUTE_GROUP
+    assert c["lanes_done"][0] <= every // 3, (c["lanes_done"][0], every)
