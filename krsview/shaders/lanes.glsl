@@ -16,9 +16,14 @@
 // group may take): llvmpipe ends every loop of an invocation after 65535 loop iterations in
 // all, which a subgroup tracing pixel after pixel would reach, and a walk cut short would
 // return a wrong distance. Its rays still live then are saved whole and queued (queue 1,
-// count[1]), and the last lane to finish sizes lanes_rest's dispatch.
+// count[1]), and the last lane to finish sizes lanes_rest's dispatch. llvmpipe's threads run
+// workgroups one after another, so each subgroup takes pixels until its budget ends and saves
+// the rays it holds then: at the zoom's stop 3 (320×180) 2,704 rays, 4.7 % of the pixels, at
+// 16 to 48 steps per pixel alike; their round is 6 % of the fragment path's tracing there.
+// The anchor of the walk restart (trace.glsl's Ray) is saved with the ray, and a lane drops
+// it with its ray (ray_begin), so lanes take the fragment path's restarted steps too.
 
-uniform uint u_lane_steps;  // steps per listed pixel that the lanes' subgroups hold
+uniform uint u_lane_steps;  // steps per listed pixel that the lanes' dispatch holds
 uniform int u_block;     // the side of the blocks: the pre-pass's tile (4 without one)
 uniform uint u_blocks;   // blocks over u_tile_rect (u_block_grid.x × .y)
 uniform ivec2 u_block_grid;  // blocks across and down
