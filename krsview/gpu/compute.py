@@ -31,10 +31,11 @@ from ..scene import MAX_COMPONENTS, Render
 from ..scene.scene import MAX_LIGHTS
 from .program import ProgramCache
 
-# Persistent lanes: their dispatch holds subgroups enough for this many steps per pixel, each
-# subgroup taking at most the iteration cap (lanes.glsl); what they leave, a round finishes
-# (8 left more to it: 0.89× the fragment path's frame inside the crown against 0.78×), and a
-# subgroup with nothing left to take runs one masked step.
+# Persistent lanes: their dispatch, sized on the GPU from the pixels listed to trace, holds
+# subgroups enough for this many steps per pixel, each subgroup taking at most the iteration
+# cap (lanes.glsl); what they leave, a round finishes (8 left more to it: 0.89× the fragment
+# path's frame inside the crown against 0.78×), and a subgroup with nothing left to take runs
+# one masked step.
 LANE_STEPS_PER_PIXEL = 16
 LANE_BLOCK = 4  # without a pre-pass, the side of the pixel blocks the lanes take
 # The measuring probes a lanes variant draws too (deferred.frag): the tracing alone, with the
@@ -151,26 +152,25 @@ class ComputePath:
         self.ctx.memory_barrier()
 
     def _lanes(self, r: Rounds, rect: tuple[int, int, int, int]) -> None:
-        """Persistent lanes (lanes.glsl) over ``rect``: list the blocks with rays to trace,
-        let the lanes trace their pixels, then a round finishes what they left, sized by the
-        last lane; nothing is read back."""
+        """Persistent lanes (lanes.glsl) over ``rect``: list the blocks with rays to trace
+        (which sizes the lanes' dispatch), let the lanes trace their pixels, then a round
+        finishes what they left, sized by the last lane; nothing is read back."""
         comp, (x, y, w, h), b = r.comp, rect, r.block
         grid = ((x + w - 1) // b - x // b + 1, (y + h - 1) // b - y // b + 1)
         blocks = grid[0] * grid[1]
-        lanes = -(-w * h * LANE_STEPS_PER_PIXEL // (COMPUTE_GROUP * r.cap))
         self.buffers[BINDING_COUNTS].write(counts(0, 0))
         self._set(
             comp,
             u_block=b,
             u_block_grid=grid,
             u_blocks=blocks,
-            u_lanes=lanes * COMPUTE_GROUP,
+            u_lane_steps=LANE_STEPS_PER_PIXEL,
             u_phase=PHASE_START,
         )
         comp.run(-(-blocks // COMPUTE_GROUP))
         self.ctx.memory_barrier()
         comp["u_phase"].value = PHASE_LANES
-        comp.run(lanes)
+        comp.run_indirect(self.buffers[BINDING_COUNTS], offset=COUNTS.offsets()["groups"])
         self.ctx.memory_barrier()
         comp["u_phase"].value = PHASE_ROUND
         comp.run_indirect(self.buffers[BINDING_COUNTS], offset=COUNTS.offsets()["groups"])
