@@ -26,8 +26,9 @@ from typing import Any
 from .frame import Frame
 from .scene import Render, Scene, SceneError, load_scene
 from .scene.info import SceneInfo, describe
+from .scene.model import KRS
 from .scene.presets import preset_names, resolve
-from .scene.render import VIEW_PREPASS
+from .scene.render import LANES_LEVELS, VIEW_PREPASS
 from .scene.schema import from_dict
 from .scene.settings import MAX_SIDE
 
@@ -92,10 +93,18 @@ def configure(
 def fast_settings(scene: Scene) -> Scene:
     """The scene with the viewer's fast settings where its file sets none: the pre-pass
     tile VIEW_PREPASS (the level of detail and the shadow rays' pixel blocks are scene
-    fields, DEFAULT_LOD and DEFAULT_SHADOW_BLOCK unless the file says otherwise). The
-    oracle certifies both geometry settings hole-free; hits may move by up to ε (pre-pass)
-    and 2·lod·ε (level of detail)."""
-    return scene if scene.render.prepass else scene.edit(("render", "prepass"), VIEW_PREPASS)
+    fields, DEFAULT_LOD and DEFAULT_SHADOW_BLOCK unless the file says otherwise), and for
+    a single KRS of LANES_LEVELS levels or more on the fragment path, persistent lanes
+    (``path="compute"``, ``steps=0``: the same image bit for bit). The oracle certifies both
+    geometry settings hole-free; hits may move by up to ε (pre-pass) and 2·lod·ε (level of
+    detail)."""
+    if not scene.render.prepass:
+        scene = scene.edit(("render", "prepass"), VIEW_PREPASS)
+    g = scene.geometry()
+    deep = isinstance(g, KRS) and len(g.levels) >= LANES_LEVELS
+    if deep and scene.render.path == "fragment":
+        scene = configure(scene, path="compute", steps=0)
+    return scene
 
 
 def exact_settings(scene: Scene) -> Scene:

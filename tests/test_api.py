@@ -230,3 +230,28 @@ def test_a_wheel_works_outside_the_checkout(tmp_path):
     assert where.startswith(str(site))
     assert int(presets) == len(krsview.presets()) >= 11
     assert int(measured) > 10
+
+
+def test_fast_settings_trace_a_deep_krs_by_persistent_lanes_the_same_image():
+    from krsview.api import configure, fast_settings
+    from krsview.cli import build_parser
+    from krsview.cli.options import scene_of
+    from krsview.cli.render import settled
+
+    tree = krsview.load("tree")
+    fast = fast_settings(tree)
+    assert (fast.render.path, fast.render.steps, fast.render.prepass) == ("compute", 0, 4)
+    # shallow, a MöKRS, a compound: the fragment path (lanes measured slower there)
+    for name in ("rock", "palm", "grove"):
+        assert fast_settings(krsview.load(name)).render.path == "fragment", name
+    assert fast_settings(tree.with_levels(12)).render.path == "fragment"
+    rounds = tree.edit("render.path", "compute")  # a file's own choice of path stands
+    assert fast_settings(rounds).render.steps == 16
+    lanes = krsview.render(tree, SIZE)
+    fragment = GpuRenderer().render(configure(fast, path="fragment", steps=16), *SIZE)
+    for name in ("color", "depth", "normal", "iterations", "hit"):
+        assert np.array_equal(getattr(lanes, name), getattr(fragment, name)), name
+    # on the command line an option given stands too
+    for argv, path in ((["tree"], "compute"), (["tree", "--path", "fragment"], "fragment")):
+        args = build_parser().parse_args(["render", *argv])
+        assert settled(args, scene_of(args)).render.path == path, argv

@@ -31,6 +31,7 @@ class Bench:
     scene_options: bool = False  # --epsilon-scale, --max-iterations, --levels, --effects
     own: tuple[tuple[str, dict], ...] = field(default=())  # its own options: flag, argparse
     needs: tuple[str, str] | None = None  # (module, extra) of an optional library it runs on
+    fast: bool = False  # draws with `render`'s fast settings where no file or option sets them
 
 
 def level_list(text: str) -> tuple[int, ...]:
@@ -110,9 +111,11 @@ BENCHES = {
         "From the scene's eye straight into its finest kernel (the tip of a tree's twig, "
         "20 and more levels down), at distances shrinking geometrically: frame time "
         "(interleaved rounds), iterations per pixel and levels walked per iteration at each "
-        "stop, and the slowest frame against the fastest. Example: krsview bench zoom tree "
-        "--stops 12 --plot out/zoom.png",
-        knobs=("prepass", "culling", "lod", "walk_restart"),
+        "stop, and the slowest frame against the fastest. It draws with `render`'s fast "
+        "settings where the scene and the options set none. Example: krsview bench zoom "
+        "tree --stops 12 --plot out/zoom.png",
+        knobs=("prepass", "culling", "lod", "walk_restart", "path", "steps"),
+        fast=True,
         own=(
             (
                 "--stops",
@@ -207,6 +210,8 @@ def run(args: argparse.Namespace) -> int:
     if needs is not None:
         options.require(needs[0], extra=needs[1], what=f"bench {args.bench}")
     scene = options.scene_of(args)
+    if BENCHES[args.bench].fast:
+        scene = options.fast_scene_of(args, scene)
     if args.csv:
         check_output_file(args.csv, "--csv", ".csv")
     module = importlib.import_module(f"krsview.bench.{args.bench}")

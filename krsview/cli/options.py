@@ -187,6 +187,16 @@ def scene_of(args: argparse.Namespace, name: str | None = None) -> Scene:
     return scene if t is None else scene.at(t, "--time")
 
 
+FAST_KNOBS = ("prepass", "path", "steps")  # the [render] fields api.fast_settings may set
+
+
+def fast_scene_of(args: argparse.Namespace, scene: Scene) -> Scene:
+    """``scene`` (``scene_of(args)``) with the viewer's fast settings (api.fast_settings)
+    where neither its file nor an option given sets them: an option given stands."""
+    given = {k: getattr(scene.render, k) for k in FAST_KNOBS if getattr(args, k, None) is not None}
+    return api.configure(api.fast_settings(scene), **given)
+
+
 def check_output_file(path: str, flag: str, suffix: str) -> Path:
     """Before any work: the file has the format's extension, is not a folder, and its folder
     exists or can be made and is writable (a render must not fail after it ran)."""

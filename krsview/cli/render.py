@@ -13,7 +13,7 @@ from .. import api, export
 from ..frame import Frame
 from ..progress import Progress
 from ..scene import Scene, SceneError
-from ..scene.render import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, VIEW_PREPASS
+from ..scene.render import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, LANES_LEVELS, VIEW_PREPASS
 from ..share.frames import DEFAULT_FPS
 from . import options
 from .options import SILENT_SECONDS, check_output_dir, check_output_file, render_option
@@ -42,9 +42,9 @@ def add(sub) -> None:
         help="render a scene headless to PNG (and raw buffers)",
         description="Render PRESET headless through EGL and write a PNG; prints the measured "
         "frame time. Draws with the viewer's fast settings (the pre-pass, the level of "
-        "detail) unless the scene or an option sets them; --exact draws every level "
-        "without the pre-pass. Example: krsview render tree -o tree.png --size 640x360 "
-        "--prepass 8",
+        f"detail; persistent lanes for a single KRS of {LANES_LEVELS} levels or more) unless "
+        "the scene or an option sets them; --exact draws every level without the pre-pass. "
+        "Example: krsview render tree -o tree.png --size 640x360 --prepass 8",
     )
     options.preset(r)
     r.add_argument(
@@ -195,7 +195,7 @@ def settled(args: argparse.Namespace, scene: Scene) -> Scene:
                 flag = "--" + knob.replace("_", "-")
                 raise SceneError(flag, getattr(args, knob), "cannot be combined with --exact")
         return api.exact_settings(scene)
-    return scene if args.prepass is not None else api.fast_settings(scene)
+    return options.fast_scene_of(args, scene)
 
 
 def reference_frame(scene: Scene, size: tuple[int, int]) -> Frame:

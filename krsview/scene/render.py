@@ -22,6 +22,10 @@ DEFAULT_LOD = 0.5
 # render.shadow_block where the file has none: soft shadows within 1/255 of per-pixel ones in
 # mean colour, for 14–26 % of a still frame on tree and grove (docs/speed.md); 1: per pixel
 DEFAULT_SHADOW_BLOCK = 2
+# A single KRS this deep traces its primary rays with persistent lanes where the file sets
+# the fragment path (the same image: inside tree's crown 0.82–0.84× the CPU, its whole views
+# within noise; a MöKRS, a compound and shallow trees lose; docs/speed.md)
+LANES_LEVELS = 20
 
 
 @dataclass(frozen=True)
