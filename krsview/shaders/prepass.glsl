@@ -8,7 +8,9 @@
 // stops where its distance is below ε(u) ≤ u·ε_per_t, so with σ' = σ + ε_per_t the ball of
 // radius s + (t + 2s)·σ' around the centre ray's point t + s holds every tile ray's points on
 // [t, t + 2s] with their ε-balls. Probed as the binary tracer does [KRS17 Alg. 2]: free →
-// t += 2s and s grows; blocked → s shrinks, until s is no larger than the cone's own width.
+// t += 2s and s grows; blocked → s shrinks, until s is no larger than PREPASS_STOP times the
+// cone's own width t·σ' (the cone creeps on with probes narrower than itself, which its 16 or
+// more rays need not take: compile/constants.py).
 // The probing starts at t0: 0, or where the cone of the coarser tile around this one stopped
 // (prepass.frag; render.prepass_levels).
 uniform int u_tile;
@@ -22,7 +24,7 @@ real cone_free(int c, vec3r dir, real sigma, real t0) {
             t += 2.0 * s;
             s *= u_xi_bonus;
         } else {
-            if (s <= t * sigma) break;
+            if (s <= PREPASS_STOP * t * sigma) break;
             s *= u_xi_penalty;
         }
     }
