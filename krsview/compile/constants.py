@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from ..scene import MAX_COMPONENTS
 from ..scene.effects import MAX_EMPTY_ZONES
+from ..scene.render import PREPASS_RATIO
 from ..scene.scene import MAX_LIGHTS
 from .krs import KERNEL_CODES, RECORD_VEC4
 
@@ -40,6 +41,10 @@ COMPUTE_GROUP = 64  # compute.comp's local size
 # display.frag's views, in order (KRS_VIEW = VIEW_<MODE>; shaded: no define)
 VIEW_MODES = ("shaded", "iterations", "depth", "normals")
 PREPASS_TARGETS = -(-MAX_COMPONENTS // 4)  # RGBA32F targets of a coarse pass: 4 components each
+# A coarse pass stores its tiles in four quarter images, blocks of PREPASS_BLOCK × PREPASS_BLOCK
+# tiles alternating between them (prepass.glsl, coarse_texel; gpu/uniforms.coarse_layout), so
+# that llvmpipe's threads share the cones and a SIMD group's tiles stay neighbours.
+PREPASS_BLOCK = 8
 # Storage buffer bindings: the scene block (KRS_DOUBLE) and the compute path's buffers.
 BINDING_KRS_BLOCK = 0  # also the uniform block binding of KRSBlock in float
 BINDING_RAYS = 1  # rays.glsl's Ray per pixel
@@ -84,6 +89,8 @@ def shared() -> dict[str, GlslValue]:
         "BARK_STRETCH": BARK_STRETCH,
         "COMPUTE_GROUP": COMPUTE_GROUP,
         "PREPASS_TARGETS": PREPASS_TARGETS,
+        "PREPASS_RATIO": PREPASS_RATIO,
+        "PREPASS_BLOCK": PREPASS_BLOCK,
         "BINDING_KRS_BLOCK": BINDING_KRS_BLOCK,
         "BINDING_RAYS": BINDING_RAYS,
         "BINDING_QUEUES": BINDING_QUEUES,

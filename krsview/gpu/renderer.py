@@ -27,10 +27,30 @@ from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
 from .readback import read_buffers, read_plane
-from .uniforms import krs_block, variant_defines, view_uniforms
+from .uniforms import coarse_layout, coarse_quarter, krs_block, variant_defines, view_uniforms
 
 PROGRESS_BANDS = 16  # bands of rows of a first frame drawn with progress
 MAX_TARGETS = 8  # render-target sizes kept (least recently used released)
+
+
+def quarters(
+    columns: int, rows: int, tiles: tuple[int, int, int, int] | None
+) -> Iterator[tuple[int, int, int, int]]:
+    """The texel rectangles (x, y, w, h) of a coarse pass's quarter images (coarse_layout) that
+    hold the tiles ``tiles`` = (x0, y0, x1, y1) (None: all), in GL coordinates; empty ones
+    left out. A quarter's tiles in a range of columns lie in a range of its columns."""
+    x0, y0, x1, y1 = tiles or (0, 0, columns, rows)
+    stride, _ = coarse_layout(columns, rows)
+    spans = []  # per axis and quarter: (first, end) of its columns (rows) holding the range
+    for a, b in ((x0, x1), (y0, y1)):
+        cells = [coarse_quarter(x) for x in range(a, b)]
+        spans.append([[c for q, c in cells if q == k] for k in (0, 1)])
+    for qy in (0, 1):
+        for qx in (0, 1):
+            xs, ys = spans[0][qx], spans[1][qy]
+            if xs and ys:
+                origin = (qx * stride[0] + xs[0], qy * stride[1] + ys[0])
+                yield (*origin, xs[-1] + 1 - xs[0], ys[-1] + 1 - ys[0])
 
 
 class Renderer:
@@ -253,26 +273,27 @@ class Renderer:
             if passes and passes[-1][1:] == grid[1:]:
                 break  # as coarse as the image allows
             passes.append(grid)
-        parent = None
+        parent, parent_stride = None, (0, 0)
         for t, cw, ch in reversed(passes):
-            fbo = self._framebuffer(cw, ch, layers=PREPASS_TARGETS)
+            fbo = self._framebuffer(*coarse_layout(cw, ch)[1], layers=PREPASS_TARGETS)
             fbo.use()
-            self.ctx.viewport = (0, 0, cw, ch)
             coarse["u_tile"].value = t
             coarse["u_parent_ratio"].value = PREPASS_RATIO if parent else 0
+            coarse["u_layout"].value = (*coarse_layout(cw, ch)[0], *parent_stride)
             # the coarsest pass reads no parent: its samplers get a texture no pass draws
             # into, so no target is ever bound for sampling while it is drawn into
             for unit, tex in enumerate(
                 parent.color_attachments if parent else (self._blank_texture(),) * PREPASS_TARGETS
             ):
                 tex.use(PREPASS_TARGETS + unit)
+            tiles = None
             if tile is not None:
                 x, y, w, h = tile
-                x0, y0 = x // t, y // t
-                self.ctx.scissor = (x0, y0, -(-(x + w) // t) - x0, -(-(y + h) // t) - y0)
-            self._full(coarse)
-            self.ctx.scissor = None
-            parent = fbo
+                tiles = (x // t, y // t, -(-(x + w) // t), -(-(y + h) // t))
+            for rect in quarters(cw, ch, tiles):  # one draw each: no texel between them
+                self.ctx.viewport = rect
+                self._full(coarse)
+            parent, parent_stride = fbo, coarse_layout(cw, ch)[0]
         for unit, tex in enumerate(parent.color_attachments):
             tex.use(unit)
 
@@ -347,9 +368,15 @@ class Renderer:
             size = self._coarse[prog][1]
             self._prepass(prog, width, height, None)
             cw, ch = -(-width // size), -(-height // size)
-            fbo = self._framebuffer(cw, ch, layers=PREPASS_TARGETS)
-            planes = [read_plane(fbo, k, cw, ch) for k in range(PREPASS_TARGETS)]
-            return np.concatenate(planes, axis=-1).astype(np.float64)
+            (sx, sy), (w, h) = coarse_layout(cw, ch)
+            fbo = self._framebuffer(w, h, layers=PREPASS_TARGETS)
+            planes = [read_plane(fbo, k, w, h)[::-1] for k in range(PREPASS_TARGETS)]  # GL rows
+            x, y = (
+                np.array([q * s + c for q, c in map(coarse_quarter, range(n))])
+                for s, n in ((sx, cw), (sy, ch))
+            )  # each tile's texel (coarse_texel)
+            texels = np.concatenate(planes, axis=-1)[y[:, None], x]
+            return texels[::-1].astype(np.float64)  # rows top → bottom
 
     def time_frame(
         self,

@@ -15,6 +15,19 @@
 // (prepass.frag; render.prepass_levels).
 uniform int u_tile;
 
+// Where a coarse pass stores its tiles: blocks of PREPASS_BLOCK × PREPASS_BLOCK tiles alternate
+// between four quarter images, block (i, j) at (i / 2, j / 2) of quarter (i % 2, j % 2),
+// quarter k starting at k × stride, on a corner of llvmpipe's 64-pixel bins. llvmpipe gives
+// each bin to one thread, and a coarse image of up to 64 × 64 tiles (the whole of it at
+// 320×180) lies in one or two bins, all of the tree's cones in one; each quarter samples the
+// whole image, so the threads share the cones, and a block keeps neighbouring tiles together
+// in a SIMD group (gpu/renderer.py draws each quarter; gpu/uniforms.py, coarse_layout, gives
+// the strides; docs/speed.md).
+ivec2 coarse_texel(ivec2 tile, ivec2 stride) {
+    ivec2 block = tile / PREPASS_BLOCK;
+    return (block & 1) * stride + (block >> 1) * PREPASS_BLOCK + tile % PREPASS_BLOCK;
+}
+
 #ifdef KRS_PREPASS_COARSE
 real cone_free(int c, vec3r dir, real sigma, real t0) {
     real t = t0, s = INITIAL_PROBE;
@@ -46,12 +59,13 @@ real cone_spread(vec2 corner, vec3r centre) {
 // Free distance per component: components 4k..4k + 3 in target k (compile/constants.py:
 // PREPASS_TARGETS × 4 = MAX_COMPONENTS).
 uniform sampler2D u_free[PREPASS_TARGETS];
+uniform ivec2 u_free_stride;  // the finest coarse pass's quarter stride (coarse_texel)
 
 // Where the ray of `pixel` starts, per component: its tile's free distance.
 void ray_start(ivec2 pixel, out real start[COMPONENT_SLOTS]) {
-    ivec2 tile = pixel / u_tile;
+    ivec2 texel = coarse_texel(pixel / u_tile, u_free_stride);
     vec4 t[PREPASS_TARGETS];
-    for (int k = 0; k < PREPASS_TARGETS; ++k) t[k] = texelFetch(u_free[k], tile, 0);
+    for (int k = 0; k < PREPASS_TARGETS; ++k) t[k] = texelFetch(u_free[k], texel, 0);
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = real(t[c / 4][c % 4]);
 }
 #else
