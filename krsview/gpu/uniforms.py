@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..compile.balls import UNBOUNDED
@@ -238,10 +240,12 @@ def coarse_quarter(x: int) -> tuple[int, int]:
     return block % 2, block // 2 * PREPASS_BLOCK + x % PREPASS_BLOCK
 
 
+@functools.cache
 def coarse_layout(columns: int, rows: int) -> tuple[tuple[int, int], tuple[int, int]]:
     """The quarter images' stride and the target's size of a coarse pass of ``columns`` ×
     ``rows`` tiles (prepass.glsl, coarse_texel): each quarter starts on a corner of
-    PREPASS_BIN-pixel bins, the bins llvmpipe gives one thread each."""
+    PREPASS_BIN-pixel bins, the bins llvmpipe gives one thread each (cached: every frame
+    asks)."""
     stride, size = [], []
     for n in (columns, rows):
         ends = [0, 0]  # each quarter's width
