@@ -17,10 +17,12 @@ import pytest
 
 from krsview.compile.constants import PREPASS_BLOCK
 from krsview.gpu import renderer as renderer_module
-from krsview.gpu.renderer import quarters
+from krsview.gpu.renderer import Renderer, quarters
 from krsview.gpu.uniforms import PREPASS_BIN, coarse_layout, coarse_quarter
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
+
+from .conftest import broken_shaders
 
 SIZES = [(1, 1), (2, 1), (3, 5), (9, 3), (20, 12), (80, 45), (121, 67), (480, 270)]
 
@@ -94,3 +96,27 @@ def test_the_prepass_drawn_in_bands_draws_every_tile(renderer, monkeypatch):
     assert whole.hit.any()
     monkeypatch.setattr(renderer_module, "quarters", lambda *a: quarters(*a)[:-1])
     assert not np.array_equal(whole.iterations, banded().iterations)
+
+
+@pytest.mark.parametrize("tile, size", [(3, (61, 35)), (5, (77, 44)), (4, (150, 83))])
+def test_each_pixel_starts_from_its_own_tile(renderer, tmp_path, tile, size):
+    """Each pixel reads its tile's free distance through the layout (ray_start): the pixels
+    the free tiles' pass wrote alone (the tracing variant counts 1000 more iterations) are
+    exactly those whose tile, pixel // tile in NumPy, is free past the far limit, for tiles
+    that are no power of two and sizes that are no multiple of them."""
+    scene = load_scene(resolve("tree")).edit(("tree", "levels"), 3)
+    scene = scene.edit(("render", "prepass"), tile).edit(("render", "shadow_block"), 1)
+    traced = "bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);"
+    marked = Renderer(
+        shader_dir=broken_shaders(
+            tmp_path, "render.frag", traced, traced + "\n iterations += 1000;"
+        )
+    )
+    w, h = size
+    skipped = marked.render(scene, w, h).iterations < 1000
+    free = renderer.free_distances(scene, w, h)[..., 0] > scene.render.max_distance
+    rows = len(free) - 1 - (h - 1 - np.arange(h)) // tile  # tiles count from the bottom row
+    assert np.array_equal(skipped, free[rows][:, np.arange(w) // tile])
+    assert 0.3 < skipped.mean() < 1.0
+    # negative control: the pixel's tile one column off is another mask
+    assert not np.array_equal(skipped, free[rows][:, (np.arange(w) + tile) // tile % free.shape[1]])

@@ -61,9 +61,11 @@ real cone_spread(vec2 corner, vec3r centre) {
 uniform sampler2D u_free[PREPASS_TARGETS];
 uniform ivec2 u_free_stride;  // the finest coarse pass's quarter stride (coarse_texel)
 
-// Where the ray of `pixel` starts, per component: its tile's free distance.
+// Where the ray of `pixel` starts, per component: its tile's free distance. The tile is
+// pixel / u_tile, found in float ((p + ½)/t lies ½/t clear of an integer): llvmpipe divides
+// integers one lane at a time, which cost the free tiles' pass a fifth of its time.
 void ray_start(ivec2 pixel, out real start[COMPONENT_SLOTS]) {
-    ivec2 texel = coarse_texel(pixel / u_tile, u_free_stride);
+    ivec2 texel = coarse_texel(ivec2((vec2(pixel) + 0.5) / float(u_tile)), u_free_stride);
     vec4 t[PREPASS_TARGETS];
     for (int k = 0; k < PREPASS_TARGETS; ++k) t[k] = texelFetch(u_free[k], texel, 0);
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = real(t[c / 4][c % 4]);
