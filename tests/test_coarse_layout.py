@@ -1,5 +1,5 @@
 """A coarse pass stores its tiles as four quarter images, each on a corner of llvmpipe's bins
-(prepass.glsl's coarse_texel, gpu/uniforms.coarse_layout, gpu/renderer.quarters), so that the
+(prepass.glsl's coarse_texel, gpu/coarse.py), so that the
 threads, which take a bin each, share the cones. Checked against brute force: every tile gets
 a texel of its own inside its quarter's rectangle, a band of tiles is drawn by the rectangles
 that hold exactly its texels, and an image drawn in bands equals the one drawn whole.
@@ -17,8 +17,8 @@ import pytest
 
 from krsview.compile.constants import PREPASS_BLOCK
 from krsview.gpu import renderer as renderer_module
-from krsview.gpu.renderer import Renderer, quarters
-from krsview.gpu.uniforms import PREPASS_BIN, coarse_layout, coarse_quarter
+from krsview.gpu.coarse import PREPASS_BIN, coarse_layout, coarse_quarter, quarters
+from krsview.gpu.renderer import Renderer
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
 

@@ -42,7 +42,7 @@ COMPUTE_GROUP = 64  # compute.comp's local size
 VIEW_MODES = ("shaded", "iterations", "depth", "normals")
 PREPASS_TARGETS = -(-MAX_COMPONENTS // 4)  # RGBA32F targets of a coarse pass: 4 components each
 # A coarse pass stores its tiles in four quarter images, blocks of PREPASS_BLOCK × PREPASS_BLOCK
-# tiles alternating between them (prepass.glsl, coarse_texel; gpu/uniforms.coarse_layout), so
+# tiles alternating between them (prepass.glsl, coarse_texel; gpu/coarse.py), so
 # that llvmpipe's threads share the cones and a SIMD group's tiles stay neighbours.
 PREPASS_BLOCK = 8
 # Storage buffer bindings: the scene block (KRS_DOUBLE) and the compute path's buffers.

@@ -7,7 +7,6 @@ far limit are written by a small pass of their own, and the full pass skips them
 
 from __future__ import annotations
 
-import functools
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -23,39 +22,16 @@ from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
 from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
+from .coarse import coarse_layout, coarse_quarter, quarters
 from .compute import LANE_PROBES, ComputePath, Rounds, compute_passes, path_defines
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
 from .readback import read_buffers, read_plane
-from .uniforms import coarse_layout, coarse_quarter, krs_block, variant_defines, view_uniforms
+from .uniforms import krs_block, variant_defines, view_uniforms
 
 PROGRESS_BANDS = 16  # bands of rows of a first frame drawn with progress
 MAX_TARGETS = 8  # render-target sizes kept (least recently used released)
-
-
-@functools.cache
-def quarters(
-    columns: int, rows: int, tiles: tuple[int, int, int, int] | None
-) -> tuple[tuple[int, int, int, int], ...]:
-    """The texel rectangles (x, y, w, h) of a coarse pass's quarter images (coarse_layout) that
-    hold the tiles ``tiles`` = (x0, y0, x1, y1) (None: all), in GL coordinates; empty ones
-    left out. A quarter's tiles in a range of columns lie in a range of its columns (cached:
-    every frame asks)."""
-    x0, y0, x1, y1 = tiles or (0, 0, columns, rows)
-    stride, _ = coarse_layout(columns, rows)
-    spans = []  # per axis and quarter: its columns (rows) that hold the range's tiles
-    for a, b in ((x0, x1), (y0, y1)):
-        cells = [coarse_quarter(x) for x in range(a, b)]
-        spans.append([[c for q, c in cells if q == k] for k in (0, 1)])
-    rects = []
-    for qy in (0, 1):
-        for qx in (0, 1):
-            xs, ys = spans[0][qx], spans[1][qy]
-            if xs and ys:
-                origin = (qx * stride[0] + xs[0], qy * stride[1] + ys[0])
-                rects.append((*origin, xs[-1] + 1 - xs[0], ys[-1] + 1 - ys[0]))
-    return tuple(rects)
 
 
 class Renderer:
@@ -269,7 +245,7 @@ class Renderer:
         """The coarse passes of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
         coarsest first, each reading the one before's free distances from the texture units
         after the first PREPASS_TARGETS; the finest's are left bound to those for the full
-        pass."""
+        pass. Each pass is drawn as its quarter images (coarse.py), one draw each."""
         coarse, size, levels = self._coarse[prog]
         passes: list[tuple[int, int, int]] = []  # (tile size, columns, rows), finest first
         for k in range(levels):

@@ -3,13 +3,11 @@
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from ..compile.balls import UNBOUNDED
 from ..compile.camera import View
-from ..compile.constants import MOBIUS_RECORD, PREPASS_BLOCK
+from ..compile.constants import MOBIUS_RECORD
 from ..compile.geometry import Compiled, walk_restarts
 from ..compile.krs import KERNEL_CODES, RECORD_VEC4, CompiledCompound
 from ..compile.mokrs import CompiledMoKRS
@@ -25,6 +23,7 @@ from ..scene.effects import (
     wind_feet,
 )
 from ..scene.scene import MAX_LIGHTS
+from .coarse import free_stride
 
 
 def variant_defines(
@@ -225,43 +224,6 @@ def per_component(c: Compiled, rows: list) -> object:
     """A per-component uniform's value: its rows in a compound; for a single KRS its one row,
     as moderngl takes a one-element array (and share/web.py bakes it back into one)."""
     return rows if isinstance(c, CompiledCompound) else rows[0]
-
-
-# llvmpipe's bin, in pixels: it gives each bin of a pass to one thread, so each quarter image of
-# a coarse pass starts on a bin corner (coarse_layout)
-PREPASS_BIN = 64
-
-
-def coarse_quarter(x: int) -> tuple[int, int]:
-    """Tile column (or row) ``x`` of a coarse pass: its quarter, 0 or 1, and its column (row)
-    in that quarter's image: blocks of PREPASS_BLOCK tiles alternate between the quarters
-    (prepass.glsl, coarse_texel)."""
-    block = x // PREPASS_BLOCK
-    return block % 2, block // 2 * PREPASS_BLOCK + x % PREPASS_BLOCK
-
-
-@functools.cache
-def coarse_layout(columns: int, rows: int) -> tuple[tuple[int, int], tuple[int, int]]:
-    """The quarter images' stride and the target's size of a coarse pass of ``columns`` ×
-    ``rows`` tiles (prepass.glsl, coarse_texel): each quarter starts on a corner of
-    PREPASS_BIN-pixel bins, the bins llvmpipe gives one thread each (cached: every frame
-    asks)."""
-    stride, size = [], []
-    for n in (columns, rows):
-        ends = [0, 0]  # each quarter's width
-        for x in range(n):
-            q, local = coarse_quarter(x)
-            ends[q] = max(ends[q], local + 1)
-        stride.append(-(-ends[0] // PREPASS_BIN) * PREPASS_BIN)
-        size.append(stride[-1] + ends[1] if ends[1] else ends[0])
-    return (stride[0], stride[1]), (size[0], size[1])
-
-
-def free_stride(view: View, tile: int) -> tuple[int, int]:
-    """The quarter stride of the finest coarse pass (tiles of ``tile`` pixels) over ``view``,
-    which the full pass reads its rays' starts from (prepass.glsl, ray_start)."""
-    tile = max(tile, 1)
-    return coarse_layout(-(-view.width // tile), -(-view.height // tile))[0]
 
 
 def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:

@@ -21,7 +21,7 @@ uniform int u_tile;
 // each bin to one thread, and a coarse image of up to 64 × 64 tiles (the whole of it at
 // 320×180) lies in one or two bins, all of the tree's cones in one; each quarter samples the
 // whole image, so the threads share the cones, and a block keeps neighbouring tiles together
-// in a SIMD group (gpu/renderer.py draws each quarter; gpu/uniforms.py, coarse_layout, gives
+// in a SIMD group (gpu/renderer.py draws each quarter; gpu/coarse.py, coarse_layout, gives
 // the strides; docs/speed.md).
 ivec2 coarse_texel(ivec2 tile, ivec2 stride) {
     ivec2 block = tile / PREPASS_BLOCK;
