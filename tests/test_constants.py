@@ -95,6 +95,7 @@ HOMES = {
     "MAX_COMPONENTS": "scene/compound.py",
     "MAX_LIGHTS": "scene/scene.py",
     "MAX_EMPTY_ZONES": "scene/effects.py",
+    "PREPASS_RATIO": "scene/render.py",
 }
 
 

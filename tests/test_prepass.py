@@ -111,8 +111,8 @@ def test_a_finer_pass_that_reads_the_wrong_coarse_tile_skips_surfaces(tmp_path):
     shaders = broken_shaders(
         tmp_path,
         "prepass.frag",
-        "ivec2(gl_FragCoord.xy) / u_parent_ratio",
-        "ivec2(gl_FragCoord.xy) / (u_parent_ratio / 2)",
+        "coarse_texel(tile / PREPASS_RATIO, u_layout.zw)",
+        "coarse_texel(tile / (PREPASS_RATIO / 2), u_layout.zw)",
     )
     scene = passes(load_scene(resolve("tree")), 2, 2)
     scene = replace(scene, render=replace(scene.render, lod=0.0))  # every level

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from ..scene import MAX_COMPONENTS
 from ..scene.effects import MAX_EMPTY_ZONES
+from ..scene.render import PREPASS_RATIO
 from ..scene.scene import MAX_LIGHTS
 from .krs import KERNEL_CODES, RECORD_VEC4
 
@@ -16,6 +17,11 @@ INITIAL_PROBE = 1.0  # first probe radius of binary tracing, scene units [KRS17 
 # A blocked probe this small has converged even where ε(t) = 0 (an eye inside a solid): in
 # exact arithmetic it would shrink forever; in float32 it underflowed to 0 within 100 probes.
 MIN_PROBE = 1e-30
+# A pre-pass cone stops once a blocked probe is no larger than this fraction of the cone's own
+# width there (prepass.glsl): one cone's further probes spare its tile's 16 rays their first
+# steps, so it pays to get closer than the width (docs/speed.md: 1 → 1/8 took the 16-level
+# tree's primary rays from 1.89 to 1.45 iterations per pixel).
+PREPASS_STOP = 0.125
 # The walk restart's anchor sits at the deepest level whose fold margin and distance above are
 # this many last steps' lengths: the next few steps fit under it (krs.glsl, krs_restart).
 RESTART_KEEP = 8.0
@@ -35,6 +41,10 @@ COMPUTE_GROUP = 64  # compute.comp's local size
 # display.frag's views, in order (KRS_VIEW = VIEW_<MODE>; shaded: no define)
 VIEW_MODES = ("shaded", "iterations", "depth", "normals")
 PREPASS_TARGETS = -(-MAX_COMPONENTS // 4)  # RGBA32F targets of a coarse pass: 4 components each
+# A coarse pass stores its tiles in four quarter images, blocks of PREPASS_BLOCK × PREPASS_BLOCK
+# tiles alternating between them (prepass.glsl, coarse_texel; gpu/coarse.py), so
+# that llvmpipe's threads share the cones and a SIMD group's tiles stay neighbours.
+PREPASS_BLOCK = 8
 # Storage buffer bindings: the scene block (KRS_DOUBLE) and the compute path's buffers.
 BINDING_KRS_BLOCK = 0  # also the uniform block binding of KRSBlock in float
 BINDING_RAYS = 1  # rays.glsl's Ray per pixel
@@ -68,6 +78,7 @@ def shared() -> dict[str, GlslValue]:
         "MAX_EMPTY_ZONES": MAX_EMPTY_ZONES,
         "INITIAL_PROBE": INITIAL_PROBE,
         "MIN_PROBE": MIN_PROBE,
+        "PREPASS_STOP": PREPASS_STOP,
         "RESTART_KEEP": RESTART_KEEP,
         "SHADOW_OFFSET": SHADOW_OFFSET,
         "AO_SAMPLES": AO_SAMPLES,
@@ -78,6 +89,8 @@ def shared() -> dict[str, GlslValue]:
         "BARK_STRETCH": BARK_STRETCH,
         "COMPUTE_GROUP": COMPUTE_GROUP,
         "PREPASS_TARGETS": PREPASS_TARGETS,
+        "PREPASS_RATIO": PREPASS_RATIO,
+        "PREPASS_BLOCK": PREPASS_BLOCK,
         "BINDING_KRS_BLOCK": BINDING_KRS_BLOCK,
         "BINDING_RAYS": BINDING_RAYS,
         "BINDING_QUEUES": BINDING_QUEUES,

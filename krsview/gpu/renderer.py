@@ -22,6 +22,7 @@ from ..compile.geometry import Compiled, compile_geometry
 from ..frame import Frame
 from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
+from .coarse import coarse_layout, coarse_quarter, quarters
 from .compute import LANE_PROBES, ComputePath, Rounds, compute_passes, path_defines
 from .context import behind_mark, headless_context, set_uniforms
 from .passes import PassImage, Targets, still_ratio
@@ -244,7 +245,7 @@ class Renderer:
         """The coarse passes of ``prog``'s pre-pass over the tiles under ``tile`` (or all),
         coarsest first, each reading the one before's free distances from the texture units
         after the first PREPASS_TARGETS; the finest's are left bound to those for the full
-        pass."""
+        pass. Each pass is drawn as its quarter images (coarse.py), one draw each."""
         coarse, size, levels = self._coarse[prog]
         passes: list[tuple[int, int, int]] = []  # (tile size, columns, rows), finest first
         for k in range(levels):
@@ -253,26 +254,27 @@ class Renderer:
             if passes and passes[-1][1:] == grid[1:]:
                 break  # as coarse as the image allows
             passes.append(grid)
-        parent = None
+        parent, parent_stride = None, (0, 0)
         for t, cw, ch in reversed(passes):
-            fbo = self._framebuffer(cw, ch, layers=PREPASS_TARGETS)
+            fbo = self._framebuffer(*coarse_layout(cw, ch)[1], layers=PREPASS_TARGETS)
             fbo.use()
-            self.ctx.viewport = (0, 0, cw, ch)
             coarse["u_tile"].value = t
             coarse["u_parent_ratio"].value = PREPASS_RATIO if parent else 0
+            coarse["u_layout"].value = (*coarse_layout(cw, ch)[0], *parent_stride)
             # the coarsest pass reads no parent: its samplers get a texture no pass draws
             # into, so no target is ever bound for sampling while it is drawn into
             for unit, tex in enumerate(
                 parent.color_attachments if parent else (self._blank_texture(),) * PREPASS_TARGETS
             ):
                 tex.use(PREPASS_TARGETS + unit)
+            tiles = None
             if tile is not None:
                 x, y, w, h = tile
-                x0, y0 = x // t, y // t
-                self.ctx.scissor = (x0, y0, -(-(x + w) // t) - x0, -(-(y + h) // t) - y0)
-            self._full(coarse)
-            self.ctx.scissor = None
-            parent = fbo
+                tiles = (x // t, y // t, -(-(x + w) // t), -(-(y + h) // t))
+            for rect in quarters(cw, ch, tiles):  # one draw each: no texel between them
+                self.ctx.viewport = rect
+                self._full(coarse)
+            parent, parent_stride = fbo, coarse_layout(cw, ch)[0]
         for unit, tex in enumerate(parent.color_attachments):
             tex.use(unit)
 
@@ -347,9 +349,15 @@ class Renderer:
             size = self._coarse[prog][1]
             self._prepass(prog, width, height, None)
             cw, ch = -(-width // size), -(-height // size)
-            fbo = self._framebuffer(cw, ch, layers=PREPASS_TARGETS)
-            planes = [read_plane(fbo, k, cw, ch) for k in range(PREPASS_TARGETS)]
-            return np.concatenate(planes, axis=-1).astype(np.float64)
+            (sx, sy), (w, h) = coarse_layout(cw, ch)
+            fbo = self._framebuffer(w, h, layers=PREPASS_TARGETS)
+            planes = [read_plane(fbo, k, w, h)[::-1] for k in range(PREPASS_TARGETS)]  # GL rows
+            x, y = (
+                np.array([q * s + c for q, c in map(coarse_quarter, range(n))])
+                for s, n in ((sx, cw), (sy, ch))
+            )  # each tile's texel (coarse_texel)
+            texels = np.concatenate(planes, axis=-1)[y[:, None], x]
+            return texels[::-1].astype(np.float64)  # rows top → bottom
 
     def time_frame(
         self,

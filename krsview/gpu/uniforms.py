@@ -23,6 +23,7 @@ from ..scene.effects import (
     wind_feet,
 )
 from ..scene.scene import MAX_LIGHTS
+from .coarse import free_stride
 
 
 def variant_defines(
@@ -253,6 +254,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_xi_penalty": scene.render.xi_penalty,
         "u_relaxation": scene.render.relaxation,
         "u_tile": scene.render.prepass,
+        "u_free_stride": free_stride(view, scene.render.prepass),
         "u_light_count": len(lights),
         "u_light_dir": [lt.direction for lt in lights]
         + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),
