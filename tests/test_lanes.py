@@ -269,10 +269,12 @@ def test_lanes_take_the_restarted_steps(renderer, name):
 
 
 def test_rays_saved_whole_keep_their_anchors(renderer, monkeypatch):
-    """Inside the crown with subgroups for 1 step per pixel, the lanes save rays in the middle
-    of their walks (anchors held) and leave pixels untaken: the image is still the fragment
-    path's restarted one."""
+    """Inside the crown with subgroups for 1 step per pixel and a cap of 48, the lanes save
+    rays in the middle of their walks (anchors held) and leave pixels untaken: the image is
+    still the fragment path's restarted one."""
     scene = restarted(crown_stops()["tree stop 3"])
+    # a lane's budget is the iteration cap: a low one leaves pixels to the last round
+    scene = scene.edit(("render", "max_iterations"), 48)
     fragment = renderer.render(scene, W, H)
     monkeypatch.setattr(compute, "LANE_STEPS_PER_PIXEL", 1)
     traced = renderer.render(lanes(scene), W, H)
