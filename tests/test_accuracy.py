@@ -126,8 +126,9 @@ def test_a_time_difference_under_the_noise_floor_is_said_to_be_within_noise():
 
 
 def test_settings_doing_the_same_work_are_grouped_and_others_not():
-    """A cap that never binds and the compute path draw the very same frames as the scene;
-    only the cap compiles the same variant. A looser ε (another image) and double precision
+    """A cap that never binds, the compute path's rounds and its persistent lanes draw the
+    very same frames as the scene; only the cap compiles the same variant, and the rounds
+    and the lanes are two ways of running. A looser ε (another image) and double precision
     (the same iterations, other colours) are not grouped either."""
     scene = load_scene(resolve("sierpinski"))
     runs = [Setting("scene", "as saved", scene)] + [
@@ -139,11 +140,12 @@ def test_settings_doing_the_same_work_are_grouped_and_others_not():
             ("precision", "double"),
         )
     ]
+    runs.append(Setting("path", "lanes", with_render(scene, path="compute", steps=0)))
     r = Renderer()
     images = {s.name: r.render(s.scene, W, H, s.geometry) for s in runs}
     walked = {s.name: levels_walked(r, s, (W, H)) for s in runs}
     a = images["scene as saved"]
-    for name in ("max_iterations 4096", "path compute"):  # the premise: identical frames
+    for name in ("max_iterations 4096", "path compute", "path lanes"):  # identical frames
         assert np.array_equal(images[name].color, a.color)
         assert np.array_equal(images[name].iterations, a.iterations)
     rep = same_work(r, runs, images, walked, (W, H))
@@ -153,6 +155,7 @@ def test_settings_doing_the_same_work_are_grouped_and_others_not():
         "path compute": "path compute",
         "epsilon_scale 8.0": "epsilon_scale 8.0",
         "precision double": "precision double",
+        "path lanes": "path lanes",
     }
 
 

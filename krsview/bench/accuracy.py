@@ -9,7 +9,8 @@ Knobs: ε-scale (LOD threshold [KRS17 §4]), iteration cap, tracer (sphere / ove
 with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision (float32 or
 float64 shader), exact level culling, the walk restart (render.walk_restart), the level of
 detail in the walk (render.lod), the pixel blocks sharing a soft shadow ray
-(render.shadow_block: colour only), the pre-pass tile, the path (fragment or compute) and
+(render.shadow_block: colour only), the pre-pass tile, the path (fragment, compute rounds or
+persistent lanes) and
 level count (LOD by truncation). One run
 writes a CSV, a Markdown report, plots (error against time and against work per knob, the
 Pareto fronts over all settings) and error images (holes red, false hits blue)."""
@@ -119,8 +120,10 @@ def settings(scene: Scene) -> list[Setting]:
                         replace(scene, render=replace(r, shadow_block=block)),
                     )
                 )
-    if r.path == "fragment":
+    if r.path == "fragment":  # the compute path's rounds, and its persistent lanes
         out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
+        lanes = replace(r, path="compute", steps=0)
+        out.append(Setting("path", "lanes", replace(scene, render=lanes)))
     for tile in PREPASS_TILES:
         if tile != r.prepass:
             out.append(
@@ -233,7 +236,7 @@ def same_work(
     for s in runs:
         rs = s.scene.render
         key = (r.prepare(s.scene, w, h, s.geometry), rs.path, rs.prepass, rs.prepass_levels)
-        key += (rs.shadow_block,)
+        key += (rs.shadow_block, rs.steps)
         a = images[s.name]
         rep[s.name] = next(
             (
