@@ -10,10 +10,9 @@ with ω [Keinert et al. 2014] / binary with ξ pairs [KRS17 Alg. 2]), precision 
 float64 shader), exact level culling, the walk restart (render.walk_restart), the level of
 detail in the walk (render.lod), the pixel blocks sharing a soft shadow ray
 (render.shadow_block: colour only), the pre-pass tile, the path (fragment, compute rounds or
-persistent lanes) and
-level count (LOD by truncation). One run
-writes a CSV, a Markdown report, plots (error against time and against work per knob, the
-Pareto fronts over all settings) and error images (holes red, false hits blue)."""
+persistent lanes) and level count (LOD by truncation). One run writes a CSV, a Markdown
+report, plots (error against time and against work per knob, the Pareto fronts over all
+settings) and error images (holes red, false hits blue)."""
 
 from __future__ import annotations
 
