@@ -105,12 +105,14 @@ def spread(m: Measured, column: str = "ms") -> float:
 
 
 def table(m: Measured) -> str:
+    rs = m.scene.render
+    path = "persistent lanes" if rs.path == "compute" and rs.steps == 0 else f"{rs.path} path"
     text = (
-        f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, median of "
-        f"{m.rounds} interleaved rounds\n\n"
+        f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, pre-pass "
+        f"{rs.prepass or 'off'}, {path}, median of {m.rounds} interleaved rounds\n\n"
     )
-    lod = m.scene.render.lod
-    walk = "off" if m.scene.render.walk_restart == "on" else "on"
+    lod = rs.lod
+    walk = "off" if rs.walk_restart == "on" else "on"
     text += markdown(
         (
             "stop",
