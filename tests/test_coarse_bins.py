@@ -27,17 +27,20 @@ def bins_across(origin: int, n: int) -> list[int]:
     return list(cover.values())
 
 
-@pytest.mark.parametrize("n", [2, 26, 45, 51, 64, 90, 127, 160, 240, 480])
-def test_a_coarse_image_is_split_evenly_across_a_bin_corner(n):
-    """Its middle on a bin corner: the two outer bins hold as many of its pixels (within
-    one), so both threads get work; at its target's corner (the control) a 90-pixel image
-    lies 64 and 26 in two bins."""
-    origin = bin_origin((n, n))
-    assert origin[0] == origin[1] and 0 <= origin[0] < BIN
-    cover = bins_across(origin[0], n)
-    assert len(cover) >= 2 and abs(cover[0] - cover[-1]) <= 1, cover
-    assert all(c == BIN for c in cover[1:-1])
-    assert bins_across(0, 90) == [64, 26]
+@pytest.mark.parametrize("n", [2, 26, 45, 51, 64, 90, 127, 128, 129, 160, 480])
+def test_an_image_within_two_bins_is_split_evenly_across_a_bin_corner(n):
+    """Within 2 × 2 bins, each axis lies in two bins holding as many of its pixels (within
+    one), so both threads get work; larger, the image starts at 0 (its bins full but the
+    last); at 0 (the control) a 90-pixel axis lies 64 and 26 in two bins, 45 in one."""
+    origin = bin_origin((n, 45))
+    assert min(origin) >= 0 and max(origin) < BIN
+    if n <= 2 * BIN:
+        for start, length in zip(origin, (n, 45)):
+            cover = bins_across(start, length)
+            assert len(cover) == 2 and abs(cover[0] - cover[1]) <= 1, cover
+    else:
+        assert origin == (0, 0)
+    assert bins_across(0, 90) == [64, 26] and bins_across(0, 45) == [45]
 
 
 def images(renderer, targets, scene, moved: bool):
