@@ -28,7 +28,7 @@ def image_of(renderer, targets, scene, one_pass=False, blocks=None, size=SIZE) -
         single = renderer.companion(
             image._programs["trace"], "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None}
         )
-        for name in ("u_block", "u_depth_slack", *SAMPLERS):
+        for name in ("u_block", "u_depth_slack", "u_coarse_origin", *SAMPLERS):
             single[name].value = split[name].value
         image._programs["shade"] = single
     for name, _, rows in image.passes:
@@ -67,7 +67,7 @@ def test_outline_pixels_apart_make_the_one_pass_image(renderer, targets, name):
     assert off.any() and not (off & ~outline[::-1]).any()
 
 
-def blocks_rule(image: PassImage, targets) -> tuple[np.ndarray, np.ndarray]:
+def blocks_rule(image: PassImage) -> tuple[np.ndarray, np.ndarray]:
     """NumPy's outline pixels of ``image`` (GL rows): hits facing a light for which none of
     the 2 × 2 blocks around it within the depth slack has a visibility; and the pixels
     within rounding of a threshold (the dot product or the depth slack)."""
@@ -76,12 +76,13 @@ def blocks_rule(image: PassImage, targets) -> tuple[np.ndarray, np.ndarray]:
     nt = np.frombuffer(raw, np.float32).reshape(h, w, 4)
     hit = np.frombuffer(image.traced.read(components=4, dtype="f4"), np.float32)
     hit = hit.reshape(h, w, 4)[..., 3] > 0.5
-    coarse = targets.get(image.coarse, 2)
+    coarse = image.coarse_target()
     cw, ch = image.coarse
     vis, cdepth = (
-        np.frombuffer(coarse.read(attachment=k, components=4, dtype="f4"), np.float32).reshape(
-            ch, cw, 4
-        )
+        np.frombuffer(
+            coarse.read((*image.origin, cw, ch), attachment=k, components=4, dtype="f4"),
+            np.float32,
+        ).reshape(ch, cw, 4)
         for k in (0, 1)
     )
     shade = image._programs["shade"]
@@ -118,7 +119,7 @@ def test_the_listed_pixels_are_those_no_block_lights(renderer, targets, monkeypa
         for slack in (passes.DEPTH_SLACK, -1.0):
             monkeypatch.setattr(passes, "DEPTH_SLACK", slack)
             image = image_of(renderer, targets, grove)
-            outline, near = blocks_rule(image, targets)
+            outline, near = blocks_rule(image)
             got = listed(targets, image)
             assert not ((got ^ outline) & ~near).any() and near.mean() < 0.005, slack
             assert 0.002 < outline.mean() < 0.2 if slack > 0 else outline.mean() > 0.3
@@ -132,11 +133,11 @@ def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch)
     drawn: list[tuple[str, int, int]] = []
     fill = PassImage._fill
 
-    def counted(image, prog, target, size, y0, rows):
+    def counted(image, prog, target, size, y0, rows, origin=(0, 0)):
         name = next(k for k, p in image._programs.items() if p is prog)
         query = renderer.ctx.query(samples=True)
         with query:
-            fill(image, prog, target, size, y0, rows)
+            fill(image, prog, target, size, y0, rows, origin)
         drawn.append((name, rows, query.samples))
 
     monkeypatch.setattr(PassImage, "_fill", counted)

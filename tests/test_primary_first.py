@@ -36,8 +36,11 @@ def first_and_final(renderer, targets, scene, visibility: float | None = None):
         moving = PassImage(renderer, targets, scene, MOVING, geometry, 2)
         moving.draw_all()
         if visibility is not None:
-            vis = targets.get(moving.coarse, 2).color_attachments[0]
-            vis.write(np.full((*moving.coarse[::-1], 4), visibility, np.float32).tobytes())
+            vis = moving.coarse_target().color_attachments[0]
+            vis.write(
+                np.full((*moving.coarse[::-1], 4), visibility, np.float32).tobytes(),
+                viewport=(*moving.origin, *moving.coarse),
+            )
         primary = PassImage(renderer, targets, scene, FULL, geometry, 2, blocks=moving)
         assert [p[0] for p in primary.passes] == ["trace", "shade"]
         first = read_buffers(primary.draw_all(), *FULL)

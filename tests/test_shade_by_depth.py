@@ -64,11 +64,11 @@ def test_each_pixel_is_shaded_by_one_pass(renderer, targets, monkeypatch, ratio,
     fill = PassImage._fill
     kept: dict[str, int] = {}
 
-    def counted(image, prog, target, size, y0, rows):
+    def counted(image, prog, target, size, y0, rows, origin=(0, 0)):
         name = next(k for k, p in image._programs.items() if p is prog)
         query = renderer.ctx.query(samples=True)
         with query:
-            fill(image, prog, target, size, y0, rows)
+            fill(image, prog, target, size, y0, rows, origin)
         kept[name] = query.samples
 
     monkeypatch.setattr(PassImage, "_fill", counted)

@@ -12,13 +12,14 @@
 uniform sampler2D u_traced_color;  // a: hit
 uniform sampler2D u_traced_depth;  // xyz: the hit's normal; w: ray distance t
 uniform int u_shadow_ratio;
+uniform ivec2 u_coarse_origin;  // the coarse image's corner in its target (bin_origin)
 
 layout(location = 0) out vec4 out_visibility;  // per light (MAX_LIGHTS is 4); < 0: faces
                                                // away, or no hit
 layout(location = 1) out vec4 out_depth;       // x: t of the block's pixel; < 0: no hit
 
 void main() {
-    ivec2 corner = ivec2(gl_FragCoord.xy) * u_shadow_ratio;
+    ivec2 corner = (ivec2(gl_FragCoord.xy) - u_coarse_origin) * u_shadow_ratio;
     ivec2 size = textureSize(u_traced_depth, 0);
     ivec2 best = ivec2(-1);
     float t_best = 0.0;

@@ -25,6 +25,7 @@ uniform sampler2D u_coarse_depth;       // x: t; < 0: no hit
 uniform vec2 u_block;                   // a block's side in this image's pixels (an earlier,
                                         // smaller image's blocks are wider than its ratio)
 uniform float u_depth_slack;            // block footprints of depth a block may differ
+uniform ivec2 u_coarse_origin;          // the coarse image's corner in its target
 
 // g_shadow: each light's visibility blended from the blocks near pixel px at depth t.
 void upsample_visibility(ivec2 px, float t) {
@@ -36,7 +37,7 @@ void upsample_visibility(ivec2 px, float t) {
     vec4 sum = vec4(0.0), weight = vec4(0.0);
     for (int j = 0; j < 2; ++j) {
         for (int i = 0; i < 2; ++i) {
-            ivec2 q = clamp(c0 + ivec2(i, j), ivec2(0), last);
+            ivec2 q = clamp(c0 + ivec2(i, j) + u_coarse_origin, u_coarse_origin, last);
             float tq = texelFetch(u_coarse_depth, q, 0).x;
             if (tq < 0.0 || abs(tq - t) > slack) continue;
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y) + 1e-3;
