@@ -17,7 +17,7 @@ import pytest
 
 from krsview.compile.constants import PREPASS_BLOCK
 from krsview.gpu import renderer as renderer_module
-from krsview.gpu.coarse import PREPASS_BIN, coarse_layout, coarse_quarter, quarters
+from krsview.gpu.coarse import BIN, coarse_layout, coarse_quarter, quarters
 from krsview.gpu.renderer import Renderer
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
@@ -55,10 +55,10 @@ def test_each_tile_has_a_texel_of_its_own_and_the_quarters_start_on_bins(columns
     assert distinct_and_inside(where, size)
     rects = list(quarters(columns, rows, None))
     assert inside(rects) == set(where.values())  # the draws cover the tiles and nothing else
-    assert all(x % PREPASS_BIN == 0 for x, _, _, _ in rects if x >= stride[0])
-    assert all(y % PREPASS_BIN == 0 for _, y, _, _ in rects if y >= stride[1])
+    assert all(x % BIN == 0 for x, _, _, _ in rects if x >= stride[0])
+    assert all(y % BIN == 0 for _, y, _, _ in rects if y >= stride[1])
     if min(columns, rows) > PREPASS_BLOCK:  # two blocks each way: four quarters, four bins
-        assert len({(x // PREPASS_BIN, y // PREPASS_BIN) for x, y, _, _ in rects}) == 4
+        assert len({(x // BIN, y // BIN) for x, y, _, _ in rects}) == 4
     # negative control: with the quarters laid over each other (no stride), tiles collide
     overlaid = {k: (v[0] % stride[0], v[1] % stride[1]) for k, v in where.items()}
     assert max(columns, rows) <= PREPASS_BLOCK or not distinct_and_inside(overlaid, size)

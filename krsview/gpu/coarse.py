@@ -11,7 +11,7 @@ import functools
 from ..compile.camera import View
 from ..compile.constants import PREPASS_BLOCK
 
-PREPASS_BIN = 64  # llvmpipe's bin, in pixels
+BIN = 64  # llvmpipe gives each BIN × BIN pixels of a pass (a bin) to one of its threads
 
 
 def coarse_quarter(x: int) -> tuple[int, int]:
@@ -26,7 +26,7 @@ def coarse_quarter(x: int) -> tuple[int, int]:
 def coarse_layout(columns: int, rows: int) -> tuple[tuple[int, int], tuple[int, int]]:
     """The quarter images' stride and the target's size of a coarse pass of ``columns`` ×
     ``rows`` tiles (prepass.glsl, coarse_texel): each quarter starts on a corner of
-    PREPASS_BIN-pixel bins, the bins llvmpipe gives one thread each (cached: every frame
+    BIN-pixel bins, the bins llvmpipe gives one thread each (cached: every frame
     asks)."""
     stride, size = [], []
     for n in (columns, rows):
@@ -34,7 +34,7 @@ def coarse_layout(columns: int, rows: int) -> tuple[tuple[int, int], tuple[int, 
         for x in range(n):
             q, local = coarse_quarter(x)
             ends[q] = max(ends[q], local + 1)
-        stride.append(-(-ends[0] // PREPASS_BIN) * PREPASS_BIN)
+        stride.append(-(-ends[0] // BIN) * BIN)
         size.append(stride[-1] + ends[1] if ends[1] else ends[0])
     return (stride[0], stride[1]), (size[0], size[1])
 

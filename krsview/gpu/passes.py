@@ -37,12 +37,12 @@ import moderngl
 
 from ..compile.constants import BINDING_OUTLINE
 from ..scene import Geometry, Scene
+from .coarse import BIN
 from .context import behind_mark
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
 MAX_KEPT = 6  # targets kept (least recently used released)
-BIN = 64  # llvmpipe gives each 64 × 64 pixels of a pass (a bin) to one of its threads
 SAMPLERS = (  # the passes' samplers by texture unit: the trace pass's targets, the blocks'
     *("u_traced_color", "u_traced_depth", "u_traced_iterations"),
     *("u_coarse_visibility", "u_coarse_depth"),
