@@ -71,6 +71,18 @@ def bin_origin(size: tuple[int, int]) -> tuple[int, int]:
     return ((-(size[0] // 2)) % BIN, (-(size[1] // 2)) % BIN)
 
 
+def packed(size: tuple[int, int], listed: int) -> tuple[int, int]:
+    """The outline pass's image for ``listed`` pixels of an image of ``size``, filled row by
+    row from its first: as wide as whole pairs of llvmpipe's bins fit in the image, so that
+    its two threads get as many bins (at 320 px the image's five bins gave one thread three),
+    or the image's width where that needs more rows than the image has."""
+    w, h = size
+    width = 2 * BIN * (w // (2 * BIN))
+    if not width or listed > width * h:
+        width = w
+    return width, -(-listed // width)
+
+
 def still_ratio(scene: Scene) -> int:
     """The passes a still image of ``scene`` is drawn in (the module's docstring): its
     ``[render] shadow_block`` where the shadows can be a pass of their own, else 0 (one pass,
@@ -106,11 +118,20 @@ class Tracer(Protocol):
     ) -> moderngl.Framebuffer: ...
 
 
+class Marked(NamedTuple):
+    """A target with a depth buffer for context.behind_mark: the depth alone (``scratch``,
+    which the mark draws, and the outline pass, which stores its colours itself) and the
+    target's colours with it (``shaded``)."""
+
+    scratch: moderngl.Framebuffer
+    shaded: moderngl.Framebuffer
+    depth: moderngl.Renderbuffer
+
+
 class Outline(NamedTuple):
     """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
-    the pixels), the target their pass draws (no colour: it stores each listed pixel's
-    colour in the image's) and the image's colour with the depth that tells the shading
-    passes hits from the sky (``shaded``)."""
+    the pixels) and its targets with the depth that tells the shading passes hits from the
+    sky."""
 
     pixels: moderngl.Buffer
     scratch: moderngl.Framebuffer
@@ -126,7 +147,8 @@ class Targets:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
-        self._outlines: dict[moderngl.Framebuffer, Outline] = {}
+        self._marked: dict[moderngl.Framebuffer, Marked] = {}
+        self._outlines: dict[moderngl.Framebuffer, moderngl.Buffer] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -137,8 +159,8 @@ class Targets:
             return self._kept[key]
         while len(self._kept) >= MAX_KEPT:
             old = self._kept.pop(next(iter(self._kept)))
-            outline = self._outlines.pop(old, None)
-            for thing in (*(outline or ()), *old.color_attachments):
+            marked, pixels = self._marked.pop(old, ()), self._outlines.pop(old, None)
+            for thing in (*marked, *([pixels] if pixels else ()), *old.color_attachments):
                 thing.release()
             old.release()
         tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
@@ -150,17 +172,23 @@ class Targets:
         self.flip ^= 1
         return self.get(size, 3, self.flip)
 
-    def outline(self, output: moderngl.Framebuffer) -> Outline:
-        """The outline list of ``output`` (made once)."""
-        if output not in self._outlines:
-            (w, h), depth = output.size, self.ctx.depth_renderbuffer(output.size)
-            self._outlines[output] = Outline(
-                self.ctx.buffer(reserve=4 * (w * h + 1)),
+    def marked(self, target: moderngl.Framebuffer) -> Marked:
+        """``target`` with a depth buffer (made once)."""
+        if target not in self._marked:
+            depth = self.ctx.depth_renderbuffer(target.size)
+            self._marked[target] = Marked(
                 self.ctx.framebuffer(depth_attachment=depth),
-                self.ctx.framebuffer(output.color_attachments, depth),
+                self.ctx.framebuffer(target.color_attachments, depth),
                 depth,
             )
-        return self._outlines[output]
+        return self._marked[target]
+
+    def outline(self, output: moderngl.Framebuffer) -> Outline:
+        """The outline list of ``output`` and its targets (made once)."""
+        if output not in self._outlines:
+            w, h = output.size
+            self._outlines[output] = self.ctx.buffer(reserve=4 * (w * h + 1))
+        return Outline(self._outlines[output], *self.marked(output))
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -267,7 +295,7 @@ class PassImage:
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
             if name == "visibility":
-                self._fill(prog, self.coarse_target(), self.coarse, y0, rows, self.origin)
+                self._visibility(prog, y0, rows)
             elif name == "shade":
                 coarse = self._blocks_image.coarse_target()
                 for k, tex in enumerate(coarse.color_attachments):
@@ -294,6 +322,21 @@ class PassImage:
         self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
         ctx.scissor = None
 
+    def _visibility(self, prog: moderngl.Program, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of the blocks' visibilities: the rows cleared to none (-1,
+        a block with no hit), then the blocks with a hit (the hits' mark at block size) drawn
+        behind it, so that llvmpipe never runs the shadow rays' code over groups of sky
+        blocks (context.behind_mark)."""
+        (w, h), (x, y) = self.coarse, self.origin
+        target, hits = self.targets.marked(self.coarse_target()), self._programs["hits"]
+        target.shaded.clear(-1.0, -1.0, -1.0, -1.0, viewport=(x, y + y0, w, min(rows, h - y0)))
+        hits["u_mark_block"].value, hits["u_mark_origin"].value = self.ratio, self.origin
+
+        def fill(prog: moderngl.Program, fbo: moderngl.Framebuffer) -> Callable[[], None]:
+            return lambda: self._fill(prog, fbo, self.coarse, y0, rows, self.origin)
+
+        behind_mark(self.renderer.ctx, fill(hits, target.scratch), None, fill(prog, target.shaded))
+
     def _shade_and_outline(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
         outline pixels (those that lack a light's visibility) listed; then the listed pixels
@@ -307,8 +350,9 @@ class PassImage:
         listed = int.from_bytes(outline.pixels.read(4), sys.byteorder)
         if listed:  # their pass over as many rows as they fill
             self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
-            rows = -(-listed // self.size[0])
-            self._fill(self._programs["outline"], outline.scratch, self.size, 0, rows)
+            prog, size = self._programs["outline"], packed(self.size, listed)
+            prog["u_outline_width"].value = size[0]
+            self._fill(prog, outline.scratch, size, 0, size[1])
             ctx.memory_barrier()  # the stored colours visible to whatever reads the image
 
     def _shade_by_depth(self, outline: Outline, y0: int, rows: int, shading: str) -> None:
@@ -320,6 +364,8 @@ class PassImage:
         def fill(name: str, target: moderngl.Framebuffer) -> Callable[[], None]:
             return lambda: self._fill(self._programs[name], target, self.size, y0, rows)
 
+        hits = self._programs["hits"]
+        hits["u_mark_block"].value, hits["u_mark_origin"].value = 1, (0, 0)  # each pixel
         behind_mark(
             self.renderer.ctx,
             fill("hits", outline.scratch),
