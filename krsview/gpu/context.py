@@ -37,15 +37,15 @@ def headless_context() -> moderngl.Context:
 def behind_mark(
     ctx: moderngl.Context,
     mark: Callable[[], None],
-    draw: Callable[[], None] | None,
+    draw: Callable[[], None],
     marked: Callable[[], None] | None = None,
 ) -> None:
     """Draw ``mark``, whose shader writes depth 0 on the pixels ``draw`` has nothing to do on
-    and 1 elsewhere, then ``draw``, if given (fragments at depth 0.5, writing no depth),
-    behind a less-than test, which llvmpipe makes before the fragment shader, and ``marked``,
-    if given, on the pixels marked 0 (a greater-than test): llvmpipe runs every branch's code
-    for every pixel it shades, so a sky pixel otherwise costs as much as a traced one. A
-    shader that writes memory declares ``early_fragment_tests``."""
+    and 1 elsewhere, then ``draw`` (fragments at depth 0.5, writing no depth) behind a
+    less-than test, which llvmpipe makes before the fragment shader, and ``marked``, if given,
+    on the pixels marked 0 (a greater-than test): llvmpipe runs every branch's code for every
+    pixel it shades, so a sky pixel otherwise costs as much as a traced one. A shader that
+    writes memory declares ``early_fragment_tests``."""
     ctx.enable(moderngl.DEPTH_TEST)
     try:
         for part, test in ((mark, "1"), (draw, "<"), (marked, ">")):  # "1": always

@@ -14,7 +14,8 @@ resolution]. ``ratio`` picks the passes:
   its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
   branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
   outline pixels listed (an atomic counter), then the listed pixels alone, packed into the
-  first rows of a pass of their own, shaded with their own rays and stored into the image;
+  first rows of a pass of their own (``packed``), shaded with their own rays and stored into
+  the image;
 - r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
@@ -118,20 +119,11 @@ class Tracer(Protocol):
     ) -> moderngl.Framebuffer: ...
 
 
-class Marked(NamedTuple):
-    """A target with a depth buffer for context.behind_mark: the depth alone (``scratch``,
-    which the mark draws, and the outline pass, which stores its colours itself) and the
-    target's colours with it (``shaded``)."""
-
-    scratch: moderngl.Framebuffer
-    shaded: moderngl.Framebuffer
-    depth: moderngl.Renderbuffer
-
-
 class Outline(NamedTuple):
     """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
-    the pixels) and its targets with the depth that tells the shading passes hits from the
-    sky."""
+    the pixels), the target their pass draws (no colour: it stores each listed pixel's
+    colour in the image's) and the image's colour with the depth that tells the shading
+    passes hits from the sky (``shaded``)."""
 
     pixels: moderngl.Buffer
     scratch: moderngl.Framebuffer
@@ -147,8 +139,7 @@ class Targets:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
-        self._marked: dict[moderngl.Framebuffer, Marked] = {}
-        self._outlines: dict[moderngl.Framebuffer, moderngl.Buffer] = {}
+        self._outlines: dict[moderngl.Framebuffer, Outline] = {}
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -159,8 +150,8 @@ class Targets:
             return self._kept[key]
         while len(self._kept) >= MAX_KEPT:
             old = self._kept.pop(next(iter(self._kept)))
-            marked, pixels = self._marked.pop(old, ()), self._outlines.pop(old, None)
-            for thing in (*marked, *([pixels] if pixels else ()), *old.color_attachments):
+            outline = self._outlines.pop(old, None)
+            for thing in (*(outline or ()), *old.color_attachments):
                 thing.release()
             old.release()
         tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
@@ -172,23 +163,17 @@ class Targets:
         self.flip ^= 1
         return self.get(size, 3, self.flip)
 
-    def marked(self, target: moderngl.Framebuffer) -> Marked:
-        """``target`` with a depth buffer (made once)."""
-        if target not in self._marked:
-            depth = self.ctx.depth_renderbuffer(target.size)
-            self._marked[target] = Marked(
+    def outline(self, output: moderngl.Framebuffer) -> Outline:
+        """The outline list of ``output`` (made once)."""
+        if output not in self._outlines:
+            (w, h), depth = output.size, self.ctx.depth_renderbuffer(output.size)
+            self._outlines[output] = Outline(
+                self.ctx.buffer(reserve=4 * (w * h + 1)),
                 self.ctx.framebuffer(depth_attachment=depth),
-                self.ctx.framebuffer(target.color_attachments, depth),
+                self.ctx.framebuffer(output.color_attachments, depth),
                 depth,
             )
-        return self._marked[target]
-
-    def outline(self, output: moderngl.Framebuffer) -> Outline:
-        """The outline list of ``output`` and its targets (made once)."""
-        if output not in self._outlines:
-            w, h = output.size
-            self._outlines[output] = self.ctx.buffer(reserve=4 * (w * h + 1))
-        return Outline(self._outlines[output], *self.marked(output))
+        return self._outlines[output]
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -295,7 +280,7 @@ class PassImage:
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
             if name == "visibility":
-                self._visibility(prog, y0, rows)
+                self._fill(prog, self.coarse_target(), self.coarse, y0, rows, self.origin)
             elif name == "shade":
                 coarse = self._blocks_image.coarse_target()
                 for k, tex in enumerate(coarse.color_attachments):
@@ -322,26 +307,11 @@ class PassImage:
         self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
         ctx.scissor = None
 
-    def _visibility(self, prog: moderngl.Program, y0: int, rows: int) -> None:
-        """Rows [y0, y0 + rows) of the blocks' visibilities: the rows cleared to none (-1,
-        a block with no hit), then the blocks with a hit (the hits' mark at block size) drawn
-        behind it, so that llvmpipe never runs the shadow rays' code over groups of sky
-        blocks (context.behind_mark)."""
-        (w, h), (x, y) = self.coarse, self.origin
-        target, hits = self.targets.marked(self.coarse_target()), self._programs["hits"]
-        target.shaded.clear(-1.0, -1.0, -1.0, -1.0, viewport=(x, y + y0, w, min(rows, h - y0)))
-        hits["u_mark_block"].value, hits["u_mark_origin"].value = self.ratio, self.origin
-
-        def fill(prog: moderngl.Program, fbo: moderngl.Framebuffer) -> Callable[[], None]:
-            return lambda: self._fill(prog, fbo, self.coarse, y0, rows, self.origin)
-
-        behind_mark(self.renderer.ctx, fill(hits, target.scratch), None, fill(prog, target.shaded))
-
     def _shade_and_outline(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
         outline pixels (those that lack a light's visibility) listed; then the listed pixels
         shaded anew with their own shadow rays, packed into the first rows of a pass of
-        their own, their colours stored over the image's."""
+        their own (``packed``), their colours stored over the image's."""
         ctx, outline = self.renderer.ctx, self.targets.outline(self.output)
         outline.pixels.write(bytes(4))  # none listed
         outline.pixels.bind_to_storage_buffer(BINDING_OUTLINE)
@@ -364,8 +334,6 @@ class PassImage:
         def fill(name: str, target: moderngl.Framebuffer) -> Callable[[], None]:
             return lambda: self._fill(self._programs[name], target, self.size, y0, rows)
 
-        hits = self._programs["hits"]
-        hits["u_mark_block"].value, hits["u_mark_origin"].value = 1, (0, 0)  # each pixel
         behind_mark(
             self.renderer.ctx,
             fill("hits", outline.scratch),

@@ -62,10 +62,7 @@ layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the im
 uniform int u_outline_width;  // the pass's width (gpu/passes.py, packed)
 #endif
 
-#ifdef KRS_HIT_DEPTH  // (which writes the depth the others are tested against)
-uniform int u_mark_block;     // the side of the blocks of pixels marked (1: each pixel)
-uniform ivec2 u_mark_origin;  // the marked image's corner in its target (gpu/passes.py)
-#else
+#ifndef KRS_HIT_DEPTH  // (which writes the depth the others are tested against)
 layout(early_fragment_tests) in;  // groups of pixels the depth test leaves out never run
 #endif
 
@@ -87,18 +84,8 @@ vec4 traced_color(ivec2 px) {
 }
 
 void main() {
-#if defined(KRS_HIT_DEPTH)  // 0 where a pixel of the block has a hit, 1 where none has
-    ivec2 corner = (ivec2(gl_FragCoord.xy) - u_mark_origin) * u_mark_block;
-    ivec2 size = textureSize(u_traced_color, 0);
-    float depth = 1.0;
-    for (int j = 0; j < u_mark_block; ++j) {
-        for (int i = 0; i < u_mark_block; ++i) {
-            ivec2 q = corner + ivec2(i, j);
-            if (q.x < size.x && q.y < size.y && texelFetch(u_traced_color, q, 0).a >= 0.5)
-                depth = 0.0;
-        }
-    }
-    gl_FragDepth = depth;
+#if defined(KRS_HIT_DEPTH)
+    gl_FragDepth = texelFetch(u_traced_color, ivec2(gl_FragCoord.xy), 0).a < 0.5 ? 1.0 : 0.0;
 #elif defined(KRS_SHADOW_OUTLINE)
     uint width = uint(textureSize(u_traced_color, 0).x);
     uint i = uint(gl_FragCoord.y) * uint(u_outline_width) + uint(gl_FragCoord.x);
