@@ -153,16 +153,17 @@ def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch)
 @pytest.mark.parametrize(
     "size, listed, want",
     [
-        ((320, 180), 1000, (256, 4)),  # four bins across, not five
+        ((320, 180), 1000, (128, 8)),  # two bins across, not five
         ((160, 90), 300, (128, 3)),
-        ((320, 180), 256 * 180, (256, 180)),
-        ((320, 180), 256 * 180 + 1, (320, 145)),  # would need more rows than the image has
+        ((320, 180), 128 * 180, (128, 180)),
+        ((320, 180), 128 * 180 + 1, (256, 91)),  # two bins would need more rows than 180
+        ((320, 180), 256 * 180 + 1, (320, 145)),  # and four
         ((100, 50), 120, (100, 2)),  # narrower than two bins
     ],
 )
 def test_the_outline_pass_spans_whole_pairs_of_bins(size, listed, want):
-    """The outline pass's image: whole pairs of 64-pixel bins across where its rows fit in
-    the image, else the image's width."""
+    """The outline pass's image: the fewest pairs of 64-pixel bins across whose rows hold
+    the listed pixels within the image's height, else the image's width."""
     assert passes.packed(size, listed) == want
 
 
