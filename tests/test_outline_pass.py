@@ -128,7 +128,7 @@ def test_the_listed_pixels_are_those_no_block_lights(renderer, targets, monkeypa
 def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch):
     """Fragments kept by each of the shading passes (an occlusion query): the hits' depth
     every pixel of its rows, the sky's pass and the shade pass the two parts of them, the
-    outline pass one per listed pixel, in the rows they fill."""
+    outline pass one per listed pixel, in the rows they fill 128 pixels wide (two bins)."""
     tree = scene_of("tree")
     drawn: list[tuple[str, int, int]] = []
     fill = PassImage._fill
@@ -147,7 +147,24 @@ def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch)
     w, h = SIZE
     assert [d[0] for d in drawn] == ["visibility", "hits", "sky", "shade", "outline"]
     assert drawn[1] == ("hits", h, w * h) and drawn[2][2] + drawn[3][2] == w * h
-    assert 0 < count < w * h / 20 and drawn[4] == ("outline", -(-count // w), count)
+    assert 0 < count < w * h / 20 and drawn[4] == ("outline", -(-count // 128), count)
+
+
+@pytest.mark.parametrize(
+    "size, listed, want",
+    [
+        ((320, 180), 1000, (128, 8)),  # two bins across, not five
+        ((160, 90), 300, (128, 3)),
+        ((320, 180), 128 * 180, (128, 180)),
+        ((320, 180), 128 * 180 + 1, (256, 91)),  # two bins would need more rows than 180
+        ((320, 180), 256 * 180 + 1, (320, 145)),  # and four
+        ((100, 50), 120, (100, 2)),  # narrower than two bins
+    ],
+)
+def test_the_outline_pass_spans_whole_pairs_of_bins(size, listed, want):
+    """The outline pass's image: the fewest pairs of 64-pixel bins across whose rows hold
+    the listed pixels within the image's height, else the image's width."""
+    assert passes.packed(size, listed) == want
 
 
 def test_the_shade_pass_compiles_no_shadow_ray(renderer, targets, monkeypatch):
