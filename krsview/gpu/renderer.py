@@ -370,19 +370,23 @@ class Renderer:
         prepass_only: bool = False,
         probes: tuple[str, ...] = (),
     ) -> list[float]:
-        """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up;
+        """Wall time of each of ``repeats`` frames (seconds, GPU finished), after a warm-up,
+        each with its uniforms' upload (``prepare``), as a rendered frame has it;
         ``prepass_only``: of the pre-pass's coarse passes alone; ``probes``: see prepare."""
         with self.current():
             ratio = 0 if prepass_only or probes or all_effects else still_ratio(scene)
             if ratio:  # as render() draws it
                 image = self._passes(scene, (width, height), geometry, ratio)
                 draw = image.draw_all
-            else:
-                prog = self.prepare(scene, width, height, geometry, all_effects, probes)
+            else:  # each frame prepares its program (uniforms) as render() and the passes do
+
+                def prog():
+                    return self.prepare(scene, width, height, geometry, all_effects, probes)
+
                 draw = (
-                    (lambda: self._prepass(prog, width, height, None))
+                    (lambda: self._prepass(prog(), width, height, None))
                     if prepass_only
-                    else (lambda: self.draw(prog, width, height))
+                    else (lambda: self.draw(prog(), width, height))
                 )
             draw()
             self.ctx.finish()
