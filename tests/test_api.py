@@ -245,6 +245,7 @@ def test_fast_settings_trace_a_deep_krs_by_persistent_lanes_the_same_image():
     for name in ("rock", "palm", "grove"):
         assert fast_settings(krsview.load(name)).render.path == "fragment", name
     assert fast_settings(tree.with_levels(12)).render.path == "fragment"
+    assert fast_settings(krsview.load("tree-sway")).render.path == "compute"  # a moving KRS
     rounds = tree.edit("render.path", "compute")  # a file's own choice of path stands
     assert fast_settings(rounds).render.steps == 16
     lanes = krsview.render(tree, SIZE)
