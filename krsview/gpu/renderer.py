@@ -7,6 +7,7 @@ far limit are written by a small pass of their own, and the full pass skips them
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -256,11 +257,12 @@ class Renderer:
             passes.append(grid)
         parent, parent_stride = None, (0, 0)
         for t, cw, ch in reversed(passes):
-            fbo = self._framebuffer(*coarse_layout(cw, ch)[1], layers=PREPASS_TARGETS)
+            stride, target = coarse_layout(cw, ch)
+            fbo = self._framebuffer(*target, layers=PREPASS_TARGETS)
             fbo.use()
             coarse["u_tile"].value = t
             coarse["u_parent_ratio"].value = PREPASS_RATIO if parent else 0
-            coarse["u_layout"].value = (*coarse_layout(cw, ch)[0], *parent_stride)
+            coarse["u_layout"].value = (*stride, *parent_stride)
             # the coarsest pass reads no parent: its samplers get a texture no pass draws
             # into, so no target is ever bound for sampling while it is drawn into
             for unit, tex in enumerate(
@@ -274,7 +276,7 @@ class Renderer:
             for rect in quarters(cw, ch, tiles):  # one draw each: no texel between them
                 self.ctx.viewport = rect
                 self._full(coarse)
-            parent, parent_stride = fbo, coarse_layout(cw, ch)[0]
+            parent, parent_stride = fbo, stride
         for unit, tex in enumerate(parent.color_attachments):
             tex.use(unit)
 
@@ -379,10 +381,9 @@ class Renderer:
                 image = self._passes(scene, (width, height), geometry, ratio)
                 draw = image.draw_all
             else:  # each frame prepares its program (uniforms) as render() and the passes do
-
-                def prog():
-                    return self.prepare(scene, width, height, geometry, all_effects, probes)
-
+                prog = functools.partial(
+                    self.prepare, scene, width, height, geometry, all_effects, probes
+                )
                 draw = (
                     (lambda: self._prepass(prog(), width, height, None))
                     if prepass_only
