@@ -145,9 +145,9 @@ def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch)
         image = image_of(renderer, targets, tree)
         count = int(listed(targets, image).sum())
     w, h = SIZE
-    assert [d[0] for d in drawn] == ["visibility", "hits", "sky", "shade", "outline"]
-    assert drawn[1] == ("hits", h, w * h) and drawn[2][2] + drawn[3][2] == w * h
-    assert 0 < count < w * h / 20 and drawn[4] == ("outline", -(-count // 128), count)
+    assert [d[0] for d in drawn] == ["visibility", "rays", "hits", "sky", "shade", "outline"]
+    assert drawn[2] == ("hits", h, w * h) and drawn[3][2] + drawn[4][2] == w * h
+    assert 0 < count < w * h / 20 and drawn[5] == ("outline", -(-count // 128), count)
 
 
 @pytest.mark.parametrize(

@@ -9,7 +9,9 @@ resolution]. ``ratio`` picks the passes:
   its own shadow rays: render.frag's image in two passes, so a later image of the same view
   and size can reuse the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
-  each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
+  each r × r block (coarse_visibility.frag: the blocks' depths, the blocks facing a light
+  listed, then their rays packed into the first rows of a pass of their own, so that they
+  fill whole groups of lanes), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
   its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
   branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
@@ -36,7 +38,7 @@ from typing import NamedTuple, Protocol
 
 import moderngl
 
-from ..compile.constants import BINDING_OUTLINE
+from ..compile.constants import BINDING_BLOCK_LIST, BINDING_OUTLINE
 from ..scene import Geometry, Scene
 from .coarse import BIN
 from .context import behind_mark
@@ -240,10 +242,11 @@ class PassImage:
         main = self.renderer.prepare(self.scene, *self.size, self.geometry, probes=probes)
         self._programs = {"render" if not self.ratio else "trace": main}
         if self.ratio > 1:
-            vis = self.renderer.companion(main, "coarse_visibility.frag")
-            vis["u_shadow_ratio"].value = self.ratio
-            vis["u_coarse_origin"].value = self.origin
-            self._programs["visibility"] = vis
+            for name, define in (("visibility", "KRS_SHADOW_LIST"), ("rays", "KRS_SHADOW_RAYS")):
+                vis = self.renderer.companion(main, "coarse_visibility.frag", {define: None})
+                vis["u_shadow_ratio"].value = self.ratio
+                vis["u_coarse_origin"].value = self.origin
+                self._programs[name] = vis
             (bw, bh), _, side = self.blocks
             for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
                 shade = self.renderer.companion(
@@ -281,7 +284,7 @@ class PassImage:
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
             if name == "visibility":
-                self._fill(prog, self.coarse_target(), self.coarse, y0, rows, self.origin)
+                self._visibility(y0, rows)
             elif name == "shade":
                 coarse = self._blocks_image.coarse_target()
                 for k, tex in enumerate(coarse.color_attachments):
@@ -307,6 +310,25 @@ class PassImage:
         ctx.scissor = (x, y + y0, size[0], min(rows, size[1] - y0))
         self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
         ctx.scissor = None
+
+    def _visibility(self, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of the blocks: each block's depth, and the blocks facing a
+        light listed (in the outline's buffer, which the shading fills only after); then the
+        listed blocks' shadow rays, packed into the first rows of a pass of their own
+        (``packed``), their visibilities stored at their blocks' texels."""
+        ctx, target = self.renderer.ctx, self.coarse_target()
+        blocks = self.targets.outline(self.output).pixels
+        blocks.write(bytes(4))  # none listed
+        blocks.bind_to_storage_buffer(BINDING_BLOCK_LIST)
+        self._fill(self._programs["visibility"], target, self.coarse, y0, rows, self.origin)
+        ctx.memory_barrier()  # the list and the blocks' depths complete
+        listed = int.from_bytes(blocks.read(4), sys.byteorder)
+        if listed:
+            target.color_attachments[0].bind_to_image(0, read=False, write=True)
+            prog, size = self._programs["rays"], packed(self.coarse, listed)
+            prog["u_rays_width"].value = size[0]
+            self._fill(prog, self.targets.outline(self.output).scratch, size, 0, size[1])
+            ctx.memory_barrier()  # the stored visibilities visible to the shading's reads
 
     def _shade_and_outline(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
