@@ -1,13 +1,15 @@
 """The blocks' shadow rays in two passes (gpu/passes.py, coarse_visibility.frag): a pass over
-the blocks writes each one's depth and lists those whose nearest hit faces a light; only
-the listed blocks run the rays pass, packed into rows two bins (128 pixels) wide, and each gets a
-visibility for exactly the lights its hit faces."""
+the blocks writes each one's depth and lists those whose nearest hit faces a light, a list
+per llvmpipe bin; only the listed blocks run the rays pass, packed two bins (128 pixels)
+wide in whole 4 × 2 groups, and each gets a visibility for exactly the lights its hit
+faces."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from krsview.gpu import passes
 from krsview.gpu.passes import PassImage
 from krsview.gpu.renderer import read_buffers
 
@@ -70,16 +72,50 @@ def test_only_blocks_facing_a_light_trace_rays(renderer, targets, monkeypatch, n
         want_depth, facing = blocks_rule(image)
         listed = int(facing.any(-1).sum())
         assert 0 < listed < facing.shape[0] * facing.shape[1]
-        across = min(128, image.coarse[0])  # two bins, or the coarse image's width
-        assert drawn["rays"] == (-(-listed // across), listed)  # a fragment per listed block
+        rows = 2 * -(-listed // 256)  # two bins across in 4 × 2 groups
+        assert drawn["rays"] == (rows, listed)  # a fragment per listed block
         assert np.array_equal(depth[..., 0], want_depth)
         assert np.array_equal(vis >= 0.0, facing) and (vis[facing] <= 1.0).all()
         # negative control: the list pass alone leaves no block a visibility, so every hit
         # facing a light is an outline pixel, lit by its own ray: another image
-        targets.outline(image.output).pixels.write(bytes(4))
+        across, bins = image.coarse_bins()
+        lists = np.frombuffer(targets.block_list(bins).read(), np.uint32)
+        targets.block_list(bins).write(bytes(4 * bins))
         prog, size = image._programs["visibility"], image.coarse
         image._fill(prog, image.coarse_target(), size, 0, size[1], image.origin)
         assert (coarse_planes(image)[0] < 0.0).all()
         image.draw("shade", 0, SIZE[1])
         alone = read_buffers(image.output, *SIZE)
     assert not np.array_equal(alone.color, whole.color)
+    # each bin listed its own blocks' nearest hits, each once: together, the blocks facing
+    # a light (coarse target coordinates: the blocks at the coarse image's origin)
+    (w, _), (ox, oy), side = SIZE, image.origin, 64
+    got = []
+    for b in range(bins):
+        hits = lists[bins + b * side * side :][: lists[b]]
+        bx, by = hits % w // 2 + ox, hits // w // 2 + oy
+        assert ((by // side * across + bx // side) == b).all(), b
+        got += zip((by - oy).tolist(), (bx - ox).tolist())
+    assert len(got) == len(set(got)) and set(got) == set(zip(*np.nonzero(facing.any(-1))))
+
+
+@pytest.mark.parametrize(
+    "size, listed, want",
+    [
+        ((320, 180), 1889, (128, 16)),  # two bins across, whole row pairs of 4 × 2 groups
+        ((320, 180), 256, (128, 2)),
+        ((320, 180), 257, (128, 4)),
+        ((320, 180), 128 * 180 + 1, (256, 92)),
+        ((102, 50), 300, (100, 4)),  # the image's width, down to whole groups
+    ],
+)
+def test_the_rays_pass_fills_whole_groups_of_lanes(size, listed, want):
+    assert passes.packed_in_groups(size, listed) == want
+
+
+def test_a_list_too_long_for_the_image_is_refused():
+    assert passes.packed_in_groups((102, 50), 5000) == (100, 50)  # control: the most it holds
+    with pytest.raises(
+        ValueError, match=r"5001 entries in groups of lanes: an image of \(102, 50\)"
+    ):
+        passes.packed_in_groups((102, 50), 5001)

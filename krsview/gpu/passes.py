@@ -87,6 +87,17 @@ def packed(size: tuple[int, int], listed: int) -> tuple[int, int]:
     return width, -(-listed // width)
 
 
+def packed_in_groups(size: tuple[int, int], listed: int) -> tuple[int, int]:
+    """``packed``'s image, its width whole 4 × 2 groups of lanes and filled group by group,
+    eight consecutive entries to a group (shadows.glsl, packed_index): for the blocks' shadow
+    rays, whose neighbours walk alike."""
+    width = packed(size, listed)[0] // 4 * 4
+    rows = 2 * -(-listed // (2 * width))
+    if width == 0 or rows > size[1]:
+        raise ValueError(f"{listed} entries in groups of lanes: an image of {size} is too small")
+    return width, rows
+
+
 def still_ratio(scene: Scene) -> int:
     """The passes a still image of ``scene`` is drawn in (the module's docstring): its
     ``[render] shadow_block`` where the shadows can be a pass of their own, else 0 (one pass,
@@ -143,6 +154,7 @@ class Targets:
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
         self._outlines: dict[moderngl.Framebuffer, Outline] = {}
+        self._block_list: moderngl.Buffer | None = None
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -177,6 +189,17 @@ class Targets:
                 depth,
             )
         return self._outlines[output]
+
+    def block_list(self, bins: int) -> moderngl.Buffer:
+        """coarse_visibility.frag's lists of blocks for a coarse target of ``bins`` of
+        llvmpipe's bins: a count and room for a bin's blocks each (one buffer, grown for a
+        target with more bins)."""
+        size = 4 * bins * (1 + BIN * BIN)
+        if self._block_list is None or self._block_list.size < size:
+            if self._block_list is not None:
+                self._block_list.release()
+            self._block_list = self.ctx.buffer(reserve=size)
+        return self._block_list
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -224,6 +247,12 @@ class PassImage:
             self.output = targets.output(size) if ratio else None
         self._programs: dict[str, moderngl.Program] = {}
 
+    def coarse_bins(self) -> tuple[int, int]:
+        """llvmpipe's bins across the coarse target and in all: one list of blocks each."""
+        (w, h), (x, y) = self.coarse, self.origin
+        across = -(-(x + w) // BIN)
+        return across, across * -(-(y + h) // BIN)
+
     def coarse_target(self) -> moderngl.Framebuffer:
         """The visibility pass's target: visibilities and depths, the coarse image at
         ``origin`` (bin_origin)."""
@@ -246,6 +275,7 @@ class PassImage:
                 vis = self.renderer.companion(main, "coarse_visibility.frag", {define: None})
                 vis["u_shadow_ratio"].value = self.ratio
                 vis["u_coarse_origin"].value = self.origin
+                vis["u_bins"].value = (*self.coarse_bins(), BIN)
                 self._programs[name] = vis
             (bw, bh), _, side = self.blocks
             for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
@@ -313,19 +343,19 @@ class PassImage:
 
     def _visibility(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the blocks: each block's depth, and the blocks facing a
-        light listed (in the outline's buffer, which the shading fills only after); then the
-        listed blocks' shadow rays, packed into the first rows of a pass of their own
-        (``packed``), their visibilities stored at their blocks' texels."""
-        ctx, target = self.renderer.ctx, self.coarse_target()
-        blocks = self.targets.outline(self.output).pixels
-        blocks.write(bytes(4))  # none listed
+        light listed, a list per bin; then the listed blocks' shadow rays, packed into the
+        first rows of a pass of their own (``packed_in_groups``), their visibilities stored
+        at their blocks' texels."""
+        ctx, target, bins = self.renderer.ctx, self.coarse_target(), self.coarse_bins()[1]
+        blocks = self.targets.block_list(bins)
+        blocks.write(bytes(4 * bins))  # none listed
         blocks.bind_to_storage_buffer(BINDING_BLOCK_LIST)
         self._fill(self._programs["visibility"], target, self.coarse, y0, rows, self.origin)
-        ctx.memory_barrier()  # the list and the blocks' depths complete
-        listed = int.from_bytes(blocks.read(4), sys.byteorder)
+        ctx.memory_barrier()  # the lists and the blocks' depths complete
+        listed = sum(memoryview(blocks.read(4 * bins)).cast("I"))
         if listed:
             target.color_attachments[0].bind_to_image(0, read=False, write=True)
-            prog, size = self._programs["rays"], packed(self.coarse, listed)
+            prog, size = self._programs["rays"], packed_in_groups(self.size, listed)
             prog["u_rays_width"].value = size[0]
             self._fill(prog, self.targets.outline(self.output).scratch, size, 0, size[1])
             ctx.memory_barrier()  # the stored visibilities visible to the shading's reads
