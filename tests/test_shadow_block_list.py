@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from krsview.gpu import passes
 from krsview.gpu.passes import PassImage
 from krsview.gpu.renderer import read_buffers
 
@@ -97,25 +96,3 @@ def test_only_blocks_facing_a_light_trace_rays(renderer, targets, monkeypatch, n
         assert ((by // side * across + bx // side) == b).all(), b
         got += zip((by - oy).tolist(), (bx - ox).tolist())
     assert len(got) == len(set(got)) and set(got) == set(zip(*np.nonzero(facing.any(-1))))
-
-
-@pytest.mark.parametrize(
-    "size, listed, want",
-    [
-        ((320, 180), 1889, (128, 16)),  # two bins across, whole row pairs of 4 × 2 groups
-        ((320, 180), 256, (128, 2)),
-        ((320, 180), 257, (128, 4)),
-        ((320, 180), 128 * 180 + 1, (256, 92)),
-        ((102, 50), 300, (100, 4)),  # the image's width, down to whole groups
-    ],
-)
-def test_the_rays_pass_fills_whole_groups_of_lanes(size, listed, want):
-    assert passes.packed_in_groups(size, listed) == want
-
-
-def test_a_list_too_long_for_the_image_is_refused():
-    assert passes.packed_in_groups((102, 50), 5000) == (100, 50)  # control: the most it holds
-    with pytest.raises(
-        ValueError, match=r"5001 entries in groups of lanes: an image of \(102, 50\)"
-    ):
-        passes.packed_in_groups((102, 50), 5001)

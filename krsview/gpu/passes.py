@@ -10,8 +10,9 @@ resolution]. ``ratio`` picks the passes:
   and size can reuse the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
   each r × r block (coarse_visibility.frag: the blocks' depths, the blocks facing a light
-  listed, then their rays packed into the first rows of a pass of their own, so that they
-  fill whole groups of lanes), then ``shade``: each pixel takes the
+  listed, a list per llvmpipe bin, then their rays packed into the first rows of a pass of
+  their own, ``packed``, so that they fill whole groups of lanes), then ``shade``: each
+  pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
   its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
   branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
@@ -75,26 +76,21 @@ def bin_origin(size: tuple[int, int]) -> tuple[int, int]:
 
 
 def packed(size: tuple[int, int], listed: int) -> tuple[int, int]:
-    """The outline pass's image for ``listed`` pixels of an image of ``size``, filled row by
-    row from its first: the fewest whole pairs of llvmpipe's bins across that hold them in
-    the image's rows, so that its two threads get as many bins (a full-width pass at 320 px
-    lay in five bins, one thread drawing three; packed, tree's and grove's outline passes
-    take 0.79-0.93× the wall time at 320 × 180 to 960 × 540), or the image's width where
-    that is narrower."""
-    w, h = size
+    """The image of a pass over ``listed`` entries of a list of an image of ``size``'s pixels
+    or blocks (the outline pixels, the blocks' shadow rays): the fewest whole pairs of
+    llvmpipe's bins across that hold them in the image's rows, so that its two threads get
+    as many bins (a full-width pass at 320 px lay in five bins, one thread drawing three;
+    packed, tree's and grove's outline passes take 0.79-0.93× the wall time at 320 × 180 to
+    960 × 540), or the image's width where that is narrower; filled by whole 4 × 2 groups
+    of lanes, eight consecutive entries to a group (shadows.glsl, packed_index), so that a
+    group's rays are neighbours (tree's outline pass: 0.82× the CPU time of rows filled
+    one by one). Drawn into ``Targets.lanes``, which holds a list of all the pixels."""
+    w, h = -(-size[0] // 4) * 4, -(-size[1] // 2) * 2
     pairs = max(1, -(-listed // (2 * BIN * h)))
     width = min(2 * BIN * pairs, w)
-    return width, -(-listed // width)
-
-
-def packed_in_groups(size: tuple[int, int], listed: int) -> tuple[int, int]:
-    """``packed``'s image, its width whole 4 × 2 groups of lanes and filled group by group,
-    eight consecutive entries to a group (shadows.glsl, packed_index): for the blocks' shadow
-    rays, whose neighbours walk alike."""
-    width = packed(size, listed)[0] // 4 * 4
     rows = 2 * -(-listed // (2 * width))
-    if width == 0 or rows > size[1]:
-        raise ValueError(f"{listed} entries in groups of lanes: an image of {size} is too small")
+    if rows > h:
+        raise ValueError(f"{listed} entries in groups of lanes: more than the {size} image's")
     return width, rows
 
 
@@ -135,9 +131,8 @@ class Tracer(Protocol):
 
 class Outline(NamedTuple):
     """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
-    the pixels), the target their pass draws (no colour: it stores each listed pixel's
-    colour in the image's) and the image's colour with the depth that tells the shading
-    passes hits from the sky (``shaded``)."""
+    the pixels), the depth that tells the shading passes hits from the sky, marked in
+    ``scratch`` (no colour), and the image's colour with that depth (``shaded``)."""
 
     pixels: moderngl.Buffer
     scratch: moderngl.Framebuffer
@@ -155,6 +150,7 @@ class Targets:
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
         self._outlines: dict[moderngl.Framebuffer, Outline] = {}
         self._block_list: moderngl.Buffer | None = None
+        self._lanes: moderngl.Framebuffer | None = None
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -200,6 +196,20 @@ class Targets:
                 self._block_list.release()
             self._block_list = self.ctx.buffer(reserve=size)
         return self._block_list
+
+    def lanes(self, size: tuple[int, int]) -> moderngl.Framebuffer:
+        """The target of the passes packed into groups of lanes (``packed``) over
+        lists of an image of ``size``: no colour, at least ``size`` in whole 4 × 2 groups, so
+        that it holds a list of all the image's pixels (one target, grown for a larger
+        image)."""
+        w, h = -(-size[0] // 4) * 4, -(-size[1] // 2) * 2
+        if self._lanes is None or self._lanes.size[0] < w or self._lanes.size[1] < h:
+            if self._lanes is not None:
+                w, h = max(w, self._lanes.size[0]), max(h, self._lanes.size[1])
+                self._lanes.depth_attachment.release()
+                self._lanes.release()
+            self._lanes = self.ctx.framebuffer(depth_attachment=self.ctx.depth_renderbuffer((w, h)))
+        return self._lanes
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -344,7 +354,7 @@ class PassImage:
     def _visibility(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the blocks: each block's depth, and the blocks facing a
         light listed, a list per bin; then the listed blocks' shadow rays, packed into the
-        first rows of a pass of their own (``packed_in_groups``), their visibilities stored
+        first rows of a pass of their own (``packed``), their visibilities stored
         at their blocks' texels."""
         ctx, target, bins = self.renderer.ctx, self.coarse_target(), self.coarse_bins()[1]
         blocks = self.targets.block_list(bins)
@@ -355,9 +365,9 @@ class PassImage:
         listed = sum(memoryview(blocks.read(4 * bins)).cast("I"))
         if listed:
             target.color_attachments[0].bind_to_image(0, read=False, write=True)
-            prog, size = self._programs["rays"], packed_in_groups(self.size, listed)
+            prog, size = self._programs["rays"], packed(self.size, listed)
             prog["u_rays_width"].value = size[0]
-            self._fill(prog, self.targets.outline(self.output).scratch, size, 0, size[1])
+            self._fill(prog, self.targets.lanes(self.size), size, 0, size[1])
             ctx.memory_barrier()  # the stored visibilities visible to the shading's reads
 
     def _shade_and_outline(self, y0: int, rows: int) -> None:
@@ -375,7 +385,7 @@ class PassImage:
             self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
             prog, size = self._programs["outline"], packed(self.size, listed)
             prog["u_outline_width"].value = size[0]
-            self._fill(prog, outline.scratch, size, 0, size[1])
+            self._fill(prog, self.targets.lanes(self.size), size, 0, size[1])
             ctx.memory_barrier()  # the stored colours visible to whatever reads the image
 
     def _shade_by_depth(self, outline: Outline, y0: int, rows: int, shading: str) -> None:

@@ -70,7 +70,7 @@ void main() {
 
 #ifdef KRS_SHADOW_RAYS
 layout(rgba32f, binding = 0) uniform writeonly image2D u_visibility_image;  // the list pass's
-uniform int u_rays_width;  // the pass's width (gpu/passes.py, packed_in_groups)
+uniform int u_rays_width;  // the pass's width (gpu/passes.py, packed)
 
 void main() {
     uint i = packed_index(ivec2(gl_FragCoord.xy), u_rays_width), first = 0u;
