@@ -9,16 +9,13 @@ resolution]. ``ratio`` picks the passes:
   its own shadow rays: render.frag's image in two passes, so a later image of the same view
   and size can reuse the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
-  each r × r block (coarse_visibility.frag: the blocks' depths, the blocks facing a light
-  listed, a list per llvmpipe bin, then their rays packed into the first rows of a pass of
-  their own, ``packed``, so that they fill whole groups of lanes), then ``shade``: each
-  pixel takes the
+  each r × r block (coarse_visibility.frag: the blocks' depths, those facing a light listed
+  per llvmpipe bin, then their rays alone, ``packed``), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
   its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
   branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
-  outline pixels listed (an atomic counter), then the listed pixels alone, packed into the
-  first rows of a pass of their own (``packed``), shaded with their own rays and stored into
-  the image;
+  outline pixels listed (an atomic counter), then the listed pixels alone (``packed``),
+  shaded with their own rays and stored into the image;
 - r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
@@ -77,14 +74,12 @@ def bin_origin(size: tuple[int, int]) -> tuple[int, int]:
 
 def packed(size: tuple[int, int], listed: int) -> tuple[int, int]:
     """The image of a pass over ``listed`` entries of a list of an image of ``size``'s pixels
-    or blocks (the outline pixels, the blocks' shadow rays): the fewest whole pairs of
-    llvmpipe's bins across that hold them in the image's rows, so that its two threads get
-    as many bins (a full-width pass at 320 px lay in five bins, one thread drawing three;
-    packed, tree's and grove's outline passes take 0.79-0.93× the wall time at 320 × 180 to
-    960 × 540), or the image's width where that is narrower; filled by whole 4 × 2 groups
-    of lanes, eight consecutive entries to a group (shadows.glsl, packed_index), so that a
-    group's rays are neighbours (tree's outline pass: 0.82× the CPU time of rows filled
-    one by one). Drawn into ``Targets.lanes``, which holds a list of all the pixels."""
+    or blocks (the outline pixels, the blocks' rays), drawn into ``Targets.lanes``: the
+    fewest whole pairs of llvmpipe's bins across that hold them in the image's rows, so that
+    its two threads get as many bins (tree's and grove's outline passes: 0.79-0.93× the
+    wall time of a full-width pass), or the image's width where that is narrower; filled by
+    4 × 2 groups of lanes, eight consecutive entries each (shadows.glsl, packed_index: a
+    group's rays are neighbours; tree's outline pass 0.82× the CPU of rows filled in turn)."""
     w, h = -(-size[0] // 4) * 4, -(-size[1] // 2) * 2
     pairs = max(1, -(-listed // (2 * BIN * h)))
     width = min(2 * BIN * pairs, w)
@@ -187,9 +182,8 @@ class Targets:
         return self._outlines[output]
 
     def block_list(self, bins: int) -> moderngl.Buffer:
-        """coarse_visibility.frag's lists of blocks for a coarse target of ``bins`` of
-        llvmpipe's bins: a count and room for a bin's blocks each (one buffer, grown for a
-        target with more bins)."""
+        """coarse_visibility.frag's lists of blocks, a count and room for a bin's blocks per
+        bin of a coarse target (one buffer, grown for more bins)."""
         size = 4 * bins * (1 + BIN * BIN)
         if self._block_list is None or self._block_list.size < size:
             if self._block_list is not None:
@@ -198,10 +192,8 @@ class Targets:
         return self._block_list
 
     def lanes(self, size: tuple[int, int]) -> moderngl.Framebuffer:
-        """The target of the passes packed into groups of lanes (``packed``) over
-        lists of an image of ``size``: no colour, at least ``size`` in whole 4 × 2 groups, so
-        that it holds a list of all the image's pixels (one target, grown for a larger
-        image)."""
+        """The target of the ``packed`` passes over lists of an image of ``size``: no
+        colour, room for every pixel in whole 4 × 2 groups (one target, grown as needed)."""
         w, h = -(-size[0] // 4) * 4, -(-size[1] // 2) * 2
         if self._lanes is None or self._lanes.size[0] < w or self._lanes.size[1] < h:
             if self._lanes is not None:
@@ -352,41 +344,36 @@ class PassImage:
         ctx.scissor = None
 
     def _visibility(self, y0: int, rows: int) -> None:
-        """Rows [y0, y0 + rows) of the blocks: each block's depth, and the blocks facing a
-        light listed, a list per bin; then the listed blocks' shadow rays, packed into the
-        first rows of a pass of their own (``packed``), their visibilities stored
-        at their blocks' texels."""
+        """Rows [y0, y0 + rows) of the blocks: their depths, those facing a light listed per
+        bin; then the listed blocks' shadow rays (``packed``), stored at their texels."""
         ctx, target, bins = self.renderer.ctx, self.coarse_target(), self.coarse_bins()[1]
         blocks = self.targets.block_list(bins)
         blocks.write(bytes(4 * bins))  # none listed
         blocks.bind_to_storage_buffer(BINDING_BLOCK_LIST)
         self._fill(self._programs["visibility"], target, self.coarse, y0, rows, self.origin)
         ctx.memory_barrier()  # the lists and the blocks' depths complete
-        listed = sum(memoryview(blocks.read(4 * bins)).cast("I"))
-        if listed:
-            target.color_attachments[0].bind_to_image(0, read=False, write=True)
-            prog, size = self._programs["rays"], packed(self.size, listed)
-            prog["u_rays_width"].value = size[0]
-            self._fill(prog, self.targets.lanes(self.size), size, 0, size[1])
-            ctx.memory_barrier()  # the stored visibilities visible to the shading's reads
+        self._packed("rays", sum(memoryview(blocks.read(4 * bins)).cast("I")), target)
 
     def _shade_and_outline(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
         outline pixels (those that lack a light's visibility) listed; then the listed pixels
-        shaded anew with their own shadow rays, packed into the first rows of a pass of
-        their own (``packed``), their colours stored over the image's."""
+        shaded anew with their own shadow rays (``packed``), stored over the image's."""
         ctx, outline = self.renderer.ctx, self.targets.outline(self.output)
         outline.pixels.write(bytes(4))  # none listed
         outline.pixels.bind_to_storage_buffer(BINDING_OUTLINE)
         self._shade_by_depth(outline, y0, rows, "shade")
         ctx.memory_barrier()  # the list and the shaded pixels complete
-        listed = int.from_bytes(outline.pixels.read(4), sys.byteorder)
-        if listed:  # their pass over as many rows as they fill
-            self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
-            prog, size = self._programs["outline"], packed(self.size, listed)
-            prog["u_outline_width"].value = size[0]
+        self._packed("outline", int.from_bytes(outline.pixels.read(4), sys.byteorder), self.output)
+
+    def _packed(self, name: str, listed: int, target: moderngl.Framebuffer) -> None:
+        """Pass ``name`` over the ``listed`` entries of its list (``packed``), storing into
+        ``target``'s first colour (then visible to whatever reads it)."""
+        if listed:
+            target.color_attachments[0].bind_to_image(0, read=False, write=True)
+            prog, size = self._programs[name], packed(self.size, listed)
+            prog["u_packed_width"].value = size[0]
             self._fill(prog, self.targets.lanes(self.size), size, 0, size[1])
-            ctx.memory_barrier()  # the stored colours visible to whatever reads the image
+            self.renderer.ctx.memory_barrier()
 
     def _shade_by_depth(self, outline: Outline, y0: int, rows: int, shading: str) -> None:
         """Rows [y0, y0 + rows) shaded by pass ``shading`` so that groups of pixels with no

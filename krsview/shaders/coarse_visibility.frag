@@ -70,10 +70,10 @@ void main() {
 
 #ifdef KRS_SHADOW_RAYS
 layout(rgba32f, binding = 0) uniform writeonly image2D u_visibility_image;  // the list pass's
-uniform int u_rays_width;  // the pass's width (gpu/passes.py, packed)
+uniform int u_packed_width;  // the pass's width (gpu/passes.py, packed)
 
 void main() {
-    uint i = packed_index(ivec2(gl_FragCoord.xy), u_rays_width), first = 0u;
+    uint i = packed_index(ivec2(gl_FragCoord.xy), u_packed_width), first = 0u;
     int b = 0;
     for (; b < u_bins.y; ++b) {  // the bin whose list holds the i-th block listed
         uint n = block_list[b];

@@ -59,7 +59,7 @@ layout(std430, binding = BINDING_OUTLINE) buffer Outline {
 #endif
 #ifdef KRS_SHADOW_OUTLINE
 layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
-uniform int u_outline_width;  // the pass's width (gpu/passes.py, packed)
+uniform int u_packed_width;  // the pass's width (gpu/passes.py, packed)
 #endif
 
 #ifndef KRS_HIT_DEPTH  // (which writes the depth the others are tested against)
@@ -88,7 +88,7 @@ void main() {
     gl_FragDepth = texelFetch(u_traced_color, ivec2(gl_FragCoord.xy), 0).a < 0.5 ? 1.0 : 0.0;
 #elif defined(KRS_SHADOW_OUTLINE)
     uint width = uint(textureSize(u_traced_color, 0).x);
-    uint i = packed_index(ivec2(gl_FragCoord.xy), u_outline_width);
+    uint i = packed_index(ivec2(gl_FragCoord.xy), u_packed_width);
     if (i >= outline_count) discard;
     ivec2 px = ivec2(outline_pixels[i] % width, outline_pixels[i] / width);
     imageStore(u_color_image, px, traced_color(px));
