@@ -11,7 +11,7 @@
 // eight neighbours to a group of lanes, and stores each one's visibilities at its block's
 // texel. Each of llvmpipe's bins keeps a list of its own: one thread fills it, in the order
 // it draws, so neighbours stay neighbours (one list for all, filled by two threads at once,
-// put far blocks into a group: grove's rays took 1.3× as long).
+// put far blocks into a group: grove's rays took 1.25× as long, forest's 1.16×).
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
