@@ -216,6 +216,7 @@ TWIN_NAMES: dict[str, str | None] = {
     "trace_ray": "sphere_trace",
     "bound_ahead": None,  # the balls' exits change no value: compared without them instead
     "leave": None,
+    "packed_index": None,  # where a packed pass reads its list (gpu/passes.py, packed)
     "nearest_kernel": "reference/geometry.py:nearest",
     "turn": "untwist",  # the rotation, inline in NumPy
 }

@@ -145,26 +145,31 @@ def test_only_listed_pixels_run_the_outline_pass(renderer, targets, monkeypatch)
         image = image_of(renderer, targets, tree)
         count = int(listed(targets, image).sum())
     w, h = SIZE
-    assert [d[0] for d in drawn] == ["visibility", "hits", "sky", "shade", "outline"]
-    assert drawn[1] == ("hits", h, w * h) and drawn[2][2] + drawn[3][2] == w * h
-    assert 0 < count < w * h / 20 and drawn[4] == ("outline", -(-count // 128), count)
+    assert [d[0] for d in drawn] == ["visibility", "rays", "hits", "sky", "shade", "outline"]
+    assert drawn[2] == ("hits", h, w * h) and drawn[3][2] + drawn[4][2] == w * h
+    assert 0 < count < w * h / 20 and drawn[5] == ("outline", 2 * -(-count // 256), count)
 
 
 @pytest.mark.parametrize(
     "size, listed, want",
     [
         ((320, 180), 1000, (128, 8)),  # two bins across, not five
-        ((160, 90), 300, (128, 3)),
+        ((160, 90), 300, (128, 4)),  # whole 4 × 2 groups: an even number of rows
         ((320, 180), 128 * 180, (128, 180)),
-        ((320, 180), 128 * 180 + 1, (256, 91)),  # two bins would need more rows than 180
-        ((320, 180), 256 * 180 + 1, (320, 145)),  # and four
+        ((320, 180), 128 * 180 + 1, (256, 92)),  # two bins would need more rows than 180
+        ((320, 180), 256 * 180 + 1, (320, 146)),  # and four
         ((100, 50), 120, (100, 2)),  # narrower than two bins
+        ((102, 51), 102 * 51, (104, 52)),  # every pixel, in whole groups
     ],
 )
-def test_the_outline_pass_spans_whole_pairs_of_bins(size, listed, want):
-    """The outline pass's image: the fewest pairs of 64-pixel bins across whose rows hold
-    the listed pixels within the image's height, else the image's width."""
+def test_a_packed_pass_spans_whole_pairs_of_bins_in_whole_groups(size, listed, want):
+    """A packed pass's image (the outline pixels', the blocks' rays'): the fewest pairs of
+    64-pixel bins across whose rows hold the listed entries within the image's height,
+    else the image's width, in whole 4 × 2 groups of lanes; more entries than pixels
+    (negative control) are refused."""
     assert passes.packed(size, listed) == want
+    with pytest.raises(ValueError, match=f"{104 * 52 + 1} entries in groups of lanes"):
+        passes.packed((102, 51), 104 * 52 + 1)
 
 
 def test_the_shade_pass_compiles_no_shadow_ray(renderer, targets, monkeypatch):

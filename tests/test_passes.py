@@ -128,8 +128,8 @@ def test_the_passes_are_valid_desktop_glsl(renderer, tmp_path, monkeypatch):
         for ratio in (1, 2):
             draw(renderer, Targets(renderer.ctx), scene, ratio, (16, 9))
     # per scene: the trace pass (and its free tiles' pass, with tree's and grove's pre-pass);
-    # ratio 1: the shading; 2: blocks, hits' depth, sky, shading, outline pixels
-    assert len(sources) == 23
+    # ratio 1: the shading; 2: blocks listed, their rays, hits' depth, sky, shading, outline
+    assert len(sources) == 26
     for version in VERSIONS:
         assert validate(sources, tmp_path, version) == ""
     # negative control: a call the language does not have

@@ -204,7 +204,7 @@ def test_camera_path_is_saved_beside_the_preset_and_loaded_again(viewer):
 def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     """The HUD's tracer choice goes through Viewer.set_render: a new define set compiles once
     (its tracing program, its pre-pass and its free tiles' pass (gpu/renderer.py), the tree's
-    shadow rays per block of pixels, the hits' depth, the sky's and the shading with those,
+    blocks listed and their shadow rays, the hits' depth, the sky's and the shading with those,
     and its outline pixels': gpu/passes.py; the still image shares them, [render]
     shadow_block); switching back, and moving accuracy knobs, compile nothing."""
     v = viewer
@@ -214,7 +214,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     sphere_image = v.read_window()
     v.set_render(tracer="binary")
     settle(v)
-    assert v.prepass and programs.compiles == before + 8
+    assert v.prepass and programs.compiles == before + 9
     assert any(("KRS_TRACER_BINARY", None) in key[2] for key in programs._programs)
     binary_image = v.read_window()
     assert np.abs(binary_image.astype(int) - sphere_image).max() > 0  # a different tracer ran
@@ -222,7 +222,7 @@ def test_tracer_switch_compiles_one_new_variant_then_hits_the_cache(viewer):
     settle(v)
     v.set_render(epsilon_scale=2.0, max_iterations=100, xi_bonus=3.0)
     settle(v)
-    assert programs.compiles == before + 8
+    assert programs.compiles == before + 9
 
 
 def test_precision_knob_switches_to_the_double_variant_in_the_window(viewer):
@@ -283,7 +283,7 @@ def test_preset_picker_and_levels_slider(viewer):
 def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     """The HUD's effect checkboxes go through Viewer.set_effect: a new effect set compiles one
     variant with its define (with shadows: the tracing, its pre-pass and its free tiles'
-    pass, the shadow rays per block of pixels, the hits' depth, the sky's and the shading
+    pass, the blocks listed and their shadow rays, the hits' depth, the sky's and the shading
     with them and its outline pixels', gpu/passes.py); switching back and forth again
     compiles nothing."""
     v = viewer
@@ -294,7 +294,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     plain = v.read_window()
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 8
+    assert programs.compiles == before + 9
     assert any(("KRS_SHADOWS", None) in key[2] for key in programs._programs)
     assert np.abs(v.read_window().astype(int) - plain).max() > 0
     v.set_effect("soft_shadows", True)  # replaces the hard shadows: they exclude each other
@@ -304,7 +304,7 @@ def test_effect_toggles_compile_once_then_hit_the_cache(viewer):
     settle(v)
     v.set_effect("shadows", True)
     settle(v)
-    assert programs.compiles == before + 16
+    assert programs.compiles == before + 18
     v.file.open(resolve("palm"))
     v.set_effect("twist", True)
     assert "twist" not in v.scene.effects and "MöKRS" in v.error

@@ -53,6 +53,7 @@ BINDING_COUNTS = 3  # compute.comp's Counts: live rays per queue, the next dispa
 BINDING_SHADOWS = 4  # shadows.glsl's Shadow per pixel and light (KRS_SHADOW_TASKS)
 BINDING_TASKS = 5  # a Ray per pixel and component (KRS_COMPONENT_TASKS)
 BINDING_OUTLINE = 6  # upsampled.frag's list of outline pixels (gpu/passes.py)
+BINDING_BLOCK_LIST = 7  # coarse_visibility.frag's list of blocks with shadow rays to trace
 # compute.comp's u_phase: what one dispatch does
 PHASE_START = 0  # start the rays (or component tasks) of the tile
 PHASE_ROUND = 1  # a round of the rays
@@ -98,6 +99,7 @@ def shared() -> dict[str, GlslValue]:
         "BINDING_SHADOWS": BINDING_SHADOWS,
         "BINDING_TASKS": BINDING_TASKS,
         "BINDING_OUTLINE": BINDING_OUTLINE,
+        "BINDING_BLOCK_LIST": BINDING_BLOCK_LIST,
         "PHASE_START": PHASE_START,
         "PHASE_ROUND": PHASE_ROUND,
         "PHASE_SIZE": PHASE_SIZE,

@@ -9,13 +9,13 @@ resolution]. ``ratio`` picks the passes:
   its own shadow rays: render.frag's image in two passes, so a later image of the same view
   and size can reuse the tracing;
 - r ≥ 2: ``trace``, then ``visibility``, one shadow ray per light from the nearest hit of
-  each r × r block (coarse_visibility.frag), then ``shade``: each pixel takes the
+  each r × r block (coarse_visibility.frag: the blocks' depths, those facing a light listed
+  per llvmpipe bin, then their rays alone, ``packed``), then ``shade``: each pixel takes the
   visibilities of the blocks near it at its depth, bilinearly weighted; one with none near
   its depth (an outline) traces its own. ``shade`` draws twice (llvmpipe runs every
   branch's code for every pixel): every pixel with no shadow-ray code compiled in, the
-  outline pixels listed (an atomic counter), then the listed pixels alone, packed into the
-  first rows of a pass of their own (``packed``), shaded with their own rays and stored into
-  the image;
+  outline pixels listed (an atomic counter), then the listed pixels alone (``packed``),
+  shaded with their own rays and stored into the image;
 - r ≥ 2 with ``blocks``, an earlier image of the same view with blocks of its own (a smaller
   one, or the last moving frame): ``trace``, then ``shade`` with that image's visibilities
   (its blocks mapped onto this image's pixels), so a full-resolution primary image shows
@@ -36,7 +36,7 @@ from typing import NamedTuple, Protocol
 
 import moderngl
 
-from ..compile.constants import BINDING_OUTLINE
+from ..compile.constants import BINDING_BLOCK_LIST, BINDING_OUTLINE
 from ..scene import Geometry, Scene
 from .coarse import BIN
 from .context import behind_mark
@@ -73,16 +73,20 @@ def bin_origin(size: tuple[int, int]) -> tuple[int, int]:
 
 
 def packed(size: tuple[int, int], listed: int) -> tuple[int, int]:
-    """The outline pass's image for ``listed`` pixels of an image of ``size``, filled row by
-    row from its first: the fewest whole pairs of llvmpipe's bins across that hold them in
-    the image's rows, so that its two threads get as many bins (a full-width pass at 320 px
-    lay in five bins, one thread drawing three; packed, tree's and grove's outline passes
-    take 0.79-0.93× the wall time at 320 × 180 to 960 × 540), or the image's width where
-    that is narrower."""
-    w, h = size
+    """The image of a pass over ``listed`` entries of a list of an image of ``size``'s pixels
+    or blocks (the outline pixels, the blocks' rays), drawn into ``Targets.lanes``: the
+    fewest whole pairs of llvmpipe's bins across that hold them in the image's rows, so that
+    its two threads get as many bins (tree's and grove's outline passes: 0.79-0.93× the
+    wall time of a full-width pass), or the image's width where that is narrower; filled by
+    4 × 2 groups of lanes, eight consecutive entries each (shadows.glsl, packed_index: a
+    group's rays are neighbours; tree's outline pass 0.82× the CPU of rows filled in turn)."""
+    w, h = -(-size[0] // 4) * 4, -(-size[1] // 2) * 2
     pairs = max(1, -(-listed // (2 * BIN * h)))
     width = min(2 * BIN * pairs, w)
-    return width, -(-listed // width)
+    rows = 2 * -(-listed // (2 * width))
+    if rows > h:
+        raise ValueError(f"{listed} entries in groups of lanes: more than the {size} image's")
+    return width, rows
 
 
 def still_ratio(scene: Scene) -> int:
@@ -122,9 +126,8 @@ class Tracer(Protocol):
 
 class Outline(NamedTuple):
     """A finished image's list of outline pixels (upsampled.frag's Outline: a count, then
-    the pixels), the target their pass draws (no colour: it stores each listed pixel's
-    colour in the image's) and the image's colour with the depth that tells the shading
-    passes hits from the sky (``shaded``)."""
+    the pixels), the depth that tells the shading passes hits from the sky, marked in
+    ``scratch`` (no colour), and the image's colour with that depth (``shaded``)."""
 
     pixels: moderngl.Buffer
     scratch: moderngl.Framebuffer
@@ -141,6 +144,8 @@ class Targets:
         self.ctx = ctx
         self._kept: dict[tuple[int, int, int, int], moderngl.Framebuffer] = {}
         self._outlines: dict[moderngl.Framebuffer, Outline] = {}
+        self._block_list: moderngl.Buffer | None = None
+        self._lanes: moderngl.Framebuffer | None = None
         self._vaos: dict[moderngl.Program, moderngl.VertexArray] = {}
         self.flip = 0
 
@@ -175,6 +180,28 @@ class Targets:
                 depth,
             )
         return self._outlines[output]
+
+    def block_list(self, bins: int) -> moderngl.Buffer:
+        """coarse_visibility.frag's lists of blocks, a count and room for a bin's blocks per
+        bin of a coarse target (one buffer, grown for more bins)."""
+        size = 4 * bins * (1 + BIN * BIN)
+        if self._block_list is None or self._block_list.size < size:
+            if self._block_list is not None:
+                self._block_list.release()
+            self._block_list = self.ctx.buffer(reserve=size)
+        return self._block_list
+
+    def lanes(self, size: tuple[int, int]) -> moderngl.Framebuffer:
+        """The target of the ``packed`` passes over lists of an image of ``size``: no
+        colour, room for every pixel in whole 4 × 2 groups (one target, grown as needed)."""
+        w, h = -(-size[0] // 4) * 4, -(-size[1] // 2) * 2
+        if self._lanes is None or self._lanes.size[0] < w or self._lanes.size[1] < h:
+            if self._lanes is not None:
+                w, h = max(w, self._lanes.size[0]), max(h, self._lanes.size[1])
+                self._lanes.depth_attachment.release()
+                self._lanes.release()
+            self._lanes = self.ctx.framebuffer(depth_attachment=self.ctx.depth_renderbuffer((w, h)))
+        return self._lanes
 
     def vao(self, prog: moderngl.Program) -> moderngl.VertexArray:
         if prog not in self._vaos:
@@ -222,6 +249,12 @@ class PassImage:
             self.output = targets.output(size) if ratio else None
         self._programs: dict[str, moderngl.Program] = {}
 
+    def coarse_bins(self) -> tuple[int, int]:
+        """llvmpipe's bins across the coarse target and in all: one list of blocks each."""
+        (w, h), (x, y) = self.coarse, self.origin
+        across = -(-(x + w) // BIN)
+        return across, across * -(-(y + h) // BIN)
+
     def coarse_target(self) -> moderngl.Framebuffer:
         """The visibility pass's target: visibilities and depths, the coarse image at
         ``origin`` (bin_origin)."""
@@ -240,10 +273,12 @@ class PassImage:
         main = self.renderer.prepare(self.scene, *self.size, self.geometry, probes=probes)
         self._programs = {"render" if not self.ratio else "trace": main}
         if self.ratio > 1:
-            vis = self.renderer.companion(main, "coarse_visibility.frag")
-            vis["u_shadow_ratio"].value = self.ratio
-            vis["u_coarse_origin"].value = self.origin
-            self._programs["visibility"] = vis
+            for name, define in (("visibility", "KRS_SHADOW_LIST"), ("rays", "KRS_SHADOW_RAYS")):
+                vis = self.renderer.companion(main, "coarse_visibility.frag", {define: None})
+                vis["u_shadow_ratio"].value = self.ratio
+                vis["u_coarse_origin"].value = self.origin
+                vis["u_bins"].value = (*self.coarse_bins(), BIN)
+                self._programs[name] = vis
             (bw, bh), _, side = self.blocks
             for name, define in (("shade", "KRS_SHADOW_MARK"), ("outline", "KRS_SHADOW_OUTLINE")):
                 shade = self.renderer.companion(
@@ -281,7 +316,7 @@ class PassImage:
             for unit, tex in enumerate(self.traced.color_attachments):
                 tex.use(unit)
             if name == "visibility":
-                self._fill(prog, self.coarse_target(), self.coarse, y0, rows, self.origin)
+                self._visibility(y0, rows)
             elif name == "shade":
                 coarse = self._blocks_image.coarse_target()
                 for k, tex in enumerate(coarse.color_attachments):
@@ -308,23 +343,37 @@ class PassImage:
         self.targets.vao(prog).render(moderngl.TRIANGLES, vertices=3)
         ctx.scissor = None
 
+    def _visibility(self, y0: int, rows: int) -> None:
+        """Rows [y0, y0 + rows) of the blocks: their depths, those facing a light listed per
+        bin; then the listed blocks' shadow rays (``packed``), stored at their texels."""
+        ctx, target, bins = self.renderer.ctx, self.coarse_target(), self.coarse_bins()[1]
+        blocks = self.targets.block_list(bins)
+        blocks.write(bytes(4 * bins))  # none listed
+        blocks.bind_to_storage_buffer(BINDING_BLOCK_LIST)
+        self._fill(self._programs["visibility"], target, self.coarse, y0, rows, self.origin)
+        ctx.memory_barrier()  # the lists and the blocks' depths complete
+        self._packed("rays", sum(memoryview(blocks.read(4 * bins)).cast("I")), target)
+
     def _shade_and_outline(self, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) of the image: every pixel shaded without shadow-ray code, the
         outline pixels (those that lack a light's visibility) listed; then the listed pixels
-        shaded anew with their own shadow rays, packed into the first rows of a pass of
-        their own (``packed``), their colours stored over the image's."""
+        shaded anew with their own shadow rays (``packed``), stored over the image's."""
         ctx, outline = self.renderer.ctx, self.targets.outline(self.output)
         outline.pixels.write(bytes(4))  # none listed
         outline.pixels.bind_to_storage_buffer(BINDING_OUTLINE)
         self._shade_by_depth(outline, y0, rows, "shade")
         ctx.memory_barrier()  # the list and the shaded pixels complete
-        listed = int.from_bytes(outline.pixels.read(4), sys.byteorder)
-        if listed:  # their pass over as many rows as they fill
-            self.output.color_attachments[0].bind_to_image(0, read=False, write=True)
-            prog, size = self._programs["outline"], packed(self.size, listed)
-            prog["u_outline_width"].value = size[0]
-            self._fill(prog, outline.scratch, size, 0, size[1])
-            ctx.memory_barrier()  # the stored colours visible to whatever reads the image
+        self._packed("outline", int.from_bytes(outline.pixels.read(4), sys.byteorder), self.output)
+
+    def _packed(self, name: str, listed: int, target: moderngl.Framebuffer) -> None:
+        """Pass ``name`` over the ``listed`` entries of its list (``packed``), storing into
+        ``target``'s first colour (then visible to whatever reads it)."""
+        if listed:
+            target.color_attachments[0].bind_to_image(0, read=False, write=True)
+            prog, size = self._programs[name], packed(self.size, listed)
+            prog["u_packed_width"].value = size[0]
+            self._fill(prog, self.targets.lanes(self.size), size, 0, size[1])
+            self.renderer.ctx.memory_barrier()
 
     def _shade_by_depth(self, outline: Outline, y0: int, rows: int, shading: str) -> None:
         """Rows [y0, y0 + rows) shaded by pass ``shading`` so that groups of pixels with no

@@ -152,6 +152,13 @@ float shadow_visibility(vec3r p, vec3 n, vec3 l, float eps) {
     return sh.vis;
 }
 
+// The entry of a list that pixel p of a pass `width` pixels wide (a multiple of 4) traces:
+// eight consecutive entries to each 4 × 2 group of pixels, the lanes llvmpipe runs in
+// lockstep, so that a group's rays are neighbours (gpu/passes.py, packed).
+uint packed_index(ivec2 p, int width) {
+    return uint(((p.y >> 1) * (width >> 2) + (p.x >> 2)) * 8 + (p.y & 1) * 4 + (p.x & 3));
+}
+
 #if defined(KRS_SHADOW_TASKS) || defined(KRS_SHADOW_UPSAMPLED)
 float g_shadow[MAX_LIGHTS];    // the compute path: each light's visibility, traced as tasks
                                // (compute.comp) and loaded by deferred.frag before shading;

@@ -6,9 +6,9 @@
 // earlier, smaller image's of the same view (gpu/passes.py, ``blocks``). Where no block is
 // (an outline), the pixel traces its own ray, in a pass apart so that only those pixels
 // run shadow-ray code (llvmpipe runs every branch's code for every pixel): KRS_SHADOW_MARK
-// compiles none and lists such a pixel; KRS_SHADOW_OUTLINE shades the listed pixels, the
-// list's i-th at the i-th pixel of its pass, so that they fill whole groups of lanes, and
-// stores each one's colour in the image's.
+// compiles none and lists such a pixel; KRS_SHADOW_OUTLINE shades the listed pixels, eight
+// consecutive ones to each group of lanes (shadows.glsl, packed_index), so that they fill
+// whole groups, and stores each one's colour in the image's.
 #include "effects.glsl"
 #include "scene_block.glsl"
 #include "trace.glsl"
@@ -59,7 +59,7 @@ layout(std430, binding = BINDING_OUTLINE) buffer Outline {
 #endif
 #ifdef KRS_SHADOW_OUTLINE
 layout(rgba32f, binding = 0) uniform writeonly image2D u_color_image;  // the image's colour
-uniform int u_outline_width;  // the pass's width (gpu/passes.py, packed)
+uniform int u_packed_width;  // the pass's width (gpu/passes.py, packed)
 #endif
 
 #ifndef KRS_HIT_DEPTH  // (which writes the depth the others are tested against)
@@ -88,7 +88,7 @@ void main() {
     gl_FragDepth = texelFetch(u_traced_color, ivec2(gl_FragCoord.xy), 0).a < 0.5 ? 1.0 : 0.0;
 #elif defined(KRS_SHADOW_OUTLINE)
     uint width = uint(textureSize(u_traced_color, 0).x);
-    uint i = uint(gl_FragCoord.y) * uint(u_outline_width) + uint(gl_FragCoord.x);
+    uint i = packed_index(ivec2(gl_FragCoord.xy), u_packed_width);
     if (i >= outline_count) discard;
     ivec2 px = ivec2(outline_pixels[i] % width, outline_pixels[i] / width);
     imageStore(u_color_image, px, traced_color(px));
