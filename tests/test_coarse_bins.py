@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from krsview.gpu import passes
-from krsview.gpu.coarse import BIN
-from krsview.gpu.passes import PassImage, bin_origin
+from krsview.gpu.bins import BIN, bin_origin
+from krsview.gpu.passes import PassImage
 from krsview.gpu.renderer import read_buffers
 
 from .test_passes import scene_of

@@ -17,7 +17,8 @@ import pytest
 
 from krsview.compile.constants import PREPASS_BLOCK
 from krsview.gpu import renderer as renderer_module
-from krsview.gpu.coarse import BIN, coarse_layout, coarse_quarter, quarters
+from krsview.gpu.bins import BIN
+from krsview.gpu.coarse import coarse_layout, coarse_quarter, quarters
 from krsview.gpu.renderer import Renderer
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from krsview.gpu import passes, program
+from krsview.gpu import bins, passes, program
 from krsview.gpu.passes import SAMPLERS, PassImage
 from krsview.gpu.renderer import read_buffers
 
@@ -167,9 +167,9 @@ def test_a_packed_pass_spans_whole_pairs_of_bins_in_whole_groups(size, listed, w
     64-pixel bins across whose rows hold the listed entries within the image's height,
     else the image's width, in whole 4 × 2 groups of lanes; more entries than pixels
     (negative control) are refused."""
-    assert passes.packed(size, listed) == want
+    assert bins.packed(size, listed) == want
     with pytest.raises(ValueError, match=f"{104 * 52 + 1} entries in groups of lanes"):
-        passes.packed((102, 51), 104 * 52 + 1)
+        bins.packed((102, 51), 104 * 52 + 1)
 
 
 def test_the_shade_pass_compiles_no_shadow_ray(renderer, targets, monkeypatch):

@@ -10,8 +10,7 @@ import functools
 
 from ..compile.camera import View
 from ..compile.constants import PREPASS_BLOCK
-
-BIN = 64  # llvmpipe gives each BIN × BIN pixels of a pass (a bin) to one of its threads
+from .bins import BIN
 
 
 def coarse_quarter(x: int) -> tuple[int, int]:
