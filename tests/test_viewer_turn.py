@@ -137,14 +137,14 @@ def clocked(display, tmp_path, monkeypatch):
 
     clock = Clock()
     monkeypatch.setattr(frames, "time", SimpleNamespace(perf_counter=clock.perf_counter))
-    draw_all = PassImage.draw_all
+    prepare = PassImage.prepare  # once per moving frame (and per refining turn)
 
     def timed(self, *a, **k):
-        out = draw_all(self, *a, **k)
+        out = prepare(self, *a, **k)
         clock.t += TRACE
         return out
 
-    monkeypatch.setattr(PassImage, "draw_all", timed)
+    monkeypatch.setattr(PassImage, "prepare", timed)
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(96, 54), hud=False)

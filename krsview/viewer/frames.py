@@ -9,6 +9,7 @@ blocks (``[render] shadow_block``), and blended as the still image's."""
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -98,9 +99,13 @@ class Frames:
             self.adaptive.full = fb
             self.dirty = True
 
-    def trace(self, scene: Scene, krs: Geometry) -> None:
+    def trace(
+        self, scene: Scene, krs: Geometry, while_tracing: Callable[[], None] | None = None
+    ) -> None:
         """One turn's tracing: a moving frame of ``scene`` after a change, else some bands of
-        the refinement's next image. A ShaderError leaves the last image in place."""
+        the refinement's next image. A ShaderError leaves the last image in place.
+        ``while_tracing``: work of the turn that needs nothing of the new image, called once
+        a moving frame's first pass is issued (see :meth:`_moving`)."""
         now = time.perf_counter()
         # the rest of the last turn, where it traced (else its time holds an idle wait)
         rest = now - self._traced_at if self._traced_at else None
@@ -108,15 +113,25 @@ class Frames:
         try:
             if self.dirty:
                 self.dirty = False  # a shader error is not retried every turn
-                self._moving(scene, krs, rest)
+                self._moving(scene, krs, rest, while_tracing)
             elif traced:
                 self._refine(scene, krs, rest or 0.0)
         finally:
             self._traced_at = time.perf_counter() if traced else 0.0
 
-    def _moving(self, scene: Scene, krs: Geometry, rest: float | None) -> None:
+    def _moving(
+        self,
+        scene: Scene,
+        krs: Geometry,
+        rest: float | None,
+        while_tracing: Callable[[], None] | None = None,
+    ) -> None:
         """A moving frame at the adaptive resolution; ``rest``: the last turn's time besides
-        its tracing (None: it traced nothing), for the resolution's controller."""
+        its tracing (None: it traced nothing), for the resolution's controller. After its
+        first pass is issued, ``while_tracing()`` runs (it starts that pass with a glFlush,
+        which moderngl lacks): llvmpipe's threads trace while this thread does the turn's
+        other work (the HUD), on a core that the passes leave idle part of the time
+        (docs/speed.md, "The HUD built while the frame is traced")."""
         t0 = time.perf_counter()
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
@@ -125,7 +140,11 @@ class Frames:
         still = scene.render.shadow_block if splits_shadows(scene) else 0
         ratio = moving_ratio(size[0], still) if still and not self.full_shadows else still
         image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)
-        image.draw_all()
+        image.prepare()
+        for k, (name, _, rows) in enumerate(image.passes):
+            image.draw(name, 0, rows)
+            if k == 0 and while_tracing is not None:
+                while_tracing()
         self.ctx.finish()  # the frame's time is read: the controller needs it
         seconds = time.perf_counter() - t0
         self.adaptive.frame_done(seconds, rest)

@@ -26,6 +26,7 @@ from .navigation import Navigation
 from .timeline import draw_time
 from .widgets import Interactions, field_widget
 
+HUD_TITLE = "krsview (F1 hides)"
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
 HUD_AT = 8  # pixels from the window's top left corner, where the HUD first opens
 HUD_RIGHT = HUD_AT + HUD_WIDTH  # its right edge there
@@ -79,6 +80,16 @@ class Viewed(Protocol):
 
 
 def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
+    """The whole HUD at once (:func:`begin_hud`, then :func:`finish_hud`); its commands."""
+    out, slot = begin_hud(v, interactions)
+    finish_hud(v, slot)
+    return out
+
+
+def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], imgui.ImVec2]:
+    """The HUD but the numbers of the image on screen, which :func:`finish_hud` draws into
+    the slot left for them (returned, with the commands): this part reads nothing of the
+    frame traced this turn, so the viewer builds it while that frame is traced."""
     out: list[c.Command] = []
     interactions.inline.clear()  # the fields drawn this frame show their own errors
     imgui.set_next_window_pos(imgui.ImVec2(HUD_AT, HUD_AT), imgui.Cond_.first_use_ever)
@@ -87,8 +98,10 @@ def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
         imgui.ImVec2(HUD_WIDTH, 0), imgui.ImVec2(HUD_WIDTH, max(tallest, 100))
     )
     imgui.set_next_window_bg_alpha(0.75)
-    imgui.begin("krsview (F1 hides)", None, imgui.WindowFlags_.always_auto_resize)
-    _performance(v, out)
+    imgui.begin(HUD_TITLE, None, imgui.WindowFlags_.always_auto_resize)
+    slot = imgui.get_cursor_pos()
+    imgui.dummy(imgui.ImVec2(0, numbers_height()))
+    _controls(v, out)
     if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
         draw_time(v.drawn.playback, out)
     if imgui.collapsing_header("accuracy and view"):
@@ -104,7 +117,23 @@ def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
         imgui.text_wrapped(v.error)
         imgui.pop_style_color()
     imgui.end()
-    return out
+    return out, slot
+
+
+def finish_hud(v: Viewed, slot: imgui.ImVec2) -> float:
+    """The numbers of the image on screen into the HUD's ``slot`` (:func:`begin_hud`), once
+    that image is done; the height in the window where they end (the slot's end)."""
+    imgui.begin(HUD_TITLE, None, imgui.WindowFlags_.always_auto_resize)  # appends to it
+    imgui.set_cursor_pos(slot)
+    _numbers(v)
+    end = imgui.get_cursor_pos().y
+    imgui.end()
+    return end
+
+
+def numbers_height() -> float:
+    """The height of :func:`_numbers` (four lines and the plot) less the spacing after it."""
+    return 4 * imgui.get_text_line_height_with_spacing() + PLOT_HEIGHT
 
 
 def draw_status(text: str) -> None:
@@ -120,7 +149,7 @@ def draw_status(text: str) -> None:
     imgui.end()
 
 
-def _performance(v: Viewed, out: list) -> None:
+def _numbers(v: Viewed) -> None:
     """The image on screen (state, resolution, time), then the moving frames' times against
     their budget: the frame budget less the rest of a turn."""
     shown = v.frames.frame_state()
@@ -139,6 +168,10 @@ def _performance(v: Viewed, out: list) -> None:
         implot.plot_line("frame ms", times)
         implot.plot_line("budget", np.full(2, budget, dtype=np.float32), xscale=PLOTTED)
         implot.end_plot()
+
+
+def _controls(v: Viewed, out: list) -> None:
+    """The frame rate aimed at, supersampling, and moving frames' shadows."""
     changed, fps_target = field_widget(
         "target FPS", v.frames.adaptive.target_fps, settings_meta("target_fps")
     )

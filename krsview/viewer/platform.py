@@ -24,6 +24,7 @@ GLFW_KEYS = (
     | {glfw.KEY_INSERT: "Insert", glfw.KEY_DELETE: "Delete", glfw.KEY_SPACE: "Space"}
 )
 GLFW_BUTTONS = {glfw.MOUSE_BUTTON_LEFT: "left", glfw.MOUSE_BUTTON_RIGHT: "right"}
+GL_VOID = ctypes.CFUNCTYPE(None)  # glFlush's signature
 
 
 class WindowError(RuntimeError):
@@ -41,6 +42,7 @@ class Platform:
         imgui.backends.glfw_init_for_opengl(self.addr, False)
         imgui.backends.opengl3_init("#version 430")
         self.drawn = False  # this turn drew an ImGui frame: its windows are on screen
+        self._gl_flush = GL_VOID(glfw.get_proc_address("glFlush"))
 
     def begin_turn(self) -> None:
         """A turn of the event loop begins: ImGui's windows are on screen for the events
@@ -106,6 +108,11 @@ class Platform:
         glfw.set_cursor_pos_callback(window, on_cursor)
         glfw.set_scroll_callback(window, on_scroll)
         glfw.set_char_callback(window, on_char)
+
+    def flush(self) -> None:
+        """Start the GL commands issued so far without waiting for them (glFlush): on
+        llvmpipe its threads draw them while this thread goes on."""
+        self._gl_flush()
 
     def new_frame(self) -> None:
         imgui.backends.opengl3_new_frame()

@@ -32,7 +32,7 @@ from .controls import Input
 from .drawn import Drawn
 from .files import ViewerFile
 from .frames import Frames
-from .hud import draw_hud, draw_status
+from .hudframe import HudFrame
 from .loop import run
 from .measured import load_measured
 from .navigation import Navigation
@@ -233,19 +233,18 @@ class Viewer:
 
     def step(self, dt: float) -> None:
         """One event-loop turn: keys, camera, reload, a bounded amount of tracing, present,
-        HUD."""
+        HUD. The HUD but the numbers of the frame traced in the turn is built while that
+        frame is traced, the numbers once it is on screen (hudframe.py)."""
         self.begin_step(dt)
         self.execute(self.input.commands())
         self.move(dt)
         self.execute(self.file.watcher.poll())
-        self.draw_image()
         status = self.status_line()
-        if self.hud or status:
-            self.platform.new_frame()
-            if self.hud:
-                self.execute(draw_hud(self, self.interactions))
-            draw_status(status)
-            self.platform.render()
+        ui = HudFrame(self, status) if self.hud or status else None
+        self.draw_image(ui.while_tracing if ui else None)
+        if ui:
+            self.execute(ui.finish())
+            ui.draw()
         glfw.swap_buffers(self.window)
 
     def begin_step(self, dt: float) -> None:
@@ -268,11 +267,13 @@ class Viewer:
             self.frames.dirty = True
         self.file.report()
 
-    def draw_image(self) -> None:
-        """Follow the document, trace within the frame budget and show the image."""
+    def draw_image(self, while_tracing: Callable[[], None] | None = None) -> None:
+        """Follow the document, trace within the frame budget and show the image;
+        ``while_tracing``: the turn's work that needs nothing of a moving frame, done while
+        it is traced (Frames.trace)."""
         self.sync()
         try:
-            self.frames.trace(self.view_scene(), self.drawn.krs)
+            self.frames.trace(self.view_scene(), self.drawn.krs, while_tracing)
         except ShaderError as e:
             self.error = str(e)
         fb = glfw.get_framebuffer_size(self.window)
