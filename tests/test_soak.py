@@ -94,8 +94,9 @@ def test_a_long_session_keeps_gl_objects_and_memory_flat(long_viewer):
 
     assert len(r._targets) <= MAX_TARGETS
     # sphere/binary × fog on/off, each: the trace, its pre-pass, the pre-pass's free tiles,
-    # the hits' depth, the sky's and the hits' shading; + the display program
-    assert len(r.programs._programs) <= 2 * 2 * 6 + 1
+    # the blocks' list and their shadow rays, the hits' depth, the sky's and the hits'
+    # shading, the outline pixels; + the display program
+    assert len(r.programs._programs) <= 2 * 2 * 9 + 1
     assert grown < 60, f"resident memory grew by {grown:.0f} MB"
     assert not v.error
 
