@@ -364,11 +364,15 @@ class PassImage:
         )
 
     def draw_all(
-        self, bands: int = 1, progress: Callable[[int, int], None] | None = None
+        self,
+        bands: int = 1,
+        progress: Callable[[int, int], None] | None = None,
+        issued: Callable[[], None] | None = None,
     ) -> moderngl.Framebuffer:
         """Every pass (a moving frame, a headless one), each in ``bands`` bands of rows,
-        ``progress(done, total)`` after each band (GPU finished); the finished image's
-        targets."""
+        ``progress(done, total)`` after each band (GPU finished), ``issued()`` once the first
+        band is issued (not finished: the viewer's turn works on while it is drawn); the
+        finished image's targets."""
         self.prepare()
         cuts = [(name, rows, min(bands, rows)) for name, _, rows in self.passes]
         total, done = sum(n for *_, n in cuts), 0
@@ -377,6 +381,8 @@ class PassImage:
                 y0, y1 = rows * b // n, rows * (b + 1) // n
                 self.draw(name, y0, y1 - y0)
                 done += 1
+                if done == 1 and issued is not None:
+                    issued()
                 if progress is not None:
                     self.renderer.ctx.finish()
                     progress(done, total)

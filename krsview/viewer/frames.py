@@ -140,11 +140,7 @@ class Frames:
         still = scene.render.shadow_block if splits_shadows(scene) else 0
         ratio = moving_ratio(size[0], still) if still and not self.full_shadows else still
         image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)
-        image.prepare()
-        for k, (name, _, rows) in enumerate(image.passes):
-            image.draw(name, 0, rows)
-            if k == 0 and while_tracing is not None:
-                while_tracing()
+        image.draw_all(issued=while_tracing)
         self.ctx.finish()  # the frame's time is read: the controller needs it
         seconds = time.perf_counter() - t0
         self.adaptive.frame_done(seconds, rest)
