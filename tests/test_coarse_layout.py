@@ -116,8 +116,12 @@ def test_each_pixel_starts_from_its_own_tile(renderer, tmp_path, tile, size):
     w, h = size
     skipped = marked.render(scene, w, h).iterations < 1000
     free = renderer.free_distances(scene, w, h)[..., 0] > scene.render.max_distance
-    rows = len(free) - 1 - (h - 1 - np.arange(h)) // tile  # tiles count from the bottom row
+    rows = np.arange(h) // tile  # tiles count from the top row, as the image's rows
     assert np.array_equal(skipped, free[rows][:, np.arange(w) // tile])
     assert 0.3 < skipped.mean() < 1.0
-    # negative control: the pixel's tile one column off is another mask
+    # negative controls: tiles counted from the bottom row (these heights are no multiple of
+    # the tile), and the pixel's tile one column off, are other masks
+    assert not np.array_equal(
+        skipped, free[len(free) - 1 - (h - 1 - np.arange(h)) // tile][:, np.arange(w) // tile]
+    )
     assert not np.array_equal(skipped, free[rows][:, (np.arange(w) + tile) // tile % free.shape[1]])

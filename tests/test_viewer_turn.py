@@ -22,7 +22,7 @@ CAP, DEPTH_SCALE = 60.0, 3.0
 
 def planes(seed: int = 1) -> list[np.ndarray]:
     """Colour (rgb, hit), normal and depth (xyz, t), iterations (x): (h, w, 4) float32 each,
-    rows in GL order (bottom first)."""
+    rows top → bottom, as the renderer's targets hold them."""
     rng = np.random.default_rng(seed)
     w, h = SOURCE
     color = rng.uniform(0, 1, (h, w, 4))
@@ -69,7 +69,8 @@ def expected(view: str, p: list[np.ndarray], wrap: bool = False) -> tuple[np.nda
 
 @pytest.fixture(scope="module")
 def shown(renderer):
-    """Each view mode's window image of the same targets: (h, w, 3) in [0, 1], GL rows."""
+    """Each view mode's window image of the same targets: (h, w, 3) in [0, 1], rows top →
+    bottom (the window's own rows run bottom → top)."""
     ctx = renderer.ctx
     p = planes()
     with renderer.current():
@@ -81,7 +82,7 @@ def shown(renderer):
         for view in VIEW_MODES:
             display.show(source, target, TARGET, view, int(CAP), DEPTH_SCALE)
             raw = np.frombuffer(target.read(components=3), np.uint8)
-            out[view] = raw.reshape(TARGET[1], TARGET[0], 3) / 255.0
+            out[view] = raw.reshape(TARGET[1], TARGET[0], 3)[::-1] / 255.0
         progs = {v: display._vao(v).program for v in VIEW_MODES}
     return out, p, progs
 

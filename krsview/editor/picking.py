@@ -77,7 +77,7 @@ def _surface(e: Picked, v: View, x: float, y: float) -> Handle | None:
         return None
     fbo, (w, h) = e.viewer.frames.image
     px = min(max(int(x / v.width * w), 0), w - 1)
-    py = min(max(int((v.height - y) / v.height * h), 0), h - 1)
+    py = min(max(int(y / v.height * h), 0), h - 1)
     t = depth_at(fbo, px, py)
     if not t > 0:
         return None

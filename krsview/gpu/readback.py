@@ -12,7 +12,7 @@ from ..frame import Frame
 def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:
     """Colour attachment k as (rows top → bottom, columns, 4) float32."""
     raw = fbo.read(attachment=k, components=4, dtype="f4")
-    return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)[::-1]
+    return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)
 
 
 def read_buffers(fbo: moderngl.Framebuffer, width: int, height: int) -> Frame:

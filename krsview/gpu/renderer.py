@@ -353,13 +353,13 @@ class Renderer:
             cw, ch = -(-width // size), -(-height // size)
             (sx, sy), (w, h) = coarse_layout(cw, ch)
             fbo = self._framebuffer(w, h, layers=PREPASS_TARGETS)
-            planes = [read_plane(fbo, k, w, h)[::-1] for k in range(PREPASS_TARGETS)]  # GL rows
+            planes = [read_plane(fbo, k, w, h) for k in range(PREPASS_TARGETS)]
             x, y = (
                 np.array([q * s + c for q, c in map(coarse_quarter, range(n))])
                 for s, n in ((sx, cw), (sy, ch))
             )  # each tile's texel (coarse_texel)
             texels = np.concatenate(planes, axis=-1)[y[:, None], x]
-            return texels[::-1].astype(np.float64)  # rows top → bottom
+            return texels.astype(np.float64)  # rows top → bottom
 
     def time_frame(
         self,

@@ -26,7 +26,8 @@ vec3 heat(float x) {
 #endif
 
 void main() {
-    vec2 uv = gl_FragCoord.xy / u_window;
+    // the image: rows top → bottom (scene_block.glsl, pixel_ray); the window: bottom → top
+    vec2 uv = vec2(gl_FragCoord.x, u_window.y - gl_FragCoord.y) / u_window;
     vec4 c = texture(u_color, uv);
     vec3 rgb = c.rgb;
 #ifdef KRS_VIEW

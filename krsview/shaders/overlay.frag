@@ -14,7 +14,8 @@ out vec4 frag_color;
 void main() {
     if (u_points && length(gl_PointCoord - 0.5) > 0.5)
         discard;                                   // round handles
-    vec2 uv = gl_FragCoord.xy / u_window;
+    // the image: rows top → bottom (scene_block.glsl, pixel_ray); the window: bottom → top
+    vec2 uv = vec2(gl_FragCoord.x, u_window.y - gl_FragCoord.y) / u_window;
     bool hit = texture(u_color, uv).a > 0.5;
     float t_surface = texture(u_normal, uv).w;
     bool hidden = hit && t_surface < length(v_relative) * (1.0 - 1e-4);

@@ -35,7 +35,7 @@ void orbit_camera(vec2 resolution, vec3 orbit) {
 // The pixel at window position `frag` (pixel centres at .5), traced and shaded as
 // pixel.glsl does, from the eye at u_eye_shift.
 vec4 krs_image(vec2 frag) {
-    vec3r dir = pixel_ray(frag);
+    vec3r dir = pixel_ray(vec2(frag.x, u_resolution.y - frag.y));  // the canvas: rows bottom → top
     real start[COMPONENT_SLOTS];
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = 0.0;
     real t;

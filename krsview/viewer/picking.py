@@ -10,7 +10,7 @@ from .camera import FlyCamera
 
 
 def depth_at(fbo: moderngl.Framebuffer, x: int, y: int) -> float:
-    """The traced ray distance at image pixel (x, y), rows bottom → top; ≤ 0 on a miss."""
+    """The traced ray distance at image pixel (x, y), rows top → bottom; ≤ 0 on a miss."""
     raw = fbo.read(viewport=(x, y, 1, 1), attachment=1, components=4, dtype="f4")
     return float(np.frombuffer(raw, np.float32)[3])
 
