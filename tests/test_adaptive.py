@@ -127,7 +127,7 @@ def test_bands_cover_every_row_of_every_pass_in_order_within_the_budget():
             rows[name].append((y0, n))
         for name, _, height in PASSES:
             ys = [y for y0, n in rows[name] for y in range(y0, y0 + n)]
-            assert ys == list(range(height)), name  # each row once, bottom to top
+            assert ys == list(range(height)), name  # each row once, top to bottom
     assert bands[0][2] == FIRST_BAND  # before any cost is known
     # once its pass is measured, no band overruns its turn's budget by more than a row
     seen: set[str] = set()
@@ -154,6 +154,40 @@ def test_costs_carry_over_to_the_next_refinement():
     r.begin(list(PASSES))
     assert r.next_band(0.02)[2] == int(0.02 / (COST["trace"] * 100))
     assert Refinement([Step(1.0, 2)]).cost == {}  # control: a fresh one knows none
+
+
+def test_a_costly_top_does_not_make_the_next_refinements_first_band_overrun():
+    """Rows run top → bottom and a crown at the top costs many times the sky below it: the
+    last band of an image (its foot) is cheap, and the next refinement's first band (its top)
+    is sized by where its rows lie, not by that last band's cost."""
+    width, height, budget = 10, 50, 0.02
+    crown = 10  # the top fifth costs ten times the rest
+
+    def seconds(y0: int, rows: int) -> float:
+        costly = max(0, min(y0 + rows, height // 5) - y0)
+        return COST["trace"] * width * (crown * costly + rows - costly)
+
+    def first_bands(images: int, profiled: bool = True) -> list[float]:
+        """The seconds of each image's first band, one image after another."""
+        cost: dict[str, float] = {}
+        profile: dict[str, list[float]] = {}
+        firsts = []
+        for _ in range(images):
+            r = Refinement([Step(1.0, 2)], cost, profile=profile)
+            r.begin([("trace", width, height)])
+            while not r.done:
+                band = r.next_band(budget)
+                firsts += [] if band[1] else [seconds(*band[1:])]
+                r.band_done(band, seconds(*band[1:]))
+                if not profiled:
+                    profile.clear()
+        return firsts
+
+    firsts = first_bands(4)
+    assert firsts[1] <= 1.5 * budget  # the profile of bands as coarse as the first image's
+    assert max(firsts[2:]) <= budget * 1.001
+    # negative control: by the pass's cost alone, as measured last (the cheap foot)
+    assert min(first_bands(4, profiled=False)[1:]) > 2 * budget
 
 
 def test_a_refining_turn_traces_as_long_as_the_rest_of_the_turn_within_two_budgets():

@@ -16,6 +16,7 @@ MIN_BLOCKS_ACROSS = 80  # (docs/speed.md, "Moving frames": the colour and the ti
 STEP_GAIN = 1.5  # a refinement step's side is at least this many times the moving frame's
 STEP_WAIT = 0.4  # seconds: an image predicted to take longer gets one of half its side first
 FIRST_BAND = 16  # rows of a pass's first band, before its cost per pixel is measured
+PROFILE_SLOTS = 32  # a pass's cost per pixel is kept per 1/32 of the image's height
 REFINING_TURNS = 2.0  # a refining turn traces for at most this many frame budgets
 REST_TURNS = 9  # the recent turns whose rest (display, HUD, swap, input) a moving frame counts
 MIN_TRACE_SHARE = 0.5  # a moving frame's tracing keeps at least this share of the budget
@@ -152,7 +153,12 @@ def primary_first(steps: list[Step], ratio: int) -> list[Step]:
 class Refinement:
     """The steps' images traced pass by pass in bands of rows, a few bands per event-loop
     turn, each band sized to the turn's budget by the measured seconds per pixel of its pass
-    (``cost``, by pass name, shared between refinements)."""
+    (``cost``, by pass name, shared between refinements) and where its rows lie
+    (``profile``, by pass name: the seconds per pixel of the last band drawn over each
+    PROFILE_SLOTS-th of the height, shared too). Rows differ: a crown at the top of the
+    image costs many times the sky or ground below it, and the pass's mean, let alone the
+    cost of the last band drawn (the image's foot), would size a first band over the crown
+    to several budgets."""
 
     steps: list[Step]
     cost: dict[str, float] = field(default_factory=dict)
@@ -160,6 +166,7 @@ class Refinement:
     passes: list[tuple[str, int, int]] = field(default_factory=list)  # step k's: name, w, rows
     p: int = 0  # the pass being drawn
     next_row: int = 0
+    profile: dict[str, list[float]] = field(default_factory=dict)
 
     @property
     def done(self) -> bool:
@@ -180,8 +187,23 @@ class Refinement:
         name, width, height = self.passes[self.p]
         rows = FIRST_BAND
         if self.cost.get(name, 0.0) > 0:
-            rows = max(1, int(budget / (self.cost[name] * width)))
+            rows = self._rows_within(name, width, height, budget)
         return name, self.next_row, min(rows, height - self.next_row)
+
+    def _rows_within(self, name: str, width: int, height: int, budget: float) -> int:
+        """Rows from ``next_row`` on that fit ``budget`` seconds by the pass's profile (its
+        mean cost where a slot has none), at least one."""
+        slots = self.profile.get(name, ())
+        left, rows, y = budget * (1.0 + 1e-9), 0, self.next_row
+        while y < height:
+            s = y * PROFILE_SLOTS // height
+            end = min(height, -(-(s + 1) * height // PROFILE_SLOTS))  # the next slot's first row
+            per_row = (slots[s] if slots and slots[s] > 0 else self.cost[name]) * width
+            if (end - y) * per_row > left:
+                rows += int(left / per_row)
+                break
+            rows, left, y = rows + end - y, left - (end - y) * per_row, end
+        return max(1, rows)
 
     def band_done(self, band: tuple[str, int, int], seconds: float) -> bool:
         """Record a drawn band; True when it finished step k's image (k moves on)."""
@@ -190,6 +212,10 @@ class Refinement:
         per_pixel = seconds / max(rows * width, 1)
         old = self.cost.get(name, 0.0)
         self.cost[name] = per_pixel if old == 0 else 0.5 * old + 0.5 * per_pixel
+        slots = self.profile.setdefault(name, [0.0] * PROFILE_SLOTS)
+        first, last = y0 * PROFILE_SLOTS // height, (y0 + rows - 1) * PROFILE_SLOTS // height
+        for s in range(first, min(last, PROFILE_SLOTS - 1) + 1):
+            slots[s] = per_pixel
         self.next_row = y0 + rows
         if self.next_row < height:
             return False

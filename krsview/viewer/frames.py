@@ -81,6 +81,7 @@ class Frames:
         self._on_screen: PassImage | None = None
         self._tracing: PassImage | None = None  # the refinement's next image
         self._cost: dict[str, float] = {}  # seconds per pixel of each pass, kept across
+        self._profile: dict[str, list[float]] = {}  # ... and per slice of rows (Refinement)
         self._step_seconds = 0.0
         self._traced_at = 0.0  # when the last turn's tracing ended (0: it traced nothing)
 
@@ -146,7 +147,7 @@ class Frames:
         self.adaptive.frame_done(seconds, rest)
         self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
         steps = refinement_steps(scale, seconds, self.adaptive.supersample, ratio, still)
-        self.refinement = Refinement(steps, self._cost) if steps else None
+        self.refinement = Refinement(steps, self._cost, profile=self._profile) if steps else None
         self._tracing = None
         state = "moving" if steps else "still"
         self._show(image, FrameState(state, size, self.adaptive.full, seconds))
