@@ -14,6 +14,8 @@ from typing import Any
 
 from imgui_bundle import imgui
 
+from ..scene.schema import describe_range
+
 LOG_RATIO = 100.0  # a range spanning more than this factor gets a logarithmic slider
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 RED_FRAME = imgui.ImVec4(0.55, 0.08, 0.06, 1.0)
@@ -73,16 +75,15 @@ class Interactions:
         return True
 
 
-def _tooltip(meta: dict, typed: bool) -> None:
+def tooltip_text(meta: dict, kind: type) -> str:
+    """A field's tooltip: its help, the range it allows in the words its errors use (an open
+    bound says <, not ≤), and for a number how to type one."""
     text = meta.get("help", "")
-    lo, hi, unit = meta.get("lo"), meta.get("hi"), meta.get("unit", "")
-    if lo is not None or hi is not None:
-        lo_text, hi_text = "" if lo is None else lo, "" if hi is None else hi
-        text += f" [{lo_text} … {hi_text}{' ' + unit if unit else ''}]"
-    if text and imgui.is_item_hovered():
-        imgui.set_tooltip(
-            text + ("\n(ctrl+click or double-click to type a value)" if typed else "")
-        )
+    if meta.get("lo") is not None or meta.get("hi") is not None:
+        text += f" ({describe_range(meta, int if kind is int else float)})"
+    if text and kind not in (bool, str):
+        text += "\n(ctrl+click or double-click to type a value)"
+    return text
 
 
 def _speed(value: float, meta: dict) -> float:
@@ -100,7 +101,12 @@ def field_widget(
     """One widget for one field (of the scene, or of the viewer's settings); (changed, new
     value). A ``refused`` value is shown instead of ``value``, on red."""
     if refused is None:
-        return _widget(label, value, meta)
+        changed, new = _widget(label, value, meta)
+        text = tooltip_text(meta, type(value))
+        if text and imgui.is_item_hovered():
+            imgui.set_tooltip(text)
+        return changed, new
+    # no tooltip: it would cover the refusal's message under the field (Interactions.key)
     imgui.push_style_color(imgui.Col_.frame_bg, RED_FRAME)
     changed, new = _widget(label, refused.value, meta)
     imgui.pop_style_color()
@@ -146,5 +152,4 @@ def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
     else:
         imgui.text_disabled(f"{label}: {value!r}")
         return False, value
-    _tooltip(meta, typed=not isinstance(value, (bool, str)))
     return changed, value
