@@ -69,7 +69,7 @@ uniform float u_max_distance;
 // The primary ray through the pixel centre at window position `frag`. Rows run top → bottom,
 // as in NumPy: every target's texel row 0 holds the image's top row, so llvmpipe, which draws
 // a pass's bins from row 0 on, starts with what is usually the costliest, a crown, and ends
-// with the cheap sky or ground, and bands drawn in turn sharpen the image from the top.
+// with the cheap sky or ground, and an image drawn in bands is drawn from the top.
 vec3r pixel_ray(vec2 frag) {
     vec2 ndc = vec2(2.0 * frag.x / u_resolution.x - 1.0, 1.0 - 2.0 * frag.y / u_resolution.y);
     float aspect = u_resolution.x / u_resolution.y;
