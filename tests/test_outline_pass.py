@@ -28,7 +28,7 @@ def image_of(renderer, targets, scene, one_pass=False, blocks=None, size=SIZE) -
         single = renderer.companion(
             image._programs["trace"], "upsampled.frag", {"KRS_SHADOW_UPSAMPLED": None}
         )
-        for name in ("u_block", "u_depth_slack", "u_coarse_origin", *SAMPLERS):
+        for name in ("u_block", "u_depth_slack", "u_coarse_origin", "u_coarse_size", *SAMPLERS):
             single[name].value = split[name].value
         image._programs["shade"] = single
     for name, _, rows in image.passes:

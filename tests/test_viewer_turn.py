@@ -80,7 +80,7 @@ def shown(renderer):
         display = Display(ctx, renderer.programs, VIEW_MODES)
         out = {}
         for view in VIEW_MODES:
-            display.show(source, target, TARGET, view, int(CAP), DEPTH_SCALE)
+            display.show(source, target, TARGET, view, int(CAP), DEPTH_SCALE, SOURCE)
             raw = np.frombuffer(target.read(components=3), np.uint8)
             out[view] = raw.reshape(TARGET[1], TARGET[0], 3)[::-1] / 255.0
         progs = {v: display._vao(v).program for v in VIEW_MODES}

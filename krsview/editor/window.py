@@ -336,9 +336,8 @@ class Editor:
             fb = glfw.get_framebuffer_size(v.window)
             view_matrix, proj = camera_matrices(view, NEAR, FAR)
             shapes = editor_shapes(self.handled_scene(), shown, self.selected, self.clipped)
-            self.overlay.draw(
-                shapes, v.frames.image[0], v.ctx.screen, fb, proj @ view_matrix, view.origin
-            )
+            fbo, image = v.frames.image
+            self.overlay.draw(shapes, fbo, v.ctx.screen, fb, proj @ view_matrix, view.origin, image)
         imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
         self.execute(draw_hud(v, v.interactions))
         self.execute(edit_panel(self, v.interactions))

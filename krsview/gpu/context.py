@@ -34,6 +34,17 @@ def headless_context() -> moderngl.Context:
     return ctx
 
 
+def texture_side(n: int) -> int:
+    """The side a texture of ``n`` texels is made with: ``n``, or the next side that is no
+    power of two. llvmpipe compiles a shader variant for each pattern of power-of-two sides
+    among the textures it samples, so an image whose size passes 128 or 64 (the viewer's
+    adaptive resolution) stalled its turn for 0.4–0.6 s while the tracer compiled anew; a
+    texel more on such sides keeps every texture of one pattern (docs/speed.md)."""
+    while n & (n - 1) == 0:  # 1, 2, 4, 8, …
+        n += 1
+    return n
+
+
 def behind_mark(
     ctx: moderngl.Context,
     mark: Callable[[], None],

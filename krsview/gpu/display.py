@@ -47,7 +47,9 @@ class Display:
         view: str,
         iteration_cap: int,
         depth_scale: float,
+        image: tuple[int, int],
     ) -> None:
+        """Draw ``source``'s image of size ``image`` over ``target``'s ``size`` in ``view``."""
         vao = self._vao(view)
         prog = vao.program
         for unit, tex in enumerate(source.color_attachments):
@@ -61,4 +63,6 @@ class Display:
             if name in prog:
                 prog[name].value = float(value)
         prog["u_window"].value = (float(size[0]), float(size[1]))
+        prog["u_image"].value = (float(image[0]), float(image[1]))
+        prog["u_texture"].value = tuple(map(float, source.color_attachments[0].size))
         vao.render(moderngl.TRIANGLES, vertices=3)

@@ -69,10 +69,11 @@ class Overlay:
         size: tuple[int, int],
         matrix: np.ndarray,
         eye: np.ndarray,
+        image: tuple[int, int],
     ) -> None:
-        """Draw ``shapes`` into ``target``; ``source`` holds the traced colour and depth,
-        ``matrix`` is projection × view (:func:`camera_matrices`), ``eye`` the camera position
-        (float64)."""
+        """Draw ``shapes`` into ``target``; ``source`` holds the traced colour and depth of an
+        ``image``-sized image, ``matrix`` is projection × view (:func:`camera_matrices`),
+        ``eye`` the camera position (float64)."""
         batches = [
             (moderngl.TRIANGLES, [(p, c, 1.0) for tri, c in shapes.triangles for p in tri]),
             (moderngl.LINES, [(p, c, 1.0) for a, b, c in shapes.lines for p in (a, b)]),
@@ -83,6 +84,8 @@ class Overlay:
         target.use()
         self.ctx.viewport = (0, 0, *size)
         self.prog["u_window"].value = (float(size[0]), float(size[1]))
+        self.prog["u_image"].value = (float(image[0]), float(image[1]))
+        self.prog["u_texture"].value = tuple(map(float, source.color_attachments[0].size))
         self.prog["u_view_projection"].write(matrix.T.astype("f4").tobytes())
         self.ctx.enable(moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
         self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA

@@ -39,7 +39,7 @@ import moderngl
 from ..compile.constants import BINDING_BLOCK_LIST, BINDING_OUTLINE
 from ..scene import Geometry, Scene
 from .bins import BIN, bin_origin, packed
-from .context import behind_mark
+from .context import behind_mark, texture_side
 
 SHADOW_EFFECTS = frozenset({"shadows", "soft_shadows"})
 DEPTH_SLACK = 3.0  # coarse pixel footprints of depth a block's sample may lie off a pixel
@@ -132,7 +132,8 @@ class Targets:
             for thing in (*(outline or ()), *old.color_attachments):
                 thing.release()
             old.release()
-        tex = [self.ctx.texture(size, 4, dtype="f4") for _ in range(layers)]
+        made = tuple(map(texture_side, size))
+        tex = [self.ctx.texture(made, 4, dtype="f4") for _ in range(layers)]
         self._kept[key] = self.ctx.framebuffer(color_attachments=tex)
         return self._kept[key]
 
@@ -261,6 +262,7 @@ class PassImage:
                 shade["u_block"].value = (side * self.size[0] / bw, side * self.size[1] / bh)
                 shade["u_depth_slack"].value = DEPTH_SLACK
                 shade["u_coarse_origin"].value = self._blocks_image.origin
+                shade["u_coarse_size"].value = self._blocks_image.coarse
                 self._programs[name] = shade
         elif self.ratio == 1:
             self._programs["shadows+shade"] = self.renderer.companion(main, "upsampled.frag")
@@ -273,6 +275,8 @@ class PassImage:
             for unit, sampler in enumerate(SAMPLERS):
                 if sampler in prog:
                     prog[sampler].value = unit
+            if "u_traced_size" in prog:  # its textures may be a texel larger
+                prog["u_traced_size"].value = self.size
 
     def draw(self, name: str, y0: int, rows: int) -> None:
         """Rows [y0, y0 + rows) (GL order) of pass ``name``; :meth:`prepare` first."""

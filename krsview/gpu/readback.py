@@ -10,8 +10,9 @@ from ..frame import Frame
 
 
 def read_plane(fbo: moderngl.Framebuffer, k: int, width: int, height: int) -> np.ndarray:
-    """Colour attachment k as (rows top → bottom, columns, 4) float32."""
-    raw = fbo.read(attachment=k, components=4, dtype="f4")
+    """Colour attachment k as (rows top → bottom, columns, 4) float32: the image's part of it
+    (its textures may be a texel larger: context.texture_side)."""
+    raw = fbo.read(viewport=(0, 0, width, height), attachment=k, components=4, dtype="f4")
     return np.frombuffer(raw, dtype=np.float32).reshape(height, width, 4)
 
 

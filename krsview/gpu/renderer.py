@@ -25,7 +25,7 @@ from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PREPASS_RATIO
 from .coarse import coarse_layout, coarse_quarter, quarters
 from .compute import LANE_PROBES, ComputePath, Rounds, compute_passes, path_defines
-from .context import behind_mark, headless_context, set_uniforms
+from .context import behind_mark, headless_context, set_uniforms, texture_side
 from .passes import PassImage, Targets, still_ratio
 from .program import SHADER_DIR, ProgramCache
 from .readback import read_buffers, read_plane
@@ -81,8 +81,9 @@ class Renderer:
                 for part in (*old.color_attachments, old.depth_attachment):
                     part.release()
                 old.release()
-            tex = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(layers)]
-            depth = self.ctx.depth_renderbuffer((width, height))
+            made = (texture_side(width), texture_side(height))
+            tex = [self.ctx.texture(made, 4, dtype="f4") for _ in range(layers)]
+            depth = self.ctx.depth_renderbuffer(made)
             self._targets[key] = self.ctx.framebuffer(color_attachments=tex, depth_attachment=depth)
         return self._targets[key]
 

@@ -19,6 +19,7 @@
 
 uniform sampler2D u_traced_color;  // a: hit
 uniform sampler2D u_traced_depth;  // xyz: the hit's normal; w: ray distance t
+uniform ivec2 u_traced_size;  // the traced image's size (its textures may be a texel larger)
 uniform int u_shadow_ratio;
 uniform ivec2 u_coarse_origin;  // the coarse image's corner in its target (bin_origin)
 uniform ivec3 u_bins;           // the coarse target's bins across, bins in all, a bin's side
@@ -42,7 +43,7 @@ layout(location = 1) out vec4 out_depth;       // x: t of the block's pixel; < 0
 
 void main() {
     ivec2 corner = (ivec2(gl_FragCoord.xy) - u_coarse_origin) * u_shadow_ratio;
-    ivec2 size = textureSize(u_traced_depth, 0);
+    ivec2 size = u_traced_size;
     ivec2 best = ivec2(-1);
     float t_best = 0.0;
     vec3 n = vec3(0.0);  // the best hit's normal
@@ -81,7 +82,7 @@ void main() {
         first += n;
     }
     if (b == u_bins.y) discard;
-    int width = textureSize(u_traced_depth, 0).x;
+    int width = u_traced_size.x;
     int hit = int(block_list[list_entry(b, i - first)]);
     ivec2 best = ivec2(hit % width, hit / width);
     vec4 nt = texelFetch(u_traced_depth, best, 0);

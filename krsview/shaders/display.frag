@@ -7,6 +7,8 @@
 
 uniform sampler2D u_color;       // rgb, hit
 uniform vec2 u_window;           // size of the target in pixels
+uniform vec2 u_image;            // size of the image in pixels
+uniform vec2 u_texture;          // and of its textures (context.texture_side)
 
 out vec4 frag_color;
 
@@ -26,8 +28,10 @@ vec3 heat(float x) {
 #endif
 
 void main() {
-    // the image: rows top → bottom (scene_block.glsl, pixel_ray); the window: bottom → top
-    vec2 uv = vec2(gl_FragCoord.x, u_window.y - gl_FragCoord.y) / u_window;
+    // the image: rows top → bottom (scene_block.glsl, pixel_ray); the window: bottom → top;
+    // the image's part of its textures (they may be a texel larger), its edge texels clamped
+    vec2 at = vec2(gl_FragCoord.x, u_window.y - gl_FragCoord.y) / u_window * u_image;
+    vec2 uv = clamp(at, vec2(0.5), u_image - 0.5) / u_texture;
     vec4 c = texture(u_color, uv);
     vec3 rgb = c.rgb;
 #ifdef KRS_VIEW

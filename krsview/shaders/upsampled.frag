@@ -18,6 +18,7 @@ uniform sampler2D u_traced_color;       // rgb: the hit's kernel-space point; a:
                                         // level (< 0.5: no hit)
 uniform sampler2D u_traced_depth;       // xyz: the hit's normal; w: ray distance t
 uniform sampler2D u_traced_iterations;  // x
+uniform ivec2 u_traced_size;            // the image's size (its textures may be a texel larger)
 
 #ifdef KRS_SHADOW_UPSAMPLED
 uniform sampler2D u_coarse_visibility;  // per light; < 0: none
@@ -26,13 +27,14 @@ uniform vec2 u_block;                   // a block's side in this image's pixels
                                         // smaller image's blocks are wider than its ratio)
 uniform float u_depth_slack;            // block footprints of depth a block may differ
 uniform ivec2 u_coarse_origin;          // the coarse image's corner in its target
+uniform ivec2 u_coarse_size;            // and its size
 
 // g_shadow: each light's visibility blended from the blocks near pixel px at depth t.
 void upsample_visibility(ivec2 px, float t) {
     vec2 c = (vec2(px) + 0.5) / u_block - 0.5;
     ivec2 c0 = ivec2(floor(c));
     vec2 f = c - vec2(c0);
-    ivec2 last = textureSize(u_coarse_depth, 0) - 1;
+    ivec2 last = u_coarse_origin + u_coarse_size - 1;
     float slack = u_depth_slack * u_footprint * u_block.x * t;
     vec4 sum = vec4(0.0), weight = vec4(0.0);
     for (int j = 0; j < 2; ++j) {
@@ -87,7 +89,7 @@ void main() {
 #if defined(KRS_HIT_DEPTH)
     gl_FragDepth = texelFetch(u_traced_color, ivec2(gl_FragCoord.xy), 0).a < 0.5 ? 1.0 : 0.0;
 #elif defined(KRS_SHADOW_OUTLINE)
-    uint width = uint(textureSize(u_traced_color, 0).x);
+    uint width = uint(u_traced_size.x);
     uint i = packed_index(ivec2(gl_FragCoord.xy), u_packed_width);
     if (i >= outline_count) discard;
     ivec2 px = ivec2(outline_pixels[i] % width, outline_pixels[i] / width);
@@ -100,7 +102,7 @@ void main() {
     out_iterations = vec4(texelFetch(u_traced_iterations, px, 0).x, 0.0, 0.0, 0.0);
 #ifdef KRS_SHADOW_MARK
     if (g_outline) {
-        uint width = uint(textureSize(u_traced_color, 0).x);
+        uint width = uint(u_traced_size.x);
         outline_pixels[atomicAdd(outline_count, 1u)] = uint(px.y) * width + uint(px.x);
     }
 #endif

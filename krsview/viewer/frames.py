@@ -209,7 +209,8 @@ class Frames:
         """The last image into ``target`` of ``size`` pixels (scaled to it), in view ``mode``;
         ``depth`` scales the depth view."""
         if self.image is not None:
-            self.display.show(self.image[0], target, size, mode, scene.render.max_iterations, depth)
+            fbo, image = self.image
+            self.display.show(fbo, target, size, mode, scene.render.max_iterations, depth, image)
 
     def still(self, scene: Scene, krs: Geometry, mode: str, depth: float) -> np.ndarray:
         """The full-resolution image of ``scene`` traced at once, in view ``mode``: (H, W, 3)
@@ -218,7 +219,7 @@ class Frames:
         prog = self.renderer.prepare(scene, *size, krs)
         fbo = self.renderer.draw(prog, *size)
         target = self.ctx.simple_framebuffer(size, components=4)
-        self.display.show(fbo, target, size, mode, scene.render.max_iterations, depth)
+        self.display.show(fbo, target, size, mode, scene.render.max_iterations, depth, size)
         rgb = np.frombuffer(target.read(components=3), np.uint8).reshape(size[1], size[0], 3)
         target.release()
         return rgb[::-1]
