@@ -1,6 +1,6 @@
 """OpenGL contexts: headless through EGL (tests, CI, `krsview render`); what the passes do
 on one: give a program its uniforms, draw a pass behind a mark of the pixels it has nothing
-to do on."""
+to do on, make a texture's sides no powers of two."""
 
 from __future__ import annotations
 
