@@ -107,7 +107,7 @@ def test_each_pixel_starts_from_its_own_tile(renderer, tmp_path, tile, size):
     that are no power of two and sizes that are no multiple of them."""
     scene = load_scene(resolve("tree")).edit(("tree", "levels"), 3)
     scene = scene.edit(("render", "prepass"), tile).edit(("render", "shadow_block"), 1)
-    traced = "bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);"
+    traced = "bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations, slots);"
     marked = Renderer(
         shader_dir=broken_shaders(
             tmp_path, "render.frag", traced, traced + "\n iterations += 1000;"

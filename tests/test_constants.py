@@ -178,6 +178,7 @@ TWIN_NAMES: dict[str, str | None] = {
     "kernel_rec_float": None,
     "krs_distance": "distance",  # reference/krs.py is the KRS's module: no prefix
     "krs_nearest": "nearest",
+    "fold_frame": "nearest",  # one level of nearest's loop
     "krs_level": "distance",  # one level of distance's loop
     "krs_lod_cut": "distance",  # the level-of-detail ball of distance's loop, after the walk
     "krs_restart": "restart",
@@ -218,6 +219,7 @@ TWIN_NAMES: dict[str, str | None] = {
     "leave": None,
     "packed_index": None,  # where a packed pass reads its list (gpu/passes.py, packed)
     "nearest_kernel": "reference/geometry.py:nearest",
+    "packed_slots": None,  # what a hit's walk hands the shading: NumPy's nearest walks all
     "turn": "untwist",  # the rotation, inline in NumPy
 }
 _FUNCTION = re.compile(r"^(?!uniform|layout|struct|return|else)\w+ (\w+)\(", re.M)

@@ -236,7 +236,10 @@ def test_the_cut_ball_drawn_after_the_walk_equals_the_cut_in_place(renderer, tmp
     from .conftest import broken_shaders
 
     deferred = "if (b.w >= 0.0 && b.w < rho) { cut = i; return false; }"
-    in_place = "if (b.w >= 0.0 && b.w < rho) { d = min(d, length(x - b.xyz) - b.w); return false; }"
+    in_place = (  # and it tells the shading that the ball won where it did (g_cut)
+        "if (b.w >= 0.0 && b.w < rho) { real k = length(x - b.xyz) - b.w; "
+        "g_cut = k < d ? i : -1; d = min(d, k); return false; }"
+    )
     inline = Renderer(shader_dir=broken_shaders(tmp_path / "a", "krs.glsl", deferred, in_place))
     above = "if (b.w >= 0.0 && b.w < rho) { cut = i + 1; return false; }"
     wrong = Renderer(shader_dir=broken_shaders(tmp_path / "b", "krs.glsl", deferred, above))

@@ -18,7 +18,7 @@ from .conftest import broken_shaders
 
 W, H = 48, 27
 MARK = "gl_FragDepth = traced ? 1.0 : 0.0;"
-TRACED = "bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);"
+TRACED = "bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations, slots);"
 FIELDS = ("color", "depth", "normal", "iterations", "hit")
 
 

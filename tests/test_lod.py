@@ -140,8 +140,8 @@ SPARSE = {  # two small spheres 2 apart (one and its mirror image) under a large
 SHRUNK_CUT = {
     "tree": (
         "krs.glsl",
-        "d = min(d, length(x - b.xyz) - b.w);",
-        "d = min(d, length(x - b.xyz) - 0.25 * b.w);",
+        "real k = length(x - b.xyz) - b.w;",
+        "real k = length(x - b.xyz) - 0.25 * b.w;",
     ),
     "tree-mokrs": (
         "mokrs.glsl",

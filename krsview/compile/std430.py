@@ -84,6 +84,7 @@ RAY = Struct(
         Field("int", "iterations"),
         Field("int", "state"),
         Field("vec3r", "wx"),
+        Field("int", "slots"),
         Field("vec3r", "wdir"),
         Field("real", "wt"),
         Field("real", "wm"),

@@ -145,7 +145,7 @@ void start_shadows(uint k) {
     vec3r dir = pixel_ray(vec2(tile_pixel(k)) + 0.5);
     int level;
     vec3 n, xk;
-    nearest_kernel(r.t * dir, r.t, level, n, xk);     // as pixel.glsl, then shade()
+    nearest_kernel(r.t * dir, r.t, r.slots, level, n, xk);     // as pixel.glsl, then shade()
     for (int j = 0; j < u_light_count; ++j) {
         if (max(dot(n, u_light_dir[j]), 0.0) <= 0.0) continue;
         uint slot = k * uint(MAX_LIGHTS) + uint(j);

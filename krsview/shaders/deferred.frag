@@ -17,11 +17,11 @@ layout(std430, binding = BINDING_SHADOWS) readonly buffer Shadows { Shadow shado
 
 // The pixel written: shaded, or its tracing alone (KRS_TRACE_ONLY: the trace pass in
 // gpu/passes.py; its shading passes follow).
-void write_ray(bool hit, real t, int iterations) {
+void write_ray(bool hit, real t, int iterations, int slots) {
 #ifdef KRS_TRACE_ONLY
-    write_trace(pixel_ray(gl_FragCoord.xy), hit, t, iterations);
+    write_trace(pixel_ray(gl_FragCoord.xy), hit, t, iterations, slots);
 #else
-    write_pixel(pixel_ray(gl_FragCoord.xy), hit, t, iterations);
+    write_pixel(pixel_ray(gl_FragCoord.xy), hit, t, iterations, slots);
 #endif
 }
 
@@ -34,11 +34,11 @@ void main() {
     if (!starts_live(ivec2(gl_FragCoord.xy), first)) r = first;
 #endif
     gl_FragDepth = r.state == RAY_HIT ? 1.0 : 0.0;
-    write_ray(false, r.t, r.iterations);
+    write_ray(false, r.t, r.iterations, r.slots);
 #else
 #ifdef KRS_SHADOW_TASKS
     for (int j = 0; j < MAX_LIGHTS; ++j) g_shadow[j] = shadows[index * MAX_LIGHTS + j].vis;
 #endif
-    write_ray(r.state == RAY_HIT, r.t, r.iterations);
+    write_ray(r.state == RAY_HIT, r.t, r.iterations, r.slots);
 #endif
 }

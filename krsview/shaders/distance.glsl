@@ -166,8 +166,10 @@ int nearest_component(vec3r p) {
 
 // Nearest kernel's level slot, its kernel-space point and the world normal at the hit point
 // p, whose ray distance t sets the smoothing band (at least 2 pixel footprints, against
-// aliasing). In a compound, the component nearest to p is asked (ties: the first).
-void scene_nearest(vec3r p, real t, out int level, out vec3 normal, out vec3 xk) {
+// aliasing). In a compound, the component nearest to p is asked (ties: the first); what the
+// trace handed on (`slot`, `cut`: trace.glsl) serves where it lies in that component.
+void scene_nearest(vec3r p, real t, int slot, int cut, out int level, out vec3 normal,
+                   out vec3 xk) {
     int c = nearest_component(p);
     vec3r q = undistort(c, p), xkr;
     float width = 0.0;
@@ -175,7 +177,7 @@ void scene_nearest(vec3r p, real t, out int level, out vec3 normal, out vec3 xk)
     width = max(u_smooth_width, 2.0 * u_footprint * float(t));
 #endif
     ivec2 k = component(c);
-    real D = krs_nearest(k.x, k.y, q, width, level, normal, xkr);
+    real D = krs_nearest(k.x, k.y, q, width, slot, cut, level, normal, xkr);
     xk = vec3(xkr);
 #ifdef KRS_TWIST
     if (EFFECT_ON(KRS_TWIST_BIT)) normal = twist_normal(vec3(p), vec3(q), normal);

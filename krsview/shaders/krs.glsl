@@ -58,7 +58,9 @@ bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e, inout i
     if (b.w >= 0.0 && b.w < rho) { cut = i; return false; }
 #endif
     e = fold(i, b.xyz, x);
-    d = min(d, kernel_distance_of(i, x, KRS_LEVEL_KERNELS));
+    real k = kernel_distance_of(i, x, KRS_LEVEL_KERNELS);
+    g_slot = k < d ? i : g_slot;  // ties to the coarser level, as krs_nearest
+    d = min(d, k);
     return true;
 }
 
@@ -68,7 +70,9 @@ real krs_lod_cut(int cut, vec3r x, real d) {
 #ifdef KRS_LOD
     if (cut >= 0) {
         vec4r b = u_bounds[cut];
-        d = min(d, length(x - b.xyz) - b.w);
+        real k = length(x - b.xyz) - b.w;
+        g_cut = k < d ? cut : -1;
+        d = min(d, k);
     }
 #endif
     return d;
@@ -77,6 +81,8 @@ real krs_lod_cut(int cut, vec3r x, real d) {
 real krs_distance(int first, int n, vec3r xw, real rho) {
     vec3r x = xw;
     real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
+    g_slot = first + n;
+    g_cut = -1;
     real e;
     int cut = -1;
     for (int i = first + n - 1; i >= first; --i) if (!krs_level(i, x, d, rho, e, cut)) break;
@@ -106,6 +112,8 @@ real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real ke
     real bound = adist - s;
     real d = again ? bound : kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
     real m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
+    g_slot = again ? -1 : first + n;  // above the anchor: not known
+    g_cut = -1;
     saved = false;
     int cut = -1;
     for (; i >= first;) {
@@ -144,20 +152,39 @@ real mirror_weight(real e, float width) {
 real mirror_weight(real e, float width) { return e > 0.0 ? 1.0 : 0.0; }
 #endif
 
+// Level slot i of the walk to the nearest kernel: x folded, and A_i taken into M (below).
+void fold_frame(int i, float width, inout vec3r x, inout mat3r M) {
+    vec3r u = u_mirrors[i].xyz;
+    real e = fold(i, u_bounds[i].xyz, x);
+    M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
+}
+
 // Winning level slot j (ties to the coarser level), the point x_j in its kernel's space, and the
 // world normal M ∇k_j(x_j) with M = A_{n−1} ⋯ A_j, A_i = I − 2 w_i u_i u_iᵀ accumulated while
 // walking down [KRS14 §6.1]: w_i = 1 where mirror i folded x, else 0 (smoothed near the plane).
-real krs_nearest(int first, int n, vec3r xw, float width, out int level, out vec3 normal,
-                 out vec3r xk) {
+// What the trace's walk at this very point handed on (trace.glsl, g_slot and g_cut) spares
+// most of the kernels: it tested every level above where it stopped, so the least of them,
+// `slot`, is the only one above that can win; below, the levels it culled could at most tie
+// with it, and those under a ball that it cut (`cut`) could win only where that ball was
+// nearer than every kernel it tested. So the walk folds down to `slot` and tests that one
+// kernel, then, below a ball that won, folds on to `cut` and goes on as the whole walk does;
+// without a known slot, the whole walk. llvmpipe runs every branch's reads, and a loop's body
+// once even where no pixel enters it, so the folds alone and the kernels' tests are loops
+// of their own, not branches in one.
+real krs_nearest(int first, int n, vec3r xw, float width, int slot, int cut, out int level,
+                 out vec3 normal, out vec3r xk) {
+    bool known = slot >= first && slot <= first + n;
     vec3r x = xw;
-    xk = xw;
-    real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
-    level = first + n;
-    mat3r M = mat3r(1.0), Mk = mat3r(1.0);
-    for (int i = first + n - 1; i >= first; --i) {
-        vec3r u = u_mirrors[i].xyz;
-        real e = fold(i, u_bounds[i].xyz, x);
-        M -= 2.0 * mirror_weight(e, width) * outerProduct(M * u, u);
+    mat3r M = mat3r(1.0);
+    int i = first + n - 1;
+    for (; known && i >= slot; --i) fold_frame(i, width, x, M);
+    level = known ? slot : first + n;
+    xk = x;
+    mat3r Mk = M;
+    real d = kernel_distance_of(level, x, KRS_TOP_KERNELS | KRS_LEVEL_KERNELS);
+    for (; known && cut >= 0 && i > cut; --i) fold_frame(i, width, x, M);
+    for (; (!known || cut >= 0) && i >= first; --i) {
+        fold_frame(i, width, x, M);
         real di = kernel_distance_of(i, x, KRS_LEVEL_KERNELS);
         if (di < d) { d = di; level = i; xk = x; Mk = M; }
     }

@@ -93,6 +93,7 @@ void lanes() {
             rays[index].t = r.t;                         // what deferred.frag reads
             rays[index].iterations = r.iterations;
             rays[index].state = r.state;
+            rays[index].slots = r.slots;
         }
         if (done) {
             p = next;

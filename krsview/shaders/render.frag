@@ -14,24 +14,25 @@ void main() {
     real start[COMPONENT_SLOTS];
     ray_start(ivec2(gl_FragCoord.xy), start);
     real t;
-    int iterations;
+    int iterations, slots;
 #ifdef KRS_FREE_TILES
     Ray r;
     bool traced = ray_starts_live(start, r);  // false: done before a step, as trace_ray is
     gl_FragDepth = traced ? 1.0 : 0.0;
     t = r.t;
     iterations = r.iterations;
+    slots = r.slots;
     const bool hit = false;  // the shading's code compiled away
 #else
-    bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations);
+    bool hit = trace_ray(vec3r(0.0), dir, start, t, iterations, slots);
 #endif
 #ifdef KRS_COUNT_LEVELS
     int levels = g_levels;   // the tracing's, before shading walks more
 #endif
 #ifdef KRS_TRACE_ONLY   // the tracing alone, its result kept, nothing shaded
-    write_trace(dir, hit, t, iterations);
+    write_trace(dir, hit, t, iterations, slots);
 #else
-    write_pixel(dir, hit, t, iterations);
+    write_pixel(dir, hit, t, iterations, slots);
 #endif
 #ifdef KRS_COUNT_LEVELS
     out_iterations.y = float(levels);

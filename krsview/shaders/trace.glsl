@@ -4,6 +4,16 @@
 // the ray; the one with the least t_c takes the step, and the ray converges when that step
 // does: at the nearest of the components' own hits [KRS17 §5.1]. Each t_c starts at
 // start[c]: 0, or the pre-pass's free distance of the pixel's tile (prepass.glsl).
+
+// What the last KRS walk found nearest (krs.glsl sets both): the slot of the least of the
+// kernels it tested (−1: not known), and the slot of the level-of-detail ball where that ball
+// was nearer still (−1: none). A hit hands them to the shading, whose walk then tests no
+// kernel above the ball (krs_nearest). The Ray packs both into one int (std430 has no room
+// for two): each slot + 1, the ball's in the bits from 16 on.
+int g_slot = -1, g_cut = -1;
+
+int packed_slots() { return (g_slot + 1) | ((g_cut + 1) << 16); }
+
 #ifdef KRS_MOBIUS
 #include "mokrs.glsl"
 #else
@@ -31,7 +41,9 @@ struct Ray {
     real t;                     // the ray distance of the last step (the hit's, once hit)
     int iterations;
     int state;                  // RAY_LIVE, RAY_HIT or RAY_MISS
-    vec3r wx, wdir;             // walk restart: the anchor's folded point and direction,
+    vec3r wx;                   // walk restart: the anchor's folded point,
+    int slots;                  // (a hit's packed_slots(), in wx's padding)
+    vec3r wdir;                 // the ray's direction folded alike,
     real wt, wm, wd, wr;        // its ray distance, fold margin, distance above, least ball
     int wj;                     // and its level slot (−1: none; krs.glsl, krs_restart)
 };
@@ -46,6 +58,7 @@ Ray ray_begin(real start[COMPONENT_SLOTS]) {
     r.t = start[0];
     r.iterations = 0;
     r.state = RAY_LIVE;
+    r.slots = 0;  // none known
     r.wx = r.wdir = vec3r(0.0);
     r.wt = r.wm = r.wd = r.wr = 0.0;
     r.wj = -1;
@@ -153,7 +166,11 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
         r.w = 1.0;
         return;
     }
-    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) {
+        r.state = RAY_HIT;
+        r.slots = packed_slots();
+        return;
+    }
     r.ts = t;
     r.ds = d;
     r.t = t + r.w * d;
@@ -184,12 +201,17 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
     ++r.iterations;
     if (!bounded && d <= u_eps_per_t * t * lod_scale(origin + t * dir)) {
         r.state = RAY_HIT;
+        r.slots = packed_slots();
         return;
     }
 #else
     real d = component_distance(c, origin + t * dir);
     ++r.iterations;
-    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) { r.state = RAY_HIT; return; }
+    if (d <= u_eps_per_t * t * lod_scale(origin + t * dir)) {
+        r.state = RAY_HIT;
+        r.slots = packed_slots();
+        return;
+    }
 #endif
     r.tc[c] = t + d;
 #if defined(KRS_BALL_EXIT) && !defined(KRS_COMPOUND)
@@ -204,23 +226,26 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
 }
 #endif
 
-// The whole trace of one ray: steps until it hits, leaves or reaches the cap.
+// The whole trace of one ray: steps until it hits, leaves or reaches the cap; `slots`: the
+// hit's packed_slots(), for nearest_kernel.
 bool trace_ray(vec3r origin, vec3r dir, real start[COMPONENT_SLOTS], out real t,
-               out int iterations) {
+               out int iterations, out int slots) {
     Ray r = ray_begin(start);
     while (r.state == RAY_LIVE) ray_step(r, origin, dir);
     t = r.t;
     iterations = r.iterations;
+    slots = r.slots;
     return r.state == RAY_HIT;
 }
 
 // The kernel level nearest to a hit point at ray distance t, the world normal there, and the
-// point in that kernel's own space (for kernel texture coordinates).
-void nearest_kernel(vec3r p, real t, out int level, out vec3 normal, out vec3 xk) {
+// point in that kernel's own space (for kernel texture coordinates); `slots`: what the trace
+// handed on (the Ray's packed_slots()).
+void nearest_kernel(vec3r p, real t, int slots, out int level, out vec3 normal, out vec3 xk) {
 #ifdef KRS_MOBIUS
     mokrs_nearest(p, level, normal);
     xk = vec3(p);
 #else
-    scene_nearest(p, t, level, normal, xk);
+    scene_nearest(p, t, (slots & 0xffff) - 1, (slots >> 16) - 1, level, normal, xk);
 #endif
 }

@@ -39,12 +39,12 @@ vec4 krs_image(vec2 frag) {
     real start[COMPONENT_SLOTS];
     for (int c = 0; c < COMPONENT_SLOTS; ++c) start[c] = 0.0;
     real t;
-    int iterations;
+    int iterations, slots;
     vec3r o = u_eye_shift;
-    if (!trace_ray(o, dir, start, t, iterations)) return vec4(encode(background(dir)), 1.0);
+    if (!trace_ray(o, dir, start, t, iterations, slots)) return vec4(encode(background(dir)), 1.0);
     int level;
     vec3 n, xk;
-    nearest_kernel(o + t * dir, t, level, n, xk);
+    nearest_kernel(o + t * dir, t, slots, level, n, xk);
     return vec4(encode(shade(o + t * dir, dir, t, level, n, xk)), 1.0);
 }
 
