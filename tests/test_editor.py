@@ -177,6 +177,46 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     Image.fromarray(shot).save(tmp_path / "edited-window.png")
 
 
+def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
+    """Press on a fork nobody selected and drag: it is selected at the press and follows the
+    pointer in the plane facing the camera, as the gizmo's centre moves it, in one undo step,
+    and the camera stays. Negative control: the same drag pressed 30 px beside the fork, off
+    every handle, moves nothing and selects nothing."""
+    from krsview.editor.picking import under
+
+    e = editor
+    settle(e)
+    e.execute([Bake()])
+    e.select(None)
+    settle(e)
+    path = ("route", "levels", LEVEL, "fork")
+    old = np.array(handle(e, path).position)
+    camera, steps = e.viewer.camera.to_camera(), len(e.doc.history.steps)
+    beside = screen_of(e, old)
+    beside = (beside[0], beside[1] - 30)
+    import glfw
+
+    wx, wy = glfw.get_window_pos(e.viewer.window)
+    assert under(e.shown(), e.window_view(), beside[0] - wx, beside[1] - wy) is None
+    drag(e, beside, (40, 0))
+    assert e.selected is None and np.array_equal(e.scene.route.levels[LEVEL].fork, old)
+    assert len(e.doc.history.steps) == steps
+    drag(e, screen_of(e, old), (40, 0))
+    assert e.selected is not None and e.selected.path == path
+    new = np.array(e.scene.route.levels[LEVEL].fork)
+    v = e.window_view()
+    depth = float((old - v.origin) @ v.forward)
+    expected = 40 * 2 * v.tan_half * depth / v.height * v.right  # the screen-plane move
+    assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected), (
+        new - old,
+        expected,
+    )
+    assert len(e.doc.history.steps) == steps + 1, e.doc.history.labels()
+    assert e.viewer.camera.to_camera() == camera
+    e.viewer.undo()
+    assert np.array_equal(e.scene.route.levels[LEVEL].fork, old)
+
+
 def test_overlay_is_composited_by_traced_depth(editor):
     """Overlay fragments behind the traced surface are hidden (drawn at HIDDEN_ALPHA, here
     set to 0 to see them vanish, then to 1 as the negative control)."""

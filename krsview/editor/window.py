@@ -44,6 +44,7 @@ from . import commands as ec
 from .dragging import manipulate
 from .file_actions import FILE_HANDLERS, FileActions
 from .gizmo import Gizmo
+from .grab import Grabbing
 from .handles import Handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
@@ -77,6 +78,7 @@ class Editor:
         self.gizmo = Gizmo()
         self.snap = self.gizmo.snap
         self.trackball = Trackball(self.snap)
+        self.grabbing = Grabbing()  # a point handle pressed on and dragged at once
         self.layout = Layout()
         self.carry = True  # a fork drag takes its subtree along
         self.structure = StructureTools()
@@ -179,8 +181,10 @@ class Editor:
         overlay and the panels; then the autosave. A click picks after the gizmo has seen the
         pointer where it clicked, still before the overlay is drawn (the gizmo of what it
         picked comes the turn after, at once); a press onto the gizmo, as this frame finds
-        it, is the gizmo's, and the view lets go of it; the motion since the press waits for
-        that finding (Input.judged), so neither orbits the camera by a poll's motion first."""
+        it, is the gizmo's, and the view lets go of it; a press onto a shown point handle
+        that the gizmo does not claim grabs that handle (grab.py), and the view lets go of it
+        too; the motion since the press waits for that finding (Input.judged), so neither
+        orbits the camera by a poll's motion first."""
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
@@ -195,12 +199,18 @@ class Editor:
         self._again = False
         if v.hud:  # the drag first, so this turn traces its edit (a turn less latency)
             manipulate(self)
+            pressed = "left" in v.input.buttons - self._held and v.input.press is not None
             if not self._claimed():
-                if click is not None:
+                if pressed and self._grab(v.input.press):
+                    v.input.let_go("left")  # the handle's press: no orbit, no click
+                    self._again = True
+                elif click is not None:
                     self.pick(*click)
                     self._again = True
-            elif "left" in v.input.buttons - self._held:  # pressed onto the gizmo
+            elif pressed:  # pressed onto the gizmo
                 v.input.let_go("left")
+            held = glfw.get_mouse_button(v.window, glfw.MOUSE_BUTTON_LEFT) == glfw.PRESS
+            self.grabbing.follow(self, v.input.cursor, held)
         v.input.judged()  # else the press is the view's, and so is its motion
         v.draw_image()
         self._follow()
@@ -312,6 +322,14 @@ class Editor:
         self.select(best)
         return best
 
+    def _grab(self, press: tuple[float, float]) -> bool:
+        """A left press at window point ``press`` on a shown point handle: it is selected and
+        follows the pointer from now on (grab.py)."""
+        h = self.grabbing.begin(self.shown(), self.window_view(), press)
+        if h is not None:
+            self.select(h)
+        return h is not None
+
     def _claimed(self) -> bool:
         """The gizmo, or the trackball on a selected normal, is under the pointer or dragged:
         a press there is neither the camera's nor a pick."""
@@ -322,7 +340,7 @@ class Editor:
         """The gizmo, the dial or the trackball is dragged: a press of another button is not
         the camera's. (Whether a press lands on one, only the frame after it can tell: the
         pointer may have moved since this frame.)"""
-        return self.gizmo.dragging() or self.trackball.active
+        return self.gizmo.dragging() or self.trackball.active or self.grabbing.now is not None
 
     # ----------------------------------------------------------------------- drawing
     def _draw_ui(self) -> None:

@@ -1,0 +1,80 @@
+"""A point handle grabbed where it lies: a left press on a shown point handle that the gizmo
+does not claim selects it and drags it at once, in the plane through it that faces the camera
+(as the gizmo's centre drags a selected point), so a fork is moved by pressing on it and
+dragging, with no click to select it first. The pointer is followed as long as the button is
+held; one press-and-drag is one undo step. Its values land as the gizmo's do: on a decimal
+step under QUANTUM_PIXELS on screen, or on the grid when snapping."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from imgui_bundle import imgui
+
+from ..compile.camera import View, pixel_ray
+from .dragging import Dragged, drag_edits
+from .gizmo import QUANTUM_PIXELS, decimal_step, moved
+from .handles import Handle
+from .picking import under
+
+
+@dataclass
+class Grab:
+    """A press-and-drag of the handle at ``start`` (world), pressed at window point
+    ``press``; ``drag`` numbers it (its edits share one undo step)."""
+
+    handle: Handle
+    start: np.ndarray
+    press: tuple[float, float]
+    drag: int
+
+    def target(self, v: View, cursor: tuple[float, float]) -> np.ndarray:
+        """Where the pointer at ``cursor`` puts the handle: moved as far as the pointer in the
+        plane through ``start`` facing the camera."""
+        depth = float((self.start - v.origin) @ v.forward)
+
+        def at(x: float, y: float) -> np.ndarray:
+            d = pixel_ray(v, x, y)
+            return d * (depth / float(d @ v.forward))
+
+        return self.start + at(*cursor) - at(*self.press)
+
+
+class Grabbing:
+    """The editor's grab, if one is under way."""
+
+    def __init__(self) -> None:
+        self.now: Grab | None = None
+        self.drags = 0
+
+    def begin(self, shown: list[Handle], v: View, press: tuple[float, float]) -> Handle | None:
+        """A left press at ``press``: the shown point handle there, grabbed (None: none)."""
+        h = under([h for h in shown if h.kind == "point"], v, *press)
+        if h is not None:
+            self.drags += 1
+            self.now = Grab(h, np.array(h.position, dtype=np.float64), press, self.drags)
+        return h
+
+    def follow(self, e: Dragged, cursor: tuple[float, float], held: bool) -> None:
+        """One turn of a grab: the handle to the pointer while the button is ``held`` (an
+        edit at once, before the turn's image is traced); the grab ends when it is let go or
+        the selection has changed."""
+        g = self.now
+        if g is None:
+            return
+        sel = e.selected
+        if not held or sel is None or not sel.same(g.handle):
+            self.now = None
+            return
+        if cursor == g.press:
+            return
+        v = e.window_view()
+        depth = float((g.start - v.origin) @ v.forward)
+        quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)
+        snap = e.gizmo.snap
+        grid = snap.grid if snap.on or imgui.get_io().key_shift else None
+        p = moved(g.start, g.target(v, cursor) - g.start, quantum, grid)
+        t = e.viewer.drawn.playback.time
+        for path, value in drag_edits(e.scene, sel, p, e.carry, t):
+            e.edit(path, value, ("grab", g.drag))
