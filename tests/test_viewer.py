@@ -491,3 +491,14 @@ def test_moving_frames_light_like_the_still_image(viewer, tmp_path):
     full = headless_render(v.view_scene().with_geometry(v.drawn.krs), tmp_path / "full", SIZE)
     close = np.abs(v.read_window().astype(int) - full.astype(int)).max(-1) <= 2
     assert close.mean() >= 0.99
+
+
+def test_drop_down_lists_are_opaque(viewer):
+    """A HUD combo's open list hides the fields under it: ImGui's default popup background
+    (alpha 0.94, the negative control) let their text show through its entries."""
+    from imgui_bundle import imgui
+
+    bg = imgui.get_style().color_(imgui.Col_.popup_bg.value)
+    assert bg.w == 1.0
+    imgui.style_colors_dark()  # ImGui's own default
+    assert imgui.get_style().color_(imgui.Col_.popup_bg.value).w < 1.0

@@ -37,6 +37,7 @@ class Platform:
         imgui.create_context()
         implot.create_context()
         imgui.get_io().set_ini_filename("")
+        opaque_popups()
         load_font()
         self.addr = ctypes.cast(self.window, ctypes.c_void_p).value
         imgui.backends.glfw_init_for_opengl(self.addr, False)
@@ -123,6 +124,14 @@ class Platform:
         self.drawn = True
         imgui.render()
         imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+
+def opaque_popups() -> None:
+    """Drop-down lists and menus drawn opaque: ImGui's default lets 6 % of the text behind a
+    HUD combo's list through, which reads as clutter over its entries."""
+    style = imgui.get_style()
+    c = style.color_(imgui.Col_.popup_bg.value)
+    style.set_color_(imgui.Col_.popup_bg.value, imgui.ImVec4(c.x, c.y, c.z, 1.0))
 
 
 def imgui_under(to: Input, taken: set[int]) -> bool:
