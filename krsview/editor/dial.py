@@ -1,8 +1,9 @@
 """The ring that turns a MöKRS rotation step's dial about its world axis through its pivot: a
 circle of fixed size on screen in the plane ⊥ the axis, grabbable anywhere along it (ImGuizmo's
 rotate ring draws its whole circle but takes a press only on the half nearer the camera, so a
-turn released on the far half could not be taken back from there). The angle is the pointer
-ray's crossing of that plane measured about the axis, so the dial follows the pointer."""
+turn released on the far half could not be taken back from there), and at the dial point
+itself, which looks as grabbable as any handle. The angle is the pointer ray's crossing of
+that plane measured about the axis, so the dial follows the pointer."""
 
 from __future__ import annotations
 
@@ -27,8 +28,8 @@ def rotation(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 class Dial:
-    """Press-and-drag on the ring of the selected dial handle; each drag is one interaction
-    (one undo step)."""
+    """Press-and-drag on the ring, or on the dial point, of the selected dial handle; each
+    drag is one interaction (one undo step)."""
 
     def __init__(self) -> None:
         self.drags = 0
@@ -46,7 +47,11 @@ class Dial:
         x, y = io.mouse_pos.x, io.mouse_pos.y
         basis = plane_basis(h.axis)
         ring = self._ring(h, v, basis)
-        self.hovered = not io.want_capture_mouse and distance_to(ring, x, y) <= GRAB_PIXELS
+        px, py, z = project(v, h.position)  # the dial point, drawn on its guide circle
+        on_point = z > 0 and math.hypot(px - x, py - y) <= GRAB_PIXELS
+        self.hovered = not io.want_capture_mouse and (
+            distance_to(ring, x, y) <= GRAB_PIXELS or on_point
+        )
         draw = imgui.get_background_draw_list()
         pts = [imgui.ImVec2(px, py) for px, py in ring]
         draw.add_polyline(pts, HOT if self.hovered or self.active else RED, 3.0, 0)
