@@ -101,6 +101,16 @@ def click(e, at) -> None:
     pump(e, 3)
 
 
+def assert_moved_right(e, old, new, pixels: float) -> None:
+    """``new`` is ``old`` moved ``pixels`` to the right in the plane through it that faces
+    the camera (as a drag of the gizmo's centre moves it), within 10 %."""
+    v = e.window_view()
+    depth = float((np.asarray(old) - v.origin) @ v.forward)
+    expected = pixels * 2 * v.tan_half * depth / v.height * v.right
+    moved = np.asarray(new) - np.asarray(old)
+    assert np.linalg.norm(moved - expected) < 0.1 * np.linalg.norm(expected), (moved, expected)
+
+
 def handle(e, path):
     return next(h for h in e.handles if h.path == path)
 
@@ -119,13 +129,7 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     old = np.array(h.position)
     drag(e, screen_of(e, old), (40, 0))
     new = np.array(e.scene.route.levels[LEVEL].fork)
-    v = e.window_view()
-    depth = float((old - v.origin) @ v.forward)
-    expected = 40 * 2 * v.tan_half * depth / v.height * v.right  # the screen-plane move
-    assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected), (
-        new - old,
-        expected,
-    )
+    assert_moved_right(e, old, new, 40)
     assert len(e.doc.history.steps) == 2, "the drag was not one undo step (bake + drag)"
     # the mirror normal of that fork, by its arrow tip: 30 px up
     normal_path = ("route", "levels", LEVEL, "normal")
@@ -204,13 +208,7 @@ def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     drag(e, screen_of(e, old), (40, 0))
     assert e.selected is not None and e.selected.path == path
     new = np.array(e.scene.route.levels[LEVEL].fork)
-    v = e.window_view()
-    depth = float((old - v.origin) @ v.forward)
-    expected = 40 * 2 * v.tan_half * depth / v.height * v.right  # the screen-plane move
-    assert np.linalg.norm(new - old - expected) < 0.1 * np.linalg.norm(expected), (
-        new - old,
-        expected,
-    )
+    assert_moved_right(e, old, new, 40)
     assert len(e.doc.history.steps) == steps + 1, e.doc.history.labels()
     assert e.viewer.camera.to_camera() == camera
     e.viewer.undo()
