@@ -78,3 +78,17 @@ def set_uniforms(prog: moderngl.Program, uniforms: dict[str, object]) -> None:
             if isinstance(value, list) and n < len(value):
                 value = value[0] if n == 1 else value[:n]
             uniform.value = value
+
+
+def image_uniforms(
+    prog: moderngl.Program,
+    source: moderngl.Framebuffer,
+    window: tuple[int, int],
+    image: tuple[int, int],
+) -> None:
+    """The sizes a pass that samples a traced image over a window reads (display.frag,
+    overlay.frag): the window's, the image's, and the texture's that holds it (texture_side:
+    no larger than the image by more than a texel a side, rows top → bottom)."""
+    prog["u_window"].value = (float(window[0]), float(window[1]))
+    prog["u_image"].value = (float(image[0]), float(image[1]))
+    prog["u_texture"].value = tuple(map(float, source.color_attachments[0].size))

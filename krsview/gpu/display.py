@@ -8,6 +8,7 @@ from __future__ import annotations
 import moderngl
 
 from ..compile.constants import VIEW_MODES
+from .context import image_uniforms
 from .program import ProgramCache
 
 UNITS = ("u_color", "u_normal", "u_iterations")  # the source's colour attachments, in order
@@ -62,7 +63,5 @@ class Display:
         for name, value in (("u_iteration_cap", iteration_cap), ("u_depth_scale", depth_scale)):
             if name in prog:
                 prog[name].value = float(value)
-        prog["u_window"].value = (float(size[0]), float(size[1]))
-        prog["u_image"].value = (float(image[0]), float(image[1]))
-        prog["u_texture"].value = tuple(map(float, source.color_attachments[0].size))
+        image_uniforms(prog, source, size, image)
         vao.render(moderngl.TRIANGLES, vertices=3)

@@ -10,6 +10,7 @@ import moderngl
 import numpy as np
 
 from ..compile.camera import View
+from .context import image_uniforms
 from .program import ProgramCache
 
 HIDDEN_ALPHA = 0.22  # strength of overlay fragments behind traced geometry
@@ -83,9 +84,7 @@ class Overlay:
         source.color_attachments[1].use(location=1)
         target.use()
         self.ctx.viewport = (0, 0, *size)
-        self.prog["u_window"].value = (float(size[0]), float(size[1]))
-        self.prog["u_image"].value = (float(image[0]), float(image[1]))
-        self.prog["u_texture"].value = tuple(map(float, source.color_attachments[0].size))
+        image_uniforms(self.prog, source, size, image)
         self.prog["u_view_projection"].write(matrix.T.astype("f4").tobytes())
         self.ctx.enable(moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
         self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
