@@ -338,14 +338,15 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
 
 
 def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
-    """The selected rotation step's dial point (on its guide circle, away from the ring)
-    turns the dial when pressed and dragged round the axis: the angle follows the pointer
-    one way, in one undo step. Negative control: the same drag pressed beside the point,
-    off the point and the ring, turns nothing."""
+    """A rotation step's dial point (on its guide circle, away from the ring) turns the dial
+    when pressed and dragged round the axis, selected or not: the angle follows the pointer,
+    in one undo step each time, and lands on hundredths of a degree. Negative control: the
+    same drag pressed beside the point, off the point and the ring, turns nothing."""
     from krsview.editor.dial import GRAB_PIXELS, distance_to, plane_basis
+    from krsview.editor.mokrs_handles import DIAL_DECIMALS
     from krsview.editor.window import Editor
 
-    from .test_editor import click, pump, screen_of, settle, xdo
+    from .test_editor import pump, screen_of, settle, xdo
 
     path = tmp_path / "palm.toml"
     shutil.copy(resolve("palm"), path)
@@ -353,44 +354,49 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
     try:
         settle(e)
         degrees = (*LEVELS, 58, "transform", 1, "degrees")
-        h = next(h for h in e.handles if h.path == degrees)
-        click(e, screen_of(e, h.position))
-        assert e.selected is not None and e.selected.path == degrees
-        v = e.window_view()
-        ring = e.gizmo.dial._ring(h, v, plane_basis(h.axis))
-        import glfw
 
-        wx, wy = glfw.get_window_pos(e.viewer.window)
-        point = screen_of(e, h.position)
-        assert distance_to(ring, point[0] - wx, point[1] - wy) > 2 * GRAB_PIXELS
-        arm = h.position - h.pivot
-        y, z = arm / np.linalg.norm(arm), np.cross(h.axis, arm / np.linalg.norm(arm))
-
-        def turned(start_offset, arc=0.3, steps=6):
+        def turned(beside=0.0, arc=0.3, steps=6):
+            """Press on the dial point (or ``beside`` it, pixels to the right) and drag it
+            ``arc`` radians round the axis: the angle before, after each move, the steps."""
+            h = next(h for h in e.handles if h.path == degrees)
             before, steps0 = get_at(e.scene, degrees), len(e.doc.history.steps)
-            x0, y0 = screen_of(e, h.pivot + np.linalg.norm(arm) * y)
-            xdo("mousemove", round(x0 + start_offset), round(y0))
-            pump(e, 2)
-            xdo("mousedown", 1)
-            pump(e, 2)
+            arm = h.position - h.pivot
+            y, z = arm / np.linalg.norm(arm), np.cross(h.axis, arm / np.linalg.norm(arm))
             angles = []
-            for k in range(1, steps + 1):
+            for k in range(steps + 1):
                 t = arc * k / steps
                 q = h.pivot + np.linalg.norm(arm) * (np.cos(t) * y + np.sin(t) * z)
                 x, yy = screen_of(e, q)
-                xdo("mousemove", round(x + start_offset), round(yy))
-                pump(e, 1)
-                angles.append(get_at(e.scene, degrees))
+                xdo("mousemove", round(x + beside), round(yy))
+                pump(e, 2 if k == 0 else 1)
+                if k == 0:
+                    xdo("mousedown", 1)
+                    pump(e, 2)
+                else:
+                    angles.append(get_at(e.scene, degrees))
             xdo("mouseup", 1)
             pump(e, 2)
             return before, angles, len(e.doc.history.steps) - steps0
 
-        before, angles, steps = turned(3 * GRAB_PIXELS)  # beside the point: nothing
+        def turns(before, angles, steps):
+            moved = np.abs(np.diff([before, *angles]))
+            assert steps == 1 and (moved > 0).sum() >= 4, (before, angles)
+            assert 5.0 < abs(angles[-1] - before) < 40.0, (before, angles)  # 0.3 rad ≈ 17°
+            assert all(a == round(a, DIAL_DECIMALS) for a in angles), angles
+
+        assert e.selected is None
+        turns(*turned())  # not selected: the press selects it and turns it
+        assert e.selected is not None and e.selected.path == degrees
+        h = e.selected
+        import glfw
+
+        wx, wy = glfw.get_window_pos(e.viewer.window)
+        x, y = screen_of(e, h.position)
+        ring = e.gizmo.dial._ring(h, e.window_view(), plane_basis(h.axis))
+        assert distance_to(ring, x - wx, y - wy) > 2 * GRAB_PIXELS  # the point is off the ring
+        before, angles, steps = turned(beside=3 * GRAB_PIXELS)
         assert angles[-1] == before and steps == 0, angles
-        before, angles, steps = turned(0)
-        moved = np.abs(np.diff([before, *angles]))
-        assert steps == 1 and (moved > 0).sum() >= 4, (before, angles)
-        assert 5.0 < abs(angles[-1] - before) < 40.0, (before, angles)  # 0.3 rad ≈ 17°
+        turns(*turned())  # selected: its point turns it as its ring does
     finally:
         e.close()
 

@@ -59,10 +59,8 @@ class Dial:
             self.active = False
             return None
         angle = pointer_angle(h, v, basis, x, y)
-        if imgui.is_mouse_clicked(imgui.MouseButton_.left) and self.hovered and angle is not None:
-            self.active, self._last, self._turned = True, angle, 0.0
-            self._start = np.array(h.position, dtype=np.float64)
-            self.drags += 1
+        if imgui.is_mouse_clicked(imgui.MouseButton_.left) and self.hovered:
+            self.start(h, v, x, y)
             return None
         if not self.active or angle is None or angle == self._last:
             return None
@@ -74,6 +72,17 @@ class Dial:
             turned = round(turned / step) * step
         p = h.pivot + rotation(h.axis, turned) @ (self._start - h.pivot)
         return p, ("dial", self.drags)
+
+    def start(self, h, v: View, x: float, y: float) -> bool:
+        """A press at window point (x, y) starts turning dial handle ``h`` (one new undo
+        step); false where the pointer reads no angle there (the plane seen edge-on)."""
+        angle = pointer_angle(h, v, plane_basis(h.axis), x, y)
+        if angle is None:
+            return False
+        self.active, self._last, self._turned = True, angle, 0.0
+        self._start = np.array(h.position, dtype=np.float64)
+        self.drags += 1
+        return True
 
     @staticmethod
     def _ring(h, v: View, basis: tuple[np.ndarray, np.ndarray]) -> list[tuple[float, float]]:

@@ -36,6 +36,7 @@ SCALE_DIRECTION = np.array([1.0, 0.0, 0.0])  # u: where a scale step's handle si
 RADIUS_DIRECTION = np.array([1.0, 0.0, 0.0])  # an inversion sphere's point handle
 SHARED = 1e-9  # a kernel point this close (× its size) to a step's handle is that handle
 GUIDE_SEGMENTS = 48  # a circle of a guide (a dial, a sphere's great circle) in segments
+DIAL_DECIMALS = 2  # a dragged angle lands on 0.01°, a hundredth of a pixel on the dial's ring
 AXIS_STEP = 1e-6  # × ρ: the step along a dial's axis whose image gives its world direction
 
 
@@ -102,13 +103,15 @@ def _dial_vector(axis) -> np.ndarray:
 def _dial_degrees(step: Rotate, q: np.ndarray) -> float:
     """The angle about the step's axis that turns the dial's 0° vector towards ``q``: the
     representative nearest the step's present angle, so a dial dragged past ±180° keeps
-    turning (within the schema's ±360°)."""
+    turning (within the schema's ±360°), written as the shortest decimal of DIAL_DECIMALS
+    places (as the gizmo writes a moved point: no float noise in the saved file)."""
     a = np.asarray(step.axis, dtype=np.float64)
     v = _dial_vector(a)
     w = q - (q @ a) * a
     angle = math.degrees(math.atan2(float(np.cross(v, w) @ a), float(v @ w)))
     new = step.degrees + (angle - step.degrees + 180.0) % 360.0 - 180.0
-    return new - 360.0 if new > 360.0 else new + 360.0 if new < -360.0 else new
+    new = new - 360.0 if new > 360.0 else new + 360.0 if new < -360.0 else new
+    return round(new, DIAL_DECIMALS)
 
 
 def level_size(lv: MobiusLevel) -> float:
