@@ -340,13 +340,14 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
 def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
     """A rotation step's dial point (on its guide circle, away from the ring) turns the dial
     when pressed and dragged round the axis, selected or not: the angle follows the pointer,
-    in one undo step each time, and lands on hundredths of a degree. Negative control: the
-    same drag pressed beside the point, off the point and the ring, turns nothing."""
+    in one undo step each time, and lands on hundredths of a degree; a click on an unselected
+    dial's point that slips 3 px selects it without turning it. Negative control: the same
+    drag pressed beside the point, off the point and the ring, turns nothing."""
     from krsview.editor.dial import GRAB_PIXELS, distance_to, plane_basis
     from krsview.editor.mokrs_handles import DIAL_DECIMALS
     from krsview.editor.window import Editor
 
-    from .test_editor import pump, screen_of, settle, xdo
+    from .test_editor import drag, pump, screen_of, settle, xdo
 
     path = tmp_path / "palm.toml"
     shutil.copy(resolve("palm"), path)
@@ -385,6 +386,12 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
             assert all(a == round(a, DIAL_DECIMALS) for a in angles), angles
 
         assert e.selected is None
+        h = next(h for h in e.handles if h.path == degrees)
+        drag(e, screen_of(e, h.position), (3, 0), steps=3)  # a click that slips: selects it
+        assert e.selected is not None and e.selected.path == degrees
+        assert get_at(e.scene, degrees) == -2.5 and not e.doc.history.steps
+        e.select(None)
+        pump(e, 2)
         turns(*turned())  # not selected: the press selects it and turns it
         assert e.selected is not None and e.selected.path == degrees
         h = e.selected

@@ -13,6 +13,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ..compile.camera import View, pixel_ray, project
+from ..viewer.controls import CLICK_PIXELS
 
 RING_PIXELS = 60.0  # the ring's radius on screen where it faces the camera
 GRAB_PIXELS = 8.0  # a press this close to the drawn ring starts turning
@@ -38,6 +39,7 @@ class Dial:
         self._last = 0.0  # the pointer's angle about the axis at the last frame
         self._turned = 0.0  # radians turned since the press
         self._start = np.zeros(3)  # the dial point at the press
+        self._selecting = False  # the press also selected it: no turn within a click's slip
 
     def update(self, h, v: View, snap: float | None) -> tuple[np.ndarray, tuple] | None:
         """Inside the ImGui frame: draw the ring of dial handle ``h``; while it is turned,
@@ -66,6 +68,8 @@ class Dial:
             return None
         self._turned += math.remainder(angle - self._last, 2.0 * math.pi)
         self._last = angle
+        if self._selecting and not imgui.is_mouse_dragging(imgui.MouseButton_.left, CLICK_PIXELS):
+            return None
         turned = self._turned
         if snap:
             step = math.radians(snap)
@@ -73,13 +77,16 @@ class Dial:
         p = h.pivot + rotation(h.axis, turned) @ (self._start - h.pivot)
         return p, ("dial", self.drags)
 
-    def start(self, h, v: View, x: float, y: float) -> bool:
+    def start(self, h, v: View, x: float, y: float, selecting: bool = False) -> bool:
         """A press at window point (x, y) starts turning dial handle ``h`` (one new undo
-        step); false where the pointer reads no angle there (the plane seen edge-on)."""
+        step); false where the pointer reads no angle there (the plane seen edge-on). A press
+        that is ``selecting`` it too turns it only once the pointer has left the press by more
+        than a click's CLICK_PIXELS, so a click that selects it does not turn it by a slip."""
         angle = pointer_angle(h, v, plane_basis(h.axis), x, y)
         if angle is None:
             return False
         self.active, self._last, self._turned = True, angle, 0.0
+        self._selecting = selecting
         self._start = np.array(h.position, dtype=np.float64)
         self.drags += 1
         return True
