@@ -37,6 +37,7 @@ CASES = {
     "tree in one pass": scene_of("tree", shadow_block=1),  # render.frag: trace and shade
     "tree in lanes": scene_of("tree", path="compute", steps=0),  # compute.comp, deferred.frag
     "tree restarted": scene_of("tree", walk_restart="on"),  # slots unknown above an anchor
+    "tree in lanes, restarted": scene_of("tree", path="compute", steps=0, walk_restart="on"),
     "grove": scene_of("grove"),  # a compound: the trace's component may not be the nearest
     "tree-wind": scene_of("tree-wind"),  # looked up where the wind undoes its bend
     "bent-tree": scene_of("bent-tree"),
