@@ -184,7 +184,8 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
 def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     """Press on a fork nobody selected and drag: it is selected at the press and follows the
     pointer in the plane facing the camera, as the gizmo's centre moves it, in one undo step,
-    and the camera stays; a press that slips less than a click's 4 px only selects it.
+    and the camera stays; a press that slips less than a click's 4 px only selects it, and
+    on the selected handle (the gizmo's centre) moves nothing.
     Negative control: the same drag pressed 30 px beside the fork, off every handle, moves
     nothing and selects nothing."""
     from krsview.editor.picking import under
@@ -221,6 +222,11 @@ def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     assert e.selected is not None and e.selected.path == path
     assert np.array_equal(e.scene.route.levels[LEVEL].fork, old)
     assert e.doc.history.index == steps and e.doc.history.can_redo  # no step pushed
+    # and now selected, the same slip on the gizmo's centre (the handle) does not nudge it
+    pump(e, 2)
+    drag(e, screen_of(e, old), (3, 0), steps=3)
+    assert np.array_equal(e.scene.route.levels[LEVEL].fork, old)
+    assert e.doc.history.index == steps and e.doc.history.can_redo
 
 
 def test_overlay_is_composited_by_traced_depth(editor):

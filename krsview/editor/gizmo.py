@@ -2,7 +2,10 @@
 stays precise at any zoom), its axes the world's (never flipped to face the camera, so the Y
 arrow points up and the tripod stays right-handed), snapping to the absolute grid, and values
 free of float32 noise; each press-and-drag is one interaction, so its edits merge into one undo
-step. (A normal is turned by the trackball, trackball.py; a MöKRS rotation by its ring, dial.py.)"""
+step. A drag pressed on the handle's own point (within PICK_PIXELS) moves it only once the
+pointer has left the press by a click's CLICK_PIXELS, so a click on the selected handle never
+nudges it; one pressed on an arrow away from the point moves at once, for fine steps. (A
+normal is turned by the trackball, trackball.py; a MöKRS rotation by its ring, dial.py.)"""
 
 from __future__ import annotations
 
@@ -12,10 +15,12 @@ from dataclasses import dataclass
 import numpy as np
 from imgui_bundle import imgui, imguizmo
 
-from ..compile.camera import View
+from ..compile.camera import View, project
 from ..gpu.overlay import camera_matrices
+from ..viewer.controls import CLICK_PIXELS
 from .dial import Dial
 from .handles import Handle
+from .picking import PICK_PIXELS
 
 gizmo = imguizmo.im_guizmo
 QUANTUM_PIXELS = 0.05  # a dragged coordinate is rounded to a decimal step under this on screen
@@ -34,6 +39,7 @@ class Gizmo:
         self.drags = 0  # numbers each drag: one undo step each
         self._was_using = False
         self._over = False  # the pointer is on a part of the gizmo drawn this frame
+        self._on_handle = False  # this drag was pressed on the handle itself
         self.dial = Dial()
 
     def begin_frame(self) -> None:
@@ -75,9 +81,16 @@ class Gizmo:
             gizmo.MODE.world,
             m,
         )
+        drags = self.drags
         using = self._track()
+        if self.drags != drags:  # pressed now: on the handle's point, or on an arrow beside it
+            x, y, _ = project(v, h.position)
+            at, since = imgui.get_io().mouse_pos, imgui.get_mouse_drag_delta(0, 0.0)
+            self._on_handle = math.hypot(at.x - since.x - x, at.y - since.y - y) <= PICK_PIXELS
         if not (changed and using):
             return None
+        if self._on_handle and not imgui.is_mouse_dragging(imgui.MouseButton_.left, CLICK_PIXELS):
+            return None  # a click on the handle that slips does not nudge it (as grab.py)
         delta = np.array(m.values[12:15], dtype=np.float64) - before
         quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)
         grid = self.snap.grid if self.snap.on or io.key_shift else None
