@@ -340,9 +340,10 @@ def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, t
 def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
     """A rotation step's dial point (on its guide circle, away from the ring) turns the dial
     when pressed and dragged round the axis, selected or not: the angle follows the pointer,
-    in one undo step each time, and lands on hundredths of a degree; a click on an unselected
-    dial's point that slips 3 px selects it without turning it. Negative control: the same
-    drag pressed beside the point, off the point and the ring, turns nothing."""
+    in one undo step each time, and lands on hundredths of a degree; a click on the point that
+    slips 3 px selects the dial, or lands on the selected one, without turning it. Negative
+    control: the same drag pressed beside the point, off the point and the ring, turns
+    nothing."""
     from krsview.editor.dial import GRAB_PIXELS, distance_to, plane_basis
     from krsview.editor.mokrs_handles import DIAL_DECIMALS
     from krsview.editor.window import Editor
@@ -403,6 +404,9 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
         assert distance_to(ring, x - wx, y - wy) > 2 * GRAB_PIXELS  # the point is off the ring
         before, angles, steps = turned(beside=3 * GRAB_PIXELS)
         assert angles[-1] == before and steps == 0, angles
+        before, steps0 = get_at(e.scene, degrees), len(e.doc.history.steps)
+        drag(e, screen_of(e, e.selected.position), (3, 0), steps=3)  # a click's slip on it
+        assert get_at(e.scene, degrees) == before and len(e.doc.history.steps) == steps0
         turns(*turned())  # selected: its point turns it as its ring does
     finally:
         e.close()

@@ -13,7 +13,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ..compile.camera import View, pixel_ray, project
-from ..viewer.controls import CLICK_PIXELS
+from .press import past_click
 
 RING_PIXELS = 60.0  # the ring's radius on screen where it faces the camera
 GRAB_PIXELS = 8.0  # a press this close to the drawn ring starts turning
@@ -39,7 +39,7 @@ class Dial:
         self._last = 0.0  # the pointer's angle about the axis at the last frame
         self._turned = 0.0  # radians turned since the press
         self._start = np.zeros(3)  # the dial point at the press
-        self._selecting = False  # the press also selected it: no turn within a click's slip
+        self._slack = False  # pressed on the dial point: no turn within a click's slip
 
     def update(self, h, v: View, snap: float | None) -> tuple[np.ndarray, tuple] | None:
         """Inside the ImGui frame: draw the ring of dial handle ``h``; while it is turned,
@@ -68,7 +68,7 @@ class Dial:
             return None
         self._turned += math.remainder(angle - self._last, 2.0 * math.pi)
         self._last = angle
-        if self._selecting and not imgui.is_mouse_dragging(imgui.MouseButton_.left, CLICK_PIXELS):
+        if self._slack and not past_click():
             return None
         turned = self._turned
         if snap:
@@ -77,16 +77,18 @@ class Dial:
         p = h.pivot + rotation(h.axis, turned) @ (self._start - h.pivot)
         return p, ("dial", self.drags)
 
-    def start(self, h, v: View, x: float, y: float, selecting: bool = False) -> bool:
+    def start(self, h, v: View, x: float, y: float) -> bool:
         """A press at window point (x, y) starts turning dial handle ``h`` (one new undo
-        step); false where the pointer reads no angle there (the plane seen edge-on). A press
-        that is ``selecting`` it too turns it only once the pointer has left the press by more
-        than a click's CLICK_PIXELS, so a click that selects it does not turn it by a slip."""
+        step); false where the pointer reads no angle there (the plane seen edge-on). Pressed
+        on the dial point (a click there selects it, or lands on the selected one), it turns
+        only once the pointer has left the press by more than a click's slip (press.py);
+        pressed on the ring, at once, for fine steps."""
         angle = pointer_angle(h, v, plane_basis(h.axis), x, y)
         if angle is None:
             return False
         self.active, self._last, self._turned = True, angle, 0.0
-        self._selecting = selecting
+        px, py, z = project(v, h.position)
+        self._slack = z > 0 and math.hypot(px - x, py - y) <= GRAB_PIXELS
         self._start = np.array(h.position, dtype=np.float64)
         self.drags += 1
         return True

@@ -17,10 +17,10 @@ from imgui_bundle import imgui, imguizmo
 
 from ..compile.camera import View, project
 from ..gpu.overlay import camera_matrices
-from ..viewer.controls import CLICK_PIXELS
 from .dial import Dial
 from .handles import Handle
 from .picking import PICK_PIXELS
+from .press import past_click
 
 gizmo = imguizmo.im_guizmo
 QUANTUM_PIXELS = 0.05  # a dragged coordinate is rounded to a decimal step under this on screen
@@ -89,7 +89,7 @@ class Gizmo:
             self._on_handle = math.hypot(at.x - since.x - x, at.y - since.y - y) <= PICK_PIXELS
         if not (changed and using):
             return None
-        if self._on_handle and not imgui.is_mouse_dragging(imgui.MouseButton_.left, CLICK_PIXELS):
+        if self._on_handle and not past_click():
             return None  # a click on the handle that slips does not nudge it (as grab.py)
         delta = np.array(m.values[12:15], dtype=np.float64) - before
         quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)

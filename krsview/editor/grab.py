@@ -2,25 +2,24 @@
 does not claim selects it and drags it at once, in the plane through it that faces the camera
 (as the gizmo's centre drags a selected point), so a fork is moved by pressing on it and
 dragging, with no click to select it first. It moves once the pointer has left the press by
-more than a click's CLICK_PIXELS (a click that selects it does not nudge it), then follows
+more than a click's slip (press.py: a click that selects it does not nudge it), then follows
 the pointer as long as the button is held; one press-and-drag is one undo step. Its values
 land as the gizmo's do: on a decimal step under QUANTUM_PIXELS on screen, or on the grid when
 snapping. A press on a dial handle's point selects it and turns its dial (dial.py)."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from imgui_bundle import imgui
 
 from ..compile.camera import View, pixel_ray
-from ..viewer.controls import CLICK_PIXELS
 from .dragging import Dragged, drag_edits
 from .gizmo import QUANTUM_PIXELS, decimal_step, moved
 from .handles import Handle
 from .picking import under
+from .press import past_click
 
 
 @dataclass
@@ -32,7 +31,6 @@ class Grab:
     start: np.ndarray
     press: tuple[float, float]
     drag: int
-    moving: bool = False  # the pointer has left the press by more than CLICK_PIXELS
 
     def target(self, v: View, cursor: tuple[float, float]) -> np.ndarray:
         """Where the pointer at ``cursor`` puts the handle: moved as far as the pointer in the
@@ -73,8 +71,7 @@ class Grabbing:
         if not held or sel is None or not sel.same(g.handle):
             self.now = None
             return
-        g.moving = g.moving or math.dist(cursor, g.press) > CLICK_PIXELS
-        if not g.moving:  # a press that selects a handle does not nudge it by a slip
+        if not past_click():  # a press that selects a handle does not nudge it by a slip
             return
         v = e.window_view()
         depth = float((g.start - v.origin) @ v.forward)

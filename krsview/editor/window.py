@@ -331,7 +331,7 @@ class Editor:
         if h is not None:
             self.select(h)
             if h.kind == "dial":
-                self.gizmo.dial.start(h, view, *press, selecting=True)
+                self.gizmo.dial.start(h, view, *press)
         return h is not None
 
     def _claimed(self) -> bool:
