@@ -212,6 +212,7 @@ def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     new = np.array(e.scene.route.levels[LEVEL].fork)
     assert_moved_right(e, old, new, 40)
     assert len(e.doc.history.steps) == steps + 1, e.doc.history.labels()
+    assert e.doc.history.labels()[0][-1] == f"drag {e.selected.label}"  # the undo tooltip
     assert e.viewer.camera.to_camera() == camera
     e.viewer.undo()
     assert np.array_equal(e.scene.route.levels[LEVEL].fork, old)

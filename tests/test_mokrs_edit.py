@@ -385,6 +385,8 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
             assert steps == 1 and (moved > 0).sum() >= 4, (before, angles)
             assert 5.0 < abs(angles[-1] - before) < 40.0, (before, angles)  # 0.3 rad ≈ 17°
             assert all(a == round(a, DIAL_DECIMALS) for a in angles), angles
+            label = e.doc.history.labels()[0][-1]  # the undo tooltip names the dial, as
+            assert label == f"drag L58 step 1 rotate {before:g} deg", label  # it was pressed
 
         assert e.selected is None
         h = next(h for h in e.handles if h.path == degrees)

@@ -35,7 +35,9 @@ class Dragged(Protocol):
     @property
     def scene(self) -> Scene: ...
     def window_view(self) -> View: ...
-    def edit(self, path: tuple, value: Any, interaction: Any = None) -> bool: ...
+    def edit(
+        self, path: tuple, value: Any, interaction: Any = None, label: str | None = None
+    ) -> bool: ...
 
 
 def drag_edits(
@@ -70,4 +72,4 @@ def manipulate(e: Dragged) -> None:
     if moved is not None:
         p, drag = moved
         for path, value in drag_edits(e.scene, sel, p, e.carry, e.viewer.drawn.playback.time):
-            e.edit(path, value, drag)
+            e.edit(path, value, drag, f"drag {sel.label}")  # not "set mokrs.levels"

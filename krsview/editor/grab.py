@@ -81,4 +81,4 @@ class Grabbing:
         p = moved(g.start, g.target(v, cursor) - g.start, quantum, grid)
         t = e.viewer.drawn.playback.time
         for path, value in drag_edits(e.scene, sel, p, e.carry, t):
-            e.edit(path, value, ("grab", g.drag))
+            e.edit(path, value, ("grab", g.drag), f"drag {sel.label}")

@@ -136,12 +136,13 @@ class Editor:
         self._follow()
         return self.shown_now.scene
 
-    def edit(self, path: tuple, value, interaction=None) -> bool:
+    def edit(self, path: tuple, value, interaction=None, label: str | None = None) -> bool:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
         the person flies must stay off every pole too, not only the file's camera
         [KRS17 §7]. A value refused for a field the panel shows keeps its message at that
         field (viewer/widgets.py), any other in the panel's error line. A value a track
-        moves is keyed at the moment shown instead (keys.py), as a drag or a typed value."""
+        moves is keyed at the moment shown instead (keys.py), as a drag or a typed value.
+        ``label`` names the undo step (the undo button's tooltip); by default the path set."""
         v = self.viewer
         path, value = keyed_edit(self.scene, path, value, v.drawn.playback.time)
         try:
@@ -151,7 +152,7 @@ class Editor:
         except SceneError as e:
             v.error = str(e)
         else:
-            self.doc.commit(scene, f"set {path_text(path)}", interaction)
+            self.doc.commit(scene, label or f"set {path_text(path)}", interaction)
             v.error = ""
             v.sync()
         ok = not v.error
