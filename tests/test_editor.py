@@ -184,8 +184,9 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
 def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     """Press on a fork nobody selected and drag: it is selected at the press and follows the
     pointer in the plane facing the camera, as the gizmo's centre moves it, in one undo step,
-    and the camera stays; a press that slips less than a click's 4 px only selects it, and
-    on the selected handle (the gizmo's centre) moves nothing.
+    and the camera stays; a press that slips a click's 4 px only selects it, and on the
+    selected handle (the gizmo's centre) moves nothing; a flick let go before a turn saw its
+    press lands too.
     Negative control: the same drag pressed 30 px beside the fork, off every handle, moves
     nothing and selects nothing."""
     from krsview.editor.picking import under
@@ -228,6 +229,20 @@ def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     drag(e, screen_of(e, old), (4, 0), steps=4)
     assert np.array_equal(e.scene.route.levels[LEVEL].fork, old)
     assert e.doc.history.index == steps and e.doc.history.can_redo
+    # a flick: pressed, dragged and let go before a turn saw the press still lands
+    e.select(None)
+    pump(e, 2)
+    x, y = screen_of(e, old)
+    xdo("mousemove", round(x), round(y))
+    pump(e, 2)
+    xdo("mousedown", 1)
+    xdo("mousemove", round(x + 20), round(y))
+    xdo("mousemove", round(x + 40), round(y))
+    xdo("mouseup", 1)
+    pump(e, 3)
+    assert e.selected is not None and e.selected.path == path
+    assert_moved_right(e, old, e.scene.route.levels[LEVEL].fork, 40)
+    assert e.doc.history.index == steps + 1 and not e.doc.history.can_redo
 
 
 def test_overlay_is_composited_by_traced_depth(editor):

@@ -5,7 +5,8 @@ dragging, with no click to select it first. It moves once the pointer has left t
 more than a click's slip (press.py: a click that selects it does not nudge it), then follows
 the pointer as long as the button is held; one press-and-drag is one undo step. Its values
 land as the gizmo's do: on a decimal step under QUANTUM_PIXELS on screen, or on the grid when
-snapping. A press on a dial handle's point selects it and turns its dial (dial.py)."""
+snapping. A press on a dial handle's point selects it and turns its dial (dial.py). A flick,
+pressed, dragged and let go before a turn saw the press, lands where it was let go."""
 
 from __future__ import annotations
 
@@ -71,8 +72,20 @@ class Grabbing:
         if not held or sel is None or not sel.same(g.handle):
             self.now = None
             return
-        if not past_click():  # a press that selects a handle does not nudge it by a slip
-            return
+        if past_click():  # a press that selects a handle does not nudge it by a slip
+            self._to(e, g, sel, cursor)
+
+    def fling(self, e: Dragged, release: tuple[float, float]) -> None:
+        """A grab whose press, drag and release all came before a turn could see the press
+        (a quick flick on a slow frame; Input.flick): the handle where it was let go, at once,
+        in one undo step."""
+        g, self.now = self.now, None
+        if g is not None and e.selected is not None and e.selected.same(g.handle):
+            self._to(e, g, e.selected, release)
+
+    @staticmethod
+    def _to(e: Dragged, g: Grab, sel: Handle, cursor: tuple[float, float]) -> None:
+        """Handle ``sel`` of grab ``g`` where the pointer at ``cursor`` puts it: edits."""
         v = e.window_view()
         depth = float((g.start - v.origin) @ v.forward)
         quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)

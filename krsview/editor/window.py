@@ -189,7 +189,7 @@ class Editor:
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
-        click = v.input.take_click()
+        click, flick = v.input.take_click(), v.input.take_flick()
         v.move(dt)
         self.execute(v.file.watcher.poll())
         self._follow()
@@ -204,6 +204,9 @@ class Editor:
             if not self._claimed():
                 if pressed and self._grab(v.input.press):
                     v.input.let_go("left")  # the handle's press: no orbit, no click
+                    self._again = True
+                elif flick is not None and self._grab(flick[0]):
+                    self.grabbing.fling(self, flick[1])
                     self._again = True
                 elif click is not None:
                     self.pick(*click)

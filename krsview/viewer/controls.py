@@ -69,6 +69,8 @@ class Input:
     # the motion since such a press waits for it, so the camera never moves by a gizmo's.
     judged_by_frame: bool = False
     unjudged: tuple[float, float] | None = None  # that motion, until the frame
+    # such a press dragged past a click and let go before any frame saw it: (press, release)
+    flick: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     def key(self, name: str, down: bool) -> None:
         """A key named as in MOVES and the keymap went down or up (others are ignored)."""
@@ -96,9 +98,11 @@ class Input:
                 self.unjudged = (0.0, 0.0)
         elif self.press is not None:
             moved = math.dist(self.cursor, self.press)
-            self.press = None
             if moved <= CLICK_PIXELS:
                 self.click = self.cursor
+            elif self.unjudged is not None:
+                self.flick = (self.press, self.cursor)
+            self.press = None
 
     def let_go(self, name: str) -> None:
         """The press of button ``name`` was not the view's after all (a frame that saw the
@@ -150,3 +154,7 @@ class Input:
     def take_click(self) -> tuple[float, float] | None:
         c, self.click = self.click, None
         return c
+
+    def take_flick(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        f, self.flick = self.flick, None
+        return f
