@@ -49,10 +49,8 @@ class Dial:
         x, y = io.mouse_pos.x, io.mouse_pos.y
         basis = plane_basis(h.axis)
         ring = self._ring(h, v, basis)
-        px, py, z = project(v, h.position)  # the dial point, drawn on its guide circle
-        on_point = z > 0 and math.hypot(px - x, py - y) <= GRAB_PIXELS
         self.hovered = not io.want_capture_mouse and (
-            distance_to(ring, x, y) <= GRAB_PIXELS or on_point
+            distance_to(ring, x, y) <= GRAB_PIXELS or on_point(h, v, x, y)
         )
         draw = imgui.get_background_draw_list()
         pts = [imgui.ImVec2(px, py) for px, py in ring]
@@ -87,8 +85,7 @@ class Dial:
         if angle is None:
             return False
         self.active, self._last, self._turned = True, angle, 0.0
-        px, py, z = project(v, h.position)
-        self._slack = z > 0 and math.hypot(px - x, py - y) <= GRAB_PIXELS
+        self._slack = on_point(h, v, x, y)
         self._start = np.array(h.position, dtype=np.float64)
         self.drags += 1
         return True
@@ -105,6 +102,12 @@ class Dial:
             if z > 0:
                 out.append((px, py))
         return out
+
+
+def on_point(h, v: View, x: float, y: float) -> bool:
+    """Window point (x, y) lies on the dial point of ``h`` (drawn on its guide circle)."""
+    px, py, z = project(v, h.position)
+    return z > 0 and math.hypot(px - x, py - y) <= GRAB_PIXELS
 
 
 def plane_basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

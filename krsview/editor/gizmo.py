@@ -85,16 +85,23 @@ class Gizmo:
         using = self._track()
         if self.drags != drags:  # pressed now: on the handle's point, or on an arrow beside it
             x, y, _ = project(v, h.position)
-            at, since = imgui.get_io().mouse_pos, imgui.get_mouse_drag_delta(0, 0.0)
+            left = imgui.MouseButton_.left.value
+            at, since = imgui.get_io().mouse_pos, imgui.get_mouse_drag_delta(left, 0.0)
             self._on_handle = math.hypot(at.x - since.x - x, at.y - since.y - y) <= PICK_PIXELS
         if not (changed and using):
             return None
         if self._on_handle and not past_click():
             return None  # a click on the handle that slips does not nudge it (as grab.py)
         delta = np.array(m.values[12:15], dtype=np.float64) - before
+        return self.placed(h.position, delta, v), ("gizmo", self.drags)
+
+    def placed(self, p: np.ndarray, delta: np.ndarray, v: View) -> np.ndarray:
+        """``p`` moved by a drag's ``delta``: on a decimal step under QUANTUM_PIXELS on screen
+        at p's distance, or on the grid when snapping (the snap's switch, or Shift held)."""
+        depth = max(float(np.linalg.norm(p - v.origin)), 1e-12)
         quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)
-        grid = self.snap.grid if self.snap.on or io.key_shift else None
-        return moved(h.position, delta, quantum, grid), ("gizmo", self.drags)
+        grid = self.snap.grid if self.snap.on or imgui.get_io().key_shift else None
+        return moved(p, delta, quantum, grid)
 
     def _track(self) -> bool:
         """Right after ``gizmo.manipulate``: note whether the pointer is on the gizmo now and

@@ -4,20 +4,19 @@ does not claim selects it and drags it at once, in the plane through it that fac
 dragging, with no click to select it first. It moves once the pointer has left the press by
 more than a click's slip (press.py: a click that selects it does not nudge it), then follows
 the pointer as long as the button is held; one press-and-drag is one undo step. Its values
-land as the gizmo's do: on a decimal step under QUANTUM_PIXELS on screen, or on the grid when
-snapping. A press on a dial handle's point selects it and turns its dial (dial.py). A flick,
-pressed, dragged and let go before a turn saw the press, lands where it was let go."""
+land as the gizmo's do (Gizmo.placed): on a decimal step under a twentieth of a pixel, or on
+the grid when snapping. A press on a dial handle's point selects it and turns its dial
+(dial.py). A flick, pressed, dragged and let go before a turn saw the press, lands where it
+was let go."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
-from imgui_bundle import imgui
 
 from ..compile.camera import View, pixel_ray
 from .dragging import Dragged, drag_edits
-from .gizmo import QUANTUM_PIXELS, decimal_step, moved
 from .handles import Handle
 from .picking import under
 from .press import past_click
@@ -87,11 +86,7 @@ class Grabbing:
     def _to(e: Dragged, g: Grab, sel: Handle, cursor: tuple[float, float]) -> None:
         """Handle ``sel`` of grab ``g`` where the pointer at ``cursor`` puts it: edits."""
         v = e.window_view()
-        depth = float((g.start - v.origin) @ v.forward)
-        quantum = decimal_step(QUANTUM_PIXELS * v.footprint * depth)
-        snap = e.gizmo.snap
-        grid = snap.grid if snap.on or imgui.get_io().key_shift else None
-        p = moved(g.start, g.target(v, cursor) - g.start, quantum, grid)
+        p = e.gizmo.placed(g.start, g.target(v, cursor) - g.start, v)
         t = e.viewer.drawn.playback.time
         for path, value in drag_edits(e.scene, sel, p, e.carry, t):
             e.edit(path, value, ("grab", g.drag), f"drag {sel.label}")

@@ -86,9 +86,9 @@ def image_uniforms(
     window: tuple[int, int],
     image: tuple[int, int],
 ) -> None:
-    """The sizes a pass that samples a traced image over a window reads (display.frag,
-    overlay.frag): the window's, the image's, and the texture's that holds it (texture_side:
-    no larger than the image by more than a texel a side, rows top → bottom)."""
+    """The sizes a pass that draws a traced image over a window reads (window_image.glsl,
+    in display.frag and overlay.frag): the window's, the image's, and the texture's that holds
+    it (texture_side: no larger than the image by more than a texel a side)."""
     prog["u_window"].value = (float(window[0]), float(window[1]))
     prog["u_image"].value = (float(image[0]), float(image[1]))
     prog["u_texture"].value = tuple(map(float, source.color_attachments[0].size))

@@ -6,9 +6,7 @@
 // every branch's texture reads and maths for every window pixel (docs/speed.md).
 
 uniform sampler2D u_color;       // rgb, hit
-uniform vec2 u_window;           // size of the target in pixels
-uniform vec2 u_image;            // size of the image in pixels
-uniform vec2 u_texture;          // and of its textures (context.texture_side)
+#include "window_image.glsl"
 
 out vec4 frag_color;
 
@@ -28,10 +26,7 @@ vec3 heat(float x) {
 #endif
 
 void main() {
-    // the image: rows top → bottom (scene_block.glsl, pixel_ray); the window: bottom → top;
-    // the image's part of its textures (they may be a texel larger), its edge texels clamped
-    vec2 at = vec2(gl_FragCoord.x, u_window.y - gl_FragCoord.y) / u_window * u_image;
-    vec2 uv = clamp(at, vec2(0.5), u_image - 0.5) / u_texture;
+    vec2 uv = window_image_uv();
     vec4 c = texture(u_color, uv);
     vec3 rgb = c.rgb;
 #ifdef KRS_VIEW

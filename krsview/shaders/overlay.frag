@@ -3,9 +3,7 @@
 // (so a handle behind a branch can still be found), else at full strength.
 uniform sampler2D u_color;       // traced rgb, hit
 uniform sampler2D u_normal;      // traced xyz, depth t along the unit ray
-uniform vec2 u_window;
-uniform vec2 u_image;            // size of the traced image in pixels
-uniform vec2 u_texture;          // and of its textures (context.texture_side)
+#include "window_image.glsl"
 uniform float u_hidden_alpha;
 uniform bool u_points;
 
@@ -16,10 +14,7 @@ out vec4 frag_color;
 void main() {
     if (u_points && length(gl_PointCoord - 0.5) > 0.5)
         discard;                                   // round handles
-    // the image: rows top → bottom (scene_block.glsl, pixel_ray); the window: bottom → top;
-    // the image's part of its textures (they may be a texel larger)
-    vec2 at = vec2(gl_FragCoord.x, u_window.y - gl_FragCoord.y) / u_window * u_image;
-    vec2 uv = clamp(at, vec2(0.5), u_image - 0.5) / u_texture;
+    vec2 uv = window_image_uv();
     bool hit = texture(u_color, uv).a > 0.5;
     float t_surface = texture(u_normal, uv).w;
     bool hidden = hit && t_surface < length(v_relative) * (1.0 - 1e-4);

@@ -8,8 +8,9 @@
 // What the last KRS walk found nearest (krs.glsl sets both): the slot of the least of the
 // kernels it tested (−1: not known), and the slot of the level-of-detail ball where that ball
 // was nearer still (−1: none). A hit hands them to the shading, whose walk then tests no
-// kernel above the ball (krs_nearest). The Ray packs both into one int (std430 has no room
-// for two): each slot + 1, the ball's in the bits from 16 on.
+// kernel above the ball (krs_nearest). The Ray packs both into one int, so that they fill a
+// padding word of its std430 layout and the ray buffer keeps its size: each slot + 1, the
+// ball's in the bits from 16 on.
 int g_slot = -1, g_cut = -1;
 
 int packed_slots() { return (g_slot + 1) | ((g_cut + 1) << 16); }
