@@ -694,10 +694,76 @@ def test_the_gizmo_axes_point_the_way_the_world_axes_do(editor, monkeypatch):
     assert arrows()["y"] < 0, "negative control: the flipped Y arrow points down"
 
 
+def x_arrow(e, h) -> tuple[tuple[float, float], np.ndarray]:
+    """The selected handle ``h``'s gizmo, as drawn: a screen point on its red X arrow (4/5
+    of the way out) and the arrow's unit direction on screen."""
+    from krsview.compile.camera import project
+
+    shot = e.viewer.read_window().astype(int)
+    x, y, _ = project(e.window_view(), h.position)
+    rows, cols = np.mgrid[0 : shot.shape[0], 0 : shot.shape[1]]
+    red = (np.hypot(cols - x, rows - y) < 120) & (shot[..., 0] > 150) & (shot[..., 1:].max(-1) < 60)
+    far = np.argmax(np.hypot(cols[red] - x, rows[red] - y))
+    step = np.array([cols[red][far] - x, rows[red][far] - y])
+    grab = window_xy(e, x + 0.8 * step[0], y + 0.8 * step[1])
+    return grab, step / np.linalg.norm(step)
+
+
+def flick(start, offset) -> None:
+    """Press at ``start``, move by ``offset`` in two moves and let go, all before the
+    editor's next turn (a quick drag on a slow frame)."""
+    x, y = start
+    xdo("mousemove", round(x), round(y))
+    xdo("mousedown", 1)
+    xdo("mousemove", round(x + offset[0] / 2), round(y + offset[1] / 2))
+    xdo("mousemove", round(x + offset[0]), round(y + offset[1]))
+    xdo("mouseup", 1)
+
+
+def test_a_flick_on_the_gizmo_lands_where_a_slow_drag_does(editor):
+    """The fork's X arrow pressed, dragged 40 px and let go before the editor's next turn
+    (one event poll): the fork lands where the same drag made slowly, a turn per move, puts
+    it (within 5 % of the way), in one undo step. ImGui used to read the last motion and the
+    release in one frame, and ImGuizmo ended the drag before moving it
+    (platform.Platform.hand). Negative control: the same flick pressed 30 px beside the
+    arrow, off the gizmo, moves nothing."""
+    e = editor
+    e.execute([Bake()])
+    h = handle(e, ("route", "levels", LEVEL, "fork"))
+    e.select(h)
+    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
+    pump(e, 3)
+    old = e.scene.route.levels[LEVEL].fork
+    grab, step = x_arrow(e, h)
+    drag(e, grab, tuple(40 * step))
+    slow = e.scene.route.levels[LEVEL].fork
+    assert slow[0] != old[0] and slow[1:] == old[1:]
+    e.viewer.undo()
+    pump(e, 3)
+    assert e.scene.route.levels[LEVEL].fork == old
+    steps = e.doc.history.index
+    xdo("mousemove", *map(round, grab))
+    pump(e, 3)
+    flick(grab, tuple(40 * step))
+    pump(e, 4)
+    fast = e.scene.route.levels[LEVEL].fork
+    assert fast[1:] == old[1:] and abs(fast[0] - slow[0]) < 0.05 * abs(slow[0] - old[0]), (
+        old,
+        slow,
+        fast,
+    )  # ImGuizmo scales its steps by the handle's depth as it moves: a path of 2 or 8 moves
+    assert e.doc.history.index == steps + 1 and not e.doc.history.can_redo
+    e.viewer.undo()
+    pump(e, 3)
+    beside = (grab[0] - 30 * step[1], grab[1] + 30 * step[0])  # the view's: it orbits
+    flick(beside, tuple(40 * step))
+    pump(e, 4)
+    assert e.scene.route.levels[LEVEL].fork == old and e.doc.history.index == steps
+
+
 def test_a_shift_drag_lands_on_the_absolute_grid_and_saves_no_float32_noise(editor):
     """Drag the fork's X arrow with Shift held: x lands on the 0.05 grid (not start + k ×
     0.05), y and z keep their float64 values bit for bit, and so does the saved file."""
-    from krsview.compile.camera import project
 
     e = editor
     e.execute([Bake()])
@@ -707,16 +773,10 @@ def test_a_shift_drag_lands_on_the_absolute_grid_and_saves_no_float32_noise(edit
     pump(e, 3)
     old = e.scene.route.levels[LEVEL].fork
     assert abs(old[0] / 0.05 - round(old[0] / 0.05)) > 0.01, "the start is off the grid"
-    shot = e.viewer.read_window().astype(int)
     v = e.window_view()
-    x, y, _ = project(v, h.position)
-    rows, cols = np.mgrid[0 : shot.shape[0], 0 : shot.shape[1]]
-    red = (np.hypot(cols - x, rows - y) < 120) & (shot[..., 0] > 150) & (shot[..., 1:].max(-1) < 60)
-    far = np.argmax(np.hypot(cols[red] - x, rows[red] - y))
-    grab = (x + 0.8 * (cols[red][far] - x), y + 0.8 * (rows[red][far] - y))
-    step = np.array([cols[red][far] - x, rows[red][far] - y])
+    grab, step = x_arrow(e, h)
     xdo("keydown", "shift")
-    drag(e, window_xy(e, *grab), tuple(40 * step / np.linalg.norm(step)))
+    drag(e, grab, tuple(40 * step))
     xdo("keyup", "shift")
     new = e.scene.route.levels[LEVEL].fork
     assert (

@@ -341,9 +341,10 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
     """A rotation step's dial point (on its guide circle, away from the ring) turns the dial
     when pressed and dragged round the axis, selected or not: the angle follows the pointer,
     in one undo step each time, and lands on hundredths of a degree; a click on the point that
-    slips 3 px selects the dial, or lands on the selected one, without turning it. Negative
-    control: the same drag pressed beside the point, off the point and the ring, turns
-    nothing."""
+    slips 3 px selects the dial, or lands on the selected one, without turning it; a flick,
+    pressed, dragged and let go before the editor's next turn, turns it as far as the same
+    drag made slowly (platform.Platform.hand). Negative control: the same drag or flick
+    pressed beside the point, off the point and the ring, turns nothing."""
     from krsview.editor.dial import GRAB_PIXELS, distance_to, plane_basis
     from krsview.editor.mokrs_handles import DIAL_DECIMALS
     from krsview.editor.window import Editor
@@ -357,11 +358,13 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
         settle(e)
         degrees = (*LEVELS, 58, "transform", 1, "degrees")
 
-        def turned(beside=0.0, arc=0.3, steps=6):
+        def turned(beside=0.0, arc=0.3, steps=6, quick=False):
             """Press on the dial point (or ``beside`` it, pixels to the right) and drag it
-            ``arc`` radians round the axis: the angle before, after each move, the steps."""
+            ``arc`` radians round the axis: the angle before, after each move, the steps.
+            ``quick``: pressed, moved and let go before the editor's next turn (a flick on a
+            slow frame); the angle after it alone."""
             h = next(h for h in e.handles if h.path == degrees)
-            before, steps0 = get_at(e.scene, degrees), len(e.doc.history.steps)
+            before, steps0 = get_at(e.scene, degrees), e.doc.history.index
             arm = h.position - h.pivot
             y, z = arm / np.linalg.norm(arm), np.cross(h.axis, arm / np.linalg.norm(arm))
             angles = []
@@ -370,6 +373,10 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
                 q = h.pivot + np.linalg.norm(arm) * (np.cos(t) * y + np.sin(t) * z)
                 x, yy = screen_of(e, q)
                 xdo("mousemove", round(x + beside), round(yy))
+                if quick:
+                    if k == 0:
+                        xdo("mousedown", 1)
+                    continue
                 pump(e, 2 if k == 0 else 1)
                 if k == 0:
                     xdo("mousedown", 1)
@@ -377,8 +384,10 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
                 else:
                     angles.append(get_at(e.scene, degrees))
             xdo("mouseup", 1)
-            pump(e, 2)
-            return before, angles, len(e.doc.history.steps) - steps0
+            pump(e, 4 if quick else 2)
+            if quick:
+                angles = [get_at(e.scene, degrees)]
+            return before, angles, e.doc.history.index - steps0
 
         def turns(before, angles, steps):
             moved = np.abs(np.diff([before, *angles]))
@@ -409,7 +418,19 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
         before, steps0 = get_at(e.scene, degrees), len(e.doc.history.steps)
         drag(e, screen_of(e, e.selected.position), (3, 0), steps=3)  # a click's slip on it
         assert get_at(e.scene, degrees) == before and len(e.doc.history.steps) == steps0
-        turns(*turned())  # selected: its point turns it as its ring does
+        before, slow, _ = turned()  # selected: its point turns it as its ring does
+        turns(before, slow, 1)
+        e.viewer.undo()
+        pump(e, 2)
+        for selected in (True, False):  # a flick turns it as far, selected or not
+            e.select(e.selected if selected else None)
+            pump(e, 2)
+            b, fast, steps = turned(quick=True)
+            assert b == before and steps == 1 and e.selected.path == degrees, (b, fast, steps)
+            assert abs(fast[0] - slow[-1]) < 0.05 * abs(slow[-1] - before), (slow, fast)
+            e.viewer.undo()
+        b, fast, steps = turned(beside=3 * GRAB_PIXELS, quick=True)  # off the point: nothing
+        assert fast == [before] and steps == 0, fast
     finally:
         e.close()
 

@@ -5,12 +5,20 @@ input (keys, buttons, cursor, wheel) unless ImGui or a gizmo wants them.
 A press or a wheel turn is ImGui's when ImGui's windows, as the last frame drew them, lie
 under the pointer where the event happened (``imgui_under``). ImGui's own
 ``want_capture_mouse`` answers for the pointer where its last frame saw it, so a pointer
-moved and pressed before the next frame (a touchpad's tap) went to the wrong side."""
+moved and pressed before the next frame (a touchpad's tap) went to the wrong side.
+
+A release reaches ImGui only once a frame has read every event before it (``Platform.hand``):
+a quick drag, pressed, moved and let go between two frames, is then seen by one frame with
+the pointer where it was let go and the button still down, and by the next as let go.
+ImGui's own trickling reads the last motion and the release in one frame, and ImGuizmo (or
+the dial, or a slider) ends a drag there before it moves it: a flick on a slow frame was
+lost."""
 
 from __future__ import annotations
 
 import ctypes
 import string
+from collections.abc import Callable
 
 import glfw  # noqa: E402  (order matters)
 from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
@@ -43,6 +51,8 @@ class Platform:
         imgui.backends.glfw_init_for_opengl(self.addr, False)
         imgui.backends.opengl3_init("#version 430")
         self.drawn = False  # this turn drew an ImGui frame: its windows are on screen
+        # ImGui's events from a held-back release on, (event, is a release), in their order
+        self.later: list[tuple[Callable[[], None], bool]] = []
         self._gl_flush = GL_VOID(glfw.get_proc_address("glFlush"))
 
     def begin_turn(self) -> None:
@@ -58,16 +68,32 @@ class Platform:
         imgui.destroy_context()
         glfw.destroy_window(self.window)
 
+    def hand(self, event: Callable[[], None], release: bool = False) -> None:
+        """Give ImGui an event (a call of its GLFW backend), in order: a release waits while
+        ImGui holds events that no frame has read yet, and so does every event after a
+        waiting one (module docstring)."""
+        if self.later or (release and unread()):
+            self.later.append((event, release))
+        else:
+            event()
+
+    def hand_on(self) -> None:
+        """After a frame has read ImGui's events: the waiting ones, up to the next release
+        that must wait in turn."""
+        while self.later and not (self.later[0][1] and unread()):
+            self.later.pop(0)[0]()
+
     def route_events(self, to: Input) -> None:
-        """GLFW events go to ImGui first, then to ``to`` unless ImGui or a gizmo takes them."""
-        b, a, window = imgui.backends, self.addr, self.window
+        """GLFW events go to ImGui first (``hand``), then to ``to`` unless ImGui or a gizmo
+        takes them."""
+        b, a, window, hand = imgui.backends, self.addr, self.window, self.hand
         taken: set[int] = set()  # the buttons whose press was not the view's, until released
 
         def ui() -> bool:
             return self.drawn and imgui_under(to, taken)
 
         def on_key(_w, key, scancode, action, mods):
-            b.glfw_key_callback(a, key, scancode, action, mods)
+            hand(lambda: b.glfw_key_callback(a, key, scancode, action, mods))
             if imgui.get_io().want_capture_keyboard:
                 return  # typing in a field
             if key not in GLFW_KEYS:
@@ -79,7 +105,8 @@ class Platform:
                 to.key(GLFW_KEYS[key], action == glfw.PRESS)
 
         def on_button(_w, button, action, mods):
-            b.glfw_mouse_button_callback(a, button, action, mods)
+            release = action == glfw.RELEASE
+            hand(lambda: b.glfw_mouse_button_callback(a, button, action, mods), release)
             if action == glfw.PRESS and (ui() or to.claimed):
                 taken.add(button)
                 return  # the HUD's or a gizmo's press, not the camera's
@@ -92,16 +119,16 @@ class Platform:
                     glfw.set_input_mode(window, glfw.CURSOR, mode)
 
         def on_cursor(_w, x, y):
-            b.glfw_cursor_pos_callback(a, x, y)
+            hand(lambda: b.glfw_cursor_pos_callback(a, x, y))
             to.move_cursor(x, y)
 
         def on_scroll(_w, dx, dy):
-            b.glfw_scroll_callback(a, dx, dy)
+            hand(lambda: b.glfw_scroll_callback(a, dx, dy))
             if not ui():
                 to.wheel(dy)
 
         def on_char(_w, c):
-            b.glfw_char_callback(a, c)
+            hand(lambda: b.glfw_char_callback(a, c))
 
         self._callbacks = (on_key, on_button, on_cursor, on_scroll, on_char)  # keep alive
         glfw.set_key_callback(window, on_key)
@@ -119,11 +146,17 @@ class Platform:
         imgui.backends.opengl3_new_frame()
         imgui.backends.glfw_new_frame()
         imgui.new_frame()
+        self.hand_on()
 
     def render(self) -> None:
         self.drawn = True
         imgui.render()
         imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+
+def unread() -> bool:
+    """ImGui holds input events that no frame has read yet."""
+    return imgui.get_current_context().input_events_queue.size() > 0
 
 
 def opaque_popups() -> None:
