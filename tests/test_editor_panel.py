@@ -190,6 +190,49 @@ def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
         v.close()
 
 
+def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_path, monkeypatch):
+    """A click on the HUD's tracer combo opens its list; Esc closes it, the tracer as it was
+    (ImGui's keyboard navigation, which would close it, is off). Negative control: the list
+    is open before the key, and another key (J, which the viewer ignores)
+    leaves it open."""
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.viewer.window import Viewer
+
+    open_from_start(monkeypatch, "accuracy and view")
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=(640, 720))
+
+    def turn(n: int = 3) -> None:
+        for _ in range(n):
+            glfw.poll_events()
+            v.step(0.02)
+
+    def is_open() -> bool:
+        return imgui.is_popup_open("", imgui.PopupFlags_.any_popup)
+
+    try:
+        turn(4)
+        x0, y0, x1, y1 = v.interactions.rects[("render", "tracer")]
+        wx, wy = glfw.get_window_pos(v.window)
+        xdo("mousemove", round(wx + (x0 + x1) / 2), round(wy + (y0 + y1) / 2))
+        turn(2)
+        xdo("click", 1)
+        turn(3)
+        assert is_open(), "the click opened no list"
+        xdo("key", "j")
+        turn(3)
+        assert is_open(), "negative control: another key closed it"
+        xdo("key", "Escape")
+        turn(3)
+        assert not is_open(), "Esc left the list open"
+        assert v.scene.render.tracer == "sphere"
+    finally:
+        v.close()
+
+
 @pytest.mark.parametrize("side", ["left", "right"])
 def test_the_panel_starts_below_the_hud_where_they_would_overlap(side):
     """The viewer's HUD bar sits at the top left, HUD_RIGHT wide: a panel docked left, or

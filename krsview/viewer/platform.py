@@ -147,11 +147,21 @@ class Platform:
         imgui.backends.glfw_new_frame()
         imgui.new_frame()
         self.hand_on()
+        close_on_escape()
 
     def render(self) -> None:
         self.drawn = True
         imgui.render()
         imgui.backends.opengl3_render_draw_data(imgui.get_draw_data())
+
+
+def close_on_escape() -> None:
+    """Inside a frame: Esc closes an open drop-down list or menu, as in any application.
+    ImGui's keyboard navigation would, but it is off: it would take the flight keys."""
+    if imgui.is_key_pressed(imgui.Key.escape, False) and imgui.is_popup_open(
+        "", imgui.PopupFlags_.any_popup
+    ):
+        imgui.internal.close_popup_to_level(0, True)
 
 
 def unread() -> bool:
