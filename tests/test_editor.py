@@ -245,6 +245,57 @@ def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     assert e.doc.history.index == steps + 1 and not e.doc.history.can_redo
 
 
+def test_a_hover_label_reaching_under_the_panel_is_hidden_there(editor, monkeypatch):
+    """A fork's hover label is drawn with the view, under ImGui's windows: with the camera
+    flown so that the panel's edge crosses the label, the label's part under the panel
+    (which lets some of the view through) changes the panel's pixels by under 0.3 of what
+    its part in the view changes there, measured against the same frame drawn without any
+    label (16 against 66 levels on average; written over the panel, as it was, 121). A
+    handle grabbed beside the panel wrote its name over the panel's text."""
+    from imgui_bundle import imgui
+
+    import krsview.editor.window as window
+    from krsview.compile.camera import project
+
+    e = editor
+    settle(e)
+    e.execute([Bake()])
+    e.select(None)
+
+    h = handle(e, ("route", "levels", LEVEL, "fork"))
+    size = imgui.calc_text_size(h.label)
+    edge = imgui.internal.find_window_by_name("edit").pos.x
+    cam = e.viewer.camera
+
+    def at() -> tuple[float, float]:
+        px, py, _ = project(e.window_view(), np.asarray(h.position))
+        return px, py
+
+    for _ in range(4):  # the camera flown sideways: the panel's edge across the label
+        px, _ = at()
+        cam.fly(np.array([1.0, 0.0, 0.0]), 0.01)
+        slope = (at()[0] - px) / 0.01
+        cam.fly(np.array([1.0, 0.0, 0.0]), (edge - size.x / 2 - 10 - at()[0]) / slope)
+    e.viewer.frames.dirty = True
+    settle(e)
+    px, py = at()
+    edge = round(edge)
+    x0, x1 = round(px + 10), round(px + 10 + size.x)
+    assert x0 + 8 < edge < x1 - 8, (x0, edge, x1)
+    xdo("mousemove", *map(round, window_xy(e, px, py)))
+    pump(e, 3)
+    rows = slice(round(py - 20), round(py - 20 + size.y))
+    labelled = e.viewer.read_window()[rows].astype(int)
+    with monkeypatch.context() as m:
+        m.setattr(window, "hover_label", lambda shown, view: None)
+        pump(e, 1)
+        bare = e.viewer.read_window()[rows].astype(int)
+    change = np.abs(labelled - bare).max(axis=(0, 2))
+    in_view, under_panel = change[x0 : edge - 2].mean(), change[edge + 2 : x1].mean()
+    assert in_view > 40, "control: no label in the view"
+    assert under_panel < 0.3 * in_view, (under_panel, in_view)
+
+
 def test_overlay_is_composited_by_traced_depth(editor):
     """Overlay fragments behind the traced surface are hidden (drawn at HIDDEN_ALPHA, here
     set to 0 to see them vanish, then to 1 as the negative control)."""

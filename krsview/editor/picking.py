@@ -99,12 +99,13 @@ def _entry_of_slot(e: Picked, slot: int) -> int:
 
 def hover_label(shown: list[Handle], view: View) -> None:
     """Inside the ImGui frame: the name of the shown handle under the pointer, beside it
-    (none while the pointer is over a panel)."""
+    (none while the pointer is over a panel). Drawn with the view, under ImGui's windows: a
+    handle dragged beside a panel does not write its name over the panel."""
     io = imgui.get_io()
     if io.want_capture_mouse:
         return
     h = under(shown, view, io.mouse_pos.x, io.mouse_pos.y)
     if h is not None:
         x, y, _ = project(view, h.position)
-        draw = imgui.get_foreground_draw_list()
+        draw = imgui.get_background_draw_list()
         draw.add_text(imgui.ImVec2(x + 10, y - 20), LABEL, h.label)
