@@ -760,6 +760,17 @@ def x_arrow(e, h) -> tuple[tuple[float, float], np.ndarray]:
     return grab, step / np.linalg.norm(step)
 
 
+def selected_fork(e):
+    """The tree baked, fork LEVEL selected (its gizmo shown) and the pointer parked in a
+    corner: its handle and position."""
+    e.execute([Bake()])
+    h = handle(e, ("route", "levels", LEVEL, "fork"))
+    e.select(h)
+    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
+    pump(e, 3)
+    return h, e.scene.route.levels[LEVEL].fork
+
+
 def flick(start, offset) -> None:
     """Press at ``start``, move by ``offset`` in two moves and let go, all before the
     editor's next turn (a quick drag on a slow frame)."""
@@ -779,12 +790,7 @@ def test_a_flick_on_the_gizmo_lands_where_a_slow_drag_does(editor):
     (platform.Platform.hand). Negative control: the same flick pressed 30 px beside the
     arrow, off the gizmo, moves nothing."""
     e = editor
-    e.execute([Bake()])
-    h = handle(e, ("route", "levels", LEVEL, "fork"))
-    e.select(h)
-    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
-    pump(e, 3)
-    old = e.scene.route.levels[LEVEL].fork
+    h, old = selected_fork(e)
     grab, step = x_arrow(e, h)
     drag(e, grab, tuple(40 * step))
     slow = e.scene.route.levels[LEVEL].fork
@@ -815,14 +821,8 @@ def test_a_flick_on_the_gizmo_lands_where_a_slow_drag_does(editor):
 def test_a_shift_drag_lands_on_the_absolute_grid_and_saves_no_float32_noise(editor):
     """Drag the fork's X arrow with Shift held: x lands on the 0.05 grid (not start + k ×
     0.05), y and z keep their float64 values bit for bit, and so does the saved file."""
-
     e = editor
-    e.execute([Bake()])
-    h = handle(e, ("route", "levels", LEVEL, "fork"))
-    e.select(h)
-    xdo("mousemove", *map(round, window_xy(e, 5, SIZE[1] - 5)))
-    pump(e, 3)
-    old = e.scene.route.levels[LEVEL].fork
+    h, old = selected_fork(e)
     assert abs(old[0] / 0.05 - round(old[0] / 0.05)) > 0.01, "the start is off the grid"
     v = e.window_view()
     grab, step = x_arrow(e, h)
