@@ -225,6 +225,29 @@ def test_a_refusal_is_shown_under_the_step_or_kernel_it_names():
     assert refusal_place("render.tracer = 'sphere': this scene is a MöKRS", 3, 3) == ""
 
 
+def test_a_linked_step_value_refused_is_named_at_the_level_edited():
+    """A step's factor typed at palm's level 58 with its 29 linked finer levels: a value the
+    level refuses is set there alone, so the refusal names level 58 and lands under its
+    step; it used to be the whole level list, refused at level 0 and shown beside another
+    step. Negative control: a valid value still goes to every linked level."""
+    from krsview.editor.keys import linked_edits
+
+    palm = load_scene(resolve("palm"))
+    path = (*LEVELS, 58, "transform", 0, "factor")
+    steps = len(palm.mokrs.levels[58].transform)
+    edits = linked_edits(palm, path, -1.0, 0.0)
+    assert edits == [(path, -1.0)]
+    with pytest.raises(SceneError) as refused:
+        apply_edit(palm, *edits[0])
+    assert str(refused.value).startswith("mokrs.levels[58].transform[0].factor = -1")
+    assert refusal_place(str(refused.value), 58, steps) == "step 0"
+    [(whole, levels)] = linked_edits(palm, path, 0.9, 0.0)
+    assert whole == LEVELS
+    s = apply_edit(palm, whole, levels)
+    factors = [lv.transform[0].factor for lv in s.mokrs.levels if lv.transform]
+    assert factors.count(0.9) == 30, factors
+
+
 def test_structural_edits_are_validated_and_one_undo_step_each(tmp_path):
     path = tmp_path / "shell.toml"
     shutil.copy(resolve("shell"), path)

@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 from imgui_bundle import imgui
 
-from ..scene import Scene
+from ..scene import Scene, SceneError
 from ..scene.animation import Animation, Key, Track, bone_offset
-from ..scene.edits import Path, get_at, parse_path, path_text, replace_at
+from ..scene.edits import Path, apply_edit, get_at, parse_path, path_text, replace_at
 from ..scene.mokrs import linked_edit, linked_levels
 from ..viewer import commands as vc
 from ..viewer.playback import Playback
@@ -105,8 +105,14 @@ def carried_tracks(scene: Scene, path: Path, delta: np.ndarray) -> Animation | N
 def linked_edits(scene: Scene, path: Path, value: Any, t: float) -> list[tuple[Path, Any]]:
     """A MöKRS step's field (``path``) set in its level and the linked finer levels
     (``linked_levels``: palm's leaflets bend alike): keyed at ``t`` in the levels where a
-    track moves it (palm-curl's curl), the value itself in the others."""
+    track moves it (palm-curl's curl), the value itself in the others. A value the level
+    itself refuses is set there alone, so that the refusal names that level and stays in
+    its field, not in the first linked level's."""
     m = scene.mokrs
+    try:
+        apply_edit(scene, path, value)
+    except SceneError:
+        return [(path, value)]
     paths = [(*path[:2], k, *path[3:]) for k in linked_levels(m, path[2])]
     tracked = [q for q in paths if track_index(scene, q) is not None]
     if not tracked:
