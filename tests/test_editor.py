@@ -658,7 +658,8 @@ def test_a_zero_normal_typed_stays_red_in_its_field_with_the_message_under_it(ed
     """Type 0 into the three components of a normal (ctrl+click, keys): the last one makes
     the zero vector, which is refused. The field keeps (0, 0, 0) on red with the message under
     it, the scene keeps its last valid normal, nothing goes to the HUD; a valid value clears
-    it, Esc cancels it (negative control: no red before)."""
+    it, Esc cancels it, and so does selecting another level (it used to come back red when
+    the level was selected again) (negative control: no red before)."""
     e = editor
     e.execute([Bake()])
     e.select_level(LEVEL)
@@ -700,6 +701,15 @@ def test_a_zero_normal_typed_stays_red_in_its_field_with_the_message_under_it(ed
     pump(e, 3)
     assert path not in e.viewer.interactions.refused and red_below() == 0
     assert e.scene.route.levels[LEVEL].normal == last
+    type_into(2, "0")  # refused again, then another level selected: the value is stale
+    pump(e, 2)
+    assert path in e.viewer.interactions.refused, "control: gone by itself"
+    e.select_level(LEVEL - 1)
+    pump(e, 2)
+    assert not e.viewer.interactions.refused
+    e.select_level(LEVEL)
+    pump(e, 3)
+    assert red_below() == 0 and e.scene.route.levels[LEVEL].normal == last
 
 
 def test_the_gizmo_axes_point_the_way_the_world_axes_do(editor, monkeypatch):

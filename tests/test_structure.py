@@ -431,6 +431,47 @@ def test_insert_delete_and_ctrl_d_keys_edit_the_selected_level(window_editor):
     assert len(e.scene.route.levels) == n
 
 
+def test_the_panels_words_go_once_stale_and_a_level_is_selected_by_its_own_handle(
+    window_editor,
+):
+    """The structure section's message and the panel's error line stay while the scene and
+    the selection are those they were said of, and go with an undo or another selection
+    (they used to stay: 'select a level first' with a level selected, 'insert a fork' after
+    its undo). Selecting the trunk by its outline entry selects its fork (the panel shows
+    the trunk's fields), not the trunk foot, which is the whole route's; so does Delete of
+    the level below it. The trunk foot's growth parameters are text there, not fields that
+    set them without growing the tree again. The control: each word is there until then."""
+    e = window_editor
+    n = len(e.scene.route.levels)
+    xdo("key", "Insert")
+    pump(e)
+    assert "select a level first" in e.viewer.error and e.structure.refused
+    pump(e, 3)
+    assert "select a level first" in e.viewer.error, "control: gone by itself"
+    e.select_level(n - 1)  # the trunk
+    pump(e)
+    assert e.viewer.error == "" and e.structure.message == ""
+    assert e.selected.owner == ("route", "levels", n - 1), e.selected.label
+    xdo("key", "Insert")
+    pump(e, 3)
+    assert e.structure.message.startswith("insert a fork in L")
+    xdo("key", "ctrl+z")
+    pump(e, 2)
+    assert e.structure.message == "" and len(e.scene.route.levels) == n
+    e.select_level(n - 2)
+    xdo("key", "Delete")
+    pump(e)
+    assert len(e.scene.route.levels) == n - 1 and e.structure.message.startswith("remove")
+    assert e.selected.owner == ("route", "levels", n - 2), e.selected.label
+    # the trunk foot shows the route's fields, but not the growth parameters as fields: set
+    # there, they would not grow the tree again (the structure section's growth node does)
+    e.select(next(h for h in e.handles if h.path == ("route", "base")))
+    e.viewer.interactions.rects.clear()
+    pump(e, 2)
+    assert ("route", "base") in e.viewer.interactions.rects
+    assert not [k for k in e.viewer.interactions.rects if k[:2] == ("route", "growth")]
+
+
 def test_saving_a_shipped_preset_asks_for_a_copy_and_never_writes_the_package(
     display, tmp_path, monkeypatch
 ):

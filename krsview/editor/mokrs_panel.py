@@ -17,12 +17,11 @@ from ..scene.edits import path_text
 from ..scene.model import Empty, Kernel
 from ..scene.mokrs import MobiusLevel, MobiusStep, linked_levels
 from ..viewer.commands import Command, Edit
-from ..viewer.widgets import Interactions
+from ..viewer.widgets import Interactions, red_text
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
 from .mokrs_handles import mokrs_outline
 
-RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 STEP_KINDS = tuple(MobiusStep.registry)  # translate, scale, rotate, invert
 KERNEL_KINDS = tuple(Kernel.registry)
 LEVELS = ("mokrs", "levels")
@@ -141,7 +140,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     if changed and kinds[k] != lv.kernel.kind:
         out.append(Edit((*lev, "kernel"), Kernel.registry[kinds[k]]()))
     fields(shown.kernel, (*lev, "kernel"), out, interactions)
-    _message(error if place == "kernel" else "")
+    red_text(error if place == "kernel" else "")
     for j, s in enumerate(shown.transform):  # as drawn now; reordered as the rest levels
         mine = step_selected and sel[len(lev) + 1] == j
         here = place == f"step {j}" or (place == "selection" and mine)
@@ -151,7 +150,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     if changed and k > 0:
         step = MobiusStep.registry[STEP_KINDS[k - 1]]()
         out.append(Edit((*lev, "transform"), [*lv.transform, step]))
-    _message(error if place == "selection" and not step_selected else "")
+    red_text(error if place == "selection" and not step_selected else "")
 
 
 def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interactions, fields):
@@ -181,11 +180,4 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
             for path, value in linked_edits(e.scene, c.path, c.value, t)
         ]
     imgui.unindent()
-    _message(error)
-
-
-def _message(text: str) -> None:
-    if text:
-        imgui.push_style_color(imgui.Col_.text, RED)
-        imgui.text_wrapped(text)
-        imgui.pop_style_color()
+    red_text(error)

@@ -16,7 +16,7 @@ from ..scene import Scene
 from ..scene.edits import get_at
 from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.hud import HUD_RIGHT
-from ..viewer.widgets import Interactions, field_widget
+from ..viewer.widgets import Interactions, field_widget, red_text
 from ..viewer.window import Viewer
 from . import commands as ec
 from .file_actions import FileActions
@@ -31,7 +31,6 @@ from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
-RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TIP_EMS = 22.0  # a bookkeeping field's tooltip wraps at this many font sizes
 
 
@@ -71,10 +70,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     if not folded:
         _dock(e, out, width)
     _file(e, out)
-    if e.viewer.error:
-        imgui.push_style_color(imgui.Col_.text, RED)
-        imgui.text_wrapped(e.viewer.error)
-        imgui.pop_style_color()
+    red_text(e.viewer.error)
     scene = e.scene
     shown = e.handled_scene()  # as drawn at the moment shown (tracks), its tracked fields marked
     fields_of = partial(_fields, marks=key_marks(scene, e.viewer.drawn.playback.time))
@@ -193,9 +189,7 @@ def _file(e: Edited, out: list) -> None:
     if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
         imgui.set_tooltip("redo: " + undone[0])
     if e.file.conflict:
-        imgui.push_style_color(imgui.Col_.text, RED)
-        imgui.text_wrapped(f"{doc.path.name} changed on disk, and you have unsaved edits.")
-        imgui.pop_style_color()
+        red_text(f"{doc.path.name} changed on disk, and you have unsaved edits.")
         if imgui.button("take the file"):
             out.append(ec.TakeFile())
         if imgui.is_item_hovered():
@@ -250,6 +244,9 @@ def _fields(
             _bookkeeping(f.name, value, path, interactions)
             continue
         if value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
+            continue
+        if f.name == "growth":  # set there, the tree grows again (structure_panel.py)
+            imgui.text_disabled("growth parameters: under structure, growth")
             continue
         if hasattr(value, "__dataclass_fields__"):
             imgui.separator_text(

@@ -13,13 +13,12 @@ from ..scene import Route
 from ..scene.edits import get_at
 from ..scene.growth import Growth
 from ..viewer.commands import Command
-from ..viewer.widgets import Interactions, field_widget
+from ..viewer.widgets import Interactions, field_widget, red_text
 from . import commands as ec
 from .handles import route_outline
 from .modals import answer_buttons
 from .structure import Structured, StructureTools, component, target
 
-RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
 
 
@@ -105,8 +104,8 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
     imgui.same_line()
     if imgui.button("move foot"):
         out.append(ec.WholeTree("base"))
-    if t.message:
-        (imgui.text_colored(RED, t.message) if t.refused else imgui.text_wrapped(t.message))
+    if t.message:  # wrapped: a narrow panel cuts nothing off
+        (red_text if t.refused else imgui.text_wrapped)(t.message)
     if route.growth is not None:
         _growth(route.growth, out, interactions)
     _regrow_dialog(t, out)

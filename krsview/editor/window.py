@@ -90,6 +90,7 @@ class Editor:
         self._again = False  # a turn at once: a pick's gizmo
         self._held: set[str] = set()  # the view's buttons held at the last turn's end
         self._title = ""
+        self._said: tuple = ((), None)  # the panel's last words, and what they were said of
         self._update_title()
         self.frame()
 
@@ -192,6 +193,7 @@ class Editor:
         click, flick = v.input.take_click(), v.input.take_flick()
         v.move(dt)
         self.execute(v.file.watcher.poll())
+        self._forget_stale_words()
         self._follow()
         status = v.status_line()
         ui = v.hud or bool(status)
@@ -275,7 +277,25 @@ class Editor:
             self.structure.level = h.path[h.path.index("levels") + 1]
 
     def select_level(self, level: int) -> None:
-        self.select(next((h for h in self.handles if h.level == level), None))
+        """Select a level by its first handle, the level's own before the route's (the
+        trunk's fork before the trunk foot), so the panel shows the level's fields."""
+        at = [h for h in self.handles if h.level == level]
+        own = [h for h in at if h.owner and h.owner[-1] == level]
+        self.select((own or at or [None])[0])
+
+    def _forget_stale_words(self) -> None:
+        """The panel's last words (its error line, the structure section's message) and the
+        values its fields refused stay while the scene and the selection are those they were
+        said of; an undo, a redo, another edit or another selection makes them stale."""
+        v = self.viewer
+        words = (v.error, self.structure.message, tuple(v.interactions.refused))
+        of = (self.scene, self.selected.path if self.selected is not None else None)
+        if words != self._said[0]:
+            self._said = (words, of)
+        elif any(words) and (of[0] is not self._said[1][0] or of[1] != self._said[1][1]):
+            v.error, self.structure.message = "", ""
+            v.interactions.refused.clear()
+            self._said = (("", "", ()), of)
 
     def place_panel(self, side: str, width: float) -> None:
         """Dock the panel on ``side`` at ``width``; what was in the middle of the view stays

@@ -24,7 +24,7 @@ from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .timeline import draw_time
-from .widgets import Interactions, field_widget
+from .widgets import Interactions, field_widget, red_text
 
 HUD_TITLE = "krsview (F1 hides)"
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
@@ -32,7 +32,6 @@ HUD_AT = 8  # pixels from the window's top left corner, where the HUD first open
 HUD_RIGHT = HUD_AT + HUD_WIDTH  # its right edge there
 PLOT_HEIGHT = 130  # the frame-time plot, tall enough for readable axis labels
 PLOTTED = 120  # moving frames in the plot
-RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
 # the last one sits beside the pre-pass tile slider
 KNOBS = (
@@ -112,10 +111,7 @@ def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], i
         _scene(v, out)
     if v.message:
         imgui.text_wrapped(v.message)
-    if v.error:
-        imgui.push_style_color(imgui.Col_.text, RED)
-        imgui.text_wrapped(v.error)
-        imgui.pop_style_color()
+    red_text(v.error)
     imgui.end()
     return out, slot
 

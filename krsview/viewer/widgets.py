@@ -57,9 +57,7 @@ class Interactions:
             if imgui.is_key_pressed(imgui.Key.escape):
                 del self.refused[path]
             else:
-                imgui.push_style_color(imgui.Col_.text, RED)
-                imgui.text_wrapped(self.refused[path].message)
-                imgui.pop_style_color()
+                red_text(self.refused[path].message)
         return ("panel", path, self.count)
 
     def settle(self, path: tuple, value: Any, error: str) -> bool:
@@ -73,6 +71,14 @@ class Interactions:
             return False
         self.refused[path] = Refused(value, error)
         return True
+
+
+def red_text(text: str) -> None:
+    """A refusal or a warning: ``text`` wrapped, in red (nothing for none)."""
+    if text:
+        imgui.push_style_color(imgui.Col_.text, RED)
+        imgui.text_wrapped(text)
+        imgui.pop_style_color()
 
 
 def tooltip_text(meta: dict, kind: type) -> str:
