@@ -245,6 +245,46 @@ def test_a_press_on_a_fork_drags_it_without_selecting_it_first(editor):
     assert e.doc.history.index == steps + 1 and not e.doc.history.can_redo
 
 
+def test_a_press_on_a_normals_tip_turns_it_without_selecting_it_first(editor):
+    """With its fork selected (so its arrow is shown), press on the tip of the mirror normal
+    and drag 30 px up: the normal is selected at the press and turned by its trackball, in
+    one undo step named after it; a press that slips a click's 4 px only selects it. Before,
+    a press there did nothing. Negative control: the same drag pressed 30 px beside the tip,
+    off every handle, turns nothing and leaves the fork selected."""
+    import glfw
+
+    from krsview.editor.picking import under
+
+    e = editor
+    settle(e)
+    e.execute([Bake()])
+    fork = handle(e, ("route", "levels", LEVEL, "fork"))
+    e.select(fork)
+    settle(e)
+    path = ("route", "levels", LEVEL, "normal")
+    n0 = np.array(e.scene.route.levels[LEVEL].normal)
+    tip = screen_of(e, handle(e, path).position)
+    beside = (tip[0] + 30, tip[1])
+    wx, wy = glfw.get_window_pos(e.viewer.window)
+    assert under(e.shown(), e.window_view(), beside[0] - wx, beside[1] - wy) is None
+    index = e.doc.history.index
+    drag(e, beside, (0, -30))
+    assert e.selected.same(fork) and e.doc.history.index == index
+    drag(e, tip, (3, 0), steps=3)  # a click that slips: selects it, turns nothing
+    assert e.selected is not None and e.selected.path == path
+    assert np.array_equal(e.scene.route.levels[LEVEL].normal, n0)
+    assert e.doc.history.index == index
+    e.select(fork)
+    pump(e, 2)
+    drag(e, tip, (0, -30))
+    assert e.selected is not None and e.selected.path == path
+    n1 = np.array(e.scene.route.levels[LEVEL].normal)
+    turned = math.degrees(math.acos(np.clip(n0 @ n1, -1, 1)))
+    assert turned > 5.0 and math.isclose(np.linalg.norm(n1), 1.0, rel_tol=1e-12), turned
+    assert e.doc.history.index == index + 1
+    assert e.doc.history.labels()[0][-1] == f"drag {e.selected.label}"
+
+
 def test_a_hover_label_reaching_under_the_panel_is_hidden_there(editor, monkeypatch):
     """A fork's hover label is drawn with the view, under ImGui's windows: with the camera
     flown so that the panel's edge crosses the label, the label's part under the panel

@@ -92,8 +92,8 @@ def _targets(m, h):
         return np.add(s.center, (2.0, -1.0, 0.5)), None
     if h.role == "point":
         return np.add(get_at(m, h.path[1:]), (0.05, 0.02, -0.04)), None
-    if h.role == "factor":
-        f = s.factor * 1.1
+    if h.role == "factor":  # on the 0.0001 a dragged factor lands on (FACTOR_DECIMALS)
+        f = round(s.factor * 1.1, 4)
         return f * rho * SCALE_DIRECTION, f
     if h.role == "radius":
         r = s.radius * 1.3
@@ -135,6 +135,29 @@ def test_a_drag_puts_the_handle_where_it_was_dragged(scene):
             wrong = apply_edit(scene, h.path, tuple(p))  # the world point as the frame's
             moved_to = next(k for k in handles(wrong) if k.same(h)).position
             assert np.linalg.norm(moved_to - p) > 1e-3 * scale, h.label
+
+
+def test_a_dragged_factor_and_a_typed_number_carry_no_float_noise():
+    """A scale handle dragged to a point between the 0.0001 steps sets a factor of four
+    decimals (the dial's angles land on 0.01° alike); a number from an ImGui float widget
+    (float32) is the decimal typed, and a component the widget left keeps its float64 value
+    bit for bit. Negative control: the raw values carry the noise."""
+    from krsview.editor.mokrs_handles import FACTOR_DECIMALS
+    from krsview.viewer.widgets import as_typed
+
+    scene = load_scene(resolve("palm"))
+    m, hs = scene.mokrs, handles(scene)
+    h = next(h for h in hs if h.role == "factor")
+    s = get_at(m, h.owner[1:])
+    raw = s.factor * 1.1 + 1.234567e-6
+    p = outward(m, h.level, h.path[4], raw * h.size * SCALE_DIRECTION)
+    path, value = h.edit_to(scene, p, carry=False)
+    assert value == round(raw, FACTOR_DECIMALS) and repr(value) == repr(round(value, 4))
+    assert abs(raw - round(raw, FACTOR_DECIMALS)) > 1e-7  # the raw value had more digits
+    typed = float(np.float32(0.09))
+    assert typed != 0.09 and as_typed(typed, 0.2) == 0.09
+    assert as_typed(float(np.float32(4.254944700928016)), 4.254944700928016) == 4.254944700928016
+    assert as_typed(float(np.float32(-0.2)), 1.0) == -0.2
 
 
 def test_a_dial_dragged_past_half_a_turn_keeps_turning():

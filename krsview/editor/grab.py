@@ -6,8 +6,8 @@ more than a click's slip (press.py: a click that selects it does not nudge it), 
 the pointer as long as the button is held; one press-and-drag is one undo step. Its values
 land as the gizmo's do (Gizmo.placed): on a decimal step under a twentieth of a pixel, or on
 the grid when snapping. A press on a dial handle's point selects it and turns its dial
-(dial.py). A flick, pressed, dragged and let go before a turn saw the press, lands where it
-was let go."""
+(dial.py), one on a mirror normal's arrow tip its trackball (trackball.py). A flick,
+pressed, dragged and let go before a turn saw the press, lands where it was let go."""
 
 from __future__ import annotations
 
@@ -52,9 +52,10 @@ class Grabbing:
         self.drags = 0
 
     def begin(self, shown: list[Handle], v: View, press: tuple[float, float]) -> Handle | None:
-        """A left press at ``press``: the shown point handle there, grabbed, or the dial
-        handle there, to be turned by its dial (Editor._grab); None: neither."""
-        h = under([h for h in shown if h.kind in ("point", "dial")], v, *press)
+        """A left press at ``press``: the shown point handle there, grabbed, or the dial or
+        normal handle there, to be turned by its dial or trackball (Editor._grab); None:
+        none."""
+        h = under([h for h in shown if h.kind in ("point", "dial", "normal")], v, *press)
         if h is not None and h.kind == "point":
             self.drags += 1
             self.now = Grab(h, np.array(h.position, dtype=np.float64), press, self.drags)

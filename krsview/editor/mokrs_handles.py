@@ -37,6 +37,7 @@ RADIUS_DIRECTION = np.array([1.0, 0.0, 0.0])  # an inversion sphere's point hand
 SHARED = 1e-9  # a kernel point this close (× its size) to a step's handle is that handle
 GUIDE_SEGMENTS = 48  # a circle of a guide (a dial, a sphere's great circle) in segments
 DIAL_DECIMALS = 2  # a dragged angle lands on 0.01°, a hundredth of a pixel on the dial's ring
+FACTOR_DECIMALS = 4  # a dragged scale factor lands on 0.0001: under 1/50 px while ρ < 200 px
 AXIS_STEP = 1e-6  # × ρ: the step along a dial's axis whose image gives its world direction
 
 
@@ -77,8 +78,8 @@ class MobiusHandle:
             q = mobius.apply(mobius.inverse(self.to_world), np.asarray(p, dtype=np.float64)[None])
         q = q[0]
         step = get_at(scene, self.owner)
-        if self.role == "factor":
-            return float(q @ SCALE_DIRECTION) / self.size
+        if self.role == "factor":  # no float noise in the saved file, as the dial
+            return round(float(q @ SCALE_DIRECTION) / self.size, FACTOR_DECIMALS)
         if self.role == "radius":
             return float(np.linalg.norm(q - np.array(step.center)))
         if self.role == "degrees":

@@ -16,6 +16,7 @@ from imgui_bundle import imgui
 from ..compile.camera import View, project
 from .gizmo import Snap
 from .handles import Handle
+from .press import past_click
 
 RADIANS_PER_PIXEL = math.radians(0.5)  # k: a 10-pixel drag turns a normal by at most 5°
 GRAB_PIXELS = 12.0  # a press this close to the arrow tip starts turning
@@ -49,8 +50,9 @@ def snap_direction(d: np.ndarray, degrees: float) -> np.ndarray:
 
 
 class Trackball:
-    """The press-and-drag on the selected normal's tip; each drag is one interaction (one
-    undo step). Snapping rounds the direction shown, not the one the drag carries on."""
+    """The press-and-drag on the selected normal's tip, or on an unselected one's, which the
+    press selects (grab.py); each drag is one interaction (one undo step). Snapping rounds
+    the direction shown, not the one the drag carries on."""
 
     def __init__(self, snap: Snap) -> None:
         self.snap = snap
@@ -59,6 +61,7 @@ class Trackball:
         self.hovered = False
         self._last = (0.0, 0.0)
         self._free = np.zeros(3)  # the turned normal before snapping
+        self._slack = False  # pressed to select it: no turn within a click's slip
 
     def claims_mouse(self) -> bool:
         """The pointer is on the tip, or turns it: a press there is not the camera's."""
@@ -75,17 +78,27 @@ class Trackball:
         if not imgui.is_mouse_down(imgui.MouseButton_.left):
             self.active = False
             return None
-        arm = h.position - h.pivot
-        length = float(np.linalg.norm(arm))
         if imgui.is_mouse_clicked(imgui.MouseButton_.left) and self.hovered:
-            self.active, self._last, self._free = True, (x, y), arm / length
-            self.drags += 1
+            self.start(h, x, y, slack=False)
             return None
         if not self.active or (x, y) == self._last:
             return None
+        if self._slack and not past_click():
+            return None
+        length = float(np.linalg.norm(h.position - h.pivot))
         self._free = turned(self._free, v, x - self._last[0], y - self._last[1])
         self._last = (x, y)
         n = self._free
         if self.snap.on or io.key_shift:
             n = snap_direction(n, self.snap.angle)
         return h.pivot + length * n, ("turn", self.drags)
+
+    def start(self, h: Handle, x: float, y: float, slack: bool = True) -> None:
+        """A press at window point (x, y) starts turning normal ``h`` (one new undo step).
+        With ``slack`` (the press selects it: grab.py), it turns only once the pointer has
+        left the press by more than a click's slip (press.py); on the selected normal's tip,
+        at once, for fine steps."""
+        arm = h.position - h.pivot
+        self.active, self._last, self._free = True, (x, y), arm / float(np.linalg.norm(arm))
+        self._slack = slack
+        self.drags += 1

@@ -348,14 +348,17 @@ class Editor:
 
     def _grab(self, press: tuple[float, float]) -> bool:
         """A left press at window point ``press`` on a shown point handle: it is selected and
-        follows the pointer from now on (grab.py); on a dial handle's point, it is selected
-        and its dial turns with the pointer (dial.py)."""
+        follows the pointer from now on (grab.py); on a dial handle's point, or a mirror
+        normal's arrow tip, it is selected and its dial or trackball turns with the pointer
+        (dial.py, trackball.py)."""
         view = self.window_view()
         h = self.grabbing.begin(self.shown(), view, press)
         if h is not None:
             self.select(h)
             if h.kind == "dial":
                 self.gizmo.dial.start(h, view, *press)
+            elif h.kind == "normal":
+                self.trackball.start(h, *press)
         return h is not None
 
     def _claimed(self) -> bool:

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 from imgui_bundle import imgui
 
 from ..scene.schema import describe_range
@@ -92,6 +93,15 @@ def tooltip_text(meta: dict, kind: type) -> str:
     return text
 
 
+def as_typed(new: float, old: float) -> float:
+    """A number from an ImGui float widget, which holds float32: ``old`` itself (float64, bit
+    for bit) where the widget left it, else the shortest decimal that float32 reads as the
+    widget's value, so typing 0.09 sets 0.09, not 0.09000000357627869."""
+    if np.float32(new) == np.float32(old):
+        return float(old)
+    return float(str(np.float32(new)))
+
+
 def _speed(value: float, meta: dict) -> float:
     """Change per pixel dragged: 1 % of the value, at most 1/500 of a bounded range."""
     speed = max(abs(value) * 0.01, 1e-4)
@@ -136,11 +146,12 @@ def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
         and lo > 0
         and hi / lo > LOG_RATIO
     ):
-        changed, value = imgui.slider_float(
+        changed, new = imgui.slider_float(
             label, value, lo, hi, "%.4g", imgui.SliderFlags_.logarithmic
         )
+        value = as_typed(new, value)
     elif isinstance(value, float):
-        changed, value = imgui.drag_float(
+        changed, new = imgui.drag_float(
             label,
             value,
             _speed(value, meta),
@@ -148,13 +159,14 @@ def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
             hi if hi is not None else 0.0,
             "%.5g",
         )
+        value = as_typed(new, value)
     elif isinstance(value, tuple) and len(value) == 3 and lo == 0.0 and hi == 1.0:
         changed, rgb = imgui.color_edit3(label, list(value), imgui.ColorEditFlags_.float)
-        value = tuple(rgb)
+        value = tuple(as_typed(c, old) for c, old in zip(rgb, value))
     elif isinstance(value, tuple) and len(value) == 3:
         speed = max(max(abs(c) for c in value) * 0.005, 1e-4)
         changed, v = imgui.drag_float3(label, list(value), speed, 0.0, 0.0, "%.5g")
-        value = tuple(float(c) for c in v)
+        value = tuple(as_typed(c, old) for c, old in zip(v, value))
     else:
         imgui.text_disabled(f"{label}: {value!r}")
         return False, value
