@@ -93,12 +93,31 @@ def test_a_quick_click_in_the_view_from_the_panel_still_picks(baked):
 
 
 def x_arrow(e) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Screen points on the selected fork's gizmo X arrow and as far off the other way (no
-    gizmo there), 30 pixels from the fork; the arrow's unit direction on screen."""
+    """Screen points 30 pixels from the selected fork: on its gizmo's X arrow, and away from
+    it where there is no gizmo nor a handle, which a press would grab (the first such point
+    from the opposite way round); the arrow's unit direction on screen."""
+    import glfw
+
+    from krsview.compile.camera import project
+    from krsview.editor.picking import PICK_PIXELS
+
+    def free(window_point) -> bool:  # no shown handle within 1.5 times the pick radius
+        v = e.window_view()
+        return all(
+            np.hypot(*(np.array(project(v, h.position)[:2]) - window_point)) > 1.5 * PICK_PIXELS
+            for h in e.shown()
+        )
+
     at = np.array(screen_of(e, handle(e, FORK).position))
     along = np.array(screen_of(e, handle(e, FORK).position + np.array([0.01, 0.0, 0.0]))) - at
     along /= np.linalg.norm(along)
-    return at + 30 * along, at - 30 * along, along
+    corner = np.array(glfw.get_window_pos(e.viewer.window))
+    for turn in np.radians([180, 195, 165, 210, 150, 225, 135, 240, 120, 255, 105]):
+        c, s_ = np.cos(turn), np.sin(turn)
+        off = at + 30 * np.array([c * along[0] - s_ * along[1], s_ * along[0] + c * along[1]])
+        if free(off - corner):
+            return at + 30 * along, off, along
+    raise AssertionError("no free point 30 px from the fork")
 
 
 def test_a_quick_tap_on_the_gizmo_keeps_the_selection(baked):
