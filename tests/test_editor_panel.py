@@ -190,6 +190,50 @@ def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
         v.close()
 
 
+def test_a_flight_key_let_go_while_a_field_has_the_keyboard_stops_the_flight(
+    display, tmp_path, monkeypatch
+):
+    """Hold W, ctrl+click into a HUD field (ImGui takes the keyboard), let W go: the viewer
+    lets it go too. It used to miss the release and fly on until W was pressed again.
+    Control: W is held before, and the field has the keyboard when it is let go."""
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.viewer.window import Viewer
+
+    open_from_start(monkeypatch, "accuracy and view")
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=(640, 720))
+
+    def turn(n: int = 3) -> None:
+        for _ in range(n):
+            glfw.poll_events()
+            v.step(0.02)
+
+    try:
+        turn(4)
+        x0, y0, x1, y1 = v.interactions.rects[("render", "max_iterations")]
+        wx, wy = glfw.get_window_pos(v.window)
+        xdo("mousemove", round(wx + x0 + 30), round(wy + (y0 + y1) / 2))
+        turn(2)
+        xdo("keydown", "w")
+        turn(2)
+        assert "W" in v.input.held
+        xdo("keydown", "ctrl")
+        xdo("click", 1)
+        xdo("keyup", "ctrl")
+        turn(3)
+        assert imgui.get_io().want_capture_keyboard, "control: the field has no keyboard"
+        xdo("keyup", "w")
+        turn(2)
+        assert "W" not in v.input.held
+        xdo("key", "Escape")
+        turn(2)
+    finally:
+        v.close()
+
+
 def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_path, monkeypatch):
     """A click on the HUD's tracer combo opens its list; Esc closes it, the tracer as it was
     (ImGui's keyboard navigation, which would close it, is off). Negative control: the list

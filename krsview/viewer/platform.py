@@ -94,15 +94,18 @@ class Platform:
 
         def on_key(_w, key, scancode, action, mods):
             hand(lambda: b.glfw_key_callback(a, key, scancode, action, mods))
-            if imgui.get_io().want_capture_keyboard:
-                return  # typing in a field
             if key not in GLFW_KEYS:
                 return
+            if action == glfw.RELEASE:  # let go, whoever has the keyboard: a flight key held
+                to.key(GLFW_KEYS[key], False)  # into a field or a slider's drag would fly on
+                return
+            if imgui.get_io().want_capture_keyboard:
+                return  # typing in a field
             if action == glfw.PRESS and mods & glfw.MOD_CONTROL:
                 shift = "shift+" if mods & glfw.MOD_SHIFT else ""
                 to.chord(f"ctrl+{shift}{GLFW_KEYS[key]}")
-            elif action != glfw.REPEAT:
-                to.key(GLFW_KEYS[key], action == glfw.PRESS)
+            elif action == glfw.PRESS:
+                to.key(GLFW_KEYS[key], True)
 
         def on_button(_w, button, action, mods):
             release = action == glfw.RELEASE
