@@ -356,3 +356,40 @@ def test_a_shipped_presets_camera_path_goes_beside_its_copy(data_home, tmp_path,
     assert path_file(resolve("tree")) == tmp_path / "tree.path.json"
     mine = tmp_path / "elsewhere" / "tree.toml"  # negative control: a file of one's own
     assert path_file(mine) == tmp_path / "elsewhere" / "tree.path.json"
+
+
+def test_a_viewers_bookmark_is_appended_to_the_file_as_written(tmp_path):
+    """The viewer's B appends the bookmark to the file's own text: its comments, its layout
+    and numbers as the person wrote them (a light direction left unnormalised) stay, and
+    the file reads back as before plus the bookmark, twice over. It used to write the whole
+    scene anew: comments gone, every default written out, the direction normalised. A file
+    that lists its bookmarks inline, where a table appended would be invalid TOML, is
+    written anew (the control: appending there fails to parse)."""
+    from krsview.scene import Camera, scene_from_toml
+
+    path = tmp_path / "grove.toml"
+    shutil.copy(resolve("grove"), path)
+    text = path.read_text()
+    assert "#" in text and "[0.5, 0.8, -0.35]" in text
+    doc = Document(path)
+    cams = [Camera((1.0, 2.0, 3.0), (0.0, 1.0, 0.0), (0.0, 1.0, 0.0), 45.0 + k) for k in (0, 1)]
+    for k, cam in enumerate(cams):
+        name, written = doc.add_bookmark(cam)
+        assert written == path and name == f"view {k + 1}"
+    now = path.read_text()
+    assert now.startswith(text), "the file's own text was rewritten"
+    again = load_scene(path)
+    assert [b.camera for b in again.bookmarks] == cams
+    assert replace(again, bookmarks=[]) == replace(load_scene(resolve("grove")), bookmarks=[])
+    assert not doc.changed_on_disk() and not doc.dirty
+    # inline bookmarks: a table appended would not parse, so the scene is written anew
+    inline = tmp_path / "inline.toml"
+    save_scene(replace(load_scene(resolve("rock")), bookmarks=[]), inline)
+    cam = "{ position = [0.0, 9.0, 9.0], target = [0.0, 0.0, 0.0] }"
+    rest = [ln for ln in inline.read_text().splitlines(True) if not ln.startswith("bookmarks")]
+    inline.write_text(f'bookmarks = [{{ name = "a", camera = {cam} }}]\n' + "".join(rest))
+    doc = Document(inline)
+    with pytest.raises(SceneError):
+        scene_from_toml(inline.read_text() + '\n[[bookmarks]]\nname = "b"\n')
+    doc.add_bookmark(cams[0])
+    assert [b.name for b in load_scene(inline).bookmarks] == ["a", "view 2"]

@@ -22,7 +22,9 @@ from ..scene import Bookmark, Camera, Scene, SceneError, load_scene, scene_to_to
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
 from ..scene.presets import PRESET_DIR
-from ..scene.scene import write_atomic
+from ..scene.scene import scene_from_toml, write_atomic
+from ..scene.schema import to_dict
+from ..scene.toml_writer import dumps
 from .history import History, Step
 
 AUTOSAVE_SECONDS = 3.0  # a crash loses at most this much work
@@ -80,7 +82,7 @@ class Document:
         self.path = Path(path)
         self._scene = load_scene(self.path)  # a bad file is a SceneError, nothing opened
         self.saved = self._scene  # the version on disk
-        self.saved_text = scene_to_toml(self._scene)
+        self.saved_text = self.path.read_text(encoding="utf-8")  # as written, comments too
         self.stamp = Stamp.of(self.path)
         self.history = History()
         self.version = 0  # bumps on every change: views redraw
@@ -206,18 +208,21 @@ class Document:
             return name, self.save(copy_target(self.path))
         on_disk = load_scene(self.path)
         name = f"view {len(on_disk.bookmarks) + 1}"
-        written = replace(on_disk, bookmarks=on_disk.bookmarks + [Bookmark(name, camera)])
+        bookmark = Bookmark(name, camera)
+        written = replace(on_disk, bookmarks=on_disk.bookmarks + [bookmark])
         try:
-            write_atomic(self.path, scene_to_toml(written))
+            text = with_bookmark(self.path.read_text(encoding="utf-8"), bookmark, written)
+            write_atomic(self.path, text)
         except OSError as e:
             raise SceneError("<file>", str(self.path), f"cannot save: {e.strerror}") from None
         self.apply(("bookmarks",), written.bookmarks)
-        self.mark_saved(written)
+        self.mark_saved(written, text)
         return name, self.path
 
-    def mark_saved(self, scene: Scene) -> None:
-        """The file now holds ``scene`` (written here, or by the viewer's bookmark)."""
-        self.saved, self.saved_text = scene, scene_to_toml(scene)
+    def mark_saved(self, scene: Scene, text: str | None = None) -> None:
+        """The file now holds ``scene`` (written here, or by the viewer's bookmark), as
+        ``text`` (default: the scene written anew)."""
+        self.saved, self.saved_text = scene, text if text is not None else scene_to_toml(scene)
         self.stamp = Stamp.of(self.path)
 
     # -------------------------------------------------------------------------- recovery
@@ -274,3 +279,17 @@ class Document:
 
     def discard_recovery(self) -> None:
         self.recovery_path.unlink(missing_ok=True)
+
+
+def with_bookmark(text: str, bookmark: Bookmark, want: Scene) -> str:
+    """A scene file's ``text`` with ``bookmark`` appended as a table of its own: the person's
+    comments, layout and numbers stay as they wrote them. Where that does not read back as
+    ``want`` (a file that lists its bookmarks inline, say), the whole scene written anew."""
+    added = text + ("" if text.endswith("\n") else "\n") + "\n"
+    added += dumps({"bookmarks": [to_dict(bookmark)]})
+    try:
+        if scene_from_toml(added) == want:
+            return added
+    except SceneError:
+        pass
+    return scene_to_toml(want)
