@@ -142,6 +142,33 @@ def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
     assert [line for line in drawn if line.startswith("screenshot: ")] == [v.status_line()]
 
 
+def test_with_the_hud_hidden_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
+    """A scene file refused on reload, the HUD hidden (F1): its error is the status line at
+    the window's foot, in red, while it stands (the HUD shows it otherwise); it used to show
+    nowhere. Control: with the HUD shown, the status line stays free of it."""
+    import krsview.viewer.hudframe as hudframe
+
+    v = hud_viewer
+    text = v.path.read_text()
+    v.path.write_text(text.replace("branch_angle = 26.0", "branch_angle = 900.0"))
+    v.file.take()
+    assert "branch_angle" in v.error
+    assert v.status_line() == "", "control: the HUD shows the error"
+    v.hud = False
+    drawn = []
+    real = hudframe.draw_status
+    monkeypatch.setattr(
+        hudframe,
+        "draw_status",
+        lambda status, error=False: (drawn.append((status, error)), real(status, error)),
+    )
+    turn(v)
+    assert v.status_line() == v.error and (v.error, True) in drawn
+    v.path.write_text(text)
+    v.file.take()
+    assert v.error == "" and v.status_line() == ""
+
+
 def test_screenshot_goes_beside_a_writable_scene(tmp_path, monkeypatch):
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     scene = tmp_path / "scenes" / "fern.toml"
@@ -151,6 +178,11 @@ def test_screenshot_goes_beside_a_writable_scene(tmp_path, monkeypatch):
     assert np.array_equal(np.asarray(Image.open(out)), RGB)
     assert os.listdir(out.parent) == [out.name]  # written whole: no temporary file left
     assert not (tmp_path / "home").exists()  # negative control: the fallback is not used
+    # two more in the same second: each a file of its own, none overwritten
+    more = [save_screenshot(255 - RGB, scene, "20260101-000000") for _ in range(2)]
+    assert [m.name for m in more] == ["fern-20260101-000000-2.png", "fern-20260101-000000-3.png"]
+    assert np.array_equal(np.asarray(Image.open(out)), RGB)
+    assert sorted(os.listdir(out.parent)) == sorted([out.name, *(m.name for m in more)])
 
 
 def test_screenshot_of_a_read_only_scene_goes_to_the_pictures_folder(tmp_path, monkeypatch):

@@ -223,7 +223,7 @@ class Editor:
         if ui:
             if v.hud:
                 self._draw_ui()
-            draw_status(status)
+            draw_status(status, status == v.error)
             v.platform.render()
         v.input.claimed = v.hud and self._dragging()
         self._held = set(v.input.buttons)

@@ -24,7 +24,7 @@ from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .timeline import draw_time
-from .widgets import Interactions, field_widget, red_text
+from .widgets import RED, Interactions, field_widget, red_text
 
 HUD_TITLE = "krsview (F1 hides)"
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
@@ -132,8 +132,9 @@ def numbers_height() -> float:
     return 4 * imgui.get_text_line_height_with_spacing() + PLOT_HEIGHT
 
 
-def draw_status(text: str) -> None:
-    """A one-line status (a screenshot's path) at the foot of the window, HUD shown or not."""
+def draw_status(text: str, error: bool = False) -> None:
+    """A one-line status (a screenshot's path; an ``error`` in red) at the foot of the
+    window, HUD shown or not."""
     if not text:
         return
     foot = imgui.get_io().display_size
@@ -141,7 +142,10 @@ def draw_status(text: str) -> None:
     imgui.set_next_window_bg_alpha(0.75)
     flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
     imgui.begin("##status", None, flags | imgui.WindowFlags_.no_inputs)
-    imgui.text(text)
+    if error:
+        imgui.text_colored(RED, text)
+    else:
+        imgui.text(text)
     imgui.end()
 
 

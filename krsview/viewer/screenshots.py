@@ -44,12 +44,17 @@ def screenshot_folders(scene: Path) -> tuple[Path, ...]:
 
 def save_screenshot(rgb: np.ndarray, scene: Path, stamp: str) -> Path:
     """Write ``rgb`` (H, W, 3 bytes) as ``SCENE-STAMP.png``, whole or not at all, in the first
-    of :func:`screenshot_folders` that can be written; returns its full path."""
+    of :func:`screenshot_folders` that can be written; returns its full path. A second shot
+    in the same second is ``SCENE-STAMP-2.png``: none overwrites another."""
     png = io.BytesIO()
     Image.fromarray(rgb).save(png, format="PNG")
     failed = []
     for folder in screenshot_folders(scene):
         out = folder.absolute() / f"{scene.stem}-{stamp}.png"
+        k = 1
+        while out.exists():
+            k += 1
+            out = folder.absolute() / f"{scene.stem}-{stamp}-{k}.png"
         try:
             folder.mkdir(parents=True, exist_ok=True)
             write_atomic(out, png.getvalue())
