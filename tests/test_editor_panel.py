@@ -234,6 +234,53 @@ def test_a_flight_key_let_go_while_a_field_has_the_keyboard_stops_the_flight(
         v.close()
 
 
+def test_a_long_tooltip_wraps_inside_a_small_window(display, tmp_path, monkeypatch):
+    """Hover the HUD's culling field in a window 640 px wide: its tooltip (a long help text and
+    its range) wraps at TIP_EMS font sizes and lies inside the window; ImGui's own tooltip is
+    one line, which ran off the window's right edge (the control: that line is wider than
+    the window)."""
+    from dataclasses import fields
+
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.scene.render import Render
+    from krsview.viewer.widgets import TIP_EMS, tooltip_text
+    from krsview.viewer.window import Viewer
+
+    open_from_start(monkeypatch, "accuracy and view")
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=(640, 720))
+
+    def turn(n: int = 3) -> None:
+        for _ in range(n):
+            glfw.poll_events()
+            v.step(0.02)
+
+    try:
+        turn(4)
+        x0, y0, x1, y1 = v.interactions.rects[("render", "culling")]
+        wx, wy = glfw.get_window_pos(v.window)
+        xdo("mousemove", round(wx + x0 + 10), round(wy + (y0 + y1) / 2))
+        turn(4)
+        meta = next(dict(f.metadata) for f in fields(Render) if f.name == "culling")
+        line = imgui.calc_text_size(tooltip_text(meta, str)).x
+        assert line > 640, "control: the help fits on one line anyway"
+        tip = next(
+            w
+            for w in imgui.get_current_context().windows
+            if w.name.startswith("##Tooltip") and w.active
+        )
+        assert tip.pos.x >= 0 and tip.pos.x + tip.size.x <= 640, (tip.pos.x, tip.size.x)
+        assert (
+            tip.size.x
+            <= TIP_EMS * imgui.get_font_size() + 2 * imgui.get_style().window_padding.x + 1
+        )
+    finally:
+        v.close()
+
+
 def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_path, monkeypatch):
     """A click on the HUD's tracer combo opens its list; Esc closes it, the tracer as it was
     (ImGui's keyboard navigation, which would close it, is off). Negative control: the list

@@ -17,7 +17,7 @@ from ..scene.edits import path_text
 from ..scene.model import Empty, Kernel
 from ..scene.mokrs import MobiusLevel, MobiusStep, linked_levels
 from ..viewer.commands import Command, Edit
-from ..viewer.widgets import Interactions, red_text
+from ..viewer.widgets import Interactions, red_text, tooltip
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
 from .mokrs_handles import mokrs_outline
@@ -121,7 +121,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
         if imgui.small_button(f"{label}##lv"):
             out.append(Edit(LEVELS, value))
         if imgui.is_item_hovered():
-            imgui.set_tooltip(tip)
+            tooltip(tip)
         imgui.same_line()
     imgui.new_line()
     with marked(key_marks(e.scene, e.viewer.drawn.playback.time).get((*lev, "reflect"))):
@@ -134,7 +134,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
         if changed:
             out.append(ec.SetCarry(on))
         if imgui.is_item_hovered():
-            imgui.set_tooltip("the finer levels whose steps equal this level's (linked)")
+            tooltip("the finer levels whose steps equal this level's (linked)")
     kinds = list(KERNEL_KINDS)
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
     if changed and kinds[k] != lv.kernel.kind:

@@ -16,7 +16,7 @@ from ..scene import Scene
 from ..scene.edits import get_at
 from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.hud import HUD_RIGHT
-from ..viewer.widgets import Interactions, field_widget, red_text
+from ..viewer.widgets import Interactions, field_widget, red_text, tooltip
 from ..viewer.window import Viewer
 from . import commands as ec
 from .file_actions import FileActions
@@ -31,7 +31,6 @@ from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
-TIP_EMS = 22.0  # a bookkeeping field's tooltip wraps at this many font sizes
 
 
 class Edited(Protocol):
@@ -106,7 +105,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
             if changed:
                 out.append(ec.SetCarry(on))
             if imgui.is_item_hovered():
-                imgui.set_tooltip(
+                tooltip(
                     "on: the finer forks, control points and mirrors move with a "
                     "dragged fork, so the crown stays attached; off: only the fork. "
                     "A keyed fork always takes its subtree along, as a bone does"
@@ -130,7 +129,7 @@ def _dock(e: Edited, out: list, width: float) -> None:
     if imgui.small_button(f"dock {other}"):
         out.append(ec.PlacePanel(other, e.layout.width))
     if imgui.is_item_hovered():
-        imgui.set_tooltip("drag the panel's edge to resize it; its title bar's arrow folds it")
+        tooltip("drag the panel's edge to resize it; its title bar's arrow folds it")
 
 
 def _about(scene: Scene, out: list, interactions: Interactions) -> None:
@@ -144,7 +143,7 @@ def _about(scene: Scene, out: list, interactions: Interactions) -> None:
         )
         key = interactions.key((name,))
         if imgui.is_item_hovered():
-            imgui.set_tooltip("Enter takes the text")
+            tooltip("Enter takes the text")
         if changed and text != getattr(scene, name):
             out.append(Edit((name,), text, key))
 
@@ -180,20 +179,20 @@ def _file(e: Edited, out: list) -> None:
         out.append(Undo())
     imgui.end_disabled()
     if done and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
-        imgui.set_tooltip("undo: " + done[-1])
+        tooltip("undo: " + done[-1])
     imgui.same_line()
     imgui.begin_disabled(not undone)
     if imgui.button("redo (Ctrl+Shift+Z)"):
         out.append(Redo())
     imgui.end_disabled()
     if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
-        imgui.set_tooltip("redo: " + undone[0])
+        tooltip("redo: " + undone[0])
     if e.file.conflict:
         red_text(f"{doc.path.name} changed on disk, and you have unsaved edits.")
         if imgui.button("take the file"):
             out.append(ec.TakeFile())
         if imgui.is_item_hovered():
-            imgui.set_tooltip("load the file's contents; your edits stay undoable")
+            tooltip("load the file's contents; your edits stay undoable")
         imgui.same_line()
         if imgui.button("keep mine"):
             out.append(ec.KeepMine())
@@ -269,12 +268,8 @@ def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions)
     place is kept in ``interactions.rects`` like a widget's, for tests and automation)."""
     text, tip = BOOKKEEPING[name](value)
     imgui.text_disabled(text)
-    if imgui.is_item_hovered():  # wrapped: a narrow window cuts nothing off
-        imgui.begin_tooltip()
-        imgui.push_text_wrap_pos(TIP_EMS * imgui.get_font_size())
-        imgui.text(tip)
-        imgui.pop_text_wrap_pos()
-        imgui.end_tooltip()
+    if imgui.is_item_hovered():
+        tooltip(tip)
     lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
     interactions.rects[path] = (lo.x, lo.y, hi.x, hi.y)
 

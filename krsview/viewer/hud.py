@@ -24,7 +24,7 @@ from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .timeline import draw_time
-from .widgets import RED, Interactions, field_widget, red_text
+from .widgets import RED, Interactions, field_widget, red_text, tooltip
 
 HUD_TITLE = "krsview (F1 hides)"
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
@@ -229,7 +229,7 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
         if changed:
             out.append(c.SetEffect(name, on))
         if imgui.is_item_hovered():
-            imgui.set_tooltip(EFFECTS[name].help)
+            tooltip(EFFECTS[name].help)
 
 
 def _scene(v: Viewed, out: list) -> None:

@@ -74,6 +74,19 @@ class Interactions:
         return True
 
 
+TIP_EMS = 22.0  # a tooltip wraps at this many font sizes
+
+
+def tooltip(text: str) -> None:
+    """The hovered item's tooltip, wrapped at TIP_EMS font sizes: ImGui's own is one line,
+    cut off at the window's edge."""
+    imgui.begin_tooltip()
+    imgui.push_text_wrap_pos(TIP_EMS * imgui.get_font_size())
+    imgui.text_unformatted(text)
+    imgui.pop_text_wrap_pos()
+    imgui.end_tooltip()
+
+
 def red_text(text: str) -> None:
     """A refusal or a warning: ``text`` wrapped, in red (nothing for none)."""
     if text:
@@ -120,7 +133,7 @@ def field_widget(
         changed, new = _widget(label, value, meta)
         text = tooltip_text(meta, type(value))
         if text and imgui.is_item_hovered():
-            imgui.set_tooltip(text)
+            tooltip(text)
         return changed, new
     # no tooltip: it would cover the refusal's message under the field (Interactions.key)
     imgui.push_style_color(imgui.Col_.frame_bg, RED_FRAME)
