@@ -502,3 +502,18 @@ def test_drop_down_lists_are_opaque(viewer):
     assert bg.w == 1.0
     imgui.style_colors_dark()  # ImGui's own default
     assert imgui.get_style().color_(imgui.Col_.popup_bg.value).w < 1.0
+
+
+def test_the_title_bar_names_the_scene_the_hud_opened(viewer, monkeypatch):
+    """Another preset chosen in the HUD: the title bar names it (it kept the first scene's
+    name). Control: nothing is set before."""
+    import glfw
+
+    from krsview.viewer.commands import OpenPreset
+
+    titles: list[str] = []
+    monkeypatch.setattr(glfw, "set_window_title", lambda window, title: titles.append(title))
+    viewer.step(0.02)
+    assert titles == []
+    viewer.execute([OpenPreset(resolve("palm"))])
+    assert titles == ["krsview — palm"] and viewer.scene.name == "palm"

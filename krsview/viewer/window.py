@@ -102,7 +102,10 @@ class Viewer:
         return self._view_prepass if self._view_prepass is not None else self.scene.render.prepass
 
     def opened(self) -> None:
-        """A document was opened: its pre-pass, moment and camera (files.py watches it)."""
+        """A document was opened: its name in the title bar, its pre-pass, moment and camera
+        (files.py watches it)."""
+        if self.window is not None:
+            glfw.set_window_title(self.window, f"krsview — {self.scene.name}")
         p = self.settings.prepass
         self._view_prepass = (
             p if p is not None else (None if self.scene.render.prepass else VIEW_PREPASS)
