@@ -119,8 +119,8 @@ def test_the_hud_says_the_primary_images_shadows_come_next(renderer):
     from krsview.viewer.frames import FrameState
 
     state = FrameState("refining", FULL, FULL, 0.1, (2, 3), 2, blocks_of=(160, 90))
-    assert state.text() == "refining 2/3, shadows next: 320×180 (100% of the window)"
+    assert state.text() == "refining 2/3, shadows next: 320×180 (100% of the window's width)"
     assert state.timing() == "traced in 100.0 ms, shadows per 2×2 px of the 160×90 image"
     plain = FrameState("refining", FULL, FULL, 0.1, (2, 3), 2)  # control: its own blocks
-    assert plain.text() == "refining 2/3: 320×180 (100% of the window)"
+    assert plain.text() == "refining 2/3: 320×180 (100% of the window's width)"
     assert plain.timing() == "traced in 100.0 ms, shadows per 2×2 px"

@@ -83,13 +83,13 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
         assert drawn[0] == s.text() and drawn[1] == f"{s.timing()}; shaded view"
     moving = images[3][0][0]
     w, h = moving.size
-    assert (
-        w < SIZE[0] and images[3][0][1][0] == f"moving: {w}×{h} ({w / SIZE[0]:.0%} of the window)"
-    )
+    share = f"{w / SIZE[0]:.0%} of the window's width"
+    assert w < SIZE[0] and images[3][0][1][0] == f"moving: {w}×{h} ({share})"
     first = images[4][0]
     w1, h1 = sizes[0]
     nxt = ", shadows next" if steps[0].primary else ""  # a fast machine plans no half step
-    assert first[1][0] == f"refining 1/{n}{nxt}: {w1}×{h1} ({w1 / SIZE[0]:.0%} of the window)"
+    share = f"{w1 / SIZE[0]:.0%} of the window's width"
+    assert first[1][0] == f"refining 1/{n}{nxt}: {w1}×{h1} ({share})"
     assert first[1][1].startswith("traced in ") and ", shadows per 2×2 px" in first[1][1]
     # the window-size primary image: lit by the blocks of the image before it, its own next
     primary, before = images[-2][0], images[-3][0]
@@ -100,7 +100,7 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
     assert primary[1][1].endswith(f", shadows per 2×2 px of the {bw}×{bh} image; shaded view")
     still, lines, _ = seen[-1]
     assert still.size == SIZE == v.frames.image[1] and lines[0] == (
-        f"still: {SIZE[0]}×{SIZE[1]} (100% of the window)"
+        f"still: {SIZE[0]}×{SIZE[1]} (100% of the window's width)"
     )
     assert "shadows per" not in lines[1]  # the still image's are per pixel
     # each image stays on screen, its very pixels (right of the HUD), until the next

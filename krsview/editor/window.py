@@ -223,7 +223,7 @@ class Editor:
         if ui:
             if v.hud:
                 self._draw_ui()
-            draw_status(status, status == v.error)
+            draw_status(status, bool(v.error) and not v.hud)
             v.platform.render()
         v.input.claimed = v.hud and self._dragging()
         self._held = set(v.input.buttons)

@@ -57,7 +57,7 @@ class FrameState:
         k, n = self.step
         state = f"refining {k}/{n}" if self.state == "refining" else self.state
         state += ", shadows next" if self.blocks_of[0] else ""
-        return f"{state}: {w}×{h} ({share:.0%} of the window)"
+        return f"{state}: {w}×{h} ({share:.0%} of the window's width)"
 
     def timing(self) -> str:
         """How it was traced: time, and the shadow rays' blocks where they are shared."""

@@ -160,7 +160,8 @@ def _numbers(v: Viewed) -> None:
     budget, rest = 1e3 * a.trace_budget, 1e3 * a.rest
     imgui.text(f"moving frames: median {np.median(times):.1f} ms, budget {budget:.1f} ms")
     imgui.text(f"the rest of a turn (display, HUD, swap): {rest:.1f} ms")
-    if implot.begin_plot("##frametime", imgui.ImVec2(-1, PLOT_HEIGHT), implot.Flags_.no_legend):
+    readout = implot.Flags_.no_legend | implot.Flags_.no_inputs  # the wheel scrolls the HUD
+    if implot.begin_plot("##frametime", imgui.ImVec2(-1, PLOT_HEIGHT), readout):
         implot.setup_axes("moving frames", "ms")
         implot.setup_axes_limits(
             0, PLOTTED, 0, max(2 * budget, float(times.max()) * 1.1), implot.Cond_.always
@@ -279,7 +280,7 @@ def _measured(v: Viewed, out: list) -> None:
         if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth, v.prepass)
     ]
     w, h = v.frames.adaptive.moving_size()
-    if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150)):
+    if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150), implot.Flags_.no_inputs):
         implot.setup_axes("ms (report size)", "hit-mask error %")
         ms = np.array([r["ms"] for r in rows], dtype=np.float32)
         err = np.array([100 * r["mask_error"] for r in rows], dtype=np.float32)

@@ -55,5 +55,5 @@ class HudFrame:
 
     def draw(self) -> None:
         """The status line, then ImGui's drawing over the image."""
-        draw_status(self.status, self.status == self.v.error)
+        draw_status(self.status, bool(self.v.error) and not self.v.hud)
         self.v.platform.render()

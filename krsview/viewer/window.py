@@ -312,10 +312,10 @@ class Viewer:
 
     def status_line(self) -> str:
         """The status line shown at the window's foot: what was said (a screenshot's path)
-        while it lasts; with the HUD hidden, the error the HUD would show (a scene file
-        refused on reload), so that none goes unseen."""
+        while it lasts; with the HUD hidden, the first line of the error the HUD would show
+        (a scene file refused on reload), so that none goes unseen."""
         if self.error and not self.hud:
-            return self.error
+            return self.error.splitlines()[0]
         return self.status[0] if self.clock < self.status[1] else ""
 
     def read_window(self) -> np.ndarray:
