@@ -557,3 +557,36 @@ def test_an_edit_that_puts_the_viewpoint_flown_in_the_editor_on_a_pole_is_refuse
         assert np.allclose(next(k for k in e.handles if k.same(h)).position, p)
     finally:
         e.close()
+
+
+def test_a_step_removed_from_a_linked_level_goes_from_its_linked_levels_and_keeps_it_selected(
+    display, tmp_path
+):
+    """palm's level 58 with its dial selected and step edits linked: removing that step
+    removes it from the 29 linked finer levels too (they stay linked, one undo step), and
+    the level stays selected (its dial's handle is gone; the panel used to fall back to
+    'select a level'). Unlinked (the control), only level 58 loses it."""
+    from krsview.editor.mokrs_panel import _steps
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    e = Editor(path, size=(640, 400))
+    try:
+        m = e.scene.mokrs
+        leaflets = [i for i, lv in enumerate(m.levels) if lv.transform == m.levels[58].transform]
+        assert len(leaflets) == 30
+        degrees = (*LEVELS, 58, "transform", 1, "degrees")
+        for carry, changed in ((True, leaflets), (False, [58])):
+            e.carry = carry
+            e.select(next(h for h in e.handles if h.path == degrees))
+            before, index = e.scene.mokrs.levels, e.doc.history.index
+            e.execute([_steps(e, 58, removed(list(before[58].transform), 1))])
+            now = e.scene.mokrs.levels
+            assert [i for i in range(len(now)) if now[i] != before[i]] == changed, carry
+            assert e.doc.history.index == index + 1
+            assert not [h for h in e.handles if h.path == degrees]  # the dial's handle is gone
+            assert e.selected is not None and e.selected.level == 58, e.selected
+            e.viewer.undo()
+    finally:
+        e.close()

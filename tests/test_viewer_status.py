@@ -248,3 +248,56 @@ def test_the_hud_offers_only_the_knobs_that_act_on_the_setting():
     binary = set(knobs_shown(replace(render, tracer="binary")))
     assert {"xi_bonus", "xi_penalty"} <= binary and "relaxation" not in binary
     assert not {"xi_bonus", "xi_penalty"} & fragment
+
+
+def test_a_coarse_image_draws_the_still_images_geometry(tmp_path):
+    """An image traced below the window's resolution takes the window's ε (frames.py,
+    at_window_epsilon): its hits cover the view as the still image's do, within a fraction
+    of a point, in the whole tree and inside the crown (zoom stops 2 and 6), at a quarter of
+    the window's side. Negative control: at its own pixel's ε every twig is a coarse pixel
+    fatter, and the hits cover 6 to 25 points more (crowns went solid while moving, then
+    thinned at once when the camera stopped)."""
+    from krsview import api
+    from krsview.bench import zoom
+    from krsview.viewer.frames import at_window_epsilon
+
+    tree = api.load("tree")
+    stops = zoom.stops(tree, 12)
+    window, size = (320, 180), (80, 45)
+    with api.Renderer(*window) as big, api.Renderer(*size) as small:
+        for scene in (tree, stops[2], stops[6]):
+            still = float(big.render(scene).hit.mean())
+            coarse = float(small.render(scene).hit.mean())
+            moving = float(small.render(at_window_epsilon(scene, size, window)).hit.mean())
+            assert abs(moving - still) < 0.005, (scene.camera, still, moving)
+            assert coarse - still > 0.01, (scene.camera, still, coarse)
+    assert at_window_epsilon(tree, window, window) is tree  # the still image: as it is
+
+
+def test_moving_and_refining_images_take_the_windows_epsilon(hud_viewer, monkeypatch):
+    """Every image the viewer traces below the window's size, moving or refining, is traced
+    with ε scaled to the window's pixel; the still image with the scene's own."""
+    import krsview.viewer.frames as frames
+
+    v = hud_viewer
+    made = []
+    real = frames.PassImage
+
+    def spy(renderer, targets, scene, size, *rest):
+        made.append((size, scene.render.epsilon_scale))
+        return real(renderer, targets, scene, size, *rest)
+
+    monkeypatch.setattr(frames, "PassImage", spy)
+    v.input.key("W", True)
+    for _ in range(4):
+        turn(v)
+    v.input.key("W", False)
+    for _ in range(400):
+        turn(v)
+        if v.frames.refined:
+            break
+    eps, full = v.scene.render.epsilon_scale, v.frames.adaptive.full
+    smaller = [(s, e) for s, e in made if s[1] < full[1]]
+    assert smaller and any(s == full for s, _ in made), made
+    assert all(e == pytest.approx(eps * s[1] / full[1]) for s, e in smaller), made
+    assert all(e == eps for s, e in made if s == full), made

@@ -15,7 +15,7 @@ from imgui_bundle import imgui
 
 from ..scene.edits import path_text
 from ..scene.model import Empty, Kernel
-from ..scene.mokrs import MobiusLevel, MobiusStep, linked_levels
+from ..scene.mokrs import MobiusLevel, MobiusStep, linked_levels, linked_steps
 from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions, red_text, tooltip
 from . import commands as ec
@@ -149,8 +149,16 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     changed, k = imgui.combo("##newstep", 0, ["add a step", *STEP_KINDS])
     if changed and k > 0:
         step = MobiusStep.registry[STEP_KINDS[k - 1]]()
-        out.append(Edit((*lev, "transform"), [*lv.transform, step]))
+        out.append(_steps(e, i, [*lv.transform, step]))
     red_text(error if place == "selection" and not step_selected else "")
+
+
+def _steps(e, i: int, steps: list) -> Edit:
+    """Level i's step list set to ``steps`` (a step added, removed or moved), in its linked
+    finer levels too while step edits go to them (they stay linked)."""
+    if e.carry:
+        return Edit(*linked_steps(e.scene.mokrs, i, steps))
+    return Edit((*LEVELS, i, "transform"), steps)
 
 
 def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interactions, fields):
@@ -168,7 +176,7 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
     ):
         imgui.same_line()
         if imgui.small_button(f"{label}##s{j}"):
-            out.append(Edit((*LEVELS, i, "transform"), value))
+            out.append(_steps(e, i, value))
     imgui.indent()
     first = len(out)
     fields(s, sp, out, interactions)

@@ -129,8 +129,11 @@ class Editor:
     def _follow(self) -> None:
         now, drawn = self.shown_now, self.viewer.drawn
         if now.follow(self.scene, drawn.playback.time, drawn.posed) and self.selected:
-            # keep the selection across edits, undo, reload
-            self.selected = next((h for h in now.handles if h.same(self.selected)), None)
+            # keep the selection across edits, undo, reload; where its handle went (a MöKRS
+            # step removed), its level stays selected
+            old = self.selected
+            same = next((h for h in now.handles if h.same(old)), None)
+            self.selected = same or level_handle(now.handles, old.level)
 
     def handled_scene(self) -> Scene:
         """The scene whose values the handles and panels show (shown.py's ``drawn``)."""
@@ -277,11 +280,7 @@ class Editor:
             self.structure.level = h.path[h.path.index("levels") + 1]
 
     def select_level(self, level: int) -> None:
-        """Select a level by its first handle, the level's own before the route's (the
-        trunk's fork before the trunk foot), so the panel shows the level's fields."""
-        at = [h for h in self.handles if h.level == level]
-        own = [h for h in at if h.owner and h.owner[-1] == level]
-        self.select((own or at or [None])[0])
+        self.select(level_handle(self.handles, level))
 
     def _forget_stale_words(self) -> None:
         """The panel's last words (its error line, the structure section's message) and the
@@ -395,6 +394,14 @@ class Editor:
             path = self.selected.path if self.selected is not None else None
             self.execute(self.timeline.draw(self.scene, v.drawn.playback, path, free))
         hover_label(shown, view)
+
+
+def level_handle(handles: list[Handle], level: int) -> Handle | None:
+    """A level's first handle, the level's own before the route's (the trunk's fork before
+    the trunk foot), so the panel shows the level's fields; None: the level has none."""
+    at = [h for h in handles if h.level == level]
+    own = [h for h in at if h.owner and h.owner[-1] == level]
+    return (own or at or [None])[0]
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an

@@ -242,6 +242,19 @@ def linked_edit(m: MoKRS, path: tuple, value) -> tuple[tuple, object]:
     return path[:2], levels
 
 
+def linked_steps(m: MoKRS, i: int, steps: list) -> tuple[tuple, object]:
+    """The edit that gives level i and its linked levels the step list ``steps`` (a step
+    added, removed or moved: they stay linked): the whole level list where others follow,
+    else level i's steps alone."""
+    linked = linked_levels(m, i)
+    if len(linked) == 1:
+        return ("mokrs", "levels", i, "transform"), steps
+    levels = list(m.levels)
+    for k in linked:
+        levels[k] = replace(levels[k], transform=list(steps))
+    return ("mokrs", "levels"), levels
+
+
 POLE_DISTANCE = 1e-6  # a viewpoint closer than this (× the level's scale) to a pole is rejected
 
 

@@ -140,7 +140,14 @@ class Frames:
         # own, ≥ 2 per block; moving frames share a shadow ray per 2 × 2 or 3 × 3 pixels
         still = scene.render.shadow_block if splits_shadows(scene) else 0
         ratio = moving_ratio(size[0], still) if still and not self.full_shadows else still
-        image = PassImage(self.renderer, self.targets, scene, size, krs, ratio)
+        image = PassImage(
+            self.renderer,
+            self.targets,
+            at_window_epsilon(scene, size, self.adaptive.full),
+            size,
+            krs,
+            ratio,
+        )
         image.draw_all(issued=while_tracing)
         self.ctx.finish()  # the frame's time is read: the controller needs it
         seconds = time.perf_counter() - t0
@@ -171,7 +178,14 @@ class Frames:
                 traced = shown if step.ratio >= 1 and shown and shown.has_trace(size) else None
                 blocks = shown if step.primary else None  # its shadow blocks, for a primary step
                 self._tracing = PassImage(
-                    self.renderer, self.targets, scene, size, krs, step.ratio, traced, blocks
+                    self.renderer,
+                    self.targets,
+                    at_window_epsilon(scene, size, self.adaptive.full),
+                    size,
+                    krs,
+                    step.ratio,
+                    traced,
+                    blocks,
                 )
                 r.begin(self._tracing.passes)
                 self._step_seconds = 0.0
@@ -237,3 +251,16 @@ class Frames:
             self.renderer.programs = old
             raise
         self.display, self.dirty = display, True
+
+
+def at_window_epsilon(scene: Scene, size: tuple[int, int], window: tuple[int, int]) -> Scene:
+    """``scene`` for an image of ``size`` pixels shown in a ``window``: its ε, and the level
+    of detail that follows ε, those of the window's pixel, so that moving and refining
+    images draw the still image's very geometry, only sampled more coarsely. At a coarse
+    pixel's ε every twig was fattened by a coarse pixel: crowns went solid while moving and
+    thinned at once when the camera stopped."""
+    k = size[1] / window[1]
+    if k >= 1.0:
+        return scene
+    render = replace(scene.render, epsilon_scale=scene.render.epsilon_scale * k)
+    return replace(scene, render=render)
