@@ -519,3 +519,50 @@ def test_the_title_bar_names_the_scene_the_hud_opened(viewer, monkeypatch):
     assert titles == []
     viewer.execute([OpenPreset(resolve("palm"))])
     assert titles == ["krsview — palm"] and viewer.scene.name == "palm"
+
+
+def test_f6_without_a_path_says_how_to_record_one_and_a_new_scene_starts_unsaid(viewer):
+    """F6 with no camera path recorded says how to record one (it did nothing); what was
+    said of one scene ('replay finished', a bookmark's file) is gone when another opens."""
+    from krsview.viewer.commands import OpenPreset, Replay
+
+    v = viewer
+    assert v.file.recorder.path is None
+    v.execute([Replay()])
+    v.step(0.02)
+    assert "F5 records one" in v.message and v.file.recorder.replay_start is None
+    v.execute([OpenPreset(resolve("rock"))])
+    assert v.message == "" and v.scene.name == "rock"
+
+
+def test_the_hud_names_a_scene_file_of_ones_own_as_its_file(display, tmp_path, monkeypatch):
+    """The HUD's preset list shows a shipped preset by its name and a file of one's own as
+    that file (it showed a blank entry, or a preset's name for a copy called tree.toml)."""
+    from imgui_bundle import imgui
+
+    from krsview.viewer.window import Viewer
+
+    from .test_editor import open_from_start
+
+    open_from_start(monkeypatch, "scene, camera, output")
+    previews: list[str] = []
+    begin = imgui.begin_combo
+
+    def spy(label, preview, *a):
+        previews.append(preview)
+        return begin(label, preview, *a)
+
+    monkeypatch.setattr(imgui, "begin_combo", spy)
+    shutil.copy(resolve("tree"), tmp_path / "tree.toml")
+    for path, name in (
+        (resolve("tree"), "tree"),
+        (tmp_path / "tree.toml", "tree.toml (your file)"),
+    ):
+        v = Viewer(path, size=SIZE, hud=True)
+        try:
+            previews.clear()
+            v.step(0.02)
+            v.step(0.02)
+            assert name in previews, previews
+        finally:
+            v.close()

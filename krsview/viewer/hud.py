@@ -12,7 +12,7 @@ import numpy as np
 from imgui_bundle import imgui, implot
 
 from ..compile.constants import VIEW_MODES
-from ..document.document import Document
+from ..document.document import Document, shipped
 from ..scene import EFFECTS, Render, Scene
 from ..scene.effects import allowed_effects
 from ..scene.presets import preset_names, resolve
@@ -234,11 +234,14 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
 
 
 def _scene(v: Viewed, out: list) -> None:
+    """The shipped presets to open; a scene of the person's own is named as its file."""
     names = preset_names()
-    current = names.index(v.path.stem) if v.path.stem in names else -1
-    changed, k = imgui.combo("preset", current, names)
-    if changed:
-        out.append(c.OpenPreset(resolve(names[k])))
+    own = v.path.stem if shipped(v.path) else f"{v.path.name} (your file)"
+    if imgui.begin_combo("preset", own):
+        for name in names:
+            if imgui.selectable(name, name == own)[0]:
+                out.append(c.OpenPreset(resolve(name)))
+        imgui.end_combo()
     imgui.text(
         f"speed ×{v.nav.speed_factor:.2f} of the nearest distance "
         f"({v.nearest_distance():.3g}); scroll to change"

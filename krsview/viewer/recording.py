@@ -61,8 +61,11 @@ class Recorder:
             self.error = f"{self.file}: cannot save the camera path: {e.strerror}"
 
     def replay(self, clock: float) -> None:
-        if self.path is not None:
-            self.replay_start = clock
+        """Fly the recorded path from ``clock`` on; without one, say how to record one."""
+        if self.path is None:
+            self.message = "no camera path to replay yet: F5 records one"
+            return
+        self.replay_start = clock
 
     def tick(self, clock: float, camera: FlyCamera) -> bool:
         """One event-loop turn: record the camera's pose, or put the camera on the replayed

@@ -106,6 +106,7 @@ class Viewer:
         (files.py watches it)."""
         if self.window is not None:
             glfw.set_window_title(self.window, f"krsview — {self.scene.name}")
+        self.message = ""  # what was said of the last scene
         p = self.settings.prepass
         self._view_prepass = (
             p if p is not None else (None if self.scene.render.prepass else VIEW_PREPASS)
