@@ -336,3 +336,33 @@ def test_the_panel_starts_below_the_hud_where_they_would_overlap(side):
     x, y, width, _ = layout.panel((1280, 720), bar, HUD_RIGHT)
     overlaps = x < HUD_RIGHT + MARGIN
     assert overlaps == (side == "left") and y == (MARGIN + bar + MARGIN if overlaps else MARGIN)
+
+
+def test_the_growth_parameters_labels_fit_in_the_panel(tree_editor, monkeypatch):
+    """The structure section's growth fields leave room for their labels: each field and
+    its name end inside the panel (branch_angle's name was cut off at its edge)."""
+    from dataclasses import fields
+
+    from imgui_bundle import imgui
+
+    from krsview.scene.growth import Growth
+
+    e = tree_editor
+    node = imgui.tree_node
+
+    def opened(label: str) -> bool:
+        if label.startswith("growth"):
+            imgui.set_next_item_open(True, imgui.Cond_.once)
+        return node(label)
+
+    monkeypatch.setattr(imgui, "tree_node", opened)
+    pump(e, 3)
+    w = imgui.internal.find_window_by_name("edit")
+    right = w.pos.x + w.size.x - w.scrollbar_sizes.x
+    shown = [
+        f.name for f in fields(Growth) if ("route", "growth", f.name) in e.viewer.interactions.rects
+    ]
+    assert "branch_angle" in shown, shown
+    for name in shown:  # a widget's rectangle holds its label
+        x0, y0, x1, y1 = e.viewer.interactions.rects[("route", "growth", name)]
+        assert x1 <= right + 0.5, (name, x1, right)

@@ -127,6 +127,8 @@ def _component_level(t: StructureTools, route: Route, out: list[Command]) -> Non
 def _growth(growth: Growth, out: list[Command], interactions: Interactions) -> None:
     if not imgui.tree_node("growth (edits kept where they can be)"):
         return
+    longest = max(imgui.calc_text_size(f.name).x for f in fields(Growth))
+    imgui.push_item_width(-longest - imgui.get_style().item_inner_spacing.x)  # labels fit
     for f in fields(Growth):
         value = getattr(growth, f.name)
         if value is None or isinstance(value, list):
@@ -135,6 +137,7 @@ def _growth(growth: Growth, out: list[Command], interactions: Interactions) -> N
         key = interactions.key(("route", "growth", f.name))
         if changed:
             out.append(ec.SetGrowth(f.name, new, key))
+    imgui.pop_item_width()
     if imgui.button("grow again"):
         out.append(ec.Regrow())
     imgui.tree_pop()
