@@ -7,6 +7,7 @@ field with the message under it, as the editor's panel keeps its own."""
 from __future__ import annotations
 
 import shutil
+from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -190,18 +191,15 @@ def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
         v.close()
 
 
-def test_a_flight_key_let_go_while_a_field_has_the_keyboard_stops_the_flight(
-    display, tmp_path, monkeypatch
-):
-    """Hold W, ctrl+click into a HUD field (ImGui takes the keyboard), let W go: the viewer
-    lets it go too. It used to miss the release and fly on until W was pressed again.
-    Control: W is held before, and the field has the keyboard when it is let go."""
+@contextmanager
+def hud_open(monkeypatch, tmp_path, section="accuracy and view"):
+    """A 640×720 viewer on a copy of tree, its HUD's ``section`` open from the start, and a
+    function that makes event-loop turns; closed afterwards."""
     import glfw
-    from imgui_bundle import imgui
 
     from krsview.viewer.window import Viewer
 
-    open_from_start(monkeypatch, "accuracy and view")
+    open_from_start(monkeypatch, section)
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(640, 720))
@@ -212,11 +210,34 @@ def test_a_flight_key_let_go_while_a_field_has_the_keyboard_stops_the_flight(
             v.step(0.02)
 
     try:
-        turn(4)
-        x0, y0, x1, y1 = v.interactions.rects[("render", "max_iterations")]
-        wx, wy = glfw.get_window_pos(v.window)
-        xdo("mousemove", round(wx + x0 + 30), round(wy + (y0 + y1) / 2))
-        turn(2)
+        yield v, turn
+    finally:
+        v.close()
+
+
+def hover(v, turn, field: tuple, dx: float | None = None) -> None:
+    """The pointer onto a HUD ``field``, ``dx`` pixels into it (None: its middle), for two
+    turns after the HUD's first four."""
+    import glfw
+
+    turn(4)
+    x0, y0, x1, y1 = v.interactions.rects[field]
+    wx, wy = glfw.get_window_pos(v.window)
+    x = x0 + dx if dx is not None else (x0 + x1) / 2
+    xdo("mousemove", round(wx + x), round(wy + (y0 + y1) / 2))
+    turn(2)
+
+
+def test_a_flight_key_let_go_while_a_field_has_the_keyboard_stops_the_flight(
+    display, tmp_path, monkeypatch
+):
+    """Hold W, ctrl+click into a HUD field (ImGui takes the keyboard), let W go: the viewer
+    lets it go too. It used to miss the release and fly on until W was pressed again.
+    Control: W is held before, and the field has the keyboard when it is let go."""
+    from imgui_bundle import imgui
+
+    with hud_open(monkeypatch, tmp_path) as (v, turn):
+        hover(v, turn, ("render", "max_iterations"), 30)
         xdo("keydown", "w")
         turn(2)
         assert "W" in v.input.held
@@ -230,8 +251,6 @@ def test_a_flight_key_let_go_while_a_field_has_the_keyboard_stops_the_flight(
         assert "W" not in v.input.held
         xdo("key", "Escape")
         turn(2)
-    finally:
-        v.close()
 
 
 def test_a_long_tooltip_wraps_inside_a_small_window(display, tmp_path, monkeypatch):
@@ -241,29 +260,14 @@ def test_a_long_tooltip_wraps_inside_a_small_window(display, tmp_path, monkeypat
     the window)."""
     from dataclasses import fields
 
-    import glfw
     from imgui_bundle import imgui
 
     from krsview.scene.render import Render
     from krsview.viewer.widgets import TIP_EMS, tooltip_text
-    from krsview.viewer.window import Viewer
 
-    open_from_start(monkeypatch, "accuracy and view")
-    path = tmp_path / "tree.toml"
-    shutil.copy(resolve("tree"), path)
-    v = Viewer(path, size=(640, 720))
-
-    def turn(n: int = 3) -> None:
-        for _ in range(n):
-            glfw.poll_events()
-            v.step(0.02)
-
-    try:
-        turn(4)
-        x0, y0, x1, y1 = v.interactions.rects[("render", "culling")]
-        wx, wy = glfw.get_window_pos(v.window)
-        xdo("mousemove", round(wx + x0 + 10), round(wy + (y0 + y1) / 2))
-        turn(4)
+    with hud_open(monkeypatch, tmp_path) as (v, turn):
+        hover(v, turn, ("render", "culling"), 10)
+        turn(2)
         meta = next(dict(f.metadata) for f in fields(Render) if f.name == "culling")
         line = imgui.calc_text_size(tooltip_text(meta, str)).x
         assert line > 640, "control: the help fits on one line anyway"
@@ -277,8 +281,6 @@ def test_a_long_tooltip_wraps_inside_a_small_window(display, tmp_path, monkeypat
             tip.size.x
             <= TIP_EMS * imgui.get_font_size() + 2 * imgui.get_style().window_padding.x + 1
         )
-    finally:
-        v.close()
 
 
 def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_path, monkeypatch):
@@ -286,30 +288,13 @@ def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_p
     (ImGui's keyboard navigation, which would close it, is off). Negative control: the list
     is open before the key, and another key (J, which the viewer ignores)
     leaves it open."""
-    import glfw
     from imgui_bundle import imgui
-
-    from krsview.viewer.window import Viewer
-
-    open_from_start(monkeypatch, "accuracy and view")
-    path = tmp_path / "tree.toml"
-    shutil.copy(resolve("tree"), path)
-    v = Viewer(path, size=(640, 720))
-
-    def turn(n: int = 3) -> None:
-        for _ in range(n):
-            glfw.poll_events()
-            v.step(0.02)
 
     def is_open() -> bool:
         return imgui.is_popup_open("", imgui.PopupFlags_.any_popup)
 
-    try:
-        turn(4)
-        x0, y0, x1, y1 = v.interactions.rects[("render", "tracer")]
-        wx, wy = glfw.get_window_pos(v.window)
-        xdo("mousemove", round(wx + (x0 + x1) / 2), round(wy + (y0 + y1) / 2))
-        turn(2)
+    with hud_open(monkeypatch, tmp_path) as (v, turn):
+        hover(v, turn, ("render", "tracer"))
         xdo("click", 1)
         turn(3)
         assert is_open(), "the click opened no list"
@@ -320,8 +305,6 @@ def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_p
         turn(3)
         assert not is_open(), "Esc left the list open"
         assert v.scene.render.tracer == "sphere"
-    finally:
-        v.close()
 
 
 @pytest.mark.parametrize("side", ["left", "right"])
