@@ -141,6 +141,10 @@ def test_structural_mistakes():
     assert error_of(GOOD + zones).path == "effect_settings.empty_zones"
     assert error_of(GOOD + "\n[effect_settings]\nao_step = 0.0\n").path == "effect_settings.ao_step"
     assert error_of("name = [").path == "<syntax>"
+    # where and what, whole: the message was cut off mid-position ("(at line 2,…")
+    syntax = error_of('name = "x"\n[render\nfoo = 1\n')
+    assert syntax.value == "line 2, column 8" and "Expected ']'" in syntax.allowed, str(syntax)
+    assert "…" not in str(syntax)
     assert error_of("[tree]\nbranch_angle = 95.0").path == "tree.branch_angle"
 
 

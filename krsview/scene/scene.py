@@ -234,7 +234,11 @@ def scene_from_toml(text: str, file: str = "<string>") -> Scene:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise SceneError("<syntax>", str(e), "the file is not valid TOML", file) from None
+        what, _, where = str(e).rpartition(" (at ")  # tomllib: "... (at line 2, column 8)"
+        where = where.rstrip(")") if what else "the file"
+        raise SceneError(
+            "<syntax>", where, f"{what or e}: the file is not valid TOML", file
+        ) from None
     try:
         return from_dict(Scene, data)
     except SceneError as e:
