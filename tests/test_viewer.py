@@ -132,6 +132,20 @@ def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):
     assert "tree.levels = -4" in v.error
     assert v.scene.material.background == (1.0, 0.0, 0.0)  # last good scene kept
     assert v.frames.image is not None
+    # changed back to the contents last read, twice over: the refusal goes each time (it
+    # stayed, since the file no longer differed from the scene shown)
+    good = v.path.read_text().replace("levels = -4", "levels = 22")
+    for _ in range(2):
+        v.path.write_text(good.replace("levels = 22", "levels = -4"))
+        time.sleep(0.6)
+        for _ in range(3):
+            v.step(0.3)
+        assert "tree.levels = -4" in v.error
+        v.path.write_text(good)
+        time.sleep(0.6)
+        for _ in range(3):
+            v.step(0.3)
+        assert v.error == "" and "as it was" in v.message
 
 
 def test_shader_edit_reloads_and_a_broken_shader_keeps_the_last_good_image(display, tmp_path):
@@ -566,3 +580,15 @@ def test_the_hud_names_a_scene_file_of_ones_own_as_its_file(display, tmp_path, m
             assert name in previews, previews
         finally:
             v.close()
+
+
+def test_f6_said_at_the_foot_while_the_hud_is_hidden(viewer):
+    """The HUD hidden (the viewer fixture's), F6 without a path says so at the window's foot
+    too (it said it only in the hidden HUD)."""
+    from krsview.viewer.commands import Replay
+
+    v = viewer
+    assert not v.hud and v.status_line() == ""
+    v.execute([Replay()])
+    v.step(0.02)
+    assert "F5 records one" in v.status_line()

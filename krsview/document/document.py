@@ -165,7 +165,7 @@ class Document:
         SceneError for a bad file, keeping the current scene."""
         scene = load_scene(self.path)
         self.commit(scene, f"reload {self.path.name}")
-        self.mark_saved(scene)
+        self.mark_saved(scene, self.path.read_text(encoding="utf-8"))  # as written
 
     def save(self, path: str | os.PathLike | None = None, overwrite: bool = False) -> Path:
         """Write the scene atomically (to ``path``: save as). Refuses, with ConflictError, to

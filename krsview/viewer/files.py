@@ -27,6 +27,9 @@ class Shows(Protocol):
     frames: Frames  # the programs it draws with
     drawn: Drawn  # the geometry drawn
 
+    hud: bool
+
+    def say(self, text: str) -> None: ...  # a line at the window's foot for a few seconds
     def sync(self) -> None: ...  # redraw when the document changed
     def opened(self) -> None: ...  # a new document: its camera, pre-pass and moment
     def view_scene(self) -> Scene: ...  # the scene as drawn now
@@ -39,6 +42,7 @@ class ViewerFile:
     def __init__(self, viewer: Shows, shader_dir: Path):
         self.viewer = viewer
         self.shader_dir = shader_dir
+        self.refused = ""  # the error of the file's contents last refused, until it changes
         self.watch()
 
     @property
@@ -52,9 +56,12 @@ class ViewerFile:
         self.report()
 
     def report(self) -> None:
-        """Show what the camera-path recorder has to say, once."""
+        """Show what the camera-path recorder has to say, once (at the window's foot too
+        while the HUD is hidden)."""
         v, r = self.viewer, self.recorder
         if r.message:
+            if not v.hud:
+                v.say(r.message)
             v.message, r.message = r.message, ""
         if r.error:
             v.error, r.error = r.error, ""
@@ -79,9 +86,15 @@ class ViewerFile:
 
     def reload(self) -> None:
         """The scene file changed on disk: take it. A viewer has no edits of its own to lose
-        (the editor asks first when it has unsaved ones)."""
-        if self.viewer.doc.changed_on_disk():
+        (the editor asks first when it has unsaved ones). Changed back to what was last
+        read, it holds the scene shown: a refusal of the contents in between is gone."""
+        v = self.viewer
+        if v.doc.changed_on_disk():
             self.take()
+        elif self.refused:
+            if v.error == self.refused:
+                v.error, v.message = "", f"{self.path.name} is as it was"
+            self.refused = ""
 
     def take(self) -> None:
         """The file's contents become the scene (an undoable step); a bad file keeps the last
@@ -89,9 +102,9 @@ class ViewerFile:
         v = self.viewer
         try:
             v.doc.reload()
-            v.error, v.message = "", f"reloaded {self.path.name}"
+            v.error, v.message, self.refused = "", f"reloaded {self.path.name}", ""
         except SceneError as e:
-            v.error = str(e)  # keep the last good scene and image
+            v.error = self.refused = str(e)  # keep the last good scene and image
         v.sync()
 
     def add_bookmark(self) -> None:
