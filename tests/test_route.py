@@ -207,3 +207,23 @@ def test_the_readme_route_example_loads_without_warnings():
         levels=[scene.route.levels[0], replace(scene.route.levels[1], normal=(-1.0, 0.0, 0.0))],
     )
     assert turned.warnings()
+
+
+def test_a_baked_radius_carries_no_float_noise():
+    """A grown radius is written as the decimal it stands for (0.1036, not the float
+    product 0.10360000000000001), within 1e-14 of the product. Control: the products
+    themselves are noisy."""
+    from krsview import load
+
+    t = load("tree").tree
+    route = t.route()
+    n = len(route.levels) - 1
+    noisy = 0
+    for i, lv in enumerate(route.levels):
+        product = t.trunk_radius
+        for _ in range(n - i):
+            product *= t.radius_ratio
+        noisy += len(repr(product)) >= 18
+        assert len(repr(lv.radius).lstrip("0.")) <= 15, lv.radius
+        assert math.isclose(lv.radius, product, rel_tol=1e-14)
+    assert noisy > 0

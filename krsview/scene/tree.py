@@ -44,16 +44,13 @@ class Tree(Growth):
             side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-6 else np.zeros(3)
             control = P + 0.5 * length * d + self.bend * length * side
             color = self.leaf if i < self.leaf_levels else self.bark
+            fork, bend, r = as_vec3(end), as_vec3(control), baked(radius)
             if i == 0:
-                entries.append(
-                    RouteLevel(as_vec3(end), as_vec3(control), radius, color, grown=n - i)
-                )
+                entries.append(RouteLevel(fork, bend, r, color, grown=n - i))
                 break
             # Mirror R_{i-1} through the fork P_i = end, containing the parent direction.
             u = _rotate(s, d, math.radians(self.divergence))
-            entries.append(
-                RouteLevel(as_vec3(end), as_vec3(control), radius, color, as_vec3(u), n - i)
-            )
+            entries.append(RouteLevel(fork, bend, r, color, as_vec3(u), n - i))
             d_child = math.cos(theta) * d - math.sin(theta) * u  # child on the negative side
             s = math.sin(theta) * d + math.cos(theta) * u
             d, P = d_child / np.linalg.norm(d_child), end
@@ -67,9 +64,19 @@ class Tree(Growth):
         return Route(self.base, entries[::-1], list(self.forest), ground, growth_of(self))
 
 
+BAKED_DIGITS = 15  # significant digits a grown radius keeps: no float noise in files
+
+
 def as_vec3(v: np.ndarray | tuple) -> Vec3:
     """A plain tuple of Python floats (what the scene dataclasses hold)."""
     return tuple(float(c) for c in v)  # type: ignore[return-value]
+
+
+def baked(x: float) -> float:
+    """``x`` to BAKED_DIGITS significant digits: a radius grown as 0.14 × 0.74 × 0.74 is
+    written 0.076664, not 0.07666400000000001. (A point's coordinates are sines and cosines
+    summed, not decimals: they keep every digit, which the finest twigs need.)"""
+    return float(f"{x:.{BAKED_DIGITS}g}")
 
 
 def perpendicular(d: np.ndarray) -> np.ndarray:
