@@ -551,9 +551,11 @@ def test_f6_without_a_path_says_how_to_record_one_and_a_new_scene_starts_unsaid(
 
 def test_the_hud_names_a_scene_file_of_ones_own_as_its_file(display, tmp_path, monkeypatch):
     """The HUD's preset list shows a shipped preset by its name and a file of one's own as
-    that file (it showed a blank entry, or a preset's name for a copy called tree.toml)."""
+    that file (it showed a blank entry, or a preset's name for a copy called tree.toml), and
+    with another preset open it still offers that file back."""
     from imgui_bundle import imgui
 
+    from krsview.viewer.commands import OpenPreset
     from krsview.viewer.window import Viewer
 
     from .test_editor import open_from_start
@@ -578,6 +580,11 @@ def test_the_hud_names_a_scene_file_of_ones_own_as_its_file(display, tmp_path, m
             v.step(0.02)
             v.step(0.02)
             assert name in previews, previews
+            if name.endswith("(your file)"):  # another preset opened: the list leads back
+                v.execute([OpenPreset(resolve("palm"))])
+                assert v.file.mine == path and v.scene.name == "palm"
+                v.execute([OpenPreset(v.file.mine)])
+                assert v.path == path and v.scene.name == "tree"
         finally:
             v.close()
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Protocol
 
-from ..document.document import Document
+from ..document.document import Document, shipped
 from ..gpu.program import ShaderError
 from ..scene import Scene, SceneError
 from .camera import FlyCamera
@@ -43,6 +43,7 @@ class ViewerFile:
         self.viewer = viewer
         self.shader_dir = shader_dir
         self.refused = ""  # the error of the file's contents last refused, until it changes
+        self.mine: Path | None = None  # the last scene file of the person's own shown
         self.watch()
 
     @property
@@ -50,7 +51,10 @@ class ViewerFile:
         return self.viewer.doc.path
 
     def watch(self) -> None:
-        """A document was opened: watch its file and the shaders; its camera path beside it."""
+        """A document was opened: watch its file and the shaders; its camera path beside it.
+        A file of the person's own is remembered (``mine``): the HUD offers it back."""
+        if not shipped(self.path):
+            self.mine = self.path
         self.watcher = FileWatcher(self.path, self.shader_dir)
         self.recorder = Recorder(self.path)
         self.report()
@@ -83,6 +87,8 @@ class ViewerFile:
         camera path beside it."""
         self.watcher.watch(self.path)
         self.recorder.file = path_file(self.path)
+        if not shipped(self.path):
+            self.mine = self.path
 
     def reload(self) -> None:
         """The scene file changed on disk: take it. A viewer has no edits of its own to lose

@@ -234,13 +234,16 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
 
 
 def _scene(v: Viewed, out: list) -> None:
-    """The shipped presets to open; a scene of the person's own is named as its file."""
-    names = preset_names()
-    own = v.path.stem if shipped(v.path) else f"{v.path.name} (your file)"
-    if imgui.begin_combo("preset", own):
-        for name in names:
-            if imgui.selectable(name, name == own)[0]:
-                out.append(c.OpenPreset(resolve(name)))
+    """The shipped presets to open, and the last file of the person's own shown, named as
+    that file."""
+    mine = v.file.mine
+    shown = v.path.stem if shipped(v.path) else f"{v.path.name} (your file)"
+    entries = [(f"{mine.name} (your file)", mine)] if mine is not None else []
+    entries += [(name, resolve(name)) for name in preset_names()]
+    if imgui.begin_combo("preset", shown):
+        for label, path in entries:
+            if imgui.selectable(label, label == shown)[0] and label != shown:
+                out.append(c.OpenPreset(path))
         imgui.end_combo()
     imgui.text(
         f"speed ×{v.nav.speed_factor:.2f} of the nearest distance "
