@@ -256,3 +256,11 @@ def polylines(scene: Scene) -> list[np.ndarray]:
 
 def _line(route: Route) -> np.ndarray:
     return np.array([route.base] + [lv.fork for lv in route.levels][::-1])
+
+
+def level_handle(handles: list[Handle], level: int) -> Handle | None:
+    """A level's first handle, the level's own before the route's (the trunk's fork before
+    the trunk foot), so the panel shows the level's fields; None: the level has none."""
+    at = [h for h in handles if h.level == level]
+    own = [h for h in at if h.owner and h.owner[-1] == level]
+    return (own or at or [None])[0]

@@ -45,7 +45,7 @@ from .dragging import manipulate
 from .file_actions import FILE_HANDLERS, FileActions
 from .gizmo import Gizmo
 from .grab import Grabbing
-from .handles import Handle
+from .handles import Handle, level_handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
 from .panels import edit_panel
@@ -55,6 +55,7 @@ from .shapes import editor_shapes
 from .shown import Shown
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
+from .words import Words
 
 VIEW = "view.position"  # the viewpoint flown in the editor, in a refused edit's message
 EDITOR_KEYS = {
@@ -90,7 +91,7 @@ class Editor:
         self._again = False  # a turn at once: a pick's gizmo
         self._held: set[str] = set()  # the view's buttons held at the last turn's end
         self._title = ""
-        self._said: tuple = ((), None)  # the panel's last words, and what they were said of
+        self.words = Words()  # the panel's last words, gone once stale (words.py)
         self._update_title()
         self.frame()
 
@@ -196,7 +197,7 @@ class Editor:
         click, flick = v.input.take_click(), v.input.take_flick()
         v.move(dt)
         self.execute(v.file.watcher.poll())
-        self._forget_stale_words()
+        self.words.forget_stale(v, self.structure, self.scene, self.selected)
         self._follow()
         status = v.status_line()
         ui = v.hud or bool(status)
@@ -281,20 +282,6 @@ class Editor:
 
     def select_level(self, level: int) -> None:
         self.select(level_handle(self.handles, level))
-
-    def _forget_stale_words(self) -> None:
-        """The panel's last words (its error line, the structure section's message) and the
-        values its fields refused stay while the scene and the selection are those they were
-        said of; an undo, a redo, another edit or another selection makes them stale."""
-        v = self.viewer
-        words = (v.error, self.structure.message, tuple(v.interactions.refused))
-        of = (self.scene, self.selected.path if self.selected is not None else None)
-        if words != self._said[0]:
-            self._said = (words, of)
-        elif any(words) and (of[0] is not self._said[1][0] or of[1] != self._said[1][1]):
-            v.error, self.structure.message = "", ""
-            v.interactions.refused.clear()
-            self._said = (("", "", ()), of)
 
     def place_panel(self, side: str, width: float) -> None:
         """Dock the panel on ``side`` at ``width``; what was in the middle of the view stays
@@ -394,14 +381,6 @@ class Editor:
             path = self.selected.path if self.selected is not None else None
             self.execute(self.timeline.draw(self.scene, v.drawn.playback, path, free))
         hover_label(shown, view)
-
-
-def level_handle(handles: list[Handle], level: int) -> Handle | None:
-    """A level's first handle, the level's own before the route's (the trunk's fork before
-    the trunk foot), so the panel shows the level's fields; None: the level has none."""
-    at = [h for h in handles if h.level == level]
-    own = [h for h in at if h.owner and h.owner[-1] == level]
-    return (own or at or [None])[0]
 
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
