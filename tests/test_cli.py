@@ -56,7 +56,7 @@ def test_reference_render_matches_size(tmp_path):
         ),
         (
             ["render", "tree", "--epsilon-scale", "0"],
-            "--epsilon-scale = 0.0: allowed: 0.0001 ≤ value",
+            "--epsilon-scale = 0: allowed: 0.0001 ≤ value",
         ),
         (
             ["render", "tree", "--max-iterations", "-3"],
@@ -358,6 +358,9 @@ def test_view_options_come_from_the_settings_fields(capsys):
     with pytest.raises(SystemExit):
         parser.parse_args(["view", "--fps", "0.5"])
     assert "--fps = 0.5: allowed: 1 ≤ value ≤ 240" in capsys.readouterr().err
+    with pytest.raises(SystemExit):  # a number is said as it was typed: 0, not 0.0
+        parser.parse_args(["view", "--fps", "0"])
+    assert "--fps = 0: allowed" in capsys.readouterr().err
 
 
 def test_render_draws_fast_unless_exact(tmp_path, capsys):
@@ -381,4 +384,4 @@ def test_render_draws_fast_unless_exact(tmp_path, capsys):
     with pytest.raises(SystemExit) as bad:
         main([*base, "--lod", "-1"])
     assert bad.value.code == 2
-    assert "--lod = -1.0: allowed: 0 ≤ value ≤ 8 ε" in capsys.readouterr().err
+    assert "--lod = -1: allowed: 0 ≤ value ≤ 8 ε" in capsys.readouterr().err

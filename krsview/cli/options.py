@@ -114,8 +114,9 @@ def field_option(
             ) from None
         try:
             return check_value(hint, value, flag, meta)
-        except SceneError as e:
-            raise argparse.ArgumentTypeError(str(e)) from None
+        except SceneError as e:  # a number said as typed: 0, not 0.0
+            shown = text if hint in (int, float) else repr(text)
+            raise argparse.ArgumentTypeError(f"{flag} = {shown}: {e.allowed}") from None
 
     allowed = (
         "one of " + ", ".join(meta["choices"])
