@@ -15,6 +15,7 @@ from PIL import Image
 from krsview import load
 from krsview.scene.presets import resolve
 from krsview.viewer.adaptive import Step
+from krsview.viewer.hud import HUD_TITLE
 from krsview.viewer.screenshots import pictures_folder, save_screenshot
 
 SIZE = (640, 360)  # wide enough to see the image right of the HUD
@@ -130,6 +131,9 @@ def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
     assert v.status_line() == f"screenshot: {out}" and str(out) in capsys.readouterr().out
     _, drawn, _ = turn(v)
     assert f"screenshot: {out}" in drawn, "the status line is not drawn"
+    status, hud = (imgui.internal.find_window_by_name(n) for n in ("##status", HUD_TITLE))
+    assert hud.pos.y + hud.size.y > status.pos.y, "control: the HUD reaches the foot"
+    assert status.pos.x >= hud.pos.x + hud.size.x, "the status line covers the HUD"
     v.clock += 10  # the status line goes after a few seconds; the HUD's message stays
     _, drawn, _ = turn(v)
     assert v.status_line() == "" and drawn.count(f"screenshot: {out}") == 0
@@ -301,3 +305,19 @@ def test_moving_and_refining_images_take_the_windows_epsilon(hud_viewer, monkeyp
     assert smaller and any(s == full for s, _ in made), made
     assert all(e == pytest.approx(eps * s[1] / full[1]) for s, e in smaller), made
     assert all(e == eps for s, e in made if s == full), made
+
+
+def test_a_frame_that_compiled_is_not_counted_as_a_moving_frame(hud_viewer):
+    """The first frame compiles the scene's shaders: the HUD's moving frames and the
+    resolution's controller leave its time out."""
+    v = hud_viewer
+    compiles = v.renderer.programs.compiles
+    scale = v.frames.adaptive.scale
+    _, drawn, _ = turn(v)
+    assert v.renderer.programs.compiles > compiles, "control: the first frame compiled"
+    assert v.frames.frame_seconds == [] and v.frames.adaptive.scale == scale
+    assert any(t.startswith("moving frames: none yet") for t in drawn)
+    v.frames.dirty = True  # the view moved: the same programs draw again
+    _, drawn, _ = turn(v)
+    assert len(v.frames.frame_seconds) == 1 and v.frames.adaptive.history[-1] > 0
+    assert any(t.startswith("moving frames: median ") for t in drawn)

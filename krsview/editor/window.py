@@ -37,8 +37,9 @@ from ..scene.mokrs import check_view
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
 from ..viewer import commands as vc
 from ..viewer.controls import VIEWER_KEYS
-from ..viewer.hud import draw_hud, draw_status
+from ..viewer.hud import draw_hud
 from ..viewer.loop import run
+from ..viewer.status import draw_status
 from ..viewer.window import Viewer
 from . import commands as ec
 from .dragging import manipulate

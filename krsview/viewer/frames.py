@@ -132,8 +132,10 @@ class Frames:
         first pass is issued, ``while_tracing()`` runs (it starts that pass with a glFlush,
         which moderngl lacks): llvmpipe's threads trace while this thread does the turn's
         other work (the HUD), on a core that the passes leave idle part of the time
-        (docs/speed.md, "The HUD built while the frame is traced")."""
+        (docs/speed.md, "The HUD built while the frame is traced"). A frame that compiled a
+        shader (the first one, a knob changed) is not counted: its time is mostly compiling."""
         t0 = time.perf_counter()
+        compiles = self.renderer.programs.compiles
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
         # the still image's passes: 0 one pass, 1 shadow rays per pixel in a pass of their
@@ -151,8 +153,9 @@ class Frames:
         image.draw_all(issued=while_tracing)
         self.ctx.finish()  # the frame's time is read: the controller needs it
         seconds = time.perf_counter() - t0
-        self.adaptive.frame_done(seconds, rest)
-        self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
+        if self.renderer.programs.compiles == compiles:  # else its time is mostly compiling
+            self.adaptive.frame_done(seconds, rest)
+            self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
         steps = refinement_steps(scale, seconds, self.adaptive.supersample, ratio, still)
         self.refinement = Refinement(steps, self._cost, profile=self._profile) if steps else None
         self._tracing = None

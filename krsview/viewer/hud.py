@@ -24,7 +24,7 @@ from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .timeline import draw_time
-from .widgets import RED, Interactions, field_widget, red_text, tooltip
+from .widgets import Interactions, field_widget, red_text, tooltip
 
 HUD_TITLE = "krsview (F1 hides)"
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
@@ -132,23 +132,6 @@ def numbers_height() -> float:
     return 4 * imgui.get_text_line_height_with_spacing() + PLOT_HEIGHT
 
 
-def draw_status(text: str, error: bool = False) -> None:
-    """A one-line status (a screenshot's path; an ``error`` in red) at the foot of the
-    window, HUD shown or not."""
-    if not text:
-        return
-    foot = imgui.get_io().display_size
-    imgui.set_next_window_pos(imgui.ImVec2(8, foot.y - 8), imgui.Cond_.always, imgui.ImVec2(0, 1))
-    imgui.set_next_window_bg_alpha(0.75)
-    flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
-    imgui.begin("##status", None, flags | imgui.WindowFlags_.no_inputs)
-    if error:
-        imgui.text_colored(RED, text)
-    else:
-        imgui.text(text)
-    imgui.end()
-
-
 def _numbers(v: Viewed) -> None:
     """The image on screen (state, resolution, time), then the moving frames' times against
     their budget: the frame budget less the rest of a turn."""
@@ -158,7 +141,8 @@ def _numbers(v: Viewed) -> None:
     times = np.array(v.frames.frame_seconds[-PLOTTED:] or [0.0], dtype=np.float32) * 1e3
     a = v.frames.adaptive
     budget, rest = 1e3 * a.trace_budget, 1e3 * a.rest
-    imgui.text(f"moving frames: median {np.median(times):.1f} ms, budget {budget:.1f} ms")
+    moved = f"median {np.median(times):.1f} ms" if v.frames.frame_seconds else "none yet"
+    imgui.text(f"moving frames: {moved}, budget {budget:.1f} ms")
     imgui.text(f"the rest of a turn (display, HUD, swap): {rest:.1f} ms")
     readout = implot.Flags_.no_legend | implot.Flags_.no_inputs  # the wheel scrolls the HUD
     if implot.begin_plot("##frametime", imgui.ImVec2(-1, PLOT_HEIGHT), readout):

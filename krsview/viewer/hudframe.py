@@ -8,8 +8,9 @@ from __future__ import annotations
 from typing import Protocol
 
 from . import commands as c
-from .hud import Viewed, begin_hud, draw_status, finish_hud
+from .hud import Viewed, begin_hud, finish_hud
 from .platform import Platform
+from .status import draw_status
 from .widgets import Interactions
 
 

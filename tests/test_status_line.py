@@ -1,0 +1,61 @@
+"""The status line's place at the window's foot: where no other window covers it."""
+
+import math
+
+from krsview.viewer.status import MARGIN, MIN_ROOM, status_spot
+
+DISPLAY = (960.0, 540.0)
+FOOT = DISPLAY[1] - MARGIN
+HUD = (8.0, 8.0, 448.0, 536.0)  # reaches the foot
+
+
+def line(length: float, height: float = 24.0):
+    """A text ``length`` px long on one line; wrapped at a width, as many lines as it takes."""
+    return lambda width: (
+        (length, height) if length <= width else (width, height * math.ceil(length / width))
+    )
+
+
+def meets(a, b) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def box(spot, measure):
+    x, foot, room = spot
+    w, h = measure(room)
+    return (x, foot - h, x + w, foot)
+
+
+def test_alone_it_sits_at_the_foot_on_the_left():
+    assert status_spot(DISPLAY, line(300), []) == (MARGIN, FOOT, DISPLAY[0] - 2 * MARGIN)
+
+
+def test_beside_a_hud_that_reaches_the_foot():
+    spot = status_spot(DISPLAY, line(300), [HUD])
+    assert spot == (HUD[2] + MARGIN, FOOT, 496.0) and not meets(box(spot, line(300)), HUD)
+    # control: at the foot's left, where it used to be, it covers the HUD's last lines
+    assert meets(box((MARGIN, FOOT, 944.0), line(300)), HUD)
+    # a short HUD leaves the foot free
+    assert status_spot(DISPLAY, line(300), [(8.0, 8.0, 448.0, 300.0)])[0] == MARGIN
+
+
+def test_between_windows_or_above_a_timeline():
+    panel = (660.0, 0.0, 960.0, 540.0)
+    assert status_spot(DISPLAY, line(150), [HUD, panel]) == (456.0, FOOT, 196.0)
+    timeline = (8.0, 470.0, 952.0, 532.0)  # the editor's strip across the foot
+    spot = status_spot(DISPLAY, line(300), [timeline])
+    assert spot[:2] == (MARGIN, timeline[1] - MARGIN)
+    assert not meets(box(spot, line(300)), timeline)
+
+
+def test_too_long_for_one_line_it_is_wrapped_into_a_gap():
+    long = line(700)
+    spot = status_spot(DISPLAY, long, [HUD])
+    assert spot == (456.0, FOOT, 496.0) and not meets(box(spot, long), HUD)
+    assert box(spot, long)[1] == FOOT - 48, "two lines"
+    # a gap under MIN_ROOM is none: then the foot's left, over the HUD
+    narrow = (456.0 + MIN_ROOM, 0.0, 960.0, 540.0)
+    assert status_spot(DISPLAY, long, [HUD, narrow])[:2] == (MARGIN, FOOT)
+    # a gap whose column is taken higher up (a window right of the HUD, above the foot)
+    above = (456.0, 0.0, 960.0, FOOT - 30)
+    assert status_spot(DISPLAY, long, [HUD, above])[:2] == (MARGIN, FOOT)
