@@ -410,6 +410,24 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     imgui.end()
     v.platform.render()
     assert commands == [] and v.drawn.levels == 12
+    # the suggestion is for the moving frames' size when the view came to rest: steady
+    # while flying, where every frame changes that size
+    settle(v)
+    rest = v.frames.rest_size
+    assert rest == v.frames.adaptive.moving_size()
+    asked = []
+    monkeypatch.setattr(hud, "best_within", lambda rows, ms, px: asked.append(px))
+    for scale in (0.2, 0.3):  # two moving frames of other sizes
+        v.frames.adaptive.scale = scale
+        v.frames.dirty = True
+        v.step(0.02)
+        assert v.frames.rest_size == rest != v.frames.adaptive.moving_size()
+        v.platform.new_frame()
+        imgui.begin("test")
+        hud._measured(v, [])
+        imgui.end()
+        v.platform.render()
+    assert asked == [rest[0] * rest[1]] * 2
     (tmp_path / "tree" / "accuracy.csv").write_text("knob,value,ms\nscene,x,notanumber\n")
     assert load_measured("tree") is None
 

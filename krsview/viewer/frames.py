@@ -84,6 +84,9 @@ class Frames:
         self._profile: dict[str, list[float]] = {}  # ... and per slice of rows (Refinement)
         self._step_seconds = 0.0
         self._traced_at = 0.0  # when the last turn's tracing ended (0: it traced nothing)
+        # the moving frames' size when the view last came to rest (the HUD's measured
+        # accuracy suggests for it: a size that does not change while flying)
+        self.rest_size: tuple[int, int] | None = None
 
     @property
     def refined(self) -> bool:
@@ -171,6 +174,8 @@ class Frames:
         """Bands of the refinement's next image for as long as ``rest``, the last turn's time
         besides its tracing, within refining_budget."""
         r = self.refinement
+        if r.k == 0 and not r.started:  # the view came to rest
+            self.rest_size = self.adaptive.moving_size()
         spent, budget = 0.0, refining_budget(self.adaptive.budget, rest)
         prepared = None
         while not r.done and spent < budget:

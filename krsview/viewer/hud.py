@@ -269,7 +269,7 @@ def _measured(v: Viewed, out: list) -> None:
         for r in rows
         if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth, v.prepass)
     ]
-    w, h = v.frames.adaptive.moving_size()
+    w, h = v.frames.rest_size or v.frames.adaptive.moving_size()  # steady while flying
     if implot.begin_plot("##accuracy", imgui.ImVec2(-1, 150), implot.Flags_.no_inputs):
         implot.setup_axes("ms (report size)", "hit-mask error %")
         ms = np.array([r["ms"] for r in rows], dtype=np.float32)
