@@ -17,14 +17,19 @@ Scenes are immutable values and may be shared freely; the float64 reference
 
 from __future__ import annotations
 
+import gc
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .frame import Frame
-from .scene import Render, Scene, SceneError, load_scene
+from .inputs import output_file, scene_of, size_of, switch, whole
+from .scene import Render, Scene, SceneError, load_scene, save_scene
+from .scene.edits import vouched
 from .scene.info import SceneInfo, describe
 from .scene.model import KRS
 from .scene.presets import preset_names, resolve
@@ -45,7 +50,24 @@ def load(name_or_path: str | Path) -> Scene:
     >>> load("tree").geometry().depth
     23
     """
+    if not isinstance(name_or_path, (str, Path)):
+        raise SceneError("name_or_path", name_or_path, "expected a preset's name or a .toml path")
     return load_scene(resolve(str(name_or_path)))
+
+
+def save(scene: Scene, path: str | Path) -> Path:
+    """Write ``scene`` as a scene file (``.toml``), validated first, atomically (a file is
+    whole or untouched); the path written. :func:`load` reads it back to an equal scene.
+
+    >>> import pathlib, tempfile
+    >>> out = save(load("rock"), pathlib.Path(tempfile.mkdtemp()) / "rock.toml")
+    >>> load(out) == load("rock")
+    True
+    """
+    scene = scene_of(scene)
+    out = output_file(path, "path", (".toml",))
+    save_scene(scene, out)
+    return out
 
 
 def load_dict(data: Mapping[str, Any], name: str = "<dict>") -> Scene:
@@ -56,8 +78,10 @@ def load_dict(data: Mapping[str, Any], name: str = "<dict>") -> Scene:
     >>> s.geometry().instance_count()
     1
     """
+    if not isinstance(data, Mapping):
+        raise SceneError(name, data, "expected a dict of a scene file's tables")
     try:
-        return from_dict(Scene, dict(data))
+        return vouched(from_dict(Scene, dict(data)))
     except SceneError as e:
         raise e.in_file(name) from None
 
@@ -68,7 +92,7 @@ def presets() -> list[str]:
 
 
 def configure(
-    scene: Scene,
+    scene: Scene | str | Path,
     *,
     levels: int | None = None,
     effects: list[str] | None = None,
@@ -76,18 +100,19 @@ def configure(
     **knobs: Any,
 ) -> Scene:
     """The scene with render knobs (the ``[render]`` fields: ``tracer``, ``epsilon_scale``,
-    ``max_iterations``, ``precision``, ``prepass``, ``path``, …), an effect set, a level
-    count and the moment drawn (``time``, seconds: :meth:`Scene.at`) applied, each checked by
-    the scene schema."""
+    ``max_iterations``, ``precision``, ``prepass``, ``path``, …), the moment drawn
+    (``time``, seconds: :meth:`Scene.at`), an effect set and a level count (of the scene as
+    posed at that moment) applied, each checked by the scene schema."""
+    scene = scene_of(scene)
     for name, value in knobs.items():
         if name not in RENDER_KNOBS:
             raise SceneError(name, value, "not a render knob; allowed: " + ", ".join(RENDER_KNOBS))
         scene = scene.edit(("render", name), value)
+    if time is not None:
+        scene = scene.at(time)
     if effects is not None:
         scene = scene.with_effects(effects)
-    if levels is not None:
-        scene = scene.with_levels(levels)
-    return scene if time is None else scene.at(time)
+    return scene if levels is None else scene.with_levels(levels)
 
 
 def fast_settings(scene: Scene) -> Scene:
@@ -141,10 +166,8 @@ class Renderer:
     """
 
     def __init__(self, width: int = DEFAULT_SIZE[0], height: int = DEFAULT_SIZE[1]):
-        for axis, v in (("width", width), ("height", height)):
-            if not (isinstance(v, int) and 1 <= v <= MAX_SIDE):
-                raise SceneError(axis, v, f"allowed: a whole number of pixels, 1..{MAX_SIDE}")
-        self.width, self.height = width, height
+        self.width = whole(width, "width", 1, MAX_SIDE)
+        self.height = whole(height, "height", 1, MAX_SIDE)
         self._gpu = None
 
     @property
@@ -166,7 +189,7 @@ class Renderer:
 
     def render(
         self,
-        scene: Scene,
+        scene: Scene | str | Path,
         *,
         reference: bool = False,
         exact: bool = False,
@@ -178,22 +201,40 @@ class Renderer:
         ``exact=True`` every level and no pre-pass (:func:`exact_settings`); ``reference=True``
         traces it with the float64 NumPy reference instead of the GPU; ``progress(done,
         total)`` is called as bands of rows (GPU) or chunks of rays (reference) finish."""
-        scene = configure(exact_settings(scene) if exact else fast_settings(scene), **knobs)
-        if reference:
+        scene = self._settled(scene, exact, **knobs)
+        if switch(reference, "reference"):
             from .reference import render_reference
 
             return render_reference(scene, self.width, self.height, progress=progress)
         return self.gpu.render(scene, self.width, self.height, progress=progress)
 
-    def time(self, scene: Scene, repeats: int = 5, **knobs: Any) -> list[float]:
-        """Wall time of ``repeats`` frames in seconds (GPU finished), after a warm-up."""
-        return self.gpu.time_frame(
-            configure(scene, **knobs), self.width, self.height, repeats=repeats
-        )
+    def time(
+        self, scene: Scene | str | Path, repeats: int = 5, *, exact: bool = False, **knobs: Any
+    ) -> list[float]:
+        """Wall time of ``repeats`` frames in seconds (GPU finished), after a warm-up: the
+        frames :meth:`render` draws with the same arguments."""
+        scene = self._settled(scene, exact, **knobs)
+        repeats = whole(repeats, "repeats", 1)
+        return self.gpu.time_frame(scene, self.width, self.height, repeats=repeats)
+
+    @staticmethod
+    def _settled(scene: Scene | str | Path, exact: bool, **knobs: Any) -> Scene:
+        scene = scene_of(scene)
+        settle = exact_settings if switch(exact, "exact") else fast_settings
+        return configure(settle(scene), **knobs)
 
     def close(self) -> None:
-        """Drop the compiled variants and targets (the shared context stays for others)."""
+        """Release the compiled variants and targets (the shared context and the shared
+        renderer of :func:`render` stay for others)."""
+        own = self._gpu is not None and self._gpu is not _shared_gpu
         self._gpu = None
+        if own:  # its GL objects go once Python drops them (the context's gc_mode)
+            from .gpu.context import release_dropped
+
+            gc.collect()
+            ctx = _shared_context()
+            with _lock, ctx:
+                release_dropped(ctx)
 
     def __enter__(self) -> Renderer:
         return self
@@ -220,13 +261,39 @@ def render(
     applied first (:func:`configure`), over the viewer's fast settings (:func:`fast_settings`), or
     over every level without the pre-pass with ``exact=True``. Variants stay compiled
     between calls."""
-    if not isinstance(scene, Scene):
-        scene = load(scene)
-    r = Renderer(*size)
+    scene = scene_of(scene)
+    r = Renderer(*size_of(size))
     with _lock:
         if not reference:
             r.gpu_shared()
         return r.render(scene, reference=reference, exact=exact, progress=progress, **knobs)
+
+
+def distance(scene: Scene | str | Path, points: Any) -> np.ndarray:
+    """Alg. 1's distance from each of ``points`` (an array (..., 3), world units) to the
+    surface the scene draws at its time, in float64 by the NumPy reference [KRS17 Alg. 1]: a
+    lower bound of the true distance (equal to it where no mirror clips a kernel), negative
+    inside a kernel; the shape of ``points`` less its last axis. A MöKRS has no distance
+    function [KRS17 §6] and is refused. (A ray's hit from the eye: :func:`render`'s
+    ``depth``.)
+
+    >>> float(distance("rock", [0.0, 100.0, 0.0])) > 90
+    True
+    """
+    from .compile.geometry import compile_geometry
+    from .reference.distortion import Distortion
+    from .reference.geometry import scene_distance
+
+    scene = scene_of(scene).posed()
+    if scene.mokrs is not None:
+        raise SceneError("scene", scene.name, "a MöKRS has no distance function [KRS17 §6]")
+    p = np.asarray(points, dtype=float)
+    if p.ndim == 0 or p.shape[-1] != 3 or not np.isfinite(p).all():
+        shown = f"<an array of shape {p.shape}>" if p.ndim else p
+        raise SceneError("points", shown, "expected finite points, an array of shape (..., 3)")
+    c = compile_geometry(scene.geometry(), scene.material.albedo)
+    d = scene_distance(c, p.reshape(-1, 3), Distortion.of(scene))
+    return d.reshape(p.shape[:-1])
 
 
 def check(scene: Scene | str | Path) -> SceneInfo:
@@ -236,7 +303,7 @@ def check(scene: Scene | str | Path) -> SceneInfo:
     >>> check("forest").instances
     4194273
     """
-    return describe(scene if isinstance(scene, Scene) else load(scene))
+    return describe(scene_of(scene))
 
 
 def hard_cases() -> dict[str, Scene]:
@@ -255,9 +322,9 @@ def stability(scene: Scene | str | Path, size: tuple[int, int] = (48, 27)):
     falls short): a :class:`krsview.bench.stability.Outcome` (``.ok``)."""
     from .bench import stability as invariants
 
-    scene = scene if isinstance(scene, Scene) else load(scene)
+    scene, size = scene_of(scene), size_of(size)
     with _lock:
-        return invariants.check(scene, Renderer(*size).gpu_shared(), tuple(size))
+        return invariants.check(scene, Renderer(*size).gpu_shared(), size)
 
 
 def certify(
@@ -272,7 +339,9 @@ def certify(
     ``tracer`` overrides the scene's."""
     from .oracle.certify import MAX_SEGMENTS, UNCOVERED, count_errors
 
-    scene = scene if isinstance(scene, Scene) else load(scene)
+    scene, size = scene_of(scene), size_of(size)
+    if max_segments is not None:
+        max_segments = whole(max_segments, "max_segments", 1)
     if UNCOVERED & set(scene.effects):
         raise SceneError(
             scene.name,

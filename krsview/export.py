@@ -16,7 +16,8 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from .scene import Scene
+from .inputs import output_dir, output_file, real, region, scene_of, size_of, whole
+from .scene import Scene, SceneError
 from .scene.camera_path import CameraPath, load_camera_path
 from .scene.scene import write_atomic
 from .share.frames import (
@@ -29,26 +30,29 @@ from .share.frames import (
 )
 
 
-def html(scene: Scene, path: str | Path) -> list[str]:
+def html(scene: Scene | str | Path, path: str | Path) -> list[str]:
     """One page (no server, no network) running the scene's own specialised tracer in
-    WebGL2, written atomically to ``path``; returns notes on what the web cannot carry
-    (double precision, the pre-pass, the compute path)."""
+    WebGL2, written atomically to ``path`` (``.html``); returns notes on what the web
+    cannot carry (double precision, the pre-pass, the compute path)."""
     from .share.web import export_notes, html_page
 
+    scene, path = scene_of(scene), output_file(path, "path", (".html", ".htm"))
     write_atomic(path, html_page(scene))
     return export_notes(scene)
 
 
-def shadertoy(scene: Scene, path: str | Path) -> list[str]:
-    """The same tracer as one Shadertoy ``mainImage`` (scene baked in as constants)."""
+def shadertoy(scene: Scene | str | Path, path: str | Path) -> list[str]:
+    """The same tracer as one Shadertoy ``mainImage`` (scene baked in as constants), written
+    atomically to ``path`` (``.glsl``)."""
     from .share.web import export_notes, shadertoy_source
 
+    scene, path = scene_of(scene), output_file(path, "path", (".glsl", ".txt"))
     write_atomic(path, shadertoy_source(scene))
     return export_notes(scene, shadertoy=True)
 
 
 def mesh(
-    scene: Scene,
+    scene: Scene | str | Path,
     path: str | Path,
     resolution: int = 256,
     lod: float = 0.5,
@@ -57,11 +61,18 @@ def mesh(
 ):
     """A triangle mesh of the surface (``.glb``, ``.ply``, ``.stl``, ``.obj`` by the suffix):
     the float64 reference sampled near the surface, marching cubes, vertices bisected onto
-    it; written whole or not at all. Returns its :class:`krsview.share.mesh.MeshStats`.
-    Needs ``pip install 'krsview[mesh]'``."""
-    from .share.mesh import build_mesh
+    it; written whole or not at all. ``resolution``: voxels along the sampled cube's side,
+    16..2048, rounded up to a power of two times the brick's side; ``lod``: mesh the level
+    set this many voxels out, 0..4 (what is thinner than a voxel then stays); ``box``: the
+    region (XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX), by default the scene's bounding ball (a
+    ground plane has none). Returns its :class:`krsview.share.mesh.MeshStats`. Needs
+    ``pip install 'krsview[mesh]'``."""
+    from .share.mesh import FORMATS, build_mesh
 
-    out = Path(path)
+    scene, out = scene_of(scene), output_file(path, "path", FORMATS)
+    resolution = whole(resolution, "resolution", 16, 2048)
+    lod = real(lod, "lod", 0.0, 4.0)
+    box = None if box is None else region(box, "box")
     m, stats = build_mesh(scene, resolution, box, lod, progress)
     tmp = out.with_name(f".{out.name}.tmp{out.suffix}")
     try:
@@ -87,8 +98,10 @@ def frames(
     frames' files in order."""
     from .api import Renderer
 
+    scene, size = scene_of(scene), size_of(size)
     path = camera_path if isinstance(camera_path, CameraPath) else load_camera_path(camera_path)
-    job = FrameJob(scene, path, fps, tuple(size), Path(folder))
+    fps = real(fps, "fps", 1.0, 240.0)
+    job = FrameJob(scene, path, fps, size, output_dir(folder, "folder"))
     wanted = parse_frames(which, job.count, "which")
     job.folder.mkdir(parents=True, exist_ok=True)
     todo = job.missing(wanted)
@@ -106,11 +119,16 @@ def video(
 ) -> Path:
     """An H.264 MP4 of the frames in ``folder`` (all, or the range ``which``), written whole
     or not at all; ``done(k)`` after each frame."""
-    folder = Path(folder)
+    folder, video = Path(folder), output_file(video_path, "video_path", (".mp4",))
+    fps = real(fps, "fps", 1.0, 240.0)
     if which is None:
         count = 0
         while frame_file(folder, count).exists():
             count += 1
         which = range(count)
-    write_video(folder, which, fps, Path(video_path), done)
-    return Path(video_path)
+    missing = next((k for k in which if not frame_file(folder, k).exists()), None)
+    if not which or missing is not None:
+        name = frame_file(folder, 0 if missing is None else missing).name
+        raise SceneError("folder", str(folder), f"has no {name} (export.frames writes frames)")
+    write_video(folder, which, fps, video, done)
+    return video

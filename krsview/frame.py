@@ -40,9 +40,18 @@ class Frame:
 
     def save(self, path: str | Path) -> Path:
         """Write the colour (``.png``, or any format Pillow knows by the suffix) or every
-        array (``.npz``); returns the path."""
+        array (``.npz``); returns the path. A suffix neither knows is refused (ValueError)
+        before anything is written."""
+        from PIL import Image
+
         path = Path(path)
-        if path.suffix.lower() == ".npz":
+        suffix = path.suffix.lower()
+        if suffix != ".npz" and suffix not in Image.registered_extensions():
+            raise ValueError(
+                f"path = {str(path)!r}: the file must end in .png, .npz or another image "
+                "format's suffix (.jpg, .tif, .webp, …)"
+            )
+        if suffix == ".npz":
             np.savez_compressed(
                 path,
                 color=self.color,
@@ -57,9 +66,18 @@ class Frame:
 
     @classmethod
     def load(cls, path: str | Path) -> Frame:
-        """A frame written by :meth:`save` as ``.npz``."""
-        with np.load(path) as data:
-            return cls(**{name: data[name] for name in cls.__dataclass_fields__})
+        """A frame written by :meth:`save` as ``.npz`` (ValueError for any other file)."""
+        names = list(cls.__dataclass_fields__)
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                return cls(**{name: data[name] for name in names})
+        except OSError as e:
+            raise ValueError(f"path = {str(path)!r}: cannot read: {e.strerror}") from None
+        except (ValueError, KeyError, AttributeError, TypeError):
+            raise ValueError(
+                f"path = {str(path)!r}: not a frame written by Frame.save as .npz "
+                f"(arrays {', '.join(names)})"
+            ) from None
 
     def _repr_png_(self) -> bytes:
         """Jupyter shows a frame as its image."""

@@ -12,7 +12,8 @@ PACKAGE = Path(__file__).resolve().parent.parent / "krsview"
 # package of krsview or a top-level module; one missing here fails the test, so a new room
 # states its arrows. Arrows run one way: cli → app → editor → viewer → document → scene;
 # viewer/editor → gpu → compile → scene → algebra; reference, oracle → compile;
-# bench/share → gpu, reference; the public API (krsview/__init__.py) sits under the CLI.
+# bench/share → gpu, reference; the public API (krsview/__init__.py) sits under the CLI, and
+# checks its arguments by inputs → scene.
 BASE = {"algebra", "frame", "progress", "heatmap", "version"}
 ALLOWED = {
     "algebra": set(),
@@ -31,10 +32,11 @@ ALLOWED = {
     "viewer": {"document", "gpu", "reference", "compile", "scene"} | BASE,
     "editor": {"viewer", "document", "gpu", "reference", "compile", "scene"} | BASE,
     "app": {"viewer", "editor", "scene"},
-    "api": {"share", "bench", "oracle", "gpu", "reference", "compile", "scene"} | BASE,
-    "export": {"api", "share", "scene"} | BASE,
+    "inputs": {"scene"},
+    "api": {"inputs", "share", "bench", "oracle", "gpu", "reference", "compile", "scene"} | BASE,
+    "export": {"api", "inputs", "share", "scene"} | BASE,
     "": {"api", "export", "scene"} | BASE,
-    "cli": {"", "api", "export", "app", "share", "bench", "oracle", "gpu", "reference"}
+    "cli": {"", "api", "inputs", "export", "app", "share", "bench", "oracle", "gpu", "reference"}
     | {"compile", "scene"}
     | BASE,
     "__main__": {"cli"},

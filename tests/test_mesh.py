@@ -148,10 +148,13 @@ def test_each_format_loads_back_with_the_same_triangles(tmp_path, suffix):
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["tree", "-o", "t.fbx"], "-o = 't.fbx': the file must end in .glb, .ply, .stl, .obj"),
+        (["tree", "-o", "t.fbx"], "-o = 't.fbx': the file must end in .glb, .ply, .stl or .obj"),
         (["grass", "-o", "g.glb"], "geometry = 'grass': is unbounded"),
-        (["tree", "-o", "t.glb", "--box", "1,2,3"], "--box '1,2,3': expected six numbers"),
-        (["tree", "-o", "t.glb", "--box", "0,0,0,1,-1,1"], "each max must exceed its min"),
+        (["tree", "-o", "t.glb", "--box", "1,2,3"], "--box '1,2,3': expected six finite numbers"),
+        (
+            ["tree", "-o", "t.glb", "--box", "0,0,0,1,-1,1"],
+            "each max (the last three) must exceed its min",
+        ),
         (["tree", "-o", "t.glb", "--resolution", "8"], "--resolution '8': allowed 16 ≤ value"),
         (["tree", "-o", "t.glb", "--lod", "nan"], "--lod 'nan': allowed 0.0 ≤ value ≤ 4.0"),
         (["tree", "-o", "t.glb", "--box", "50,50,50,51,51,51"], "no surface inside the region"),

@@ -13,11 +13,12 @@ from pathlib import Path
 from .. import app
 from ..bench.expansion import TOLERANCE
 from ..bench.report import markdown, write_csv
+from ..inputs import output_dir, output_file
 from ..scene import MAX_LEVELS, SceneError
 from ..scene.presets import DEFAULT_PRESET, resolve
 from ..scene.render import VIEW_PREPASS
 from . import options
-from .options import check_output_dir, check_output_file, render_option
+from .options import render_option
 
 
 @dataclass(frozen=True)
@@ -129,7 +130,7 @@ BENCHES = {
             (
                 "--plot",
                 dict(
-                    type=lambda text: check_output_file(text, "--plot", ".png"),
+                    type=lambda text: output_file(text, "--plot", (".png",)),
                     help="also draw time and work along the flight into this PNG",
                 ),
             ),
@@ -213,7 +214,7 @@ def run(args: argparse.Namespace) -> int:
     if BENCHES[args.bench].fast:
         scene = options.fast_scene_of(args, scene)
     if args.csv:
-        check_output_file(args.csv, "--csv", ".csv")
+        output_file(args.csv, "--csv", (".csv",))
     module = importlib.import_module(f"krsview.bench.{args.bench}")
     own = {dest: getattr(args, dest) for dest in args.own}
     measured = getattr(module, f"bench_{args.bench}")(scene, args.size, rounds=args.rounds, **own)
@@ -295,7 +296,7 @@ def run_accuracy(args: argparse.Namespace) -> int:
         raise SceneError("PRESET", " ".join(names), "each preset once")
     outs = {n: report_folder(args.out, n, len(names) > 1) for n in names}
     for out in outs.values():
-        check_output_dir(out, "--out")
+        output_dir(out, "--out")
     cache = Path(args.cache) if args.cache else None
     if args.workers > 1 or args.address is not None:
         return run_accuracy_on_ray(args, scenes, outs, cache)
@@ -364,7 +365,7 @@ def add_latency(bsub) -> None:
 
 def run_latency(args: argparse.Namespace) -> int:
     if args.csv:
-        check_output_file(args.csv, "--csv", ".csv")
+        output_file(args.csv, "--csv", (".csv",))
     rows = app.drag_latency(resolve(args.preset), args.size, args.steps)
     print(
         markdown(

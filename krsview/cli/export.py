@@ -5,15 +5,15 @@ from __future__ import annotations
 
 import argparse
 import resource
-from pathlib import Path
 
 from .. import export
+from ..inputs import output_file
 from ..progress import Progress
-from ..scene import MAX_LEVELS, SceneError
+from ..scene import MAX_LEVELS
 from ..share.mesh import BRICK as MESH_BRICK
 from ..share.mesh import FORMATS as MESH_FORMATS
 from . import options
-from .options import SILENT_SECONDS, check_output_file
+from .options import SILENT_SECONDS
 
 WEB = {  # format → (suffix, what it is); the text is the format's help and description
     "html": (
@@ -100,7 +100,7 @@ def add_mesh(xsub) -> None:
 
 def run_web(args: argparse.Namespace) -> int:
     scene = options.scene_of(args)
-    out = check_output_file(args.output, "-o", args.suffix)
+    out = output_file(args.output, "-o", (args.suffix,))
     notes = (export.html if args.format == "html" else export.shadertoy)(scene, out)
     for note in notes:
         print(f"  note: {note}")
@@ -111,10 +111,7 @@ def run_web(args: argparse.Namespace) -> int:
 def run_mesh(args: argparse.Namespace) -> int:
     options.require("skimage", "trimesh", extra="mesh", what="export mesh")
     scene = options.scene_of(args)
-    suffix = Path(args.output).suffix.lower()
-    if suffix not in MESH_FORMATS:
-        raise SceneError("-o", args.output, "the file must end in " + ", ".join(MESH_FORMATS))
-    out = check_output_file(args.output, "-o", suffix)
+    out = output_file(args.output, "-o", MESH_FORMATS)
     print(
         f"krsview: {scene.name}: meshing at {args.resolution} voxels a side, level set "
         f"{args.lod:g} voxel out …",

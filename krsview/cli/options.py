@@ -10,10 +10,10 @@ import math
 import types
 import typing
 from dataclasses import MISSING, fields
-from pathlib import Path
 from typing import Any
 
 from .. import api
+from ..inputs import region
 from ..scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError
 from ..scene.presets import DEFAULT_PRESET
 from ..scene.schema import check_value, describe_range
@@ -61,13 +61,10 @@ def box(text: str) -> tuple[float, ...]:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
         values = ()
-    if len(values) != 6 or not all(map(math.isfinite, values)):
-        raise argparse.ArgumentTypeError(
-            f"--box {text!r}: expected six numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX"
-        )
-    if not all(values[k + 3] > values[k] for k in range(3)):
-        raise argparse.ArgumentTypeError(f"--box {text!r}: each max must exceed its min")
-    return values
+    try:
+        return region(values, "--box")
+    except SceneError as e:
+        raise argparse.ArgumentTypeError(f"--box {text!r}: {e.allowed}") from None
 
 
 def field_option(
@@ -196,36 +193,6 @@ def fast_scene_of(args: argparse.Namespace, scene: Scene) -> Scene:
     where neither its file nor an option given sets them: an option given stands."""
     given = {k: getattr(scene.render, k) for k in FAST_KNOBS if getattr(args, k, None) is not None}
     return api.configure(api.fast_settings(scene), **given)
-
-
-def check_output_file(path: str, flag: str, suffix: str) -> Path:
-    """Before any work: the file has the format's extension, is not a folder, and its folder
-    exists or can be made and is writable (a render must not fail after it ran)."""
-    p = Path(path)
-    if p.suffix.lower() != suffix:
-        raise SceneError(
-            flag, path, f"the file must end in {suffix} (it is written as {suffix[1:].upper()})"
-        )
-    if p.is_dir():
-        raise SceneError(flag, path, "is a folder; give a file name ending in " + suffix)
-    _probe(p.parent, f".{p.name}.write-test", flag, path)
-    return p
-
-
-def check_output_dir(path: Path, flag: str) -> None:
-    """Before any work: the folder exists or can be made, and is writable."""
-    if path.exists() and not path.is_dir():
-        raise SceneError(flag, str(path), "is a file; give a folder for the report")
-    _probe(path, ".write-test", flag, str(path))
-
-
-def _probe(folder: Path, name: str, flag: str, given: str) -> None:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / name).write_text("")
-        (folder / name).unlink()
-    except OSError as e:
-        raise SceneError(flag, given, f"cannot write there: {e.strerror}") from None
 
 
 class MissingExtra(RuntimeError):

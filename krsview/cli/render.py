@@ -11,12 +11,13 @@ import numpy as np
 
 from .. import api, export
 from ..frame import Frame
+from ..inputs import output_dir, output_file
 from ..progress import Progress
 from ..scene import Scene, SceneError
 from ..scene.render import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, LANES_LEVELS, VIEW_PREPASS
 from ..share.frames import DEFAULT_FPS
 from . import options
-from .options import SILENT_SECONDS, check_output_dir, check_output_file, render_option
+from .options import SILENT_SECONDS, render_option
 
 KNOBS = (
     "tracer",
@@ -152,9 +153,9 @@ def run(args: argparse.Namespace) -> int:
     for flag in ("frames", "video"):
         if getattr(args, flag) is not None:
             raise SceneError(f"--{flag}", getattr(args, flag), "needs --camera-path FILE")
-    out = check_output_file(args.output or "out/render.png", "-o", ".png")
+    out = output_file(args.output or "out/render.png", "-o", (".png",))
     if args.buffers:
-        check_output_file(args.buffers, "--buffers", ".npz")
+        output_file(args.buffers, "--buffers", (".npz",))
     info = api.check(scene)
     print(
         f"krsview: {scene.name}: {info.levels} levels, {info.instances:,} kernel "
@@ -165,7 +166,7 @@ def run(args: argparse.Namespace) -> int:
     if args.reference:
         frame = reference_frame(scene, args.size)
     else:
-        frame = timed_frame(scene, args.size, args.repeats)
+        frame = timed_frame(scene, args.size, args.repeats, args.exact)
     if args.view == "iterations":
         from ..heatmap import save_heatmap
 
@@ -211,13 +212,15 @@ def reference_frame(scene: Scene, size: tuple[int, int]) -> Frame:
     return frame
 
 
-def timed_frame(scene: Scene, size: tuple[int, int], repeats: int) -> Frame:
-    """The GPU's frame, and the median of ``repeats`` more frames' times, printed."""
+def timed_frame(scene: Scene, size: tuple[int, int], repeats: int, exact: bool) -> Frame:
+    """The GPU's frame, and the median of ``repeats`` more frames' times, printed (``exact``:
+    as run() settled it, without the fast settings' persistent lanes)."""
     r = api.Renderer(*size)
     t0 = time.perf_counter()
     print("  compiling shader variant …", flush=True)
     frame = r.render(
         scene,
+        exact=exact,
         prepass=scene.render.prepass,  # as run() settled it
         progress=Progress(1, "  first frame, rows", SILENT_SECONDS),
     )
@@ -225,7 +228,7 @@ def timed_frame(scene: Scene, size: tuple[int, int], repeats: int) -> Frame:
     bar = Progress(repeats, "  timing frames", SILENT_SECONDS)
     times = []
     for _ in range(repeats):
-        times += r.time(scene, repeats=1)
+        times += r.time(scene, repeats=1, exact=exact, prepass=scene.render.prepass)
         bar.step()
     print(
         f"  frame time {sorted(times)[len(times) // 2] * 1e3:.1f} ms (median of {repeats}), "
@@ -245,7 +248,7 @@ def frame_job(args: argparse.Namespace, scene: Scene):
     folder = Path(args.output or "out/frames")
     if folder.suffix.lower() == ".png":
         raise SceneError("-o", str(folder), "with --camera-path, give a folder for the frames")
-    check_output_dir(folder, "-o")
+    output_dir(folder, "-o")
     job = FrameJob(scene, path, args.fps, args.size, folder)
     return job, parse_frames(args.frames, job.count)
 
@@ -254,7 +257,7 @@ def check_video(text: str | None, size: tuple[int, int]) -> Path | None:
     """``--video``: an .mp4 that can be written, of a size H.264 4:2:0 takes."""
     if text is None:
         return None
-    video = check_output_file(text, "--video", ".mp4")
+    video = output_file(text, "--video", (".mp4",))
     if size[0] % 2 or size[1] % 2:
         raise SceneError(
             "--size",

@@ -30,8 +30,23 @@ def headless_context() -> moderngl.Context:
             f"context through EGL ({e}). On Debian install libegl1 libegl-mesa0 libgl1 "
             "libgl1-mesa-dri (`make deps` does it)."
         ) from None
+    ctx.gc_mode = "context_gc"  # objects dropped by Python wait for release_dropped()
     ctx.__exit__(None, None, None)  # release it: nothing is current on this thread now
     return ctx
+
+
+def release_dropped(ctx: moderngl.Context) -> int:
+    """Release the GL objects Python has dropped (the headless context's gc_mode is
+    "context_gc", so they wait in ``ctx.objects`` until here); how many. moderngl 5.13
+    also queues objects released before they were dropped: those hold nothing and are
+    skipped (its own ``ctx.gc()`` fails on them). The context must be current."""
+    count = 0
+    while ctx.objects:
+        obj = ctx.objects.popleft()
+        if not isinstance(obj, moderngl.InvalidObject):
+            obj.release()
+            count += 1
+    return count
 
 
 def texture_side(n: int) -> int:

@@ -18,7 +18,12 @@ class Growth:
     """Growth parameters of a KRS tree [KRS17 §9.2]: a ``[tree]`` table, and a baked
     route's ``[route.growth]``, from which it can be grown again."""
 
-    levels: int = param(20, lo=1, hi=63, help="forks from trunk to twig (2^levels twigs)")
+    levels: int = param(
+        20,
+        lo=1,
+        hi=63,
+        help="forks from trunk to twig (2^levels twigs; drawn as levels + 1 KRS levels)",
+    )
     base: Vec3 = param((0.0, 0.0, 0.0), help="foot of the trunk")
     up: Vec3 = param((0.0, 1.0, 0.0), unit_vector="normalise", help="trunk direction")
     trunk_length: float = param(1.5, lo=0.0, lo_open=True, help="length of the trunk")

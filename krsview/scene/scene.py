@@ -4,6 +4,7 @@ and the effect set; loaded from and saved to TOML."""
 from __future__ import annotations
 
 import contextlib
+import numbers
 import os
 import stat
 import tempfile
@@ -20,7 +21,7 @@ from .animation import (
     reads_time,
 )
 from .compound import Component, Compound, check_compound
-from .edits import apply_edit, parse_path
+from .edits import apply_edit, parse_path, vouched
 from .effects import EffectSettings, check_effects
 from .model import KRS
 from .mokrs import MoKRS, check_view
@@ -206,9 +207,11 @@ class Scene:
         """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation), as
         posed at its time (see :meth:`with_geometry`)."""
         g = self.posed().geometry()
-        if not (isinstance(levels, int) and 1 <= levels <= g.depth):
+        if not isinstance(levels, numbers.Integral) or isinstance(levels, bool):
+            raise SceneError(path, levels, f"expected a whole number, 1..{g.depth}")
+        if not 1 <= levels <= g.depth:
             raise SceneError(path, levels, f"this scene has {g.depth} levels; allowed 1..{g.depth}")
-        return self.with_geometry(g.truncated(levels))
+        return self.with_geometry(g.truncated(int(levels)))
 
     def with_effects(self, effects: list[str], path: str = "effects") -> Scene:
         """The scene with this effect set compiled in (checked against what it allows)."""
@@ -273,7 +276,7 @@ def load_scene(path: str | os.PathLike) -> Scene:
             + ("; this one is UTF-16: save it as UTF-8" if bom else ""),
             str(p),
         ) from None
-    return scene_from_toml(text, str(p))
+    return vouched(scene_from_toml(text, str(p)))
 
 
 def scene_to_toml(scene: Scene) -> str:

@@ -14,6 +14,8 @@ import typing
 from dataclasses import MISSING, field, fields, is_dataclass
 from typing import Any, ClassVar
 
+import numpy as np
+
 Vec3 = tuple[float, float, float]
 UNIT_TOLERANCE = 1e-6  # how far a plane normal's length may be from 1 before it is an error
 
@@ -122,7 +124,16 @@ def describe_range(meta: dict, kind: type = float) -> str:
     return "allowed: a finite number"
 
 
+def _plain(x: Any) -> Any:
+    """A NumPy scalar as the Python number it holds, an array as a list (values from NumPy
+    code are taken as a file's numbers are)."""
+    if isinstance(x, np.generic):
+        return x.item()
+    return x.tolist() if isinstance(x, np.ndarray) else x
+
+
 def _check_number(x: Any, path: str, meta: dict, kind: type) -> float | int:
+    x = _plain(x)
     if isinstance(x, bool) or not isinstance(x, (int, float)):
         raise SceneError(path, x, f"expected a number ({kind.__name__})")
     if kind is int and not isinstance(x, int):
@@ -137,6 +148,7 @@ def _check_number(x: Any, path: str, meta: dict, kind: type) -> float | int:
 
 
 def _check_vec3(x: Any, path: str, meta: dict) -> Vec3:
+    x = _plain(x)
     if not isinstance(x, (list, tuple)) or len(x) != 3:
         raise SceneError(path, x, "expected a list of 3 numbers [x, y, z]")
     v = tuple(_check_number(c, f"{path}[{i}]", meta, float) for i, c in enumerate(x))
@@ -175,6 +187,7 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
     if hint is float or hint is int:
         return _check_number(x, path, meta, hint)
     if hint is bool:
+        x = _plain(x)
         if not isinstance(x, bool):
             raise SceneError(path, x, "expected true or false")
         return x
@@ -187,6 +200,7 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
     if origin is tuple:  # Vec3
         return _check_vec3(x, path, meta)
     if origin is list:
+        x = list(x) if isinstance(x, tuple) else _plain(x)
         if not isinstance(x, list):
             raise SceneError(path, x, "expected a list")
         if len(x) > MAX_ITEMS:  # before converting: 500,000 levels took 100 s and 900 MB

@@ -1,0 +1,248 @@
+"""The Python API's arguments (krsview/inputs.py): a scene built or changed in Python is
+validated as a file would be, sizes and switches and paths are checked before any work,
+NumPy values are numbers, a closed Renderer gives its GL objects back, and the moment and
+the level count compose. Each refusal is one line naming the argument and what is allowed;
+each is set beside the call that works (the control)."""
+
+from __future__ import annotations
+
+import dataclasses
+import gc
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import krsview
+from krsview.scene import KRS, Camera, Level, Mirror, Sphere
+
+SIZE = (24, 14)
+BALL = {"krs": {"levels": [{"kernel": {"type": "sphere", "radius": 0.5}}]}}
+
+
+def one_line(e: pytest.ExceptionInfo) -> str:
+    text = str(e.value)
+    assert "\n" not in text
+    return text
+
+
+def test_a_scene_built_from_the_classes_is_validated_where_the_api_takes_it(tmp_path):
+    good = krsview.Scene(krs=KRS(levels=[Level(kernel=Sphere(radius=0.5))]))
+    assert krsview.render(good, SIZE).hit.any()  # control: a valid one draws
+    assert np.array_equal(
+        krsview.render(good, SIZE).color, krsview.render(krsview.load_dict(BALL), SIZE).color
+    )
+    rock = krsview.load("rock")
+    bad = {
+        "krs.levels[0].kernel.radius = -1.0": krsview.Scene(
+            krs=KRS(levels=[Level(kernel=Sphere(radius=-1.0))])
+        ),
+        "krs.levels[0].kernel.radius = nan": krsview.Scene(
+            krs=KRS(levels=[Level(kernel=Sphere(radius=float("nan")))])
+        ),
+        "a scene has exactly one geometry": krsview.Scene(),
+        "render.tracer = 'bogus'": dataclasses.replace(
+            rock, render=dataclasses.replace(rock.render, tracer="bogus")
+        ),
+        "camera.target": krsview.Scene(
+            krs=rock.krs, camera=Camera(position=(0, 1, 0), target=(0, 1, 0))
+        ),
+        "'<krs and tree>'": dataclasses.replace(rock, tree=krsview.load("tree").tree),
+    }
+    for said, scene in bad.items():
+        for call in (
+            lambda s: krsview.render(s, SIZE),
+            krsview.check,
+            lambda s: krsview.save(s, tmp_path / "x.toml"),
+            lambda s: krsview.configure(s, epsilon_scale=2.0),
+            lambda s: krsview.Renderer(*SIZE).time(s, 1),
+        ):
+            with pytest.raises(krsview.SceneError) as e:
+                call(scene)
+            assert said in one_line(e)
+    assert not (tmp_path / "x.toml").exists()
+    # a mirror normal must be a unit vector, as in a file (its offset is in its units)
+    turned = krsview.Scene(
+        krs=KRS(levels=[Level(kernel=Sphere()), Level(mirror=Mirror(normal=(3.0, 0, 0)))])
+    )
+    with pytest.raises(krsview.SceneError) as e:
+        krsview.render(turned, SIZE)
+    assert "krs.levels[1].mirror.normal = [3.0, 0, 0]: must be a unit vector" in one_line(e)
+
+
+def test_a_scene_changed_in_place_is_drawn_as_it_is_now():
+    """Its lists are Python lists: popped levels draw as the shorter scene a file would
+    give (not the compiled geometry of before); an effect appended is checked."""
+    s = krsview.load("rock")
+    before = krsview.render(s, SIZE)
+    for _ in range(6):
+        s.krs.levels.pop()
+    after = krsview.render(s, SIZE)
+    fresh = krsview.render(krsview.load_dict(krsview.scene.schema.to_dict(s)), SIZE)
+    assert np.array_equal(after.color, fresh.color)
+    assert not np.array_equal(after.color, before.color), "control: the change shows"
+    s.effects.append("bloom")
+    with pytest.raises(krsview.SceneError) as e:
+        krsview.render(s, SIZE)
+    assert "'bloom': unknown effect" in one_line(e)
+
+
+def test_a_closed_renderer_gives_its_gl_objects_back(monkeypatch):
+    from krsview.gpu import context
+
+    released = []
+    real = context.release_dropped
+    monkeypatch.setattr(context, "release_dropped", lambda ctx: released.append(real(ctx)))
+    with krsview.Renderer(*SIZE) as r:
+        r.render("rock")
+    assert released and released[-1] > 10, "its programs, targets and buffers"
+    gc.collect()
+    assert not krsview.api._shared_context().objects, "nothing of it left for later"
+    krsview.render("rock", SIZE)  # the shared renderer of render() stays
+    shared = krsview.api._shared_gpu
+    krsview.Renderer(*SIZE).close()
+    assert krsview.api._shared_gpu is shared
+
+
+def test_the_moment_and_the_level_count_compose():
+    s = krsview.load("tree-sway")
+    both = krsview.render(s, SIZE, time=0.6, levels=14)
+    assert np.array_equal(both.color, krsview.render(s.at(0.6).with_levels(14), SIZE).color)
+    start = krsview.render(s, SIZE, time=0.0, levels=14)
+    assert not np.array_equal(both.color, start.color), "control: the tree sways"
+    grown = krsview.configure("tree-growing", time=5.0)
+    depth = grown.geometry().depth
+    assert depth > krsview.load("tree-growing").geometry().depth  # it grows
+    assert krsview.configure("tree-growing", time=5.0, levels=depth).geometry().depth == depth
+
+
+def test_a_renderer_times_what_it_draws(monkeypatch):
+    drawn, timed = [], []
+    r = krsview.Renderer(*SIZE)
+    monkeypatch.setattr(r.gpu, "render", lambda s, w, h, progress=None: drawn.append(s))
+    monkeypatch.setattr(r.gpu, "time_frame", lambda s, w, h, repeats: timed.append(s) or [0.0])
+    for kw in ({}, {"exact": True}, {"epsilon_scale": 2.0, "levels": 9}):
+        r.render("tree", **kw)
+        r.time("tree", 1, **kw)
+    assert drawn == timed and len(set(map(id, timed))) == 3
+    assert timed[0].render.prepass and not timed[1].render.prepass  # fast, then exact
+
+
+def test_numpy_values_are_numbers():
+    s = krsview.load("rock")
+    assert s.edit("render.epsilon_scale", np.float32(0.5)).render.epsilon_scale == 0.5
+    assert s.edit("render.max_iterations", np.int64(100)).render.max_iterations == 100
+    assert s.edit("camera.position", np.array([1.0, 2.0, -8.0])).camera.position == (1, 2, -8)
+    assert s.with_levels(np.int64(3)).geometry().depth == 3
+    assert krsview.render(s, (np.int64(16), np.int64(9))).size == (16, 9)
+    assert s.with_effects(("fog",)).effects == ["fog"]
+    with pytest.raises(krsview.SceneError) as e:  # control: still checked
+        s.edit("render.epsilon_scale", np.float32(-1))
+    assert "render.epsilon_scale = -1.0: allowed" in one_line(e)
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [
+        (lambda: krsview.render("rock", "160x90"), "size = '160x90': expected (width, height)"),
+        (lambda: krsview.render("rock", 160), "size = 160: expected (width, height)"),
+        (lambda: krsview.render("rock", (16, 9, 3)), "size = (16, 9, 3): expected"),
+        (lambda: krsview.render("rock", SIZE, reference="yes"), "reference = 'yes': expected"),
+        (lambda: krsview.render("rock", SIZE, exact=1), "exact = 1: expected True or False"),
+        (lambda: krsview.render("rock", SIZE, levels="5"), "levels = '5': expected a whole"),
+        (lambda: krsview.load("rock").with_levels(3.0), "levels = 3.0: expected a whole"),
+        (lambda: krsview.load(None), "name_or_path = None: expected a preset's name"),
+        (lambda: krsview.render({"krs": {}}, SIZE), "a dict: krsview.load_dict"),
+        (lambda: krsview.load_dict([1]), "<dict> = [1]: expected a dict"),
+        (lambda: krsview.certify("rock", max_segments=-1), "max_segments = -1: allowed: a whole"),
+        (lambda: krsview.stability("rock", "48x27"), "size = '48x27': expected"),
+        (lambda: krsview.Renderer(16, 9).render("nope"), "'nope': not a file and not a preset"),
+        (lambda: krsview.Renderer(16, 9).time("rock", 0), "repeats = 0: allowed"),
+        (lambda: krsview.distance("palm", [0, 0, 0]), "a MöKRS has no distance function"),
+        (lambda: krsview.distance("rock", [0, 0]), "expected finite points"),
+        (
+            lambda: krsview.load("tree").edit("route.levels[3].fork", (0, 1, 0)),
+            "this scene has no [route] table",
+        ),
+        (
+            lambda: krsview.load("rock").edit("krs.levels[99].kernel.radius", 1.0),
+            "krs.levels has 13 items (0..12)",
+        ),
+        (
+            lambda: krsview.load("rock").edit("render.nope", 1.0),
+            "render has no field 'nope'; its fields: tracer,",
+        ),
+    ],
+)
+def test_bad_arguments_are_refused_in_one_line(call, said):
+    with pytest.raises(krsview.SceneError) as e:
+        call()
+    assert said in one_line(e)
+
+
+def test_files_are_checked_before_any_work(tmp_path):
+    import krsview.export as export
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    cases = [
+        (lambda: export.html("rock", blocker / "x.html"), "cannot write there"),
+        (lambda: export.html("rock", tmp_path / "x.txt"), "must end in .html"),
+        (lambda: export.mesh("rock", tmp_path / "m.xyz"), "must end in .glb, .ply, .stl or .obj"),
+        (lambda: export.mesh("rock", tmp_path / "m.ply", resolution=0), "resolution = 0"),
+        (lambda: export.mesh("rock", tmp_path / "m.ply", resolution="64"), "resolution = '64'"),
+        (lambda: export.mesh("rock", tmp_path / "m.ply", lod=float("nan")), "lod = nan"),
+        (
+            lambda: export.mesh("rock", tmp_path / "m.ply", box=(3, 3, 3, -3, -3, -3)),
+            "each max (the last three) must exceed its min",
+        ),
+        (lambda: export.video(frames, tmp_path / "v.mp4"), "has no frame_00000.png"),
+        (lambda: export.video(frames, tmp_path / "v.avi"), "must end in .mp4"),
+        (lambda: krsview.save("rock", tmp_path / "r.json"), "must end in .toml"),
+    ]
+    for call, said in cases:
+        with pytest.raises(krsview.SceneError) as e:
+            call()
+        assert said in one_line(e)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file", "frames"], "nothing written"
+    frame = krsview.render("rock", SIZE)
+    with pytest.raises(ValueError, match=r"must end in \.png, \.npz"):
+        frame.save(tmp_path / "x.foo")
+    png = frame.save(tmp_path / "x.png")  # control
+    with pytest.raises(ValueError, match="not a frame written by Frame.save"):
+        krsview.Frame.load(png)
+    with pytest.raises(ValueError, match="cannot read: No such file"):
+        krsview.Frame.load(tmp_path / "none.npz")
+
+
+def test_save_writes_what_load_reads(tmp_path):
+    built = krsview.Scene(krs=KRS(levels=[Level(kernel=Sphere(radius=0.25))]), name="ball")
+    out = krsview.save(built, tmp_path / "sub" / "ball.toml")
+    assert krsview.load(out) == built
+    edited = krsview.load("bent-tree").edit("route.levels[2].fork", (0.1, 2.0, 0.3))
+    assert krsview.load(krsview.save(edited, tmp_path / "b.toml")) == edited
+    assert krsview.load(out) != edited  # control
+
+
+def test_distance_is_the_kernels_at_points():
+    """One ball of radius 0.5 at the origin: |p| − 0.5, inside negative; a mirror at x = 0.8
+    doubles it (the nearer copy counts)."""
+    p = np.array([[0.0, 2.0, 0.0], [0.0, 0.0, 0.0], [3.0, 4.0, 0.0]])
+    assert np.allclose(krsview.distance(krsview.load_dict(BALL), p), [1.5, -0.5, 4.5])
+    two = {
+        "krs": {
+            "levels": [*BALL["krs"]["levels"], {"mirror": {"normal": [1, 0, 0], "offset": 0.8}}]
+        }
+    }
+    d = krsview.distance(krsview.load_dict(two), [[1.6, 0.0, 0.0], [3.0, 0.0, 0.0]])
+    assert np.allclose(d, [-0.5, 0.9]), "the mirrored copy at x = 1.6"
+    assert krsview.distance("grove", np.zeros((2, 2, 3))).shape == (2, 2)
+
+
+def test_export_and_bench_come_with_a_plain_import():
+    code = "import krsview; print(krsview.export.html.__name__, krsview.bench.__name__)"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.stdout.split() == ["html", "krsview.bench"], r.stderr
