@@ -195,7 +195,11 @@ class Scene:
     def edit(self, path: str | tuple, value: object) -> Scene:
         """A new scene with the value at ``path`` replaced, validated by the schema that
         reads files (a SceneError names the field and what is allowed; this scene is left as
-        it is). ``path``: ``"render.tracer"``, ``"route.levels[3].fork"`` or a tuple.
+        it is). ``path``: ``"render.tracer"``, ``"route.levels[3].fork"`` or a tuple. A table
+        given whole (``edit("camera", {...})``) replaces it: the fields it leaves out take
+        their defaults, so set one field by its own path (``"camera.position"``). Scenes
+        share their unchanged parts: change one by ``edit``, not in place (a list changed in
+        place changes every scene holding it).
 
         >>> from krsview import load
         >>> load("tree").edit("render.epsilon_scale", 0.5).render.epsilon_scale
