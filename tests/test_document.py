@@ -63,6 +63,28 @@ def test_one_drag_is_one_undo_step_and_two_drags_are_two(route_file):
     assert doc.scene == start and not doc.history.can_undo
 
 
+def test_a_step_keeps_the_callers_memo_and_undo_brings_it_back(route_file):
+    """The editor keeps its selection with each step: undo brings back the selection the
+    step was taken with (a drag's first, where its steps merged); redo the one it was undone
+    with. Without a memo (the viewer) nothing is kept."""
+    doc = Document(route_file)
+    doc.apply(FORK, [1.0, 5.0, 0.5])
+    assert doc.undo() and doc.restored is None
+    selected = ["fork 5"]
+    doc.memo = lambda: selected[0]
+    for k in range(3):  # one drag, the selection moving along (the first one counts)
+        doc.apply(FORK, [1.0 + k, 5.0, 0.5], interaction=("drag", 1))
+        selected[0] = f"after {k}"
+    doc.apply(("render", "epsilon_scale"), 2.0)
+    selected[0] = "elsewhere"
+    said = []
+    for step in (doc.undo, doc.undo, doc.redo, doc.redo):
+        assert step()
+        selected[0] = doc.restored  # the editor selects what came back
+        said.append(selected[0])
+    assert said == ["after 2", "fork 5", "after 2", "elsewhere"]
+
+
 def test_history_forgets_the_oldest_steps_beyond_its_limit(route_file, monkeypatch):
     monkeypatch.setattr("krsview.document.history.MAX_STEPS", 30)
     doc = Document(route_file)

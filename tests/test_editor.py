@@ -294,7 +294,7 @@ def test_a_hover_label_reaching_under_the_panel_is_hidden_there(editor, monkeypa
     handle grabbed beside the panel wrote its name over the panel's text."""
     from imgui_bundle import imgui
 
-    import krsview.editor.window as window
+    import krsview.editor.drawing as drawing
     from krsview.compile.camera import project
 
     e = editor
@@ -327,7 +327,7 @@ def test_a_hover_label_reaching_under_the_panel_is_hidden_there(editor, monkeypa
     rows = slice(round(py - 20), round(py - 20 + size.y))
     labelled = e.viewer.read_window()[rows].astype(int)
     with monkeypatch.context() as m:
-        m.setattr(window, "hover_label", lambda shown, view: None)
+        m.setattr(drawing, "hover_label", lambda shown, view: None)
         pump(e, 1)
         bare = e.viewer.read_window()[rows].astype(int)
     change = np.abs(labelled - bare).max(axis=(0, 2))

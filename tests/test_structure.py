@@ -431,6 +431,35 @@ def test_insert_delete_and_ctrl_d_keys_edit_the_selected_level(window_editor):
     assert len(e.scene.route.levels) == n
 
 
+def test_undo_and_redo_bring_the_selection_back(window_editor):
+    """Ctrl+Z after an insert selects what was selected before it (it used to keep the
+    selection's level number, now another branch); Ctrl+Shift+Z what was selected when it
+    was undone."""
+    e = window_editor
+
+    def chosen():
+        return (e.selected.path, e.selected.kind) if e.selected else None
+
+    e.select_level(3)
+    before = chosen()
+    xdo("key", "Insert")
+    pump(e)
+    inserted = chosen()
+    assert inserted != before, "control: the insert selects its new level"
+    e.select_level(1)
+    looked = chosen()
+    xdo("key", "ctrl+z")
+    pump(e)
+    assert chosen() == before
+    xdo("key", "ctrl+shift+z")
+    pump(e)
+    assert chosen() == looked
+    e.select(None)
+    xdo("key", "ctrl+z")
+    pump(e)
+    assert chosen() == before
+
+
 def test_the_panels_words_go_once_stale_and_a_level_is_selected_by_its_own_handle(
     window_editor,
 ):

@@ -13,7 +13,7 @@ to the user's data folder.
 from __future__ import annotations
 
 import os
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -85,6 +85,10 @@ class Document:
         self.saved_text = self.path.read_text(encoding="utf-8")  # as written, comments too
         self.stamp = Stamp.of(self.path)
         self.history = History()
+        # the caller's own state kept with each step (the editor: its selection), and what
+        # the last undo or redo brought back of it
+        self.memo: Callable[[], Hashable] | None = None
+        self.restored: Hashable | None = None
         self.version = 0  # bumps on every change: views redraw
         self._autosaved: Scene | None = None
         self._autosave_clock: float | None = None
@@ -130,7 +134,7 @@ class Document:
         """Make ``scene`` (already valid) the document's scene, as one undo step."""
         if scene == self._scene:
             return
-        self.history.push(Step(label, self._scene, scene, interaction))
+        self.history.push(Step(label, self._scene, scene, interaction, self._memo()))
         self._set(scene)
 
     def replace_scene(self, scene: Scene, label: str) -> None:
@@ -138,16 +142,23 @@ class Document:
         self.commit(validated(scene), label)
 
     def undo(self) -> bool:
-        scene = self.history.undo()
-        if scene is not None:
-            self._set(scene)
-        return scene is not None
+        """The scene before the last step; :attr:`restored`, the memo taken with it."""
+        step = self.history.undo(self._memo())
+        if step is not None:
+            self.restored = step.memo_before
+            self._set(step.before)
+        return step is not None
 
     def redo(self) -> bool:
-        scene = self.history.redo()
-        if scene is not None:
-            self._set(scene)
-        return scene is not None
+        """The scene after the next step; :attr:`restored`, the memo it was undone with."""
+        step = self.history.redo()
+        if step is not None:
+            self.restored = step.memo_after
+            self._set(step.after)
+        return step is not None
+
+    def _memo(self) -> Hashable | None:
+        return self.memo() if self.memo is not None else None
 
     # ------------------------------------------------------------------------------ disk
     def changed_on_disk(self) -> bool:

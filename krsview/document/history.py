@@ -3,12 +3,14 @@
 A step keeps the scene before and after it; scenes are frozen dataclasses that share every
 unchanged part, so a step costs little. Consecutive steps of one interaction (a gizmo drag, a
 slider drag) merge into one step: the merge is keyed on the interaction, never on a timer.
+A step also keeps a memo of the caller's own state around it (the editor: what was
+selected), so that undo and redo bring that back with the scene, as Blender's do.
 """
 
 from __future__ import annotations
 
 from collections.abc import Hashable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..scene import Scene
 
@@ -21,6 +23,8 @@ class Step:
     before: Scene
     after: Scene
     interaction: Hashable | None = None  # steps of one interaction merge; None never merges
+    memo_before: Hashable | None = None  # the caller's state when the step was taken
+    memo_after: Hashable | None = None  # ... and when it was undone (what redo brings back)
 
 
 class History:
@@ -36,7 +40,7 @@ class History:
             and step.interaction is not None
             and last.interaction == step.interaction
         ):
-            step = Step(last.label, last.before, step.after, step.interaction)
+            step = Step(last.label, last.before, step.after, step.interaction, last.memo_before)
             self.steps[-1] = step
         else:
             self.steps.append(step)
@@ -52,17 +56,21 @@ class History:
     def can_redo(self) -> bool:
         return self.index < len(self.steps)
 
-    def undo(self) -> Scene | None:
+    def undo(self, memo: Hashable | None = None) -> Step | None:
+        """Step back: the step undone (its ``before`` is the scene now), which keeps
+        ``memo``, the caller's state before undoing, for redo; None if there is none."""
         if not self.can_undo:
             return None
         self.index -= 1
-        return self.steps[self.index].before
+        step = self.steps[self.index] = replace(self.steps[self.index], memo_after=memo)
+        return step
 
-    def redo(self) -> Scene | None:
+    def redo(self) -> Step | None:
+        """Step forward: the step redone (its ``after`` is the scene now); None if none."""
         if not self.can_redo:
             return None
         self.index += 1
-        return self.steps[self.index - 1].after
+        return self.steps[self.index - 1]
 
     def labels(self) -> tuple[list[str], list[str]]:
         """(done, undone) step labels, oldest first: for the history panel."""

@@ -25,34 +25,31 @@ from typing import Any
 
 import glfw  # noqa: E402  (after imgui, as the viewer)
 import numpy as np
-from imgui_bundle import imgui
 
 from ..compile.camera import View, view_of
 from ..compile.geometry import scene_ball
 from ..document.document import Document
-from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
+from ..gpu.overlay import Overlay
 from ..scene import Scene, SceneError
 from ..scene.edits import apply_edit, path_text
 from ..scene.mokrs import check_view
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
 from ..viewer import commands as vc
 from ..viewer.controls import VIEWER_KEYS
-from ..viewer.hud import draw_hud
 from ..viewer.loop import run
 from ..viewer.status import draw_status
 from ..viewer.window import Viewer
 from . import commands as ec
 from .dragging import manipulate
+from .drawing import draw_ui
 from .file_actions import FILE_HANDLERS, FileActions
 from .gizmo import Gizmo
 from .grab import Grabbing
 from .handles import Handle, level_handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
-from .panels import edit_panel
-from .picking import hover_label, pick, visible
+from .picking import pick, visible
 from .saving import autosave
-from .shapes import editor_shapes
 from .shown import Shown
 from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
@@ -93,6 +90,7 @@ class Editor:
         self._held: set[str] = set()  # the view's buttons held at the last turn's end
         self._title = ""
         self.words = Words()  # the panel's last words, gone once stale (words.py)
+        self.doc.memo = self._memo
         self._update_title()
         self.frame()
 
@@ -227,7 +225,7 @@ class Editor:
         self._follow()
         if ui:
             if v.hud:
-                self._draw_ui()
+                draw_ui(self)
             draw_status(status, bool(v.error) and not v.hud)
             v.platform.render()
         v.input.claimed = v.hud and self._dragging()
@@ -307,7 +305,20 @@ class Editor:
     def _opened(self) -> None:
         """Another scene was opened (file_actions.py): nothing selected, the scene framed."""
         self.selected = None
+        self.doc.memo = self._memo
         self.frame()
+
+    def _memo(self) -> tuple | None:
+        """What an undo step keeps of the editor: the selection (history.py)."""
+        return None if self.selected is None else (self.selected.path, self.selected.kind)
+
+    def undo(self, redo: bool = False) -> None:
+        """Ctrl+Z (``redo``: Ctrl+Shift+Z): the scene of the step before (after), and the
+        selection it was taken (undone) with, as Blender brings both back."""
+        if not (self.viewer.redo() if redo else self.viewer.undo()):
+            return
+        memo, handles = self.doc.restored, self.handles
+        self.select(next((h for h in handles if (h.path, h.kind) == memo), None))
 
     def frame(self) -> None:
         """Turn the camera so the scene camera's target sits in the middle of the part of the
@@ -360,29 +371,6 @@ class Editor:
         pointer may have moved since this frame.)"""
         return self.gizmo.dragging() or self.trackball.active or self.grabbing.now is not None
 
-    # ----------------------------------------------------------------------- drawing
-    def _draw_ui(self) -> None:
-        """Inside the ImGui frame, after the trace: the overlay over the image, the viewer's
-        HUD (collapsed at first: the view stays free), the edit panel, and the name of the
-        handle under the pointer (the gizmo came before the trace: dragging.py)."""
-        v = self.viewer
-        view = self.window_view()
-        shown = self.shown()
-        if v.frames.image is not None:
-            fb = glfw.get_framebuffer_size(v.window)
-            view_matrix, proj = camera_matrices(view, NEAR, FAR)
-            shapes = editor_shapes(self.handled_scene(), shown, self.selected, self.clipped)
-            fbo, image = v.frames.image
-            self.overlay.draw(shapes, fbo, v.ctx.screen, fb, proj @ view_matrix, view.origin, image)
-        imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
-        self.execute(draw_hud(v, v.interactions))
-        self.execute(edit_panel(self, v.interactions))
-        if self.scene.animated:  # a still scene keeps the whole view (K starts a track)
-            free = self.layout.free(glfw.get_window_size(v.window))
-            path = self.selected.path if self.selected is not None else None
-            self.execute(self.timeline.draw(self.scene, v.drawn.playback, path, free))
-        hover_label(shown, view)
-
 
 # The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
 # edit, opening or reloading asks about unsaved edits: the file part's, FILE_HANDLERS);
@@ -397,6 +385,8 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),
     vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction),
     vc.ResetView: lambda e, c: e.reset_view(),
+    vc.Undo: lambda e, c: e.undo(),
+    vc.Redo: lambda e, c: e.undo(redo=True),
     ec.PlacePanel: lambda e, c: e.place_panel(c.side, c.width),
     ec.FoldPanel: lambda e, c: e.fold_panel(c.folded),
     **STRUCTURE_HANDLERS,

@@ -194,13 +194,17 @@ class Viewer:
         self.moving_effects, self.frames.dirty = on, True
         self.frames.full_shadows = on
 
-    def undo(self) -> None:
+    def undo(self) -> bool:
         if self.doc.undo():
             self.sync()
+            return True
+        return False
 
-    def redo(self) -> None:
+    def redo(self) -> bool:
         if self.doc.redo():
             self.sync()
+            return True
+        return False
 
     def reset_view(self) -> None:
         self.nav.reset(self.scene.camera)

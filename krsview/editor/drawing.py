@@ -1,0 +1,56 @@
+"""What the editor draws in a turn's ImGui frame, after the trace: the overlay over the
+image (handles, clipped parts), the viewer's HUD (collapsed at first: the view stays free),
+the edit panel, the timeline of a moving scene, and the name of the handle under the
+pointer (the gizmo came before the trace: dragging.py). Each part returns commands, which
+the editor applies."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import glfw
+import numpy as np
+from imgui_bundle import imgui
+
+from ..compile.camera import View
+from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
+from ..viewer import commands as vc
+from ..viewer.hud import draw_hud
+from .handles import Handle
+from .keys import Timeline
+from .panels import Edited, edit_panel
+from .picking import hover_label
+from .shapes import editor_shapes
+
+
+class Drawing(Edited):
+    """What the drawing reads of the editor besides what the panels do."""
+
+    overlay: Overlay
+    timeline: Timeline
+    execute: Callable[[list[vc.Command]], None]
+
+    @property
+    def clipped(self) -> list[tuple[int, np.ndarray]]: ...
+    def window_view(self) -> View: ...
+    def shown(self) -> list[Handle]: ...
+
+
+def draw_ui(e: Drawing) -> None:
+    v = e.viewer
+    view = e.window_view()
+    shown = e.shown()
+    if v.frames.image is not None:
+        fb = glfw.get_framebuffer_size(v.window)
+        view_matrix, proj = camera_matrices(view, NEAR, FAR)
+        shapes = editor_shapes(e.handled_scene(), shown, e.selected, e.clipped)
+        fbo, image = v.frames.image
+        e.overlay.draw(shapes, fbo, v.ctx.screen, fb, proj @ view_matrix, view.origin, image)
+    imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
+    e.execute(draw_hud(v, v.interactions))
+    e.execute(edit_panel(e, v.interactions))
+    if e.scene.animated:  # a still scene keeps the whole view (K starts a track)
+        free = e.layout.free(glfw.get_window_size(v.window))
+        path = e.selected.path if e.selected is not None else None
+        e.execute(e.timeline.draw(e.scene, v.drawn.playback, path, free))
+    hover_label(shown, view)
