@@ -124,7 +124,7 @@ def fast_settings(scene: Scene) -> Scene:
     geometry settings hole-free; hits may move by up to ε (pre-pass) and 2·lod·ε (level of
     detail)."""
     r, fast = scene.render, {}
-    if not r.prepass:
+    if r.prepass is None:  # 0 is the file's own "off"
         fast["prepass"] = VIEW_PREPASS
     g = replace(scene, animation=None).geometry()  # the levels, not posed: motion adds none
     if r.path == "fragment" and isinstance(g, KRS) and g.depth >= LANES_LEVELS:

@@ -246,3 +246,19 @@ def test_export_and_bench_come_with_a_plain_import():
     code = "import krsview; print(krsview.export.html.__name__, krsview.bench.__name__)"
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert r.stdout.split() == ["html", "krsview.bench"], r.stderr
+
+
+def test_a_files_prepass_0_is_off_and_none_given_is_the_fast_default(tmp_path):
+    """`prepass = 0` in a file turns the pre-pass off for `render` and the viewer (it was
+    taken for "not given" and drawn at VIEW_PREPASS); a file that gives none gets the fast
+    default, and saving it writes none."""
+    from krsview.api import fast_settings
+    from krsview.scene.render import VIEW_PREPASS
+
+    s = krsview.load("sierpinski")
+    assert s.render.prepass is None and fast_settings(s).render.prepass == VIEW_PREPASS
+    off = krsview.load(krsview.save(s.edit("render.prepass", 0), tmp_path / "off.toml"))
+    assert off.render.prepass == 0 and fast_settings(off).render.prepass == 0
+    given, fast = krsview.render(off, SIZE), krsview.render(s, SIZE)
+    assert given.iterations.mean() > fast.iterations.mean(), "control: the pre-pass spares steps"
+    assert "prepass =" not in krsview.save(s, tmp_path / "s.toml").read_text()

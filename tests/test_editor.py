@@ -568,7 +568,7 @@ def test_the_hud_prepass_knob_is_an_edit_saved_with_the_scene_and_undone_by_ctrl
     unsaved, Ctrl+Z (a real key) takes it back, and Ctrl+S writes it to the file."""
     e = editor
     pump(e)
-    assert load_scene(e.path).render.prepass == 0
+    assert load_scene(e.path).render.prepass is None
     e.execute([SetPrepass(8)])
     pump(e)
     assert e.scene.render.prepass == 8 == e.viewer.prepass and e._title.startswith(
@@ -576,7 +576,7 @@ def test_the_hud_prepass_knob_is_an_edit_saved_with_the_scene_and_undone_by_ctrl
     )
     xdo("key", "ctrl+z")
     pump(e)
-    assert e.scene.render.prepass == 0 and not e.doc.dirty and "*" not in e._title
+    assert e.scene.render.prepass is None and not e.doc.dirty and "*" not in e._title
     xdo("key", "ctrl+shift+z")
     xdo("key", "ctrl+s")
     pump(e)

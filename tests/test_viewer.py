@@ -441,7 +441,7 @@ def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(view
 
     v = viewer
     settle(v)
-    assert v.scene.render.prepass == 0, "the shipped tree has no pre-pass of its own"
+    assert v.scene.render.prepass is None, "the shipped tree gives no pre-pass of its own"
     assert v.prepass == VIEW_PREPASS and v.view_scene().render.prepass == VIEW_PREPASS
     with_prepass = v.read_window().astype(int)
     steps = len(v.doc.history.steps)
@@ -451,14 +451,16 @@ def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(view
     v.execute([SetPrepass(8)])
     assert v.scene.render.prepass == 8 and v.view_scene().render.prepass == 8 and v.doc.dirty
     assert len(v.doc.history.steps) == steps + 1 and not v.error
-    v.execute([Undo()])  # back to the file's: no pre-pass
-    assert v.scene.render.prepass == 0 and v.view_scene().render.prepass == 0
+    v.execute([Undo()])  # back to the file's: none given, so the view's own
+    assert v.scene.render.prepass is None and v.view_scene().render.prepass == VIEW_PREPASS
     assert not v.doc.dirty
+    v.execute([Redo()])
+    assert v.view_scene().render.prepass == 8
+    v.execute([SetPrepass(0)])  # off, as a file's 0 says
+    assert v.scene.render.prepass == 0 and v.view_scene().render.prepass == 0
     settle(v)
     changed = (np.abs(v.read_window().astype(int) - with_prepass).max(-1) > 40).mean()
     assert 0 < changed < 0.02
-    v.execute([Redo()])
-    assert v.view_scene().render.prepass == 8
 
 
 def test_the_compute_path_draws_the_same_window(viewer):

@@ -253,8 +253,8 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_xi_bonus": scene.render.xi_bonus,
         "u_xi_penalty": scene.render.xi_penalty,
         "u_relaxation": scene.render.relaxation,
-        "u_tile": scene.render.prepass,
-        "u_free_stride": free_stride(view, scene.render.prepass),
+        "u_tile": scene.render.prepass or 0,  # not given: off (api.fast_settings sets one)
+        "u_free_stride": free_stride(view, scene.render.prepass or 0),
         "u_light_count": len(lights),
         "u_light_dir": [lt.direction for lt in lights]
         + [(0.0, 0.0, 0.0)] * (MAX_LIGHTS - len(lights)),

@@ -192,14 +192,15 @@ class Render:
         "component (off). The same hits except where a ray "
         "reaches the iteration cap, which counts per task",
     )
-    prepass: int = param(
-        0,
+    prepass: int | None = param(
+        None,
         lo=0,
         hi=64,
         unit="pixels",
         help="tile size of the low-resolution pre-pass: one cone per tile "
         "finds how far all its rays are free, and each ray starts there "
-        "(0: off)",
+        "(0: off; not given: the viewer's and `krsview render`'s fast "
+        f"default, {VIEW_PREPASS}, and off with --exact)",
     )
     prepass_levels: int = param(
         2,

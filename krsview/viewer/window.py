@@ -99,7 +99,10 @@ class Viewer:
     def prepass(self) -> int:
         """The pre-pass tile the view draws with: the scene's, once the HUD's knob set it;
         until then the command line's, else the file's, else VIEW_PREPASS."""
-        return self._view_prepass if self._view_prepass is not None else self.scene.render.prepass
+        if self._view_prepass is not None:
+            return self._view_prepass
+        p = self.scene.render.prepass
+        return VIEW_PREPASS if p is None else p
 
     def opened(self) -> None:
         """A document was opened: its name in the title bar, its pre-pass, moment and camera
@@ -107,10 +110,7 @@ class Viewer:
         if self.window is not None:
             glfw.set_window_title(self.window, f"krsview — {self.scene.name}")
         self.message = ""  # what was said of the last scene
-        p = self.settings.prepass
-        self._view_prepass = (
-            p if p is not None else (None if self.scene.render.prepass else VIEW_PREPASS)
-        )
+        self._view_prepass = self.settings.prepass
         self.drawn.open()
         self.nav.reset(self.scene.camera)
 
