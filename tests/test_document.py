@@ -415,3 +415,38 @@ def test_a_viewers_bookmark_is_appended_to_the_file_as_written(tmp_path):
         scene_from_toml(inline.read_text() + '\n[[bookmarks]]\nname = "b"\n')
     doc.add_bookmark(cams[0])
     assert [b.name for b in load_scene(inline).bookmarks] == ["a", "view 2"]
+    # the shipped presets' empty ``bookmarks = []``: only that line goes (it used to write
+    # every default out, a pre-pass and compute path among them)
+    palm = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), palm)
+    text = palm.read_text()
+    assert "\nbookmarks = []\n" in text
+    Document(palm).add_bookmark(cams[0])
+    now = palm.read_text()
+    assert now.startswith(text.replace("\nbookmarks = []\n", "\n")) and "[[bookmarks]]" in now
+    assert load_scene(palm) == replace(
+        load_scene(resolve("palm")), bookmarks=load_scene(palm).bookmarks
+    )
+    assert len(load_scene(palm).bookmarks) == 1
+
+
+def test_a_shipped_presets_copy_made_by_a_bookmark_keeps_its_text(tmp_path, monkeypatch):
+    """B on a shipped preset writes its copy as the preset's own text with the bookmark
+    appended (it used to write every default out: a pre-pass, the fragment path, all the
+    effect settings); a copy with other edits too is written anew (the control)."""
+    from krsview.scene import Camera
+
+    monkeypatch.chdir(tmp_path)
+    cam = Camera((1.0, 2.0, 3.0), (0.0, 1.0, 0.0), (0.0, 1.0, 0.0), 45.0)
+    text = resolve("palm").read_text()
+    doc = Document(resolve("palm"))
+    name, copy = doc.add_bookmark(cam)
+    assert copy == tmp_path / "palm.toml" and not doc.dirty
+    now = copy.read_text()
+    assert now.startswith(text.replace("\nbookmarks = []\n", "\n")) and name in now
+    assert load_scene(copy).bookmarks[0].camera == cam
+    other = Document(resolve("rock"))
+    other.apply(("render", "epsilon_scale"), 2.0)
+    _, written = other.add_bookmark(cam)
+    assert "prepass_levels" in written.read_text() and "prepass_levels" not in now
+    assert load_scene(written).render.epsilon_scale == 2.0

@@ -13,6 +13,7 @@ to the user's data folder.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -197,16 +198,33 @@ class Document:
         try:
             if target.parent == user_folder():  # a preset's copy: the folder may be new
                 target.parent.mkdir(parents=True, exist_ok=True)
-            write_atomic(target, scene_to_toml(self._scene))
+            text = self._text_of(self._scene)
+            write_atomic(target, text)
         except OSError as e:
             raise SceneError("<file>", str(target), f"cannot save: {e.strerror}") from None
         old_recovery = self.recovery_path
         self.path = target
-        self.mark_saved(self._scene)
+        self.mark_saved(self._scene, text)
         old_recovery.unlink(missing_ok=True)
         self.recovery_path.unlink(missing_ok=True)
         self.version += 1
         return target
+
+    def _text_of(self, scene: Scene) -> str:
+        """The file's text for ``scene``: where it is the saved scene with bookmarks added,
+        the saved text with them appended (its comments and layout kept: a shipped preset's
+        copy made by the viewer's B), else the scene written anew."""
+        saved, n = self.saved, len(self.saved.bookmarks)
+        if (
+            replace(scene, bookmarks=saved.bookmarks) != saved
+            or scene.bookmarks[:n] != saved.bookmarks
+        ):
+            return scene_to_toml(scene)
+        text = self.saved_text
+        for k in range(n, len(scene.bookmarks)):
+            want = replace(saved, bookmarks=scene.bookmarks[: k + 1])
+            text = with_bookmark(text, scene.bookmarks[k], want)
+        return text
 
     def add_bookmark(self, camera: Camera) -> tuple[str, Path]:
         """Append a bookmark of ``camera`` to the file (one undo step), its name and the file
@@ -296,11 +314,18 @@ def with_bookmark(text: str, bookmark: Bookmark, want: Scene) -> str:
     """A scene file's ``text`` with ``bookmark`` appended as a table of its own: the person's
     comments, layout and numbers stay as they wrote them. Where that does not read back as
     ``want`` (a file that lists its bookmarks inline, say), the whole scene written anew."""
-    added = text + ("" if text.endswith("\n") else "\n") + "\n"
-    added += dumps({"bookmarks": [to_dict(bookmark)]})
-    try:
-        if scene_from_toml(added) == want:
-            return added
-    except SceneError:
-        pass
+    table = dumps({"bookmarks": [to_dict(bookmark)]})
+    # the shipped presets say ``bookmarks = []`` above their tables: that line goes
+    bases = [text]
+    empty = re.search(r"(?m)^bookmarks[ \t]*=[ \t]*\[[ \t]*\][ \t]*(#.*)?\n", text)
+    first = re.search(r"(?m)^\[", text)
+    if empty and (first is None or empty.start() < first.start()):
+        bases.append(text[: empty.start()] + text[empty.end() :])
+    for base in bases:
+        added = base + ("" if base.endswith("\n") else "\n") + "\n" + table
+        try:
+            if scene_from_toml(added) == want:
+                return added
+        except SceneError:
+            pass
     return scene_to_toml(want)
