@@ -103,7 +103,7 @@ def frames(
     fps = real(fps, "fps", 1.0, 240.0)
     job = FrameJob(scene, path, fps, size, output_dir(folder, "folder"))
     wanted = parse_frames(which, job.count, "which")
-    job.folder.mkdir(parents=True, exist_ok=True)
+    job.claim()
     todo = job.missing(wanted)
     if todo:
         render_frames(job, todo, Renderer(*size).gpu_shared(), done)

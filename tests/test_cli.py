@@ -103,6 +103,59 @@ def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):
     assert "frame time" not in r.stdout  # refused before any work
 
 
+def test_an_options_mistake_is_one_line():
+    """argparse's usage block (15 lines for `render`) no longer comes before the mistake."""
+    r = krsview_cli("render", "tree", "--lod", "-1")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "--lod = -1: allowed: 0 ≤ value ≤ 8 ε" in r.stderr and "--help" in r.stderr
+
+
+def test_ctrl_c_a_full_disk_and_a_closed_pipe_end_in_one_line(tmp_path, monkeypatch, capsys):
+    import os
+    import signal
+    import time
+
+    from PIL import Image
+
+    p = subprocess.Popen(
+        [sys.executable, "-m", "krsview", "render", "tree", "--size", "320x180"]
+        + ["--repeats", "500", "-o", str(tmp_path / "a.png")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "DISPLAY": ""},
+    )
+    assert "krsview: tree" in p.stdout.readline()  # working now
+    time.sleep(1.0)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and err.strip() == "krsview: interrupted", err
+    assert not (tmp_path / "a.png").exists()
+
+    def full(*args, **kw):
+        raise OSError(28, "No space left on device", str(tmp_path / "b.png"))
+
+    monkeypatch.setattr(Image.Image, "save", full)
+    capsys.readouterr()
+    assert (
+        main(["render", "rock", "--size", "16x9", "--repeats", "1", "-o", str(tmp_path / "b.png")])
+        == 3
+    )
+    assert (
+        capsys.readouterr().err
+        == f"krsview: error: {tmp_path / 'b.png'}: No space left on device\n"
+    )
+    monkeypatch.undo()
+
+    read, write = os.pipe()
+    os.close(read)  # `| head` gone
+    closed = os.fdopen(write, "w")
+    monkeypatch.setattr(sys, "stdout", closed)
+    assert main(["check", "palm"]) == 1
+    assert "Traceback" not in capsys.readouterr().err
+    closed.close()  # main put /dev/null under it: what was left goes nowhere, quietly
+
+
 def test_version():
     r = krsview_cli("--version")
     assert r.returncode == 0 and r.stdout.strip().startswith("krsview 0.")

@@ -124,12 +124,36 @@ def test_chunks_and_an_interrupted_run_give_the_same_files(path_file, tmp_path, 
 def test_a_resumed_run_skips_the_frames_already_written(path_file, tmp_path):
     out = tmp_path / "frames"
     assert render_path(path_file, out, "--frames", "1-3").returncode == 0
-    assert sorted(p.name for p in out.iterdir()) == [f"frame_0000{k}.png" for k in (1, 2, 3)]
+    assert sorted(p.name for p in out.glob("*.png")) == [f"frame_0000{k}.png" for k in (1, 2, 3)]
     stamps = {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)}
     r = render_path(path_file, out)
     assert "3 already there, 2 to render" in r.stdout
     assert {k: frame_file(out, k).stat().st_mtime_ns for k in (1, 2, 3)} == stamps
-    assert len(list(out.iterdir())) == 5
+    assert len(list(out.glob("*.png"))) == 5
+
+
+def test_a_folder_of_another_runs_frames_is_refused(path_file, tmp_path):
+    """A resumed run kept any frame there: another size broke the video (ffmpeg wrote it
+    anyway, exit 0), another scene showed in it. The folder's frames.json says what made
+    its frames; a folder without it is judged by its frames' size."""
+    import krsview.export
+
+    out = tmp_path / "frames"
+    assert render_path(path_file, out, "--frames", "0-1").returncode == 0
+    base = ("--camera-path", str(path_file), "--fps", str(FPS), "-o", str(out))
+    other = ("render", "tree", *base, "--size", "48x28")
+    r = krsview_cli(*other)
+    assert r.returncode == 2 and "holds frames of another run (its size differ)" in r.stderr
+    r = krsview_cli("render", "rock", *base, "--size", f"{SIZE[0]}x{SIZE[1]}")
+    assert r.returncode == 2 and "(its scene differ)" in r.stderr
+    (out / "frames.json").unlink()  # frames an older krsview wrote
+    r = krsview_cli(*other)
+    assert r.returncode == 2 and "holds frame_00000.png of 64×36, not 48×28" in r.stderr
+    assert render_path(path_file, out).returncode == 0, "control: the same run resumes"
+    Image.new("RGB", (10, 10)).save(frame_file(out, 4))
+    with pytest.raises(SceneError, match="frame_00004.png is 10×10, frame 0 of the video 64×36"):
+        krsview.export.video(out, tmp_path / "v.mp4")
+    assert not list(tmp_path.glob("*.mp4")) and not list(tmp_path.glob(".*.tmp*"))
 
 
 def test_the_video_holds_the_frames(path_file, tmp_path):

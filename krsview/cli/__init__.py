@@ -6,6 +6,7 @@ what it returns."""
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 
@@ -15,6 +16,7 @@ from ..version import __version__
 from . import batch, bench, check, export, render, window
 
 EXIT_SCENE, EXIT_GL = 2, 3  # a user's mistake (as argparse's usage errors); the environment
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports Ctrl+C
 
 COMMANDS = (  # in the order `krsview --help` lists them
     render.add,  # render
@@ -37,8 +39,17 @@ EXAMPLES = """examples:
 `krsview COMMAND --help` says more about each command."""
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, whose mistakes are one line (not the usage block above them), as
+    a scene file's are; ``--help`` has the usage. Its subcommands' parsers are of this
+    class too."""
+
+    def error(self, message: str):
+        self.exit(EXIT_SCENE, f"{self.prog}: error: {message} (`{self.prog} --help` lists all)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = Parser(
         prog="krsview",
         description="Render, check and benchmark Kernel–Reflection Sequence scenes [KRS17]. "
         "A PRESET is a scene file (.toml) or the name of a shipped preset: "
@@ -72,10 +83,22 @@ def main(argv: list[str] | None = None) -> int:
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     args = build_parser().parse_args(argv)
     try:
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the try, not at exit
+        return code
     except SceneError as e:
         print(f"krsview: error: {e}", file=sys.stderr)
         return EXIT_SCENE
     except RuntimeError as e:  # ContextError, ShaderError, MissingExtra: the environment
         print(f"krsview: error: {e}", file=sys.stderr)
+        return EXIT_GL
+    except KeyboardInterrupt:  # Ctrl+C: what was written is whole (atomic writes)
+        print("\nkrsview: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # `krsview check tree | head`: the reader has gone
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except OSError as e:  # a disk full, a folder gone while writing: the environment
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"krsview: error: {where}{e.strerror or e}", file=sys.stderr)
         return EXIT_GL

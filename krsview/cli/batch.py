@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     scene = options.scene_of(args)
     job, frames = frame_job(args, scene)
     video = check_video(args.video, job.size)
+    job.claim("-o")  # the last check: it writes the folder's frames.json
     print(
         f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of {job.count}, "
         f"{job.size[0]}×{job.size[1]} → {job.folder}/ on {args.workers} worker(s) of "

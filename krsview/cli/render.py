@@ -277,6 +277,7 @@ def write_video(job, frames: range, video: Path) -> None:
 def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
     job, frames = frame_job(args, scene)
     video = check_video(args.video, job.size)
+    job.claim("-o")  # the last check: it writes the folder's frames.json
     todo = job.missing(frames)
     print(
         f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of "

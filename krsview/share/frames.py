@@ -6,7 +6,9 @@ scene's time advances with the frames, so a moving scene plays along with the fl
 
 from __future__ import annotations
 
+import hashlib
 import io
+import json
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -15,10 +17,11 @@ from pathlib import Path
 from PIL import Image
 
 from ..scene import Scene, SceneError
-from ..scene.camera_path import CameraPath
-from ..scene.scene import write_atomic
+from ..scene.camera_path import CameraPath, camera_path_json
+from ..scene.scene import scene_to_toml, write_atomic
 
 DEFAULT_FPS = 30.0
+MANIFEST = "frames.json"  # in the frames' folder: what made them (FrameJob.claim)
 
 
 def frame_file(folder: Path, k: int) -> Path:
@@ -49,6 +52,59 @@ class FrameJob:
     def missing(self, frames: range) -> list[int]:
         """Frames of ``frames`` with no file yet (what a resumed run still renders)."""
         return [k for k in frames if not frame_file(self.folder, k).exists()]
+
+    def made_by(self) -> dict:
+        """What makes this run's frames (the folder's MANIFEST): the scene, the camera
+        path (digests of their files' text), the frame rate and the size."""
+        poses = camera_path_json(list(self.path.poses))
+        return {
+            "scene": hashlib.sha256(scene_to_toml(self.scene).encode()).hexdigest()[:16],
+            "camera_path": hashlib.sha256(poses.encode()).hexdigest()[:16],
+            "fps": self.fps,
+            "size": list(self.size),
+        }
+
+    def claim(self, what: str = "folder") -> None:
+        """Before any frame is drawn: the folder holds no frame of another run, which a
+        resumed run would otherwise keep beside its own (another size breaks the video,
+        another scene or path shows in it). Its MANIFEST says what made its frames; one
+        without (made before krsview wrote it) is taken where its frames have this size.
+        Then the MANIFEST says this run's. SceneError names ``what`` and what differs."""
+        mine, file = self.made_by(), self.folder / MANIFEST
+        if file.exists():
+            try:
+                theirs = json.loads(file.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                theirs = {}
+            differ = [k for k in mine if not isinstance(theirs, dict) or theirs.get(k) != mine[k]]
+            if differ and any(frame_file(self.folder, k).exists() for k in range(self.count)):
+                raise SceneError(
+                    what,
+                    str(self.folder),
+                    f"holds frames of another run (its {', '.join(differ)} differ); give "
+                    "another folder, or empty this one",
+                )
+        else:
+            for k in range(self.count):
+                f = frame_file(self.folder, k)
+                if f.exists() and frame_size(f) != self.size:
+                    w, h = frame_size(f)
+                    raise SceneError(
+                        what,
+                        str(self.folder),
+                        f"holds {f.name} of {w}×{h}, not {self.size[0]}×{self.size[1]}; give "
+                        "another folder, or empty this one",
+                    )
+        write_atomic(file, json.dumps(mine, indent=1) + "\n")
+
+
+def frame_size(f: Path) -> tuple[int, int]:
+    """A frame file's (width, height), read from its header (None-sized if unreadable)."""
+    try:
+        with Image.open(f) as im:
+            return im.size
+    except OSError:
+        return (0, 0)
 
 
 def parse_frames(text: str | None, count: int, flag: str = "--frames") -> range:
@@ -105,8 +161,13 @@ def write_video(
     import imageio.v3 as iio
     import imageio_ffmpeg
 
-    first = iio.imread(frame_file(folder, frames[0]))
-    h, w = first.shape[:2]
+    w, h = frame_size(frame_file(folder, frames[0]))
+    for k in frames:  # before any is encoded: ffmpeg would write a broken video
+        if frame_size(frame_file(folder, k)) != (w, h):
+            a, b = frame_size(frame_file(folder, k))
+            raise SceneError(
+                "folder", str(folder), f"frame_{k:05d}.png is {a}×{b}, frame 0 of the video {w}×{h}"
+            )
     tmp = video.with_name(f".{video.name}.tmp{video.suffix}")
     writer = imageio_ffmpeg.write_frames(
         str(tmp),
@@ -123,6 +184,8 @@ def write_video(
             writer.send(iio.imread(frame_file(folder, k))[..., :3].copy(order="C"))
             if done is not None:
                 done(k)
+        writer.close()
+        os.replace(tmp, video)
     finally:
         writer.close()
-    os.replace(tmp, video)
+        tmp.unlink(missing_ok=True)
