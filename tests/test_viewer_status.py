@@ -146,18 +146,25 @@ def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
     assert [line for line in drawn if line.startswith("screenshot: ")] == [v.status_line()]
 
 
-def test_with_the_hud_hidden_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
-    """A scene file refused on reload, the HUD hidden (F1): its error is the status line at
-    the window's foot, in red, while it stands (the HUD shows it otherwise); it used to show
-    nowhere. Control: with the HUD shown, the status line stays free of it."""
+def test_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
+    """A scene file refused on reload: its error's first line is the status line at the
+    window's foot, in red, while it stands, the HUD shown (whose own line at its end may be
+    scrolled or folded out of sight) or hidden (F1); it used to show nowhere. What was said
+    before it ("reloaded …") goes. A screenshot's path said after it takes the line for a
+    while (the control: not red)."""
     import krsview.viewer.hudframe as hudframe
 
     v = hud_viewer
     text = v.path.read_text()
+    v.file.take()
+    assert v.message.startswith("reloaded")
     v.path.write_text(text.replace("branch_angle = 26.0", "branch_angle = 900.0"))
     v.file.take()
-    assert "branch_angle" in v.error
-    assert v.status_line() == "", "control: the HUD shows the error"
+    assert "branch_angle" in v.error and v.message == ""
+    assert v.status_line() == v.error.splitlines()[0] and v.status_is_error(v.status_line())
+    v.say("screenshot: x.png")
+    assert v.status_line() == "screenshot: x.png" and not v.status_is_error(v.status_line())
+    v.clock += 10
     v.hud = False
     drawn = []
     real = hudframe.draw_status

@@ -226,7 +226,7 @@ class Editor:
         if ui:
             if v.hud:
                 draw_ui(self)
-            draw_status(status, bool(v.error) and not v.hud)
+            draw_status(status, v.status_is_error(status))
             v.platform.render()
         v.input.claimed = v.hud and self._dragging()
         self._held = set(v.input.buttons)

@@ -109,8 +109,9 @@ class ViewerFile:
         try:
             v.doc.reload()
             v.error, v.message, self.refused = "", f"reloaded {self.path.name}", ""
-        except SceneError as e:
-            v.error = self.refused = str(e)  # keep the last good scene and image
+        except SceneError as e:  # keep the last good scene and image; say only this
+            v.error = self.refused = str(e)
+            v.message = ""
         v.sync()
 
     def add_bookmark(self) -> None:

@@ -21,6 +21,8 @@ class HudViewer(Viewed, Protocol):
     interactions: Interactions
     hud: bool  # the HUD shown (else only the status line, where there is one)
 
+    def status_is_error(self, status: str) -> bool: ...
+
 
 class HudFrame:
     """One turn's ImGui frame: :meth:`while_tracing` (or :meth:`begin` in a turn that traces
@@ -56,5 +58,5 @@ class HudFrame:
 
     def draw(self) -> None:
         """The status line, then ImGui's drawing over the image."""
-        draw_status(self.status, bool(self.v.error) and not self.v.hud)
+        draw_status(self.status, self.v.status_is_error(self.status))
         self.v.platform.render()

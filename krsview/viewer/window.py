@@ -316,12 +316,17 @@ class Viewer:
         self.status = (text, self.clock + STATUS_SECONDS)
 
     def status_line(self) -> str:
-        """The status line shown at the window's foot: what was said (a screenshot's path)
-        while it lasts; with the HUD hidden, the first line of the error the HUD would show
-        (a scene file refused on reload), so that none goes unseen."""
-        if self.error and not self.hud:
-            return self.error.splitlines()[0]
-        return self.status[0] if self.clock < self.status[1] else ""
+        """The status line shown at the window's foot, HUD shown or not: what was said (a
+        screenshot's path) while it lasts, else the first line of the error the HUD shows
+        whole (a scene file refused on reload), so that none goes unseen: the HUD's may be
+        scrolled or folded out of sight."""
+        if self.clock < self.status[1]:
+            return self.status[0]
+        return self.error.splitlines()[0] if self.error else ""
+
+    def status_is_error(self, status: str) -> bool:
+        """The status line ``status`` is the error's (drawn in red)."""
+        return bool(status) and bool(self.error) and status == self.error.splitlines()[0]
 
     def read_window(self) -> np.ndarray:
         """The window's pixels (H, W, 3), rows top → bottom (for tests and screenshots)."""
