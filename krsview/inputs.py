@@ -91,7 +91,7 @@ def output_file(path: Any, what: str, suffixes: Iterable[str]) -> Path:
     """Before any work: ``path`` ends in one of ``suffixes`` (the format written), is not a
     folder, and its folder exists or can be made and is writable (a render must not fail
     after it ran)."""
-    if not isinstance(path, (str, Path)):
+    if not isinstance(path, (str, Path)) or str(path) == "":
         raise SceneError(what, path, "expected a file's path")
     p, allowed = Path(path), tuple(suffixes)
     if p.suffix.lower() not in allowed:
@@ -105,7 +105,7 @@ def output_file(path: Any, what: str, suffixes: Iterable[str]) -> Path:
 
 def output_dir(path: Any, what: str) -> Path:
     """Before any work: the folder exists or can be made, and is writable."""
-    if not isinstance(path, (str, Path)):
+    if not isinstance(path, (str, Path)) or str(path) == "":
         raise SceneError(what, path, "expected a folder's path")
     p = Path(path)
     if p.exists() and not p.is_dir():
@@ -115,6 +115,9 @@ def output_dir(path: Any, what: str) -> Path:
 
 
 def _probe(folder: Path, name: str, what: str, given: str) -> None:
+    above = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if above is not None and not above.is_dir():
+        raise SceneError(what, given, f"{str(above)!r} is a file, not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         (folder / name).write_text("")

@@ -438,3 +438,14 @@ def test_render_draws_fast_unless_exact(tmp_path, capsys):
         main([*base, "--lod", "-1"])
     assert bad.value.code == 2
     assert "--lod = -1: allowed: 0 ≤ value ≤ 8 ε" in capsys.readouterr().err
+
+
+def test_written_files_are_said_by_their_whole_path(tmp_path):
+    r = krsview_cli(
+        "bench", "zoom", "tree", "--size", "16x9", "--rounds", "1", "--stops", "2",
+        "--plot", "z.png", "--csv", "z.csv", cwd=tmp_path,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert f"wrote {tmp_path / 'z.png'}" in lines and f"wrote {tmp_path / 'z.csv'}" in lines
+    assert (tmp_path / "z.png").stat().st_size > 1000

@@ -156,8 +156,14 @@ def test_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
 
     v = hud_viewer
     text = v.path.read_text()
+    v.edit(("render", "epsilon_scale"), 2.0)  # a HUD change: the file's contents replace it
     v.file.take()
-    assert v.message.startswith("reloaded")
+    assert v.message == "reloaded tree.toml; the HUD's changes before it are one Ctrl+Z back"
+    v.undo()
+    assert v.scene.render.epsilon_scale == 2.0
+    v.undo()
+    v.file.take()
+    assert v.message == "reloaded tree.toml", "control: nothing of the HUD's lost"
     v.path.write_text(text.replace("branch_angle = 26.0", "branch_angle = 900.0"))
     v.file.take()
     assert "branch_angle" in v.error and v.message == ""

@@ -220,7 +220,9 @@ def run(args: argparse.Namespace) -> int:
     measured = getattr(module, f"bench_{args.bench}")(scene, args.size, rounds=args.rounds, **own)
     print(module.table(measured))
     if args.csv:
-        print(f"wrote {write_csv(measured.rows, args.csv)}")
+        print(f"wrote {write_csv(measured.rows, args.csv).resolve()}")
+    if own.get("plot"):
+        print(f"wrote {own['plot'].resolve()}")
     return 0
 
 
@@ -394,5 +396,5 @@ def run_latency(args: argparse.Namespace) -> int:
         )
     )
     if args.csv:
-        print(f"wrote {write_csv(rows, args.csv)}")
+        print(f"wrote {write_csv(rows, args.csv).resolve()}")
     return 0

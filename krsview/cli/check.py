@@ -67,6 +67,10 @@ def run(args: argparse.Namespace) -> int:
         return stability(scenes_named(args.preset, catalogue=True), args.size)
     if args.oracle:
         return oracle(scenes_named(args.preset)[0], args.size, args.segments)
+    if args.preset == "hard" or args.preset.startswith("hard:"):  # the cases' statistics
+        for scene in scenes_named(args.preset, catalogue=True):
+            print(scene_text(api.check(scene), f"hard:{scene.name}"))
+        return 0
     source = resolve(args.preset)
     print(scene_text(api.check(source), source))
     return 0

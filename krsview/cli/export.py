@@ -36,7 +36,7 @@ def add(sub) -> None:
         "export",
         help="a web page, a Shadertoy shader or a mesh of a scene",
         description="Take a scene out of krsview. Examples: krsview export html tree -o "
-        "tree.html; krsview export mesh rock -o rock.glb --resolution 128",
+        "tree.html; krsview export mesh sierpinski -o sierpinski.glb --resolution 128",
     )
     xsub = x.add_subparsers(dest="format", required=True, metavar="FORMAT")
     for fmt, (suffix, text) in WEB.items():

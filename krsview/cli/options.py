@@ -23,9 +23,9 @@ SILENT_SECONDS = 1.0  # work quicker than this shows no progress bar
 
 
 def size(text: str) -> tuple[int, int]:
-    """``WIDTHxHEIGHT`` → (width, height)."""
+    """``WIDTHxHEIGHT`` (or ``WIDTH×HEIGHT``, as krsview prints sizes) → (width, height)."""
     try:
-        w, h = (int(v) for v in text.lower().split("x"))
+        w, h = (int(v) for v in text.lower().replace("×", "x").split("x"))
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"--size {text!r}: expected WIDTHxHEIGHT, e.g. 640x360"
@@ -90,7 +90,7 @@ def field_option(
             flag if on else "--no-" + flag[2:],
             dest=name,
             action="store_true" if on else "store_false",
-            help=meta["help"] if on else f"{meta['help']}: off (default on)",
+            help=meta["help"] if on else f"do not {meta['help']} (on by default)",
         )
         return
     if typing.get_origin(hint) is tuple:

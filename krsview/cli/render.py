@@ -153,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
     for flag in ("frames", "video"):
         if getattr(args, flag) is not None:
             raise SceneError(f"--{flag}", getattr(args, flag), "needs --camera-path FILE")
-    out = output_file(args.output or "out/render.png", "-o", (".png",))
+    out = output_file("out/render.png" if args.output is None else args.output, "-o", (".png",))
     if args.buffers:
         output_file(args.buffers, "--buffers", (".npz",))
     info = api.check(scene)
@@ -183,7 +183,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"  wrote {out.resolve()}")
     if args.buffers:
         frame.save(args.buffers)
-        print(f"  wrote {args.buffers} (color, depth, normal, iterations, hit)")
+        print(f"  wrote {Path(args.buffers).resolve()} (color, depth, normal, iterations, hit)")
     return 0
 
 
@@ -245,10 +245,10 @@ def frame_job(args: argparse.Namespace, scene: Scene):
     from ..share.frames import FrameJob, parse_frames
 
     path = load_camera_path(args.camera_path)
-    folder = Path(args.output or "out/frames")
-    if folder.suffix.lower() == ".png":
-        raise SceneError("-o", str(folder), "with --camera-path, give a folder for the frames")
-    output_dir(folder, "-o")
+    given = "out/frames" if args.output is None else args.output
+    if Path(given).suffix.lower() == ".png":
+        raise SceneError("-o", given, "with --camera-path, give a folder for the frames")
+    folder = output_dir(given, "-o")
     job = FrameJob(scene, path, args.fps, args.size, folder)
     return job, parse_frames(args.frames, job.count)
 

@@ -28,6 +28,8 @@ def _brief(value: Any, limit: int = 60) -> str:
             if len(repr(value)) > limit
             else repr(value)
         )
+    if isinstance(value, bool):  # as a scene file (TOML) spells it
+        return "true" if value else "false"
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
@@ -193,7 +195,9 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
         return x
     if hint is str:
         if not isinstance(x, str):
-            raise SceneError(path, x, "expected a string")
+            choices = meta.get("choices")
+            one_of = f"; allowed: {', '.join(map(repr, choices))}" if choices else ""
+            raise SceneError(path, x, "expected a string" + one_of)
         if meta.get("choices") and x not in meta["choices"]:
             raise SceneError(path, x, "allowed: " + ", ".join(map(repr, meta["choices"])))
         return x

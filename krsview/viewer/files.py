@@ -106,9 +106,11 @@ class ViewerFile:
         """The file's contents become the scene (an undoable step); a bad file keeps the last
         good scene and shows why."""
         v = self.viewer
+        dirty = v.doc.dirty  # changes made in the HUD: the file's contents replace them
         try:
             v.doc.reload()
-            v.error, v.message, self.refused = "", f"reloaded {self.path.name}", ""
+            kept = "; the HUD's changes before it are one Ctrl+Z back" if dirty else ""
+            v.error, v.message, self.refused = "", f"reloaded {self.path.name}{kept}", ""
         except SceneError as e:  # keep the last good scene and image; say only this
             v.error = self.refused = str(e)
             v.message = ""

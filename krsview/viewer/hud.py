@@ -92,9 +92,11 @@ def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], i
     out: list[c.Command] = []
     interactions.inline.clear()  # the fields drawn this frame show their own errors
     imgui.set_next_window_pos(imgui.ImVec2(HUD_AT, HUD_AT), imgui.Cond_.first_use_ever)
-    tallest = imgui.get_io().display_size.y - 16
+    display = imgui.get_io().display_size
+    tallest, widest = display.y - 2 * HUD_AT, display.x - 2 * HUD_AT
+    width = max(min(HUD_WIDTH, widest), 160)  # a small window: as wide as it (it scrolls)
     imgui.set_next_window_size_constraints(
-        imgui.ImVec2(HUD_WIDTH, 0), imgui.ImVec2(HUD_WIDTH, max(tallest, 100))
+        imgui.ImVec2(width, 0), imgui.ImVec2(width, max(tallest, 100))
     )
     imgui.set_next_window_bg_alpha(0.75)
     imgui.begin(HUD_TITLE, None, imgui.WindowFlags_.always_auto_resize)
@@ -255,6 +257,14 @@ def _scene(v: Viewed, out: list) -> None:
         out.append(c.Replay())
 
 
+def padded(values: np.ndarray, share: float = 0.08) -> tuple[float, float]:
+    """The span of ``values`` with ``share`` of it added each side (a span of at least 1 %
+    of the values' size, so a single value or equal ones still get room)."""
+    lo, hi = float(values.min()), float(values.max())
+    pad = share * max(hi - lo, 0.01 * max(abs(lo), abs(hi), 1e-6))
+    return lo - pad, hi + pad
+
+
 def _measured(v: Viewed, out: list) -> None:
     """Where the current setting sits on the preset's measured time/error curve, and a
     button for the most accurate measured setting that fits the frame budget."""
@@ -274,6 +284,8 @@ def _measured(v: Viewed, out: list) -> None:
         implot.setup_axes("ms (report size)", "hit-mask error %")
         ms = np.array([r["ms"] for r in rows], dtype=np.float32)
         err = np.array([100 * r["mask_error"] for r in rows], dtype=np.float32)
+        (x0, x1), (y0, y1) = padded(ms), padded(err)  # no marker cut in half at an edge
+        implot.setup_axes_limits(x0, x1, y0, y1, implot.Cond_.always)
         implot.plot_scatter("measured", ms, err)
         if now:
             implot.plot_scatter(

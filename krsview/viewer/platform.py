@@ -219,6 +219,7 @@ def open_window(size: tuple[int, int], title: str, visible: bool):
             "cannot open a window: GLFW found no display (is DISPLAY set? "
             "use `krsview render` to render headless)"
         )
+    size = fitted(size, _screen())
     for minor in (5, 3):  # 4.6 fails on llvmpipe (DESIGN.md)
         glfw.default_window_hints()
         glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
@@ -232,3 +233,30 @@ def open_window(size: tuple[int, int], title: str, visible: bool):
             glfw.swap_interval(0)
             return window
     raise WindowError("cannot open an OpenGL 4.3+ core window on this display")
+
+
+def _screen() -> tuple[int, int] | None:
+    """The primary monitor's work area (less task bars), or None where GLFW knows none."""
+    monitor = glfw.get_primary_monitor()
+    if not monitor:
+        return None
+    _, _, w, h = glfw.get_monitor_workarea(monitor)
+    return (w, h) if w > 0 and h > 0 else None
+
+
+def fitted(size: tuple[int, int], screen: tuple[int, int] | None) -> tuple[int, int]:
+    """``size``, or where it is larger than the ``screen``'s work area, the largest size of
+    its shape that fits, said once: a window past the screen's edge traced pixels nobody
+    saw (4000×3000 took 6.5 s a still frame)."""
+    if screen is None:
+        return size
+    scale = min(1.0, screen[0] / size[0], screen[1] / size[1])
+    if scale >= 1.0:
+        return size
+    out = (max(1, int(size[0] * scale)), max(1, int(size[1] * scale)))
+    print(
+        f"krsview: a window of {size[0]}×{size[1]} does not fit the screen "
+        f"({screen[0]}×{screen[1]}): it opens at {out[0]}×{out[1]}",
+        flush=True,
+    )
+    return out

@@ -1,4 +1,5 @@
-"""The status line's place at the window's foot: where no other window covers it."""
+"""Where the HUD's parts go: the status line at the window's foot where no other window covers
+it, and the measured-accuracy plot's room around its points."""
 
 import math
 
@@ -59,3 +60,24 @@ def test_too_long_for_one_line_it_is_wrapped_into_a_gap():
     # a gap whose column is taken higher up (a window right of the HUD, above the foot)
     above = (456.0, 0.0, 960.0, FOOT - 30)
     assert status_spot(DISPLAY, long, [HUD, above])[:2] == (MARGIN, FOOT)
+
+
+def test_the_measured_plot_leaves_room_around_its_points():
+    import numpy as np
+
+    from krsview.viewer.hud import padded
+
+    lo, hi = padded(np.array([10.0, 30.0, 20.0]))
+    assert lo < 10.0 and hi > 30.0 and np.isclose(10.0 - lo, hi - 30.0)
+    one = padded(np.array([5.0]))  # one point: still a span around it
+    assert one[0] < 5.0 < one[1]
+
+
+def test_a_window_larger_than_the_screen_opens_at_the_largest_size_that_fits(capsys):
+    from krsview.viewer.platform import fitted
+
+    assert fitted((960, 540), (1600, 1000)) == (960, 540) and capsys.readouterr().out == ""
+    w, h = fitted((4000, 3000), (1600, 1000))
+    assert (w, h) == (1333, 1000)
+    assert "4000×3000 does not fit the screen (1600×1000)" in capsys.readouterr().out
+    assert fitted((4000, 3000), None) == (4000, 3000)  # no monitor known: as asked
