@@ -13,6 +13,9 @@ LEGEND_HEIGHT = 42  # pixels below the image: colour bar, tick labels, caption
 LEGEND_BACKGROUND = (32, 32, 36)  # dark, so the white end of the bar shows
 
 
+VIEW_WHITE = 32  # iterations: the viewer's heat map is white here until the HUD says more
+
+
 def heat(x: np.ndarray) -> np.ndarray:
     """Black → purple → orange → white for x in [0, 1]; returns (..., 3) in [0, 1]."""
     x = np.clip(x, 0.0, 1.0)

@@ -334,3 +334,33 @@ def test_a_frame_that_compiled_is_not_counted_as_a_moving_frame(hud_viewer):
     _, drawn, _ = turn(v)
     assert len(v.frames.frame_seconds) == 1 and v.frames.adaptive.history[-1] > 0
     assert any(t.startswith("moving frames: median ") for t in drawn)
+
+
+def test_the_iterations_view_has_a_scale_and_a_legend(hud_viewer, monkeypatch):
+    """The iterations view was white at the iteration cap (256 on tree), so a frame of 1–10
+    iterations a pixel was nearly black, with no legend. White is now at the HUD's count
+    (VIEW_WHITE at first), and the HUD draws the ramp with 0, N/2 and N under it; the
+    control: the same image at the cap is darker."""
+    from krsview.heatmap import VIEW_WHITE
+    from krsview.viewer import commands as c
+
+    v = hud_viewer
+    header = imgui.collapsing_header  # the view's section open, as a person opens it
+    monkeypatch.setattr(
+        imgui,
+        "collapsing_header",
+        lambda label, *a: label == "accuracy and view" or header(label, *a),
+    )
+    v.execute([c.SetViewMode("iterations")])
+    assert v.iteration_scale == VIEW_WHITE
+    v.frames.dirty = True
+    for _ in range(3):
+        turn(v)
+    v.execute([c.SetIterationScale(4)])
+    _, drawn, bright = turn(v)
+    legend = drawn[drawn.index("0") :][:3] if "0" in drawn else []
+    assert legend == ["0", "2", "4"], "the legend's numbers"
+    v.execute([c.SetIterationScale(v.scene.render.max_iterations)])
+    _, _, dark = turn(v)
+    view = np.s_[:, HUD_RIGHT:]
+    assert bright[view].mean() > 2 * dark[view].mean() + 10

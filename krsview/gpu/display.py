@@ -46,11 +46,12 @@ class Display:
         target: moderngl.Framebuffer,
         size: tuple[int, int],
         view: str,
-        iteration_cap: int,
+        iteration_scale: float,
         depth_scale: float,
         image: tuple[int, int],
     ) -> None:
-        """Draw ``source``'s image of size ``image`` over ``target``'s ``size`` in ``view``."""
+        """Draw ``source``'s image of size ``image`` over ``target``'s ``size`` in ``view``;
+        the iterations view is white at ``iteration_scale``, the depth view at ``depth_scale``."""
         vao = self._vao(view)
         prog = vao.program
         for unit, tex in enumerate(source.color_attachments):
@@ -60,7 +61,7 @@ class Display:
                 tex.use(location=unit)
         target.use()
         self.ctx.viewport = (0, 0, *size)
-        for name, value in (("u_iteration_cap", iteration_cap), ("u_depth_scale", depth_scale)):
+        for name, value in (("u_iteration_scale", iteration_scale), ("u_depth_scale", depth_scale)):
             if name in prog:
                 prog[name].value = float(value)
         image_uniforms(prog, source, size, image)

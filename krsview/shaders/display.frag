@@ -13,7 +13,7 @@ out vec4 frag_color;
 #ifdef KRS_VIEW
 uniform sampler2D u_normal;      // xyz, depth t
 uniform sampler2D u_iterations;  // x
-uniform float u_iteration_cap;
+uniform float u_iteration_scale;  // white at this many
 uniform float u_depth_scale;     // depth shown as 1 − log(1 + t / scale) / 4
 
 // Black → purple → orange → white heat ramp for iteration counts [KRS17 Fig. 13]; twin of
@@ -32,7 +32,7 @@ void main() {
 #ifdef KRS_VIEW
     vec4 nd = texture(u_normal, uv);  // the compiler drops what the view does not read
     if (KRS_VIEW == VIEW_ITERATIONS)
-        rgb = heat(texture(u_iterations, uv).x / u_iteration_cap);
+        rgb = heat(texture(u_iterations, uv).x / u_iteration_scale);
     else if (KRS_VIEW == VIEW_DEPTH)
         rgb = c.a > 0.5 ? vec3(1.0 - log(1.0 + nd.w / u_depth_scale) / 4.0) : vec3(0.0);
     else

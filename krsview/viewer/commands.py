@@ -71,6 +71,13 @@ class SetViewMode(Command):
 
 
 @dataclass(frozen=True)
+class SetIterationScale(Command):
+    """The iterations view: white at this many iterations of a pixel."""
+
+    iterations: int
+
+
+@dataclass(frozen=True)
 class SetTargetFps(Command):
     fps: float
 

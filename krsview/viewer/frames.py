@@ -225,23 +225,24 @@ class Frames:
         target: moderngl.Framebuffer,
         size: tuple[int, int],
         mode: str,
-        scene: Scene,
-        depth: float,
+        scales: tuple[float, float],
     ) -> None:
         """The last image into ``target`` of ``size`` pixels (scaled to it), in view ``mode``;
-        ``depth`` scales the depth view."""
+        ``scales``: what the iterations and the depth views show as white."""
         if self.image is not None:
             fbo, image = self.image
-            self.display.show(fbo, target, size, mode, scene.render.max_iterations, depth, image)
+            self.display.show(fbo, target, size, mode, *scales, image)
 
-    def still(self, scene: Scene, krs: Geometry, mode: str, depth: float) -> np.ndarray:
+    def still(
+        self, scene: Scene, krs: Geometry, mode: str, scales: tuple[float, float]
+    ) -> np.ndarray:
         """The full-resolution image of ``scene`` traced at once, in view ``mode``: (H, W, 3)
         bytes, rows top → bottom."""
         size = self.adaptive.still_size()
         prog = self.renderer.prepare(scene, *size, krs)
         fbo = self.renderer.draw(prog, *size)
         target = self.ctx.simple_framebuffer(size, components=4)
-        self.display.show(fbo, target, size, mode, scene.render.max_iterations, depth, size)
+        self.display.show(fbo, target, size, mode, *scales, size)
         rgb = np.frombuffer(target.read(components=3), np.uint8).reshape(size[1], size[0], 3)
         target.release()
         return rgb[::-1]

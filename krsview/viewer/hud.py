@@ -13,6 +13,7 @@ from imgui_bundle import imgui, implot
 
 from ..compile.constants import VIEW_MODES
 from ..document.document import Document, shipped
+from ..heatmap import heat
 from ..scene import EFFECTS, Render, Scene
 from ..scene.effects import allowed_effects
 from ..scene.presets import preset_names, resolve
@@ -32,6 +33,7 @@ HUD_AT = 8  # pixels from the window's top left corner, where the HUD first open
 HUD_RIGHT = HUD_AT + HUD_WIDTH  # its right edge there
 PLOT_HEIGHT = 130  # the frame-time plot, tall enough for readable axis labels
 PLOTTED = 120  # moving frames in the plot
+LEGEND_STEPS = 24  # the iterations view's legend: its ramp in this many blends
 TRACER_KNOBS = {"xi_bonus": "binary", "xi_penalty": "binary", "relaxation": "relaxed"}
 # the last one sits beside the pre-pass tile slider
 KNOBS = (
@@ -62,6 +64,7 @@ class Viewed(Protocol):
     file: ViewerFile  # its camera path's recorder
     drawn: Drawn  # the moment shown, the levels kept
     view: str
+    iteration_scale: int  # the iterations view: white at this many
     nav: Navigation
     moving_effects: bool
     message: str
@@ -210,6 +213,8 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))
     if changed:
         out.append(c.SetViewMode(VIEW_MODES[k]))
+    if v.view == "iterations":
+        _iteration_legend(v, out)
     imgui.text("effects (each compiles its own shader variant, cached)")
     for name in allowed_effects(v.scene.mokrs is not None):
         changed, on = imgui.checkbox(name, name in v.scene.effects)
@@ -217,6 +222,31 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
             out.append(c.SetEffect(name, on))
         if imgui.is_item_hovered():
             tooltip(EFFECTS[name].help)
+
+
+def _iteration_legend(v: Viewed, out: list) -> None:
+    """The iterations view's scale (white at N iterations of a pixel, up to the cap) and
+    its legend: the ramp with 0, N/2 and N under it, as `krsview render --view iterations`
+    draws below its image."""
+    cap = v.scene.render.max_iterations
+    flags = imgui.SliderFlags_.logarithmic | imgui.SliderFlags_.always_clamp
+    changed, n = imgui.slider_int("white at (iterations)", v.iteration_scale, 1, cap, flags=flags)
+    if changed:
+        out.append(c.SetIterationScale(n))
+    draw, x0 = imgui.get_window_draw_list(), imgui.get_cursor_screen_pos()
+    width, h = imgui.calc_item_width(), imgui.get_frame_height() * 0.6
+    ramp = (np.round(heat(np.linspace(0.0, 1.0, LEGEND_STEPS + 1)) * 255)).astype(int)
+    for k in range(LEGEND_STEPS):
+        a, b = (imgui.IM_COL32(*ramp[j], 255) for j in (k, k + 1))
+        p0 = imgui.ImVec2(x0.x + width * k / LEGEND_STEPS, x0.y)
+        p1 = imgui.ImVec2(x0.x + width * (k + 1) / LEGEND_STEPS, x0.y + h)
+        draw.add_rect_filled_multi_color(p0, p1, a, b, b, a)
+    imgui.dummy(imgui.ImVec2(width, h))
+    y = imgui.get_cursor_screen_pos().y
+    for k, text in enumerate(("0", f"{v.iteration_scale / 2:g}", f"{v.iteration_scale}")):
+        label = imgui.calc_text_size(text).x  # left, middle, right under the ramp
+        imgui.set_cursor_screen_pos(imgui.ImVec2(x0.x + (width - label) * k / 2, y))
+        imgui.text(text)
 
 
 def _scene(v: Viewed, out: list) -> None:

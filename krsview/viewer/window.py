@@ -21,6 +21,7 @@ from ..document.document import Document
 from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
+from ..heatmap import VIEW_WHITE
 from ..scene import Scene, SceneError
 from ..scene.effects import EXCLUSIVE
 from ..scene.render import VIEW_PREPASS
@@ -67,6 +68,7 @@ class Viewer:
         self.interactions = Interactions()
         self.hud = self.settings.hud
         self.view = "shaded"
+        self.iteration_scale = VIEW_WHITE  # the iterations view: white at this many
         self.nav = Navigation(self.input, self.scene.camera)
         self.message, self.error = "", ""
         self.clock = 0.0
@@ -289,18 +291,19 @@ class Viewer:
         self.ctx.screen.use()
         if self.frames.image is None:  # else the image covers every pixel: no clear to pay
             self.ctx.clear(*self.scene.material.background)
-        self.frames.show(self.ctx.screen, fb, self.view, self.scene, self._depth_scale())
+        self.frames.show(self.ctx.screen, fb, self.view, self._scales())
 
-    def _depth_scale(self) -> float:
-        return max(
-            float(np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))), 1e-9
-        )
+    def _scales(self) -> tuple[float, float]:
+        """What the iterations and depth views show as white: the HUD's iteration count,
+        the distance from the eye to the scene camera's target."""
+        eye_to_target = np.linalg.norm(self.camera.position - np.array(self.scene.camera.target))
+        return float(self.iteration_scale), max(float(eye_to_target), 1e-9)
 
     # -------------------------------------------------------------------------- output
     def screenshot(self) -> Path | None:
         """A full-resolution PNG of the current view and view mode, beside the scene (else in
         the pictures folder); its full path is printed and shown for STATUS_SECONDS."""
-        rgb = self.frames.still(self.view_scene(), self.drawn.krs, self.view, self._depth_scale())
+        rgb = self.frames.still(self.view_scene(), self.drawn.krs, self.view, self._scales())
         try:
             out = save_screenshot(rgb, self.path, time.strftime("%Y%m%d-%H%M%S"))
         except OSError as e:
@@ -345,6 +348,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.Redo: lambda v, e: v.redo(),
     c.SetLevels: lambda v, e: v.drawn.set_levels(e.levels),
     c.SetViewMode: lambda v, e: setattr(v, "view", e.mode),
+    c.SetIterationScale: lambda v, e: setattr(v, "iteration_scale", max(1, e.iterations)),
     c.SetTargetFps: lambda v, e: v.set_target_fps(e.fps),
     c.SetSupersample: lambda v, e: v.set_supersample(e.factor),
     c.SetMovingEffects: lambda v, e: v.set_moving_effects(e.on),
