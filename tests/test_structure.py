@@ -431,6 +431,32 @@ def test_insert_delete_and_ctrl_d_keys_edit_the_selected_level(window_editor):
     assert len(e.scene.route.levels) == n
 
 
+def test_the_grow_again_question_lists_the_edits_it_would_lose(window_editor):
+    """After an insert, growing the tree again asks first, in a dialog listing the hand
+    edits lost (drawing it closed the editor: it listed the new route instead). Cancel keeps
+    the tree; the control: the question was up."""
+    from imgui_bundle import imgui
+
+    e = window_editor
+    e.select_level(3)
+    xdo("key", "Insert")
+    pump(e)
+    inserted = e.scene
+    listed = []
+    bullet = imgui.bullet_text
+    imgui.bullet_text = lambda text: (listed.append(text), bullet(text))[1]
+    try:
+        e.execute([ec.Regrow()])
+        pump(e, 3)
+    finally:
+        imgui.bullet_text = bullet
+    assert e.structure.pending is not None
+    assert listed and all(line in e.structure.pending.lost for line in listed)
+    e.execute([ec.CancelRegrow()])
+    pump(e)
+    assert e.scene == inserted and e.structure.pending is None
+
+
 def test_undo_and_redo_bring_the_selection_back(window_editor):
     """Ctrl+Z after an insert selects what was selected before it (it used to keep the
     selection's level number, now another branch); Ctrl+Shift+Z what was selected when it

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 from ..document.document import Document
 from ..scene import Route, Scene, SceneError
@@ -45,6 +45,15 @@ STRUCTURE_KEYS: dict[str, Command] = {
 }
 
 
+class Regrowth(NamedTuple):
+    """A tree grown again that would lose hand edits: it waits for a yes."""
+
+    at: Path  # the route's path in the scene
+    route: Route  # grown again
+    lost: list[str]  # the hand edits it drops, a line each
+    label: str  # the undo step's
+
+
 @dataclass
 class StructureTools:
     """The structure section's values and its last word."""
@@ -57,7 +66,7 @@ class StructureTools:
     level: int = 0  # in a compound: the level of the component's route the keys act on
     message: str = ""
     refused: bool = False
-    pending: tuple[Path, Route, list[str], str] | None = None  # a re-grow waiting for a yes
+    pending: Regrowth | None = None  # a re-grow waiting for a yes
 
 
 class Structured(Protocol):
@@ -240,16 +249,16 @@ def _grow_again(e: Structured, label: str, interaction: Any, *change: Any) -> No
         _say(e, f"{label} refused: {err}", True)
         return
     if lost:
-        e.structure.pending = (at, new, lost, label)
+        e.structure.pending = Regrowth(at, new, lost, label)
     else:
         commit_route(e, lambda r: new, label, interaction, at)
 
 
 def confirm_regrow(e: Structured) -> None:
-    pending, e.structure.pending = e.structure.pending, None
-    if pending is not None:
-        at, new, lost, label = pending
-        commit_route(e, lambda r: new, f"{label} (losing {len(lost)} hand edits)", at=at)
+    p, e.structure.pending = e.structure.pending, None
+    if p is not None:
+        label = f"{p.label} (losing {len(p.lost)} hand edits)"
+        commit_route(e, lambda r: p.route, label, at=p.at)
 
 
 STRUCTURE_HANDLERS: dict[type[Command], Callable[[Any, Any], None]] = {

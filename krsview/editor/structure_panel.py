@@ -148,7 +148,7 @@ def _regrow_dialog(t: StructureTools, out: list[Command]) -> None:
         imgui.open_popup("grow again?")
     if not imgui.begin_popup_modal("grow again?", None, imgui.WindowFlags_.always_auto_resize)[0]:
         return
-    lost = t.pending[1] if t.pending else []
+    lost = t.pending.lost if t.pending else []
     imgui.text("Growing the tree again loses these edits made by hand:")
     for line in lost[:MAX_LISTED]:
         imgui.bullet_text(line)
