@@ -349,3 +349,40 @@ def test_the_growth_parameters_labels_fit_in_the_panel(tree_editor, monkeypatch)
     for name in shown:  # a widget's rectangle holds its label
         x0, y0, x1, y1 = e.viewer.interactions.rects[("route", "growth", name)]
         assert x1 <= right + 0.5, (name, x1, right)
+
+
+def test_ctrl_shift_s_asks_the_name_and_enter_saves_there(display, tmp_path):
+    """Ctrl+Shift+S saved at once under whatever the panel's field held (its own file at
+    first: a plain save). Now a dialog asks, its field focused: typed name, Enter, saved
+    there; Esc cancels, writing nothing (the control)."""
+    import glfw
+
+    from krsview.editor.window import Editor
+
+    mine = tmp_path / "mine.toml"
+    shutil.copy(resolve("tree"), mine)
+    e = Editor(mine, size=SIZE)
+    try:
+        x, y = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", x + SIZE[0] - 40, y + SIZE[1] - 40)
+        pump(e)
+        e.edit(("render", "epsilon_scale"), 2.0)
+        xdo("key", "ctrl+shift+s")
+        pump(e, 3)
+        assert e.file.copy_to is not None and e.file.copy_to.text == str(mine)
+        xdo("key", "Escape")
+        pump(e, 3)
+        assert e.file.copy_to is None and e.doc.dirty and sorted(tmp_path.iterdir()) == [mine]
+        xdo("key", "ctrl+shift+s")
+        pump(e, 3)
+        other = tmp_path / "other.toml"
+        xdo("key", "ctrl+a")
+        xdo("type", str(other))
+        pump(e, 2 * len(str(other)))  # ImGui takes the typed characters one per frame
+        xdo("key", "Return")
+        pump(e, 3)
+        assert e.file.copy_to is None and e.path == other and not e.doc.dirty
+        assert load_scene(other).render.epsilon_scale == 2.0
+        assert load_scene(mine).render.epsilon_scale == 1.0
+    finally:
+        e.close()

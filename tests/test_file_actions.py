@@ -92,6 +92,35 @@ def test_a_disk_change_is_taken_unless_there_are_unsaved_edits(tree):
     assert not f.conflict and w.doc.scene.name == "second" and not w.doc.dirty
 
 
+def test_keeping_mine_in_a_conflict_lets_the_next_save_overwrite(tree):
+    """ "keep mine" used to be followed by a save refused again and again: nothing ever
+    saved over the file. Now it does, once; a later change on disk asks again. A file
+    deleted or spoilt on disk cannot be taken: the conflict says so, and keeping mine
+    writes it anew."""
+    f, w, _ = part(tree)
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    change_on_disk(tree, w.doc, "theirs")
+    f.reload_scene()
+    assert f.conflict and not f.unreadable
+    assert not f.save(), "control: a save is refused before the answer"
+    f.keep_mine()
+    assert "Ctrl+S overwrites tree.toml" in w.said[-1]
+    assert f.save() and load_scene(tree).render.epsilon_scale == 2.0
+    assert load_scene(tree).name == "tree" and not f.kept
+    w.doc.apply(("render", "epsilon_scale"), 3.0)
+    change_on_disk(tree, w.doc, "again")
+    assert not f.save() and f.conflict, "kept once is not kept for ever"
+    tree.unlink()
+    f.reload_scene()
+    assert f.conflict and "cannot read" in f.unreadable
+    f.keep_mine()
+    assert f.save() and load_scene(tree).render.epsilon_scale == 3.0
+    w.doc.apply(("render", "epsilon_scale"), 4.0)
+    tree.write_text("fov_y = banana\n")
+    f.reload_scene()
+    assert f.conflict and "not valid TOML" in f.unreadable
+
+
 def test_closing_asks_only_with_unsaved_edits_and_discard_writes_nothing(tree):
     f, w, _ = part(tree)
     assert f.may_close() and f.asking is None, "a clean scene closes at once"

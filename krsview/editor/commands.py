@@ -53,7 +53,12 @@ class Save(Command):
 
 @dataclass(frozen=True)
 class SaveAs(Command):
-    """Ctrl+Shift+S: save under the name typed in the save-as field."""
+    """Save under the name typed in the panel's save-as field (its button, or Enter)."""
+
+
+@dataclass(frozen=True)
+class AskSaveAs(Command):
+    """Ctrl+Shift+S: a dialog asks the name to save under."""
 
 
 @dataclass(frozen=True)
@@ -68,7 +73,7 @@ class TakeFile(Command):
 
 @dataclass(frozen=True)
 class KeepMine(Command):
-    """A conflict: keep the edits; saving will ask to overwrite."""
+    """A conflict: keep the edits; the next save overwrites the file."""
 
 
 @dataclass(frozen=True)

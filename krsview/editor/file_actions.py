@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from ..document.document import ConflictError, Document, copy_target
-from ..scene import Bookmark, SceneError
+from ..scene import Bookmark, SceneError, load_scene
 from ..viewer import commands as vc
 from ..viewer.camera import FlyCamera
 from ..viewer.files import ViewerFile
@@ -65,6 +65,8 @@ class FileActions:
         self.copy_to: CopyAsk | None = None  # a shipped preset's copy, being asked for
         self.recovered = self.doc.recovery()  # a recovery file's scene, offered in a modal
         self.conflict = False  # the file changed on disk while there are unsaved edits
+        self.unreadable = ""  # why the file's new contents cannot be taken (deleted, bad)
+        self.kept = False  # the person kept their edits: the next save overwrites the file
         self.save_as_text = save_as_default(self.doc)
         self.quit = False  # the question was answered: the window closes
 
@@ -84,9 +86,19 @@ class FileActions:
         if not self.doc.changed_on_disk():
             return
         if self.doc.dirty:
-            self.conflict = True
+            self._conflict()
         else:
             self.viewer.file.take()
+
+    def _conflict(self) -> None:
+        """The file changed on disk under unsaved edits: ask, knowing whether its new
+        contents can be taken at all (a file deleted, or no scene any more, cannot)."""
+        self.conflict, self.kept = True, False
+        try:
+            load_scene(self.doc.path)
+            self.unreadable = ""
+        except SceneError as e:
+            self.unreadable = str(e)
 
     def save(self, path: str | None = None, overwrite: bool = False) -> bool:
         """Save (atomic); a shipped preset first asks where its copy goes, taking over the
@@ -95,33 +107,39 @@ class FileActions:
         if not path and self.doc.template:
             self.copy_to, self.asking = CopyAsk(str(copy_target(self.doc.path)), self.asking), None
             return False
+        own = not path or Path(path).resolve() == self.doc.path.resolve()
         try:
-            saved = self.doc.save(path or None, overwrite=overwrite)
-        except ConflictError as e:
-            v.error, self.conflict = str(e), True
+            saved = self.doc.save(path or None, overwrite=overwrite or (self.kept and own))
+        except ConflictError:
+            v.error = f"{self.doc.path.name} changed on disk: take it, or keep yours and save"
+            self._conflict()
             return False
         except SceneError as e:
             v.error = str(e)
             return False
         v.file.follow()
-        v.error, v.message, self.conflict = "", f"saved {saved.resolve()}", False
+        v.error, v.message, self.conflict, self.kept = "", f"saved {saved.resolve()}", False, False
         self.save_as_text = str(saved)
         return True
 
-    def save_as(self, text: str) -> None:
+    def save_as(self, text: str) -> bool:
         target = Path(text.strip()).expanduser()
         if target.suffix != ".toml" or target.is_dir():
             self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
-            return
-        self.save(str(target))
+            return False
+        return self.save(str(target))
+
+    def ask_save_as(self) -> None:
+        """Ctrl+Shift+S: the dialog asks where to save (a shipped preset's: its copy)."""
+        start = str(copy_target(self.doc.path)) if self.doc.template else self.save_as_text
+        self.copy_to = CopyAsk(start)
 
     def save_copy(self) -> None:
         """Save to the copy named in the dialog; then go on with the question that asked."""
         ask = self.copy_to
         if ask is None:
             return
-        self.save_as(ask.text)
-        if self.doc.template:
+        if not self.save_as(ask.text):
             return  # refused: the dialog stays, with the error
         self.copy_to = None
         if ask.then is not None:
@@ -133,8 +151,11 @@ class FileActions:
         self.viewer.file.take()
 
     def keep_mine(self) -> None:
-        self.conflict = False
-        self.viewer.message = "kept your edits; saving will ask to overwrite"
+        """The person's edits win over the file's new contents: the next save overwrites
+        the file (saving elsewhere leaves it)."""
+        self.conflict, self.kept = False, True
+        self.viewer.message = f"kept your edits: Ctrl+S overwrites {self.doc.path.name}"
+        self.viewer.say(self.viewer.message)
 
     def restore(self) -> None:
         self.doc.restore_recovery()
@@ -190,6 +211,7 @@ class FileActions:
 FILE_HANDLERS: dict[type[vc.Command], Callable[[FileActions, Any], None]] = {
     ec.Save: lambda f, c: f.save(),
     ec.SaveAs: lambda f, c: f.save_as(f.save_as_text),
+    ec.AskSaveAs: lambda f, c: f.ask_save_as(),
     ec.SetSaveAsText: lambda f, c: setattr(f, "save_as_text", c.text),
     ec.SetCopyText: lambda f, c: setattr(f, "copy_to", replace(f.copy_to, text=c.text)),
     ec.SaveCopy: lambda f, c: f.save_copy(),

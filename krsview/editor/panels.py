@@ -170,9 +170,12 @@ def _file(e: Edited, out: list) -> None:
         out.append(ec.SaveAs())
     imgui.same_line()
     imgui.set_next_item_width(-1)  # the rest of the line, however wide the panel
-    changed, text = imgui.input_text("##saveas", e.file.save_as_text)
-    if changed:
+    enter = imgui.InputTextFlags_.enter_returns_true
+    done, text = imgui.input_text("##saveas", e.file.save_as_text, enter)
+    if text != e.file.save_as_text:
         out.append(ec.SetSaveAsText(text))
+    if done:  # Enter saves under the name typed, as the button does
+        out.append(ec.SaveAs())
     done, undone = doc.history.labels()
     imgui.begin_disabled(not done)
     if imgui.button("undo (Ctrl+Z)"):
@@ -188,14 +191,19 @@ def _file(e: Edited, out: list) -> None:
     if undone and imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled):
         tooltip("redo: " + undone[0])
     if e.file.conflict:
-        red_text(f"{doc.path.name} changed on disk, and you have unsaved edits.")
-        if imgui.button("take the file"):
-            out.append(ec.TakeFile())
-        if imgui.is_item_hovered():
-            tooltip("load the file's contents; your edits stay undoable")
-        imgui.same_line()
+        if e.file.unreadable:  # nothing to take: a file deleted, or no scene any more
+            red_text(f"{doc.path.name} changed on disk and cannot be read: {e.file.unreadable}")
+        else:
+            red_text(f"{doc.path.name} changed on disk, and you have unsaved edits.")
+            if imgui.button("take the file"):
+                out.append(ec.TakeFile())
+            if imgui.is_item_hovered():
+                tooltip("load the file's contents; your edits stay undoable")
+            imgui.same_line()
         if imgui.button("keep mine"):
             out.append(ec.KeepMine())
+        if imgui.is_item_hovered():
+            tooltip("keep your edits: the next save (Ctrl+S) writes the file anew with them")
 
 
 def _outline(e: Edited, out: list) -> None:
@@ -294,8 +302,12 @@ def _modals(e: Edited, out: list) -> None:
     if begin_modal("unsaved changes"):
         what = "closing" if e.file.asking == ("close", None) else "opening another scene"
         imgui.text_wrapped(f"{e.doc.path.name} has unsaved edits. Save them before {what}?")
+        red_text(e.viewer.error)  # a save that failed says why here, where one looks
         answers = [("save", ec.AnswerSave()), ("discard", ec.AnswerDiscard())]
-        answer_buttons([*answers, ("cancel", ec.AnswerCancel())], out)
+        answer_buttons([*answers, ("cancel (Esc)", ec.AnswerCancel())], out)
+        if imgui.is_key_pressed(imgui.Key.escape):
+            out.append(ec.AnswerCancel())
+            imgui.close_current_popup()
         imgui.end_popup()
     if e.file.recovered is not None and not imgui.is_popup_open("recover"):
         imgui.open_popup("recover")

@@ -11,7 +11,7 @@ from ..viewer.commands import Command
 from . import commands as ec
 from .file_actions import FileActions
 
-DIALOG = "save a copy"
+DIALOG = "###save"  # the dialog's id, whichever title it shows
 
 
 def autosave(f: FileActions, now: float) -> None:
@@ -29,20 +29,28 @@ def copy_dialog(f: FileActions) -> list[Command]:
     out: list[Command] = []
     if f.copy_to is not None and not imgui.is_popup_open(DIALOG):
         imgui.open_popup(DIALOG)
-    if not imgui.begin_popup_modal(DIALOG, None, imgui.WindowFlags_.always_auto_resize)[0]:
+    template = f.doc.template
+    title = ("save a copy" if template else "save as") + DIALOG
+    if not imgui.begin_popup_modal(title, None, imgui.WindowFlags_.always_auto_resize)[0]:
         return out
-    imgui.text(f"{f.doc.path.name} is a preset shipped with krsview: a template, never")
-    imgui.text("overwritten. Save your version as:")
+    if template:
+        imgui.text(f"{f.doc.path.name} is a preset shipped with krsview: a template, never")
+        imgui.text("overwritten. Save your version as:")
+    else:
+        imgui.text(f"Save {f.doc.path.name} as:")
     imgui.set_next_item_width(420)
-    changed, text = imgui.input_text("##copy", f.copy_to.text if f.copy_to else "")
-    if changed:
+    if imgui.is_window_appearing():
+        imgui.set_keyboard_focus_here()
+    enter = imgui.InputTextFlags_.enter_returns_true
+    done, text = imgui.input_text("##copy", f.copy_to.text if f.copy_to else "", enter)
+    if text != (f.copy_to.text if f.copy_to else ""):
         out.append(ec.SetCopyText(text))
     if f.viewer.error and f.copy_to is not None:
         imgui.text_wrapped(f.viewer.error)
-    if imgui.button("save the copy"):
+    if imgui.button("save the copy" if template else "save") or done:
         out.append(ec.SaveCopy())
     imgui.same_line()
-    if imgui.button("cancel"):
+    if imgui.button("cancel (Esc)") or imgui.is_key_pressed(imgui.Key.escape):
         out.append(ec.CancelCopy())
     if f.copy_to is None:
         imgui.close_current_popup()

@@ -59,7 +59,7 @@ VIEW = "view.position"  # the viewpoint flown in the editor, in a refused edit's
 EDITOR_KEYS = {
     **VIEWER_KEYS,
     "ctrl+S": ec.Save(),
-    "ctrl+shift+S": ec.SaveAs(),
+    "ctrl+shift+S": ec.AskSaveAs(),
     "K": ec.SetKey(),
     **STRUCTURE_KEYS,
 }
