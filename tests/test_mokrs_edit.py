@@ -14,7 +14,8 @@ from krsview.algebra import mobius
 from krsview.document.document import Document
 from krsview.editor.handles import handles
 from krsview.editor.mokrs_handles import RADIUS_DIRECTION, SCALE_DIRECTION
-from krsview.editor.mokrs_panel import LEVELS, inserted, moved, refusal_place, removed
+from krsview.editor.mokrs_levels import changed
+from krsview.editor.mokrs_panel import LEVELS, moved, refusal_place, removed
 from krsview.scene import SceneError, load_scene
 from krsview.scene.edits import apply_edit, get_at
 from krsview.scene.mokrs import Rotate, Scale, Translate
@@ -197,12 +198,10 @@ def test_an_inserted_identity_level_can_be_grabbed_and_a_drag_gives_it_a_transla
     """An identity level without a kernel has its origin as a handle (else nothing selects
     it); dragging it adds a translate step whose handle, on the same path, is where the
     origin was dragged, so the drag goes on. Negative control: a level with steps has none."""
-    from krsview.scene.model import Empty
-    from krsview.scene.mokrs import MobiusLevel
 
     palm = load_scene(resolve("palm"))
     levels = palm.mokrs.levels
-    s = apply_edit(palm, LEVELS, inserted(levels, 31, MobiusLevel(Empty(), [], False)))
+    s = apply_edit(palm, LEVELS, changed(levels, 30, "insert")[0])
     origin = [h for h in handles(s) if h.role == "origin"]
     assert [h.level for h in origin] == [31]
     h = origin[0]
@@ -291,7 +290,7 @@ def test_structural_edits_are_validated_and_one_undo_step_each(tmp_path):
     ]
     # shell has 64 levels, the most a MöKRS may have: a duplicate is refused with the limit
     with pytest.raises(SceneError, match="at most 64"):
-        doc.apply(LEVELS, inserted(m.levels, 6, m.levels[5]))
+        doc.apply(LEVELS, changed(m.levels, 5, "duplicate")[0])
     doc.apply(LEVELS, removed(m.levels, 0))
     assert doc.scene.mokrs.n == 63 and len(doc.history.steps) == 4
     with pytest.raises(SceneError, match="numerically singular|allowed"):
@@ -317,7 +316,7 @@ def test_drags_and_step_list_edits_keep_the_shader_variant():
     h = next(h for h in handles(palm) if h.role == "degrees" and h.level == 30)
     dragged = apply_edit(palm, h.path, 12.0)
     levels = palm.mokrs.levels
-    longer = apply_edit(palm, LEVELS, inserted(levels, 31, levels[30]))
+    longer = apply_edit(palm, LEVELS, changed(levels, 30, "duplicate")[0])
     assert defines(dragged) == base and defines(longer) == base
     sphere = apply_edit(palm, (*LEVELS, 30, "kernel"), Sphere((0.0, 0.0, 0.0), 0.1))
     assert defines(sphere) != base
@@ -588,5 +587,54 @@ def test_a_step_removed_from_a_linked_level_goes_from_its_linked_levels_and_keep
             assert not [h for h in e.handles if h.path == degrees]  # the dial's handle is gone
             assert e.selected is not None and e.selected.level == 58, e.selected
             e.viewer.undo()
+    finally:
+        e.close()
+
+
+def test_level_operations_move_the_selection_with_the_level():
+    levels = list("abcde")
+    assert changed(levels, 3, "inward") == (list("abdce"), 2)
+    assert changed(levels, 3, "outward") == (list("abced"), 4)
+    assert changed(levels, 0, "inward") == (levels, 0)  # nothing inside the innermost
+    assert changed(levels, 4, "outward") == (levels, 4)
+    assert changed(levels, 1, "duplicate") == (list("abbcde"), 1)
+    assert changed(levels, 4, "remove") == (list("abcd"), 3)
+    new, k = changed(levels, 1, "insert")
+    assert k == 2 and len(new) == 6 and new[2].transform == [] and new[:2] == levels[:2]
+
+
+def test_inward_twice_moves_a_level_two_steps_and_the_keys_act_on_levels(display, tmp_path):
+    """ "inward" kept the selection at the index, now the other level: a second click swapped
+    them back. And Insert / Delete / Ctrl+D said "select a level first" with one selected:
+    they act on the selected MöKRS level now, each one undo step."""
+    from krsview.editor.mokrs_levels import level_commands
+    from krsview.editor.window import Editor
+
+    from .test_editor import pump, xdo
+
+    path = tmp_path / "tree-mokrs.toml"
+    shutil.copy(resolve("tree-mokrs"), path)
+    e = Editor(path, size=(640, 400))
+    try:
+        pump(e)
+        start = e.scene.mokrs.levels
+        e.select_level(17)
+        for _ in range(2):
+            e.execute(level_commands(e.scene.mokrs.levels, e.selected.level, "inward"))
+        assert e.selected.level == 15 and e.scene.mokrs.levels[15] == start[17]
+        assert e.scene.mokrs.levels[16:18] == [start[15], start[16]]
+        assert len(e.doc.history.steps) == 2
+        import glfw
+
+        x, y = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", x + 620, y + 380)  # over the view
+        n = len(e.scene.mokrs.levels)
+        for key, change in (("Delete", -1), ("ctrl+d", 1), ("Insert", 1)):
+            xdo("key", key)
+            pump(e, 2)
+            assert len(e.scene.mokrs.levels) == n + change and not e.viewer.error, key
+            n = len(e.scene.mokrs.levels)
+        assert e.scene.mokrs.levels[e.selected.level].transform == []  # the identity, selected
+        assert len(e.doc.history.steps) == 5
     finally:
         e.close()

@@ -14,17 +14,18 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ..scene.edits import path_text
-from ..scene.model import Empty, Kernel
-from ..scene.mokrs import MobiusLevel, MobiusStep, linked_levels, linked_steps
+from ..scene.model import Kernel
+from ..scene.mokrs import MobiusStep, linked_levels, linked_steps
 from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions, red_text, tooltip
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
 from .mokrs_handles import mokrs_outline
+from .mokrs_levels import LEVELS, OPS, level_commands
 
 STEP_KINDS = tuple(MobiusStep.registry)  # translate, scale, rotate, invert
 KERNEL_KINDS = tuple(Kernel.registry)
-LEVELS = ("mokrs", "levels")
+OP_KEYS = {"duplicate": "Ctrl+D", "insert": "Insert", "remove": "Delete"}
 
 Fields = Callable[[Any, tuple, list, Interactions], None]  # the panel's field widgets
 HINTS = {  # what dragging each kind of handle changes
@@ -46,10 +47,6 @@ def moved(items: list, k: int, by: int) -> list:
     if 0 <= j < len(out):
         out[k], out[j] = out[j], out[k]
     return out
-
-
-def inserted(items: list, k: int, item: Any) -> list:
-    return [*items[:k], item, *items[k:]]
 
 
 def removed(items: list, k: int) -> list:
@@ -89,6 +86,7 @@ def mokrs_section(e: Any, out: list[Command], interactions: Interactions, fields
             clicked, _ = imgui.selectable(f"{entries[i]}##m{i}", i == level)
             if clicked:
                 out.append(ec.SelectLevel(i))
+            out += _level_menu(m.levels, i, entries[i])
             if i == level and e.scroll_outline:
                 imgui.set_scroll_here_y()
                 out.append(ec.OutlineScrolled())
@@ -97,6 +95,22 @@ def mokrs_section(e: Any, out: list[Command], interactions: Interactions, fields
         imgui.text_disabled("select a level: its steps get handles in the view")
         return
     _level(e, m.levels, level, out, interactions, fields)
+
+
+def _level_menu(levels: list, i: int, name: str) -> list[Command]:
+    """Level i's right-click menu, as a route's outline entry has; opening it selects the
+    level, so what is marked is what the menu acts on."""
+    out: list[Command] = []
+    if imgui.begin_popup_context_item(f"mokrs level##{i}"):
+        if imgui.is_window_appearing():
+            out.append(ec.SelectLevel(i))
+        imgui.text_disabled(name)
+        imgui.separator()
+        for op, tip in OPS.items():
+            if imgui.menu_item(f"{op}: {tip}", OP_KEYS.get(op, ""), False)[0]:
+                out += level_commands(levels, i, op)
+        imgui.end_popup()
+    return out
 
 
 def _level(e, levels: list, i: int, out: list, interactions: Interactions, fields) -> None:
@@ -111,17 +125,11 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     imgui.separator_text(f"level {i} of {len(levels)}")
     if e.selected is not None and e.selected.level == i:
         imgui.text_wrapped(f"{e.selected.label}: {HINTS.get(e.selected.role, '')}")
-    for label, value, tip in (
-        ("duplicate", inserted(levels, i + 1, lv), "a copy of this level above it"),
-        ("insert", inserted(levels, i + 1, MobiusLevel(Empty(), [], False)), "an identity level"),
-        ("remove", removed(levels, i), "remove this level"),
-        ("inward", moved(levels, i, -1), "swap with the level inside it"),
-        ("outward", moved(levels, i, 1), "swap with the level outside it"),
-    ):
-        if imgui.small_button(f"{label}##lv"):
-            out.append(Edit(LEVELS, value))
+    for op, tip in OPS.items():
+        if imgui.small_button(f"{op}##lv"):
+            out += level_commands(levels, i, op)
         if imgui.is_item_hovered():
-            tooltip(tip)
+            tooltip(tip + ("" if op in ("inward", "outward") else f" ({OP_KEYS[op]})"))
         imgui.same_line()
     imgui.new_line()
     with marked(key_marks(e.scene, e.viewer.drawn.playback.time).get((*lev, "reflect"))):

@@ -35,6 +35,7 @@ from ..viewer.commands import Command
 from ..viewer.window import Viewer
 from . import commands as ec
 from .handles import Handle
+from .mokrs_levels import key_op
 
 # Insert / Delete / Ctrl+D act on the selected level (the viewer's keys are letters, F-keys
 # and Ctrl+Z/Y; Ctrl+D is free: D alone flies).
@@ -262,9 +263,9 @@ def confirm_regrow(e: Structured) -> None:
 
 
 STRUCTURE_HANDLERS: dict[type[Command], Callable[[Any, Any], None]] = {
-    ec.InsertLevel: lambda e, c: insert(e, c.level),
-    ec.RemoveLevel: lambda e, c: remove(e, c.level),
-    ec.DuplicateLevel: lambda e, c: duplicate(e, c.level),
+    ec.InsertLevel: lambda e, c: key_op(e, c) or insert(e, c.level),
+    ec.RemoveLevel: lambda e, c: key_op(e, c) or remove(e, c.level),
+    ec.DuplicateLevel: lambda e, c: key_op(e, c) or duplicate(e, c.level),
     ec.WholeTree: lambda e, c: whole_tree(e, c.op),
     ec.SetToolValue: lambda e, c: setattr(e.structure, c.name, c.value),
     ec.SetGrowth: lambda e, c: set_growth(e, c.name, c.value, c.interaction),
