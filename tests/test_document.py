@@ -450,3 +450,49 @@ def test_a_shipped_presets_copy_made_by_a_bookmark_keeps_its_text(tmp_path, monk
     _, written = other.add_bookmark(cam)
     assert "prepass_levels" in written.read_text() and "prepass_levels" not in now
     assert load_scene(written).render.epsilon_scale == 2.0
+
+
+def test_a_save_writes_only_what_changed_into_the_persons_text(tmp_path):
+    """Saving wrote the whole scene anew: comments gone, every default written out, a light
+    direction never touched normalised (a one-value change on palm: a 156-line diff). Now
+    the changed values are written into the file's own text; the file reads back as the
+    scene saved. Levels inserted rewrite that list only; a field unset again goes."""
+    import difflib
+
+    def changed_lines(a: str, b: str) -> list[str]:
+        return [
+            line
+            for line in difflib.unified_diff(a.splitlines(), b.splitlines(), lineterm="")
+            if line[:1] in "+-" and line[:3] not in ("+++", "---")
+        ]
+
+    path = tmp_path / "tree.toml"
+    text = "# my notes, kept\n" + resolve("tree").read_text()
+    path.write_text(text)
+    doc = Document(path)
+    doc.apply(("render", "epsilon_scale"), 2.0)
+    doc.apply(("camera", "fov_y"), 50.0)
+    doc.save()
+    now = path.read_text()
+    assert changed_lines(text, now) == [
+        "-fov_y = 45.0",
+        "+fov_y = 50.0",
+        "-epsilon_scale = 1.0",
+        "+epsilon_scale = 2.0",
+    ]
+    assert load_scene(path) == doc.scene and "[0.5, 0.8, -0.35]" in now
+    doc.apply(("render", "prepass"), 8)
+    doc.save()
+    assert changed_lines(now, path.read_text()) == ["+prepass = 8"]
+    doc.undo()
+    doc.save()
+    assert path.read_text() == now, "unset again, the line goes"
+    # a route's levels inserted: the list is written anew, the rest stays
+    bent = tmp_path / "bent.toml"
+    bent.write_text("# bent notes\n" + resolve("bent-tree").read_text())
+    doc = Document(bent)
+    from krsview.scene.restructure import split_level
+
+    doc.commit(replace(doc.scene, route=split_level(doc.scene.route, 2, 0.5)), "insert")
+    doc.save()
+    assert bent.read_text().startswith("# bent notes\n") and load_scene(bent) == doc.scene

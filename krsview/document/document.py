@@ -26,6 +26,7 @@ from ..scene.presets import PRESET_DIR
 from ..scene.scene import scene_from_toml, write_atomic
 from ..scene.schema import to_dict
 from ..scene.toml_writer import dumps
+from .filetext import saved_text
 from .history import History, Step
 
 AUTOSAVE_SECONDS = 3.0  # a crash loses at most this much work
@@ -211,15 +212,15 @@ class Document:
         return target
 
     def _text_of(self, scene: Scene) -> str:
-        """The file's text for ``scene``: where it is the saved scene with bookmarks added,
-        the saved text with them appended (its comments and layout kept: a shipped preset's
-        copy made by the viewer's B), else the scene written anew."""
+        """The file's text for ``scene``: the saved text with only what changed written
+        into it, comments and layout kept (filetext.py); bookmarks added alone appended as
+        tables of their own (a shipped preset's copy made by the viewer's B)."""
         saved, n = self.saved, len(self.saved.bookmarks)
         if (
             replace(scene, bookmarks=saved.bookmarks) != saved
             or scene.bookmarks[:n] != saved.bookmarks
         ):
-            return scene_to_toml(scene)
+            return saved_text(self.saved_text, saved, scene)
         text = self.saved_text
         for k in range(n, len(scene.bookmarks)):
             want = replace(saved, bookmarks=scene.bookmarks[: k + 1])
