@@ -433,7 +433,7 @@ def test_a_viewers_bookmark_is_appended_to_the_file_as_written(tmp_path):
 def test_a_shipped_presets_copy_made_by_a_bookmark_keeps_its_text(tmp_path, monkeypatch):
     """B on a shipped preset writes its copy as the preset's own text with the bookmark
     appended (it used to write every default out: a pre-pass, the fragment path, all the
-    effect settings); a copy with other edits too is written anew (the control)."""
+    effect settings); a copy with other edits too keeps the preset's text."""
     from krsview.scene import Camera
 
     monkeypatch.chdir(tmp_path)
@@ -448,8 +448,9 @@ def test_a_shipped_presets_copy_made_by_a_bookmark_keeps_its_text(tmp_path, monk
     other = Document(resolve("rock"))
     other.apply(("render", "epsilon_scale"), 2.0)
     _, written = other.add_bookmark(cam)
-    assert "prepass_levels" in written.read_text() and "prepass_levels" not in now
-    assert load_scene(written).render.epsilon_scale == 2.0
+    back = load_scene(written)  # with other edits too, the preset's text is kept
+    assert back.render.epsilon_scale == 2.0 and back.bookmarks[0].camera == cam
+    assert "prepass_levels" not in written.read_text() and "prepass_levels" not in now
 
 
 def test_a_save_writes_only_what_changed_into_the_persons_text(tmp_path):
