@@ -227,3 +227,45 @@ def test_a_baked_radius_carries_no_float_noise():
         assert len(repr(lv.radius).lstrip("0.")) <= 15, lv.radius
         assert math.isclose(lv.radius, product, rel_tol=1e-14)
     assert noisy > 0
+
+
+def test_a_stub_left_of_a_sibling_branch_is_warned_drawn_red_and_not_made_by_an_insert():
+    """A fork inserted mid-branch (L20 of the baked tree) grew a sibling (the rest of the
+    branch mirrored at the new fork) that reached across the mirror of the fork below:
+    Alg. 1 cut it off there, leaving a square stub, with no warning and nothing red. The
+    insert now turns the new mirror so that the sibling stays clear (the control: its route
+    warns of nothing); turned as the insert turned it before, the route warns, and the part
+    drawn red is what Alg. 1's distance (the float64 reference) does not draw: its centre
+    line clear of the cut is outside the surface (drawn, it would lie a radius inside),
+    while the sibling's kept part is inside it."""
+    import krsview
+    from krsview.editor.clipped import clipped_parts
+    from krsview.scene.restructure import free_normal, split_level, subtree_points, tangent_at
+    from krsview.scene.route import centre_at
+
+    tree = krsview.load("tree")
+    route = tree.tree.route()
+    cut = split_level(route, 20, 0.5)
+    assert route.warnings() == cut.warnings() == [] and clipped_parts(cut) == []
+    # the normal the insert chose before: the same choice without the fork below
+    k = route.kernel(20)
+    q, mid_up = centre_at(k, np.array([0.5, 0.75]))
+    upper = replace(k, start=tuple(q), control=tuple(mid_up))
+    subtree = subtree_points(
+        [route.kernel(j) for j in range(20)] + [upper], [route.mirror(j) for j in range(1, 21)]
+    )
+    child = centre_at(upper, np.linspace(0.0, 1.0, 41))
+    before = free_normal(q, tangent_at(k, 0.5), child, subtree, route.levels[20].normal)
+    levels = [*cut.levels[:21], replace(cut.levels[21], normal=before), *cut.levels[22:]]
+    turned = replace(cut, levels=levels)
+    (said,) = turned.warnings()
+    assert said.startswith("levels[20]: its mirror image at the fork of levels[21]")
+    (level, red), *_ = clipped_parts(turned)
+    scene = replace(tree, tree=None, route=turned)
+    radius = turned.levels[20].radius
+    up = turned.mirror(22)
+    past = red[(red @ np.array(up.normal) - up.offset) > radius]  # clear of the cut
+    assert level == 20 and len(past) and (krsview.distance(scene, past) > 0).all()
+    sibling = turned.sibling(21, 65)
+    kept = sibling[(sibling @ np.array(up.normal) - up.offset) < -2 * radius]
+    assert len(kept) and (krsview.distance(scene, kept) < 0).all()

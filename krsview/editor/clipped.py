@@ -62,17 +62,38 @@ def centre_line(route: Route, i: int, s: np.ndarray) -> np.ndarray:
 
 def clipped_parts(route: Route) -> list[tuple[int, np.ndarray]]:
     """(level, polyline) for every piece Alg. 1 clips off a branch that `Route.warnings`
-    names (its samples cross deeper than CLIP_TOLERANCE × its radius: the same test)."""
+    names (its samples cross deeper than CLIP_TOLERANCE × its radius: the same test), and
+    off a branch's sibling (its mirror image at its fork) across the mirror below."""
     out = []
     for i in range(1, len(route.levels)):
         m = route.mirror(i)
         worst = float((arc_points(route.kernel(i - 1)) @ np.array(m.normal)).max()) - m.offset
-        if worst <= CLIP_TOLERANCE * route.levels[i - 1].radius:
-            continue
-        for s0, s1 in positive_spans(route, i):
-            pieces = max(2, math.ceil((s1 - s0) / DRAW_STEP) + 1)
-            out.append((i - 1, centre_line(route, i - 1, np.linspace(s0, s1, pieces))))
+        if worst > CLIP_TOLERANCE * route.levels[i - 1].radius:
+            for s0, s1 in positive_spans(route, i):
+                pieces = max(2, math.ceil((s1 - s0) / DRAW_STEP) + 1)
+                out.append((i - 1, centre_line(route, i - 1, np.linspace(s0, s1, pieces))))
+        if i + 1 < len(route.levels):
+            out += [(i - 1, line) for line in _sibling_cut(route, i)]
     return out
+
+
+def _sibling_cut(route: Route, i: int) -> list[np.ndarray]:
+    """The runs of the sibling of level i − 1's branch on the positive side of the mirror
+    at fork P_{i+1}, where it crosses deeper than the tolerance (sampled: the sibling is
+    drawn in pieces of DRAW_STEP anyway)."""
+    up = route.mirror(i + 1)
+    points = route.sibling(i, round(1 / DRAW_STEP) + 1)
+    e = points @ np.array(up.normal) - up.offset
+    if e.max() <= CLIP_TOLERANCE * route.levels[i - 1].radius:
+        return []
+    runs, start = [], None
+    for k, out in enumerate([*(e > 0), False]):
+        if out and start is None:
+            start = k
+        elif not out and start is not None:
+            runs.append(points[max(start - 1, 0) : k + 1][: len(points)])
+            start = None
+    return [r for r in runs if len(r) >= 2]
 
 
 def scene_clipped(scene: Scene) -> list[tuple[int, np.ndarray]]:

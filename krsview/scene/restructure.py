@@ -59,15 +59,22 @@ def subtree_points(kernels: list[ToroidalCapsule], mirrors: list[Mirror]) -> np.
 
 
 def free_normal(
-    fork: np.ndarray, t: np.ndarray, child: np.ndarray, subtree: np.ndarray, hint
+    fork: np.ndarray,
+    t: np.ndarray,
+    child: np.ndarray,
+    subtree: np.ndarray,
+    hint,
+    below: Mirror | None = None,
 ) -> Vec3:
     """The normal of a new mirror through ``fork`` on a branch of direction ``t``. Alg. 1
     folds away what the mirror's positive side holds, so it keeps the ``child`` branch's
-    centre line on the negative side, and as much of the ``subtree`` it doubles as it can:
-    a plane containing ``t`` if one leaves at most KEEP_OUT of the subtree's points outside,
-    else tilted back from ``t`` by the least angle that does (its mirror image of the crown
-    then leaves the branch at twice that angle, as a fork does); among equally good
-    directions the nearest to ``hint``."""
+    centre line on the negative side, and the child's mirror image (the sibling it grows)
+    on the negative side of the mirror ``below`` (the fork the branch grows from: past it,
+    Alg. 1 cut the sibling off, leaving a stub), and as much of the ``subtree`` it doubles
+    as it can: a plane containing ``t`` if one leaves at most KEEP_OUT of the subtree's
+    points outside, else tilted back from ``t`` by the least angle that does (its mirror
+    image of the crown then leaves the branch at twice that angle, as a fork does); among
+    equally good directions the nearest to ``hint``."""
     a = np.cross(t, hint if hint is not None else (0.0, 0.0, 0.0))
     if np.linalg.norm(a) < 1e-9:
         a = np.cross(t, [1.0, 0.0, 0.0] if abs(t[0]) < 0.9 else [0.0, 0.0, 1.0])
@@ -79,7 +86,12 @@ def free_normal(
     best, best_out = around[0], np.inf
     for tilt in TILTS:
         u = np.cos(tilt) * around - np.sin(tilt) * t
-        worst = ((child - fork) @ u.T).max(axis=0)
+        ec = (child - fork) @ u.T  # (points, candidates)
+        worst = ec.max(axis=0)
+        if below is not None:  # the sibling: the child mirrored by each candidate
+            n = np.asarray(below.normal)
+            sibling = (child @ n)[:, None] - 2.0 * ec * (u @ n)[None, :] - below.offset
+            worst = np.maximum(worst, sibling.max(axis=0))
         e = (subtree - fork) @ u.T
         clipped = np.where(
             worst <= worst.min() + 1e-6 * size, np.maximum(e, 0.0).mean(axis=0), np.inf
@@ -113,7 +125,8 @@ def split_level(route: Route, i: int, s: float = 0.5) -> Route:
     subtree = subtree_points(
         [route.kernel(j) for j in range(i)] + [upper_k], [route.mirror(j) for j in range(1, i + 1)]
     )
-    normal = free_normal(q, tangent_at(k, s), child, subtree, lv.normal)
+    below = route.mirror(i + 1) if i + 1 < len(route.levels) else None
+    normal = free_normal(q, tangent_at(k, s), child, subtree, lv.normal, below)
     lower = RouteLevel(as_vec3(q), as_vec3(mid_low), lv.radius, lv.color, normal, None)
     levels = route.levels[:i] + [upper, lower] + route.levels[i + 1 :]
     return replace(route, levels=levels)

@@ -160,10 +160,20 @@ class Route:
             levels.append(Level(self.ground if last and self.ground is not None else Empty(), m))
         return KRS(levels)
 
+    def sibling(self, i: int, samples: int = ARC_SAMPLES) -> np.ndarray:
+        """Points along level i − 1's branch mirrored by R_{i−1} (through fork P_i): the
+        centre line of its sibling, the other branch growing from that fork; i ≥ 1."""
+        m = self.mirror(i)
+        n = np.array(m.normal)
+        points = arc_points(self.kernel(i - 1), samples)
+        return points - 2.0 * (points @ n - m.offset)[:, None] * n
+
     def warnings(self) -> list[str]:
         """Where Alg. 1 clips the route: a child branch reaching across the mirror of the
         fork it grows from is cut off there (DISTANCE folds every point into the mirror's
-        negative side [KRS14 Fig. 2]), so the drawn tree loses that part."""
+        negative side [KRS14 Fig. 2]), so the drawn tree loses that part; and so is its
+        sibling (its mirror image) where it reaches across the mirror of the fork below
+        (a fork inserted mid-branch can leave a stub of it, cut square)."""
         out = []
         for i in range(1, len(self.levels)):
             m = self.mirror(i)
@@ -176,6 +186,16 @@ class Route:
                     f"(levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — "
                     "turn the normal or move the branch to the mirror's negative side"
                 )
+            if i + 1 < len(self.levels):
+                up = self.mirror(i + 1)
+                worst = float((self.sibling(i) @ np.array(up.normal)).max() - up.offset)
+                if worst > CLIP_TOLERANCE * child.radius:
+                    out.append(
+                        f"levels[{i - 1}]: its mirror image at the fork of levels[{i}] (the "
+                        f"sibling branch) crosses the mirror at levels[{i + 1}]'s fork by "
+                        f"{worst:.3g}; Alg. 1 cuts it off there, leaving a stub — turn "
+                        f"levels[{i}].normal"
+                    )
         return out
 
 
