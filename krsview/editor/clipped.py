@@ -86,12 +86,18 @@ def _sibling_cut(route: Route, i: int) -> list[np.ndarray]:
     e = points @ np.array(up.normal) - up.offset
     if e.max() <= CLIP_TOLERANCE * route.levels[i - 1].radius:
         return []
+    def crossing(a: int, b: int) -> np.ndarray:  # where the line between samples a, b meets it
+        f = e[a] / (e[a] - e[b])
+        return points[a] + f * (points[b] - points[a])
+
     runs, start = [], None
     for k, out in enumerate([*(e > 0), False]):
         if out and start is None:
             start = k
         elif not out and start is not None:
-            runs.append(points[max(start - 1, 0) : k + 1][: len(points)])
+            head = [crossing(start - 1, start)] if start > 0 else []
+            tail = [crossing(k - 1, k)] if k < len(points) else []
+            runs.append(np.array([*head, *points[start:k], *tail]))
             start = None
     return [r for r in runs if len(r) >= 2]
 
