@@ -86,6 +86,7 @@ def _sibling_cut(route: Route, i: int) -> list[np.ndarray]:
     e = points @ np.array(up.normal) - up.offset
     if e.max() <= CLIP_TOLERANCE * route.levels[i - 1].radius:
         return []
+
     def crossing(a: int, b: int) -> np.ndarray:  # where the line between samples a, b meets it
         f = e[a] / (e[a] - e[b])
         return points[a] + f * (points[b] - points[a])

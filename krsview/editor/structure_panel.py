@@ -13,13 +13,20 @@ from ..scene import Route
 from ..scene.edits import get_at
 from ..scene.growth import Growth
 from ..viewer.commands import Command
-from ..viewer.widgets import Interactions, field_widget, red_text
+from ..viewer.widgets import Interactions, as_typed, field_widget, red_text, tooltip
 from . import commands as ec
 from .handles import route_outline
 from .modals import answer_buttons
 from .structure import Structured, StructureTools, component, target
 
 MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
+TIPS = {  # the structure tools' values (ctrl+click a slider to type one)
+    "split_at": "where along the selected branch Insert puts the new fork: 0 its start, 1 its end",
+    "taper": "each branch's radius set to this × its parent's, from the trunk up",
+    "widths": "every branch's radius × this",
+    "scale": "the whole tree × this, about its foot (the route's base stays put)",
+    "base": "where the tree's foot goes: the whole tree moves with it",
+}
 
 
 def outline_menu(k: int, name: str) -> list[Command]:
@@ -72,7 +79,9 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
     imgui.set_next_item_width(120)
     changed, s = imgui.slider_float("split at##structure", t.split_at, 0.05, 0.95, "%.2f")
     if changed:
-        out.append(ec.SetToolValue("split_at", s))
+        out.append(ec.SetToolValue("split_at", as_typed(s, t.split_at)))
+    if imgui.is_item_hovered():
+        tooltip(TIPS["split_at"])
     for k, (text, command) in enumerate(
         (
             ("insert (Ins)", ec.InsertLevel()),
@@ -93,17 +102,26 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
         imgui.set_next_item_width(120)
         changed, v = imgui.slider_float(f"##{name}", getattr(t, name), lo, hi, "%.3g")
         if changed:
-            out.append(ec.SetToolValue(name, v))
+            out.append(ec.SetToolValue(name, as_typed(v, getattr(t, name))))
+        if imgui.is_item_hovered():
+            tooltip(TIPS[name])
         imgui.same_line()
         if imgui.button(button):
             out.append(ec.WholeTree(op))
+        if imgui.is_item_hovered():
+            tooltip(TIPS[name])
     imgui.set_next_item_width(180)
-    changed, b = imgui.drag_float3("##base", list(t.base or route.base), 0.01, 0.0, 0.0, "%.3g")
+    base = t.base or route.base
+    changed, b = imgui.drag_float3("##base", list(base), 0.01, 0.0, 0.0, "%.3g")
     if changed:
-        out.append(ec.SetToolValue("base", tuple(float(c) for c in b)))
+        out.append(ec.SetToolValue("base", tuple(as_typed(c, o) for c, o in zip(b, base))))
+    if imgui.is_item_hovered():
+        tooltip(TIPS["base"])
     imgui.same_line()
     if imgui.button("move foot"):
         out.append(ec.WholeTree("base"))
+    if imgui.is_item_hovered():
+        tooltip(TIPS["base"])
     if t.message:  # wrapped: a narrow panel cuts nothing off
         (red_text if t.refused else imgui.text_wrapped)(t.message)
     if route.growth is not None:
