@@ -184,6 +184,24 @@ def test_the_description_is_typed_in_the_panel_as_one_undo_step(display, tmp_pat
         xdo("key", "ctrl+z")
         pump(e, 3)
         assert e.scene.description == shipped
+        # a click elsewhere takes the text too (it was dropped); Esc gives it up
+        x0, y0, x1, y1 = e.viewer.interactions.rects[("name",)]
+        for leave, kept in (("click", "rolled"), ("Escape", "rolled")):
+            xdo("mousemove", round(wx + x0 + 20), round(wy + (y0 + y1) / 2))
+            pump(e, 2)
+            xdo("click", 1)
+            pump(e, 2)
+            xdo("key", "ctrl+a")
+            xdo("type", "rolled" if leave == "click" else "not this")
+            pump(e, 12)
+            if leave == "click":
+                xdo("mousemove", round(wx + 100), round(wy + 300))
+                pump(e, 2)
+                xdo("click", 1)
+            else:
+                xdo("key", "Escape")
+            pump(e, 3)
+            assert e.scene.name == kept, leave
     finally:
         e.close()
 

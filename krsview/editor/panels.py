@@ -134,17 +134,19 @@ def _dock(e: Edited, out: list, width: float) -> None:
 
 def _about(scene: Scene, out: list, interactions: Interactions) -> None:
     """The scene's name and one-line description, to be told after a reshaping (the shipped
-    tree's says how many forks it has). Enter takes the typed text, as one undo step (the
-    view is not redrawn at every key)."""
+    tree's says how many forks it has). Enter, or leaving the field, takes the typed text,
+    as one undo step (the view is not redrawn at every key; a click elsewhere used to drop
+    it); Esc gives it up."""
     for name in ("name", "description"):
         imgui.set_next_item_width(-imgui.calc_text_size("description").x - 8)
-        changed, text = imgui.input_text(
+        entered, text = imgui.input_text(
             f"{name}##scene", getattr(scene, name), imgui.InputTextFlags_.enter_returns_true
         )
+        left = imgui.is_item_deactivated_after_edit()
         key = interactions.key((name,))
         if imgui.is_item_hovered():
-            tooltip("Enter takes the text")
-        if changed and text != getattr(scene, name):
+            tooltip("Enter or a click elsewhere takes the text; Esc gives it up")
+        if (entered or left) and text != getattr(scene, name):
             out.append(Edit((name,), text, key))
 
 
