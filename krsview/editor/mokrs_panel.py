@@ -136,13 +136,13 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
         changed, on = imgui.checkbox("reflect (x = 0 of this level)", shown.reflect)
     if changed:
         out.append(Edit((*lev, "reflect"), on))
-    linked = len(linked_levels(e.scene.mokrs, i)) - 1
-    if linked:
-        changed, on = imgui.checkbox(f"step edits also go to {linked} finer levels", e.carry)
-        if changed:
-            out.append(ec.SetCarry(on))
-        if imgui.is_item_hovered():
-            tooltip("the finer levels whose steps equal this level's (linked)")
+    linked = len(linked_levels(e.scene.mokrs, i)) - 1  # the option stays, none linked too
+    now = f"{linked} finer levels" if linked else "the finer levels (none has this one's now)"
+    changed, on = imgui.checkbox(f"step edits also go to {now}", e.carry)
+    if changed:
+        out.append(ec.SetCarry(on))
+    if imgui.is_item_hovered():
+        tooltip("the finer levels whose steps equal this level's (linked), for every level")
     kinds = list(KERNEL_KINDS)
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
     if changed and kinds[k] != lv.kernel.kind:
