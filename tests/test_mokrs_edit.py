@@ -636,5 +636,15 @@ def test_inward_twice_moves_a_level_two_steps_and_the_keys_act_on_levels(display
             n = len(e.scene.mokrs.levels)
         assert e.scene.mokrs.levels[e.selected.level].transform == []  # the identity, selected
         assert len(e.doc.history.steps) == 5
+        # the linked-levels option stays at a level with none linked (it vanished there)
+        from imgui_bundle import imgui
+
+        labels, box = [], imgui.checkbox
+        imgui.checkbox = lambda label, on: (labels.append(label), box(label, on))[1]
+        try:
+            pump(e, 2)
+        finally:
+            imgui.checkbox = box
+        assert "step edits also go to the finer levels (none has this one's now)" in labels
     finally:
         e.close()
