@@ -148,6 +148,7 @@ def test_a_bookmark_is_an_edit_saved_with_the_scene_not_written_at_once(tree):
     before = len(load_scene(tree).bookmarks)
     f.add_bookmark()
     assert w.doc.dirty and len(w.doc.scene.bookmarks) == before + 1 and "added" in w.message
+    assert w.said == [w.message], "said at the window's foot too: the HUD is folded away"
     assert len(load_scene(tree).bookmarks) == before, "the editor's bookmark skipped the save"
     # the viewer's own bookmark (negative control) is appended to the file on disk at once
     w.file.add_bookmark()

@@ -78,8 +78,9 @@ class FileActions:
         """In the editor a bookmark is an edit like any other (saved with the scene)."""
         scene = self.doc.scene
         b = Bookmark(f"view {len(scene.bookmarks) + 1}", self.viewer.camera.to_camera())
-        if self._edit(("bookmarks",), scene.bookmarks + [b]):
+        if self._edit(("bookmarks",), scene.bookmarks + [b]):  # said where one looks too
             self.viewer.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
+            self.viewer.say(self.viewer.message)
 
     def reload_scene(self) -> None:
         """Unsaved edits are never overwritten by the file's new contents: ask first."""
