@@ -364,3 +364,31 @@ def test_the_iterations_view_has_a_scale_and_a_legend(hud_viewer, monkeypatch):
     _, _, dark = turn(v)
     view = np.s_[:, HUD_RIGHT:]
     assert bright[view].mean() > 2 * dark[view].mean() + 10
+
+
+def test_the_hud_opens_any_scene_file_by_its_path(hud_viewer, monkeypatch, tmp_path):
+    """The HUD listed the shipped presets and the last file of one's own: no other file
+    could be opened. Its "open" field takes a path; Enter opens it (the control: a path
+    that is no file says so and keeps the scene)."""
+    from krsview.viewer import commands as c
+
+    v = hud_viewer
+    other = tmp_path / "mine" / "rock.toml"
+    other.parent.mkdir()
+    shutil.copy(resolve("rock"), other)
+    header = imgui.collapsing_header
+    monkeypatch.setattr(
+        imgui,
+        "collapsing_header",
+        lambda label, *a: label == "scene, camera, output" or header(label, *a),
+    )
+    typed = [str(other)]
+    monkeypatch.setattr(
+        imgui, "input_text_with_hint", lambda label, hint, text, flags=0: (True, typed[0])
+    )
+    turn(v)
+    assert v.path == other and v.scene.name == "rock" and v.file.open_text == str(other)
+    typed[0] = str(tmp_path / "none.toml")
+    turn(v)
+    assert v.path == other and "cannot read" in v.error
+    v.execute([c.SetOpenText("")])

@@ -94,7 +94,16 @@ class SetMovingEffects(Command):
 
 @dataclass(frozen=True)
 class OpenPreset(Command):
+    """Open a shipped preset or any scene file (the HUD's list, or its file field)."""
+
     path: Path
+
+
+@dataclass(frozen=True)
+class SetOpenText(Command):
+    """The HUD's "open a file" field, as typed."""
+
+    text: str
 
 
 @dataclass(frozen=True)

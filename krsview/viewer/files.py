@@ -44,6 +44,7 @@ class ViewerFile:
         self.shader_dir = shader_dir
         self.refused = ""  # the error of the file's contents last refused, until it changes
         self.mine: Path | None = None  # the last scene file of the person's own shown
+        self.open_text = ""  # the HUD's "open a file" field
         self.watch()
 
     @property

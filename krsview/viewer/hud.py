@@ -261,6 +261,19 @@ def _scene(v: Viewed, out: list) -> None:
             if imgui.selectable(label, label == shown)[0] and label != shown:
                 out.append(c.OpenPreset(path))
         imgui.end_combo()
+    typed = v.file.open_text  # any scene file: its path, Enter or the button opens it
+    imgui.set_next_item_width(imgui.calc_item_width() - imgui.calc_text_size("open").x - 16)
+    entered, text = imgui.input_text_with_hint(
+        "##open",
+        "a scene file: path/to/scene.toml",
+        typed,
+        imgui.InputTextFlags_.enter_returns_true,
+    )
+    if text != typed:
+        out.append(c.SetOpenText(text))
+    imgui.same_line()
+    if (imgui.button("open") or entered) and text.strip():
+        out.append(c.OpenPreset(Path(text.strip()).expanduser()))
     imgui.text(
         f"speed ×{v.nav.speed_factor:.2f} of the nearest distance "
         f"({v.nearest_distance():.3g}); scroll to change"

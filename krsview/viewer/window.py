@@ -353,6 +353,7 @@ HANDLERS: dict[type[c.Command], Callable[[Viewer, Any], None]] = {
     c.SetSupersample: lambda v, e: v.set_supersample(e.factor),
     c.SetMovingEffects: lambda v, e: v.set_moving_effects(e.on),
     c.OpenPreset: lambda v, e: v.file.open(e.path),
+    c.SetOpenText: lambda v, e: setattr(v.file, "open_text", e.text),
     c.ResetView: lambda v, e: v.reset_view(),
     c.ToggleOrbit: lambda v, e: v.toggle_orbit(),
     c.Screenshot: lambda v, e: v.screenshot(),
