@@ -648,3 +648,32 @@ def test_inward_twice_moves_a_level_two_steps_and_the_keys_act_on_levels(display
         assert "step edits also go to the finer levels (none has this one's now)" in labels
     finally:
         e.close()
+
+
+def test_a_scale_that_outgrows_float32_over_linked_levels_is_refused(display, tmp_path):
+    """A factor of 50 typed at palm's level 58 goes to its 29 linked levels: the bounds grow
+    50× a level, to 1.9e51, and the view was drawn one solid colour with overflow warnings.
+    Now the edit is refused, naming the level, and so is a render of such a scene; a factor
+    of 2 (2e9: within float32) is taken (the control)."""
+    import krsview
+    from krsview.editor.keys import linked_edits
+    from krsview.editor.window import Editor
+
+    from .test_editor import pump
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    factor = (*LEVELS, 58, "transform", 0, "factor")
+    palm = load_scene(path)
+    [(whole, wide)] = linked_edits(palm, factor, 50.0, 0.0)
+    with pytest.raises(SceneError, match=r"mokrs.levels\[21\] = '<a bound reaching 1.06e\+19>'"):
+        krsview.render(apply_edit(palm, whole, wide), (8, 4))
+    e = Editor(path, size=(320, 200))
+    try:
+        pump(e)
+        assert not e.edit(whole, wide) and "past what float32 holds" in e.viewer.error
+        assert e.scene == palm
+        [(whole, fine)] = linked_edits(palm, factor, 2.0, 0.0)
+        assert e.edit(whole, fine) and e.scene.mokrs.levels[58].transform[0].factor == 2.0
+    finally:
+        e.close()

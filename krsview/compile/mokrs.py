@@ -9,10 +9,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..algebra import mobius
-from ..scene import MoKRS
+from ..scene import MoKRS, SceneError
 from ..scene.model import Empty
 from .balls import CULL_MARGIN, UNBOUNDED, kernel_ball, union_ball
 from .krs import kernel_records
+
+FLOAT32_REACH = 1e18  # a bound's reach in its level's space: its square stays in float32
 
 
 def level_bounds(m: MoKRS) -> np.ndarray:
@@ -104,8 +106,26 @@ def pole_record(H: np.ndarray, reflect: bool) -> np.ndarray:
 
 
 def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS:
+    """The tracer's arrays; a SceneError where its bounding balls outgrow float32."""
     inverse = np.array([lv.inverse() for lv in m.levels])
     reflect = np.array([lv.reflect for lv in m.levels])
     records, types = kernel_records(m.kernels, albedo)
     poles = np.array([pole_record(H, r) for H, r in zip(inverse, reflect)])
-    return CompiledMoKRS(inverse, reflect, records, types, poles, *bounds_in_and_out(m))
+    bounds = bounds_in_and_out(m)
+    check_float32(bounds[0])
+    return CompiledMoKRS(inverse, reflect, records, types, poles, *bounds)
+
+
+def check_float32(bounds: np.ndarray, path: str = "mokrs.levels") -> None:
+    """Each level's bounding ball fits float32 with room for its square (the tracer compares
+    squared lengths): a scale factor that grows every level by itself, repeated over linked
+    levels, multiplies past it (palm's 29 linked levels at a factor of 50: 1.9e51, drawn as
+    a solid colour). A SceneError names the first level too far."""
+    reach = np.abs(bounds[:, :3]).max(axis=1) + np.maximum(bounds[:, 3], 0.0)
+    for i in np.flatnonzero(~(reach <= FLOAT32_REACH)):
+        raise SceneError(
+            f"{path}[{int(i)}]",
+            f"<a bound reaching {reach[i]:.3g}>",
+            f"its levels' maps scale it past what float32 holds (allowed: {FLOAT32_REACH:g} "
+            "in its level's space); a smaller scale factor, or fewer levels sharing it",
+        )

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..compile.camera import View, view_of
 from ..compile.geometry import scene_ball
+from ..compile.mokrs import bounds_in_and_out, check_float32
 from ..document.document import Document
 from ..gpu.overlay import Overlay
 from ..scene import Scene, SceneError
@@ -153,6 +154,7 @@ class Editor:
             scene = apply_edit(self.scene, path, value)
             if scene.mokrs is not None:
                 check_view(scene.mokrs, tuple(v.camera.position), VIEW)
+                check_float32(bounds_in_and_out(scene.mokrs)[0])  # refused, not drawn solid
         except SceneError as e:
             v.error = str(e)
         else:
