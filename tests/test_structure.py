@@ -33,6 +33,7 @@ from krsview.scene.restructure import (
     taper,
 )
 from krsview.scene.route import centre_at
+from krsview.viewer.widgets import Interactions
 
 ALBEDO = (0.5, 0.5, 0.5)
 LINE = np.linspace(0.0, 1.0, 41)
@@ -294,7 +295,9 @@ class FakeEditor:
     """What editor/structure.py reads and calls of the editor, without a window."""
 
     def __init__(self, path):
-        self.viewer = SimpleNamespace(doc=None, sync=lambda: None, error="", message="")
+        self.viewer = SimpleNamespace(
+            doc=None, sync=lambda: None, error="", message="", interactions=Interactions()
+        )
         self.viewer.doc = Document(path)
         self.selected = SimpleNamespace(level=3)
         self.structure = StructureTools()
@@ -375,6 +378,15 @@ def test_growing_again_asks_before_losing_hand_edits(editor):
     assert editor.scene == inserted
     editor.run(ec.SetGrowth("branch_angle", 200.0, None))
     assert "branch_angle" in editor.viewer.error and editor.scene == inserted
+    # drawn in the panel, the field keeps the refused value and says why under it
+    from krsview.editor.structure import growth_field
+
+    field = growth_field("branch_angle")
+    editor.viewer.interactions.refusal(field)
+    editor.run(ec.SetGrowth("branch_angle", 200.0, None))
+    refused = editor.viewer.interactions.refused[field]
+    assert refused.value == 200.0 and "branch_angle" in refused.message
+    assert editor.viewer.error == "" and editor.scene == inserted
 
 
 # ---------------------------------------------------------------------- in a real window

@@ -223,9 +223,19 @@ def whole_tree(e: Structured, op: str) -> None:
     commit_route(e, *ops[op])
 
 
+def growth_field(name: str) -> Path:
+    """The growth parameter's field in the panel (its refusal is said there)."""
+    return ("route", "growth", name)
+
+
 def set_growth(e: Structured, name: str, value: Any, interaction: Any) -> None:
-    """Grow again with one parameter changed; ask first when hand edits would be lost."""
+    """Grow again with one parameter changed; ask first when hand edits would be lost. A
+    refused value stays in its field, red, with the reason under it (as a field of the
+    scene's does), until corrected or Esc; it used to snap back."""
     _grow_again(e, f"grow again with {name} = {value}", interaction, name, value)
+    error = e.viewer.error if e.structure.refused else ""
+    if e.viewer.interactions.settle(growth_field(name), value, error):
+        e.viewer.error, e.structure.message = "", ""
 
 
 def regrow(e: Structured) -> None:

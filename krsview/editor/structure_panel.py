@@ -17,7 +17,7 @@ from ..viewer.widgets import Interactions, as_typed, field_widget, red_text, too
 from . import commands as ec
 from .handles import route_outline
 from .modals import answer_buttons
-from .structure import Structured, StructureTools, component, target
+from .structure import Structured, StructureTools, component, growth_field, target
 
 MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
 TIPS = {  # the structure tools' values (ctrl+click a slider to type one)
@@ -151,8 +151,10 @@ def _growth(growth: Growth, out: list[Command], interactions: Interactions) -> N
         value = getattr(growth, f.name)
         if value is None or isinstance(value, list):
             continue
-        changed, new = field_widget(f"{f.name}##growth", value, dict(f.metadata))
-        key = interactions.key(("route", "growth", f.name))
+        path = growth_field(f.name)
+        refused = interactions.refusal(path)  # a refused value stays red in its field
+        changed, new = field_widget(f"{f.name}##growth", value, dict(f.metadata), refused)
+        key = interactions.key(path)
         if changed:
             out.append(ec.SetGrowth(f.name, new, key))
     imgui.pop_item_width()
