@@ -93,9 +93,11 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     if imgui.collapsing_header("material"):
         fields_of(shown.material, ("material",), out, interactions)
     if imgui.collapsing_header("effect settings"):
+        imgui.push_text_wrap_pos(0.0)  # wrapped: a narrow panel cut the list off
         imgui.text_disabled(
-            "effects: " + (", ".join(scene.effects) or "none") + " (switched in the krsview window)"
+            "effects: " + (", ".join(scene.effects) or "none") + " (switched in the HUD, F1)"
         )
+        imgui.pop_text_wrap_pos()
         fields_of(shown.effect_settings, ("effect_settings",), out, interactions)
     if scene.tree is None and imgui.collapsing_header(  # a grown tree has nothing to drag
         "dragging", imgui.TreeNodeFlags_.default_open
@@ -245,24 +247,29 @@ def _fields(
 ) -> None:
     """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse; the
     fields the program keeps (BOOKKEEPING) as a line of text; a field a track moves marked
-    (``marks``: keys.key_marks)."""
+    (``marks``: keys.key_marks). The widgets leave room for the longest label: a narrow
+    panel cut labels off (shadow_softness)."""
+    longest = max((imgui.calc_text_size(f.name).x for f in fields(obj)), default=0.0)
+    imgui.push_item_width(-longest - imgui.get_style().item_inner_spacing.x)
     for f in fields(obj):
-        value = getattr(obj, f.name)
-        path = (*at, f.name)
-        if f.name in BOOKKEEPING:
-            _bookkeeping(f.name, value, path, interactions)
-            continue
-        if value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
-            continue
-        if f.name == "growth":  # set there, the tree grows again (structure_panel.py)
-            imgui.text_disabled("growth parameters: under structure, growth")
-            continue
-        if hasattr(value, "__dataclass_fields__"):
-            imgui.separator_text(
-                f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else "")
-            )
-            _fields(value, path, out, interactions, marks)
-            continue
+        _field(obj, f, at, out, interactions, marks)
+    imgui.pop_item_width()
+
+
+def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, marks) -> None:
+    """Field ``f`` of ``obj`` (see :func:`_fields`)."""
+    value = getattr(obj, f.name)
+    path = (*at, f.name)
+    if f.name in BOOKKEEPING:
+        _bookkeeping(f.name, value, path, interactions)
+    elif value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
+        return
+    elif f.name == "growth":  # set there, the tree grows again (structure_panel.py)
+        imgui.text_disabled("growth parameters: under structure, growth")
+    elif hasattr(value, "__dataclass_fields__"):
+        imgui.separator_text(f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else ""))
+        _fields(value, path, out, interactions, marks)
+    else:
         refused = interactions.refusal(path)
         with marked((marks or {}).get(path)):
             changed, new = field_widget(
