@@ -150,3 +150,13 @@ def test_split_table_names_the_prepass_it_measured():
     m = Measured(replace(tree, render=replace(tree.render, prepass=8)), SIZE, 1, [])
     assert "pre-pass 8 × 2" in split.table(m)
     assert "pre-pass off" in split.table(Measured(tree, SIZE, 1, []))
+
+
+def test_a_split_part_whose_rounds_disagree_on_its_sign_is_within_noise():
+    """A part is a difference of two variants' times: on a busy machine its rounds may
+    straddle zero (−0.6 ms, −24 % was printed as a finding). Such a part is said to be
+    within noise; one whose rounds agree is not (the control), nor is a whole frame."""
+    row = dict(part="secondary effects (shadow rays, occlusion)", low=-0.8, high=0.5)
+    assert split.noted(row).endswith("(within noise)")
+    assert split.noted({**row, "low": 0.1}) == row["part"]
+    assert split.noted({**row, "part": "frame"}) == "frame"

@@ -10,6 +10,7 @@ shadow ray per pixel); where the scene has the shadow cone, both again without i
 
 from __future__ import annotations
 
+import statistics
 from dataclasses import replace
 
 from ..compile.geometry import compile_geometry
@@ -18,7 +19,7 @@ from ..gpu.readback import read_plane
 from ..gpu.renderer import Renderer
 from ..gpu.uniforms import variant_defines
 from ..scene import EFFECTS, Scene
-from .harness import Variant, median_times
+from .harness import Variant, round_times
 from .report import Measured, markdown
 
 WORK = ("shadow steps/px", "shadow levels/px")  # the frames' rows' work (shadow_work)
@@ -67,34 +68,48 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
     (:func:`shadow_work`), the others none."""
     r = Renderer()
     variants = split_variants(scene)
-    med = median_times(r, variants, size, rounds, f"bench split {scene.name}")
-    coarse = med.get("coarse", 0.0)
-    parts = [
-        ("coarse passes", coarse),
-        ("tracing", med["trace"] - coarse),
-        ("nearest kernel and shading", med["moving"] - med["trace"]),
-        ("secondary effects (shadow rays, occlusion)", med["frame"] - med["moving"]),
-        ("frame", med["frame"]),
-        ("frame without secondary effects", med["moving"]),
+    times = round_times(r, variants, size, rounds, f"bench split {scene.name}")
+    med = {name: statistics.median(t) for name, t in times.items()}
+    parts = [  # (name, the part in a round's times): medians of them add up to the frame
+        ("coarse passes", lambda t: t.get("coarse", 0.0)),
+        ("tracing", lambda t: t["trace"] - t.get("coarse", 0.0)),
+        ("nearest kernel and shading", lambda t: t["moving"] - t["trace"]),
+        ("secondary effects (shadow rays, occlusion)", lambda t: t["frame"] - t["moving"]),
+        ("frame", lambda t: t["frame"]),
+        ("frame without secondary effects", lambda t: t["moving"]),
     ]
-    rows = [dict(part=name, ms=t * 1e3, share=t / med["frame"]) for name, t in parts]
     for key, label in (("per pixel", "a shadow ray per pixel"), ("cone off", "shadow cone off")):
         if key in med:  # shares of that frame
-            whole = med[key]
-            rows += [
-                dict(
-                    part=f"secondary effects, {label}",
-                    ms=(whole - med["moving"]) * 1e3,
-                    share=(whole - med["moving"]) / whole,
-                ),
-                dict(part=f"frame, {label}", ms=whole * 1e3, share=1.0),
+            parts += [
+                (f"secondary effects, {label}", lambda t, k=key: t[k] - t["moving"]),
+                (f"frame, {label}", lambda t, k=key: t[k]),
             ]
+    rows = []
+    for name, part in parts:
+        ms = part(med) * 1e3
+        whole = med.get(_frame_of(name), med["frame"])
+        each = [part({k: v[i] for k, v in times.items()}) * 1e3 for i in range(rounds)]
+        rows.append(dict(part=name, ms=ms, share=ms / 1e3 / whole, low=min(each), high=max(each)))
     work = {"frame": variants["frame"], "frame, shadow cone off": variants.get("cone off")}
     for row in rows:
         v = work.get(row["part"])
         steps, levels = shadow_work(r, v.scene, size) if v else ("", "")
         row.update({"shadow steps/px": steps, "shadow levels/px": levels})
     return Measured(scene, size, rounds, rows)
+
+
+def _frame_of(part: str) -> str:
+    """The frame a part is a share of: an alternative frame's own, else the frame."""
+    return {"a shadow ray per pixel": "per pixel", "shadow cone off": "cone off"}.get(
+        part.rpartition(", ")[2], "frame"
+    )
+
+
+def noted(row: dict) -> str:
+    """A part's name, said to be within noise where its rounds disagree on its sign (a part
+    measured as a difference of two variants' times: their noise can make it negative)."""
+    within = row["low"] <= 0.0 <= row["high"] and not row["part"].startswith("frame")
+    return row["part"] + (" (within noise)" if within else "")
 
 
 def table(m: Measured) -> str:
@@ -105,14 +120,23 @@ def table(m: Measured) -> str:
         f"\nWhere the time goes — {m.scene.name} at {m.size[0]}×{m.size[1]}, pre-pass "
         f"{f'{r.prepass} × {r.prepass_levels}' if r.prepass else 'off'}, culling "
         f"{r.culling}, lod {r.lod:g}{shared}; median of {m.rounds} interleaved rounds, each "
-        "part the difference of two variants\n\n"
+        "part the difference of two variants (within noise where its rounds disagree on "
+        "its sign)\n\n"
     ) + markdown(
-        ("part", "ms", "share of the frame", "shadow steps/px", "shadow levels/px"),
-        "lrrrr",
+        (
+            "part",
+            "ms",
+            "rounds [min–max]",
+            "share of the frame",
+            "shadow steps/px",
+            "shadow levels/px",
+        ),
+        "lrrrrr",
         (
             (
-                row["part"],
+                noted(row),
                 f"{row['ms']:.1f}",
+                f"{row['low']:.1f}–{row['high']:.1f}",
                 f"{row['share']:.0%}",
                 *(f"{row[k]:.2f}" if row[k] != "" else "" for k in WORK),
             )
