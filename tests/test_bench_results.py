@@ -160,3 +160,11 @@ def test_a_split_part_whose_rounds_disagree_on_its_sign_is_within_noise():
     assert split.noted(row).endswith("(within noise)")
     assert split.noted({**row, "low": 0.1}) == row["part"]
     assert split.noted({**row, "part": "frame"}) == "frame"
+
+
+def test_an_effect_cost_whose_rounds_disagree_on_its_sign_is_within_noise():
+    """smooth_shading −20 % was printed as a finding from two noisy rounds."""
+    row = dict(variant="smooth_shading", low=-0.2, high=0.05)
+    assert effects._noise(row) == " (within noise)"
+    assert effects._noise({**row, "low": 0.02}) == ""  # the control: a cost every round
+    assert effects._noise({**row, "variant": "plain"}) == ""

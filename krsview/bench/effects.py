@@ -16,12 +16,13 @@ we trace shadows at full resolution.
 
 from __future__ import annotations
 
+import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
-from .harness import Variant, median_times
+from .harness import Variant, round_times
 from .report import Measured, markdown
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
@@ -60,13 +61,18 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
     """One row per variant (:func:`runs_of`, then the components' sum for a compound): its
     effects, ms per frame, ratio to the plain render and incremental cost."""
     runs = runs_of(scene)
-    med = median_times(
+    times = round_times(
         Renderer(),
         {name: Variant(s, all_effects=uber) for name, (s, uber) in runs.items()},
         size,
         rounds,
         f"bench effects {scene.name}",
     )
+    med = {name: statistics.median(t) for name, t in times.items()}
+
+    def each(name: str) -> list[float]:  # its cost over plain's, round by round
+        return [a / b - 1.0 for a, b in zip(times[name], times["plain"])]
+
     rows = [
         dict(
             variant=name,
@@ -75,6 +81,8 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
             ms=med[name] * 1e3,
             ratio_to_plain=med[name] / med["plain"],
             incremental=med[name] / med["plain"] - 1.0,
+            low=min(each(name)),
+            high=max(each(name)),
         )
         for name, (s, uber) in runs.items()
     ]
@@ -88,9 +96,17 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
                 ms=sum(alone) * 1e3,
                 ratio_to_plain=sum(alone) / med["plain"],
                 incremental=sum(alone) / med["plain"] - 1.0,
+                low="",
+                high="",
             )
         )
     return Measured(scene, size, rounds, rows)
+
+
+def _noise(r: dict) -> str:
+    """ " (within noise)" where the rounds disagree on the cost's sign (not for plain)."""
+    within = r["low"] != "" and r["variant"] != "plain" and r["low"] <= 0.0 <= r["high"]
+    return " (within noise)" if within else ""
 
 
 def table(m: Measured) -> str:
@@ -98,18 +114,19 @@ def table(m: Measured) -> str:
     text = (
         f"\nEffect costs — {m.scene.name}, {m.size[0]}×{m.size[1]}, {m.scene.render.tracer} "
         f"tracing, median of {m.rounds} interleaved rounds (ratios to plain = no effect, "
-        "specialised)\n\n"
+        "specialised; a cost whose rounds disagree on its sign is within noise)\n\n"
     )
     text += markdown(
-        ("variant", "effects", "ms/frame", "× plain", "incremental cost"),
-        "llrrr",
+        ("variant", "effects", "ms/frame", "× plain", "incremental cost", "rounds [min–max]"),
+        "llrrrr",
         (
             (
                 r["variant"],
                 r["effects"],
                 f"{r['ms']:.1f}",
                 f"{r['ratio_to_plain']:.2f}",
-                f"{r['incremental']:+.0%}",
+                f"{r['incremental']:+.0%}" + _noise(r),
+                "" if r["low"] == "" else f"{r['low']:+.0%} … {r['high']:+.0%}",
             )
             for r in m.rows
         ),
