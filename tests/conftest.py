@@ -125,7 +125,7 @@ def display():
     # test processes running side by side never share or race for one.
     read, write = os.pipe()
     proc = subprocess.Popen(
-        [xvfb, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        [xvfb, "-displayfd", str(write), "-screen", "0", "1920x1200x24", "-nolisten", "tcp"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         pass_fds=(write,),

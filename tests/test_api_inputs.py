@@ -48,7 +48,7 @@ def test_a_scene_built_from_the_classes_is_validated_where_the_api_takes_it(tmp_
         "camera.target": krsview.Scene(
             krs=rock.krs, camera=Camera(position=(0, 1, 0), target=(0, 1, 0))
         ),
-        "'<krs and tree>'": dataclasses.replace(rock, tree=krsview.load("tree").tree),
+        "= <krs and tree>:": dataclasses.replace(rock, tree=krsview.load("tree").tree),
     }
     for said, scene in bad.items():
         for call in (
@@ -189,7 +189,8 @@ def test_files_are_checked_before_any_work(tmp_path):
     frames = tmp_path / "frames"
     frames.mkdir()
     cases = [
-        (lambda: export.html("rock", blocker / "x.html"), "cannot write there"),
+        (lambda: export.html("rock", blocker / "x.html"), "a-file' is a file, not a folder"),
+        (lambda: export.html("rock", "/proc/no/x.html"), "cannot write there"),
         (lambda: export.html("rock", tmp_path / "x.txt"), "must end in .html"),
         (lambda: export.mesh("rock", tmp_path / "m.xyz"), "must end in .glb, .ply, .stl or .obj"),
         (lambda: export.mesh("rock", tmp_path / "m.ply", resolution=0), "resolution = 0"),

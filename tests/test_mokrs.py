@@ -146,7 +146,7 @@ def test_mokrs_needs_binary_tracer():
         ),
         (
             [{"type": "scale", "factor": 1e-6}] * 3,
-            r"mokrs.levels\[0\].transform = '<condition number .*>': numerically singular",
+            r"mokrs.levels\[0\].transform = <condition number .*>: numerically singular",
         ),
     ],
 )

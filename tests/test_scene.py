@@ -273,7 +273,7 @@ PALM_ROTATE = (
         ),
         (
             ("[krs]\n" + "[[krs.levels]]\n" * 2000).encode(),
-            "krs.levels = '<a list of 2,000 items>': too long; allowed: at most 1024 items",
+            "krs.levels = <a list of 2,000 items>: too long; allowed: at most 1024 items",
         ),
     ],
 )

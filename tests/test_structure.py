@@ -295,8 +295,14 @@ class FakeEditor:
     """What editor/structure.py reads and calls of the editor, without a window."""
 
     def __init__(self, path):
+        self.said: list[str] = []
         self.viewer = SimpleNamespace(
-            doc=None, sync=lambda: None, error="", message="", interactions=Interactions()
+            doc=None,
+            sync=lambda: None,
+            error="",
+            message="",
+            interactions=Interactions(),
+            say=self.said.append,
         )
         self.viewer.doc = Document(path)
         self.selected = SimpleNamespace(level=3)
@@ -340,6 +346,7 @@ def test_each_operation_is_one_undo_step(editor):
         assert editor.scene == before
         editor.doc.redo()
     assert len(editor.doc.history.steps) == 4 and editor.chosen == [4, 2, 3]
+    assert editor.said[0].startswith("insert a fork in L3"), "said at the window's foot too"
     while editor.doc.undo():
         pass
     assert editor.scene == start

@@ -96,7 +96,7 @@ def test_a_large_amplitude_is_refused_naming_the_level_and_time():
 
 
 def test_sway_needs_a_tree_and_enough_forks():
-    with pytest.raises(SceneError, match=r"^animation\.sway = '<sway>': sway turns the fork"):
+    with pytest.raises(SceneError, match=r"^animation\.sway = <sway>: sway turns the fork"):
         load("palm").edit("animation", {"sway": {}})
     with pytest.raises(SceneError, match=r"^animation\.sway\.levels = 8: this tree has 3 fork"):
         load("tree").edit("tree.levels", 3).edit("animation", {"sway": {"levels": 8}})

@@ -31,6 +31,7 @@ from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
+WARNINGS_OPEN = 2  # more warnings than this are folded under one line that counts them
 
 
 class Edited(Protocol):
@@ -156,12 +157,23 @@ def _warnings(e: Edited, out: list) -> None:
     """Each warning names its level (in a compound, its component's route's); a click
     selects that level or component (the view shows the clipped part in red)."""
     what = "component" if e.scene.compound else "level"
-    for k, (entry, text) in enumerate(e.warnings):
+    said = e.warnings
+    if not said:
+        return
+    if len(said) > WARNINGS_OPEN:  # folded: eight of four lines each pushed the outline away
+        imgui.push_style_color(imgui.Col_.text, YELLOW)
+        shown = imgui.tree_node(f"{len(said)} warnings: branches Alg. 1 cuts (red in the view)")
+        imgui.pop_style_color()
+        if not shown:
+            return
+    for k, (entry, text) in enumerate(said):
         imgui.push_style_color(imgui.Col_.text, YELLOW)
         imgui.text_wrapped(text)
         imgui.pop_style_color()
         if imgui.small_button(f"select {what} {entry}##warn{k}"):
             out.append(ec.SelectLevel(entry))
+    if len(said) > WARNINGS_OPEN:
+        imgui.tree_pop()
 
 
 def _file(e: Edited, out: list) -> None:

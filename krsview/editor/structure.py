@@ -103,12 +103,15 @@ def baked(scene: Scene, component: int | None) -> tuple[Scene, str, str]:
 
 # ----------------------------------------------------------------------------- applying
 def _say(e: Structured, text: str, refused: bool) -> None:
+    """In the structure section, and at the window's foot: the section's end may be below
+    the panel's fold (a refusal is the error, which the status line shows)."""
     t = e.structure
     t.message, t.refused = text, refused
     if refused:
         e.viewer.error = text
     else:
         e.viewer.error, e.viewer.message = "", text
+        e.viewer.say(text)
 
 
 def component(e: Structured) -> int | None:

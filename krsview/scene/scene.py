@@ -209,7 +209,9 @@ class Scene:
 
     def with_levels(self, levels: int, path: str = "levels") -> Scene:
         """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation), as
-        posed at its time (see :meth:`with_geometry`)."""
+        posed at its time (see :meth:`with_geometry`): the finest go, so a tree keeps its
+        trunk and loses its leaves first (a tree grown with fewer forks, ``tree.levels``,
+        keeps its leaves on the last levels it grows)."""
         g = self.posed().geometry()
         if not isinstance(levels, numbers.Integral) or isinstance(levels, bool):
             raise SceneError(path, levels, f"expected a whole number, 1..{g.depth}")

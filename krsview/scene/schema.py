@@ -30,6 +30,8 @@ def _brief(value: Any, limit: int = 60) -> str:
         )
     if isinstance(value, bool):  # as a scene file (TOML) spells it
         return "true" if value else "false"
+    if isinstance(value, str) and value.startswith("<") and value.endswith(">"):
+        return value  # a description of the value ("<65 levels>"), not the value: no quotes
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
