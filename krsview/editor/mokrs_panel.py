@@ -20,6 +20,7 @@ from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions, red_text, tooltip
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
+from .modals import entry_menu
 from .mokrs_handles import mokrs_outline
 from .mokrs_levels import LEVELS, OPS, level_commands
 
@@ -98,19 +99,12 @@ def mokrs_section(e: Any, out: list[Command], interactions: Interactions, fields
 
 
 def _level_menu(levels: list, i: int, name: str) -> list[Command]:
-    """Level i's right-click menu, as a route's outline entry has; opening it selects the
-    level, so what is marked is what the menu acts on."""
-    out: list[Command] = []
-    if imgui.begin_popup_context_item(f"mokrs level##{i}"):
-        if imgui.is_window_appearing():
-            out.append(ec.SelectLevel(i))
-        imgui.text_disabled(name)
-        imgui.separator()
-        for op, tip in OPS.items():
-            if imgui.menu_item(f"{op}: {tip}", OP_KEYS.get(op, ""), False)[0]:
-                out += level_commands(levels, i, op)
-        imgui.end_popup()
-    return out
+    """Level i's right-click menu, as a route's outline entry has: the level operations."""
+    items = [
+        (f"{op}: {tip}", OP_KEYS.get(op, ""), lambda op=op: level_commands(levels, i, op))
+        for op, tip in OPS.items()
+    ]
+    return entry_menu(f"mokrs level##{i}", i, name, items)
 
 
 def _level(e, levels: list, i: int, out: list, interactions: Interactions, fields) -> None:

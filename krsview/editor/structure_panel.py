@@ -16,7 +16,7 @@ from ..viewer.commands import Command
 from ..viewer.widgets import Interactions, as_typed, field_widget, red_text, tooltip
 from . import commands as ec
 from .handles import route_outline
-from .modals import answer_buttons
+from .modals import answer_buttons, entry_menu
 from .structure import Structured, StructureTools, component, growth_field, target
 
 MAX_LISTED = 12  # lost edits listed in the re-grow dialog; the rest are counted
@@ -31,22 +31,13 @@ TIPS = {  # the structure tools' values (ctrl+click a slider to type one)
 
 def outline_menu(k: int, name: str) -> list[Command]:
     """The right-click menu of outline entry k, titled by its ``name`` (call right after its
-    selectable); opening it selects the entry, so what is marked is what the menu acts on."""
-    out: list[Command] = []
-    if imgui.begin_popup_context_item(f"structure##{k}"):
-        if imgui.is_window_appearing():
-            out.append(ec.SelectLevel(k))
-        imgui.text_disabled(name)
-        imgui.separator()
-        for text, keys, command in (
-            ("insert a fork", "Insert", ec.InsertLevel(k)),
-            ("remove this fork", "Delete", ec.RemoveLevel(k)),
-            ("duplicate", "Ctrl+D", ec.DuplicateLevel(k)),
-        ):
-            if imgui.menu_item(text, keys, False)[0]:
-                out.append(command)
-        imgui.end_popup()
-    return out
+    selectable): the structure keys' operations on that level."""
+    items = (
+        ("insert a fork", "Insert", lambda: [ec.InsertLevel(k)]),
+        ("remove this fork", "Delete", lambda: [ec.RemoveLevel(k)]),
+        ("duplicate", "Ctrl+D", lambda: [ec.DuplicateLevel(k)]),
+    )
+    return entry_menu(f"structure##{k}", k, name, items)
 
 
 def structure_section(e: Structured, interactions: Interactions) -> list[Command]:
