@@ -386,3 +386,29 @@ def test_ctrl_shift_s_asks_the_name_and_enter_saves_there(display, tmp_path):
         assert load_scene(mine).render.epsilon_scale == 1.0
     finally:
         e.close()
+
+
+def test_the_status_line_is_not_drawn_under_the_panel_docked_left(display, tmp_path):
+    """Docked left, the panel reaches the window's foot: the status line (a bookmark's
+    words) goes beside it. It went under it: the editor's gizmo draws over the whole window
+    in a window of its own, so no gap was found (the control: that window is there)."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.commands import PlacePanel
+    from krsview.editor.window import Editor
+    from krsview.viewer.commands import AddBookmark
+
+    mine = tmp_path / "mine.toml"
+    shutil.copy(resolve("tree"), mine)
+    e = Editor(mine, size=(900, 500))
+    try:
+        pump(e)
+        e.execute([PlacePanel("left", 320.0), AddBookmark()])
+        pump(e, 3)
+        status, panel = (imgui.internal.find_window_by_name(n) for n in ("##status", "edit"))
+        assert panel.pos.x < 10 and panel.pos.y + panel.size.y > status.pos.y
+        assert status.pos.x >= panel.pos.x + panel.size.x, "under the panel"
+        wide = [w for w in imgui.get_current_context().windows if w.size.x >= 890]
+        assert wide, "control: a window as wide as the editor's (the gizmo's)"
+    finally:
+        e.close()

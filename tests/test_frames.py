@@ -143,9 +143,9 @@ def test_a_folder_of_another_runs_frames_is_refused(path_file, tmp_path):
     base = ("--camera-path", str(path_file), "--fps", str(FPS), "-o", str(out))
     other = ("render", "tree", *base, "--size", "48x28")
     r = krsview_cli(*other)
-    assert r.returncode == 2 and "holds frames of another run (its size differ)" in r.stderr
+    assert r.returncode == 2 and "holds frames of another run (its size differs)" in r.stderr
     r = krsview_cli("render", "rock", *base, "--size", f"{SIZE[0]}x{SIZE[1]}")
-    assert r.returncode == 2 and "(its scene differ)" in r.stderr
+    assert r.returncode == 2 and "(its scene differs)" in r.stderr
     (out / "frames.json").unlink()  # frames an older krsview wrote
     r = krsview_cli(*other)
     assert r.returncode == 2 and "holds frame_00000.png of 64×36, not 48×28" in r.stderr

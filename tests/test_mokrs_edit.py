@@ -645,7 +645,7 @@ def test_inward_twice_moves_a_level_two_steps_and_the_keys_act_on_levels(display
             pump(e, 2)
         finally:
             imgui.checkbox = box
-        assert "step edits also go to the finer levels (none has this one's now)" in labels
+        assert "step edits also go to linked levels (none now)" in labels
     finally:
         e.close()
 

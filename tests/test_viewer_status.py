@@ -386,8 +386,12 @@ def test_the_hud_opens_any_scene_file_by_its_path(hud_viewer, monkeypatch, tmp_p
     monkeypatch.setattr(
         imgui, "input_text_with_hint", lambda label, hint, text, flags=0: (True, typed[0])
     )
+    v.execute([c.SetIterationScale(8)])
     turn(v)
     assert v.path == other and v.scene.name == "rock" and v.file.open_text == str(other)
+    from krsview.heatmap import VIEW_WHITE
+
+    assert v.iteration_scale == VIEW_WHITE, "another scene: the iterations view's own scale"
     typed[0] = str(tmp_path / "none.toml")
     turn(v)
     assert v.path == other and "cannot read" in v.error

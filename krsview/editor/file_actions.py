@@ -98,8 +98,8 @@ class FileActions:
         try:
             load_scene(self.doc.path)
             self.unreadable = ""
-        except SceneError as e:
-            self.unreadable = str(e)
+        except SceneError as e:  # a file unread: why alone (its name is said before it)
+            self.unreadable = e.allowed if e.path == "<file>" else str(e)
 
     def save(self, path: str | None = None, overwrite: bool = False) -> bool:
         """Save (atomic); a shipped preset first asks where its copy goes, taking over the
@@ -120,6 +120,7 @@ class FileActions:
             return False
         v.file.follow()
         v.error, v.message, self.conflict, self.kept = "", f"saved {saved.resolve()}", False, False
+        v.say(v.message)  # over what the foot said before (kept your edits: Ctrl+S …)
         self.save_as_text = str(saved)
         return True
 

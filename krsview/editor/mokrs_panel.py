@@ -131,7 +131,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     if changed:
         out.append(Edit((*lev, "reflect"), on))
     linked = len(linked_levels(e.scene.mokrs, i)) - 1  # the option stays, none linked too
-    now = f"{linked} finer levels" if linked else "the finer levels (none has this one's now)"
+    now = f"{linked} linked levels" if linked else "linked levels (none now)"
     changed, on = imgui.checkbox(f"step edits also go to {now}", e.carry)
     if changed:
         out.append(ec.SetCarry(on))

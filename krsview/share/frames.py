@@ -81,7 +81,8 @@ class FrameJob:
                 raise SceneError(
                     what,
                     str(self.folder),
-                    f"holds frames of another run (its {', '.join(differ)} differ); give "
+                    f"holds frames of another run (its {' and '.join(differ)} "
+                    f"{'differ' if len(differ) > 1 else 'differs'}); give "
                     "another folder, or empty this one",
                 )
         else:

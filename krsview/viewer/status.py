@@ -59,12 +59,20 @@ def _gaps(width: float, foot: float, h: float, rects: list[Rect]) -> Iterator[tu
 
 
 def _other_windows() -> list[Rect]:
-    """The rectangles of the top-level windows drawn this frame (tooltips and popups move
-    or close of themselves: they are left out)."""
-    skip = imgui.WindowFlags_.tooltip | imgui.WindowFlags_.popup | imgui.WindowFlags_.child_window
+    """The rectangles of the top-level windows drawn this frame that show something: not
+    tooltips and popups (they move or close of themselves), not an overlay that takes no
+    mouse or has no background (the editor's gizmo draws over the whole window in one),
+    not ImGui's own implicit "Debug" window."""
+    skip = (
+        imgui.WindowFlags_.tooltip
+        | imgui.WindowFlags_.popup
+        | imgui.WindowFlags_.child_window
+        | imgui.WindowFlags_.no_background
+        | imgui.WindowFlags_.no_mouse_inputs
+    )
     out = []
     for w in imgui.get_current_context().windows:
-        if w.active and not w.hidden and not (w.flags & skip):
+        if w.active and not w.hidden and not (w.flags & skip) and not w.name.startswith("Debug##"):
             out.append((w.pos.x, w.pos.y, w.pos.x + w.size.x, w.pos.y + w.size.y))
     return out
 

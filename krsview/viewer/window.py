@@ -112,6 +112,7 @@ class Viewer:
         if self.window is not None:
             glfw.set_window_title(self.window, f"krsview — {self.scene.name}")
         self.message = ""  # what was said of the last scene
+        self.iteration_scale = VIEW_WHITE  # another scene: another iteration count
         self._view_prepass = self.settings.prepass
         self.drawn.open()
         self.nav.reset(self.scene.camera)
