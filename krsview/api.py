@@ -30,10 +30,12 @@ from .frame import Frame
 from .inputs import output_file, scene_of, size_of, switch, whole
 from .scene import Render, Scene, SceneError, load_scene, save_scene
 from .scene.edits import vouched
+from .scene.filetext import saved_text
 from .scene.info import SceneInfo, describe
 from .scene.model import KRS
 from .scene.presets import preset_names, resolve
 from .scene.render import LANES_LEVELS, VIEW_PREPASS
+from .scene.scene import scene_from_toml, write_atomic
 from .scene.schema import from_dict
 from .scene.settings import MAX_SIDE
 
@@ -50,14 +52,16 @@ def load(name_or_path: str | Path) -> Scene:
     >>> load("tree").geometry().depth
     23
     """
-    if not isinstance(name_or_path, (str, Path)):
+    if not isinstance(name_or_path, (str, Path)) or str(name_or_path) == "":
         raise SceneError("name_or_path", name_or_path, "expected a preset's name or a .toml path")
     return load_scene(resolve(str(name_or_path)))
 
 
 def save(scene: Scene, path: str | Path) -> Path:
     """Write ``scene`` as a scene file (``.toml``), validated first, atomically (a file is
-    whole or untouched); the path written. :func:`load` reads it back to an equal scene.
+    whole or untouched); over a scene file, only the values that changed are written into
+    its text, its comments kept. The path written. :func:`load` reads it back to an equal
+    scene.
 
     >>> import pathlib, tempfile
     >>> out = save(load("rock"), pathlib.Path(tempfile.mkdtemp()) / "rock.toml")
@@ -66,7 +70,11 @@ def save(scene: Scene, path: str | Path) -> Path:
     """
     scene = scene_of(scene)
     out = output_file(path, "path", (".toml",))
-    save_scene(scene, out)
+    try:  # over a scene file: only what changed is written into its text, comments kept
+        text = out.read_text(encoding="utf-8")
+        write_atomic(out, saved_text(text, scene_from_toml(text, str(out)), scene))
+    except (OSError, UnicodeDecodeError, SceneError):
+        save_scene(scene, out)
     return out
 
 
@@ -176,6 +184,7 @@ class Renderer:
         if self._gpu is None:
             from .gpu.renderer import Renderer as GpuRenderer
 
+            _release_dropped()  # what Renderers dropped without close() left behind
             self._gpu = GpuRenderer(_shared_context())
         return self._gpu
 
@@ -202,6 +211,8 @@ class Renderer:
         traces it with the float64 NumPy reference instead of the GPU; ``progress(done,
         total)`` is called as bands of rows (GPU) or chunks of rays (reference) finish."""
         scene = self._settled(scene, exact, **knobs)
+        if progress is not None and not callable(progress):
+            raise SceneError("progress", progress, "expected a function of (done, total)")
         if switch(reference, "reference"):
             from .reference import render_reference
 
@@ -219,9 +230,14 @@ class Renderer:
 
     @staticmethod
     def _settled(scene: Scene | str | Path, exact: bool, **knobs: Any) -> Scene:
+        """``scene`` with the fast or exact settings, then ``knobs`` over them; a pre-pass
+        left unset (``prepass=None``: "not given", as in a file) gets the fast one."""
         scene = scene_of(scene)
         settle = exact_settings if switch(exact, "exact") else fast_settings
-        return configure(settle(scene), **knobs)
+        scene = configure(settle(scene), **knobs)
+        if scene.render.prepass is None:
+            scene = replace(scene, render=replace(scene.render, prepass=VIEW_PREPASS))
+        return scene
 
     def close(self) -> None:
         """Release the compiled variants and targets (the shared context and the shared
@@ -229,12 +245,7 @@ class Renderer:
         own = self._gpu is not None and self._gpu is not _shared_gpu
         self._gpu = None
         if own:  # its GL objects go once Python drops them (the context's gc_mode)
-            from .gpu.context import release_dropped
-
-            gc.collect()
-            ctx = _shared_context()
-            with _lock, ctx:
-                release_dropped(ctx)
+            _release_dropped()
 
     def __enter__(self) -> Renderer:
         return self
@@ -244,6 +255,17 @@ class Renderer:
 
 
 _shared_gpu = None  # the module-level render()'s GPU renderer: variants kept between calls
+
+
+def _release_dropped() -> None:
+    """Give back the GL objects of renderers Python has dropped: at a Renderer's close(),
+    and when a new one starts (one dropped without close() held 11 MB until then)."""
+    from .gpu.context import release_dropped
+
+    gc.collect()
+    ctx = _shared_context()
+    with _lock, ctx:
+        release_dropped(ctx)
 
 
 def render(
@@ -287,7 +309,12 @@ def distance(scene: Scene | str | Path, points: Any) -> np.ndarray:
     scene = scene_of(scene).posed()
     if scene.mokrs is not None:
         raise SceneError("scene", scene.name, "a MöKRS has no distance function [KRS17 §6]")
-    p = np.asarray(points, dtype=float)
+    try:  # a complex number, text, a ragged list: refused below
+        if np.iscomplexobj(points):
+            raise TypeError
+        p = np.asarray(points, dtype=float)
+    except (ValueError, TypeError):
+        p = np.full((), np.nan)
     if p.ndim == 0 or p.shape[-1] != 3 or not np.isfinite(p).all():
         shown = f"<an array of shape {p.shape}>" if p.ndim else p
         raise SceneError("points", shown, "expected finite points, an array of shape (..., 3)")

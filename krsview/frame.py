@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 
-@dataclass
+@dataclass(eq=False)  # arrays: == would be ambiguous; compare the arrays themselves
 class Frame:
     """``color`` (H, W, 3) display colour in [0, 1] (gamma-encoded); ``depth`` (H, W) ray
     distance t to the hit, 0 where missed; ``normal`` (H, W, 3) unit world normal, 0 where
@@ -44,6 +44,8 @@ class Frame:
         before anything is written."""
         from PIL import Image
 
+        if not isinstance(path, (str, Path)) or str(path) == "":
+            raise ValueError(f"path = {path!r}: expected a file's path")
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix != ".npz" and suffix not in Image.registered_extensions():
@@ -51,6 +53,7 @@ class Frame:
                 f"path = {str(path)!r}: the file must end in .png, .npz or another image "
                 "format's suffix (.jpg, .tif, .webp, …)"
             )
+        path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do
         if suffix == ".npz":
             np.savez_compressed(
                 path,

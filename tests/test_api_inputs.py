@@ -16,6 +16,7 @@ import pytest
 
 import krsview
 from krsview.scene import KRS, Camera, Level, Mirror, Sphere
+from krsview.scene.presets import resolve
 
 SIZE = (24, 14)
 BALL = {"krs": {"levels": [{"kernel": {"type": "sphere", "radius": 0.5}}]}}
@@ -263,3 +264,66 @@ def test_a_files_prepass_0_is_off_and_none_given_is_the_fast_default(tmp_path):
     given, fast = krsview.render(off, SIZE), krsview.render(s, SIZE)
     assert given.iterations.mean() > fast.iterations.mean(), "control: the pre-pass spares steps"
     assert "prepass =" not in krsview.save(s, tmp_path / "s.toml").read_text()
+
+
+def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
+    """What a second newcomer's review found: NumPy arrays inside the scene's classes,
+    a string for the effect list, a NumPy time, malformed edit paths, a progress that is no
+    function, points that are no points, an empty name; each has its control beside it."""
+    import pickle
+
+    import numpy as np
+
+    ball = krsview.Scene(krs=KRS(levels=[Level(kernel=Sphere(center=np.zeros(3), radius=0.5))]))
+    assert krsview.check(ball).instances == 1  # an array in a class field: a list of numbers
+    saved = krsview.save(ball.edit("render.epsilon_scale", np.float32(2.0)), tmp_path / "b.toml")
+    assert krsview.load(saved).render.epsilon_scale == 2.0
+    refusals = [
+        (lambda: krsview.render("rock", SIZE, effects="sky"), "effects = 'sky': expected a list"),
+        (lambda: krsview.load("rock").edit("krs.levels[0.kernel", 1), "expected names and"),
+        (lambda: krsview.load("rock").edit(None, 1), "path = None: expected a path"),
+        (lambda: krsview.render("rock", SIZE, progress=3), "progress = 3: expected a function"),
+        (lambda: krsview.distance("rock", ["a", "b", "c"]), "expected finite points"),
+        (lambda: krsview.distance("rock", [[1, 2, 3], [1, 2]]), "expected finite points"),
+        (lambda: krsview.distance("rock", [1j, 0, 0]), "expected finite points"),
+        (lambda: krsview.load(""), "name_or_path = '': expected"),
+    ]
+    for call, said in refusals:
+        with pytest.raises(krsview.SceneError) as e:
+            call()
+        assert said in one_line(e)
+    sway = krsview.load("tree-sway")
+    assert sway.at(np.float32(0.6)).time == 0.6  # the decimal it shows
+    error = pickle.loads(pickle.dumps(krsview.SceneError("a", 1, "b", "f.toml")))
+    assert str(error) == "f.toml: a = 1: b"  # a pool's worker's error reaches it whole
+    a, b = krsview.render("rock", SIZE), krsview.render("rock", SIZE)
+    assert a != b and a == a  # identity, not an ambiguous array comparison
+    assert b.save(tmp_path / "new" / "f.png").exists()
+
+
+def test_a_prepass_knob_of_none_is_the_fast_default_and_a_dropped_renderer_is_given_back():
+    from krsview.api import _shared_context
+    from krsview.scene.render import VIEW_PREPASS
+
+    drawn = []
+    r = krsview.Renderer(*SIZE)
+    r.gpu.render = lambda s, w, h, progress=None: drawn.append(s.render.prepass)
+    r.render("tree", prepass=None)
+    r.render("tree", prepass=0)
+    assert drawn == [VIEW_PREPASS, 0]
+    dropped = krsview.Renderer(*SIZE)
+    dropped.render("rock")
+    del dropped
+    assert krsview.Renderer(*SIZE).gpu is not None  # a new one gives back the dropped's
+    assert not _shared_context().objects
+
+
+def test_saving_over_a_scene_file_keeps_its_comments(tmp_path):
+    path = tmp_path / "tree.toml"
+    text = "# my notes\n" + resolve("tree").read_text()
+    path.write_text(text)
+    krsview.save(krsview.load(path).edit("render.epsilon_scale", 2.0), path)
+    now = path.read_text()
+    assert now.startswith("# my notes\n") and "[0.5, 0.8, -0.35]" in now
+    assert len(now.splitlines()) == len(text.splitlines())
+    assert krsview.load(path).render.epsilon_scale == 2.0

@@ -22,11 +22,11 @@ from typing import Any
 from ..scene import Bookmark, Camera, Scene, SceneError, load_scene, scene_to_toml
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
+from ..scene.filetext import saved_text
 from ..scene.presets import PRESET_DIR
 from ..scene.scene import scene_from_toml, write_atomic
 from ..scene.schema import to_dict
 from ..scene.toml_writer import dumps
-from .filetext import saved_text
 from .history import History, Step
 
 AUTOSAVE_SECONDS = 3.0  # a crash loses at most this much work

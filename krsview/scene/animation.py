@@ -38,7 +38,12 @@ def reads_time(effects: list[str]) -> bool:
 
 
 def check_time(t: object, path: str = "time") -> float:
-    """``t`` as a time in seconds, or a one-line error saying what is allowed."""
+    """``t`` as a time in seconds (a NumPy number too, taken as the decimal it shows), or a
+    one-line error saying what is allowed."""
+    if isinstance(t, np.floating):
+        t = float(str(t))  # np.float32(0.6) is 0.6, not 0.6000000238418579
+    elif isinstance(t, np.integer):
+        t = int(t)
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not 0.0 <= t <= MAX_TIME:
         raise SceneError(path, t, f"a time in seconds; allowed 0..{MAX_TIME:g}")
     return float(t)

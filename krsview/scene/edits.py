@@ -8,6 +8,7 @@ it prints as ``route.levels[3].fork``, the form scene-file errors use.
 
 from __future__ import annotations
 
+import re
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
@@ -59,7 +60,7 @@ def checked(scene: Any) -> Any:
     if seen is not None and seen[0] == data:
         return seen[1]
     good = validated(scene)
-    if seen is None and good == scene:
+    if seen is None and to_dict(good) == data:  # the same values: keep its caches
         good = scene
     object.__setattr__(scene, "_checked", (data, good))
     return good
@@ -74,13 +75,15 @@ def vouched(scene: Any) -> Any:
 
 def parse_path(text: str | Path) -> Path:
     """``"route.levels[3].fork"`` → ``("route", "levels", 3, "fork")`` (a tuple passes)."""
+    if isinstance(text, tuple):
+        return text
     if not isinstance(text, str):
-        return tuple(text)
+        raise SceneError("path", text, "expected a path such as 'render.tracer', or a tuple")
     out: list[str | int] = []
     for part in text.split("."):
-        name, *indices = part.replace("]", "").split("[")
-        if not name or not all(i.isdigit() for i in indices):
+        if not re.fullmatch(r"[A-Za-z_]\w*(\[\d+\])*", part):
             raise SceneError(text, "<path>", "expected names and [indices], e.g. render.tracer")
+        name, *indices = part.replace("]", "").split("[")
         out += [name, *(int(i) for i in indices)]
     return tuple(out)
 

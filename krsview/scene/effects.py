@@ -213,6 +213,8 @@ def allowed_effects(mokrs: bool) -> list[str]:
 
 def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> None:
     """Known names, no pair that excludes each other, nothing a MöKRS cannot draw."""
+    if isinstance(effects, str):  # one name would be read letter by letter
+        raise SceneError(path, effects, f"expected a list of effect names, e.g. [{effects!r}]")
     for i, e in enumerate(effects):
         if e not in EFFECTS:
             raise SceneError(f"{path}[{i}]", e, "unknown effect; allowed: " + ", ".join(EFFECTS))

@@ -221,7 +221,7 @@ class Scene:
 
     def with_effects(self, effects: list[str], path: str = "effects") -> Scene:
         """The scene with this effect set compiled in (checked against what it allows)."""
-        check_effects(list(effects), self.mokrs is not None, path)
+        check_effects(effects, self.mokrs is not None, path)
         return replace(self, effects=list(effects))
 
     def with_geometry(self, geometry: Geometry) -> Scene:

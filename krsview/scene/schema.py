@@ -47,6 +47,9 @@ class SceneError(ValueError):
         where = f"{self.file}: " if self.file else ""
         return f"{where}{self.path} = {_brief(self.value)}: {self.allowed}"
 
+    def __reduce__(self):  # picklable: a worker process's error reaches its pool whole
+        return (SceneError, (self.path, self.value, self.allowed, self.file))
+
     def in_file(self, file: str) -> SceneError:
         return SceneError(self.path, self.value, self.allowed, file)
 
@@ -276,7 +279,7 @@ def to_dict(obj: Any) -> Any:
         return out
     if isinstance(obj, (list, tuple)):
         return [to_dict(v) for v in obj]
-    return obj
+    return _plain(obj)  # a NumPy number or array given in Python: as a file writes it
 
 
 class Tagged:

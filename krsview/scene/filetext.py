@@ -15,9 +15,8 @@ from typing import Any
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
 
-from ..scene import Scene, SceneError, scene_to_toml
-from ..scene.scene import scene_from_toml
-from ..scene.schema import to_dict
+from .scene import Scene, scene_from_toml, scene_to_toml
+from .schema import SceneError, to_dict
 
 
 def saved_text(text: str, before: Scene, after: Scene) -> str:
