@@ -158,8 +158,10 @@ def test_drag_a_fork_and_turn_a_normal_undo_redo_save_and_render_headless(editor
     # picking the tree itself: a trunk pixel away from the handles selects the trunk level
     click(e, screen_of(e, (0.0, 0.4, -0.2)))
     assert e.selected is not None and e.selected.level == len(saved.route.levels) - 1
-    # the window (HUD and overlays hidden) against a headless render of the saved file
+    # the window (HUD and overlays hidden, the status line's "saved …" gone) against a
+    # headless render of the saved file
     e.viewer.hud = False
+    e.viewer.clock += 60
     e.viewer.frames.dirty = True
     settle(e)
     shot = e.viewer.read_window()
