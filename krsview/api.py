@@ -28,12 +28,12 @@ import numpy as np
 
 from .frame import Frame
 from .inputs import output_file, scene_of, size_of, switch, whole
-from .scene import Render, Scene, SceneError, load_scene, save_scene
+from .scene import Render, Scene, SceneError, save_scene
 from .scene.edits import vouched
 from .scene.filetext import saved_text
 from .scene.info import SceneInfo, describe
 from .scene.model import KRS
-from .scene.presets import preset_names, resolve
+from .scene.presets import preset_names
 from .scene.render import LANES_LEVELS, VIEW_PREPASS
 from .scene.scene import scene_from_toml, write_atomic
 from .scene.schema import from_dict
@@ -52,9 +52,9 @@ def load(name_or_path: str | Path) -> Scene:
     >>> load("tree").geometry().depth
     23
     """
-    if not isinstance(name_or_path, (str, Path)) or str(name_or_path) == "":
+    if not isinstance(name_or_path, (str, Path)):
         raise SceneError("name_or_path", name_or_path, "expected a preset's name or a .toml path")
-    return load_scene(resolve(str(name_or_path)))
+    return scene_of(name_or_path, "name_or_path")
 
 
 def save(scene: Scene, path: str | Path) -> Path:
@@ -231,12 +231,14 @@ class Renderer:
     @staticmethod
     def _settled(scene: Scene | str | Path, exact: bool, **knobs: Any) -> Scene:
         """``scene`` with the fast or exact settings, then ``knobs`` over them; a pre-pass
-        left unset (``prepass=None``: "not given", as in a file) gets the fast one."""
+        left unset by a knob (``prepass=None``: "not given", as in a file) is the setting's
+        own (the fast tile, or none with ``exact``)."""
         scene = scene_of(scene)
-        settle = exact_settings if switch(exact, "exact") else fast_settings
-        scene = configure(settle(scene), **knobs)
+        exact = switch(exact, "exact")
+        scene = configure((exact_settings if exact else fast_settings)(scene), **knobs)
         if scene.render.prepass is None:
-            scene = replace(scene, render=replace(scene.render, prepass=VIEW_PREPASS))
+            tile = 0 if exact else VIEW_PREPASS
+            scene = replace(scene, render=replace(scene.render, prepass=tile))
         return scene
 
     def close(self) -> None:

@@ -27,9 +27,9 @@ def scene_of(x: Any, what: str = "scene") -> Scene:
     contents: unchanged, the same validated scene comes back, with its compiled caches."""
     if isinstance(x, Scene):
         return checked(x)
-    if isinstance(x, (str, Path)):
+    if isinstance(x, (str, Path)) and str(x) != "":
         return load_scene(resolve(str(x)))
-    hint = "; a dict: krsview.load_dict(d)" if isinstance(x, dict) else ""
+    hint = "; a dict: krsview.load_dict(d)" if isinstance(x, dict) else ""  # "" too
     raise SceneError(what, x, "expected a Scene, a preset's name or a .toml path" + hint)
 
 

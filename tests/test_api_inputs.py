@@ -276,6 +276,9 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
 
     ball = krsview.Scene(krs=KRS(levels=[Level(kernel=Sphere(center=np.zeros(3), radius=0.5))]))
     assert krsview.check(ball).instances == 1  # an array in a class field: a list of numbers
+    plain = krsview.Scene(krs=KRS(levels=[Level(kernel=Sphere(radius=0.5))]))
+    assert np.array_equal(krsview.render(ball, SIZE).color, krsview.render(plain, SIZE).color)
+    assert krsview.api.scene_of(ball).krs.levels[0].kernel.center == (0.0, 0.0, 0.0)
     saved = krsview.save(ball.edit("render.epsilon_scale", np.float32(2.0)), tmp_path / "b.toml")
     assert krsview.load(saved).render.epsilon_scale == 2.0
     refusals = [
@@ -310,7 +313,8 @@ def test_a_prepass_knob_of_none_is_the_fast_default_and_a_dropped_renderer_is_gi
     r.gpu.render = lambda s, w, h, progress=None: drawn.append(s.render.prepass)
     r.render("tree", prepass=None)
     r.render("tree", prepass=0)
-    assert drawn == [VIEW_PREPASS, 0]
+    r.render("tree", exact=True, prepass=None)  # exact's own: none
+    assert drawn == [VIEW_PREPASS, 0, 0]
     dropped = krsview.Renderer(*SIZE)
     dropped.render("rock")
     del dropped

@@ -60,7 +60,11 @@ def checked(scene: Any) -> Any:
     if seen is not None and seen[0] == data:
         return seen[1]
     good = validated(scene)
-    if seen is None and to_dict(good) == data:  # the same values: keep its caches
+    try:  # the same values, of the same types: keep its caches (NumPy inside: the new one)
+        same = seen is None and bool(good == scene)
+    except ValueError:
+        same = False
+    if same:
         good = scene
     object.__setattr__(scene, "_checked", (data, good))
     return good
