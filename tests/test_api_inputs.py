@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import krsview
-from krsview.scene import KRS, Camera, Level, Mirror, Sphere
+from krsview.scene import KRS, Camera, Level, Mirror, Scene, SceneError, Sphere
 from krsview.scene.presets import resolve
 
 SIZE = (24, 14)
@@ -331,3 +331,18 @@ def test_saving_over_a_scene_file_keeps_its_comments(tmp_path):
     assert now.startswith("# my notes\n") and "[0.5, 0.8, -0.35]" in now
     assert len(now.splitlines()) == len(text.splitlines())
     assert krsview.load(path).render.epsilon_scale == 2.0
+
+
+def test_scenes_hash_by_value():
+    a, b = krsview.load("tree"), krsview.load("tree")
+    other = a.edit("render.lod", 1.0)
+    assert hash(a) == hash(b) and len({a, b, other}) == 2
+    assert {a: "tree"}[b] == "tree"
+    # negative control: the hash follows the values, as == does
+    assert hash(other) != hash(a) and other != a
+
+
+def test_with_levels_validates_the_scene_first():
+    with pytest.raises(SceneError, match="exactly one geometry"):
+        Scene().with_levels(1)
+    assert krsview.load("tree").with_levels(5).geometry().depth == 5

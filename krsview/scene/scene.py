@@ -21,7 +21,7 @@ from .animation import (
     reads_time,
 )
 from .compound import Component, Compound, check_compound
-from .edits import apply_edit, parse_path, vouched
+from .edits import apply_edit, checked, parse_path, vouched
 from .effects import EffectSettings, check_effects
 from .model import KRS
 from .mokrs import MoKRS, check_view
@@ -102,6 +102,12 @@ class Scene:
         reads the time (the wind)."""
         a = self.animation
         return (a is not None and a.moves) or reads_time(self.effects)
+
+    def __hash__(self) -> int:
+        """By value, as ``==`` compares: scenes can be keys of a dict or members of a set.
+        (Its lists are Python lists: a scene changed in place hashes anew, so change one by
+        :meth:`edit`.)"""
+        return hash(_frozen(to_dict(self)))
 
     def posed(self) -> Scene:
         """The static scene drawn at this scene's time: its tracks' values there and its sway
@@ -211,8 +217,10 @@ class Scene:
         """The scene drawn with only its coarsest ``levels`` levels (LOD by truncation), as
         posed at its time (see :meth:`with_geometry`): the finest go, so a tree keeps its
         trunk and loses its leaves first (a tree grown with fewer forks, ``tree.levels``,
-        keeps its leaves on the last levels it grows)."""
-        g = self.posed().geometry()
+        keeps its leaves on the last levels it grows). The result no longer moves: to draw
+        a moving scene's levels at another moment, ``krsview.configure(scene, time=T,
+        levels=N)`` poses it first."""
+        g = checked(self).posed().geometry()
         if not isinstance(levels, numbers.Integral) or isinstance(levels, bool):
             raise SceneError(path, levels, f"expected a whole number, 1..{g.depth}")
         if not 1 <= levels <= g.depth:
@@ -234,6 +242,15 @@ class Scene:
         if isinstance(geometry, Compound):
             return replace(base, **{**none, "compound": [Component(krs=p) for p in geometry.parts]})
         return replace(base, **{**none, "krs": geometry})
+
+
+def _frozen(data: object) -> object:
+    """A TOML-ready value as nested tuples, to hash."""
+    if isinstance(data, dict):
+        return tuple((k, _frozen(v)) for k, v in data.items())
+    if isinstance(data, list):
+        return tuple(_frozen(v) for v in data)
+    return data
 
 
 MAX_FILE_BYTES = 4 * 1024 * 1024
