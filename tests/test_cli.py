@@ -49,6 +49,9 @@ def test_reference_render_matches_size(tmp_path):
     [
         (["render", "tree", "--size", "640"], "expected WIDTHxHEIGHT"),
         (["render", "tree", "--size", "0x10"], "each side must be 1..8192"),
+        # a window needs room for its image and HUD; the control: 64x48 opens (test_playback)
+        (["view", "tree", "--size", "10x10"], "--size '10x10': each side must be 48..8192"),
+        (["edit", "tree", "--size", "47x200"], "--size '47x200': each side must be 48..8192"),
         (
             ["render", "tree", "--epsilon-scale", "nan"],
             "--epsilon-scale = nan: NaN and infinity are "

@@ -22,16 +22,19 @@ from ..scene.settings import MAX_SIDE
 SILENT_SECONDS = 1.0  # work quicker than this shows no progress bar
 
 
-def size(text: str) -> tuple[int, int]:
-    """``WIDTHxHEIGHT`` (or ``WIDTH×HEIGHT``, as krsview prints sizes) → (width, height)."""
+def size(text: str, lo: int = 1, flag: str = "--size") -> tuple[int, int]:
+    """``WIDTHxHEIGHT`` (or ``WIDTH×HEIGHT``, as krsview prints sizes) → (width, height),
+    each side ``lo``..MAX_SIDE pixels."""
     try:
         w, h = (int(v) for v in text.lower().replace("×", "x").split("x"))
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"--size {text!r}: expected WIDTHxHEIGHT, e.g. 640x360"
+            f"{flag} {text!r}: expected WIDTHxHEIGHT, e.g. 640x360"
         ) from None
-    if not (1 <= w <= MAX_SIDE and 1 <= h <= MAX_SIDE):
-        raise argparse.ArgumentTypeError(f"--size {text!r}: each side must be 1..{MAX_SIDE} pixels")
+    if not (lo <= w <= MAX_SIDE and lo <= h <= MAX_SIDE):
+        raise argparse.ArgumentTypeError(
+            f"{flag} {text!r}: each side must be {lo}..{MAX_SIDE} pixels"
+        )
     return w, h
 
 
@@ -94,9 +97,13 @@ def field_option(
         )
         return
     if typing.get_origin(hint) is tuple:
-        shown = "x".join(map(str, default))
+        shown, lo = "x".join(map(str, default)), meta.get("lo", 1)
         sp.add_argument(
-            flag, dest=name, type=size, default=default, help=f"{meta['help']} (default {shown})"
+            flag,
+            dest=name,
+            type=lambda text: size(text, lo, flag),
+            default=default,
+            help=f"{meta['help']} (default {shown}; each side {lo}..{MAX_SIDE} {meta['unit']})",
         )
         return
     if typing.get_origin(hint) in (typing.Union, types.UnionType):

@@ -19,7 +19,7 @@ class ViewerSettings:
     """How a window opens and draws (``krsview view`` and ``krsview edit`` options)."""
 
     size: tuple[int, int] = param(
-        (960, 540), lo=1, hi=MAX_SIDE, unit="pixels", help="window size, width × height"
+        (960, 540), lo=48, hi=MAX_SIDE, unit="pixels", help="window size, width × height"
     )
     target_fps: float = param(
         30.0,
