@@ -90,7 +90,7 @@ def test_viewer_settings_are_declared_once_with_ranges_the_schema_checks():
     "options, message",
     [
         (dict(target_fps=0.5), "target_fps = 0.5: allowed: 1 ≤ value ≤ 240 frames/s"),
-        (dict(size=(0, 100)), "size[0] = 0: allowed: 1 ≤ value ≤ 8192 pixels"),
+        (dict(size=(0, 100)), "size[0] = 0: allowed: 48 ≤ value ≤ 8192 pixels"),
         (dict(size=(100,)), "size = (100,): expected (width, height)"),
         (dict(hud="yes"), "hud = 'yes': expected true or false"),
         (dict(fps=30), "fps = 30: unknown option; allowed: hud, moving_effects, prepass"),
