@@ -161,6 +161,19 @@ def test_a_dragged_factor_and_a_typed_number_carry_no_float_noise():
     assert as_typed(float(np.float32(-0.2)), 1.0) == -0.2
 
 
+def test_a_vector_field_shows_no_rounding_noise():
+    """tree-mokrs's kernels start at x = 4.6e-17 beside y = 6.3 (left by its conversion from
+    the tree), and its axes hold −0: the fields show 0 there. Control: a small component
+    that is a value (1e-4 beside 6.3) is shown as it is."""
+    from krsview.viewer.widgets import shown_vector
+
+    scene = load_scene(resolve("tree-mokrs"))
+    start = next(lv.kernel.start for lv in scene.mokrs.levels if lv.kernel is not None)
+    assert 0 < abs(start[0]) < 1e-15 and shown_vector(start) == (0.0, start[1], start[2])
+    assert repr(shown_vector((-0.0, 0.97, 0.24))[0]) == "0.0"
+    assert shown_vector((1e-4, 6.3, 0.5)) == (1e-4, 6.3, 0.5)
+
+
 def test_a_dial_dragged_past_half_a_turn_keeps_turning():
     """The rotate dial reads the angle nearest the present one: 170° + 20° is 190°, not −170°
     (a monotone response); its negative control, 0° + 20°, is 20°."""

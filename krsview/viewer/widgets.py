@@ -115,6 +115,14 @@ def as_typed(new: float, old: float) -> float:
     return float(str(np.float32(new)))
 
 
+def shown_vector(value: tuple) -> tuple:
+    """A vector as its field shows it: a component below 1e-9 of the largest (rounding left
+    by a conversion, 4.6e-17 beside 6.3) and −0 read 0; the value itself is kept where the
+    field is not changed."""
+    tiny = 1e-9 * max(abs(c) for c in value)
+    return tuple(0.0 if abs(c) <= tiny else float(c) for c in value)
+
+
 def _speed(value: float, meta: dict) -> float:
     """Change per pixel dragged: 1 % of the value, at most 1/500 of a bounded range."""
     speed = max(abs(value) * 0.01, 1e-4)
@@ -166,7 +174,7 @@ def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
     elif isinstance(value, float):
         changed, new = imgui.drag_float(
             label,
-            value,
+            value + 0.0,  # −0 shown as 0
             _speed(value, meta),
             lo if lo is not None else 0.0,
             hi if hi is not None else 0.0,
@@ -178,8 +186,12 @@ def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
         value = tuple(as_typed(c, old) for c, old in zip(rgb, value))
     elif isinstance(value, tuple) and len(value) == 3:
         speed = max(max(abs(c) for c in value) * 0.005, 1e-4)
-        changed, v = imgui.drag_float3(label, list(value), speed, 0.0, 0.0, "%.5g")
-        value = tuple(as_typed(c, old) for c, old in zip(v, value))
+        shown = shown_vector(value)
+        changed, v = imgui.drag_float3(label, list(shown), speed, 0.0, 0.0, "%.5g")
+        value = tuple(
+            old if np.float32(c) == np.float32(s) else as_typed(c, s)
+            for c, s, old in zip(v, shown, value)
+        )
     else:
         imgui.text_disabled(f"{label}: {value!r}")
         return False, value
