@@ -19,6 +19,11 @@ class View:
     tan_half: float  # tan(fov_y / 2)
     width: int
     height: int
+    # the height of the image whose pixel sets the detail drawn (ε, the level of detail, the
+    # textures' filter, the normals' smoothing); 0: this image's own. A viewer's coarse
+    # moving image takes the window's, so it draws and shades the still image's detail,
+    # only sampled more coarsely
+    detail_height: int = 0
 
     @property
     def aspect(self) -> float:
@@ -29,15 +34,21 @@ class View:
         """Pixel size per unit ray distance: ε = footprint × t × ε-scale stays sub-pixel."""
         return 2.0 * self.tan_half / self.height
 
+    @property
+    def detail_footprint(self) -> float:
+        """The footprint of the pixel whose detail is drawn (``detail_height``)."""
+        return 2.0 * self.tan_half / (self.detail_height or self.height)
 
-def view_of(camera: Camera, width: int, height: int) -> View:
+
+def view_of(camera: Camera, width: int, height: int, detail_height: int = 0) -> View:
     o = np.array(camera.position, dtype=np.float64)
     f = np.array(camera.target, dtype=np.float64) - o
     f /= np.linalg.norm(f)
     r = np.cross(f, camera.up)
     r /= np.linalg.norm(r)
     u = np.cross(r, f)
-    return View(o, f, r, u, math.tan(math.radians(camera.fov_y) / 2.0), width, height)
+    tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
+    return View(o, f, r, u, tan_half, width, height, detail_height)
 
 
 def primary_rays(v: View) -> np.ndarray:

@@ -85,6 +85,7 @@ class Tracer(Protocol):
         geometry: Geometry | None = None,
         all_effects: bool = False,
         probes: tuple[str, ...] = (),
+        detail_height: int = 0,
     ) -> moderngl.Program: ...
 
     def companion(
@@ -186,7 +187,8 @@ class PassImage:
     """One image of ``scene`` at ``size`` in passes (the module's docstring); ``traced``: an
     image of the same view and size whose trace pass this one reuses (it has none);
     ``blocks``: an image of the same view whose shadow blocks this one's shading blends (it
-    traces no shadow rays but an outline's)."""
+    traces no shadow rays but an outline's); ``detail_height``: the height of the image
+    whose pixel sets the detail drawn (Renderer.prepare; 0: this one's)."""
 
     def __init__(
         self,
@@ -198,8 +200,9 @@ class PassImage:
         ratio: int,
         traced: PassImage | None = None,
         blocks: PassImage | None = None,
+        detail_height: int = 0,
     ):
-        self.renderer, self.targets = renderer, targets
+        self.renderer, self.targets, self.detail_height = renderer, targets, detail_height
         self.scene, self.size, self.geometry, self.ratio = scene, size, geometry, ratio
         w, h = size
         self.coarse = (-(-w // max(ratio, 1)), -(-h // max(ratio, 1)))
@@ -243,7 +246,9 @@ class PassImage:
         """Compile or fetch the passes' programs and upload the uniforms: at each turn's
         start, since other drawing may have happened in between."""
         probes = ("KRS_TRACE_ONLY", "KRS_TRACE_KERNELS") if self.ratio else ()
-        main = self.renderer.prepare(self.scene, *self.size, self.geometry, probes=probes)
+        main = self.renderer.prepare(
+            self.scene, *self.size, self.geometry, probes=probes, detail_height=self.detail_height
+        )
         self._programs = {"render" if not self.ratio else "trace": main}
         if self.ratio > 1:
             for name, define in (("visibility", "KRS_SHADOW_LIST"), ("rays", "KRS_SHADOW_RAYS")):

@@ -95,15 +95,20 @@ class Renderer:
         geometry: Geometry | None = None,
         all_effects: bool = False,
         probes: tuple[str, ...] = (),
+        detail_height: int = 0,
     ) -> moderngl.Program:
-        """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
+        """Compile (or fetch) the scene's variant and upload its uniforms; ``detail_height``:
+        the height of the image whose pixel sets the detail drawn (compile/camera.View; 0:
+        this one's); ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms,
         ``probes`` the defines of a measuring variant, drawn on the fragment path (the
         tracing alone by persistent lanes too, compute.LANE_PROBES): KRS_COUNT_LEVELS counts
         the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY traces without shading
         (bench split, the passes' trace pass)."""
         with self.current():
-            return self._prepare(scene, width, height, geometry, all_effects, probes)
+            return self._prepare(
+                scene, width, height, geometry, all_effects, probes, detail_height
+            )
 
     def _prepare(
         self,
@@ -113,9 +118,10 @@ class Renderer:
         geometry: Geometry | None,
         all_effects: bool,
         probes: tuple[str, ...] = (),
+        detail_height: int = 0,
     ) -> moderngl.Program:
         scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
-        view = view_of(scene.camera, width, height)
+        view = view_of(scene.camera, width, height, detail_height)
         geometry = geometry or self.geometry_of(scene)
         c = self.world(geometry, scene.material.albedo).relative_to(view.origin)
         block = krs_block(c, scene.render.precision)
@@ -299,18 +305,20 @@ class Renderer:
         height: int,
         geometry: Geometry | None = None,
         progress: Callable[[int, int], None] | None = None,
+        detail_height: int = 0,
     ) -> Frame:
         """The image; with ``progress`` it is drawn in PROGRESS_BANDS bands of rows, each
         finished before progress(done, total) is called (the same pixels either way). Where
         the scene's shadow rays are shared by pixel blocks (passes.still_ratio), the image is
-        drawn in passes: trace, shadow rays per block, shade."""
+        drawn in passes: trace, shadow rays per block, shade. ``detail_height``: see
+        :meth:`prepare`."""
         with self.current():
             ratio = still_ratio(scene)
             if ratio:
-                image = self._passes(scene, (width, height), geometry, ratio)
+                image = self._passes(scene, (width, height), geometry, ratio, detail_height)
                 bands = PROGRESS_BANDS if progress else 1
                 return read_buffers(image.draw_all(bands, progress), width, height)
-            prog = self.prepare(scene, width, height, geometry)
+            prog = self.prepare(scene, width, height, geometry, detail_height=detail_height)
             if progress is None:
                 return read_buffers(self.draw(prog, width, height), width, height)
             bands = min(PROGRESS_BANDS, height)
@@ -322,13 +330,20 @@ class Renderer:
             return read_buffers(fbo, width, height)
 
     def _passes(
-        self, scene: Scene, size: tuple[int, int], geometry: Geometry | None, ratio: int
+        self,
+        scene: Scene,
+        size: tuple[int, int],
+        geometry: Geometry | None,
+        ratio: int,
+        detail_height: int = 0,
     ) -> PassImage:
         if self._pass_targets is None:
             self._pass_targets = Targets(self.ctx)
         scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
         geometry = geometry or self.geometry_of(scene)
-        return PassImage(self, self._pass_targets, scene, size, geometry, ratio)
+        return PassImage(
+            self, self._pass_targets, scene, size, geometry, ratio, detail_height=detail_height
+        )
 
     def levels(
         self, scene: Scene, width: int, height: int, geometry: Geometry | None = None

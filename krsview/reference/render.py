@@ -25,11 +25,14 @@ def render_reference(
     height: int,
     geometry: Geometry | None = None,
     progress: Callable[[int, int], None] | None = None,
+    detail_height: int = 0,
 ) -> Frame:
     """The image in float64. With ``progress``, rays go in chunks and progress(done, total)
-    is called after each (every ray is independent: the image is the same)."""
+    is called after each (every ray is independent: the image is the same).
+    ``detail_height``: the height of the image whose pixel sets the detail drawn (ε, the level
+    of detail, textures, smoothing; compile/camera.View), 0: this one's."""
     scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
-    view = view_of(scene.camera, width, height)
+    view = view_of(scene.camera, width, height, detail_height)
     c = compile_geometry(geometry or scene.geometry(), scene.material.albedo)
     dist = Distortion.of(scene)
     dirs = primary_rays(view)
@@ -56,7 +59,7 @@ def _trace_and_shade(
 ) -> tuple[np.ndarray, ...]:
     """Colour, depth (0 on a miss), normal, iterations and hit of the rays ``dirs``."""
     r = scene.render
-    eps = view.footprint * r.epsilon_scale
+    eps = view.detail_footprint * r.epsilon_scale
     scale = dist.lod_scale if dist is not None else None
     lod = Lod.of(r.lod, view.origin, eps)
     if r.tracer == "binary":
@@ -97,12 +100,12 @@ def _trace_and_shade(
     if h.size:
         p = view.origin + tr.t[h, None] * dirs[h]
         width_ = (
-            np.maximum(scene.effect_settings.smooth_width, 2.0 * view.footprint * tr.t[h])
+            np.maximum(scene.effect_settings.smooth_width, 2.0 * view.detail_footprint * tr.t[h])
             if "smooth_shading" in scene.effects
             else None
         )
         level, g, xk = nearest(c, p, width_, dist)
         normal[h] = g
         hits = Hits(p, dirs[h], tr.t[h], level, g, xk)
-        color[h] = encode(scene, shade(scene, c, dist, hits, view.footprint, eps, lod))
+        color[h] = encode(scene, shade(scene, c, dist, hits, view.detail_footprint, eps, lod))
     return color, np.where(tr.hit, tr.t, 0.0), normal, tr.iterations, tr.hit

@@ -174,7 +174,7 @@ void scene_nearest(vec3r p, real t, int slot, int cut, out int level, out vec3 n
     vec3r q = undistort(c, p), xkr;
     float width = 0.0;
 #ifdef KRS_SMOOTH_SHADING
-    width = max(u_smooth_width, 2.0 * u_footprint * float(t));
+    width = max(u_smooth_width, 2.0 * u_detail_footprint * float(t));
 #endif
     ivec2 k = component(c);
     real D = krs_nearest(k.x, k.y, q, width, slot, cut, level, normal, xkr);

@@ -59,7 +59,10 @@ uniform vec3r u_up;
 uniform vec2 u_resolution;
 uniform float u_tan_half;
 uniform float u_footprint;  // pixel size at unit distance (the LOD measure [KRS17 §4])
-uniform float u_eps_per_t;  // pixel footprint × ε-scale
+// ... of the pixel whose detail is drawn: the textures' filter, the normals' smoothing (the
+// window's for a viewer's coarse moving image: compile/camera.py, View.detail_height)
+uniform float u_detail_footprint;
+uniform float u_eps_per_t;  // the detail's pixel footprint × ε-scale
 uniform int u_max_iterations;
 uniform float u_xi_bonus;   // binary tracing [KRS17 Alg. 2]
 uniform float u_xi_penalty;

@@ -23,7 +23,7 @@ vec3 encode(vec3 linear) {
 vec3 shade(vec3r p, vec3 dir, real t_ray, int level, vec3 n, vec3 xk) {
     float t = float(t_ray);
     vec3 albedo = kernel_rec_float(level, 0).rgb;
-    float footprint = u_footprint * t;
+    float footprint = u_detail_footprint * t;
 #ifdef KRS_TRIPLANAR_TEXTURE
     if (EFFECT_ON(KRS_TRIPLANAR_TEXTURE_BIT))
         albedo *= texture_modulation(triplanar(vec3(p) + u_eye, n, footprint));

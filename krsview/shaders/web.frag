@@ -29,6 +29,7 @@ void orbit_camera(vec2 resolution, vec3 orbit) {
     u_up = cross(u_right, u_forward);
     u_resolution = resolution;
     u_footprint = 2.0 * u_tan_half / resolution.y;
+    u_detail_footprint = u_footprint;
     u_eps_per_t = u_footprint * u_epsilon_scale;
 }
 

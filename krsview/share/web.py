@@ -36,6 +36,7 @@ CAMERA = (
     "u_up",
     "u_resolution",
     "u_footprint",
+    "u_detail_footprint",
     "u_eps_per_t",
 )
 PAGE = ("u_orbit", "u_canvas")  # the page's own uniforms (Shadertoy has iMouse instead)
