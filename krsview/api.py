@@ -18,6 +18,7 @@ Scenes are immutable values and may be shared freely; the float64 reference
 from __future__ import annotations
 
 import gc
+import os
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import fields, replace
@@ -44,6 +45,12 @@ RENDER_KNOBS = tuple(f.name for f in fields(Render))  # render(**knobs): the [re
 
 _lock = threading.RLock()
 _context = None  # the process's headless GL context, made on first use
+_context_pid = 0  # the process that made it: a child forked after it cannot draw with it
+FORKED = (
+    "krsview: this process was forked after krsview had drawn in its parent: an OpenGL "
+    "context does not survive a fork (and with Mesa the child cannot make its own); start "
+    "worker processes with multiprocessing.get_context('spawn') or 'forkserver'"
+)
 
 
 def load(name_or_path: str | Path) -> Scene:
@@ -153,13 +160,21 @@ def exact_settings(scene: Scene) -> Scene:
 
 
 def _shared_context():
-    global _context
+    global _context, _context_pid
     with _lock:
+        _not_forked()
         if _context is None:
             from .gpu.context import headless_context
 
-            _context = headless_context()
+            _context, _context_pid = headless_context(), os.getpid()
         return _context
+
+
+def _not_forked() -> None:
+    """A RuntimeError in a child forked after its parent made the GL context: drawing there
+    waits forever on the parent's rasteriser threads, which the fork did not copy."""
+    if _context is not None and _context_pid != os.getpid():
+        raise RuntimeError(FORKED)
 
 
 class Renderer:
@@ -181,6 +196,7 @@ class Renderer:
     @property
     def gpu(self):
         """The GPU renderer underneath (krsview.gpu.renderer.Renderer), made on first use."""
+        _not_forked()
         if self._gpu is None:
             from .gpu.renderer import Renderer as GpuRenderer
 

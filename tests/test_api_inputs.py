@@ -346,3 +346,32 @@ def test_with_levels_validates_the_scene_first():
     with pytest.raises(SceneError, match="exactly one geometry"):
         Scene().with_levels(1)
     assert krsview.load("tree").with_levels(5).geometry().depth == 5
+
+
+FORK = """
+import krsview, multiprocessing as mp
+def work(eps):
+    try:
+        return krsview.render("rock", (16, 9), epsilon_scale=eps).size
+    except RuntimeError as e:
+        return str(e)
+if __name__ == "__main__":
+    krsview.render("rock", (16, 9))
+    for method in ("fork", "spawn"):
+        with mp.get_context(method).Pool(1) as p:
+            print(method, p.map(work, [0.5])[0])
+"""
+
+
+def test_a_process_forked_after_drawing_is_told_to_spawn(tmp_path):
+    """A pool forked after the parent drew waited forever on the parent's rasteriser
+    threads (a new context in the child waits alike): the child now says why in one line.
+    The control: a spawned pool draws."""
+    script = tmp_path / "pool.py"
+    script.write_text(FORK)
+    out = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=120
+    ).stdout.splitlines()
+    assert out[0].startswith("fork krsview: this process was forked after krsview had drawn")
+    assert "get_context('spawn')" in out[0]
+    assert out[1] == "spawn (16, 9)"

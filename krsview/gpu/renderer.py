@@ -106,9 +106,7 @@ class Renderer:
         the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY traces without shading
         (bench split, the passes' trace pass)."""
         with self.current():
-            return self._prepare(
-                scene, width, height, geometry, all_effects, probes, detail_height
-            )
+            return self._prepare(scene, width, height, geometry, all_effects, probes, detail_height)
 
     def _prepare(
         self,
