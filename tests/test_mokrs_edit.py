@@ -227,6 +227,34 @@ def test_an_inserted_identity_level_can_be_grabbed_and_a_drag_gives_it_a_transla
     assert not [k for k in handles(moved_level) if k.role == "origin"]
 
 
+def test_every_mokrs_handle_drags_through_the_editors_path_carry_on_or_off():
+    """The editor's drag (dragging.drag_edits, with "a fork carries its subtree" on by
+    default) on every role of handle, an inserted identity level's origin included: a kernel
+    point or an origin dragged closed the window (a MöKRS handle had no ``carries``). Each
+    drag's edits apply and change the scene; a free point's (a kernel point, an origin, a
+    translation, an inversion's centre) puts the handle where it was dragged, where a
+    factor or a radius slides along its own line."""
+    from krsview.editor.dragging import drag_edits
+
+    tree = load_scene(resolve("tree-mokrs"))
+    palm = load_scene(resolve("palm"))
+    inserted = apply_edit(palm, LEVELS, changed(palm.mokrs.levels, 30, "insert")[0])
+    for scene in (tree, palm, inserted):
+        hs = handles(scene)
+        for h in [h for role in {h.role for h in hs} for h in sample(hs, role, 2)]:
+            if h.kind != "point":
+                continue
+            p = h.position + 0.01 * np.array([1.0, -0.5, 0.25])
+            for carry in (True, False):
+                s = scene
+                for path, value in drag_edits(scene, h, p, carry, 0.0):
+                    s = apply_edit(s, path, value)
+                assert s != scene, (h.label, carry)
+                if h.role in ("point", "origin", "by", "center"):
+                    new = next(k for k in handles(s) if k.same(h))
+                    assert np.linalg.norm(new.position - p) < 1e-6, (h.label, carry)
+
+
 def test_a_linked_step_drag_bends_the_finer_levels_with_the_same_steps_alike():
     """palm's leaflets share their steps: turning level 30's dial (linked, the default)
     turns every finer leaflet level the same and no coarser one, and the dial still lands

@@ -60,6 +60,12 @@ class MobiusHandle:
     guides: tuple[np.ndarray, ...] = field(default=(), repr=False)  # world polylines
     axis: np.ndarray | None = None  # "dial": the world direction it turns about, at pivot
 
+    @property
+    def carries(self) -> bool:
+        """A MöKRS has no subtree to carry: the finer levels follow a level's maps anyway
+        (its steps' links are ``carry`` for the step handles: dragging.drag_edits)."""
+        return False
+
     def edit_to(self, scene: Scene, p: np.ndarray, carry: bool = True) -> tuple[Path, Any]:
         """The edit (field path, new value) that puts the handle at world point ``p``; with
         ``carry``, a step's change goes to the finer levels with the same steps too
