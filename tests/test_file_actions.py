@@ -199,3 +199,24 @@ def test_an_autosave_that_cannot_write_is_said_once_in_the_status_line(tree):
     for k in (2, 3):
         autosave(f, k * (AUTOSAVE_SECONDS + 1))
     assert w.said == [w.error] and "autosave cannot write" in w.error
+
+
+def test_save_as_replaces_another_file_only_when_asked_twice(tree, tmp_path):
+    """Save-as over another scene file replaced it without a word (a review lost a tree
+    that way): the first save says it exists, the same name again replaces it, and a
+    changed name asks anew. The controls: a new name, and the document's own file, save
+    at once."""
+    other = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), other)
+    f, w, _ = part(tree)
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    assert not f.save_as(str(other)) and "palm.toml exists; save again to replace it" in w.error
+    assert load_scene(other).name == "palm" and f.replace_asked(str(other))
+    assert f.save_as(str(tmp_path / "new.toml"))  # a new name: saved at once
+    assert load_scene(tmp_path / "new.toml").render.epsilon_scale == 2.0
+    assert not f.replace_asked(str(other)), "another save in between asks again"
+    assert not f.save_as(str(other)) and load_scene(other).name == "palm"
+    assert f.save_as(str(other)) and load_scene(other).name == "tree"
+    w.doc.apply(("render", "epsilon_scale"), 3.0)
+    assert f.save_as(str(other)), "the document's own file now: saved at once"
+    assert load_scene(other).render.epsilon_scale == 3.0

@@ -68,6 +68,7 @@ class FileActions:
         self.unreadable = ""  # why the file's new contents cannot be taken (deleted, bad)
         self.kept = False  # the person kept their edits: the next save overwrites the file
         self.save_as_text = save_as_default(self.doc)
+        self.replacing: Path | None = None  # another file save-as was told exists: again replaces
         self.quit = False  # the question was answered: the window closes
 
     @property
@@ -125,11 +126,28 @@ class FileActions:
         return True
 
     def save_as(self, text: str) -> bool:
+        """Save to the file named; another file that exists is replaced only when asked
+        twice (the first time says so: the panel's field, the dialog's button)."""
         target = Path(text.strip()).expanduser()
         if target.suffix != ".toml" or target.is_dir():
             self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
             return False
+        if self.replaces(text) and self.replacing != target.resolve():
+            self.replacing = target.resolve()
+            self.viewer.error = f"save as: {target} exists; save again to replace it"
+            return False
+        self.replacing = None
         return self.save(str(target))
+
+    def replaces(self, text: str) -> bool:
+        """Whether saving as ``text`` would replace a file other than the document's own."""
+        target = Path(text.strip()).expanduser()
+        return target.is_file() and target.resolve() != self.doc.path.resolve()
+
+    def replace_asked(self, text: str) -> bool:
+        """Whether the next save as ``text`` replaces another file (told once already)."""
+        target = Path(text.strip()).expanduser()
+        return self.replacing is not None and self.replacing == target.resolve()
 
     def ask_save_as(self) -> None:
         """Ctrl+Shift+S: the dialog asks where to save (a shipped preset's: its copy)."""

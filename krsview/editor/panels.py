@@ -178,11 +178,12 @@ def _warnings(e: Edited, out: list) -> None:
 
 def _file(e: Edited, out: list) -> None:
     doc = e.doc
-    imgui.text(("* unsaved: " if doc.dirty else "saved: ") + str(doc.path.name))
+    imgui.text(("* unsaved edits: " if doc.dirty else "as on disk: ") + str(doc.path.name))
     if imgui.button("save (Ctrl+S)"):
         out.append(ec.Save())
     imgui.same_line()
-    if imgui.button("save as"):
+    asked = e.file.replace_asked(e.file.save_as_text)  # the field names another file: again
+    if imgui.button("replace it###save as" if asked else "save as"):
         out.append(ec.SaveAs())
     imgui.same_line()
     imgui.set_next_item_width(-1)  # the rest of the line, however wide the panel

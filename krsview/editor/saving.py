@@ -47,7 +47,8 @@ def copy_dialog(f: FileActions) -> list[Command]:
         out.append(ec.SetCopyText(text))
     if f.viewer.error and f.copy_to is not None:
         imgui.text_wrapped(f.viewer.error)
-    if imgui.button("save the copy" if template else "save") or done:
+    asked = f.copy_to is not None and f.replace_asked(f.copy_to.text)
+    if imgui.button("replace it" if asked else "save the copy" if template else "save") or done:
         out.append(ec.SaveCopy())
     imgui.same_line()
     if imgui.button("cancel (Esc)") or imgui.is_key_pressed(imgui.Key.escape):
