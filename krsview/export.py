@@ -94,7 +94,8 @@ def frames(
 ) -> list[Path]:
     """The frames of a camera path (a ``NAME.path.json`` the viewer recorded) as PNGs in
     ``folder`` (``frame_00000.png`` …), each written atomically; frames already there are
-    kept, so a run resumes. ``which``: ``"A-B"`` or ``"A"`` (default all). Returns the
+    kept, so a run resumes. ``which``: ``"A-B"``, ``"A"``, a frame number or a range
+    (default all). Returns the
     frames' files in order."""
     from .api import Renderer
 
@@ -114,18 +115,17 @@ def video(
     folder: str | Path,
     video_path: str | Path,
     fps: float = DEFAULT_FPS,
-    which: range | None = None,
+    which: str | int | range | None = None,
     done: Callable[[int], None] | None = None,
 ) -> Path:
-    """An H.264 MP4 of the frames in ``folder`` (all, or the range ``which``), written whole
-    or not at all; ``done(k)`` after each frame."""
+    """An H.264 MP4 of the frames in ``folder`` (all, or ``which``: ``"A-B"``, ``"A"``, a
+    frame number or a range, as :func:`frames` takes), written whole or not at all;
+    ``done(k)`` after each frame. The frames need an even width and height."""
     folder, video = Path(folder), output_file(video_path, "video_path", (".mp4",))
     fps = real(fps, "fps", 1.0, 240.0)
-    if which is None:
-        count = 0
-        while frame_file(folder, count).exists():
-            count += 1
-        which = range(count)
+    numbers = [int(f.stem[6:]) for f in folder.glob("frame_*.png") if f.stem[6:].isdigit()]
+    count = max(numbers, default=0) + 1  # which=None: from 0 to the last (each must be there)
+    which = parse_frames(which, max(count, 1), "which", "the folder has frames {}")
     missing = next((k for k in which if not frame_file(folder, k).exists()), None)
     if not which or missing is not None:
         name = frame_file(folder, 0 if missing is None else missing).name

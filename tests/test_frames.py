@@ -229,3 +229,32 @@ def test_frames_outside_the_path_are_refused():
     assert parse_frames(None, 5) == range(5) and parse_frames("2", 5) == range(2, 3)
     with pytest.raises(SceneError, match="allowed 0 ≤ FIRST ≤ LAST ≤ 4"):
         parse_frames("4-2", 5)
+
+
+def test_frames_are_named_alike_for_frames_and_video():
+    """``which`` took a string in export.frames and a range in export.video, and neither
+    checked it (an int or a range crashed deep inside): both take every form now, and
+    anything else is refused in one line."""
+    for which, wanted in (("1-3", range(1, 4)), ("2", range(2, 3)), (2, range(2, 3))):
+        assert parse_frames(which, 5, "which") == wanted
+    assert parse_frames(range(1, 4), 5, "which") == range(1, 4)
+    for bad in (2.5, range(0, 4, 2), True, [1, 2]):
+        with pytest.raises(SceneError, match="which = .*: expected 'FIRST-LAST'"):
+            parse_frames(bad, 5, "which")
+    with pytest.raises(SceneError, match="the folder has frames 0-1; allowed"):
+        parse_frames(range(0, 7), 2, "which", "the folder has frames {}")
+
+
+def test_a_video_of_odd_sized_frames_is_refused_before_ffmpeg(path_file, tmp_path):
+    """ffmpeg refuses odd sides (H.264 4:2:0) and wrote an empty .mp4 that the call
+    returned as done. Control: even frames make a video."""
+    import krsview.export
+
+    scene = load_scene(resolve("rock"))
+    odd = krsview.export.frames(scene, path_file, tmp_path / "odd", (33, 19), FPS, "0-1")
+    with pytest.raises(SceneError, match="its frames are 33×19: a video needs an even width"):
+        krsview.export.video(odd[0].parent, tmp_path / "odd.mp4")
+    assert not list(tmp_path.glob("*.mp4")) and not list(tmp_path.glob(".*.tmp*"))
+    even = krsview.export.frames(scene, path_file, tmp_path / "even", (32, 18), FPS, 1)
+    video = krsview.export.video(even[0].parent, tmp_path / "even.mp4", which="1")
+    assert video.stat().st_size > 0

@@ -108,23 +108,39 @@ def frame_size(f: Path) -> tuple[int, int]:
         return (0, 0)
 
 
-def parse_frames(text: str | None, count: int, flag: str = "--frames") -> range:
-    """``A-B`` (inclusive), ``A`` or None (all) → a range within 0 … count−1."""
+def parse_frames(
+    text: str | int | range | None,
+    count: int,
+    flag: str = "--frames",
+    has: str = "the path has frames {} at this frame rate",
+) -> range:
+    """``"A-B"`` (inclusive), ``"A"``, a frame number, a ``range`` or None (all) → a range
+    within 0 … count−1 (``has``: what holds them, said where one is out of range)."""
     if text is None:
         return range(count)
-    try:
-        a, _, b = text.partition("-")
-        lo, hi = int(a), int(b) if b else int(a)
-    except ValueError:
+    if isinstance(text, range) and text.step == 1 and len(text):
+        lo, hi = text.start, text.stop - 1
+    elif isinstance(text, int) and not isinstance(text, bool):
+        lo = hi = text
+    elif isinstance(text, str):
+        try:
+            a, _, b = text.partition("-")
+            lo, hi = int(a), int(b) if b else int(a)
+        except ValueError:
+            raise SceneError(
+                flag, text, "expected FIRST-LAST or one frame number, e.g. 0-119"
+            ) from None
+    else:
         raise SceneError(
-            flag, text, "expected FIRST-LAST or one frame number, e.g. 0-119"
-        ) from None
+            flag,
+            text,
+            "expected 'FIRST-LAST' or one frame number, e.g. '0-119', 7 or range(0, 120)",
+        )
     if not 0 <= lo <= hi < count:
         raise SceneError(
             flag,
             text,
-            f"the path has frames 0-{count - 1} at this frame rate; "
-            "allowed 0 ≤ FIRST ≤ LAST ≤ " + str(count - 1),
+            has.format(f"0-{count - 1}") + "; allowed 0 ≤ FIRST ≤ LAST ≤ " + str(count - 1),
         )
     return range(lo, hi + 1)
 
@@ -163,6 +179,12 @@ def write_video(
     import imageio_ffmpeg
 
     w, h = frame_size(frame_file(folder, frames[0]))
+    if w % 2 or h % 2:  # ffmpeg refuses, and writes an empty file
+        raise SceneError(
+            "folder",
+            str(folder),
+            f"its frames are {w}×{h}: a video needs an even width and height (H.264, 4:2:0 colour)",
+        )
     for k in frames:  # before any is encoded: ffmpeg would write a broken video
         if frame_size(frame_file(folder, k)) != (w, h):
             a, b = frame_size(frame_file(folder, k))
@@ -186,6 +208,8 @@ def write_video(
             if done is not None:
                 done(k)
         writer.close()
+        if not tmp.exists() or tmp.stat().st_size == 0:
+            raise RuntimeError(f"ffmpeg wrote nothing for {video} (its messages are above)")
         os.replace(tmp, video)
     finally:
         writer.close()
