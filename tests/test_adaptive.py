@@ -32,6 +32,32 @@ def test_the_scale_drops_when_slow_and_grows_back_when_fast():
     assert a.still_size() == (1280, 720) and a.size_at(0.5) == (320, 180)
 
 
+def test_a_frame_far_over_budget_shrinks_the_next_at_once():
+    """A review saw the first flight open with frames of 250, 200, 150 and 100 ms: the scale
+    fell by at most 0.7× a frame. A frame over OVERRUN trace budgets now sets the next
+    frame's scale to fit (down to 0.35×); one a little over is still damped (the control)."""
+    a = AdaptiveResolution((960, 540), target_fps=30)
+    a.frame_done(0.25)  # 7.5 budgets
+    assert a.scale == pytest.approx(0.5 * 0.365, rel=0.01)
+    b = AdaptiveResolution((960, 540), target_fps=30)
+    b.frame_done(0.05)  # 1.5 budgets: noise-like, damped
+    assert b.scale == pytest.approx(0.5 * 0.816, rel=0.01)
+
+
+def test_the_first_moving_frame_after_a_rest_is_sized_by_the_measured_cost():
+    """From the refinement's seconds per pixel, the scale whose frame fits the trace budget
+    (the window's pixels times that cost: the whole budget), within the scale's limits."""
+    a = AdaptiveResolution((960, 540), target_fps=30)
+    a.predict(1.0 / 30 / (480 * 270))
+    assert a.moving_size() == (480, 270)
+    a.predict(1.0)  # far too slow for any image: the floor
+    assert a.scale == a.min_scale
+    a.predict(1e-12)
+    assert a.scale == 1.0
+    a.predict(0.0)  # nothing measured: unchanged
+    assert a.scale == 1.0
+
+
 P = True  # a primary step (Step.primary)
 
 

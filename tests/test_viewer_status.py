@@ -409,3 +409,28 @@ def test_the_hud_opens_any_scene_file_by_its_path(hud_viewer, monkeypatch, tmp_p
     turn(v)
     assert v.path == other and "cannot read" in v.error
     v.execute([c.SetOpenText("")])
+
+
+def test_a_flight_starts_at_the_scale_its_measured_cost_fits(hud_viewer, monkeypatch):
+    """The first moving frame after the view came to rest is sized by the refinement's
+    measured seconds per pixel (a review saw a first flight open with half a second of slow
+    frames, the scale shrinking 0.7× a frame from half the window's side); the frames of a
+    flight go on from the controller's scale (the control: no prediction between them)."""
+    v = hud_viewer
+    for _ in range(400):
+        turn(v)
+        if v.frames.refined:
+            break
+    asked: list[float] = []
+    predict = v.frames.adaptive.predict
+    monkeypatch.setattr(v.frames.adaptive, "predict", lambda c: (asked.append(c), predict(c))[1])
+    v.frames.adaptive.scale = 1.0  # a scale far too large for the budget, as after a resize
+    v.frames.adaptive.target_fps = 240.0  # a budget no window-size frame fits here
+    v.input.key("W", True)
+    turn(v)
+    assert len(asked) == 1 and asked[0] == v.frames.moving_cost() > 0
+    assert v.frames.shown.size[0] < v.frames.adaptive.full[0]
+    turn(v)
+    turn(v)
+    v.input.key("W", False)
+    assert len(asked) == 1, "a flight's later frames follow the controller"

@@ -20,6 +20,8 @@ PROFILE_SLOTS = 32  # a pass's cost per pixel is kept per 1/32 of the image's he
 REFINING_TURNS = 2.0  # a refining turn traces for at most this many frame budgets
 REST_TURNS = 9  # the recent turns whose rest (display, HUD, swap, input) a moving frame counts
 MIN_TRACE_SHARE = 0.5  # a moving frame's tracing keeps at least this share of the budget
+DAMPED = (0.7, 1.25)  # a moving frame's scale changes by at most these factors ...
+OVERRUN = 2.0  # ... unless it took this many trace budgets: then at once (to 0.35 at least)
 
 
 @dataclass
@@ -70,8 +72,19 @@ class AdaptiveResolution:
         if seconds <= 0:
             return
         factor = math.sqrt(self.trace_budget / seconds)
-        factor = min(1.25, max(0.7, factor))  # damped: a noisy frame moves scale a little
+        low = DAMPED[0] if seconds < OVERRUN * self.trace_budget else 0.35
+        factor = min(DAMPED[1], max(low, factor))  # damped: a noisy frame moves scale a little
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
+
+    def predict(self, seconds_per_pixel: float) -> None:
+        """Before the first moving frame after a rest: the scale whose image fits the trace
+        budget at ``seconds_per_pixel`` (measured by the refinement just traced), so that
+        flying starts at its rate (it started at the last flight's scale, or half the side,
+        and shrank by DAMPED[0] a frame: half a second of slow frames, or after a resize)."""
+        if seconds_per_pixel > 0:
+            pixels = self.trace_budget / seconds_per_pixel
+            scale = math.sqrt(pixels / (self.full[0] * self.full[1]))
+            self.scale = min(1.0, max(self.min_scale, scale))
 
 
 def moving_ratio(width: int, still: int) -> int:

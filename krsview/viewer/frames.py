@@ -24,6 +24,7 @@ from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.scene import Geometry
 from .adaptive import (
+    SHADOW_RATIO,
     AdaptiveResolution,
     Refinement,
     moving_ratio,
@@ -139,6 +140,9 @@ class Frames:
         shader (the first one, a knob changed) is not counted: its time is mostly compiling."""
         t0 = time.perf_counter()
         compiles = self.renderer.programs.compiles
+        r = self.refinement
+        if r is not None and (r.k or r.started):  # the first moving frame after a rest
+            self.adaptive.predict(self.moving_cost())
         size = self.adaptive.moving_size()
         scale = size[0] / self.adaptive.full[0]
         # the still image's passes: 0 one pass, 1 shadow rays per pixel in a pass of their
@@ -170,6 +174,17 @@ class Frames:
         crown 24 % brighter at 96×54 than at 960×540)."""
         window = self.adaptive.full[1]
         return window if size[1] < window else 0
+
+    def moving_cost(self) -> float:
+        """Seconds per pixel of a moving frame, from the refinement's measured passes (0:
+        none measured): tracing, shading, and the shadow rays per SHADOW_RATIO² pixels."""
+        c = self._cost
+        if "render" in c:  # every effect in one pass
+            return c["render"]
+        if "trace" not in c:
+            return 0.0
+        shade = c.get("shade", c.get("shadows+shade", 0.0))
+        return c["trace"] + shade + c.get("visibility", 0.0) / SHADOW_RATIO**2
 
     def _show(self, image: PassImage, state: FrameState) -> None:
         """``image`` goes on screen; ``state`` says what it is."""
