@@ -497,3 +497,30 @@ def test_a_save_writes_only_what_changed_into_the_persons_text(tmp_path):
     doc.commit(replace(doc.scene, route=split_level(doc.scene.route, 2, 0.5)), "insert")
     doc.save()
     assert bent.read_text().startswith("# bent notes\n") and load_scene(bent) == doc.scene
+
+
+def test_a_shipped_presets_own_camera_path_replays_until_one_is_recorded(
+    data_home, tmp_path, monkeypatch
+):
+    """grove-wind ships its camera path, yet F6 said there was none: the viewer looked only
+    beside the copy a recording would make. It replays the shipped one (and says it
+    replays); a recording saves beside the copy and is replayed from then on. Control: a
+    shipped preset without a path of its own has none."""
+    from krsview.scene.camera_path import Pose
+    from krsview.viewer.camera import FlyCamera
+    from krsview.viewer.recording import Recorder
+
+    monkeypatch.chdir(tmp_path)
+    r = Recorder(resolve("grove-wind"))
+    assert r.path is not None and r.source == resolve("grove-wind").with_suffix(".path.json")
+    r.replay(0.0)
+    assert r.message.startswith("replaying grove-wind.path.json (")
+    camera = FlyCamera.from_camera(load_scene(resolve("grove-wind")).camera)
+    r.toggle()
+    r.tick(0.0, camera)
+    r.replay_start = None
+    r.recording = [Pose(0.0, (1.0, 2.0, 3.0), 0.0, 0.0), Pose(1.0, (1.0, 2.0, 4.0), 0.0, 0.0)]
+    r.toggle()
+    assert r.source == tmp_path / "grove-wind.path.json" and r.source.exists()
+    assert Recorder(resolve("grove-wind")).path.duration == 1.0
+    assert Recorder(resolve("tree")).path is None

@@ -27,16 +27,20 @@ class Recorder:
     """The camera path of one preset: recorded here or loaded from its file, and replayed."""
 
     def __init__(self, scene_file: Path):
-        self.file = path_file(scene_file)
+        self.file = path_file(scene_file)  # where a recording is saved
         self.recording: list[Pose] | None = None
         self.path: CameraPath | None = None
         self.replay_start: float | None = None
         self.message, self.error = "", ""
-        if self.file.exists():  # a damaged file is reported, not fatal
+        # a shipped preset's own path (grove-wind's) until one is recorded beside its copy
+        own = scene_file.with_name(scene_file.stem + ".path.json")
+        source = self.file if self.file.exists() or not own.exists() else own
+        if source.exists():  # a damaged file is reported, not fatal
             try:
-                self.path = load_camera_path(self.file)
+                self.path = load_camera_path(source)
             except SceneError as e:
                 self.error = str(e)
+        self.source = source
 
     def toggle(self) -> None:
         """Start recording, or stop and save what was recorded."""
@@ -53,6 +57,7 @@ class Recorder:
         try:
             self.file.parent.mkdir(parents=True, exist_ok=True)
             write_atomic(self.file, camera_path_json(poses))
+            self.source = self.file
             self.message = (
                 f"recorded {len(poses)} poses to {self.file.name} "
                 "(F6 replays; `krsview render --camera-path` renders its frames)"
@@ -66,6 +71,7 @@ class Recorder:
             self.message = "no camera path to replay yet: F5 records one"
             return
         self.replay_start = clock
+        self.message = f"replaying {self.source.name} ({self.path.duration:.1f} s)"
 
     def tick(self, clock: float, camera: FlyCamera) -> bool:
         """One event-loop turn: record the camera's pose, or put the camera on the replayed
