@@ -100,9 +100,11 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
     )
     assert primary[1][1].endswith(f", shadows per 2×2 px of the {bw}×{bh} image; shaded view")
     still, lines, _ = seen[-1]
+    after = sum(g[0][0].seconds for g in images[4:])  # the refinement's images' tracing
     assert still.size == SIZE == v.frames.image[1] and lines[0] == (
-        f"still: {SIZE[0]}×{SIZE[1]} (100% of the window's width)"
+        f"still {after:.2f} s after the stop: {SIZE[0]}×{SIZE[1]} (100% of the window's width)"
     )
+    assert still.since_stop == pytest.approx(after) and still.since_stop > still.seconds
     assert "shadows per" not in lines[1]  # the still image's are per pixel
     # each image stays on screen, its very pixels (right of the HUD), until the next
     for g in images:

@@ -42,7 +42,9 @@ class FrameState:
     is being traced) or "still" (the last one: final); ``seconds`` is the time its tracing
     took (all its bands for a refinement's), ``shadows`` the side of the pixel blocks that
     share a shadow ray (1: each pixel its own), ``blocks_of`` the size of the earlier image
-    whose blocks it took (a primary image: its own shadow rays come next), else (0, 0)."""
+    whose blocks it took (a primary image: its own shadow rays come next), else (0, 0);
+    ``since_stop`` the tracing of the refinement's images up to this one (0: a moving
+    frame)."""
 
     state: str
     size: tuple[int, int]  # internal resolution of the image on screen
@@ -51,12 +53,15 @@ class FrameState:
     step: tuple[int, int] = (0, 0)  # refining: (k, n)
     shadows: int = 1
     blocks_of: tuple[int, int] = (0, 0)
+    since_stop: float = 0.0  # the refinement's tracing so far, this image's included
 
     def text(self) -> str:
         w, h = self.size
         share = w / max(self.window[0], 1)
         k, n = self.step
         state = f"refining {k}/{n}" if self.state == "refining" else self.state
+        if self.state == "still" and self.since_stop > self.seconds:  # after steps before it
+            state += f" {self.since_stop:.2f} s after the stop"
         state += ", shadows next" if self.blocks_of[0] else ""
         return f"{state}: {w}×{h} ({share:.0%} of the window's width)"
 
@@ -84,6 +89,7 @@ class Frames:
         self._cost: dict[str, float] = {}  # seconds per pixel of each pass, kept across
         self._profile: dict[str, list[float]] = {}  # ... and per slice of rows (Refinement)
         self._step_seconds = 0.0
+        self._since_stop = 0.0  # the refinement's tracing so far
         self._traced_at = 0.0  # when the last turn's tracing ended (0: it traced nothing)
         # the moving frames' size when the view last came to rest (the HUD's measured
         # accuracy suggests for it: a size that does not change while flying)
@@ -197,6 +203,7 @@ class Frames:
         r = self.refinement
         if r.k == 0 and not r.started:  # the view came to rest
             self.rest_size = self.adaptive.moving_size()
+            self._since_stop = 0.0
         spent, budget = 0.0, refining_budget(self.adaptive.budget, rest)
         prepared = None
         while not r.done and spent < budget:
@@ -229,6 +236,7 @@ class Frames:
             seconds = time.perf_counter() - t0
             spent += seconds
             self._step_seconds += seconds
+            self._since_stop += seconds
             if r.band_done(band, seconds):
                 k, n = r.k, len(r.steps)
                 state = FrameState(
@@ -238,6 +246,7 @@ class Frames:
                     self._step_seconds,
                     (k, n) if k < n else (0, 0),
                     blocks_of=self._tracing.blocks[0] if r.steps[k - 1].primary else (0, 0),
+                    since_stop=self._since_stop,
                 )
                 self._show(self._tracing, state)
                 self._tracing = None
