@@ -82,7 +82,8 @@ class Frames:
         self.full_shadows = False  # moving frames and steps trace shadow rays as still ones
         self.image: tuple[moderngl.Framebuffer, tuple[int, int]] | None = None
         self.refinement: Refinement | None = None
-        self.frame_seconds: list[float] = []  # moving frames
+        self.frame_seconds: list[float] = []  # moving frames while moving (see _moving)
+        self._moved_last = False  # the last turn traced a moving frame
         self.shown = FrameState("moving", (0, 0), adaptive.full, 0.0)  # no image yet
         self._on_screen: PassImage | None = None
         self._tracing: PassImage | None = None  # the refinement's next image
@@ -121,10 +122,11 @@ class Frames:
         # the rest of the last turn, where it traced (else its time holds an idle wait)
         rest = now - self._traced_at if self._traced_at else None
         traced = self.dirty or not self.refined
+        moving, self._moved_last = self._moved_last, self.dirty
         try:
             if self.dirty:
                 self.dirty = False  # a shader error is not retried every turn
-                self._moving(scene, krs, rest, while_tracing)
+                self._moving(scene, krs, rest, while_tracing, moving)
             elif traced:
                 self._refine(scene, krs, rest or 0.0)
         finally:
@@ -136,6 +138,7 @@ class Frames:
         krs: Geometry,
         rest: float | None,
         while_tracing: Callable[[], None] | None = None,
+        moving: bool = True,
     ) -> None:
         """A moving frame at the adaptive resolution; ``rest``: the last turn's time besides
         its tracing (None: it traced nothing), for the resolution's controller. After its
@@ -143,7 +146,10 @@ class Frames:
         which moderngl lacks): llvmpipe's threads trace while this thread does the turn's
         other work (the HUD), on a core that the passes leave idle part of the time
         (docs/speed.md, "The HUD built while the frame is traced"). A frame that compiled a
-        shader (the first one, a knob changed) is not counted: its time is mostly compiling."""
+        shader (the first one, a knob changed) is not counted: its time is mostly compiling.
+        ``moving``: the turn before traced a moving frame too; the HUD's moving frames are
+        those (a flight, a scene playing), not one drawn after a reload, a bookmark or a
+        resize, whose image a rest refines at once."""
         t0 = time.perf_counter()
         compiles = self.renderer.programs.compiles
         r = self.refinement
@@ -163,7 +169,8 @@ class Frames:
         seconds = time.perf_counter() - t0
         if self.renderer.programs.compiles == compiles:  # else its time is mostly compiling
             self.adaptive.frame_done(seconds, rest)
-            self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
+            if moving:
+                self.frame_seconds = (self.frame_seconds + [seconds])[-KEPT_FRAME_TIMES:]
         steps = refinement_steps(scale, seconds, self.adaptive.supersample, ratio, still)
         self.refinement = Refinement(steps, self._cost, profile=self._profile) if steps else None
         self._tracing = None
