@@ -177,6 +177,8 @@ def test_the_controller_counts_the_turns_rest_besides_the_tracing_not_idle_waits
     # the HUD's moving frames are the four that followed a moving frame
     assert a.history[-5:] == pytest.approx([TRACE] * 5)
     assert v.frames.frame_seconds == pytest.approx([TRACE] * 4)
+    assert a.rests == pytest.approx([REST] * 4) and a.rest == pytest.approx(REST)
+    assert a.trace_budget == pytest.approx(a.budget - REST)
     for _ in range(200):
         clock.t += REST
         v.step(REST)
@@ -185,8 +187,6 @@ def test_the_controller_counts_the_turns_rest_besides_the_tracing_not_idle_waits
     v.frames.dirty = True  # one image anew (a reload, a bookmark, a resize): not a flight's
     v.step(REST)
     assert len(a.history) == 6 and len(v.frames.frame_seconds) == 4
-    assert a.rests == pytest.approx([REST] * 4) and a.rest == pytest.approx(REST)
-    assert a.trace_budget == pytest.approx(a.budget - REST)
 
 
 def test_the_window_keeps_no_stale_pixels_without_the_clear(clocked):
