@@ -166,6 +166,10 @@ def test_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
     v.undo()
     v.file.take()
     assert v.message == "reloaded tree.toml", "control: nothing of the HUD's lost"
+    v.path.write_text(text.replace("fov_y = 45", "fov_y = 60"))
+    v.file.take()  # the file's camera changed: the view stays, and that is said
+    assert v.message == "reloaded tree.toml; the view stays where it is (R: the file's camera)"
+    assert v.scene.camera.fov_y == 60.0
     v.path.write_text(text.replace("branch_angle = 26.0", "branch_angle = 900.0"))
     v.file.take()
     assert "branch_angle" in v.error and v.message == ""

@@ -108,9 +108,12 @@ class ViewerFile:
         good scene and shows why."""
         v = self.viewer
         dirty = v.doc.dirty  # changes made in the HUD: the file's contents replace them
+        camera = v.doc.scene.camera
         try:
             v.doc.reload()
             kept = "; the HUD's changes before it are one Ctrl+Z back" if dirty else ""
+            if v.doc.scene.camera != camera:  # the view is the person's: said, not taken
+                kept += "; the view stays where it is (R: the file's camera)"
             v.error, v.message, self.refused = "", f"reloaded {self.path.name}{kept}", ""
         except SceneError as e:  # keep the last good scene and image; say only this
             v.error = self.refused = str(e)
