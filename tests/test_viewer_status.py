@@ -440,3 +440,21 @@ def test_a_flight_starts_at_the_scale_its_measured_cost_fits(hud_viewer, monkeyp
     turn(v)
     v.input.key("W", False)
     assert len(asked) == 1, "a flight's later frames follow the controller"
+
+
+def test_an_error_is_shown_once_its_further_lines_in_the_hud(hud_viewer, monkeypatch):
+    """A refused reload's line was drawn twice, in the HUD and at the window's foot: the
+    HUD now shows only the lines after the first (a shader's log), the status line the
+    first. Control: a two-line error's second line is in the HUD."""
+    v = hud_viewer
+    wrapped: list[str] = []
+    real = imgui.text_wrapped
+    monkeypatch.setattr(imgui, "text_wrapped", lambda s: (wrapped.append(s), real(s))[1])
+    v.path.write_text(v.path.read_text().replace("branch_angle = 26.0", "branch_angle = 900.0"))
+    v.file.take()
+    turn(v)
+    assert v.status_line() == v.error and not any(v.error in s for s in wrapped)
+    v.error = "first line\nsecond line"
+    wrapped.clear()
+    turn(v)
+    assert "second line" in wrapped and not any("first line" in s for s in wrapped)

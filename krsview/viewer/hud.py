@@ -116,7 +116,7 @@ def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], i
         _scene(v, out)
     if v.message:
         imgui.text_wrapped(v.message)
-    red_text(v.error)
+    red_text("\n".join(v.error.splitlines()[1:]))  # the first is the status line (status.py)
     imgui.end()
     return out, slot
 
