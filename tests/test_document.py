@@ -524,3 +524,41 @@ def test_a_shipped_presets_own_camera_path_replays_until_one_is_recorded(
     assert r.source == tmp_path / "grove-wind.path.json" and r.source.exists()
     assert Recorder(resolve("grove-wind")).path.duration == 1.0
     assert Recorder(resolve("tree")).path is None
+
+
+def test_a_level_inserted_or_removed_changes_its_own_lines_alone(tmp_path):
+    """A MöKRS level duplicated wrote the whole list of levels anew, every inline kernel
+    turned into a table of its own (a 654-line diff on palm for one level). Now the level
+    added or removed is the only change, written as its neighbours are (the kernel inline),
+    and the file reads back as the scene saved. Control: a level changed in place changes
+    its own lines, in place."""
+    import difflib
+
+    from krsview.editor.mokrs_levels import changed
+
+    def diff(a: str, b: str) -> list[str]:
+        lines = difflib.unified_diff(a.splitlines(), b.splitlines(), lineterm="", n=0)
+        return [x for x in lines if x[:1] in "+-" and x[:3] not in ("+++", "---")]
+
+    for name in ("palm", "tree-mokrs"):
+        path = tmp_path / f"{name}.toml"
+        shutil.copy(resolve(name), path)
+        text = path.read_text()
+        doc = Document(path)
+        levels = doc.scene.mokrs.levels
+        for op in ("duplicate", "insert", "remove"):
+            doc.apply(("mokrs", "levels"), changed(levels, 5, op)[0])
+            doc.save()
+            lines = diff(text, path.read_text())
+            assert load_scene(path) == doc.scene, (name, op)
+            sign = "-" if op == "remove" else "+"
+            assert lines and all(x.startswith(sign) for x in lines), (name, op, lines[:4])
+            assert len(lines) < 25, (name, op, len(lines))
+            if op == "duplicate":
+                assert any(x.startswith("+kernel = {") for x in lines), (name, lines[:4])
+            doc.undo()
+            doc.save()
+            assert path.read_text() == text, (name, op)
+        doc.apply(("mokrs", "levels", 5, "reflect"), not levels[5].reflect)
+        doc.save()
+        assert len(diff(text, path.read_text())) == 2

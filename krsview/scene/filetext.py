@@ -4,12 +4,15 @@ document's trivia as it edits it). A save used to write the whole scene anew: co
 gone, every default spelled out, a light direction never touched written normalised.
 
 The two scenes are compared as the file schema writes them (``to_dict``): a table's changed
-fields are set in place; a list of tables of the same length is changed table by table; one
-that grew or shrank (a level inserted) is written anew; a field that became unset goes.
-What comes out must read back as the scene saved, else the scene is written anew."""
+fields are set in place; a list of tables is matched item by item (difflib), so a level
+inserted, duplicated or removed adds or drops its own table alone, written in the style of
+its neighbours (inline kernels stay inline), and the others are changed in place; a field
+that became unset goes. What comes out must read back as the scene saved, else the scene is
+written anew."""
 
 from __future__ import annotations
 
+import difflib
 from typing import Any
 
 import tomlkit
@@ -49,14 +52,64 @@ def _patch(table: Any, before: dict, after: dict) -> None:
         elif (
             _tables(value)
             and _tables(old)
-            and len(value) == len(old)
-            and here is not None
-            and len(here) == len(value)
+            and isinstance(here, (tomlkit.items.AoT, tomlkit.items.Array))
+            and len(here) == len(old)
         ):
-            for item, was, now in zip(here, old, value):
-                _patch(item, was, now)
+            _patch_tables(here, old, value)
         else:
             table[key] = _item(value, here)
+
+
+def _patch_tables(here: Any, before: list[dict], after: list[dict]) -> None:
+    """``here`` (the file's list of tables, holding ``before``) changed to hold ``after``:
+    the items matched by difflib stay as written, a replaced run of the same length is
+    patched item by item, and the rest are inserted or deleted where they lie."""
+    keys = [[repr(v) for v in items] for items in (before, after)]
+    ops = difflib.SequenceMatcher(None, *keys, autojunk=False).get_opcodes()
+    for tag, i1, i2, j1, j2 in reversed(ops):  # from the end: earlier indices stay valid
+        if tag == "equal":
+            continue
+        if i2 - i1 == j2 - j1:
+            for k in range(i2 - i1):
+                _patch(here[i1 + k], before[i1 + k], after[j1 + k])
+            continue
+        model = here[0] if len(here) else None
+        for k in reversed(range(i1, i2)):
+            del here[k]
+        for k in range(j1, j2):
+            here.insert(
+                i1 + k - j1, _like(after[k], model, inline=isinstance(here, tomlkit.items.Array))
+            )
+
+
+def _like(value: dict, model: Any, inline: bool) -> Any:
+    """A new table holding ``value`` written as ``model`` (a sibling) is: its tables inline
+    where the sibling's are; an item of an inline list inline throughout."""
+    if inline:
+        return _inline(value, _spaced(model))
+    out = tomlkit.table()
+    for key, v in value.items():
+        was = model.get(key) if model is not None else None
+        inline_was = isinstance(was, tomlkit.items.InlineTable)
+        out[key] = _inline(v, _spaced(was)) if inline_was else tomlkit.item(v)
+    out.add(tomlkit.nl())  # a blank line before the next table, as between the others
+    return out
+
+
+def _spaced(model: Any) -> bool:
+    """Whether an inline table is written ``{ a = 1 }`` (as krsview writes) or ``{a = 1}``."""
+    return model is None or model.as_string().startswith("{ ")
+
+
+def _inline(value: Any, spaced: bool = True) -> Any:
+    """``value`` with every table in it inline, ``{ a = 1 }`` or, not ``spaced``,
+    ``{a = 1}``."""
+    if isinstance(value, dict):
+        body = ", ".join(f"{k} = {_inline(v, spaced).as_string()}" for k, v in value.items())
+        return tomlkit.parse(f"x = {{ {body} }}" if spaced else f"x = {{{body}}}")["x"]
+    if isinstance(value, list):
+        return tomlkit.item([_inline(v, spaced) for v in value])
+    return tomlkit.item(value)
 
 
 def _tables(value: Any) -> bool:
