@@ -412,3 +412,27 @@ def test_the_status_line_is_not_drawn_under_the_panel_docked_left(display, tmp_p
         assert wide, "control: a window as wide as the editor's (the gizmo's)"
     finally:
         e.close()
+
+
+def test_a_warning_or_an_error_appearing_moves_no_field(tree_editor, monkeypatch):
+    """A warning appearing after an edit pushed the fields below it down by four lines, and
+    a review's next Ctrl+click set another field; an error at the panel's top did the same.
+    Warnings now keep one line (folded, counted), errors come last (and in the status line):
+    every field stays where it was. Control: the warnings' line is there, and says them."""
+    from imgui_bundle import imgui
+
+    e = tree_editor
+    e.selected = next(h for h in e.handles if h.path[-1] == "fork" and h.path[2] == 16)
+    pump(e, 3)
+    before = dict(e.viewer.interactions.rects)
+    said = [(15, "route.levels[15]: the branch crosses the mirror"), (3, "another")]
+    monkeypatch.setattr(type(e), "warnings", property(lambda self: said))
+    e.viewer.error = "a refusal\nof two lines"
+    lines: list[str] = []
+    node = imgui.tree_node
+    monkeypatch.setattr(imgui, "tree_node", lambda label, *a: (lines.append(label), node(label, *a))[1])
+    pump(e, 2)
+    after = e.viewer.interactions.rects
+    assert before and set(before) == set(after)
+    assert all(abs(after[k][1] - before[k][1]) < 0.5 for k in before), "a field moved"
+    assert any(s.startswith("2 warnings: branches Alg. 1 cuts") for s in lines)

@@ -17,7 +17,7 @@ from ..scene.edits import path_text
 from ..scene.model import Kernel
 from ..scene.mokrs import MobiusStep, linked_levels, linked_steps
 from ..viewer.commands import Command, Edit
-from ..viewer.widgets import Interactions, red_text, tooltip
+from ..viewer.widgets import Interactions, counted, red_text, tooltip
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
 from .modals import entry_menu
@@ -131,7 +131,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     if changed:
         out.append(Edit((*lev, "reflect"), on))
     linked = len(linked_levels(e.scene.mokrs, i)) - 1  # the option stays, none linked too
-    now = f"{linked} linked levels" if linked else "linked levels (none now)"
+    now = counted(linked, "linked level") if linked else "linked levels (none now)"
     changed, on = imgui.checkbox(f"step edits also go to {now}", e.carry)
     if changed:
         out.append(ec.SetCarry(on))

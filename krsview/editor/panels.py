@@ -16,7 +16,7 @@ from ..scene import Scene
 from ..scene.edits import get_at
 from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.hud import HUD_RIGHT
-from ..viewer.widgets import Interactions, field_widget, red_text, tooltip
+from ..viewer.widgets import Interactions, counted, field_widget, red_text, tooltip
 from ..viewer.window import Viewer
 from . import commands as ec
 from .file_actions import FileActions
@@ -31,7 +31,7 @@ from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
-WARNINGS_OPEN = 2  # more warnings than this are folded under one line that counts them
+WARNINGS_OPEN = 0  # warnings are folded under one line that counts them (it never moves)
 
 
 class Edited(Protocol):
@@ -70,7 +70,6 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     if not folded:
         _dock(e, out, width)
     _file(e, out)
-    red_text(e.viewer.error)
     scene = e.scene
     shown = e.handled_scene()  # as drawn at the moment shown (tracks), its tracked fields marked
     fields_of = partial(_fields, marks=key_marks(scene, e.viewer.drawn.playback.time))
@@ -117,6 +116,9 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         if changed:
             out.append(ec.SetSnap(on))
         imgui.text(f"grid {e.snap.grid:g} units, angle {e.snap.angle:g}°")
+    # last: a message appearing above the fields moved them under the pointer (a review's
+    # next Ctrl+click set another field); its first line is the status line's too
+    red_text(e.viewer.error)
     imgui.end()
     _modals(e, out)
     out += copy_dialog(e.file)
@@ -158,11 +160,13 @@ def _warnings(e: Edited, out: list) -> None:
     selects that level or component (the view shows the clipped part in red)."""
     what = "component" if e.scene.compound else "level"
     said = e.warnings
-    if not said:
+    if not said:  # the line is kept: a warning appearing moves no field under the pointer
+        imgui.text_disabled("no warnings: Alg. 1 cuts no branch")
         return
     if len(said) > WARNINGS_OPEN:  # folded: eight of four lines each pushed the outline away
         imgui.push_style_color(imgui.Col_.text, YELLOW)
-        shown = imgui.tree_node(f"{len(said)} warnings: branches Alg. 1 cuts (red in the view)")
+        count = counted(len(said), "warning")
+        shown = imgui.tree_node(f"{count}: branches Alg. 1 cuts (red in the view)###warnings")
         imgui.pop_style_color()
         if not shown:
             return

@@ -32,6 +32,7 @@ from ..scene.restructure import (
 )
 from ..scene.schema import Vec3, from_dict, to_dict
 from ..viewer.commands import Command
+from ..viewer.widgets import counted
 from ..viewer.window import Viewer
 from . import commands as ec
 from .handles import Handle
@@ -166,7 +167,7 @@ def commit_route(
     e.doc.commit(scene, label, interaction)
     e.viewer.sync()
     warned = get_at(scene, at).warnings()
-    _say(e, label + (f" ({len(warned)} warnings)" if warned else ""), False)
+    _say(e, label + (f" ({counted(len(warned), 'warning')})" if warned else ""), False)
     return True
 
 
