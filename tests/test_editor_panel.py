@@ -430,7 +430,9 @@ def test_a_warning_or_an_error_appearing_moves_no_field(tree_editor, monkeypatch
     e.viewer.error = "a refusal\nof two lines"
     lines: list[str] = []
     node = imgui.tree_node
-    monkeypatch.setattr(imgui, "tree_node", lambda label, *a: (lines.append(label), node(label, *a))[1])
+    monkeypatch.setattr(
+        imgui, "tree_node", lambda label, *a: (lines.append(label), node(label, *a))[1]
+    )
     pump(e, 2)
     after = e.viewer.interactions.rects
     assert before and set(before) == set(after)
