@@ -714,6 +714,16 @@ def test_a_scale_that_outgrows_float32_over_linked_levels_is_refused(display, tm
         pump(e)
         assert not e.edit(whole, wide) and "past what float32 holds" in e.viewer.error
         assert e.scene == palm
+        # typed in L58's field: the refusal names that field first and stays at it, red
+        # (it named levels[21] alone, beside the selection, and the field showed 0.93)
+        e.selected = next(h for h in e.handles if h.path == factor)
+        pump(e)
+        assert factor in e.viewer.interactions.rects, "control: the field is drawn"
+        assert not e.edit(whole, wide, field=(factor, 50.0)) and e.viewer.error == ""
+        refused = e.viewer.interactions.refused[factor]
+        assert refused.value == 50.0 and refused.message.startswith(
+            "mokrs.levels[58].transform[0].factor = 50.0: mokrs.levels[21] = <a bound"
+        )
         [(whole, fine)] = linked_edits(palm, factor, 2.0, 0.0)
         assert e.edit(whole, fine) and e.scene.mokrs.levels[58].transform[0].factor == 2.0
     finally:

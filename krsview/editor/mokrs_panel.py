@@ -185,7 +185,7 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
     if e.carry:  # linked: the same change in the finer levels with the same steps (keyed
         t = e.viewer.drawn.playback.time  # where a track moves it)
         out[first:] = [
-            Edit(path, value, c.interaction)
+            Edit(path, value, c.interaction, field=(c.path, c.value))
             for c in out[first:]
             for path, value in linked_edits(e.scene, c.path, c.value, t)
         ]

@@ -141,13 +141,22 @@ class Editor:
         self._follow()
         return self.shown_now.scene
 
-    def edit(self, path: tuple, value, interaction=None, label: str | None = None) -> bool:
+    def edit(
+        self,
+        path: tuple,
+        value,
+        interaction=None,
+        label: str | None = None,
+        field: tuple[tuple, Any] | None = None,
+    ) -> bool:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
         the person flies must stay off every pole too, not only the file's camera
         [KRS17 §7]. A value refused for a field the panel shows keeps its message at that
         field (viewer/widgets.py), any other in the panel's error line. A value a track
         moves is keyed at the moment shown instead (keys.py), as a drag or a typed value.
-        ``label`` names the undo step (the undo button's tooltip); by default the path set."""
+        ``label`` names the undo step (the undo button's tooltip); by default the path set.
+        ``field``: the (path, value) the person changed where ``path`` is a larger edit (a
+        step carried to its linked levels): a refusal names it first and stays at it."""
         v = self.viewer
         path, value = keyed_edit(self.scene, path, value, v.drawn.playback.time)
         try:
@@ -157,11 +166,15 @@ class Editor:
                 check_float32(bounds_in_and_out(scene.mokrs)[0])  # refused, not drawn solid
         except SceneError as e:
             v.error = str(e)
+            if field is not None and e.path != path_text(field[0]):  # named where it was typed
+                v.error = str(SceneError(path_text(field[0]), field[1], str(e)))
         else:
             self.doc.commit(scene, label or f"set {path_text(path)}", interaction)
             v.error = ""
             v.sync()
         ok = not v.error
+        if field is not None:
+            path, value = field
         if v.interactions.settle(path, value, v.error):
             v.error = ""
         return ok
@@ -385,7 +398,7 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),
     ec.SetSnap: lambda e, c: setattr(e.snap, "on", c.on),
     ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),
-    vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction),
+    vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction, field=c.field),
     vc.ResetView: lambda e, c: e.reset_view(),
     vc.Undo: lambda e, c: e.undo(),
     vc.Redo: lambda e, c: e.undo(redo=True),

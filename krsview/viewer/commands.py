@@ -30,6 +30,9 @@ class Edit(Command):
     path: tuple  # a scene field, as in scene.edits
     value: Any
     interaction: Hashable | None = None  # edits of one drag merge into one undo step
+    # the field the person changed and its value, where the edit is a larger one (a MöKRS
+    # step's change carried to its linked levels): a refusal is shown there
+    field: tuple[tuple, Any] | None = None
 
 
 @dataclass(frozen=True)
