@@ -461,16 +461,18 @@ def test_the_grow_again_question_lists_the_edits_it_would_lose(window_editor):
     xdo("key", "Insert")
     pump(e)
     inserted = e.scene
-    listed = []
-    bullet = imgui.bullet_text
+    listed, said = [], []
+    bullet, text_ = imgui.bullet_text, imgui.text
     imgui.bullet_text = lambda text: (listed.append(text), bullet(text))[1]
+    imgui.text = lambda text: (said.append(text), text_(text))[1]
     try:
         e.execute([ec.Regrow()])
         pump(e, 3)
     finally:
-        imgui.bullet_text = bullet
+        imgui.bullet_text, imgui.text = bullet, text_
     assert e.structure.pending is not None
     assert listed and all(line in e.structure.pending.lost for line in listed)
+    assert "Grow again from the growth parameters?" in said  # what is applied, said first
     e.execute([ec.CancelRegrow()])
     pump(e)
     assert e.scene == inserted and e.structure.pending is None

@@ -160,6 +160,8 @@ def _regrow_dialog(t: StructureTools, out: list[Command]) -> None:
     if not imgui.begin_popup_modal("grow again?", None, imgui.WindowFlags_.always_auto_resize)[0]:
         return
     lost = t.pending.lost if t.pending else []
+    if t.pending:  # what is being applied ("grow again with levels = 18")
+        imgui.text(t.pending.label[:1].upper() + t.pending.label[1:] + "?")
     imgui.text("Growing the tree again loses these edits made by hand:")
     for line in lost[:MAX_LISTED]:
         imgui.bullet_text(line)
