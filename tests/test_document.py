@@ -245,8 +245,9 @@ def test_an_unknown_path_is_a_clear_error(route_file):
 
 
 def test_a_read_only_folder_fails_the_save_clearly_and_keeps_the_edit(route_file, tmp_path):
-    if os.geteuid() == 0:
-        target = tmp_path / "no-such-dir" / "x.toml"  # root may write anywhere: a missing folder
+    if os.geteuid() == 0:  # root may write anywhere: a folder that is a file
+        (tmp_path / "a-file").write_text("")
+        target = tmp_path / "a-file" / "x.toml"
     else:
         ro = tmp_path / "ro"
         ro.mkdir()
@@ -258,6 +259,8 @@ def test_a_read_only_folder_fails_the_save_clearly_and_keeps_the_edit(route_file
         doc.save(target)
     assert doc.dirty and doc.path == route_file
     shutil.rmtree(tmp_path / "ro", ignore_errors=True)
+    new = tmp_path / "new-folder" / "x.toml"  # the control: a folder not there yet is made
+    assert doc.save(new) == new and load_scene(new) == doc.scene
 
 
 # ------------------------------------------------------------------------------ file safety

@@ -197,8 +197,7 @@ class Document:
                 "reload it (your edits stay undoable) or overwrite it"
             )
         try:
-            if target.parent == user_folder():  # a preset's copy: the folder may be new
-                target.parent.mkdir(parents=True, exist_ok=True)
+            target.parent.mkdir(parents=True, exist_ok=True)  # save as into a new folder
             text = self._text_of(self._scene)
             write_atomic(target, text)
         except OSError as e:
