@@ -375,3 +375,29 @@ def test_a_process_forked_after_drawing_is_told_to_spawn(tmp_path):
     assert out[0].startswith("fork krsview: this process was forked after krsview had drawn")
     assert "get_context('spawn')" in out[0]
     assert out[1] == "spawn (16, 9)"
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [
+        (lambda b: b.bench_levels("sierpinski", (0, 0), rounds=1), "size = (0, 0): expected"),
+        (lambda b: b.bench_levels("sierpinski", (16, 9), step=0), "step = 0: allowed"),
+        (lambda b: b.bench_split("sierpinski", (16, 9), rounds=0), "rounds = 0: allowed"),
+        (lambda b: b.bench_paths("no-such", (16, 9)), "PRESET = 'no-such': not a file"),
+        (lambda b: b.bench_zoom("tree", (16, 9), stops_count=1), "stops_count = 1: allowed"),
+    ],
+)
+def test_the_benchmarks_check_their_arguments_first(call, said):
+    """``krsview.bench``'s functions crashed deep inside on a preset's name, a size of 0, a
+    step or rounds of 0 (AttributeError, ZeroDivisionError, StatisticsError); they take
+    what the API takes and refuse the rest in one line."""
+    with pytest.raises(SceneError) as e:
+        call(krsview.bench)
+    assert said in one_line(e)
+
+
+def test_the_benchmarks_are_named_in_krsview_bench():
+    """The control: a preset's name runs, and ``dir`` lists the benchmarks."""
+    assert "bench_levels" in dir(krsview.bench)
+    m = krsview.bench.bench_levels("sierpinski", (16, 9), step=8, rounds=1)
+    assert m.rows and m.scene.name == "sierpinski"

@@ -13,7 +13,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "krsview"
 # states its arrows. Arrows run one way: cli → app → editor → viewer → document → scene;
 # viewer/editor → gpu → compile → scene → algebra; reference, oracle → compile;
 # bench/share → gpu, reference; the public API (krsview/__init__.py) sits under the CLI, and
-# checks its arguments by inputs → scene.
+# checks its arguments by inputs → scene, as the benchmarks' functions check theirs.
 BASE = {"algebra", "frame", "progress", "heatmap", "version"}
 ALLOWED = {
     "algebra": set(),
@@ -27,7 +27,7 @@ ALLOWED = {
     "reference": {"compile", "scene"} | BASE,
     "gpu": {"compile", "scene"} | BASE,
     "oracle": {"reference", "compile", "scene"} | BASE,
-    "bench": {"gpu", "reference", "oracle", "compile", "scene"} | BASE,
+    "bench": {"inputs", "gpu", "reference", "oracle", "compile", "scene"} | BASE,
     "share": {"bench", "gpu", "reference", "compile", "scene"} | BASE,
     "viewer": {"document", "gpu", "reference", "compile", "scene"} | BASE,
     "editor": {"viewer", "document", "gpu", "reference", "compile", "scene"} | BASE,

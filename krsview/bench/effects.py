@@ -22,7 +22,7 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
-from .harness import Variant, round_times
+from .harness import Variant, bench_inputs, round_times
 from .report import Measured, markdown
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
@@ -60,6 +60,7 @@ def runs_of(scene: Scene) -> dict[str, tuple[Scene, bool]]:
 def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
     """One row per variant (:func:`runs_of`, then the components' sum for a compound): its
     effects, ms per frame, ratio to the plain render and incremental cost."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
     runs = runs_of(scene)
     times = round_times(
         Renderer(),

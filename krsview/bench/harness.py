@@ -9,8 +9,10 @@ from __future__ import annotations
 import statistics
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from ..gpu.renderer import Renderer
+from ..inputs import scene_of, size_of, whole
 from ..progress import Progress
 from ..scene import Geometry, Scene
 
@@ -22,6 +24,15 @@ class Variant:
     all_effects: bool = False  # the variant with every effect switched by uniforms
     prepass_only: bool = False  # time the pre-pass's coarse passes alone
     probes: tuple[str, ...] = ()  # a measuring variant's defines (Renderer.prepare)
+
+
+MAX_ROUNDS = 1000  # interleaved rounds a benchmark takes
+
+
+def bench_inputs(scene: Any, size: Any, rounds: Any) -> tuple[Scene, tuple[int, int], int]:
+    """A benchmark's common arguments checked before any work, as the API checks its own
+    (krsview/inputs.py): a scene, a preset's name or a file; (width, height); rounds ≥ 1."""
+    return scene_of(scene), size_of(size), whole(rounds, "rounds", 1, MAX_ROUNDS)
 
 
 def round_times(

@@ -12,8 +12,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..gpu.renderer import Renderer
+from ..inputs import whole
 from ..scene import Scene
-from .harness import Variant, median_times
+from .harness import Variant, bench_inputs, median_times
 from .report import Measured, markdown
 
 
@@ -27,6 +28,8 @@ def level_counts(total: int, step: int) -> list[int]:
 def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int = 5) -> Measured:
     """One row per level count (every ``step`` levels, and all): kernel instances, ms per
     frame, time ratio to the fewest levels, iterations per pixel, time per iteration ratio."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
+    step = whole(step, "step", 1)
     w, h = size
     krs = scene.geometry()
     counts = level_counts(krs.depth, step)

@@ -14,7 +14,7 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.render import VIEW_PREPASS
-from .harness import Variant, median_times
+from .harness import Variant, bench_inputs, median_times
 from .report import Measured, markdown
 
 TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
@@ -106,6 +106,7 @@ def lever_name(k: tuple) -> str:
 def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measured:
     """One row per lever (:func:`levers`) at ``size`` and twice it: ms per frame, speed-up
     against the plain frame, iterations and levels walked per pixel, coarse passes' share."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
     r = Renderer()
     rows = []
     for w, h in (size, (2 * size[0], 2 * size[1])):

@@ -19,7 +19,7 @@ from ..gpu.readback import read_plane
 from ..gpu.renderer import Renderer
 from ..gpu.uniforms import variant_defines
 from ..scene import EFFECTS, Scene
-from .harness import Variant, round_times
+from .harness import Variant, bench_inputs, round_times
 from .report import Measured, markdown
 
 WORK = ("shadow steps/px", "shadow levels/px")  # the frames' rows' work (shadow_work)
@@ -66,6 +66,7 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
     frame with a shadow ray per pixel too (shares of that frame); where it has the shadow
     cone, the frame without it too. The frames' rows carry the shadow rays' work
     (:func:`shadow_work`), the others none."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
     r = Renderer()
     variants = split_variants(scene)
     times = round_times(r, variants, size, rounds, f"bench split {scene.name}")

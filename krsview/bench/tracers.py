@@ -15,7 +15,7 @@ import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
-from .harness import Variant, median_times
+from .harness import Variant, bench_inputs, median_times
 from .report import Measured, markdown
 
 BONUS = (1.5, 2.0, 3.0)
@@ -42,6 +42,7 @@ def bench_tracers(
 ) -> Measured:
     """One row per tracer setting: iterations per pixel (median, mean, ratio to the first),
     ms per frame, time ratio, hit fraction and agreement with the first's hit mask."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
     if scene.mokrs is not None and not sweep:
         raise SceneError(
             "--no-sweep",

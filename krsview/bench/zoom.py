@@ -13,8 +13,9 @@ import numpy as np
 
 from ..compile.balls import kernel_ball
 from ..gpu.renderer import Renderer
+from ..inputs import whole
 from ..scene import Scene, SceneError
-from .harness import Variant, median_times
+from .harness import Variant, bench_inputs, median_times
 from .report import Measured, markdown
 
 END_RADII = 3.0  # the last stop is this many of the finest kernel's ball radii from its centre
@@ -57,6 +58,8 @@ def bench_zoom(
     iterations per pixel, levels walked per iteration, hit fraction, and beside them every
     level (lod 0) and the other walk (``[render] walk_restart`` switched); ``plot``: a PNG path
     for the plot of time and work along the flight."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
+    stops_count = whole(stops_count, "stops_count", 2, 1000)
     w, h = size
     views = stops(scene, stops_count)
     r = Renderer()
