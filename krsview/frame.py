@@ -3,7 +3,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import io
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,8 +42,9 @@ class Frame:
 
     def save(self, path: str | Path) -> Path:
         """Write the colour (``.png``, or any format Pillow knows by the suffix) or every
-        array (``.npz``); returns the path. A suffix neither knows is refused (ValueError)
-        before anything is written."""
+        array (``.npz``), whole or not at all (a temporary file beside it, renamed); returns
+        the path. A suffix neither knows, a folder, or a place that cannot be written is
+        refused in one line (ValueError)."""
         from PIL import Image
 
         if not isinstance(path, (str, Path)) or str(path) == "":
@@ -53,18 +56,31 @@ class Frame:
                 f"path = {str(path)!r}: the file must end in .png, .npz or another image "
                 "format's suffix (.jpg, .tif, .webp, …)"
             )
-        path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do
-        if suffix == ".npz":
-            np.savez_compressed(
-                path,
-                color=self.color,
-                depth=self.depth,
-                normal=self.normal,
-                iterations=self.iterations,
-                hit=self.hit,
-            )
-        else:
-            self.image().save(path)
+        if path.is_dir():
+            raise ValueError(f"path = {str(path)!r}: is a folder; give a file name")
+        above = next((p for p in path.parents if p.exists()), None)
+        if above is not None and not above.is_dir():
+            raise ValueError(f"path = {str(path)!r}: {str(above)!r} is a file, not a folder")
+        tmp = path.with_name(f".{path.name}.tmp{suffix}")
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do
+            if suffix == ".npz":
+                np.savez_compressed(
+                    tmp,
+                    color=self.color,
+                    depth=self.depth,
+                    normal=self.normal,
+                    iterations=self.iterations,
+                    hit=self.hit,
+                )
+            else:
+                self.image().save(tmp)
+            os.replace(tmp, path)
+        except OSError as e:
+            raise ValueError(f"path = {str(path)!r}: cannot write it: {e.strerror or e}") from None
+        finally:
+            with contextlib.suppress(OSError):  # under a file, say: nothing was made
+                tmp.unlink(missing_ok=True)
         return path
 
     @classmethod

@@ -10,6 +10,7 @@ import dataclasses
 import gc
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -214,6 +215,18 @@ def test_files_are_checked_before_any_work(tmp_path):
     with pytest.raises(ValueError, match=r"must end in \.png, \.npz"):
         frame.save(tmp_path / "x.foo")
     png = frame.save(tmp_path / "x.png")  # control
+    # a folder, a place under a file, a place that cannot be written: one line, as the
+    # API's other writers say (these were raw OSErrors), and no file left half written
+    (tmp_path / "d.png").mkdir()
+    for bad, said in (
+        (tmp_path / "d.png", "is a folder; give a file name"),
+        (tmp_path / "a-file" / "x.png", "a-file' is a file, not a folder"),
+        (Path("/proc/x.png"), "cannot write it"),
+    ):
+        with pytest.raises(ValueError) as e:
+            frame.save(bad)
+        assert said in one_line(e), bad
+    assert not list(tmp_path.glob(".*.tmp*")) and png.exists()
     with pytest.raises(ValueError, match="not a frame written by Frame.save"):
         krsview.Frame.load(png)
     with pytest.raises(ValueError, match="cannot read: No such file"):
