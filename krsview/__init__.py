@@ -2,7 +2,7 @@
 
 The Python API (see the README, "Use it from Python"):
 
-- :func:`load`, :func:`load_dict` → :class:`Scene` (immutable; ``scene.edit(path, value)``
+- :func:`load`, :func:`load_dict` → :class:`Scene` (frozen; ``scene.edit(path, value)``
   returns a new, validated scene); :func:`save` writes one; :func:`presets` lists the
   shipped scenes; a scene built from :mod:`krsview.scene`'s classes is validated as a file
   would be wherever the API takes it;

@@ -11,8 +11,8 @@ viewer and the editor are users of the same functions (modelled on mitsuba3's ``
 Threads: every GPU render goes through one headless OpenGL context per process, created on
 first use; :func:`render` serialises its calls on a lock, so it may be called from several
 threads. A :class:`Renderer` holds that context too and must be used by one thread at a time.
-Scenes are immutable values and may be shared freely; the float64 reference
-(``reference=True``) uses no GL at all.
+Scenes are frozen values (change one by ``edit``, not its lists in place) and may be shared
+freely; the float64 reference (``reference=True``) uses no GL at all.
 """
 
 from __future__ import annotations
