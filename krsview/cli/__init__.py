@@ -31,7 +31,7 @@ EXAMPLES = """examples:
   krsview render tree -o tree.png --size 640x360
   krsview check grass
   krsview bench levels tree
-  krsview render palm --view iterations -o palm-iterations.png
+  krsview render palm --view iterations --exact -o palm-iterations.png
   krsview bench tracers tree
   krsview view forest
   krsview export html tree -o tree.html
