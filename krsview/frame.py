@@ -43,8 +43,9 @@ class Frame:
     def save(self, path: str | Path) -> Path:
         """Write the colour (``.png``, or any format Pillow knows by the suffix) or every
         array (``.npz``), whole or not at all (a temporary file beside it, renamed); returns
-        the path. A suffix neither knows, a folder, or a place that cannot be written is
-        refused in one line (ValueError)."""
+        the path. A suffix neither knows, a folder, or a place under a file is refused in
+        one line (ValueError) before anything is written; a write that fails (a disk full)
+        is an OSError naming ``path``, and leaves nothing behind."""
         from PIL import Image
 
         if not isinstance(path, (str, Path)) or str(path) == "":
@@ -76,8 +77,8 @@ class Frame:
             else:
                 self.image().save(tmp)
             os.replace(tmp, path)
-        except OSError as e:
-            raise ValueError(f"path = {str(path)!r}: cannot write it: {e.strerror or e}") from None
+        except OSError as e:  # a disk full, a place not writable: said of the file asked for
+            raise OSError(e.errno, e.strerror, str(path)) from None
         finally:
             with contextlib.suppress(OSError):  # under a file, say: nothing was made
                 tmp.unlink(missing_ok=True)

@@ -10,7 +10,6 @@ import dataclasses
 import gc
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -221,11 +220,13 @@ def test_files_are_checked_before_any_work(tmp_path):
     for bad, said in (
         (tmp_path / "d.png", "is a folder; give a file name"),
         (tmp_path / "a-file" / "x.png", "a-file' is a file, not a folder"),
-        (Path("/proc/x.png"), "cannot write it"),
     ):
         with pytest.raises(ValueError) as e:
             frame.save(bad)
         assert said in one_line(e), bad
+    with pytest.raises(OSError) as e:  # a write that fails names the file asked for
+        frame.save("/proc/x.png")
+    assert e.value.filename == "/proc/x.png" and ".tmp" not in one_line(e)
     assert not list(tmp_path.glob(".*.tmp*")) and png.exists()
     with pytest.raises(ValueError, match="not a frame written by Frame.save"):
         krsview.Frame.load(png)
@@ -296,6 +297,9 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
     assert krsview.load(saved).render.epsilon_scale == 2.0
     refusals = [
         (lambda: krsview.render("rock", SIZE, effects="sky"), "effects = 'sky': expected a list"),
+        # the advice is one that works (it said "e.g. ['none']", itself refused)
+        (lambda: krsview.render("rock", SIZE, effects="none"), "list of effect names; none is []"),
+        (lambda: krsview.load("rock").with_effects(None), "effects = None: expected a list"),
         (lambda: krsview.load("rock").edit("krs.levels[0.kernel", 1), "expected names and"),
         (lambda: krsview.load("rock").edit(None, 1), "path = None: expected a path"),
         (lambda: krsview.render("rock", SIZE, progress=3), "progress = 3: expected a function"),
@@ -414,3 +418,14 @@ def test_the_benchmarks_are_named_in_krsview_bench():
     assert "bench_levels" in dir(krsview.bench)
     m = krsview.bench.bench_levels("sierpinski", (16, 9), step=8, rounds=1)
     assert m.rows and m.scene.name == "sierpinski"
+
+
+def test_a_scenes_statistics_read_as_check_prints_them():
+    """``str(krsview.check(...))`` was the dataclass's repr, empty fields and all; it is the
+    text `krsview check` prints (the CLI's own call), and the Scene class says what it is."""
+    info = krsview.check("grove")
+    text = str(info)
+    assert text.startswith("grove\n") and "geometry        compound of 8" in text
+    assert info.text("grove.toml").startswith("grove.toml: ok — grove\n")
+    assert "SceneInfo(" not in text and "parts=" not in text
+    assert "scene file holds" in krsview.Scene.__doc__

@@ -81,6 +81,7 @@ def test_reference_render_matches_size(tmp_path):
         (["render", "tree", "--epsilon-scale", "-inf"], "--epsilon-scale = -inf: NaN and infinity"),
         # outputs are checked before the render runs
         (["render", "tree", "-o", "x.jpg"], "-o = 'x.jpg': the file must end in .png"),
+        (["bench", "zoom", "tree", "--plot", "z.txt"], "--plot = 'z.txt': the file must end in"),
         (["render", "tree", "-o", "/tmp"], "-o = '/tmp': the file must end in .png"),
         (
             ["render", "tree", "-o", "/proc/no/such.png"],

@@ -14,7 +14,6 @@ import numpy as np
 
 from ..oracle.certify import Counts
 from ..scene import Scene
-from ..scene.info import SceneInfo
 
 
 @dataclass(frozen=True)
@@ -163,37 +162,6 @@ def _time_bars(group: list[dict], cost: str) -> np.ndarray | None:
     return np.array(
         [[r["ms"] - r["ms_min"] for r in group], [r["ms_max"] - r["ms"] for r in group]]
     )
-
-
-def scene_text(info: SceneInfo, source: str | Path) -> str:
-    """``krsview check``'s report of a scene's statistics (``source``: the file read)."""
-    lines = [f"{source}: ok — {info.name}"]
-    if info.description:
-        lines.append(f"  {info.description}")
-    if info.geometry == "MöKRS":
-        lines.append(
-            f"  geometry        MöKRS: {info.mirrors} levels, {info.reflecting} reflecting"
-        )
-    elif info.geometry == "compound":
-        lines.append(f"  geometry        compound of {len(info.parts)}: " + ", ".join(info.parts))
-    else:
-        lines.append(f"  geometry        {info.geometry}")
-        lines.append(
-            f"  levels          {info.levels} (kernels K_0..K_{info.mirrors}, "
-            f"{info.mirrors} mirrors)"
-        )
-    lines.append(f"  kernel instances {info.instances:,}")
-    lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in info.kernels.items()))
-    lines.append(f"  effects         {', '.join(info.effects) or 'none'}")
-    if info.moves:
-        lines.append(f"  moves           {info.moves}")
-    lines += [f"  warning         {w}" for w in info.warnings]
-    binary = f" (ξ_bonus {info.xi[0]}, ξ_penalty {info.xi[1]})" if info.xi else ""
-    lines.append(
-        f"  render          {info.tracer} tracer{binary}, ε-scale {info.epsilon_scale}, "
-        f"≤ {info.max_iterations} iterations, far {info.max_distance}"
-    )
-    return "\n".join(lines)
 
 
 def oracle_header(name: str, size: tuple[int, int]) -> str:

@@ -130,7 +130,7 @@ BENCHES = {
             (
                 "--plot",
                 dict(
-                    type=lambda text: output_file(text, "--plot", (".png",)),
+                    metavar="PATH",
                     help="also draw time and work along the flight into this PNG",
                 ),
             ),
@@ -215,8 +215,10 @@ def run(args: argparse.Namespace) -> int:
         scene = options.fast_scene_of(args, scene)
     if args.csv:
         output_file(args.csv, "--csv", (".csv",))
-    module = importlib.import_module(f"krsview.bench.{args.bench}")
     own = {dest: getattr(args, dest) for dest in args.own}
+    if own.get("plot"):  # checked here, where its error is one line (argparse hid it)
+        own["plot"] = output_file(own["plot"], "--plot", (".png",))
+    module = importlib.import_module(f"krsview.bench.{args.bench}")
     measured = getattr(module, f"bench_{args.bench}")(scene, args.size, rounds=args.rounds, **own)
     print(module.table(measured))
     if args.csv:

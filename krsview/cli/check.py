@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from .. import api
-from ..bench.report import oracle_header, oracle_row, scene_text
+from ..bench.report import oracle_header, oracle_row
 from ..oracle.certify import MAX_SEGMENTS
 from ..progress import Progress
 from ..scene import Scene, SceneError
@@ -69,10 +69,10 @@ def run(args: argparse.Namespace) -> int:
         return oracle(scenes_named(args.preset)[0], args.size, args.segments)
     if args.preset == "hard" or args.preset.startswith("hard:"):  # the cases' statistics
         for scene in scenes_named(args.preset, catalogue=True):
-            print(scene_text(api.check(scene), f"hard:{scene.name}"))
+            print(api.check(scene).text(f"hard:{scene.name}"))
         return 0
     source = resolve(args.preset)
-    print(scene_text(api.check(source), source))
+    print(api.check(source).text(source))
     return 0
 
 

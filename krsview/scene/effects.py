@@ -213,8 +213,13 @@ def allowed_effects(mokrs: bool) -> list[str]:
 
 def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> None:
     """Known names, no pair that excludes each other, nothing a MöKRS cannot draw."""
-    if isinstance(effects, str):  # one name would be read letter by letter
-        raise SceneError(path, effects, f"expected a list of effect names, e.g. [{effects!r}]")
+    if isinstance(effects, str) or not isinstance(effects, (list, tuple)):
+        if effects in ("none", "", None):
+            said = "expected a list of effect names; none is []"
+        else:  # one name would be read letter by letter
+            one = effects if isinstance(effects, str) else "sky"
+            said = f"expected a list of effect names, e.g. [{one!r}]"
+        raise SceneError(path, effects, said)
     for i, e in enumerate(effects):
         if e not in EFFECTS:
             raise SceneError(f"{path}[{i}]", e, "unknown effect; allowed: " + ", ".join(EFFECTS))

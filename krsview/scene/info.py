@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
+from pathlib import Path
 
 from .effects import EFFECTS
 from .scene import Scene
@@ -29,6 +30,42 @@ class SceneInfo:
     max_distance: float
     xi: tuple[float, float] | None  # binary tracing's (ξ_bonus, ξ_penalty)
     moves: str  # what changes with time ("" for a still scene), e.g. "wind; 2 keyframe tracks"
+
+    def text(self, source: str | Path | None = None) -> str:
+        """The statistics as `krsview check` prints them (``source``: the file read, said
+        first); ``str(info)`` is this without a source."""
+        info = self
+        lines = [f"{source}: ok — {info.name}" if source is not None else info.name]
+        if info.description:
+            lines.append(f"  {info.description}")
+        if info.geometry == "MöKRS":
+            lines.append(
+                f"  geometry        MöKRS: {info.mirrors} levels, {info.reflecting} reflecting"
+            )
+        elif info.geometry == "compound":
+            parts = ", ".join(info.parts)
+            lines.append(f"  geometry        compound of {len(info.parts)}: {parts}")
+        else:
+            lines.append(f"  geometry        {info.geometry}")
+            lines.append(
+                f"  levels          {info.levels} (kernels K_0..K_{info.mirrors}, "
+                f"{info.mirrors} mirrors)"
+            )
+        lines.append(f"  kernel instances {info.instances:,}")
+        lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in info.kernels.items()))
+        lines.append(f"  effects         {', '.join(info.effects) or 'none'}")
+        if info.moves:
+            lines.append(f"  moves           {info.moves}")
+        lines += [f"  warning         {w}" for w in info.warnings]
+        binary = f" (ξ_bonus {info.xi[0]}, ξ_penalty {info.xi[1]})" if info.xi else ""
+        lines.append(
+            f"  render          {info.tracer} tracer{binary}, ε-scale {info.epsilon_scale}, "
+            f"≤ {info.max_iterations} iterations, far {info.max_distance}"
+        )
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.text()
 
 
 def describe(scene: Scene) -> SceneInfo:

@@ -48,6 +48,12 @@ MAX_LIGHTS = 4  # the shaders' light slots (given to them by compile/constants.p
 
 @dataclass(frozen=True)
 class Scene:
+    """What a scene file holds: one geometry (a ``krs``, ``tree``, ``route`` or ``mokrs``
+    table, or a ``compound`` list), the camera, lights, material, render settings, the
+    effect set and its settings, bookmarks and an animation. A frozen value, compared and
+    hashed by value: :meth:`edit` returns a new scene validated as a file would be (change
+    none of its lists in place); ``krsview.load`` reads one, ``krsview.save`` writes one."""
+
     name: str = param("untitled", help="shown in the viewer and reports")
     description: str = param("", help="one line about the scene")
     camera: Camera = param(Camera())
