@@ -102,8 +102,8 @@ def frames(
     scene, size = scene_of(scene), size_of(size)
     path = camera_path if isinstance(camera_path, CameraPath) else load_camera_path(camera_path)
     fps = real(fps, "fps", 1.0, 240.0)
+    wanted = parse_frames(which, path.frame_count(fps), "which")  # before the folder is made
     job = FrameJob(scene, path, fps, size, output_dir(folder, "folder"))
-    wanted = parse_frames(which, job.count, "which")
     job.claim()
     todo = job.missing(wanted)
     if todo:

@@ -61,8 +61,8 @@ def run(args: argparse.Namespace) -> int:
 
     check_address(args.address)
     scene = options.scene_of(args)
+    video = check_video(args.video, args.size)  # before frame_job makes the folder
     job, frames = frame_job(args, scene)
-    video = check_video(args.video, job.size)
     job.claim("-o")  # the last check: it writes the folder's frames.json
     print(
         f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of {job.count}, "

@@ -250,9 +250,9 @@ def frame_job(args: argparse.Namespace, scene: Scene):
     given = "out/frames" if args.output is None else args.output
     if Path(given).suffix.lower() == ".png":
         raise SceneError("-o", given, "with --camera-path, give a folder for the frames")
-    folder = output_dir(given, "-o")
-    job = FrameJob(scene, path, args.fps, args.size, folder)
-    return job, parse_frames(args.frames, job.count)
+    frames = parse_frames(args.frames, path.frame_count(args.fps))  # before the folder is made
+    job = FrameJob(scene, path, args.fps, args.size, output_dir(given, "-o"))
+    return job, frames
 
 
 def check_video(text: str | None, size: tuple[int, int]) -> Path | None:
@@ -277,8 +277,8 @@ def write_video(job, frames: range, video: Path) -> None:
 
 
 def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
+    video = check_video(args.video, args.size)  # before frame_job makes the folder
     job, frames = frame_job(args, scene)
-    video = check_video(args.video, job.size)
     job.claim("-o")  # the last check: it writes the folder's frames.json
     todo = job.missing(frames)
     print(
