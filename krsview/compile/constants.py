@@ -34,6 +34,8 @@ SUN_SHARPNESS = 600.0  # cosine power of the sky's glow towards the first light
 TEXTURE_OCTAVES = 5
 TEXTURE_OCTAVE_SHIFT = (17.0, 31.0)  # decorrelates the octaves
 BARK_STRETCH = (0.25, 2.0)  # kernel texture: streaks long along a branch, fine around
+GROUND_STRETCH = (0.25, 0.25)  # ... and a plane's patches as wide as a streak is long (the
+# bark's streaks on a ground plane read as motion blur)
 
 # The GPU's own (gpu/uniforms.py, gpu/renderer.py, gpu/display.py and their shaders)
 MOBIUS_RECORD = 6  # vec4s per MöKRS level: a, b, c, d of H_i, its pole record, its bound
@@ -88,6 +90,7 @@ def shared() -> dict[str, GlslValue]:
         "TEXTURE_OCTAVES": TEXTURE_OCTAVES,
         "TEXTURE_OCTAVE_SHIFT": TEXTURE_OCTAVE_SHIFT,
         "BARK_STRETCH": BARK_STRETCH,
+        "GROUND_STRETCH": GROUND_STRETCH,
         "COMPUTE_GROUP": COMPUTE_GROUP,
         "PREPASS_TARGETS": PREPASS_TARGETS,
         "PREPASS_RATIO": PREPASS_RATIO,

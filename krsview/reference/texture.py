@@ -8,7 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..compile.constants import BARK_STRETCH, TEXTURE_OCTAVE_SHIFT, TEXTURE_OCTAVES
+from ..compile.constants import (
+    BARK_STRETCH,
+    GROUND_STRETCH,
+    TEXTURE_OCTAVE_SHIFT,
+    TEXTURE_OCTAVES,
+)
 from ..scene.tree import perpendicular
 from .kernels import arc_local
 
@@ -94,5 +99,6 @@ def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
 def kernel_texture(
     kind: str, rec: np.ndarray, xk: np.ndarray, footprint: np.ndarray, scale: float
 ) -> np.ndarray:
-    x = np.array(BARK_STRETCH) * kernel_uv(kind, rec, xk) / scale
-    return fbm(x, BARK_STRETCH[1] * footprint / scale)
+    stretch = np.array(GROUND_STRETCH if kind == "plane" else BARK_STRETCH)
+    x = stretch * kernel_uv(kind, rec, xk) / scale
+    return fbm(x, stretch.max() * footprint / scale)

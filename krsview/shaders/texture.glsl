@@ -80,8 +80,11 @@ vec2 kernel_uv(int level, vec3 xk, vec3 eye) {
     return vec2(dot(q, e1), dot(q, cross(u, e1)));
 }
 
+// Bark streaks along a branch; a ground plane's patches the same across (GROUND_STRETCH).
 float kernel_texture(int level, vec3 xk, vec3 eye, float footprint) {
-    vec2 x = BARK_STRETCH * kernel_uv(level, xk, eye) / u_texture_scale;
-    return texture_fbm(x, BARK_STRETCH.y * footprint / u_texture_scale);
+    bool plane = int(kernel_rec_float(level, 0).w) == KERNEL_PLANE;
+    vec2 stretch = plane ? vec2(GROUND_STRETCH) : vec2(BARK_STRETCH);
+    vec2 x = stretch * kernel_uv(level, xk, eye) / u_texture_scale;
+    return texture_fbm(x, max(stretch.x, stretch.y) * footprint / u_texture_scale);
 }
 #endif
