@@ -527,6 +527,10 @@ def test_a_shipped_presets_own_camera_path_replays_until_one_is_recorded(
     assert r.source == tmp_path / "grove-wind.path.json" and r.source.exists()
     assert Recorder(resolve("grove-wind")).path.duration == 1.0
     assert Recorder(resolve("tree")).path is None
+    copy = tmp_path / "mine" / "grove-wind.toml"  # a copy elsewhere: the shipped path too
+    copy.parent.mkdir()
+    shutil.copy(resolve("grove-wind"), copy)
+    assert Recorder(copy).path is not None and Recorder(copy).source.parent == PRESET_DIR
 
 
 def test_a_level_inserted_or_removed_changes_its_own_lines_alone(tmp_path):

@@ -102,7 +102,7 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
     still, lines, _ = seen[-1]
     after = sum(g[0][0].seconds for g in images[4:])  # the refinement's images' tracing
     assert still.size == SIZE == v.frames.image[1] and lines[0] == (
-        f"still {after:.2f} s after the stop: {SIZE[0]}×{SIZE[1]} (100% of the window's width)"
+        f"still (refined in {after:.2f} s): {SIZE[0]}×{SIZE[1]} (100% of the window's width)"
     )
     assert still.since_stop == pytest.approx(after) and still.since_stop > still.seconds
     assert "shadows per" not in lines[1]  # the still image's are per pixel
@@ -170,6 +170,8 @@ def test_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
     v.file.take()  # the file's camera changed: the view stays, and that is said
     assert v.message == "reloaded tree.toml; the view stays where it is (R: the file's camera)"
     assert v.scene.camera.fov_y == 60.0
+    v.reset_view()  # R: the file's camera taken, and said no more
+    assert v.message == "reloaded tree.toml"
     v.path.write_text(text.replace("branch_angle = 26.0", "branch_angle = 900.0"))
     v.file.take()
     assert "branch_angle" in v.error and v.message == ""

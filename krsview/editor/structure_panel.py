@@ -168,5 +168,7 @@ def _regrow_dialog(t: StructureTools, out: list[Command]) -> None:
     if len(lost) > MAX_LISTED:
         imgui.text(f"... and {len(lost) - MAX_LISTED} more")
     answers = [("grow again, losing them", ec.ConfirmRegrow())]
-    answer_buttons([*answers, ("cancel (keep the tree)", ec.CancelRegrow())], out)
+    answer_buttons([*answers, ("cancel (Esc: keep the tree)", ec.CancelRegrow())], out)
+    if imgui.is_key_pressed(imgui.Key.escape):  # as the other dialogs
+        out.append(ec.CancelRegrow())
     imgui.end_popup()

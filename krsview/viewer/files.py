@@ -16,6 +16,8 @@ from .frames import Frames
 from .recording import Recorder, path_file
 from .watch import FileWatcher
 
+CAMERA_KEPT = "; the view stays where it is (R: the file's camera)"  # said on a reload
+
 
 class Shows(Protocol):
     """What the file part reads and sets of the viewer."""
@@ -113,7 +115,7 @@ class ViewerFile:
             v.doc.reload()
             kept = "; the HUD's changes before it are one Ctrl+Z back" if dirty else ""
             if v.doc.scene.camera != camera:  # the view is the person's: said, not taken
-                kept += "; the view stays where it is (R: the file's camera)"
+                kept += CAMERA_KEPT
             v.error, v.message, self.refused = "", f"reloaded {self.path.name}{kept}", ""
         except SceneError as e:  # keep the last good scene and image; say only this
             v.error = self.refused = str(e)

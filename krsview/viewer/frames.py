@@ -61,7 +61,7 @@ class FrameState:
         k, n = self.step
         state = f"refining {k}/{n}" if self.state == "refining" else self.state
         if self.state == "still" and self.since_stop > self.seconds:  # after steps before it
-            state += f" {self.since_stop:.2f} s after the stop"
+            state += f" (refined in {self.since_stop:.2f} s)"
         state += ", shadows next" if self.blocks_of[0] else ""
         return f"{state}: {w}×{h} ({share:.0%} of the window's width)"
 

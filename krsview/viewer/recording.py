@@ -11,6 +11,7 @@ import numpy as np
 from ..document.document import copy_target, shipped
 from ..scene import SceneError
 from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
+from ..scene.presets import PRESET_DIR
 from ..scene.scene import write_atomic
 from .camera import FlyCamera
 
@@ -32,8 +33,11 @@ class Recorder:
         self.path: CameraPath | None = None
         self.replay_start: float | None = None
         self.message, self.error = "", ""
-        # a shipped preset's own path (grove-wind's) until one is recorded beside its copy
+        # a shipped preset's own path (grove-wind's), opened by name or as a copy, until one
+        # is recorded beside the copy
         own = scene_file.with_name(scene_file.stem + ".path.json")
+        if not own.exists():
+            own = PRESET_DIR / own.name
         source = self.file if self.file.exists() or not own.exists() else own
         if source.exists():  # a damaged file is reported, not fatal
             try:

@@ -31,7 +31,7 @@ from .adaptive import AdaptiveResolution
 from .camera import FlyCamera
 from .controls import Input
 from .drawn import Drawn
-from .files import ViewerFile
+from .files import CAMERA_KEPT, ViewerFile
 from .frames import Frames
 from .hudframe import HudFrame
 from .loop import run
@@ -212,6 +212,8 @@ class Viewer:
     def reset_view(self) -> None:
         self.nav.reset(self.scene.camera)
         self.frames.dirty = True
+        if self.message.endswith(CAMERA_KEPT):  # R took the file's camera: said no more
+            self.message = self.message[: -len(CAMERA_KEPT)]
 
     def toggle_orbit(self) -> None:
         def centre():
