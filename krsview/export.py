@@ -24,6 +24,7 @@ from .share.frames import (
     DEFAULT_FPS,
     FrameJob,
     frame_file,
+    frames_in,
     parse_frames,
     render_frames,
     write_video,
@@ -123,9 +124,8 @@ def video(
     ``done(k)`` after each frame. The frames need an even width and height."""
     folder, video = Path(folder), output_file(video_path, "video_path", (".mp4",))
     fps = real(fps, "fps", 1.0, 240.0)
-    numbers = [int(f.stem[6:]) for f in folder.glob("frame_*.png") if f.stem[6:].isdigit()]
-    count = max(numbers, default=0) + 1  # which=None: from 0 to the last (each must be there)
-    which = parse_frames(which, max(count, 1), "which", "the folder has frames {}")
+    count = max(frames_in(folder), 1)  # which=None: from 0 to the last (each must be there)
+    which = parse_frames(which, count, "which", "the folder has frames {}")
     missing = next((k for k in which if not frame_file(folder, k).exists()), None)
     if not which or missing is not None:
         name = frame_file(folder, 0 if missing is None else missing).name

@@ -128,7 +128,7 @@ class FileActions:
     def save_as(self, text: str) -> bool:
         """Save to the file named; another file that exists is replaced only when asked
         twice (the first time says so: the panel's field, the dialog's button)."""
-        target = Path(text.strip()).expanduser()
+        target = _target(text)
         if target.suffix != ".toml" or target.is_dir():
             self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
             return False
@@ -141,13 +141,12 @@ class FileActions:
 
     def replaces(self, text: str) -> bool:
         """Whether saving as ``text`` would replace a file other than the document's own."""
-        target = Path(text.strip()).expanduser()
+        target = _target(text)
         return target.is_file() and target.resolve() != self.doc.path.resolve()
 
     def replace_asked(self, text: str) -> bool:
         """Whether the next save as ``text`` replaces another file (told once already)."""
-        target = Path(text.strip()).expanduser()
-        return self.replacing is not None and self.replacing == target.resolve()
+        return self.replacing is not None and self.replacing == _target(text).resolve()
 
     def ask_save_as(self) -> None:
         """Ctrl+Shift+S: the dialog asks where to save (a shipped preset's: its copy)."""
@@ -247,3 +246,8 @@ FILE_HANDLERS: dict[type[vc.Command], Callable[[FileActions, Any], None]] = {
     vc.OpenPreset: lambda f, c: f.open_preset(c.path),
     vc.ReloadScene: lambda f, c: f.reload_scene(),
 }
+
+
+def _target(text: str) -> Path:
+    """The file a save-as field's text names."""
+    return Path(text.strip()).expanduser()

@@ -141,14 +141,7 @@ class Editor:
         self._follow()
         return self.shown_now.scene
 
-    def edit(
-        self,
-        path: tuple,
-        value,
-        interaction=None,
-        label: str | None = None,
-        field: tuple[tuple, Any] | None = None,
-    ) -> bool:
+    def edit(self, path: tuple, value, interaction=None, label=None, field=None) -> bool:
         """An edit through the document, validated by the schema; in a MöKRS the viewpoint
         the person flies must stay off every pole too, not only the file's camera
         [KRS17 §7]. A value refused for a field the panel shows keeps its message at that

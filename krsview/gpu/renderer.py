@@ -97,14 +97,12 @@ class Renderer:
         probes: tuple[str, ...] = (),
         detail_height: int = 0,
     ) -> moderngl.Program:
-        """Compile (or fetch) the scene's variant and upload its uniforms; ``detail_height``:
-        the height of the image whose pixel sets the detail drawn (compile/camera.View; 0:
-        this one's); ``all_effects``
+        """Compile (or fetch) the scene's variant and upload its uniforms; ``all_effects``
         picks the variant with every effect compiled in and switched by uniforms,
         ``probes`` the defines of a measuring variant, drawn on the fragment path (the
         tracing alone by persistent lanes too, compute.LANE_PROBES): KRS_COUNT_LEVELS counts
         the levels Alg. 1 walks (:meth:`levels`), KRS_TRACE_ONLY traces without shading
-        (bench split, the passes' trace pass)."""
+        (bench split, the passes' trace pass); ``detail_height``: see compile/camera.View."""
         with self.current():
             return self._prepare(scene, width, height, geometry, all_effects, probes, detail_height)
 
@@ -327,20 +325,14 @@ class Renderer:
                 progress(k + 1, bands)
             return read_buffers(fbo, width, height)
 
-    def _passes(
-        self,
-        scene: Scene,
-        size: tuple[int, int],
-        geometry: Geometry | None,
-        ratio: int,
-        detail_height: int = 0,
-    ) -> PassImage:
+    def _passes(self, scene: Scene, size, geometry: Geometry | None, ratio: int, detail=0):
+        """``scene`` as a PassImage (passes.py) of ``size``; ``detail``: its detail_height."""
         if self._pass_targets is None:
             self._pass_targets = Targets(self.ctx)
         scene = scene.posed()  # the static scene drawn at its time (tracks, sway)
         geometry = geometry or self.geometry_of(scene)
         return PassImage(
-            self, self._pass_targets, scene, size, geometry, ratio, detail_height=detail_height
+            self, self._pass_targets, scene, size, geometry, ratio, detail_height=detail
         )
 
     def levels(

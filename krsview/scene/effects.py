@@ -213,10 +213,10 @@ def allowed_effects(mokrs: bool) -> list[str]:
 
 def check_effects(effects: list[str], mokrs: bool, path: str = "effects") -> None:
     """Known names, no pair that excludes each other, nothing a MöKRS cannot draw."""
-    if isinstance(effects, str) or not isinstance(effects, (list, tuple)):
+    if not isinstance(effects, (list, tuple)):  # a string would be read letter by letter
         if effects in ("none", "", None):
             said = "expected a list of effect names; none is []"
-        else:  # one name would be read letter by letter
+        else:
             one = effects if isinstance(effects, str) else "sky"
             said = f"expected a list of effect names, e.g. [{one!r}]"
         raise SceneError(path, effects, said)

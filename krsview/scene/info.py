@@ -34,33 +34,32 @@ class SceneInfo:
     def text(self, source: str | Path | None = None) -> str:
         """The statistics as `krsview check` prints them (``source``: the file read, said
         first); ``str(info)`` is this without a source."""
-        info = self
-        lines = [f"{source}: ok — {info.name}" if source is not None else info.name]
-        if info.description:
-            lines.append(f"  {info.description}")
-        if info.geometry == "MöKRS":
+        lines = [f"{source}: ok — {self.name}" if source is not None else self.name]
+        if self.description:
+            lines.append(f"  {self.description}")
+        if self.geometry == "MöKRS":
             lines.append(
-                f"  geometry        MöKRS: {info.mirrors} levels, {info.reflecting} reflecting"
+                f"  geometry        MöKRS: {self.mirrors} levels, {self.reflecting} reflecting"
             )
-        elif info.geometry == "compound":
-            parts = ", ".join(info.parts)
-            lines.append(f"  geometry        compound of {len(info.parts)}: {parts}")
+        elif self.geometry == "compound":
+            parts = ", ".join(self.parts)
+            lines.append(f"  geometry        compound of {len(self.parts)}: {parts}")
         else:
-            lines.append(f"  geometry        {info.geometry}")
+            lines.append(f"  geometry        {self.geometry}")
             lines.append(
-                f"  levels          {info.levels} (kernels K_0..K_{info.mirrors}, "
-                f"{info.mirrors} mirrors)"
+                f"  levels          {self.levels} (kernels K_0..K_{self.mirrors}, "
+                f"{self.mirrors} mirrors)"
             )
-        lines.append(f"  kernel instances {info.instances:,}")
-        lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in info.kernels.items()))
-        lines.append(f"  effects         {', '.join(info.effects) or 'none'}")
-        if info.moves:
-            lines.append(f"  moves           {info.moves}")
-        lines += [f"  warning         {w}" for w in info.warnings]
-        binary = f" (ξ_bonus {info.xi[0]}, ξ_penalty {info.xi[1]})" if info.xi else ""
+        lines.append(f"  kernel instances {self.instances:,}")
+        lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in self.kernels.items()))
+        lines.append(f"  effects         {', '.join(self.effects) or 'none'}")
+        if self.moves:
+            lines.append(f"  moves           {self.moves}")
+        lines += [f"  warning         {w}" for w in self.warnings]
+        binary = f" (ξ_bonus {self.xi[0]}, ξ_penalty {self.xi[1]})" if self.xi else ""
         lines.append(
-            f"  render          {info.tracer} tracer{binary}, ε-scale {info.epsilon_scale}, "
-            f"≤ {info.max_iterations} iterations, far {info.max_distance}"
+            f"  render          {self.tracer} tracer{binary}, ε-scale {self.epsilon_scale}, "
+            f"≤ {self.max_iterations} iterations, far {self.max_distance}"
         )
         return "\n".join(lines)
 

@@ -226,12 +226,13 @@ class Scene:
         keeps its leaves on the last levels it grows). The result no longer moves: to draw
         a moving scene's levels at another moment, ``krsview.configure(scene, time=T,
         levels=N)`` poses it first."""
-        g = checked(self).posed().geometry()
+        scene = checked(self)  # validated (a copy, where its lists changed in place)
+        g = scene.posed().geometry()
         if not isinstance(levels, numbers.Integral) or isinstance(levels, bool):
             raise SceneError(path, levels, f"expected a whole number, 1..{g.depth}")
         if not 1 <= levels <= g.depth:
             raise SceneError(path, levels, f"this scene has {g.depth} levels; allowed 1..{g.depth}")
-        return self.with_geometry(g.truncated(int(levels)))
+        return scene.with_geometry(g.truncated(int(levels)))
 
     def with_effects(self, effects: list[str], path: str = "effects") -> Scene:
         """The scene with this effect set compiled in (checked against what it allows)."""

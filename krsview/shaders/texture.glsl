@@ -82,8 +82,10 @@ vec2 kernel_uv(int level, vec3 xk, vec3 eye) {
 
 // Bark streaks along a branch; a ground plane's patches the same across (GROUND_STRETCH).
 float kernel_texture(int level, vec3 xk, vec3 eye, float footprint) {
-    bool plane = int(kernel_rec_float(level, 0).w) == KERNEL_PLANE;
-    vec2 stretch = plane ? vec2(GROUND_STRETCH) : vec2(BARK_STRETCH);
+    vec2 stretch = vec2(BARK_STRETCH);
+#ifdef KRS_KERNEL_PLANE  // a scene without a plane reads no kernel type here
+    if (int(kernel_rec_float(level, 0).w) == KERNEL_PLANE) stretch = vec2(GROUND_STRETCH);
+#endif
     vec2 x = stretch * kernel_uv(level, xk, eye) / u_texture_scale;
     return texture_fbm(x, max(stretch.x, stretch.y) * footprint / u_texture_scale);
 }

@@ -28,6 +28,12 @@ def frame_file(folder: Path, k: int) -> Path:
     return Path(folder) / f"frame_{k:05d}.png"
 
 
+def frames_in(folder: Path) -> int:
+    """One more than the highest frame number in ``folder`` (0: none there)."""
+    numbers = [f.stem[6:] for f in Path(folder).glob("frame_*.png")]
+    return max((int(n) + 1 for n in numbers if n.isdigit()), default=0)
+
+
 @dataclass(frozen=True)
 class FrameJob:
     """Everything a renderer needs for frames of one path: plain data, so it can be sent

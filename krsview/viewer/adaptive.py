@@ -21,7 +21,8 @@ REFINING_TURNS = 2.0  # a refining turn traces for at most this many frame budge
 REST_TURNS = 9  # the recent turns whose rest (display, HUD, swap, input) a moving frame counts
 MIN_TRACE_SHARE = 0.5  # a moving frame's tracing keeps at least this share of the budget
 DAMPED = (0.7, 1.25)  # a moving frame's scale changes by at most these factors ...
-OVERRUN = 2.0  # ... unless it took this many trace budgets: then at once (to 0.35 at least)
+OVERRUN = 2.0  # ... unless it took this many trace budgets: then at once, down to
+OVERRUN_FACTOR = 0.35  # this factor at least
 
 
 @dataclass
@@ -72,7 +73,7 @@ class AdaptiveResolution:
         if seconds <= 0:
             return
         factor = math.sqrt(self.trace_budget / seconds)
-        low = DAMPED[0] if seconds < OVERRUN * self.trace_budget else 0.35
+        low = DAMPED[0] if seconds < OVERRUN * self.trace_budget else OVERRUN_FACTOR
         factor = min(DAMPED[1], max(low, factor))  # damped: a noisy frame moves scale a little
         self.scale = min(1.0, max(self.min_scale, self.scale * factor))
 
