@@ -145,6 +145,10 @@ def test_structural_mistakes():
     syntax = error_of('name = "x"\n[render\nfoo = 1\n')
     assert syntax.value == "line 2, column 8" and "Expected ']'" in syntax.allowed, str(syntax)
     assert "…" not in str(syntax)
+    # the file, where in it, what is wrong: no "<syntax> = " (a field it is not)
+    assert str(syntax.in_file("s.toml")) == (
+        "s.toml: line 2, column 8: not valid TOML (Expected ']' at the end of a table declaration)"
+    )
     assert error_of("[tree]\nbranch_angle = 95.0").path == "tree.branch_angle"
 
 
@@ -239,7 +243,7 @@ PALM_ROTATE = (
     [
         (
             b"\x89PNG\r\n\x1a\n\x00\x00garbage",
-            "<file> = 'byte 0x89 at offset 0': a scene file is UTF-8 text",
+            "bad.toml: byte 0x89 at offset 0: a scene file is UTF-8 text",
         ),
         ("[camera]\nfov_y = 40.0\n".encode("utf-16"), "this one is UTF-16: save it as UTF-8"),
         (

@@ -269,9 +269,7 @@ def scene_from_toml(text: str, file: str = "<string>") -> Scene:
     except tomllib.TOMLDecodeError as e:
         what, _, where = str(e).rpartition(" (at ")  # tomllib: "... (at line 2, column 8)"
         where = where.rstrip(")") if what else "the file"
-        raise SceneError(
-            "<syntax>", where, f"{what or e}: the file is not valid TOML", file
-        ) from None
+        raise SceneError("<syntax>", where, f"not valid TOML ({what or e})", file) from None
     try:
         return from_dict(Scene, data)
     except SceneError as e:

@@ -36,6 +36,11 @@ def _brief(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
+# The "paths" of mistakes in a file as a whole (unreadable, too large, not UTF-8 or not TOML),
+# not in one of its fields: their message says the file, then where in it, then what is wrong.
+WHOLE_FILE = ("<file>", "<syntax>")
+
+
 class SceneError(ValueError):
     """A user mistake in a scene: names the file, the field path, the value and what is allowed."""
 
@@ -44,6 +49,9 @@ class SceneError(ValueError):
         super().__init__(self._text())
 
     def _text(self) -> str:
+        if self.path in WHOLE_FILE:  # no field to name: the file, where in it, what is wrong
+            parts = [self.file, None if str(self.value) == self.file else str(self.value)]
+            return ": ".join([p for p in parts if p] + [self.allowed])
         where = f"{self.file}: " if self.file else ""
         return f"{where}{self.path} = {_brief(self.value)}: {self.allowed}"
 
