@@ -7,6 +7,7 @@ the same checks through the API."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
 from collections.abc import Iterable
@@ -114,12 +115,27 @@ def output_dir(path: Any, what: str) -> Path:
     return p
 
 
+# Folders the output checks made, deepest last: a command refused after its outputs were
+# checked takes back those still empty (unmake_folders), and leaves nothing behind.
+MADE: list[Path] = []
+
+
+def unmake_folders() -> None:
+    """Remove the folders the output checks made that are still empty, deepest first."""
+    for folder in reversed(MADE):
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+    MADE.clear()
+
+
 def _probe(folder: Path, name: str, what: str, given: str) -> None:
     above = next((p for p in (folder, *folder.parents) if p.exists()), None)
     if above is not None and not above.is_dir():
         raise SceneError(what, given, f"{str(above)!r} is a file, not a folder")
+    new = [p for p in (folder, *folder.parents) if not p.exists()]
     try:
         folder.mkdir(parents=True, exist_ok=True)
+        MADE.extend(reversed(new))
         (folder / name).write_text("")
         (folder / name).unlink()
     except OSError as e:

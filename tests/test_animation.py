@@ -81,3 +81,43 @@ def test_equal_geometry_compiles_once_and_a_change_compiles_anew():
     assert all(np.array_equal(getattr(ca, f), getattr(fresh, f)) for f in ("mirrors", "records"))
     moved = a.edit("tree.bend", 0.1)  # negative control: another geometry, another compile
     assert compile_geometry(moved.geometry(), moved.material.albedo) is not ca
+
+
+def turning(keys: str, interpolation: str = "linear") -> str:
+    return (
+        'name = "turning"\n[tree]\nlevels = 6\nup = [1.0, 0.0, 0.0]\n[[animation.tracks]]\n'
+        f'path = "tree.up"\ninterpolation = "{interpolation}"\nkeys = {keys}\n'
+    )
+
+
+def test_check_poses_tracks_between_keys_and_warns_where_a_vector_flips(tmp_path):
+    """`krsview check` said "ok" for a direction keyed through the zero vector half way
+    between two valid keys; a render then stopped at that moment [review]. It poses the
+    scene between keys, and warns where a vector track passes (almost) through what it must
+    keep away from, where the view or direction flips in an instant."""
+    from krsview import check
+
+    f = tmp_path / "t.toml"
+    f.write_text(turning("[[0.0, [1.0, 0.0, 0.0]], [3.0, [-1.0, 0.0, 0.0]]]"))
+    with pytest.raises(SceneError) as e:  # exactly zero at the keys' middle, 1.5 s
+        check(f)
+    assert str(e.value).startswith(f"{f}: animation.tracks[0] at t = 1.5 s = [0.0, 0.0, 0.0]")
+    # the zero at 2/3 of the way, smooth: no time drawn is exactly zero, but it flips there
+    flips = check(scene_from_toml(turning("[[0.0, [2.0, 0.0, 0.0]], [3.0, [-1.0, 0.0, 0.0]]]",
+                                          "smooth")))  # fmt: skip
+    (w,) = flips.warnings
+    assert w.startswith("animation.tracks[0]: tree.up passes through the zero vector at t ≈ ")
+    t = float(w.split("≈ ")[1].split(" s")[0])
+    s = t / 3.0  # eased: 2 − 3 (3s² − 2s³) = 0 there
+    assert abs(2 - 3 * (3 * s**2 - 2 * s**3)) < 1e-3 and "posed at 3 moments" in flips.moves
+    # control: a key off the line, the path passes 0.1 from zero: no warning
+    off = "[[0.0, [2.0, 0.0, 0.0]], [3.0, [-1.0, 0.1, 0.0]]]"
+    assert check(scene_from_toml(turning(off, "smooth"))).warnings == ()
+    # the camera keyed through what it looks at (its target stays at the preset's)
+    tree = load("tree")
+    p, q = list(tree.camera.position), tree.camera.target
+    beyond = [2 * b - a for a, b in zip(p, q)]
+    track = {"path": "camera.position", "interpolation": "linear"}
+    through = tree.edit("animation", {"tracks": [{**track, "keys": [[0.0, p], [3.0, beyond]]}]})
+    with pytest.raises(SceneError, match=r"between its keys: camera\.target: must be at least"):
+        check(through)

@@ -213,6 +213,17 @@ def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, 
         ),
         ('{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 2}]}', "−π/2 < pitch"),
         ('{"poses": [{"t": 0, "position": [0, 0, NaN], "yaw": 0, "pitch": 0}]}', "finite"),
+        # a pose's time far out: the run checked every frame of the path and hung [review]
+        (
+            '{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 0},'
+            ' {"t": 1e9, "position": [0, 0, 0], "yaw": 0, "pitch": 0}]}',
+            "poses[1].t = 1000000000.0: a path lasts at most 1e+06 s",
+        ),
+        (
+            '{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 0, "roll": 1}]}',
+            "poses[0].roll = 1: unknown key; a pose has t, position, yaw, pitch",
+        ),
+        ('{"poses": [{"t": 0, "position": [0, 2e9, 0], "yaw": 0, "pitch": 0}]}', "±1e+09"),
     ],
 )
 def test_a_damaged_path_file_names_the_file_and_the_pose(tmp_path, text, message):
@@ -258,3 +269,39 @@ def test_a_video_of_odd_sized_frames_is_refused_before_ffmpeg(path_file, tmp_pat
     even = krsview.export.frames(scene, path_file, tmp_path / "even", (32, 18), FPS, 1)
     video = krsview.export.video(even[0].parent, tmp_path / "even.mp4", which="1")
     assert video.stat().st_size > 0
+
+
+TURNING_UP = """name = "turning"
+[tree]
+levels = 6
+up = [1.0, 0.0, 0.0]
+[[animation.tracks]]
+path = "tree.up"
+interpolation = "linear"
+keys = [[0.0, [1.0, 0.0, 0.0]], [KEY, [-1.0, 0.0, 0.0]]]
+"""
+
+
+def test_a_track_that_breaks_its_rule_between_keys_is_refused_before_any_frame(tmp_path):
+    """tree.up through the zero vector half way (t = 0.5 s, frame 2 at 4 fps): the run used to
+    draw the frames before it and stop there, leaving frames and no video [review]."""
+    f = tmp_path / "turning.toml"
+    f.write_text(TURNING_UP.replace("KEY", "1.0"))
+    path = tmp_path / "p.path.json"
+    path.write_text(json.dumps({"poses": POSES}))
+    out = tmp_path / "frames"
+    r = krsview_cli(
+        "render", str(f), "--camera-path", str(path), "--fps", str(FPS), "--size", "32x18",
+        "-o", str(out), "--video", str(tmp_path / "v" / "v.mp4"),
+    )  # fmt: skip
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert f"{f}: animation.tracks[0] at t = 0.5 s" in r.stderr and "zero vector" in r.stderr
+    assert not out.exists() and not (tmp_path / "v").exists(), "a refused run made folders"
+    # control: keys 1.1 s apart put the zero between frames (0.55 s): every frame draws
+    f.write_text(TURNING_UP.replace("KEY", "1.1"))
+    r = krsview_cli(
+        "render", str(f), "--camera-path", str(path), "--fps", str(FPS), "--size", "32x18",
+        "-o", str(out), "--frames", "1-2",
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in out.glob("*.png")) == ["frame_00001.png", "frame_00002.png"]

@@ -10,6 +10,7 @@ import os
 import re
 import sys
 
+from ..inputs import unmake_folders
 from ..scene import SceneError
 from ..scene.presets import preset_names
 from ..version import __version__
@@ -87,6 +88,7 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, inside the try, not at exit
         return code
     except SceneError as e:
+        unmake_folders()  # a refused command leaves no empty folder behind
         print(f"krsview: error: {e}", file=sys.stderr)
         return EXIT_SCENE
     except RuntimeError as e:  # ContextError, ShaderError, MissingExtra: the environment

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from ..frame import Frame
 from ..inputs import output_dir, output_file
 from ..progress import Progress
 from ..scene import Scene, SceneError
+from ..scene.presets import resolve
 from ..scene.render import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, LANES_LEVELS, VIEW_PREPASS
 from ..share.frames import DEFAULT_FPS
 from . import options
@@ -251,8 +253,16 @@ def frame_job(args: argparse.Namespace, scene: Scene):
     if Path(given).suffix.lower() == ".png":
         raise SceneError("-o", given, "with --camera-path, give a folder for the frames")
     frames = parse_frames(args.frames, path.frame_count(args.fps))  # before the folder is made
-    job = FrameJob(scene, path, args.fps, args.size, output_dir(given, "-o"))
-    return job, frames
+    job = FrameJob(scene, path, args.fps, args.size, Path(given))
+    if scene.animation is not None and scene.animation.tracks:  # a track between its keys
+        bar = Progress(len(frames), "  posing the frames", SILENT_SECONDS)
+        try:
+            for k in frames:
+                job.frame_scene(k).posed()
+                bar.step()
+        except SceneError as e:
+            raise e.in_file(str(resolve(args.preset))) if e.file is None else e from None
+    return replace(job, folder=output_dir(given, "-o")), frames
 
 
 def check_video(text: str | None, size: tuple[int, int]) -> Path | None:

@@ -13,9 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .animation import MAX_TIME
 from .render import Camera
-from .schema import SceneError
+from .schema import COORDINATE_LIMIT, SceneError
 
+POSE_KEYS = ("t", "position", "yaw", "pitch")
 FORMAT = '{"poses": [{"t": seconds, "position": [x, y, z], "yaw": radians, "pitch": radians}, …]}'
 
 
@@ -106,6 +108,14 @@ def load_camera_path(path: str | Path) -> CameraPath:
         raise SceneError("poses", poses, f"a non-empty list; expected {FORMAT}", str(f))
     out = []
     for i, p in enumerate(poses):
+        unknown = sorted(set(p) - set(POSE_KEYS)) if isinstance(p, dict) else []
+        if unknown:
+            raise SceneError(
+                f"poses[{i}].{unknown[0]}",
+                p[unknown[0]],
+                f"unknown key; a pose has {', '.join(POSE_KEYS)}",
+                str(f),
+            )
         try:
             pose = Pose(
                 float(p["t"]),
@@ -123,6 +133,17 @@ def load_camera_path(path: str | Path) -> CameraPath:
         values = (pose.t, *pose.position, pose.yaw, pose.pitch)
         if len(pose.position) != 3 or not all(math.isfinite(v) for v in values):
             raise SceneError(f"poses[{i}]", p, "finite numbers and a 3-vector position", str(f))
+        if not all(abs(c) <= COORDINATE_LIMIT for c in pose.position):
+            raise SceneError(
+                f"poses[{i}].position",
+                list(pose.position),
+                f"allowed ±{COORDINATE_LIMIT:g}",
+                str(f),
+            )
+        if pose.t - (out[0].t if out else pose.t) > MAX_TIME or abs(pose.t) > MAX_TIME:
+            raise SceneError(
+                f"poses[{i}].t", pose.t, f"a path lasts at most {MAX_TIME:g} s", str(f)
+            )
         if out and pose.t < out[-1].t:
             raise SceneError(
                 f"poses[{i}].t",

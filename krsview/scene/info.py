@@ -7,6 +7,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+from .animation import near_misses
 from .effects import EFFECTS
 from .scene import Scene
 
@@ -67,8 +68,9 @@ class SceneInfo:
         return self.text()
 
 
-def describe(scene: Scene) -> SceneInfo:
-    """The statistics of a (validated) scene."""
+def describe(scene: Scene, posed: int = 0) -> SceneInfo:
+    """The statistics of a (validated) scene; ``posed``: at how many moments its motion
+    was checked (animation.check_motion)."""
     g = scene.geometry()
     if scene.mokrs is not None:
         kind = "MöKRS"
@@ -90,7 +92,8 @@ def describe(scene: Scene) -> SceneInfo:
         instances=g.instance_count(),
         kernels=dict(sorted(Counter(k.kind for k in g.kernels).items())),
         effects=tuple(scene.effects),
-        warnings=tuple(f"route.{w}" for w in (scene.route.warnings() if scene.route else ())),
+        warnings=tuple(f"route.{w}" for w in (scene.route.warnings() if scene.route else ()))
+        + tuple(near_misses(scene)),
         parts=parts,
         reflecting=sum(lv.reflect for lv in scene.mokrs.levels) if scene.mokrs else 0,
         tracer=r.tracer,
@@ -98,12 +101,13 @@ def describe(scene: Scene) -> SceneInfo:
         max_iterations=r.max_iterations,
         max_distance=r.max_distance,
         xi=(r.xi_bonus, r.xi_penalty) if r.tracer == "binary" else None,
-        moves=motion(scene),
+        moves=motion(scene, posed),
     )
 
 
-def motion(scene: Scene) -> str:
-    """What moves the scene with time, in a line ("" when nothing does)."""
+def motion(scene: Scene, posed: int = 0) -> str:
+    """What moves the scene with time, in a line ("" when nothing does); ``posed``: at
+    how many moments its tracks were checked."""
     a = scene.animation
     parts = [e for e in scene.effects if EFFECTS[e].reads_time]
     if a is not None and a.tracks:
@@ -113,4 +117,5 @@ def motion(scene: Scene) -> str:
         parts.append(f"sway of {w.levels} levels, {w.amplitude:g}° at {w.frequency:g} Hz")
     if not parts:
         return ""
-    return "; ".join(parts) + f" — loop {scene.duration:g} s"
+    checked = f", posed at {posed} moments" if posed else ""
+    return "; ".join(parts) + f" — loop {scene.duration:g} s{checked}"

@@ -83,7 +83,7 @@ class FrameJob:
             except (OSError, ValueError):
                 theirs = {}
             differ = [k for k in mine if not isinstance(theirs, dict) or theirs.get(k) != mine[k]]
-            if differ and any(frame_file(self.folder, k).exists() for k in range(self.count)):
+            if differ and self._frames_there():
                 raise SceneError(
                     what,
                     str(self.folder),
@@ -92,9 +92,8 @@ class FrameJob:
                     "another folder, or empty this one",
                 )
         else:
-            for k in range(self.count):
-                f = frame_file(self.folder, k)
-                if f.exists() and frame_size(f) != self.size:
+            for f in self._frames_there():
+                if frame_size(f) != self.size:
                     w, h = frame_size(f)
                     raise SceneError(
                         what,
@@ -103,6 +102,12 @@ class FrameJob:
                         "another folder, or empty this one",
                     )
         write_atomic(file, json.dumps(mine, indent=1) + "\n")
+
+    def _frames_there(self) -> list[Path]:
+        """The folder's files of this path's frames (listed once: a long path's frame count
+        can be far larger than what the folder holds)."""
+        there = (frame_file(self.folder, k) for k in range(min(self.count, frames_in(self.folder))))
+        return [f for f in there if f.exists()]
 
 
 def frame_size(f: Path) -> tuple[int, int]:
