@@ -138,6 +138,29 @@ def test_batch_on_the_command_line(tmp_path, path_file):
     assert r.returncode == 0 and "0 already there, 5 rendered" in r.stdout, r.stderr[-3000:]
     r = krsview_cli(*args)
     assert r.returncode == 0 and "5 already there, 0 rendered" in r.stdout
+    # the files are those `render --camera-path` writes: batch drew its frames with other
+    # settings (no fast settings), 6.6 % of the pixels apart, and could not resume them [review]
+    rendered = tmp_path / "r"
+    r = krsview_cli(*(["render", *args[1:8], "-o", str(rendered)]))
+    assert r.returncode == 0, r.stderr[-3000:]
+    for k in range(5):
+        a, b = (np.asarray(Image.open(frame_file(d, k))) for d in (tmp_path / "f", rendered))
+        assert np.array_equal(a, b), f"frame {k} differs"
+    assert (tmp_path / "f" / "frames.json").read_text() == (rendered / "frames.json").read_text()
+    # control: --exact draws other frames, so its run refuses the folder of the fast ones
+    r = krsview_cli(*args, "--exact")
+    assert r.returncode == 2 and "holds frames of another run (its scene differs)" in r.stderr
+
+
+def test_a_local_cluster_takes_a_worker_per_cpu_and_no_more_than_its_chunks(tmp_path, path_file):
+    base = ["batch", "tree", "--camera-path", str(path_file), "--fps", "4", "--size", "32x18"]
+    many = os.cpu_count() + 1
+    r = krsview_cli(*base, "-o", str(tmp_path / "f"), "--workers", str(many))
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr  # it hung [review]
+    assert f"--workers = {many}: a local cluster runs one worker per CPU" in r.stderr
+    assert not (tmp_path / "f").exists()
+    r = krsview_cli(*base, "-o", str(tmp_path / "g"), "--frames", "0-1", "--workers", "2")
+    assert r.returncode == 0 and "on 1 worker(s)" in r.stdout, r.stderr[-2000:]  # one chunk
 
 
 def test_an_accuracy_sweep_on_ray_measures_what_the_local_bench_measures(cluster, tmp_path):

@@ -5,11 +5,21 @@ writes."""
 from __future__ import annotations
 
 import argparse
+import math
+import os
 import sys
 
 from ..progress import Progress
+from ..scene import SceneError
 from . import options
-from .render import camera_path_options, check_video, frame_job, write_video
+from .render import (
+    camera_path_options,
+    check_video,
+    drawing_options,
+    frame_job,
+    settled,
+    write_video,
+)
 
 
 def add(sub) -> None:
@@ -32,7 +42,8 @@ def add(sub) -> None:
         "--workers",
         type=options.number_in("--workers", 1, 1024),
         default=2,
-        help="actors, one EGL context each (default 2)",
+        help="actors, one EGL context each (default 2; a local cluster: at most one per CPU, "
+        "and never more than the chunks to render)",
     )
     bt.add_argument(
         "--chunk",
@@ -51,7 +62,7 @@ def add(sub) -> None:
         metavar="ADDRESS",
         help="an existing Ray cluster (ray://HOST:10001, or 'auto'); default: start a local one",
     )
-    options.scene_options(bt)
+    drawing_options(bt)
     bt.set_defaults(func=run)
 
 
@@ -60,21 +71,31 @@ def run(args: argparse.Namespace) -> int:
     from ..share.batch import check_address, run_batch
 
     check_address(args.address)
-    scene = options.scene_of(args)
+    cpus = os.cpu_count() or 1
+    if args.address is None and args.workers > cpus:  # a local cluster: one CPU each
+        raise SceneError(
+            "--workers",
+            args.workers,
+            f"a local cluster runs one worker per CPU, and this machine has {cpus}; "
+            "give --address for a larger cluster",
+        )
+    scene = settled(args, options.scene_of(args))  # as render draws its frames
     video = check_video(args.video, args.size)  # before frame_job makes the folder
     job, frames = frame_job(args, scene)
     job.claim("-o")  # the last check: it writes the folder's frames.json
+    todo = job.missing(frames)
+    workers = max(1, min(args.workers, math.ceil(len(todo) / args.chunk)))  # idle ones: none
     print(
         f"krsview: {scene.name}: frames {frames.start}-{frames.stop - 1} of {job.count}, "
-        f"{job.size[0]}×{job.size[1]} → {job.folder}/ on {args.workers} worker(s) of "
+        f"{job.size[0]}×{job.size[1]} → {job.folder}/ on {workers} worker(s) of "
         f"{args.address or 'a local Ray cluster'}, {args.chunk} frames per chunk",
         flush=True,
     )
-    bar = Progress(max(1, len(job.missing(frames))), "  frames")
+    bar = Progress(max(1, len(todo)), "  frames")
     report = run_batch(
         job,
         frames,
-        args.workers,
+        workers,
         args.chunk,
         args.address,
         args.retries,

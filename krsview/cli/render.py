@@ -66,15 +66,6 @@ def add(sub) -> None:
         "NumPy file, ending in .npz",
     )
     r.add_argument(
-        "--exact",
-        action="store_true",
-        help="every level, no pre-pass and a shadow ray per pixel: the image the float64 "
-        "reference matches, for tests (default: the viewer's fast settings where the scene "
-        f"sets none: the pre-pass at {VIEW_PREPASS} pixels and the level of detail lod = "
-        f"{DEFAULT_LOD:g}, both certified hole-free, and soft shadows shared by "
-        f"{DEFAULT_SHADOW_BLOCK}×{DEFAULT_SHADOW_BLOCK} pixels)",
-    )
-    r.add_argument(
         "--reference",
         action="store_true",
         help="render with the float64 NumPy reference instead of the GPU (slow)",
@@ -101,9 +92,7 @@ def add(sub) -> None:
         help="iterations shown as white in --view iterations (default: the image's "
         "maximum); fix it to compare tracers on one scale",
     )
-    for name in KNOBS:
-        render_option(r, name)
-    options.scene_options(r)
+    drawing_options(r)
     cp = r.add_argument_group(
         "camera paths",
         "Render the frames of a path recorded in the viewer (F5; saved as "
@@ -112,6 +101,23 @@ def add(sub) -> None:
     )
     camera_path_options(cp, required=False)
     r.set_defaults(func=run)
+
+
+def drawing_options(sp) -> None:
+    """How a frame is drawn, the same for `render` and `batch` (whose frames are those
+    `render --camera-path` writes): --exact, the [render] knobs and the scene options."""
+    sp.add_argument(
+        "--exact",
+        action="store_true",
+        help="every level, no pre-pass and a shadow ray per pixel: the image the float64 "
+        "reference matches, for tests (default: the viewer's fast settings where the scene "
+        f"sets none: the pre-pass at {VIEW_PREPASS} pixels and the level of detail lod = "
+        f"{DEFAULT_LOD:g}, both certified hole-free, and soft shadows shared by "
+        f"{DEFAULT_SHADOW_BLOCK}×{DEFAULT_SHADOW_BLOCK} pixels)",
+    )
+    for name in KNOBS:
+        render_option(sp, name)
+    options.scene_options(sp)
 
 
 def camera_path_options(sp, required: bool) -> None:
