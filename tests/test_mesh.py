@@ -191,3 +191,15 @@ def test_a_mobius_scene_in_the_wind_meshes_bent():
     assert np.abs(back - bent.vertices).max() < 1e-6 * st.voxel
     rest, _ = build_mesh(scene.with_effects([e for e in scene.effects if e != "wind"]), 32)
     assert sign_change_near(rest.vertices, field, st.voxel, 2.0**-REFINE_STEPS)[0].mean() < 0.5
+
+
+def test_the_mesh_reports_the_resolution_it_sampled_and_steps_its_progress(tmp_path):
+    """`--resolution 48` said "meshing at 48" and sampled 64 voxels a side; and the bar
+    moved once, at the end, where every brick fitted one call [review]."""
+    r = krsview_cli("export", "mesh", "sierpinski", "-o", "s.glb", "--resolution", "48",
+                    timeout=120, cwd=tmp_path)  # fmt: skip
+    assert r.returncode == 0 and "meshing at 64 voxels a side" in r.stdout, r.stderr
+    calls = []
+    _, st = build_mesh(load_scene(resolve("sierpinski")), 48, progress=lambda d, n: calls.append(d))
+    assert st.resolution == 64 and len(calls) >= 10, (len(calls), st.bricks)  # it was 1
+    assert calls == sorted(calls) and calls[-1] == st.bricks

@@ -12,6 +12,7 @@ from ..progress import Progress
 from ..scene import MAX_LEVELS
 from ..share.mesh import BRICK as MESH_BRICK
 from ..share.mesh import FORMATS as MESH_FORMATS
+from ..share.mesh import sampled_resolution
 from . import options
 from .options import SILENT_SECONDS
 
@@ -113,7 +114,8 @@ def run_mesh(args: argparse.Namespace) -> int:
     scene = options.scene_of(args)
     out = output_file(args.output, "-o", MESH_FORMATS)
     print(
-        f"krsview: {scene.name}: meshing at {args.resolution} voxels a side, level set "
+        f"krsview: {scene.name}: meshing at {sampled_resolution(args.resolution)} voxels a "
+        "side, level set "
         f"{args.lod:g} voxel out …",
         flush=True,
     )
@@ -123,8 +125,8 @@ def run_mesh(args: argparse.Namespace) -> int:
     print(
         f"  {st.triangles:,} triangles, {'watertight' if st.watertight else 'open'}; "
         f"{st.bricks} bricks of {(st.resolution // MESH_BRICK) ** 3} sampled, "
-        f"{st.samples:,} reference samples ({st.samples / (st.resolution + 1) ** 3:.1%} of "
-        f"a dense grid); {st.seconds:.1f} s, peak memory {peak:.0f} MiB"
+        f"{st.samples:,} reference samples (a dense grid: {(st.resolution + 1) ** 3:,}); "
+        f"{st.seconds:.1f} s, peak memory {peak:.0f} MiB"
     )
     print(f"  wrote {out.resolve()}")
     return 0

@@ -26,6 +26,7 @@ from ..scene import Scene, SceneError
 BRICK = 16  # voxels per brick side: one marching-cubes call each
 FORMATS = (".glb", ".ply", ".stl", ".obj")  # what trimesh writes
 BATCH = 1 << 18  # points per reference call (memory stays flat)
+PROGRESS_STEPS = 20  # the bricks are sampled in at least this many calls, each reported
 REFINE_STEPS = 8  # bisections per vertex along its grid edge: within h / 256
 
 
@@ -67,6 +68,12 @@ def box_of(
     return ball[:3] - pad, 2 * pad
 
 
+def sampled_resolution(resolution: int) -> int:
+    """The voxels along the sampled cube's side for ``resolution``: rounded up to BRICK·2^k
+    (the octree halves the cube down to bricks)."""
+    return BRICK << max(0, math.ceil(math.log2(max(resolution, BRICK) / BRICK)))
+
+
 def build_mesh(
     scene: Scene,
     resolution: int,
@@ -89,14 +96,14 @@ def build_mesh(
     dist = Distortion.of(scene)
     value, is_empty = mesh_field(c, dist)
     lo, side = box_of(scene, c, box, dist)
-    bricks_per_side = 1 << max(0, math.ceil(math.log2(max(resolution, BRICK) / BRICK)))
-    n = bricks_per_side * BRICK
+    n = sampled_resolution(resolution)
+    bricks_per_side = n // BRICK
     h = side / n
     iso = lod * h
     boxes, samples = occupied_bricks(is_empty, lo, h, iso, bricks_per_side)
     verts, faces, count = [], [], 0
     grid = np.stack(np.meshgrid(*[np.arange(BRICK + 1)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    per_call = max(1, BATCH // len(grid))
+    per_call = max(1, min(BATCH // len(grid), math.ceil(len(boxes) / PROGRESS_STEPS)))
     for k0 in range(0, len(boxes), per_call):
         chunk = boxes[k0 : k0 + per_call]
         corners = (chunk[:, None, :] * BRICK + grid[None]).reshape(-1, 3)
