@@ -929,7 +929,7 @@ def test_the_clipped_part_of_a_warned_branch_is_drawn_red_in_the_view(editor):
     parts = clipped_parts(e.scene.route)  # the turned branch, and the sibling below it
     assert [level for level, _ in parts] == [19, 20]
     assert [entry for entry, _ in e.warnings] == [19, 20]
-    assert e.warnings[1][1].startswith("route.levels[20]: the branch crosses")
+    assert e.warnings[1][1].startswith("route.levels[20] (L20): the branch crosses")
     points = parts[1][1][::4]
     assert red_at(points) > 0.8
     e.doc.commit(before, "back")

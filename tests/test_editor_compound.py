@@ -103,7 +103,7 @@ def test_a_component_routes_clipped_part_is_drawn_where_its_placed_mirror_clips(
     assert raw and [k for k, _ in parts] == [0] * len(raw)
     said = warnings(s)  # the panel names the component's level, and selects the component
     assert [k for k, _ in said] == [0, 0]
-    assert said[1][1].startswith("compound[0].route.levels[20]: the branch crosses")
+    assert said[1][1].startswith("compound[0].route.levels[20] (L20): the branch crosses")
     plain = replace(c, route=tree.tree.route())  # negative control: the tree as grown
     assert warnings(replace(s, compound=[plain])) == [] and not scene_clipped(
         replace(s, compound=[plain])

@@ -169,8 +169,26 @@ def test_the_clipped_part_is_the_branch_on_the_mirrors_positive_side(route_scene
     s = turned_route(route_scene)
     route = s.route
     said = route.warnings()  # the branch, and its sibling of the fork below, are cut
-    assert len(said) == 2 and said[0].startswith("levels[19]: its mirror image at the fork")
-    assert said[1].startswith("levels[20]: the branch crosses the mirror")
+    assert len(said) == 2 and said[0].startswith(
+        "levels[19] (L19): its mirror image in R19 at fork P20"
+    )
+    assert said[1].startswith("levels[20] (L20): the branch crosses mirror R20 at its fork P21")
+    # the names are the handles' own: each R and P the warnings say is the handle of the
+    # field in parentheses, and each L is the outline's entry (they were levels[21].normal,
+    # which the panel calls R20: one off [review])
+    import re
+
+    labels = {h.label: h.path for h in handles(s)}
+    for text in said:
+        for name, field in re.findall(r"(R\d+) \((levels\[\d+\]\.normal)\)", text):
+            k = int(field[7 : field.index("]")])
+            assert labels[f"mirror normal {name}"] == ("route", "levels", k, "normal"), text
+        for name in re.findall(r"fork (P\d+)", text):
+            assert labels[f"fork {name}"][-1] == "fork" and labels[f"fork {name}"][2] == int(
+                name[1:]
+            )
+        k = int(text[7 : text.index("]")])
+        assert outline(s)[k].startswith(text[text.index("(") + 1 : text.index(")")] + " ")
     m = route.mirror(21)
     samples = np.linspace(0.0, 1.0, 4001)
     g = arc_points(route.kernel(20), len(samples)) @ np.array(m.normal) - m.offset

@@ -191,7 +191,12 @@ def test_a_child_crossing_its_forks_mirror_is_a_warning_naming_the_level():
     # turn the mirror so the twig (at x < 0) lies on its positive side: Alg. 1 clips it
     crossed = replace(r, levels=[r.levels[0], replace(r.levels[1], normal=(-1.0, 0.0, 0.0))])
     (w,) = crossed.warnings()
-    assert w.startswith("levels[0]:") and "levels[1].normal" in w and "clips" in w
+    assert (
+        w.startswith(
+            "levels[0] (L0): the branch crosses mirror R0 at its fork P1 (levels[1].normal)"
+        )
+        and "clips" in w
+    )
     # the shipped trees' small bends stay inside the fork joint: no warning
     assert load_scene(resolve("tree")).tree.route().warnings() == []
 
@@ -259,7 +264,10 @@ def test_a_stub_left_of_a_sibling_branch_is_warned_drawn_red_and_not_made_by_an_
     levels = [*cut.levels[:21], replace(cut.levels[21], normal=before), *cut.levels[22:]]
     turned = replace(cut, levels=levels)
     (said,) = turned.warnings()
-    assert said.startswith("levels[20]: its mirror image at the fork of levels[21]")
+    assert said.startswith(
+        "levels[20] (L20): its mirror image in R20 at fork P21 (the sibling branch) crosses "
+        "mirror R21 at fork P22"
+    )
     (level, red), *_ = clipped_parts(turned)
     scene = replace(tree, tree=None, route=turned)
     radius = turned.levels[20].radius

@@ -280,12 +280,12 @@ def test_hand_edits_survive_a_change_of_the_growth_parameters(route):
 def test_growing_again_lists_what_it_cannot_keep(route):
     inserted = split_level(route, 3, 0.5)
     _, lost = rebake(inserted, route.growth)
-    assert any("levels[4]: a fork made by hand" in line for line in lost)
+    assert any("levels[4] (L4): a fork made by hand" in line for line in lost)
     _, lost = rebake(merge_level(route, 3), route.growth)
     assert any("depth 5 was removed by hand" in line for line in lost)
     moved = replace(route, levels=[replace(route.levels[0], radius=0.5), *route.levels[1:]])
     _, lost = rebake(moved, replace(route.growth, levels=5))
-    assert any("levels[0]: its edits are dropped" in line for line in lost)
+    assert any("levels[0] (L0): its edits are dropped" in line for line in lost)
     _, nothing = rebake(route, replace(route.growth, levels=5))  # unedited: nothing to lose
     assert nothing == []
 

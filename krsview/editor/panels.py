@@ -174,7 +174,8 @@ def _warnings(e: Edited, out: list) -> None:
         imgui.push_style_color(imgui.Col_.text, YELLOW)
         imgui.text_wrapped(text)
         imgui.pop_style_color()
-        if imgui.small_button(f"select {what} {entry}##warn{k}"):
+        name = f"component {entry}" if what == "component" else f"L{entry}"
+        if imgui.small_button(f"select {name}##warn{k}"):
             out.append(ec.SelectLevel(entry))
     if len(said) > WARNINGS_OPEN:
         imgui.tree_pop()

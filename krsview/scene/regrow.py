@@ -18,7 +18,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from .growth import Growth, growth_of
-from .route import Route, RouteLevel
+from .route import Route, RouteLevel, level_name
 from .schema import SceneError, Vec3
 from .tree import Tree, as_vec3, perpendicular
 
@@ -146,7 +146,7 @@ def _edits(route: Route, old: Route, depth: int) -> tuple[dict[int, LevelEdit], 
     n = len(route.levels)
     for k, lv in enumerate(route.levels):
         if lv.grown is None:
-            lost.append(f"levels[{k}]: a fork made by hand (inserted or duplicated) is dropped")
+            lost.append(f"{level_name(k)}: a fork made by hand (inserted or duplicated) is dropped")
             continue
         below = route.levels[k + 1].grown if k + 1 < n else -1
         shape = below == lv.grown - 1
@@ -155,11 +155,13 @@ def _edits(route: Route, old: Route, depth: int) -> tuple[dict[int, LevelEdit], 
         bn = None if baked is None else frame(old, len(old.levels) - 1 - lv.grown).T @ baked
         if lv.grown > depth:
             if e.shape_changed(bn):
-                lost.append(f"levels[{k}]: its edits are dropped (the tree now has {depth} forks)")
+                lost.append(
+                    f"{level_name(k)}: its edits are dropped (the tree now has {depth} forks)"
+                )
             continue
         if not shape and level_edit(route, k, old, True).shape_changed(bn):
             lost.append(
-                f"levels[{k}]: its branch goes back to the grown shape (a fork next to it "
+                f"{level_name(k)}: its branch goes back to the grown shape (a fork next to it "
                 "was added or removed by hand)"
             )
         edits[lv.grown] = e

@@ -182,21 +182,27 @@ class Route:
             worst = float(e.max())
             if worst > CLIP_TOLERANCE * child.radius:
                 out.append(
-                    f"levels[{i - 1}]: the branch crosses the mirror at its fork "
-                    f"(levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — "
-                    "turn the normal or move the branch to the mirror's negative side"
+                    f"{level_name(i - 1)}: the branch crosses mirror R{i - 1} at its fork "
+                    f"P{i} (levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — turn "
+                    "the normal or move the branch to the mirror's negative side"
                 )
             if i + 1 < len(self.levels):
                 up = self.mirror(i + 1)
                 worst = float((self.sibling(i) @ np.array(up.normal)).max() - up.offset)
                 if worst > CLIP_TOLERANCE * child.radius:
                     out.append(
-                        f"levels[{i - 1}]: its mirror image at the fork of levels[{i}] (the "
-                        f"sibling branch) crosses the mirror at levels[{i + 1}]'s fork by "
+                        f"{level_name(i - 1)}: its mirror image in R{i - 1} at fork P{i} (the "
+                        f"sibling branch) crosses mirror R{i} at fork P{i + 1} by "
                         f"{worst:.3g}; Alg. 1 cuts it off there, leaving a stub — turn "
-                        f"levels[{i}].normal"
+                        f"R{i - 1} (levels[{i}].normal)"
                     )
         return out
+
+
+def level_name(k: int) -> str:
+    """Level k as the editor names it (L0 the twig), with its path in the file: the names
+    the editor's outline and handles use (fork Pk, mirror normal R(k−1) of levels[k])."""
+    return f"levels[{k}] (L{k})"
 
 
 def arc_points(k: ToroidalCapsule, samples: int = ARC_SAMPLES) -> np.ndarray:
