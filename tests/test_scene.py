@@ -302,3 +302,29 @@ def test_an_oversized_scene_file_is_refused_before_it_is_parsed(tmp_path, monkey
     monkeypatch.setattr(scene_module.tomllib, "loads", lambda _: pytest.fail("parsed"))
     with pytest.raises(SceneError, match="scene files hold at most 1,000 bytes"):
         load_scene(path)
+
+
+def test_a_kernel_changed_to_another_kind_keeps_its_colour_radius_and_place():
+    """The editor's kernel choice made a default kernel: a level lost its colour, which no
+    field could give back, and its place [review]."""
+    import numpy as np
+
+    from krsview.scene.model import Capsule, Kernel, Sphere, ToroidalCapsule, kernel_as
+    from krsview.scene.schema import to_dict
+
+    bent = ToroidalCapsule(
+        (0.0, 0.0, 0.0), (-0.9, 0.2, 0.0), (-1.9, -0.2, 0.2), 0.05, (0.4, 0.5, 0.2)
+    )
+    for kind, cls in Kernel.registry.items():
+        k = kernel_as(bent, kind)
+        assert isinstance(k, cls) and Kernel.from_toml(to_dict(k), "k") == k  # a valid kernel
+        assert getattr(k, "color", bent.color) == bent.color
+    cap = kernel_as(bent, "capsule")
+    assert (cap.a, cap.b, cap.radius) == (bent.start, bent.end, bent.radius)
+    back = kernel_as(cap, "toroidal_capsule")  # straight: the control point half way
+    assert (back.start, back.end) == (bent.start, bent.end)
+    assert np.allclose(back.control, np.add(bent.start, bent.end) / 2)
+    ball = kernel_as(bent, "sphere")
+    assert np.allclose(ball.center, np.add(bent.start, bent.end) / 2) and ball.radius == 0.05
+    # control: a default kernel of the kind has neither
+    assert Sphere().color is None and Capsule().b != bent.end

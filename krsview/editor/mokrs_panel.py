@@ -14,7 +14,7 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ..scene.edits import path_text
-from ..scene.model import Kernel
+from ..scene.model import Kernel, kernel_as
 from ..scene.mokrs import MobiusStep, linked_levels, linked_steps
 from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions, counted, red_text, tooltip
@@ -140,7 +140,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     kinds = list(KERNEL_KINDS)
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
     if changed and kinds[k] != lv.kernel.kind:
-        out.append(Edit((*lev, "kernel"), Kernel.registry[kinds[k]]()))
+        out.append(Edit((*lev, "kernel"), kernel_as(lv.kernel, kinds[k])))
     fields(shown.kernel, (*lev, "kernel"), out, interactions)
     red_text(error if place == "kernel" else "")
     for j, s in enumerate(shown.transform):  # as drawn now; reordered as the rest levels

@@ -14,6 +14,7 @@ from imgui_bundle import imgui
 from ..document.document import Document
 from ..scene import Scene
 from ..scene.edits import get_at
+from ..scene.render import Material
 from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.hud import HUD_RIGHT
 from ..viewer.widgets import Interactions, counted, field_widget, red_text, tooltip
@@ -280,6 +281,12 @@ def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, m
     path = (*at, f.name)
     if f.name in BOOKKEEPING:
         _bookkeeping(f.name, value, path, interactions)
+    elif f.name == "color" and value is None:  # drawn in the material's albedo
+        changed, _ = imgui.checkbox(f"own color##{'.'.join(map(str, path))}", False)
+        if imgui.is_item_hovered():
+            tooltip("drawn in the material's albedo; tick to give it a colour of its own")
+        if changed:
+            out.append(Edit(path, Material().albedo))
     elif value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
         return
     elif f.name == "growth":  # set there, the tree grows again (structure_panel.py)
@@ -296,6 +303,12 @@ def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, m
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))
+        if f.name == "color" and f.default is None:  # and back to the material's albedo
+            imgui.same_line()
+            if imgui.small_button(f"material's##{'.'.join(map(str, path))}"):
+                out.append(Edit(path, None))
+            if imgui.is_item_hovered():
+                tooltip("draw it in the material's albedo again (color = none)")
 
 
 def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions) -> None:

@@ -7,7 +7,7 @@ Names follow [KRS17 §3]: a KRS is (K_0..K_n; R_0..R_{n-1}); level i ≥ 1 holds
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
@@ -78,6 +78,40 @@ class Plane(Kernel):
     normal: Vec3 = param((0.0, 1.0, 0.0), unit_vector="require", help="outward unit normal")
     offset: float = param(0.0, help="plane offset w in u·x = w")
     color: Vec3 | None = param(None, **COLOR)
+
+
+def kernel_as(k: Kernel, kind: str) -> Kernel:
+    """``k`` as a kernel of ``kind`` (the editor's kernel choice), keeping what carries
+    over: its colour and radius, and its place: a capsule's ends a, b are a toroidal
+    capsule's start and end (straight: the control point half way), a sphere sits at their
+    middle and becomes an upright segment of its diameter."""
+    new = Kernel.registry[kind]()
+    names = {f for f in new.__dataclass_fields__}
+    ends = next(
+        (
+            (np.array(getattr(k, a)), np.array(getattr(k, b)))
+            for a, b in (("a", "b"), ("start", "end"))
+            if hasattr(k, a)
+        ),
+        None,
+    )
+    radius = getattr(k, "radius", None)
+    if isinstance(k, Sphere):
+        half = np.array([0.0, k.radius / 2, 0.0])
+        ends, radius = (np.array(k.center) - half, np.array(k.center) + half), k.radius / 2
+    keep: dict = {n: getattr(k, n) for n in ("color",) if n in names and hasattr(k, n)}
+    if radius is not None and "radius" in names:
+        keep["radius"] = radius
+    if ends is not None:
+        a, b = (tuple(float(c) for c in e) for e in ends)
+        mid = tuple(float(c) for c in (ends[0] + ends[1]) / 2)
+        if "a" in names:
+            keep.update(a=a, b=b)
+        elif "start" in names and math.dist(a, b) >= 1e-9:
+            keep.update(start=a, control=mid, end=b)
+        elif "center" in names:
+            keep["center"] = mid
+    return replace(new, **keep)
 
 
 # ---------------------------------------------------------------------------------- KRS
