@@ -263,6 +263,20 @@ def test_a_read_only_folder_fails_the_save_clearly_and_keeps_the_edit(route_file
     assert doc.save(new) == new and load_scene(new) == doc.scene
 
 
+@pytest.mark.parametrize("depth", [1, 2])
+def test_a_save_under_a_file_says_it_is_a_file(route_file, tmp_path, depth):
+    """Right under a file the save said "File exists" (as if x.toml were there), deeper
+    "Not a directory" [review]."""
+    (tmp_path / "a-file").write_text("")
+    target = tmp_path / "a-file" / ("sub/" * (depth - 1) + "x.toml")
+    doc = Document(route_file)
+    doc.apply(FORK, [1.0, 5.0, 0.5])
+    with pytest.raises(SceneError) as e:
+        doc.save(target)
+    assert str(e.value).endswith(f"cannot save: {str(tmp_path / 'a-file')!r} is a file")
+    assert doc.dirty and doc.path == route_file
+
+
 # ------------------------------------------------------------------------------ file safety
 @pytest.mark.parametrize("mode", [0o644, 0o664])
 def test_saving_keeps_the_files_mode(route_file, mode):
@@ -569,3 +583,16 @@ def test_a_level_inserted_or_removed_changes_its_own_lines_alone(tmp_path):
         doc.apply(("mokrs", "levels", 5, "reflect"), not levels[5].reflect)
         doc.save()
         assert len(diff(text, path.read_text())) == 2
+
+
+def test_the_title_says_which_file_after_a_save_as_into_another_folder(
+    route_file, tmp_path, monkeypatch
+):
+    """After a save as into another folder the title still said the name alone [review]."""
+    monkeypatch.chdir(tmp_path)
+    doc = Document(route_file)
+    other = tmp_path / "elsewhere" / route_file.name
+    doc.save(other)
+    assert doc.title.startswith(f"elsewhere/{route_file.name} — ")
+    monkeypatch.chdir(other.parent)  # control: from its own folder, the name alone
+    assert doc.title.startswith(f"{route_file.name} — ")

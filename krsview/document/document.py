@@ -113,7 +113,18 @@ class Document:
 
     @property
     def title(self) -> str:
-        return f"{'* ' if self.dirty else ''}{self.path.name} — {self._scene.name}"
+        return f"{'* ' if self.dirty else ''}{self.shown_path} — {self._scene.name}"
+
+    @property
+    def shown_path(self) -> str:
+        """The file as a person finds it: relative to the working folder when inside it,
+        else from the home folder (~/…), else whole; after a save as into another folder
+        the name alone would not say which file it is."""
+        p = self.path.resolve()
+        for base, prefix in ((Path.cwd(), ""), (Path.home(), "~/")):
+            if p.is_relative_to(base):
+                return prefix + str(p.relative_to(base))
+        return str(p)
 
     def _set(self, scene: Scene) -> None:
         self._scene = scene
@@ -196,6 +207,9 @@ class Document:
                 f"{self.path} changed on disk since it was opened here; "
                 "reload it (your edits stay undoable) or overwrite it"
             )
+        above = next((p for p in target.parents if p.exists()), None)
+        if above is not None and not above.is_dir():  # mkdir would say "File exists"
+            raise SceneError("<file>", str(target), f"cannot save: {str(above)!r} is a file")
         try:
             target.parent.mkdir(parents=True, exist_ok=True)  # save as into a new folder
             text = self._text_of(self._scene)

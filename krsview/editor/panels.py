@@ -185,6 +185,8 @@ def _warnings(e: Edited, out: list) -> None:
 def _file(e: Edited, out: list) -> None:
     doc = e.doc
     imgui.text(("* unsaved edits: " if doc.dirty else "as on disk: ") + str(doc.path.name))
+    if imgui.is_item_hovered():
+        tooltip(str(doc.path.resolve()))
     if imgui.button("save (Ctrl+S)"):
         out.append(ec.Save())
     imgui.same_line()
