@@ -103,7 +103,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     if scene.tree is None and imgui.collapsing_header(  # a grown tree has nothing to drag
         "dragging", imgui.TreeNodeFlags_.default_open
     ):
-        if scene.route is not None:  # only a route's forks carry anything
+        if scene.route is not None or any(c.route for c in scene.compound):  # a route's forks
             changed, on = imgui.checkbox("a fork carries its subtree", e.carry)
             if changed:
                 out.append(ec.SetCarry(on))
