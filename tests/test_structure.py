@@ -809,3 +809,15 @@ def test_a_compounds_outline_entries_have_no_level_menu(display, scene, tmp_path
             assert e.selected is not None and e.selected.level == level, "no selection"
         finally:
             e.close()
+
+
+def test_the_growth_section_says_when_the_forks_differ_from_the_growth(route):
+    """After forks inserted or removed by hand the growth section said levels 22 beside a
+    route of 24 forks, with nothing to tell them apart [review]."""
+    from krsview.editor.structure_panel import forks_note
+
+    assert forks_note(route) == ""  # as baked: the forks are the growth's
+    grown = route.growth.levels
+    more = split_level(route, 5)
+    assert forks_note(more) == f"the route has {grown + 1} forks now; grow again makes {grown}"
+    assert forks_note(merge_level(more, 5)) == ""  # control: back to the grown count

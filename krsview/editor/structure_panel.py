@@ -116,7 +116,7 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
     if t.message:  # wrapped: a narrow panel cuts nothing off
         (red_text if t.refused else imgui.text_wrapped)(t.message)
     if route.growth is not None:
-        _growth(route.growth, out, interactions)
+        _growth(route, out, interactions)
     _regrow_dialog(t, out)
     return out
 
@@ -133,9 +133,21 @@ def _component_level(t: StructureTools, route: Route, out: list[Command]) -> Non
         out.append(ec.SetToolValue("level", n - 1 - k if changed else level))
 
 
-def _growth(growth: Growth, out: list[Command], interactions: Interactions) -> None:
+def forks_note(route: Route) -> str:
+    """What the growth section says where the route's forks no longer match its growth
+    parameters (forks inserted, removed or duplicated by hand), "" where they do."""
+    forks, grown = len(route.levels) - 1, route.growth.levels
+    if forks == grown:
+        return ""
+    return f"the route has {forks} forks now; grow again makes {grown}"
+
+
+def _growth(route: Route, out: list[Command], interactions: Interactions) -> None:
+    growth = route.growth
     if not imgui.tree_node("growth (edits kept where they can be)"):
         return
+    if note := forks_note(route):
+        imgui.text_disabled(note)
     longest = max(imgui.calc_text_size(f.name).x for f in fields(Growth))
     imgui.push_item_width(-longest - imgui.get_style().item_inner_spacing.x)  # labels fit
     for f in fields(Growth):
