@@ -117,8 +117,12 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     sel = e.selected.path if e.selected is not None else ()
     step_selected = sel[: len(lev) + 1] == (*lev, "transform")
     imgui.separator_text(f"level {i} of {len(levels)}")
-    if e.selected is not None and e.selected.level == i:
-        imgui.text_wrapped(f"{e.selected.label}: {HINTS.get(e.selected.role, '')}")
+    if e.selected is not None and e.selected.level == i:  # two lines, whichever handle:
+        imgui.text(e.selected.label)  # a wrapped hint moved the rows below it [review]
+        hint = HINTS.get(e.selected.role, "")
+        imgui.text_disabled(hint)  # one line, cut at the panel's edge; whole on hover
+        if hint and imgui.is_item_hovered():
+            tooltip(hint)
     for op, tip in OPS.items():
         if imgui.small_button(f"{op}##lv"):
             out += level_commands(levels, i, op)
