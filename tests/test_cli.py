@@ -97,6 +97,21 @@ def test_reference_render_matches_size(tmp_path):
             "no such scene file; the preset of that name is `tree` (no .toml)",
         ),
         (["check", "/tmp"], "'/tmp': is a folder"),
+        # options this run would ignore: accepted silently, they seemed to take effect [review]
+        (["render", "tree", "--fps", "60"], "--fps = 60.0: needs --camera-path FILE"),
+        (["render", "tree", "--legend-max", "50"], "--legend-max = 50: needs --view iterations"),
+        (
+            ["render", "tree", "--relaxation", "1.5"],
+            "--relaxation = 1.5: applies to --tracer relaxed (this run traces sphere)",
+        ),
+        (
+            ["render", "tree", "--walk-restart", "on", "--tracer", "binary"],
+            "--walk-restart = 'on': applies to --tracer sphere (this run traces binary)",
+        ),
+        (["render", "tree", "--reference", "--repeats", "3"], "--repeats = 3: has no effect with"),
+        (["render", "tree", "--reference", "--path", "compute"], "--path = 'compute': has no"),
+        (["check", "tree", "--segments", "10"], "--segments = 10: needs --oracle"),
+        (["check", "tree", "--size", "10x10"], "--size = '10x10': needs --stability or --oracle"),
     ],
 )
 def test_bad_arguments_exit_nonzero_with_a_clear_message(args, message):

@@ -182,6 +182,9 @@ def test_the_video_holds_the_frames(path_file, tmp_path):
         (["-o", "f.png"], "-o = 'f.png': with --camera-path, give a folder for the frames"),
         (["--buffers", "b.npz"], "--buffers = 'b.npz': cannot be combined with --camera-path"),
         (["--view", "iterations"], "--view = 'iterations': cannot be combined with"),
+        (["--repeats", "50"], "--repeats = 50: cannot be combined with --camera-path"),
+        (["--legend-max", "9"], "--legend-max = 9: cannot be combined with --camera-path"),
+        (["--frames", "3-"], "--frames = '3-': expected FIRST-LAST"),  # it drew frame 3 alone
     ],
 )
 def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, message):

@@ -14,6 +14,7 @@ from ..scene import Scene, SceneError
 from ..scene.presets import resolve
 from . import options
 
+SIZE = (48, 27)  # the image --stability and --oracle trace by default
 TRACERS = ("sphere", "binary")  # what the oracle certifies (a MöKRS: binary only)
 
 
@@ -49,24 +50,29 @@ def add(sub) -> None:
     c.add_argument(
         "--segments",
         type=options.number_in("--segments", 1, 1_000_000),
-        default=MAX_SEGMENTS,
         metavar="N",
         help=f"--oracle: segments per ray before it counts as undecided (default {MAX_SEGMENTS})",
     )
     c.add_argument(
         "--size",
         type=options.size,
-        default=(48, 27),
-        help="image size for --stability and --oracle (default 48x27)",
+        help=f"image size for --stability and --oracle (default {SIZE[0]}x{SIZE[1]})",
     )
     c.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    for name, needs in (("segments", args.oracle), ("size", args.oracle or args.stability)):
+        if getattr(args, name) is not None and not needs:
+            mode = "--oracle" if name == "segments" else "--stability or --oracle"
+            given = getattr(args, name)
+            shown = "x".join(map(str, given)) if name == "size" else given
+            raise SceneError(f"--{name}", shown, f"needs {mode}")
+    size = args.size or SIZE
     if args.stability:
-        return stability(scenes_named(args.preset, catalogue=True), args.size)
+        return stability(scenes_named(args.preset, catalogue=True), size)
     if args.oracle:
-        return oracle(scenes_named(args.preset)[0], args.size, args.segments)
+        return oracle(scenes_named(args.preset)[0], size, args.segments or MAX_SEGMENTS)
     if args.preset == "hard" or args.preset.startswith("hard:"):  # the cases' statistics
         for scene in scenes_named(args.preset, catalogue=True):
             print(api.check(scene).text(f"hard:{scene.name}"))

@@ -21,6 +21,7 @@ from ..share.frames import DEFAULT_FPS
 from . import options
 from .options import SILENT_SECONDS, render_option
 
+REPEATS = 5  # frames timed by default
 KNOBS = (
     "tracer",
     "relaxation",
@@ -73,8 +74,7 @@ def add(sub) -> None:
     r.add_argument(
         "--repeats",
         type=options.number_in("--repeats", 1, 1000),
-        default=5,
-        help="frames timed; the median is printed (default 5)",
+        help=f"frames timed; the median is printed (default {REPEATS})",
     )
     r.add_argument(
         "--view",
@@ -134,7 +134,6 @@ def camera_path_options(sp, required: bool) -> None:
     sp.add_argument(
         "--fps",
         type=options.number_in("--fps", 1.0, 240.0, float),
-        default=DEFAULT_FPS,
         help=f"frames per second of path time (default {DEFAULT_FPS:g})",
     )
     sp.add_argument(
@@ -147,22 +146,9 @@ def camera_path_options(sp, required: bool) -> None:
 
 def run(args: argparse.Namespace) -> int:
     scene = settled(args, options.scene_of(args))
+    refuse_unused(args, scene)
     if args.camera_path is not None:
-        for flag, given in (
-            ("--buffers", args.buffers),
-            ("--reference", args.reference),
-            ("--view", args.view != "shaded"),
-        ):
-            if given:
-                raise SceneError(
-                    flag,
-                    getattr(args, flag[2:]),
-                    "cannot be combined with --camera-path (it writes shaded frames)",
-                )
         return render_camera_path(args, scene)
-    for flag in ("frames", "video"):
-        if getattr(args, flag) is not None:
-            raise SceneError(f"--{flag}", getattr(args, flag), "needs --camera-path FILE")
     out = output_file("out/render.png" if args.output is None else args.output, "-o", (".png",))
     if args.buffers:
         output_file(args.buffers, "--buffers", (".npz",))
@@ -176,7 +162,7 @@ def run(args: argparse.Namespace) -> int:
     if args.reference:
         frame = reference_frame(scene, args.size)
     else:
-        frame = timed_frame(scene, args.size, args.repeats, args.exact)
+        frame = timed_frame(scene, args.size, args.repeats or REPEATS, args.exact)
     if args.view == "iterations":
         from ..heatmap import save_heatmap
 
@@ -195,6 +181,39 @@ def run(args: argparse.Namespace) -> int:
         frame.save(args.buffers)
         print(f"  wrote {Path(args.buffers).resolve()} (color, depth, normal, iterations, hit)")
     return 0
+
+
+GPU_ONLY = ("repeats", "path", "steps", "shadow_tasks", "component_tasks", "precision")
+
+
+def refuse_unused(args: argparse.Namespace, scene: Scene) -> None:
+    """Before any work: an option that this run would ignore is refused, naming what it
+    needs (a person who gives one believes it took effect)."""
+
+    def refuse(name: str, why: str) -> None:
+        raise SceneError("--" + name.replace("_", "-"), getattr(args, name), why)
+
+    if args.camera_path is not None:
+        shaded = {"buffers": args.buffers, "reference": args.reference}
+        shaded |= {"view": args.view != "shaded", "legend_max": args.legend_max is not None}
+        for name, given in shaded.items():
+            if given:
+                refuse(name, "cannot be combined with --camera-path (it writes shaded frames)")
+        if args.repeats is not None:
+            refuse("repeats", "cannot be combined with --camera-path (it times no frame)")
+    for name in ("frames", "video", "fps"):
+        if args.camera_path is None and getattr(args, name) is not None:
+            refuse(name, "needs --camera-path FILE")
+    if args.legend_max is not None and args.view != "iterations":
+        refuse("legend_max", "needs --view iterations (it sets the heat map's white)")
+    for name in GPU_ONLY if args.reference else ():
+        if getattr(args, name) is not None:
+            refuse(name, "has no effect with --reference (a setting of the GPU's)")
+    tracer = scene.render.tracer
+    if args.relaxation is not None and tracer != "relaxed":
+        refuse("relaxation", f"applies to --tracer relaxed (this run traces {tracer})")
+    if args.walk_restart == "on" and tracer != "sphere":
+        refuse("walk_restart", f"applies to --tracer sphere (this run traces {tracer})")
 
 
 def settled(args: argparse.Namespace, scene: Scene) -> Scene:
@@ -258,8 +277,9 @@ def frame_job(args: argparse.Namespace, scene: Scene):
     given = "out/frames" if args.output is None else args.output
     if Path(given).suffix.lower() == ".png":
         raise SceneError("-o", given, "with --camera-path, give a folder for the frames")
-    frames = parse_frames(args.frames, path.frame_count(args.fps))  # before the folder is made
-    job = FrameJob(scene, path, args.fps, args.size, Path(given))
+    fps = DEFAULT_FPS if args.fps is None else args.fps
+    frames = parse_frames(args.frames, path.frame_count(fps))  # before the folder is made
+    job = FrameJob(scene, path, fps, args.size, Path(given))
     if scene.animation is not None and scene.animation.tracks:  # a track between its keys
         bar = Progress(len(frames), "  posing the frames", SILENT_SECONDS)
         try:

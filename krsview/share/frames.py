@@ -135,8 +135,8 @@ def parse_frames(
         lo = hi = text
     elif isinstance(text, str):
         try:
-            a, _, b = text.partition("-")
-            lo, hi = int(a), int(b) if b else int(a)
+            a, dash, b = text.partition("-")
+            lo, hi = int(a), int(b if dash else a)  # "3-" is no range: int("") refuses it
         except ValueError:
             raise SceneError(
                 flag, text, "expected FIRST-LAST or one frame number, e.g. 0-119"
