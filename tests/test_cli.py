@@ -111,6 +111,11 @@ def test_reference_render_matches_size(tmp_path):
         (["render", "tree", "--reference", "--repeats", "3"], "--repeats = 3: has no effect with"),
         (["render", "tree", "--reference", "--path", "compute"], "--path = 'compute': has no"),
         (["check", "tree", "--segments", "10"], "--segments = 10: needs --oracle"),
+        (["render", "tree", "--effects", ""], "--effects = '': give effects by name, or 'none'"),
+        (
+            ["bench", "accuracy", "tree", "--cache", "/proc/no/cache"],
+            "--cache = '/proc/no/cache': cannot write there",
+        ),
         (["check", "tree", "--size", "10x10"], "--size = '10x10': needs --stability or --oracle"),
     ],
 )

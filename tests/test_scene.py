@@ -328,3 +328,26 @@ def test_a_kernel_changed_to_another_kind_keeps_its_colour_radius_and_place():
     assert np.allclose(ball.center, np.add(bent.start, bent.end) / 2) and ball.radius == 0.05
     # control: a default kernel of the kind has neither
     assert Sphere().color is None and Capsule().b != bent.end
+
+
+def test_a_byte_order_mark_is_read_as_no_text(tmp_path):
+    from krsview.scene.presets import resolve
+
+    """A file Notepad saved as UTF-8 starts with a byte-order mark, which read as "not valid
+    TOML (Invalid statement)" at line 1, column 1 [review]."""
+    f = tmp_path / "bom.toml"
+    f.write_bytes(b"\xef\xbb\xbf" + resolve("rock").read_bytes())
+    assert load_scene(f) == load_scene(resolve("rock"))
+    f.write_bytes(b"\xef\xbb\xbf" + b"[camera\n")  # control: what follows is still read
+    with pytest.raises(SceneError, match="line 1, column 8: not valid TOML"):
+        load_scene(f)
+
+
+def test_a_long_vector_in_a_message_is_cut_after_whole_numbers():
+    """camera.target = [-44.901…, -44.9012806053457…: the noise of the first numbers took the
+    line [review]."""
+    from krsview.scene.schema import _brief
+
+    assert _brief([-44.90128060534571, -44.90128060534571, 1.0]) == "[-44.9013, -44.9013, 1.0]"
+    assert _brief((0.0, 1.0, 0.0)) == "[0.0, 1.0, 0.0]"  # a tuple as a file writes a list
+    assert _brief([1, "x"]) == "[1, 'x']"  # control: not a vector of numbers

@@ -233,8 +233,12 @@ def test_export_on_the_command_line_and_its_refusals(tmp_path):
     assert r.returncode == 0 and "wrote" in r.stdout, r.stderr
     r = run("shadertoy", "palm", "-o", str(tmp_path / "p.glsl"))
     assert r.returncode == 0 and (tmp_path / "p.glsl").read_text().count("mainImage") == 1
-    bad = run("html", "tree", "-o", str(tmp_path / "t.htm"))
-    assert bad.returncode == 2 and "-o = " in bad.stderr and "must end in .html" in bad.stderr
+    r = run("html", "rock", "-o", str(tmp_path / "t.htm"))  # as export.html takes it
+    assert r.returncode == 0 and (tmp_path / "t.htm").exists(), r.stderr
+    bad = run("html", "tree", "-o", str(tmp_path / "t.txt"))
+    assert (
+        bad.returncode == 2 and "-o = " in bad.stderr and "must end in .html or .htm" in bad.stderr
+    )
     deep = load_scene(resolve("tree"))
     save_scene(
         replace(deep, render=replace(deep.render, precision="double", prepass=8)),
@@ -382,3 +386,16 @@ def test_a_track_that_switches_the_variant_is_baked_and_said(tmp_path):
     assert [u[0] for u in poses["uniforms"]] == ["u_max_iterations"] and poses["block"] == 0
     toy = shadertoy_source(capped)
     assert "// note: keyframe tracks and sway are drawn as at t = 0 s (Shadertoy" in toy
+
+
+def test_the_page_shows_its_notes_to_the_exporter_not_in_its_caption():
+    """The caption carried "render.lod = 0.5: the page draws every level …" over half of
+    a small window, for a default nobody set [review]; the notes are the command's output
+    and a comment at the top of the page."""
+    scene = load_scene(resolve("sierpinski"))
+    notes = export_notes(scene)
+    page = html_page(scene)
+    caption = page[page.index('<div id="help">') : page.index("</div>", page.index('id="help"'))]
+    assert notes and all(n not in caption for n in notes) and "drag to orbit" in caption
+    head = page[: page.index("-->")]
+    assert all(f"Note: {n}" in head for n in notes)

@@ -301,7 +301,7 @@ def run_accuracy(args: argparse.Namespace) -> int:
     outs = {n: report_folder(args.out, n, len(names) > 1) for n in names}
     for out in outs.values():
         output_dir(out, "--out")
-    cache = Path(args.cache) if args.cache else None
+    cache = output_dir(args.cache, "--cache") if args.cache else None  # writable, up front
     if args.workers > 1 or args.address is not None:
         return run_accuracy_on_ray(args, scenes, outs, cache)
     for n in names:  # here, one after the other

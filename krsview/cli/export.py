@@ -18,13 +18,13 @@ from .options import SILENT_SECONDS
 
 WEB = {  # format → (suffix, what it is); the text is the format's help and description
     "html": (
-        ".html",
+        (".html", ".htm"),
         "one self-contained page (no server, no network) that runs the "
         "scene's own specialised tracer in WebGL2: drag to orbit, wheel to zoom, "
         "double-click to reset. Open it in any current browser.",
     ),
     "shadertoy": (
-        ".glsl",
+        (".glsl",),
         "the same shader as one Shadertoy mainImage (scene baked "
         "in as constants; iResolution, iTime and iMouse drive the camera). Paste it into "
         "a new shader on shadertoy.com.",
@@ -49,7 +49,9 @@ def add(sub) -> None:
             "are left out (the same surfaces, one fragment pass).",
         )
         options.preset(xp)
-        xp.add_argument("-o", "--output", required=True, help=f"file to write, ending in {suffix}")
+        xp.add_argument(
+            "-o", "--output", required=True, help=f"file to write, ending in {' or '.join(suffix)}"
+        )
         options.scene_options(xp)
         xp.set_defaults(func=run_web, suffix=suffix)
     add_mesh(xsub)
@@ -101,7 +103,7 @@ def add_mesh(xsub) -> None:
 
 def run_web(args: argparse.Namespace) -> int:
     scene = options.scene_of(args)
-    out = output_file(args.output, "-o", (args.suffix,))
+    out = output_file(args.output, "-o", args.suffix)
     notes = (export.html if args.format == "html" else export.shadertoy)(scene, out)
     for note in notes:
         print(f"  note: {note}")

@@ -183,6 +183,8 @@ def scene_of(args: argparse.Namespace, name: str | None = None) -> Scene:
     scene = api.configure(scene, **knobs)
     effects = getattr(args, "effects", None)
     if effects is not None:
+        if not effects.strip():
+            raise SceneError("--effects", effects, "give effects by name, or 'none' for no effects")
         names = [] if effects.strip() == "none" else [e.strip() for e in effects.split(",")]
         scene = scene.with_effects(names, "--effects")
     levels = getattr(args, "levels", None)

@@ -294,7 +294,7 @@ def load_scene(path: str | os.PathLike) -> Scene:
     except OSError as e:
         raise SceneError("<file>", str(p), f"cannot read: {e.strerror}", str(p)) from None
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a byte-order mark (Windows' Notepad writes one) is no text
     except UnicodeDecodeError as e:
         bom = raw[:2] in (b"\xff\xfe", b"\xfe\xff")
         raise SceneError(

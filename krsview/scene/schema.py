@@ -32,8 +32,21 @@ def _brief(value: Any, limit: int = 60) -> str:
         return "true" if value else "false"
     if isinstance(value, str) and value.startswith("<") and value.endswith(">"):
         return value  # a description of the value ("<65 levels>"), not the value: no quotes
-    text = repr(value)
+    if isinstance(value, (list, tuple)) and value and all(_is_real(x) for x in value):
+        text = "[" + ", ".join(_short(x) for x in value) + "]"  # as a file writes a vector
+    else:
+        text = repr(value)
     return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _short(x: float) -> str:
+    """A number as written, or to 6 digits where that is longer (a vector's noise cut a
+    message off in its first number)."""
+    return repr(x) if len(repr(x)) <= 9 else f"{x:.6g}"
+
+
+def _is_real(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
 # The "paths" of mistakes in a file as a whole (unreadable, too large, not UTF-8 or not TOML),

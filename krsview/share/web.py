@@ -224,7 +224,7 @@ def html_page(scene: Scene) -> str:
     fragment, poses = page_shader(scene)
     return (
         template.replace("{{TITLE}}", html.escape(f"krsview — {scene.name}"))
-        .replace("{{NOTES}}", html.escape(" · ".join(notes)))
+        .replace("{{NOTES}}", "\n".join(f"Note: {n}" for n in notes).replace("--", "- -"))
         .replace("{{TIME}}", json.dumps(scene.time))
         .replace("{{DURATION}}", json.dumps(scene.duration))
         .replace("{{VERTEX}}", json.dumps(vertex_shader()))
