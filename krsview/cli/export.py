@@ -10,6 +10,7 @@ from .. import export
 from ..inputs import output_file
 from ..progress import Progress
 from ..scene import MAX_LEVELS
+from ..scene.schema import counted
 from ..share.mesh import BRICK as MESH_BRICK
 from ..share.mesh import FORMATS as MESH_FORMATS
 from ..share.mesh import sampled_resolution
@@ -126,7 +127,7 @@ def run_mesh(args: argparse.Namespace) -> int:
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(
         f"  {st.triangles:,} triangles, {'watertight' if st.watertight else 'open'}; "
-        f"{st.bricks} bricks of {(st.resolution // MESH_BRICK) ** 3} sampled, "
+        f"{counted(st.bricks, 'brick')} of {(st.resolution // MESH_BRICK) ** 3} sampled, "
         f"{st.samples:,} reference samples (a dense grid: {(st.resolution + 1) ** 3:,}); "
         f"{st.seconds:.1f} s, peak memory {peak:.0f} MiB"
     )

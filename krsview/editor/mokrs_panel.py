@@ -16,8 +16,9 @@ from imgui_bundle import imgui
 from ..scene.edits import path_text
 from ..scene.model import Kernel, kernel_as
 from ..scene.mokrs import MobiusStep, linked_levels, linked_steps
+from ..scene.schema import counted
 from ..viewer.commands import Command, Edit
-from ..viewer.widgets import Interactions, counted, red_text, tooltip
+from ..viewer.widgets import Interactions, red_text, tooltip
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
 from .modals import entry_menu

@@ -15,9 +15,10 @@ from ..document.document import Document
 from ..scene import Scene
 from ..scene.edits import get_at
 from ..scene.render import Material
+from ..scene.schema import counted
 from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.hud import HUD_RIGHT
-from ..viewer.widgets import Interactions, counted, field_widget, red_text, tooltip
+from ..viewer.widgets import Interactions, field_widget, red_text, tooltip
 from ..viewer.window import Viewer
 from . import commands as ec
 from .file_actions import FileActions

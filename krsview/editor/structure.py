@@ -30,9 +30,8 @@ from ..scene.restructure import (
     split_level,
     taper,
 )
-from ..scene.schema import Vec3, from_dict, to_dict
+from ..scene.schema import Vec3, counted, from_dict, to_dict
 from ..viewer.commands import Command
-from ..viewer.widgets import counted
 from ..viewer.window import Viewer
 from . import commands as ec
 from .handles import Handle

@@ -10,6 +10,7 @@ from pathlib import Path
 from .animation import near_misses
 from .effects import EFFECTS
 from .scene import Scene
+from .schema import counted
 
 
 @dataclass(frozen=True)
@@ -49,7 +50,7 @@ class SceneInfo:
             lines.append(f"  geometry        {self.geometry}")
             lines.append(
                 f"  levels          {self.levels} (kernels K_0..K_{self.mirrors}, "
-                f"{self.mirrors} mirrors)"
+                f"{counted(self.mirrors, 'mirror')})"
             )
         lines.append(f"  kernel instances {self.instances:,}")
         lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in self.kernels.items()))
@@ -117,5 +118,5 @@ def motion(scene: Scene, posed: int = 0) -> str:
         parts.append(f"sway of {w.levels} levels, {w.amplitude:g}° at {w.frequency:g} Hz")
     if not parts:
         return ""
-    checked = f", posed at {posed} moments" if posed else ""
+    checked = f", posed at {counted(posed, 'moment')}" if posed else ""
     return "; ".join(parts) + f" — loop {scene.duration:g} s{checked}"

@@ -39,6 +39,11 @@ def _brief(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
+def counted(n: int, noun: str) -> str:
+    """``1 warning``, ``2 warnings``: a count with its noun in the number it takes."""
+    return f"{n:,} {noun}" + ("" if n == 1 else "s")
+
+
 def _short(x: float) -> str:
     """A number as written, or to 6 digits where that is longer (a vector's noise cut a
     message off in its first number)."""

@@ -87,11 +87,6 @@ def tooltip(text: str) -> None:
     imgui.end_tooltip()
 
 
-def counted(n: int, noun: str) -> str:
-    """``1 warning``, ``2 warnings``: a count with its noun in the number it takes."""
-    return f"{n} {noun}" + ("" if n == 1 else "s")
-
-
 def red_text(text: str) -> None:
     """A refusal or a warning: ``text`` wrapped, in red (nothing for none)."""
     if text:
