@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .messages import SceneError
+
 
 @dataclass(eq=False)  # arrays: == would be ambiguous; compare the arrays themselves
 class Frame:
@@ -44,24 +46,26 @@ class Frame:
         """Write the colour (``.png``, or any format Pillow knows by the suffix) or every
         array (``.npz``), whole or not at all (a temporary file beside it, renamed); returns
         the path. A suffix neither knows, a folder, or a place under a file is refused in
-        one line (ValueError) before anything is written; a write that fails (a disk full)
-        is an OSError naming ``path``, and leaves nothing behind."""
+        one line (SceneError, a ValueError) before anything is written; a write that fails
+        (a disk full) is an OSError naming ``path``, and leaves nothing behind."""
         from PIL import Image
 
         if not isinstance(path, (str, Path)) or str(path) == "":
-            raise ValueError(f"path = {path!r}: expected a file's path")
+            raise SceneError("path", path, "expected a file's path")
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix != ".npz" and suffix not in Image.registered_extensions():
-            raise ValueError(
-                f"path = {str(path)!r}: the file must end in .png, .npz or another image "
-                "format's suffix (.jpg, .tif, .webp, …)"
+            raise SceneError(
+                "path",
+                str(path),
+                "the file must end in .png, .npz or another image format's suffix (.jpg, "
+                ".tif, .webp, …)",
             )
         if path.is_dir():
-            raise ValueError(f"path = {str(path)!r}: is a folder; give a file name")
+            raise SceneError("path", str(path), "is a folder; give a file name")
         above = next((p for p in path.parents if p.exists()), None)
         if above is not None and not above.is_dir():
-            raise ValueError(f"path = {str(path)!r}: {str(above)!r} is a file, not a folder")
+            raise SceneError("path", str(path), f"{str(above)!r} is a file, not a folder")
         tmp = path.with_name(f".{path.name}.tmp{suffix}")
         try:
             path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do
@@ -86,17 +90,18 @@ class Frame:
 
     @classmethod
     def load(cls, path: str | Path) -> Frame:
-        """A frame written by :meth:`save` as ``.npz`` (ValueError for any other file)."""
+        """A frame written by :meth:`save` as ``.npz`` (SceneError for any other file)."""
         names = list(cls.__dataclass_fields__)
         try:
             with np.load(path, allow_pickle=False) as data:
                 return cls(**{name: data[name] for name in names})
         except OSError as e:
-            raise ValueError(f"path = {str(path)!r}: cannot read: {e.strerror}") from None
+            raise SceneError("path", str(path), f"cannot read: {e.strerror}") from None
         except (ValueError, KeyError, AttributeError, TypeError):
-            raise ValueError(
-                f"path = {str(path)!r}: not a frame written by Frame.save as .npz "
-                f"(arrays {', '.join(names)})"
+            raise SceneError(
+                "path",
+                str(path),
+                f"not a frame written by Frame.save as .npz (arrays {', '.join(names)})",
             ) from None
 
     def _repr_png_(self) -> bytes:

@@ -211,7 +211,7 @@ def test_files_are_checked_before_any_work(tmp_path):
         assert said in one_line(e)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file", "frames"], "nothing written"
     frame = krsview.render("rock", SIZE)
-    with pytest.raises(ValueError, match=r"must end in \.png, \.npz"):
+    with pytest.raises(krsview.SceneError, match=r"must end in \.png, \.npz"):  # [review]
         frame.save(tmp_path / "x.foo")
     png = frame.save(tmp_path / "x.png")  # control
     # a folder, a place under a file, a place that cannot be written: one line, as the
@@ -221,16 +221,16 @@ def test_files_are_checked_before_any_work(tmp_path):
         (tmp_path / "d.png", "is a folder; give a file name"),
         (tmp_path / "a-file" / "x.png", "a-file' is a file, not a folder"),
     ):
-        with pytest.raises(ValueError) as e:
+        with pytest.raises(krsview.SceneError) as e:
             frame.save(bad)
         assert said in one_line(e), bad
     with pytest.raises(OSError) as e:  # a write that fails names the file asked for
         frame.save("/proc/x.png")
     assert e.value.filename == "/proc/x.png" and ".tmp" not in one_line(e)
     assert not list(tmp_path.glob(".*.tmp*")) and png.exists()
-    with pytest.raises(ValueError, match="not a frame written by Frame.save"):
+    with pytest.raises(krsview.SceneError, match="not a frame written by Frame.save"):
         krsview.Frame.load(png)
-    with pytest.raises(ValueError, match="cannot read: No such file"):
+    with pytest.raises(krsview.SceneError, match="cannot read: No such file"):
         krsview.Frame.load(tmp_path / "none.npz")
 
 

@@ -14,14 +14,15 @@ PACKAGE = Path(__file__).resolve().parent.parent / "krsview"
 # viewer/editor → gpu → compile → scene → algebra; reference, oracle → compile;
 # bench/share → gpu, reference; the public API (krsview/__init__.py) sits under the CLI, and
 # checks its arguments by inputs → scene, as the benchmarks' functions check theirs.
-BASE = {"algebra", "frame", "progress", "heatmap", "version"}
+BASE = {"algebra", "frame", "progress", "heatmap", "version", "messages"}
 ALLOWED = {
     "algebra": set(),
     "version": set(),
-    "frame": set(),
+    "messages": set(),
+    "frame": {"messages"},
     "progress": set(),
     "heatmap": set(),
-    "scene": {"algebra"},
+    "scene": {"algebra", "messages"},
     "compile": {"scene", "algebra"},
     "document": {"scene", "algebra", "progress"},
     "reference": {"compile", "scene"} | BASE,

@@ -346,8 +346,8 @@ def test_a_byte_order_mark_is_read_as_no_text(tmp_path):
 def test_a_long_vector_in_a_message_is_cut_after_whole_numbers():
     """camera.target = [-44.901…, -44.9012806053457…: the noise of the first numbers took the
     line [review]."""
-    from krsview.scene.schema import _brief
+    from krsview.messages import _brief
 
     assert _brief([-44.90128060534571, -44.90128060534571, 1.0]) == "[-44.9013, -44.9013, 1.0]"
-    assert _brief((0.0, 1.0, 0.0)) == "[0.0, 1.0, 0.0]"  # a tuple as a file writes a list
+    assert _brief((0.0, 1.0, 0.0)) == "(0.0, 1.0, 0.0)" and _brief((2,)) == "(2,)"
     assert _brief([1, "x"]) == "[1, 'x']"  # control: not a vector of numbers

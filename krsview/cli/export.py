@@ -8,9 +8,9 @@ import resource
 
 from .. import export
 from ..inputs import output_file
+from ..messages import counted
 from ..progress import Progress
 from ..scene import MAX_LEVELS
-from ..scene.schema import counted
 from ..share.mesh import BRICK as MESH_BRICK
 from ..share.mesh import FORMATS as MESH_FORMATS
 from ..share.mesh import sampled_resolution

@@ -13,10 +13,10 @@ from typing import Any
 
 from imgui_bundle import imgui
 
+from ..messages import counted
 from ..scene.edits import path_text
 from ..scene.model import Kernel, kernel_as
 from ..scene.mokrs import MobiusStep, linked_levels, linked_steps
-from ..scene.schema import counted
 from ..viewer.commands import Command, Edit
 from ..viewer.widgets import Interactions, red_text, tooltip
 from . import commands as ec

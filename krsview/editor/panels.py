@@ -12,10 +12,10 @@ from typing import Any, Protocol
 from imgui_bundle import imgui
 
 from ..document.document import Document
+from ..messages import counted
 from ..scene import Scene
 from ..scene.edits import get_at
 from ..scene.render import Material
-from ..scene.schema import counted
 from ..viewer.commands import Command, Edit, Redo, Undo
 from ..viewer.hud import HUD_RIGHT
 from ..viewer.widgets import Interactions, field_widget, red_text, tooltip

@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 from typing import Any, NamedTuple, Protocol
 
 from ..document.document import Document
+from ..messages import counted
 from ..scene import Route, Scene, SceneError
 from ..scene.edits import Path, get_at, path_text, replace_at, validated
 from ..scene.growth import Growth
@@ -30,7 +31,7 @@ from ..scene.restructure import (
     split_level,
     taper,
 )
-from ..scene.schema import Vec3, counted, from_dict, to_dict
+from ..scene.schema import Vec3, from_dict, to_dict
 from ..viewer.commands import Command
 from ..viewer.window import Viewer
 from . import commands as ec

@@ -1,5 +1,6 @@
 """Scene model: validated dataclasses, TOML load/save, tree → KRS. Imports nothing from GL."""
 
+from ..messages import SceneError
 from .compound import MAX_COMPONENTS, Component, Compound
 from .effects import EFFECTS, EffectSettings, EmptyZone
 from .model import (
@@ -20,7 +21,6 @@ from .mokrs import Invert, MobiusLevel, MobiusStep, MoKRS, Rotate, Scale, Transl
 from .render import TRACERS, Camera, Light, Material, Render
 from .route import Route, RouteLevel
 from .scene import Bookmark, Geometry, Scene, load_scene, save_scene, scene_from_toml, scene_to_toml
-from .schema import SceneError
 from .tree import Tree
 
 __all__ = [

@@ -18,10 +18,11 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..messages import SceneError
 from .edits import get_at, parse_path, replace_at, revalidated
 from .effects import EFFECTS
 from .route import Route
-from .schema import SceneError, param, to_dict
+from .schema import param, to_dict
 from .sway import Sway, check_sway, swayed
 
 MAX_TIME = 1e6  # seconds (11.5 days): float32 keeps the time uniform to 0.06 s there

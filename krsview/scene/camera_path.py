@@ -13,9 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..messages import SceneError
 from .animation import MAX_TIME
 from .render import Camera
-from .schema import COORDINATE_LIMIT, SceneError
+from .schema import COORDINATE_LIMIT
 
 POSE_KEYS = ("t", "position", "yaw", "pitch")
 FORMAT = '{"poses": [{"t": seconds, "position": [x, y, z], "yaw": radians, "pitch": radians}, …]}'

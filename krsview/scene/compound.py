@@ -15,6 +15,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..messages import SceneError
 from .model import (
     KRS,
     MAX_LEVELS,
@@ -28,7 +29,7 @@ from .model import (
     ToroidalCapsule,
 )
 from .route import Route
-from .schema import SceneError, Vec3, cached, param
+from .schema import Vec3, cached, param
 from .tree import Tree, as_vec3
 
 MAX_COMPONENTS = 8  # [KRS17 §8.3]: "compound of eight KRSs"

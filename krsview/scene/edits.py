@@ -12,7 +12,8 @@ import re
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
-from .schema import SceneError, Tagged, from_dict, to_dict
+from ..messages import SceneError
+from .schema import Tagged, from_dict, to_dict
 
 Path = tuple[str | int, ...]
 

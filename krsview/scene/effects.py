@@ -13,8 +13,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..messages import SceneError
 from .compound import Placement
-from .schema import COLOR, SceneError, Vec3, param
+from .schema import COLOR, Vec3, param
 
 
 @dataclass(frozen=True)

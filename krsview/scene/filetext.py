@@ -18,8 +18,9 @@ from typing import Any
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
 
+from ..messages import SceneError
 from .scene import Scene, scene_from_toml, scene_to_toml
-from .schema import SceneError, to_dict
+from .schema import to_dict
 
 
 def saved_text(text: str, before: Scene, after: Scene) -> str:

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
+from ..messages import SceneError
 from .model import Mirror
-from .schema import COLOR, SceneError, Vec3, param
+from .schema import COLOR, Vec3, param
 
 
 @dataclass(frozen=True)

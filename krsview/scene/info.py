@@ -7,10 +7,10 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..messages import counted
 from .animation import near_misses
 from .effects import EFFECTS
 from .scene import Scene
-from .schema import counted
 
 
 @dataclass(frozen=True)

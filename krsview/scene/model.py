@@ -12,7 +12,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from .schema import COLOR, SceneError, Tagged, Vec3, cached, param, to_dict
+from ..messages import SceneError
+from .schema import COLOR, Tagged, Vec3, cached, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
 

@@ -23,8 +23,9 @@ from typing import ClassVar
 import numpy as np
 
 from ..algebra import mobius
+from ..messages import SceneError
 from .model import Empty, Kernel, Plane, Sphere, check_level_count
-from .schema import SceneError, Tagged, Vec3, cached, param
+from .schema import Tagged, Vec3, cached, param
 
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from importlib.resources import files
 from pathlib import Path
 
-from .schema import SceneError
+from ..messages import SceneError
 
 PRESET_DIR = Path(str(files("krsview.presets")))
 DEFAULT_PRESET = "tree"

@@ -17,9 +17,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..messages import SceneError
 from .growth import Growth, growth_of
 from .route import Route, RouteLevel, level_name
-from .schema import SceneError, Vec3
+from .schema import Vec3
 from .tree import Tree, as_vec3, perpendicular
 
 SAME = 1e-9  # an edit smaller than this (relative) is no edit

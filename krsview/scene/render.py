@@ -6,7 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .schema import COLOR, SceneError, Vec3, param
+from ..messages import SceneError
+from .schema import COLOR, Vec3, param
 
 TRACERS = ("sphere", "binary", "relaxed")
 PRECISIONS = ("float", "double")

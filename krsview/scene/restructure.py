@@ -14,9 +14,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..messages import SceneError
 from .model import Mirror, Plane, ToroidalCapsule
 from .route import Route, RouteLevel, centre_at
-from .schema import SceneError, Vec3
+from .schema import Vec3
 from .tree import as_vec3
 
 NORMAL_CANDIDATES = 360  # directions around the branch tried for a new fork's mirror

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..messages import SceneError
 from .growth import Growth
 from .model import (
     KRS,
@@ -31,7 +32,7 @@ from .model import (
     arc_of,
     check_mirror_per_level,
 )
-from .schema import COLOR, SceneError, Vec3, param
+from .schema import COLOR, Vec3, param
 
 FORK_SEPARATION = 1e-9  # forks closer than this × the route's size are "on top of each other"
 CLIP_TOLERANCE = 0.5  # × a child's radius: a shallower crossing stays inside the fork joint

@@ -12,6 +12,7 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..messages import SceneError
 from .animation import (
     DEFAULT_DURATION,
     Animation,
@@ -27,7 +28,7 @@ from .model import KRS
 from .mokrs import MoKRS, check_view
 from .render import Camera, Light, Material, Render
 from .route import Route
-from .schema import SceneError, from_dict, param, to_dict
+from .schema import from_dict, param, to_dict
 from .toml_writer import dumps
 from .tree import Tree
 

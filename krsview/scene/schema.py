@@ -16,68 +16,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..messages import SceneError
+
 Vec3 = tuple[float, float, float]
 UNIT_TOLERANCE = 1e-6  # how far a plane normal's length may be from 1 before it is an error
-
-
-def _brief(value: Any, limit: int = 60) -> str:
-    """A value as it is shown in an error: one short line (a table is not printed whole)."""
-    if isinstance(value, dict):
-        return (
-            "{a table with " + (", ".join(map(str, value)) or "no fields") + "}"
-            if len(repr(value)) > limit
-            else repr(value)
-        )
-    if isinstance(value, bool):  # as a scene file (TOML) spells it
-        return "true" if value else "false"
-    if isinstance(value, str) and value.startswith("<") and value.endswith(">"):
-        return value  # a description of the value ("<65 levels>"), not the value: no quotes
-    if isinstance(value, (list, tuple)) and value and all(_is_real(x) for x in value):
-        text = "[" + ", ".join(_short(x) for x in value) + "]"  # as a file writes a vector
-    else:
-        text = repr(value)
-    return text if len(text) <= limit else text[: limit - 1] + "…"
-
-
-def counted(n: int, noun: str) -> str:
-    """``1 warning``, ``2 warnings``: a count with its noun in the number it takes."""
-    return f"{n:,} {noun}" + ("" if n == 1 else "s")
-
-
-def _short(x: float) -> str:
-    """A number as written, or to 6 digits where that is longer (a vector's noise cut a
-    message off in its first number)."""
-    return repr(x) if len(repr(x)) <= 9 else f"{x:.6g}"
-
-
-def _is_real(x: Any) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
-
-
-# The "paths" of mistakes in a file as a whole (unreadable, too large, not UTF-8 or not TOML),
-# not in one of its fields: their message says the file, then where in it, then what is wrong.
-WHOLE_FILE = ("<file>", "<syntax>")
-
-
-class SceneError(ValueError):
-    """A user mistake in a scene: names the file, the field path, the value and what is allowed."""
-
-    def __init__(self, path: str, value: Any, allowed: str, file: str | None = None):
-        self.file, self.path, self.value, self.allowed = file, path, value, allowed
-        super().__init__(self._text())
-
-    def _text(self) -> str:
-        if self.path in WHOLE_FILE:  # no field to name: the file, where in it, what is wrong
-            parts = [self.file, None if str(self.value) == self.file else str(self.value)]
-            return ": ".join([p for p in parts if p] + [self.allowed])
-        where = f"{self.file}: " if self.file else ""
-        return f"{where}{self.path} = {_brief(self.value)}: {self.allowed}"
-
-    def __reduce__(self):  # picklable: a worker process's error reaches its pool whole
-        return (SceneError, (self.path, self.value, self.allowed, self.file))
-
-    def in_file(self, file: str) -> SceneError:
-        return SceneError(self.path, self.value, self.allowed, file)
 
 
 def cached(obj: Any, name: str, make: Any) -> Any:

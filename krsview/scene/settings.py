@@ -8,8 +8,9 @@ import typing
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
+from ..messages import SceneError
 from .render import VIEW_PREPASS
-from .schema import SceneError, check_value, param
+from .schema import check_value, param
 
 MAX_SIDE = 8192  # pixels, each side of a window
 

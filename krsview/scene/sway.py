@@ -18,8 +18,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..messages import SceneError
 from .route import CLIP_TOLERANCE, Route, arc_points
-from .schema import SceneError, param
+from .schema import param
 from .tree import as_vec3, perpendicular
 
 SAFETY = 0.05  # first samples: the crossing grows by at most this fraction of its limit between
