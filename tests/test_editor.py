@@ -991,3 +991,27 @@ def test_nothing_is_cut_off_and_the_scene_is_framed_beside_the_panel(display, tm
             assert abs(size[0] / 2 - (x0 + x1) / 2) > 50
     finally:
         e.close()
+
+
+def test_a_mokrs_steps_hint_is_one_line_that_neither_wraps_nor_widens_the_panel(display, tmp_path):
+    """Selecting a step wrapped its drag hint to two lines and moved every row below it
+    between two clicks [review]: the hint is one line, cut at the panel's edge."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.mokrs_panel import HINTS
+    from krsview.editor.window import Editor
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    e = Editor(path, size=(640, 360))
+    try:
+        for role in ("point", "factor"):
+            e.select(next(h for h in e.handles if getattr(h, "role", "") == role))
+            pump(e, 3)
+            w = imgui.internal.find_window_by_name("edit")
+            assert w.content_size.x <= w.size.x, f"{role}: the panel is widened"
+        # control: the one line it was, the name and the hint, is wider than the panel
+        said = f"{e.selected.label}: {HINTS['factor']}"
+        assert imgui.calc_text_size(said).x > w.size.x - 2 * imgui.get_style().window_padding.x
+    finally:
+        e.close()

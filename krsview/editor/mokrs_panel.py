@@ -18,7 +18,7 @@ from ..scene.edits import path_text
 from ..scene.model import Kernel, kernel_as
 from ..scene.mokrs import MobiusStep, linked_levels, linked_steps
 from ..viewer.commands import Command, Edit
-from ..viewer.widgets import Interactions, red_text, tooltip
+from ..viewer.widgets import Interactions, one_line, red_text, tooltip
 from . import commands as ec
 from .keys import key_marks, linked_edits, marked
 from .modals import entry_menu
@@ -120,10 +120,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     imgui.separator_text(f"level {i} of {len(levels)}")
     if e.selected is not None and e.selected.level == i:  # two lines, whichever handle:
         imgui.text(e.selected.label)  # a wrapped hint moved the rows below it [review]
-        hint = HINTS.get(e.selected.role, "")
-        imgui.text_disabled(hint)  # one line, cut at the panel's edge; whole on hover
-        if hint and imgui.is_item_hovered():
-            tooltip(hint)
+        one_line(HINTS.get(e.selected.role, ""))
     for op, tip in OPS.items():
         if imgui.small_button(f"{op}##lv"):
             out += level_commands(levels, i, op)

@@ -284,12 +284,8 @@ def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, m
     path = (*at, f.name)
     if f.name in BOOKKEEPING:
         _bookkeeping(f.name, value, path, interactions)
-    elif f.name == "color" and value is None:  # drawn in the material's albedo
-        changed, _ = imgui.checkbox(f"own color##{'.'.join(map(str, path))}", False)
-        if imgui.is_item_hovered():
-            tooltip("drawn in the material's albedo; tick to give it a colour of its own")
-        if changed:
-            out.append(Edit(path, Material().albedo))
+    elif f.name == "color" and f.default is None and not _own_color(value, path, out):
+        return  # drawn in the material's albedo: no colour field
     elif value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
         return
     elif f.name == "growth":  # set there, the tree grows again (structure_panel.py)
@@ -306,12 +302,17 @@ def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, m
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))
-        if f.name == "color" and f.default is None:  # and back to the material's albedo
-            imgui.same_line()
-            if imgui.small_button(f"material's##{'.'.join(map(str, path))}"):
-                out.append(Edit(path, None))
-            if imgui.is_item_hovered():
-                tooltip("draw it in the material's albedo again (color = none)")
+
+
+def _own_color(value: Any, path: tuple, out: list) -> bool:
+    """A colour that may be left to the material's albedo (none): a box that gives it one
+    of its own, or takes it back; whether it has one (its field follows)."""
+    changed, own = imgui.checkbox(f"own color##{'.'.join(map(str, path))}", value is not None)
+    if imgui.is_item_hovered():
+        tooltip("ticked: its own colour, below; not: drawn in the material's albedo")
+    if changed:
+        out.append(Edit(path, Material().albedo if own else None))
+    return value is not None
 
 
 def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions) -> None:

@@ -87,6 +87,24 @@ def tooltip(text: str) -> None:
     imgui.end_tooltip()
 
 
+def one_line(text: str) -> None:
+    """``text`` dimmed on one line, cut with "…" where the window is narrower (whole on
+    hover): a line that wraps, or runs past the edge, moves or widens what is around it."""
+    room = imgui.get_content_region_avail().x
+    shown = text
+    if imgui.calc_text_size(text).x > room:
+        lo, hi = 0, len(text)  # the longest start of it that fits with "…"
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            lo, hi = (
+                (mid, hi) if imgui.calc_text_size(text[:mid] + "…").x <= room else (lo, mid - 1)
+            )
+        shown = text[:lo].rstrip() + "…"
+    imgui.text_disabled(shown)
+    if shown != text and imgui.is_item_hovered():
+        tooltip(text)
+
+
 def red_text(text: str) -> None:
     """A refusal or a warning: ``text`` wrapped, in red (nothing for none)."""
     if text:
