@@ -203,3 +203,17 @@ def test_the_mesh_reports_the_resolution_it_sampled_and_steps_its_progress(tmp_p
     _, st = build_mesh(load_scene(resolve("sierpinski")), 48, progress=lambda d, n: calls.append(d))
     assert st.resolution == 64 and len(calls) >= 10, (len(calls), st.bricks)  # it was 1
     assert calls == sorted(calls) and calls[-1] == st.bricks
+
+
+def test_export_mesh_takes_the_moment_as_render_does(tmp_path):
+    """`export mesh` had no --time, though exports take time as any scene value [review]:
+    palm-curl's tracks curl it, so two moments mesh apart and one moment alike."""
+
+    def mesh_at(t: str, name: str) -> bytes:
+        r = krsview_cli("export", "mesh", "palm-curl", "-o", name, "--resolution", "16",
+                        "--time", t, timeout=120, cwd=tmp_path)  # fmt: skip
+        assert r.returncode == 0, r.stderr
+        return (tmp_path / name).read_bytes()
+
+    assert mesh_at("0", "a.ply") == mesh_at("0", "b.ply")
+    assert mesh_at("0", "a.ply") != mesh_at("3", "c.ply")

@@ -99,6 +99,7 @@ def add_mesh(xsub) -> None:
         type=options.number_in("--levels", 1, MAX_LEVELS),
         help="keep only the coarsest N levels",
     )
+    options.time_option(xm)
     xm.set_defaults(func=run_mesh)
 
 

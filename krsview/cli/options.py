@@ -159,6 +159,11 @@ def scene_options(sp: argparse.ArgumentParser) -> None:
         help="comma-separated effects replacing the scene's, or 'none'; one of: "
         + ", ".join(EFFECTS),
     )
+    time_option(sp)
+
+
+def time_option(sp: argparse.ArgumentParser) -> None:
+    """``--time``: the moment a moving scene is drawn or exported at."""
     sp.add_argument(
         "--time",
         type=float,

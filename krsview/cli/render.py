@@ -83,7 +83,7 @@ def add(sub) -> None:
         help="shaded image, or the per-pixel iteration count as a heat map with a "
         "legend (black = 0, white = the maximum) [KRS17 Fig. 13]: the full pass's steps, "
         "after the pre-pass's cones (per tile, not counted) moved each ray's start; "
-        "--exact counts every step from the eye",
+        "--exact counts every step from the eye; the legend adds rows below the image",
     )
     r.add_argument(
         "--legend-max",

@@ -48,9 +48,11 @@ class SceneInfo:
             lines.append(f"  geometry        compound of {len(self.parts)}: {parts}")
         else:
             lines.append(f"  geometry        {self.geometry}")
+            grown = self.geometry == "tree (grown)"
+            forks = f"; [tree] levels counts its {self.mirrors} forks" if grown else ""
             lines.append(
                 f"  levels          {self.levels} (kernels K_0..K_{self.mirrors}, "
-                f"{counted(self.mirrors, 'mirror')})"
+                f"{counted(self.mirrors, 'mirror')}{forks})"
             )
         lines.append(f"  kernel instances {self.instances:,}")
         lines.append("  kernels         " + ", ".join(f"{v}× {k}" for k, v in self.kernels.items()))

@@ -60,9 +60,8 @@ def box_of(
         raise SceneError(
             "geometry",
             scene.name,
-            "is unbounded (a ground plane, or a MöKRS "
-            "whose outer bound is not a ball): give the region to mesh with "
-            "box=(XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX) (--box on the command line)",
+            "is unbounded (a ground plane, or a MöKRS whose outer bound is not a ball): "
+            "give the region to mesh, its box XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX",
         )
     pad = 1.02 * ball[3]  # a margin, so the surface never touches the cube's faces
     return ball[:3] - pad, 2 * pad
