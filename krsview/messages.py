@@ -35,6 +35,7 @@ def counted(n: int, noun: str) -> str:
 def _short(x: float) -> str:
     """A number as written, or to 6 digits where that is longer (a vector's noise cut a
     message off in its first number)."""
+    x = x + 0  # −0.0 is shown as 0.0: the sign of a zero says nothing to a person
     return repr(x) if len(repr(x)) <= 9 else f"{x:.6g}"
 
 

@@ -351,3 +351,4 @@ def test_a_long_vector_in_a_message_is_cut_after_whole_numbers():
     assert _brief([-44.90128060534571, -44.90128060534571, 1.0]) == "[-44.9013, -44.9013, 1.0]"
     assert _brief((0.0, 1.0, 0.0)) == "(0.0, 1.0, 0.0)" and _brief((2,)) == "(2,)"
     assert _brief([1, "x"]) == "[1, 'x']"  # control: not a vector of numbers
+    assert _brief([0.0, 0.0, -0.0]) == "[0.0, 0.0, 0.0]"  # a zero axis read "-0.0" [review]
