@@ -16,7 +16,7 @@ import pytest
 
 from krsview.document.document import Document
 from krsview.editor import commands as ec
-from krsview.editor.file_actions import FileActions
+from krsview.editor.file_actions import FILE_HANDLERS, FileActions
 from krsview.editor.saving import autosave
 from krsview.editor.window import EDITOR_HANDLERS
 from krsview.gpu.program import SHADER_DIR
@@ -220,3 +220,20 @@ def test_save_as_replaces_another_file_only_when_asked_twice(tree, tmp_path):
     w.doc.apply(("render", "epsilon_scale"), 3.0)
     assert f.save_as(str(other)), "the document's own file now: saved at once"
     assert load_scene(other).render.epsilon_scale == 3.0
+
+
+def test_the_save_as_dialog_says_its_own_refusal_and_opens_again_without_it(tree, tmp_path):
+    """A save as refused under a file, then Esc: Ctrl+Shift+S opened the dialog with the old
+    refusal still in it [review]. The dialog says its own, until the name changes."""
+    f, w, _ = part(tree)
+    (tmp_path / "afile").write_text("")
+    f.ask_save_as()
+    FILE_HANDLERS[ec.SetCopyText](f, ec.SetCopyText(str(tmp_path / "afile" / "x.toml")))
+    f.save_copy()
+    assert f.copy_to is not None and "is a file" in f.copy_to.said  # it stays, saying why
+    FILE_HANDLERS[ec.SetCopyText](f, ec.SetCopyText(str(tmp_path / "afile" / "y.toml")))
+    assert f.copy_to.said == ""  # another name: not said of it yet
+    f.save_copy()
+    FILE_HANDLERS[ec.CancelCopy](f, ec.CancelCopy())
+    f.ask_save_as()
+    assert f.copy_to.said == "" and "is a file" in w.error  # control: the error still stands

@@ -172,7 +172,9 @@ def test_the_clipped_part_is_the_branch_on_the_mirrors_positive_side(route_scene
     assert len(said) == 2 and said[0].startswith(
         "levels[19] (L19): its mirror image in R19 at fork P20"
     )
-    assert said[1].startswith("levels[20] (L20): the branch crosses mirror R20 at its fork P21")
+    assert said[1].startswith(
+        "levels[20] (L20): the branch crosses mirror R20 at fork P21, where it grows from"
+    )
     # the names are the handles' own: each R and P the warnings say is the handle of the
     # field in parentheses, and each L is the outline's entry (they were levels[21].normal,
     # which the panel calls R20: one off [review])

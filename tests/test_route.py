@@ -193,7 +193,8 @@ def test_a_child_crossing_its_forks_mirror_is_a_warning_naming_the_level():
     (w,) = crossed.warnings()
     assert (
         w.startswith(
-            "levels[0] (L0): the branch crosses mirror R0 at its fork P1 (levels[1].normal)"
+            "levels[0] (L0): the branch crosses mirror R0 at fork P1, where it grows from "
+            "(levels[1].normal)"
         )
         and "clips" in w
     )

@@ -42,6 +42,7 @@ class CopyAsk:
 
     text: str
     then: tuple[str, Path | None] | None = None
+    said: str = ""  # why the last save from this dialog was refused (it stays open)
 
 
 def save_as_default(doc: Document) -> str:
@@ -159,7 +160,8 @@ class FileActions:
         if ask is None:
             return
         if not self.save_as(ask.text):
-            return  # refused: the dialog stays, with the error
+            self.copy_to = replace(ask, said=self.viewer.error)  # the dialog stays, saying why
+            return
         self.copy_to = None
         if ask.then is not None:
             self.asking = ask.then
@@ -232,7 +234,7 @@ FILE_HANDLERS: dict[type[vc.Command], Callable[[FileActions, Any], None]] = {
     ec.SaveAs: lambda f, c: f.save_as(f.save_as_text),
     ec.AskSaveAs: lambda f, c: f.ask_save_as(),
     ec.SetSaveAsText: lambda f, c: setattr(f, "save_as_text", c.text),
-    ec.SetCopyText: lambda f, c: setattr(f, "copy_to", replace(f.copy_to, text=c.text)),
+    ec.SetCopyText: lambda f, c: setattr(f, "copy_to", replace(f.copy_to, text=c.text, said="")),
     ec.SaveCopy: lambda f, c: f.save_copy(),
     ec.CancelCopy: lambda f, c: setattr(f, "copy_to", None),
     ec.TakeFile: lambda f, c: f.take_file(),

@@ -45,8 +45,8 @@ def copy_dialog(f: FileActions) -> list[Command]:
     done, text = imgui.input_text("##copy", f.copy_to.text if f.copy_to else "", enter)
     if text != (f.copy_to.text if f.copy_to else ""):
         out.append(ec.SetCopyText(text))
-    if f.viewer.error and f.copy_to is not None:
-        imgui.text_wrapped(f.viewer.error)
+    if f.copy_to is not None and f.copy_to.said:  # this dialog's refusal, not an older one
+        imgui.text_wrapped(f.copy_to.said)
     asked = f.copy_to is not None and f.replace_asked(f.copy_to.text)
     if imgui.button("replace it" if asked else "save the copy" if template else "save") or done:
         out.append(ec.SaveCopy())

@@ -60,9 +60,9 @@ class ToroidalCapsule(Kernel):
     spheres [KRS17 §9.2]. Nearly collinear points give a straight capsule."""
 
     kind: ClassVar[str] = "toroidal_capsule"
-    start: Vec3 = param((0.0, 0.0, 0.0), help="fork point where the branch starts")
+    start: Vec3 = param((0.0, 0.0, 0.0), help="where the arc starts (a tree branch: its fork)")
     control: Vec3 = param((0.1, 0.5, 0.0), help="point the arc passes through (sets curvature)")
-    end: Vec3 = param((0.0, 1.0, 0.0), help="fork point where the branch ends")
+    end: Vec3 = param((0.0, 1.0, 0.0), help="where the arc ends (a tree branch: the next fork)")
     radius: float = param(0.1, lo=0.0, lo_open=True, help="section radius")
     color: Vec3 | None = param(None, **COLOR)
 

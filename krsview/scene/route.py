@@ -183,9 +183,9 @@ class Route:
             worst = float(e.max())
             if worst > CLIP_TOLERANCE * child.radius:
                 out.append(
-                    f"{level_name(i - 1)}: the branch crosses mirror R{i - 1} at its fork "
-                    f"P{i} (levels[{i}].normal) by {worst:.3g}; Alg. 1 clips it there — turn "
-                    "the normal or move the branch to the mirror's negative side"
+                    f"{level_name(i - 1)}: the branch crosses mirror R{i - 1} at fork P{i}, where "
+                    f"it grows from (levels[{i}].normal), by {worst:.3g}; Alg. 1 clips it there "
+                    "— turn the normal or move the branch to the mirror's negative side"
                 )
             if i + 1 < len(self.levels):
                 up = self.mirror(i + 1)
