@@ -16,7 +16,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from .inputs import output_dir, output_file, real, region, scene_of, size_of, whole
+from .inputs import output_dir, output_file, real, region, scene_of, size_of, switch, whole
 from .scene import Scene, SceneError
 from .scene.camera_path import CameraPath, load_camera_path
 from .scene.scene import write_atomic
@@ -92,15 +92,19 @@ def frames(
     fps: float = DEFAULT_FPS,
     which: str | None = None,
     done: Callable[[int], None] | None = None,
+    exact: bool = False,
 ) -> list[Path]:
     """The frames of a camera path (a ``NAME.path.json`` the viewer recorded) as PNGs in
     ``folder`` (``frame_00000.png`` …), each written atomically; frames already there are
     kept, so a run resumes. ``which``: ``"A-B"``, ``"A"``, a frame number or a range
-    (default all). Returns the
-    frames' files in order."""
-    from .api import Renderer
+    (default all). Drawn as :func:`krsview.render` draws: the fast settings where the scene
+    sets none, or with ``exact`` every level and no pre-pass; so they are the frames of
+    `krsview render --camera-path` (and ``--exact``), and either resumes the other's folder.
+    Returns the frames' files in order."""
+    from .api import Renderer, exact_settings, fast_settings
 
-    scene, size = scene_of(scene), size_of(size)
+    settle = exact_settings if switch(exact, "exact") else fast_settings
+    scene, size = settle(scene_of(scene)), size_of(size)
     path = camera_path if isinstance(camera_path, CameraPath) else load_camera_path(camera_path)
     fps = real(fps, "fps", 1.0, 240.0)
     wanted = parse_frames(which, path.frame_count(fps), "which")  # before the folder is made

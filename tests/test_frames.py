@@ -308,3 +308,24 @@ def test_a_track_that_breaks_its_rule_between_keys_is_refused_before_any_frame(t
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in out.glob("*.png")) == ["frame_00001.png", "frame_00002.png"]
+
+
+@pytest.mark.parametrize("exact", [False, True])
+def test_the_apis_frames_are_the_command_lines(path_file, tmp_path, exact):
+    """export.frames drew the scene as given (no pre-pass), `render --camera-path` with the
+    fast settings: two sets of frames under one name [review]. Both settle alike now, so the
+    API resumes the command line's folder (a folder of other frames is refused)."""
+    import krsview
+
+    out = tmp_path / "f"
+    r = render_path(path_file, out, "--frames", "0-1", *(["--exact"] if exact else []))
+    assert r.returncode == 0, r.stderr
+    cli = [read(frame_file(out, k)) for k in (0, 1)]
+    files = krsview.export.frames("tree", path_file, out, SIZE, FPS, exact=exact)
+    assert len(files) == 5 and all(f.exists() for f in files)  # resumed: 2 there, 3 drawn
+    api = tmp_path / "api"
+    krsview.export.frames("tree", path_file, api, SIZE, FPS, "0-1", exact=exact)
+    for k in (0, 1):
+        assert np.array_equal(read(frame_file(api, k)), cli[k]), k
+    with pytest.raises(SceneError, match="holds frames of another run"):  # control
+        krsview.export.frames("tree", path_file, out, SIZE, FPS, exact=not exact)

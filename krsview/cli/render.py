@@ -334,6 +334,7 @@ def render_camera_path(args: argparse.Namespace, scene: Scene) -> int:
             job.fps,
             args.frames,
             lambda k: bar.step(f"frame {k}"),
+            exact=args.exact,
         )
     if video is not None:
         write_video(job, frames, video)
