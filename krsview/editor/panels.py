@@ -74,7 +74,8 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     _file(e, out)
     scene = e.scene
     shown = e.handled_scene()  # as drawn at the moment shown (tracks), its tracked fields marked
-    fields_of = partial(_fields, marks=key_marks(scene, e.viewer.drawn.playback.time))
+    marks = key_marks(scene, e.viewer.drawn.playback.time)
+    fields_of = partial(_fields, marks=marks, albedo=scene.material.albedo)
     if scene.tree is not None:
         imgui.text_wrapped(
             "This tree is grown from ratios. Bake it into a route to drag its "
@@ -265,7 +266,12 @@ def _selection(e: Edited, out: list, interactions: Interactions, fields_of: Call
 
 
 def _fields(
-    obj: Any, at: tuple, out: list, interactions: Interactions, marks: dict | None = None
+    obj: Any,
+    at: tuple,
+    out: list,
+    interactions: Interactions,
+    marks: dict | None = None,
+    albedo: tuple = Material().albedo,
 ) -> None:
     """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse; the
     fields the program keeps (BOOKKEEPING) as a line of text; a field a track moves marked
@@ -274,17 +280,19 @@ def _fields(
     longest = max((imgui.calc_text_size(f.name).x for f in fields(obj)), default=0.0)
     imgui.push_item_width(-longest - imgui.get_style().item_inner_spacing.x)
     for f in fields(obj):
-        _field(obj, f, at, out, interactions, marks)
+        _field(obj, f, at, out, interactions, marks, albedo)
     imgui.pop_item_width()
 
 
-def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, marks) -> None:
+def _field(
+    obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, marks, albedo: tuple
+) -> None:
     """Field ``f`` of ``obj`` (see :func:`_fields`)."""
     value = getattr(obj, f.name)
     path = (*at, f.name)
     if f.name in BOOKKEEPING:
         _bookkeeping(f.name, value, path, interactions)
-    elif f.name == "color" and f.default is None and not _own_color(value, path, out):
+    elif f.name == "color" and f.default is None and not _own_color(value, path, out, albedo):
         return  # drawn in the material's albedo: no colour field
     elif value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
         return
@@ -292,7 +300,7 @@ def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, m
         imgui.text_disabled("growth parameters: under structure, growth")
     elif hasattr(value, "__dataclass_fields__"):
         imgui.separator_text(f"{f.name}" + (f" ({value.kind})" if hasattr(value, "kind") else ""))
-        _fields(value, path, out, interactions, marks)
+        _fields(value, path, out, interactions, marks, albedo)
     else:
         refused = interactions.refusal(path)
         with marked((marks or {}).get(path)):
@@ -304,14 +312,15 @@ def _field(obj: Any, f: Any, at: tuple, out: list, interactions: Interactions, m
             out.append(Edit(path, new, key))
 
 
-def _own_color(value: Any, path: tuple, out: list) -> bool:
-    """A colour that may be left to the material's albedo (none): a box that gives it one
-    of its own, or takes it back; whether it has one (its field follows)."""
+def _own_color(value: Any, path: tuple, out: list, albedo: tuple) -> bool:
+    """A colour that may be left to the material's ``albedo`` (none): a box that gives it
+    one of its own, starting at that albedo (so nothing changes until it is set), or takes
+    it back; whether it has one (its field follows)."""
     changed, own = imgui.checkbox(f"own color##{'.'.join(map(str, path))}", value is not None)
     if imgui.is_item_hovered():
         tooltip("ticked: its own colour, below; not: drawn in the material's albedo")
     if changed:
-        out.append(Edit(path, Material().albedo if own else None))
+        out.append(Edit(path, tuple(albedo) if own else None))
     return value is not None
 
 
