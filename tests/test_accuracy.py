@@ -248,7 +248,7 @@ def test_bench_accuracy_writes_a_readable_report(tmp_path):
         "--size",
         "48x27",
         "--rounds",
-        "1",
+        "3",
         "--out",
         str(out),
         "--cache",
@@ -268,6 +268,35 @@ def test_bench_accuracy_writes_a_readable_report(tmp_path):
         head
     )
     assert "same_as" in head
+    # the pre-pass unset and 0 draw alike: one time, no "prepass 0" row timed apart [review]
+    assert "| prepass | 0 |" not in text
+    rows = list(__import__("csv").DictReader(csv))
+    tiles = [r for r in rows if r["knob"] == "prepass"]
+    assert tiles and all(r["value"] != "0" for r in tiles)
+    assert "| prepass | 4 |" in text and "†" in text  # its work marked: cones not counted
+    front = text[text.index("Pareto front in work") :].split("\n")[0]
+    assert "prepass" not in front
+    # one or two rounds give no spread to judge by: refused before any work
+    r = krsview_cli("bench", "accuracy", "sierpinski", "--rounds", "2", "--out", str(out))
+    assert r.returncode == 2 and "--rounds '2': allowed 3 ≤ value" in r.stderr
+
+
+def test_a_setting_is_never_worth_it_only_when_beaten_on_every_error():
+    """ "Never worth it" named a setting that was better on depth and beaten by a few
+    pixels of hit mask (forest's ε 0.5 by levels 18), or one beaten by a setting that
+    traded false hits for holes (rock's cap 64) [review]."""
+    from krsview.bench.accuracy_report import dominated
+
+    def row(ms, mask, holes, depth):
+        return dict(ms=ms, mask_error=mask, holes=holes, depth_eps_p99=depth, same_as=None)
+
+    rows = [row(60, 0.004, 0.0, 130), row(62, 0.0040, 0.0009, 142), row(79, 0.0043, 0.0, 128)]
+    rows += [row(90, 0.0043, 0.0, 128)]  # the control: beaten on time, alike in every error
+    for k, r in enumerate(rows):
+        r["same_as"] = k
+    assert dominated(rows, 0.05) == [rows[3]]
+    rows[1]["depth_eps_p99"] = 120  # better depth: now it beats the third, 0.03 % off in mask
+    assert dominated(rows, 0.05) == [rows[2], rows[3]]
 
 
 def test_bench_accuracy_refuses_a_file_as_its_folder_before_any_work(tmp_path):

@@ -124,7 +124,7 @@ def settings(scene: Scene) -> list[Setting]:
         lanes = replace(r, path="compute", steps=0)
         out.append(Setting("path", "lanes", replace(scene, render=lanes)))
     for tile in PREPASS_TILES:
-        if tile != r.prepass:
+        if tile != (r.prepass or 0):  # unset is off here (the bench draws the file's settings)
             out.append(
                 Setting("prepass", f"{tile}", replace(scene, render=replace(r, prepass=tile)))
             )
@@ -234,7 +234,8 @@ def same_work(
     seen: list[tuple[tuple, str]] = []
     for s in runs:
         rs = s.scene.render
-        key = (r.prepare(s.scene, w, h, s.geometry), rs.path, rs.prepass, rs.prepass_levels)
+        tile = rs.prepass or 0  # unset and 0 both draw no pre-pass
+        key = (r.prepare(s.scene, w, h, s.geometry), rs.path, tile, rs.prepass_levels)
         key += (rs.shadow_block, rs.steps)
         a = images[s.name]
         rep[s.name] = next(

@@ -15,6 +15,8 @@ import numpy as np
 from ..oracle.certify import Counts
 from ..scene import Scene
 
+MIN_ACCURACY_ROUNDS = 3  # the accuracy verdict needs each setting's spread: 1 or 2 rounds have none
+
 
 @dataclass(frozen=True)
 class Measured:
@@ -68,41 +70,56 @@ def accuracy_plots(rows: list[dict], fronts: dict[str, list[dict]], out: Path, t
     _pareto_plots(rows, knobs, fronts, out, title)
 
 
+SWEPT = ("epsilon_scale", "max_iterations", "lod", "levels")  # knobs with an order: a line
+PLOT_COLUMNS = 4  # knobs side by side in time-vs-error.png (a row of 11 was 5,000 px wide)
+
+
 def _knob_plots(rows: list[dict], knobs: list[str], out: Path, title: str) -> None:
+    """Per knob, hit-mask error against time and, under it, against work; four knobs a row,
+    a knob swept in order drawn as a line, one of choices as points; the y axis linear
+    where the errors span little (numbers on every panel)."""
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, len(knobs), figsize=(4.2 * len(knobs), 7.0), squeeze=False)
-    for (cost, label), line in zip(AXES, axes):
-        for ax, knob in zip(line, knobs):
-            group = [r for r in rows if r["knob"] == knob]
+    cols = min(PLOT_COLUMNS, len(knobs))
+    grid = -(-len(knobs) // cols)
+    fig, axes = plt.subplots(2 * grid, cols, figsize=(4.2 * cols, 3.4 * 2 * grid), squeeze=False)
+    base = rows[0]
+    for k, knob in enumerate(knobs):
+        group = [r for r in rows if r["knob"] == knob]
+        y = [100 * r["mask_error"] for r in group]
+        for line, (cost, label) in enumerate(AXES):
+            ax = axes[2 * (k // cols) + line][k % cols]
             x = [r[cost] for r in group]
-            y = [100 * r["mask_error"] for r in group]
-            ax.errorbar(x, y, xerr=_time_bars(group, cost), fmt="o-", color="tab:blue", ms=4)
-            for r, xi, yi in zip(group, x, y):
+            fmt = "o-" if knob in SWEPT else "o"
+            ax.errorbar(x, y, xerr=_time_bars(group, cost), fmt=fmt, color="tab:blue", ms=4)
+            for j, (r, xi, yi) in enumerate(zip(group, x, y)):  # alternate sides: no overlap
                 ax.annotate(
-                    r["value"], (xi, yi), fontsize=7, xytext=(3, 3), textcoords="offset points"
+                    r["value"],
+                    (xi, yi),
+                    fontsize=7,
+                    xytext=(4, 4 if j % 2 == 0 else -10),
+                    textcoords="offset points",
                 )
-            base = rows[0]
-            ax.plot(
-                [base[cost]],
-                [100 * base["mask_error"]],
-                "*",
-                color="tab:red",
-                ms=10,
-                label="as saved",
-            )
-            ax.set_title(knob.replace("_", " "))
+            ax.plot([base[cost]], [100 * base["mask_error"]], "*", color="tab:red", ms=10,
+                    label="as saved")  # fmt: skip
+            ax.set_title(f"{knob.replace('_', ' ')}: against {'time' if cost == 'ms' else cost}")
             ax.set_xlabel(label)
             ax.set_ylabel("hit-mask error (% of pixels)")
-            ax.set_yscale("symlog", linthresh=0.1)
+            every = y + [100 * base["mask_error"]]
+            if max(every) > 10 * max(min(every), 0.1):  # errors over decades: a log scale
+                ax.set_yscale("symlog", linthresh=0.1)
+            ax.ticklabel_format(axis="x", useOffset=False, style="plain")
             ax.grid(alpha=0.3)
+    for k in range(len(knobs), grid * cols):  # the last row's empty places
+        for line in range(2):
+            axes[2 * (k // cols) + line][k % cols].set_visible(False)
     axes[0][0].legend(fontsize=7)
     fig.suptitle(
         f"{title}: error against time (noise floor {rows[0]['noise_floor']:.1%}) and against "
         "work, one knob at a time"
     )
-    fig.tight_layout()
-    fig.savefig(out / "time-vs-error.png", dpi=110)
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.3 / fig.get_figheight()))  # room for the title
+    fig.savefig(out / "time-vs-error.png", dpi=100)
     plt.close(fig)
 
 
@@ -111,8 +128,9 @@ def _pareto_plots(
 ) -> None:
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(12.8, 4.6))
-    colours = dict(zip(knobs + ["scene"], plt.get_cmap("tab20").colors))  # ≤ 20 knobs
+    fig, axes = plt.subplots(1, 2, figsize=(14.4, 4.6))
+    palette = plt.get_cmap("tab10").colors + plt.get_cmap("Dark2").colors  # distinct hues
+    colours = dict(zip(knobs + ["scene"], palette))  # ≤ 18 knobs
     for ax, (cost, label) in zip(axes, AXES):
         for knob in knobs + ["scene"]:
             group = [r for r in rows if r["knob"] == knob]
@@ -148,9 +166,9 @@ def _pareto_plots(
         ax.grid(alpha=0.3)
     axes[0].set_title(f"time: medians' front (noise floor {rows[0]['noise_floor']:.1%})")
     axes[1].set_title("work (deterministic)")
-    axes[0].legend(fontsize=7, loc="lower left")
+    fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, loc="center right")
     fig.suptitle(f"{title}: every setting; below the line nothing is cheaper and better")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 0.9, 1))  # the legend to the right, off the points
     fig.savefig(out / "pareto.png", dpi=110)
     plt.close(fig)
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .. import app
 from ..bench.expansion import TOLERANCE
-from ..bench.report import markdown, write_csv
+from ..bench.report import MIN_ACCURACY_ROUNDS, markdown, write_csv
 from ..inputs import output_dir, output_file
 from ..scene import MAX_LEVELS, SceneError
 from ..scene.presets import DEFAULT_PRESET, resolve
@@ -266,10 +266,10 @@ def add_accuracy(bsub) -> None:
     )
     ba.add_argument(
         "--rounds",
-        type=options.number_in("--rounds", 1, 100),
+        type=options.number_in("--rounds", MIN_ACCURACY_ROUNDS, 100),
         default=5,
-        help="interleaved rounds; medians with [min–max] and the run's noise floor are "
-        "reported (default 5)",
+        help="interleaved rounds, 3..100; medians with [min–max] and the run's noise floor "
+        "are reported (default 5; fewer than 3 rounds give no spread to draw a verdict on)",
     )
     ba.add_argument(
         "--out",
