@@ -168,3 +168,17 @@ def test_an_effect_cost_whose_rounds_disagree_on_its_sign_is_within_noise():
     assert effects._noise(row) == " (within noise)"
     assert effects._noise({**row, "low": 0.02}) == ""  # the control: a cost every round
     assert effects._noise({**row, "variant": "plain"}) == ""
+
+
+def test_a_lever_whose_rounds_straddle_the_plain_frame_is_within_noise():
+    """Culling on against off read 0.65× with the very same work and no spread shown
+    [review]: each speed-up now carries its round-by-round [min–max], and where that holds
+    1× it is said to be within noise."""
+    scene = krsview.load("sierpinski")
+    m = paths.bench_paths(scene, (8, 6), rounds=2)
+    assert all(r["speedup_min"] <= r["speedup"] <= r["speedup_max"] for r in m.rows)
+    row = dict(m.rows[1], speedup=0.65, speedup_min=0.55, speedup_max=1.1)
+    text = paths.table(replace(m, rows=[row, dict(row, speedup_max=0.7)]))
+    lines = [x for x in text.splitlines() if x.startswith("| 8x6")]
+    assert "0.65× [0.55–1.10] within noise" in lines[0]
+    assert "0.65× [0.55–0.70] |" in lines[1]  # control: slower in every round

@@ -9,12 +9,13 @@ passes' share of the frame. Variants are interleaved round by round (bench/harne
 
 from __future__ import annotations
 
+import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.render import VIEW_PREPASS
-from .harness import Variant, bench_inputs, median_times
+from .harness import Variant, bench_inputs, median_times, round_times
 from .report import Measured, markdown
 
 TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
@@ -111,13 +112,14 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
     rows = []
     for w, h in (size, (2 * size[0], 2 * size[1])):
         variants = levers(scene)
-        med = median_times(
+        times = round_times(
             r,
             {lever_name(k): Variant(s) for k, s in variants.items()},
             (w, h),
             rounds,
             f"bench paths {scene.name}",
         )
+        med = {name: statistics.median(t) for name, t in times.items()}
         tiles = {k[1:4]: s for k, s in variants.items() if k[2]}
         coarse = {
             k: median_times(
@@ -125,9 +127,11 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
             )["pre-pass"]
             for k, s in tiles.items()
         }
-        base = med[lever_name(("fragment", "off", 0, 0, 0, ""))]
+        plain = lever_name(("fragment", "off", 0, 0, 0, ""))
+        base = med[plain]
         for k, s in variants.items():
             t = med[lever_name(k)]
+            per_round = [b / x for b, x in zip(times[plain], times[lever_name(k)])]
             rows.append(
                 dict(
                     size=f"{w}x{h}",
@@ -139,6 +143,8 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
                     shadow_rays=k[5],
                     ms=t * 1e3,
                     speedup=base / t,
+                    speedup_min=min(per_round),  # the round-by-round ratio's spread
+                    speedup_max=max(per_round),
                     iterations=float(r.render(s, w, h).iterations.mean()),
                     levels=float(r.levels(s, w, h).mean()),
                     coarse_share=coarse.get(k[1:4], 0.0) / t,
@@ -150,7 +156,9 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
 def table(m: Measured) -> str:
     caption = (
         f"\nSpeed levers — {m.scene.name}, median of {m.rounds} interleaved rounds; speed-up "
-        "against the fragment path without culling or pre-pass at the same size\n\n"
+        "against the fragment path without culling or pre-pass at the same size, with the "
+        "[min–max] of its round-by-round ratio: where that range holds 1×, the difference is "
+        "within noise\n\n"
     )
     return caption + markdown(
         (
@@ -178,7 +186,8 @@ def table(m: Measured) -> str:
                 r["steps"] or "—",
                 r["shadow_rays"] or "—",
                 f"{r['ms']:.1f}",
-                f"{r['speedup']:.2f}×",
+                f"{r['speedup']:.2f}× [{r['speedup_min']:.2f}–{r['speedup_max']:.2f}]"
+                + (" within noise" if r["speedup_min"] <= 1 <= r["speedup_max"] else ""),
                 f"{r['iterations']:.1f}",
                 f"{r['levels']:.1f}",
                 f"{r['coarse_share']:.0%}",
