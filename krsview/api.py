@@ -30,11 +30,11 @@ import numpy as np
 from .frame import Frame
 from .inputs import output_file, scene_of, size_of, switch, whole
 from .scene import Render, Scene, SceneError, save_scene
-from .scene.animation import check_motion
 from .scene.edits import vouched
 from .scene.filetext import saved_text
 from .scene.info import SceneInfo, describe
 from .scene.model import KRS
+from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
 from .scene.render import LANES_LEVELS, VIEW_PREPASS
 from .scene.scene import scene_from_toml, write_atomic

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .messages import SceneError
+from .messages import SceneError, under_a_file
 
 
 @dataclass(eq=False)  # arrays: == would be ambiguous; compare the arrays themselves
@@ -63,9 +63,8 @@ class Frame:
             )
         if path.is_dir():
             raise SceneError("path", str(path), "is a folder; give a file name")
-        above = next((p for p in path.parents if p.exists()), None)
-        if above is not None and not above.is_dir():
-            raise SceneError("path", str(path), f"{str(above)!r} is a file, not a folder")
+        if why := under_a_file(path.parent):
+            raise SceneError("path", str(path), why)
         tmp = path.with_name(f".{path.name}.tmp{suffix}")
         try:
             path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do

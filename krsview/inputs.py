@@ -14,6 +14,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from .messages import under_a_file
 from .scene import Scene, SceneError
 from .scene.edits import checked
 from .scene.presets import resolve
@@ -129,9 +130,8 @@ def unmake_folders() -> None:
 
 
 def _probe(folder: Path, name: str, what: str, given: str) -> None:
-    above = next((p for p in (folder, *folder.parents) if p.exists()), None)
-    if above is not None and not above.is_dir():
-        raise SceneError(what, given, f"{str(above)!r} is a file, not a folder")
+    if why := under_a_file(folder):
+        raise SceneError(what, given, why)
     new = [p for p in (folder, *folder.parents) if not p.exists()]
     try:
         folder.mkdir(parents=True, exist_ok=True)

@@ -4,6 +4,7 @@ frame and everything above raise it."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 
@@ -41,6 +42,13 @@ def _short(x: float) -> str:
 
 def _is_real(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def under_a_file(folder: Path) -> str:
+    """Why nothing can be written in ``folder`` when it, or the nearest of its parents that
+    exists, is a file ("'x' is a file, not a folder"); "" where it is not."""
+    above = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    return f"{str(above)!r} is a file, not a folder" if above and not above.is_dir() else ""
 
 
 # The "paths" of mistakes in a file as a whole (unreadable, too large, not UTF-8 or not TOML),

@@ -113,6 +113,10 @@ def test_check_poses_tracks_between_keys_and_warns_where_a_vector_flips(tmp_path
     # control: a key off the line, the path passes 0.1 from zero: no warning
     off = "[[0.0, [2.0, 0.0, 0.0]], [3.0, [-1.0, 0.1, 0.0]]]"
     assert check(scene_from_toml(turning(off, "smooth"))).warnings == ()
+    # a point through the origin is no flip: only directions and the camera are warned of
+    base = "[[0.0, [1.0, 0.0, 0.0]], [2.0, [-1.0, 0.0, 0.0]]]"
+    moved = turning(base).replace('path = "tree.up"', 'path = "tree.base"')
+    assert check(scene_from_toml(moved)).warnings == ()
     # the camera keyed through what it looks at (its target stays at the preset's)
     tree = load("tree")
     p, q = list(tree.camera.position), tree.camera.target

@@ -273,7 +273,9 @@ def test_a_save_under_a_file_says_it_is_a_file(route_file, tmp_path, depth):
     doc.apply(FORK, [1.0, 5.0, 0.5])
     with pytest.raises(SceneError) as e:
         doc.save(target)
-    assert str(e.value).endswith(f"cannot save: {str(tmp_path / 'a-file')!r} is a file")
+    assert str(e.value).endswith(
+        f"cannot save: {str(tmp_path / 'a-file')!r} is a file, not a folder"
+    )
     assert doc.dirty and doc.path == route_file
 
 

@@ -268,8 +268,9 @@ def add_accuracy(bsub) -> None:
         "--rounds",
         type=options.number_in("--rounds", MIN_ACCURACY_ROUNDS, 100),
         default=5,
-        help="interleaved rounds, 3..100; medians with [min–max] and the run's noise floor "
-        "are reported (default 5; fewer than 3 rounds give no spread to draw a verdict on)",
+        help=f"interleaved rounds, {MIN_ACCURACY_ROUNDS}..100; medians with [min–max] and the "
+        "run's noise floor are reported (default 5; fewer rounds give no spread to draw a "
+        "verdict on)",
     )
     ba.add_argument(
         "--out",

@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from ..messages import under_a_file
 from ..scene import Bookmark, Camera, Scene, SceneError, load_scene, scene_to_toml
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
@@ -207,9 +208,8 @@ class Document:
                 f"{self.path} changed on disk since it was opened here; "
                 "reload it (your edits stay undoable) or overwrite it"
             )
-        above = next((p for p in target.parents if p.exists()), None)
-        if above is not None and not above.is_dir():  # mkdir would say "File exists"
-            raise SceneError("<file>", str(target), f"cannot save: {str(above)!r} is a file")
+        if why := under_a_file(target.parent):  # mkdir would say "File exists"
+            raise SceneError("<file>", str(target), f"cannot save: {why}")
         try:
             target.parent.mkdir(parents=True, exist_ok=True)  # save as into a new folder
             text = self._text_of(self._scene)

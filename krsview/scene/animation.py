@@ -207,7 +207,7 @@ class Animation:
         return bool(self.tracks) or self.sway is not None
 
 
-def _field_meta(obj: Any, path: tuple) -> dict:
+def field_meta(obj: Any, path: tuple) -> dict:
     """The schema metadata of the field a path ends at ({} for an item of a list/vector)."""
     meta: dict = {}
     for key in path:
@@ -278,80 +278,6 @@ def check_animation(scene: Any) -> None:
         check_sway(_sway_route(rest, "animation.sway"), a.sway, "animation.sway")
 
 
-def moments(scene: Any) -> list[float]:
-    """The times at which `krsview check` poses a scene with tracks: the loop's ends, every
-    key and the middle of every pair of keys (where two keys symmetric about a forbidden
-    value, a direction and its opposite, meet it exactly). Numbers between two valid keys
-    stay valid (a field's range is an interval); the sway is checked over a period at load."""
-    a = scene.animation
-    if a is None or not a.tracks:
-        return []
-    out = {0.0, float(a.duration)}
-    for tr in a.tracks:
-        times = [k.time for k in tr.keys]
-        out.update(times)
-        out.update((p + q) / 2 for p, q in zip(times, times[1:]))
-    return sorted(t for t in out if t <= MAX_TIME)
-
-
-NEAR_MISS = 1e-6  # of the keys' own distance from it: a vector track that flips there
-
-
-def near_misses(scene: Any) -> list[str]:
-    """Warnings for vector tracks that pass almost through what they must keep away from
-    (the camera's target for its position and back, else the zero vector, which a
-    direction must not be): valid at every time but one, they flip the view or the
-    direction in an instant there."""
-    a = scene.animation
-    out: list[str] = []
-    for k, tr in enumerate(a.tracks if a is not None else ()):
-        if not isinstance(tr.keys[0].value, tuple):
-            continue
-        path = parse_path(tr.path)
-        other = {("camera", "position"): "target", ("camera", "target"): "position"}.get(path)
-        away = np.array(getattr(scene.camera, other)) if other else np.zeros(len(tr.keys[0].value))
-        scale = max(float(np.linalg.norm(np.subtract(key.value, away))) for key in tr.keys)
-        times = [key.time for key in tr.keys]
-        for p, q in zip(times, times[1:]):
-            t, gap = _nearest_time(tr, p, q, away)
-            if gap < NEAR_MISS * scale:
-                what = f"the camera's {other}" if other else "the zero vector"
-                out.append(
-                    f"animation.tracks[{k}]: {tr.path} passes through {what} at t ≈ {t:.4g} s "
-                    "and flips there"
-                )
-    return out
-
-
-def _nearest_time(tr: Track, p: float, q: float, away: np.ndarray) -> tuple[float, float]:
-    """The time in [p, q] where the track's value (not re-normalised) is nearest ``away``,
-    and that distance: the least of 33 samples, refined by golden sections between its
-    neighbours."""
-
-    def gap(t: float) -> float:
-        return float(np.linalg.norm(np.subtract(tr.value_at(t, False, False), away)))
-
-    ts = np.linspace(p, q, 33)
-    k = int(np.argmin([gap(t) for t in ts]))
-    lo, hi = ts[max(k - 1, 0)], ts[min(k + 1, 32)]
-    g = (math.sqrt(5) - 1) / 2
-    for _ in range(60):
-        a, b = hi - g * (hi - lo), lo + g * (hi - lo)
-        lo, hi = (lo, b) if gap(a) < gap(b) else (a, hi)
-    t = float((lo + hi) / 2)
-    return t, gap(t)
-
-
-def check_motion(scene: Any, times: list[float] | None = None) -> int:
-    """Pose ``scene`` at each of ``times`` (default: :func:`moments`); a value that breaks
-    its field's rule there is the one-line error :func:`pose` raises, naming the track and
-    the time. Returns how many moments were posed."""
-    times = moments(scene) if times is None else times
-    for t in times:
-        pose(replace(scene, animation=replace(scene.animation, time=t)))
-    return len(times)
-
-
 def _track_values(scene: Any) -> tuple[Any, list[tuple[tuple, Any]]]:
     """The scene without tracks or sway (its rest values), and each track's path and value
     at the scene's time."""
@@ -360,7 +286,7 @@ def _track_values(scene: Any) -> tuple[Any, list[tuple[tuple, Any]]]:
     values = []
     for tr in a.tracks:
         path = parse_path(tr.path)
-        unit = bool(_field_meta(rest, path).get("unit_vector"))
+        unit = bool(field_meta(rest, path).get("unit_vector"))
         values.append((path, tr.value_at(a.time, _steps(rest, path, tr), unit)))
     return rest, values
 

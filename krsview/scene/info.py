@@ -8,8 +8,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..messages import counted
-from .animation import near_misses
 from .effects import EFFECTS
+from .motion import near_misses
 from .scene import Scene
 
 

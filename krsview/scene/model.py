@@ -87,7 +87,7 @@ def kernel_as(k: Kernel, kind: str) -> Kernel:
     capsule's start and end (straight: the control point half way), a sphere sits at their
     middle and becomes an upright segment of its diameter."""
     new = Kernel.registry[kind]()
-    names = {f for f in new.__dataclass_fields__}
+    names = set(new.__dataclass_fields__)
     ends = next(
         (
             (np.array(getattr(k, a)), np.array(getattr(k, b)))
