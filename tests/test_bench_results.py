@@ -10,7 +10,16 @@ import numpy as np
 import pytest
 
 import krsview
-from krsview.bench import accuracy, accuracy_report, effects, levels, paths, split, tracers
+from krsview.bench import (
+    accuracy,
+    accuracy_report,
+    effects,
+    harness,
+    levels,
+    paths,
+    split,
+    tracers,
+)
 from krsview.bench.report import Measured, markdown, write_csv
 from krsview.scene import SceneError
 from krsview.scene.effects import allowed_effects
@@ -34,12 +43,23 @@ def test_levels_returns_a_row_per_level_count():
         "levels",
         "instances",
         "ms",
+        "ms_min",
+        "ms_max",
         "time_ratio",
+        "time_ratio_min",
+        "time_ratio_max",
+        "to_previous",
+        "to_previous_min",
+        "to_previous_max",
         "iterations",
         "ratio_per_iteration",
         "ms_every_level",
+        "lod_speedup",
+        "lod_speedup_min",
+        "lod_speedup_max",
     ]
     assert m.rows[0]["time_ratio"] == 1.0 and m.rows[0]["ratio_per_iteration"] == 1.0
+    assert all(r["ms_min"] <= r["ms"] <= r["ms_max"] for r in m.rows)
     assert m.column("instances") == [
         scene.geometry().truncated(n).instance_count() for n in (8, 16, 22)
     ]
@@ -182,3 +202,22 @@ def test_a_lever_whose_rounds_straddle_the_plain_frame_is_within_noise():
     lines = [x for x in text.splitlines() if x.startswith("| 8x6")]
     assert "0.65× [0.55–1.10] within noise" in lines[0]
     assert "0.65× [0.55–0.70] |" in lines[1]  # control: slower in every round
+
+
+def test_a_ratio_carries_its_round_by_round_range_and_is_within_noise_where_it_holds_one():
+    """bench levels, zoom and tracers printed bare ratios of medians (L30/L23 1.07× with no
+    spread): each now carries the [min–max] of its round-by-round ratio."""
+    assert harness.ratio_range([2.0, 3.0, 4.0], [2.0, 2.0, 2.0]) == (1.0, 2.0)
+    assert harness.with_range(1.07, 0.98, 1.12) == "1.07× [0.98–1.12] within noise"
+    assert harness.with_range(1.07, 1.03, 1.12) == "1.07× [1.03–1.12]"  # control: every round
+    with pytest.raises(ValueError):  # rounds of two runs do not pair
+        harness.ratio_range([1.0, 2.0], [1.0])
+    scene = krsview.load("sierpinski")
+    m = levels.bench_levels(scene, SIZE, step=11, rounds=2)
+    assert all(r["time_ratio_min"] <= r["time_ratio"] <= r["time_ratio_max"] for r in m.rows)
+    row = dict(m.rows[1], to_previous=1.07, to_previous_min=0.9, to_previous_max=1.2)
+    lines = data_rows(
+        levels.table(replace(m, rows=[m.rows[0], row, dict(row, to_previous_min=1.01)]))
+    )
+    assert "1.07× [0.90–1.20] within noise" in lines[1]
+    assert "1.07× [1.01–1.20] |" in lines[2]  # control: slower in every round

@@ -216,7 +216,7 @@ def test_bench_levels_prints_the_ratio_table(capsys):
     assert "| levels | kernel instances |" in out
     rows = [line for line in out.splitlines() if line.startswith("| ") and line[2].isdigit()]
     assert [int(r.split("|")[1]) for r in rows] == [8, 16, 22]
-    assert rows[0].split("|")[4].strip() == "1.00"  # the smallest level count is the unit
+    assert rows[0].split("|")[4].strip() == "1.00×"  # the smallest level count is the unit
 
 
 def test_view_without_a_display_says_what_to_do():

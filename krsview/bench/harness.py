@@ -81,6 +81,20 @@ def median_times(
     return {name: statistics.median(t) for name, t in times.items()}
 
 
+def ratio_range(num: list[float], den: list[float]) -> tuple[float, float]:
+    """The [min, max] of the round-by-round ratio ``num[k] / den[k]`` of two variants timed
+    in the same interleaved rounds: the spread a ratio of their medians carries."""
+    per_round = [a / b for a, b in zip(num, den, strict=True)]
+    return min(per_round), max(per_round)
+
+
+def with_range(value: float, lo: float, hi: float, unit: str = "×") -> str:
+    """``value`` with its round-by-round [lo–hi], said to be within noise where that range
+    holds 1 (the rounds disagree on which side of 1 it lies)."""
+    noise = " within noise" if lo <= 1 <= hi else ""
+    return f"{value:.2f}{unit} [{lo:.2f}–{hi:.2f}]{noise}"
+
+
 def noise_floor(groups: list[list[list[float]]]) -> float:
     """The largest relative spread (max/min − 1) between the medians of variants that do the
     same work; each group is a list of per-round times, one per variant. 0 where no group has

@@ -7,6 +7,7 @@ every variant alike.
 
 from __future__ import annotations
 
+import statistics
 from dataclasses import replace
 
 import numpy as np
@@ -14,7 +15,7 @@ import numpy as np
 from ..gpu.renderer import Renderer
 from ..inputs import whole
 from ..scene import Scene
-from .harness import Variant, bench_inputs, median_times
+from .harness import Variant, bench_inputs, ratio_range, round_times, with_range
 from .report import Measured, markdown
 
 
@@ -27,7 +28,9 @@ def level_counts(total: int, step: int) -> list[int]:
 
 def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int = 5) -> Measured:
     """One row per level count (every ``step`` levels, and all): kernel instances, ms per
-    frame, time ratio to the fewest levels, iterations per pixel, time per iteration ratio."""
+    frame (median, min, max), time ratio to the fewest levels and to the row before (each
+    with its round-by-round [min, max]), iterations per pixel, time per iteration ratio, and
+    every level walked (lod 0) beside it."""
     scene, size, rounds = bench_inputs(scene, size, rounds)
     step = whole(step, "step", 1)
     w, h = size
@@ -36,24 +39,39 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
     variants = {m: krs.truncated(m) for m in counts}
     r = Renderer()
     iters = {m: float(r.render(scene, w, h, k).iterations.mean()) for m, k in variants.items()}
-    every = replace(scene, render=replace(scene.render, lod=0.0))  # today's walk, beside it
+    all_levels = replace(scene, render=replace(scene.render, lod=0.0))  # every level, beside
     timed = {f"{m} levels": Variant(scene, variants[m]) for m in counts}
-    timed |= {f"{m} levels, every level": Variant(every, variants[m]) for m in counts}
-    med = median_times(r, timed, size, rounds, f"bench levels {scene.name}")
+    timed |= {f"{m} levels, every level": Variant(all_levels, variants[m]) for m in counts}
+    times = round_times(r, timed, size, rounds, f"bench levels {scene.name}")
+    med = {name: statistics.median(t) for name, t in times.items()}
     base = counts[0]
     t_base = med[f"{base} levels"]
     rows = []
-    for m in counts:
-        t = med[f"{m} levels"]
+    for before, m in zip([base, *counts], counts):
+        name, t = f"{m} levels", med[f"{m} levels"]
+        every = times[f"{name}, every level"]
+        lo, hi = ratio_range(times[name], times[f"{base} levels"])
+        prev_lo, prev_hi = ratio_range(times[name], times[f"{before} levels"])
+        gain_lo, gain_hi = ratio_range(every, times[name])
         rows.append(
             dict(
                 levels=m,
                 instances=variants[m].instance_count(),
                 ms=t * 1e3,
+                ms_min=min(times[name]) * 1e3,
+                ms_max=max(times[name]) * 1e3,
                 time_ratio=t / t_base,
+                time_ratio_min=lo,
+                time_ratio_max=hi,
+                to_previous=t / med[f"{before} levels"],  # 1 in the first row
+                to_previous_min=prev_lo,
+                to_previous_max=prev_hi,
                 iterations=iters[m],
                 ratio_per_iteration=(t / iters[m]) / (t_base / iters[base]),
-                ms_every_level=med[f"{m} levels, every level"] * 1e3,
+                ms_every_level=statistics.median(every) * 1e3,
+                lod_speedup=statistics.median(every) / t,
+                lod_speedup_min=gain_lo,
+                lod_speedup_max=gain_hi,
             )
         )
     return Measured(scene, size, rounds, rows)
@@ -72,8 +90,10 @@ def table(m: Measured) -> str:
     rows = m.rows
     text = (
         f"\nFrame time against levels — {m.scene.name}, {m.size[0]}×{m.size[1]}, lod "
-        f"{m.scene.render.lod:g} beside every level, median of {m.rounds} interleaved rounds "
-        f"(ratios to {rows[0]['levels']} levels)\n\n"
+        f"{m.scene.render.lod:g} beside every level, median [min–max] of {m.rounds} "
+        f"interleaved rounds; ratios to {rows[0]['levels']} levels and to the row before, "
+        "each with the [min–max] of its round-by-round ratio (within noise where that holds "
+        "1×)\n\n"
     )
     text += markdown(
         (
@@ -81,22 +101,30 @@ def table(m: Measured) -> str:
             "kernel instances",
             "ms/frame",
             "time ratio",
+            "× row before",
             "iterations/px",
             "time/iteration ratio",
             "ms/frame, every level (lod 0)",
+            "lod's speed-up",
         ),
-        "rrrrrrr",
+        "rrrrrrrrr",
         (
             (
                 r["levels"],
                 f"{r['instances']:,}",
-                f"{r['ms']:.2f}",
-                f"{r['time_ratio']:.2f}",
+                f"{r['ms']:.2f} [{r['ms_min']:.2f}–{r['ms_max']:.2f}]",
+                "1.00×"  # the base row: a ratio to itself
+                if k == 0
+                else with_range(r["time_ratio"], r["time_ratio_min"], r["time_ratio_max"]),
+                "—"
+                if k == 0
+                else with_range(r["to_previous"], r["to_previous_min"], r["to_previous_max"]),
                 f"{r['iterations']:.1f}",
                 f"{r['ratio_per_iteration']:.2f}",
                 f"{r['ms_every_level']:.2f}",
+                with_range(r["lod_speedup"], r["lod_speedup_min"], r["lod_speedup_max"]),
             )
-            for r in rows
+            for k, r in enumerate(rows)
         ),
     )
     if len(rows) >= 3:

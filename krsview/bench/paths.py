@@ -15,7 +15,7 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.render import VIEW_PREPASS
-from .harness import Variant, bench_inputs, median_times, round_times
+from .harness import Variant, bench_inputs, median_times, ratio_range, round_times, with_range
 from .report import Measured, markdown
 
 TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
@@ -131,7 +131,7 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
         base = med[plain]
         for k, s in variants.items():
             t = med[lever_name(k)]
-            per_round = [b / x for b, x in zip(times[plain], times[lever_name(k)])]
+            lo, hi = ratio_range(times[plain], times[lever_name(k)])
             rows.append(
                 dict(
                     size=f"{w}x{h}",
@@ -143,8 +143,8 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
                     shadow_rays=k[5],
                     ms=t * 1e3,
                     speedup=base / t,
-                    speedup_min=min(per_round),  # the round-by-round ratio's spread
-                    speedup_max=max(per_round),
+                    speedup_min=lo,  # the round-by-round ratio's spread
+                    speedup_max=hi,
                     iterations=float(r.render(s, w, h).iterations.mean()),
                     levels=float(r.levels(s, w, h).mean()),
                     coarse_share=coarse.get(k[1:4], 0.0) / t,
@@ -186,8 +186,7 @@ def table(m: Measured) -> str:
                 r["steps"] or "—",
                 r["shadow_rays"] or "—",
                 f"{r['ms']:.1f}",
-                f"{r['speedup']:.2f}× [{r['speedup_min']:.2f}–{r['speedup_max']:.2f}]"
-                + (" within noise" if r["speedup_min"] <= 1 <= r["speedup_max"] else ""),
+                with_range(r["speedup"], r["speedup_min"], r["speedup_max"]),
                 f"{r['iterations']:.1f}",
                 f"{r['levels']:.1f}",
                 f"{r['coarse_share']:.0%}",

@@ -9,13 +9,14 @@ ratios to sphere tracing. "Hit agreement" compares each hit mask with sphere tra
 from __future__ import annotations
 
 import itertools
+import statistics
 from dataclasses import replace
 
 import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
-from .harness import Variant, bench_inputs, median_times
+from .harness import Variant, bench_inputs, ratio_range, round_times, with_range
 from .report import Measured, markdown
 
 BONUS = (1.5, 2.0, 3.0)
@@ -53,19 +54,21 @@ def bench_tracers(
     runs = variants(scene, sweep)
     r = Renderer()
     buffers = {name: r.render(s, w, h) for name, s in runs.items()}
-    med = median_times(
+    times = round_times(
         r,
         {name: Variant(s) for name, s in runs.items()},
         size,
         rounds,
         f"bench tracers {scene.name}",
     )
+    med = {name: statistics.median(t) for name, t in times.items()}
     base = next(iter(runs))
     t0 = med[base]
     it0 = float(np.mean(buffers[base].iterations))
     rows = []
     for name, s in runs.items():
         b, t = buffers[name], med[name]
+        lo, hi = ratio_range(times[name], times[base])
         binary = s.render.tracer == "binary"
         rows.append(
             dict(
@@ -76,7 +79,11 @@ def bench_tracers(
                 mean_iterations=float(np.mean(b.iterations)),
                 iteration_ratio=float(np.mean(b.iterations)) / it0,
                 ms=t * 1e3,
+                ms_min=min(times[name]) * 1e3,
+                ms_max=max(times[name]) * 1e3,
                 time_ratio=t / t0,
+                time_ratio_min=lo,
+                time_ratio_max=hi,
                 hit_fraction=float(b.hit.mean()),
                 hit_agreement=float((b.hit == buffers[base].hit).mean()),
             )
@@ -93,8 +100,9 @@ def table(m: Measured) -> str:
     )
     text = (
         f"\nSphere vs binary tracing — {m.scene.name}, {m.size[0]}×{m.size[1]}, ε-scale "
-        f"{m.scene.render.epsilon_scale}, median of {m.rounds} interleaved rounds "
-        f"(ratios to {base})\n\n"
+        f"{m.scene.render.epsilon_scale}, median [min–max] of {m.rounds} interleaved rounds "
+        f"(ratios to {base}; time ratios with the [min–max] of their round-by-round ratio, "
+        "within noise where that holds 1×)\n\n"
     )
     text += markdown(
         (
@@ -117,8 +125,8 @@ def table(m: Measured) -> str:
                 f"{r['median_iterations']:.0f}",
                 f"{r['mean_iterations']:.1f}",
                 f"{r['iteration_ratio']:.2f}",
-                f"{r['ms']:.1f}",
-                f"{r['time_ratio']:.2f}",
+                f"{r['ms']:.1f} [{r['ms_min']:.1f}–{r['ms_max']:.1f}]",
+                with_range(r["time_ratio"], r["time_ratio_min"], r["time_ratio_max"]),
                 f"{r['hit_agreement']:.2%}",
             )
             for r in m.rows
@@ -130,7 +138,8 @@ def table(m: Measured) -> str:
         few = min(binaries, key=lambda row: row["mean_iterations"])
         text += (
             f"\n\nfastest ξ pair: {fast['xi_bonus']}/{fast['xi_penalty']} "
-            f"({fast['time_ratio']:.2f}× {base}); fewest iterations: "
+            f"({with_range(fast['time_ratio'], fast['time_ratio_min'], fast['time_ratio_max'])} "
+            f"{base}); fewest iterations: "
             f"{few['xi_bonus']}/{few['xi_penalty']} ({few['mean_iterations']:.1f} it/px)"
         )
     return text

@@ -7,6 +7,7 @@ fastest."""
 
 from __future__ import annotations
 
+import statistics
 from dataclasses import replace
 
 import numpy as np
@@ -15,7 +16,7 @@ from ..compile.balls import kernel_ball
 from ..gpu.renderer import Renderer
 from ..inputs import whole
 from ..scene import Scene, SceneError
-from .harness import Variant, bench_inputs, median_times
+from .harness import Variant, bench_inputs, ratio_range, round_times, with_range
 from .report import Measured, markdown
 
 END_RADII = 3.0  # the last stop is this many of the finest kernel's ball radii from its centre
@@ -71,7 +72,8 @@ def bench_zoom(
     variants = {n: Variant(v) for n, v in zip(names, views)}
     variants |= {f"{n}, every level": Variant(v) for n, v in zip(names, every)}
     variants |= {f"{n}, restart {walk}": Variant(v) for n, v in zip(names, other)}
-    med = median_times(r, variants, size, rounds, f"bench zoom {scene.name}")
+    times = round_times(r, variants, size, rounds, f"bench zoom {scene.name}")
+    med = {name: statistics.median(t) for name, t in times.items()}
     rows = []
     for name, v, e, o in zip(names, views, every, other):
         frame = r.render(v, w, h)
@@ -83,6 +85,8 @@ def bench_zoom(
                 stop=name,
                 distance=float(np.linalg.norm(np.array(v.camera.position) - centre)),
                 ms=med[name] * 1e3,
+                ms_min=min(times[name]) * 1e3,
+                ms_max=max(times[name]) * 1e3,
                 ms_every_level=med[f"{name}, every level"] * 1e3,
                 iterations=iterations,
                 levels_per_iteration=float(walked.sum() / max(frame.iterations.sum(), 1)),
@@ -96,6 +100,15 @@ def bench_zoom(
                 ),
             )
         )
+    for column, suffix in (
+        ("ms", ""),
+        ("ms_every_level", ", every level"),
+        ("ms_other_walk", f", restart {walk}"),
+    ):  # each stop against the fastest, round by round: the spread of the zoom's ratio
+        fastest = min(names, key=lambda n: med[n + suffix])
+        for row, name in zip(rows, names):
+            lo, hi = ratio_range(times[name + suffix], times[fastest + suffix])
+            row |= {f"{column}_to_fastest_min": lo, f"{column}_to_fastest_max": hi}
     m = Measured(scene, size, rounds, rows)
     if plot is not None:
         write_plot(m, plot)
@@ -103,8 +116,16 @@ def bench_zoom(
 
 
 def spread(m: Measured, column: str = "ms") -> float:
-    """The slowest frame's time over the fastest's along the flight."""
+    """The slowest frame's time over the fastest's along the flight (medians)."""
     return max(m.column(column)) / min(m.column(column))
+
+
+def spread_text(m: Measured, column: str = "ms") -> str:
+    """:func:`spread` with the [min–max] of the slowest stop's round-by-round ratio to the
+    fastest's."""
+    slowest = max(m.rows, key=lambda row: row[column])
+    lo, hi = slowest[f"{column}_to_fastest_min"], slowest[f"{column}_to_fastest_max"]
+    return with_range(spread(m, column), lo, hi)
 
 
 def table(m: Measured) -> str:
@@ -112,7 +133,7 @@ def table(m: Measured) -> str:
     path = "persistent lanes" if rs.path == "compute" and rs.steps == 0 else f"{rs.path} path"
     text = (
         f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, pre-pass "
-        f"{rs.prepass or 'off'}, {path}, median of {m.rounds} interleaved rounds\n\n"
+        f"{rs.prepass or 'off'}, {path}, median [min–max] of {m.rounds} interleaved rounds\n\n"
     )
     lod = rs.lod
     walk = "off" if rs.walk_restart == "on" else "on"
@@ -134,7 +155,7 @@ def table(m: Measured) -> str:
             (
                 r["stop"],
                 f"{r['distance']:.4g}",
-                f"{r['ms']:.1f}",
+                f"{r['ms']:.1f} [{r['ms_min']:.1f}–{r['ms_max']:.1f}]",
                 f"{r['ms_every_level']:.1f}",
                 f"{r['iterations']:.1f}",
                 f"{r['levels_per_iteration']:.1f}",
@@ -147,9 +168,10 @@ def table(m: Measured) -> str:
         ),
     )
     return (
-        text + f"\n\nslowest frame / fastest: {spread(m):.2f}× (lod {lod:g}), "
-        f"{spread(m, 'ms_every_level'):.2f}× (every level), "
-        f"{spread(m, 'ms_other_walk'):.2f}× (walk restart {walk})"
+        text + f"\n\nslowest frame / fastest (medians, with the [min–max] of the slowest "
+        f"stop's round-by-round ratio to the fastest's): {spread_text(m)} (lod {lod:g}), "
+        f"{spread_text(m, 'ms_every_level')} (every level), "
+        f"{spread_text(m, 'ms_other_walk')} (walk restart {walk})"
     )
 
 
@@ -162,11 +184,14 @@ def write_plot(m: Measured, path) -> None:
 
     d = m.column("distance")
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    a.plot(d, m.column("ms"), "o-", color="C0", label=f"lod {m.scene.render.lod:g}")
+    ms = np.array(m.column("ms"))
+    bars = [ms - m.column("ms_min"), np.array(m.column("ms_max")) - ms]
+    lod = f"lod {m.scene.render.lod:g}"
+    a.errorbar(d, ms, yerr=bars, fmt="o-", color="C0", capsize=3, label=lod)
     a.plot(d, m.column("ms_every_level"), "o--", color="C3", label="every level (lod 0)")
     walk = "off" if m.scene.render.walk_restart == "on" else "on"
     a.plot(d, m.column("ms_other_walk"), "s:", color="C4", label=f"walk restart {walk}")
-    a.set_ylabel("ms per frame")
+    a.set_ylabel("ms per frame (median, bar: min–max)")
     a.legend()
     a.set_title(f"{m.scene.name}: zoom into the finest kernel, {m.size[0]}×{m.size[1]}")
     b.plot(d, m.column("iterations"), "o-", color="C1", label="iterations per pixel")

@@ -44,8 +44,10 @@ def level_list(text: str) -> tuple[int, ...]:
 BENCHES = {
     "levels": Bench(
         "frame time against level count (O(n) vs 2^n)",
-        "Render the same view with the coarsest 4, 8, … levels, interleaved, median of "
-        "several frames; print time relative to the smallest level count beside the kernel "
+        "Render the same view with the coarsest 4, 8, … levels, interleaved rounds, and "
+        "every level (lod 0) beside; print the median [min–max] time per frame, its ratio "
+        "to the smallest level count and to the row before (each with the [min–max] of its "
+        "round-by-round ratio, 'within noise' where that holds 1×) beside the kernel "
         "instances. Example: krsview bench levels tree --step 4",
         knobs=("epsilon_scale", "max_iterations", "lod", "prepass", "walk_restart"),
         own=(
@@ -86,8 +88,9 @@ BENCHES = {
         "sphere vs binary sphere tracing, and a ξ sweep",
         "On one scene and view: sphere tracing, binary tracing at the paper's "
         "ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over ξ_bonus ∈ {1.5, 2, 3} × ξ_penalty ∈ "
-        "{0.2, 0.3, 0.5}; iterations per pixel, frame time and hit agreement, as ratios to "
-        "sphere tracing (to binary 2.0/0.3 for a MöKRS). Example: krsview bench tracers "
+        "{0.2, 0.3, 0.5}; iterations per pixel, frame time (median [min–max] of interleaved "
+        "rounds) and hit agreement, as ratios to sphere tracing (to binary 2.0/0.3 for a "
+        "MöKRS), time ratios with their round-by-round [min–max]. Example: krsview bench tracers "
         "palm --epsilon-scale 0.5",
         scene_options=True,
         own=(
@@ -112,7 +115,8 @@ BENCHES = {
         "From the scene's eye straight into its finest kernel (the tip of a tree's twig, "
         "20 and more levels down), at distances shrinking geometrically: frame time "
         "(interleaved rounds), iterations per pixel and levels walked per iteration at each "
-        "stop, and the slowest frame against the fastest. It draws with `render`'s fast "
+        "stop, and the slowest frame against the fastest with the [min–max] of its "
+        "round-by-round ratio. It draws with `render`'s fast "
         "settings where the scene and the options set none. Example: krsview bench zoom "
         "tree --stops 12 --plot out/zoom.png",
         knobs=("prepass", "culling", "lod", "walk_restart", "path", "steps"),
