@@ -200,9 +200,15 @@ def test_the_mesh_reports_the_resolution_it_sampled_and_steps_its_progress(tmp_p
                     timeout=120, cwd=tmp_path)  # fmt: skip
     assert r.returncode == 0 and "meshing at 64 voxels a side" in r.stdout, r.stderr
     calls = []
-    _, st = build_mesh(load_scene(resolve("sierpinski")), 48, progress=lambda d, n: calls.append(d))
+    _, st = build_mesh(load_scene(resolve("sierpinski")), 48, progress=lambda *c: calls.append(c))
     assert st.resolution == 64 and len(calls) >= 10, (len(calls), st.bricks)  # it was 1
-    assert calls == sorted(calls) and calls[-1] == st.bricks
+    done = [d for d, _ in calls]
+    assert done == sorted(done) and calls[-1][0] == calls[-1][1]  # one way, to the end
+    assert all(d < n for d, n in calls[:-1])  # a bar closes at its total: not before the end
+    # the vertices' bisections were silent, as long as the bricks' sampling [review]: now
+    # REFINE_STEPS + 1 calls after the bricks', and the colours' last
+    bricks = [c for c in calls if c[1] == calls[0][1]]
+    assert len(calls) - len(bricks) == REFINE_STEPS + 2, calls
 
 
 def test_export_mesh_takes_the_moment_as_render_does(tmp_path):

@@ -123,7 +123,7 @@ def run_mesh(args: argparse.Namespace) -> int:
         f"{args.lod:g} voxel out …",
         flush=True,
     )
-    bar = Progress(1, "  bricks", SILENT_SECONDS)
+    bar = Progress(1, "  samples", SILENT_SECONDS)  # the bricks', then the vertices' bisections
     st = export.mesh(scene, out, args.resolution, args.lod, args.box, bar)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(

@@ -28,6 +28,7 @@ FORMATS = (".glb", ".ply", ".stl", ".obj")  # what trimesh writes
 BATCH = 1 << 18  # points per reference call (memory stays flat)
 PROGRESS_STEPS = 20  # the bricks are sampled in at least this many calls, each reported
 REFINE_STEPS = 8  # bisections per vertex along its grid edge: within h / 256
+REFINE_SHARE = 0.2  # the bisections and colours against the bricks (tree 8 %, palm 32 %)
 
 
 @dataclass
@@ -84,7 +85,9 @@ def build_mesh(
     its MeshStats. ``resolution`` voxels along the sampled cube's side, rounded up to a
     multiple of BRICK. ``lod`` > 0 meshes the level set at lod voxels instead of the surface
     (the renderer's level of detail [KRS17 §4]: what is thinner than a voxel is thickened to
-    about one instead of vanishing between samples)."""
+    about one instead of vanishing between samples). ``progress(done, total)`` counts the
+    bricks' samples, then the vertices' bisections and colours; their total is known once
+    the bricks are done (until then it is guessed at REFINE_SHARE more than the bricks')."""
     import trimesh
     from skimage.measure import marching_cubes
 
@@ -102,6 +105,7 @@ def build_mesh(
     boxes, samples = occupied_bricks(is_empty, lo, h, iso, bricks_per_side)
     verts, faces, count = [], [], 0
     grid = np.stack(np.meshgrid(*[np.arange(BRICK + 1)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    sampled = len(boxes) * len(grid)  # the bricks' corners: the first part of the work
     per_call = max(1, min(BATCH // len(grid), math.ceil(len(boxes) / PROGRESS_STEPS)))
     for k0 in range(0, len(boxes), per_call):
         chunk = boxes[k0 : k0 + per_call]
@@ -118,7 +122,7 @@ def build_mesh(
             faces.append(f + count)
             count += len(v)
         if progress is not None:
-            progress(min(k0 + per_call, len(boxes)), len(boxes))
+            progress(min(k0 + per_call, len(boxes)) * len(grid), int(sampled * (1 + REFINE_SHARE)))
     if not faces:
         raise SceneError("geometry", scene.name, "no surface inside the region sampled")
     grid_verts, index = np.unique(np.concatenate(verts), axis=0, return_inverse=True)
@@ -126,10 +130,18 @@ def build_mesh(
     faces = faces[
         (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])
     ]
-    positions = lo + refine(grid_verts, lambda g: value(lo + g * h) - iso) * h
+    total = sampled + (REFINE_STEPS + 2) * len(grid_verts)  # + the bisections, the colours
+
+    def bisected(k: int) -> None:
+        if progress is not None:
+            progress(sampled + k * len(grid_verts), total)
+
+    positions = lo + refine(grid_verts, lambda g: value(lo + g * h) - iso, bisected) * h
     samples += REFINE_STEPS * len(grid_verts)
     mesh = trimesh.Trimesh(positions, faces, process=False)
     level, _, _ = nearest(c, np.asarray(mesh.vertices), None, dist)
+    if progress is not None:
+        progress(total, total)
     albedo = np.clip(c.records[level, 0, :3], 0.0, 1.0) ** (1 / 2.2)
     mesh.visual.vertex_colors = np.concatenate(
         [np.round(albedo * 255), np.full((len(albedo), 1), 255)], axis=1
@@ -187,13 +199,18 @@ def _batched(f: Callable, *xs: np.ndarray) -> np.ndarray:
     return np.concatenate([f(*(x[k : k + BATCH] for x in xs)) for k in range(0, len(xs[0]), BATCH)])
 
 
-def refine(g: np.ndarray, f: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+def refine(
+    g: np.ndarray,
+    f: Callable[[np.ndarray], np.ndarray],
+    passes: Callable[[int], None] = lambda k: None,
+) -> np.ndarray:
     """Marching cubes places a vertex on a grid edge whose corners f has opposite signs, by
     linear interpolation: up to half a voxel off where f is not a true distance (Alg. 1
     gives a bound). Bisect f along that edge instead, REFINE_STEPS times: each vertex ends
     within 2^-REFINE_STEPS voxel of a sign change of f. ``g``: vertices in grid units
     (exactly one coordinate fractional; others, such as marching cubes 33's cell-interior
-    vertices, are left where they are)."""
+    vertices, are left where they are). ``passes(k)`` is told after each of the
+    REFINE_STEPS + 1 passes of f over the vertices."""
     frac = np.abs(g - np.round(g)) > 1e-9
     on_edge = frac.sum(1) == 1
     out = g.copy()
@@ -206,12 +223,14 @@ def refine(g: np.ndarray, f: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     a[rows, axis] = np.floor(g[idx, axis])
     b[rows, axis] = np.ceil(g[idx, axis])
     fa = _batched(f, a)
-    for _ in range(REFINE_STEPS):
+    passes(1)
+    for k in range(REFINE_STEPS):
         m = (a + b) / 2
         fm = _batched(f, m)
         same = (fm < 0) == (fa < 0)  # the sign change lies in [m, b]
         a = np.where(same[:, None], m, a)
         fa = np.where(same, fm, fa)
         b = np.where(same[:, None], b, m)
+        passes(k + 2)
     out[idx] = (a + b) / 2
     return out
