@@ -728,3 +728,30 @@ def test_a_scale_that_outgrows_float32_over_linked_levels_is_refused(display, tm
         assert e.edit(whole, fine) and e.scene.mokrs.levels[58].transform[0].factor == 2.0
     finally:
         e.close()
+
+
+def test_a_kernel_changed_back_to_its_kind_comes_back_as_it_was():
+    """A bent toroidal capsule turned into a capsule and back came back straight [review]:
+    the kind change remembers what it left, while nothing was edited since."""
+    from dataclasses import replace
+
+    from krsview.editor.mokrs_panel import KindsLeft
+    from krsview.scene.model import kernel_as
+
+    bent = load_scene(resolve("palm")).mokrs.levels[0].kernel
+    assert bent.kind == "toroidal_capsule"
+    where = (*LEVELS, 0)
+    kinds = KindsLeft()
+    cap = kinds.switch(where, bent, "capsule")
+    assert cap == kernel_as(bent, "capsule")
+    assert kinds.switch(where, cap, "toroidal_capsule") == bent  # the bend is back
+    # through a third kind too, each step undisturbed
+    ball = kinds.switch(where, kinds.switch(where, bent, "capsule"), "sphere")
+    assert kinds.switch(where, kinds.switch(where, ball, "capsule"), "toroidal_capsule") == bent
+    # controls: a capsule edited in between, or another level's, is made afresh
+    cap = kinds.switch(where, bent, "capsule")
+    thicker = replace(cap, radius=cap.radius * 2)
+    assert kinds.switch(where, thicker, "toroidal_capsule") == kernel_as(
+        thicker, "toroidal_capsule"
+    )
+    assert kinds.switch((*LEVELS, 1), cap, "toroidal_capsule") != bent

@@ -42,6 +42,23 @@ HINTS = {  # what dragging each kind of handle changes
 }
 
 
+class KindsLeft:
+    """The kernels a kind change left, so that changing back restores one (a toroidal
+    capsule's bend, a sphere's centre) where nothing was edited since: a capsule made from
+    a bent toroid and turned back was straight [review]."""
+
+    def __init__(self) -> None:
+        self._left: dict[tuple, tuple[Kernel, Kernel]] = {}  # (path, kind) → (left, made)
+
+    def switch(self, path: tuple, kernel: Kernel, kind: str) -> Kernel:
+        """``kernel`` (at ``path``) as a kernel of ``kind``: the one it was made from, if
+        that had this kind and it is unchanged since, else :func:`kernel_as`."""
+        left, made = self._left.get((path, kind), (None, None))
+        new = left if left is not None and made == kernel else kernel_as(kernel, kind)
+        self._left[(path, kernel.kind)] = (kernel, new)
+        return new
+
+
 def moved(items: list, k: int, by: int) -> list:
     """``items`` with entry k swapped with entry k + by (unchanged at either end)."""
     j = k + by
@@ -142,7 +159,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
     kinds = list(KERNEL_KINDS)
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
     if changed and kinds[k] != lv.kernel.kind:
-        out.append(Edit((*lev, "kernel"), kernel_as(lv.kernel, kinds[k])))
+        out.append(Edit((*lev, "kernel"), e.kinds_left.switch(lev, lv.kernel, kinds[k])))
     fields(shown.kernel, (*lev, "kernel"), out, interactions)
     red_text(error if place == "kernel" else "")
     for j, s in enumerate(shown.transform):  # as drawn now; reordered as the rest levels

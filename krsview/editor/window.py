@@ -49,6 +49,7 @@ from .grab import Grabbing
 from .handles import Handle, level_handle
 from .keys import Timeline, key_now, keyed_edit
 from .layout import Layout, frame, shift
+from .mokrs_panel import KindsLeft
 from .picking import pick, visible
 from .saving import autosave
 from .shown import Shown
@@ -81,6 +82,7 @@ class Editor:
         self.grabbing = Grabbing()  # a point handle pressed on and dragged at once
         self.layout = Layout()
         self.carry = True  # a fork drag takes its subtree along
+        self.kinds_left = KindsLeft()  # a MöKRS kernel's kind changed back restores it
         self.structure = StructureTools()
         self.timeline = Timeline()
         self.selected: Handle | None = None
