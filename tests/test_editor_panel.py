@@ -18,7 +18,7 @@ from krsview.scene import load_scene
 from krsview.scene.presets import PRESET_DIR, resolve
 from krsview.viewer.hud import HUD_RIGHT
 
-from .test_editor import LEVEL, open_from_start, pump, scroll_to, window_xy, xdo
+from .test_editor import LEVEL, click, open_from_start, pump, scroll_to, window_xy, xdo
 from .test_editor import type_at as type_into
 
 SIZE = (640, 400)
@@ -438,3 +438,33 @@ def test_a_warning_or_an_error_appearing_moves_no_field(tree_editor, monkeypatch
     assert before and set(before) == set(after)
     assert all(abs(after[k][1] - before[k][1]) < 0.5 for k in before), "a field moved"
     assert any(s.startswith("2 warnings: branches Alg. 1 cuts") for s in lines)
+
+
+def test_own_color_gives_a_level_the_albedo_it_is_drawn_in_and_takes_it_back(tree_editor):
+    """The "own color" box of a level, clicked: a level with its own colour goes to the
+    material's albedo (None); clicked again, it gets a colour of its own, that albedo, so
+    its pixels do not change (it started at the default grey, and the level changed colour
+    when ticked [review]). Negative control: its own bark colour, before, shows."""
+    e = tree_editor
+    e.select_level(LEVEL)
+    pump(e, 3)
+    path = ("route", "levels", LEVEL, "color")
+    bark = e.scene.route.levels[LEVEL].color
+    assert bark is not None and bark != e.scene.material.albedo
+
+    def image():
+        return e.viewer.renderer.render(e.scene, 96, 54).color
+
+    def click_box() -> None:
+        x0, y0, _, y1 = scroll_to(e, (*path, "own"), 40, 5)
+        click(e, window_xy(e, x0 + 6, (y0 + y1) / 2))
+
+    before = image()
+    click_box()
+    assert e.scene.route.levels[LEVEL].color is None
+    albedo = image()
+    assert not np.array_equal(albedo, before), "negative control: the bark colour shows"
+    click_box()
+    assert e.scene.route.levels[LEVEL].color == tuple(e.scene.material.albedo)
+    assert np.array_equal(image(), albedo)  # ticked: nothing changes until it is set
+    assert len(e.doc.history.steps) == 3  # the bake and one undo step per click

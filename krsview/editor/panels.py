@@ -292,7 +292,11 @@ def _field(
     path = (*at, f.name)
     if f.name in BOOKKEEPING:
         _bookkeeping(f.name, value, path, interactions)
-    elif f.name == "color" and f.default is None and not _own_color(value, path, out, albedo):
+    elif (
+        f.name == "color"
+        and f.default is None
+        and not _own_color(value, path, out, albedo, interactions)
+    ):
         return  # drawn in the material's albedo: no colour field
     elif value is None or isinstance(value, list) or f.name in GEOMETRY_TABLES:
         return
@@ -312,11 +316,14 @@ def _field(
             out.append(Edit(path, new, key))
 
 
-def _own_color(value: Any, path: tuple, out: list, albedo: tuple) -> bool:
+def _own_color(
+    value: Any, path: tuple, out: list, albedo: tuple, interactions: Interactions
+) -> bool:
     """A colour that may be left to the material's ``albedo`` (none): a box that gives it
     one of its own, starting at that albedo (so nothing changes until it is set), or takes
-    it back; whether it has one (its field follows)."""
+    it back; whether it has one (its field follows). The box's place: ``(*path, "own")``."""
     changed, own = imgui.checkbox(f"own color##{'.'.join(map(str, path))}", value is not None)
+    interactions.place((*path, "own"))
     if imgui.is_item_hovered():
         tooltip("ticked: its own colour, below; not: drawn in the material's albedo")
     if changed:
@@ -329,10 +336,9 @@ def _bookkeeping(name: str, value: Any, path: tuple, interactions: Interactions)
     place is kept in ``interactions.rects`` like a widget's, for tests and automation)."""
     text, tip = BOOKKEEPING[name](value)
     imgui.text_disabled(text)
+    interactions.place(path)
     if imgui.is_item_hovered():
         tooltip(tip)
-    lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
-    interactions.rects[path] = (lo.x, lo.y, hi.x, hi.y)
 
 
 def _grown(depth: int | None) -> tuple[str, str]:

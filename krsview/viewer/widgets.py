@@ -52,14 +52,18 @@ class Interactions:
         field's message goes under it; Esc cancels the refused value."""
         if imgui.is_item_activated():
             self.count += 1
-        lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
-        self.rects[path] = (lo.x, lo.y, hi.x, hi.y)
+        self.place(path)
         if path in self.refused:
             if imgui.is_key_pressed(imgui.Key.escape):
                 del self.refused[path]
             else:
                 red_text(self.refused[path].message)
         return ("panel", path, self.count)
+
+    def place(self, path: tuple) -> None:
+        """Keep where the last widget was drawn, as ``path``'s."""
+        lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        self.rects[path] = (lo.x, lo.y, hi.x, hi.y)
 
     def settle(self, path: tuple, value: Any, error: str) -> bool:
         """An edit of ``path`` was applied (``error`` empty) or refused: a field showing its
