@@ -1,8 +1,9 @@
 """The one timing harness of the benchmarks: every variant is compiled and drawn once
 (warm-up), then the variants are drawn round after round, interleaved, so machine noise hits
-them alike, and each variant's median frame time is kept (DESIGN.md, Measure as ratios).
-The noise floor of a run is the spread between the medians of variants that do the same
-work: a time difference under it is not a measurement."""
+them alike, and each variant's median frame time is kept (DESIGN.md, Measure as ratios), or
+its fastest round where a busy machine slows many rounds (the accuracy bench). The noise
+floor of a run is the spread between those times of variants that do the same work: a time
+difference under it is not a measurement."""
 
 from __future__ import annotations
 
@@ -95,13 +96,14 @@ def with_range(value: float, lo: float, hi: float, unit: str = "×") -> str:
     return f"{value:.2f}{unit} [{lo:.2f}–{hi:.2f}]{noise}"
 
 
-def noise_floor(groups: list[list[list[float]]]) -> float:
-    """The largest relative spread (max/min − 1) between the medians of variants that do the
-    same work; each group is a list of per-round times, one per variant. 0 where no group has
-    two variants (nothing measured the noise)."""
+def noise_floor(
+    groups: list[list[list[float]]], estimate: Callable[[list[float]], float] = statistics.median
+) -> float:
+    """The largest relative spread (max/min − 1) between the ``estimate`` (median, or the
+    fastest round) of variants that do the same work; each group is a list of per-round
+    times, one per variant. 0 where no group has two variants (nothing measured the noise)."""
     spreads = [
-        max(meds) / min(meds) - 1
-        for meds in ([statistics.median(t) for t in g] for g in groups if len(g) >= 2)
+        max(est) / min(est) - 1 for est in ([estimate(t) for t in g] for g in groups if len(g) >= 2)
     ]
     return max(spreads, default=0.0)
 

@@ -239,7 +239,8 @@ def add_accuracy(bsub) -> None:
         "with plots",
         description="On one view: sweep ε-scale, the iteration cap, the tracer (sphere, "
         "over-relaxed with ω, binary with ξ pairs) and the level count; time each setting "
-        "on the GPU (interleaved rounds, median [min–max]; settings doing the same work "
+        "on the GPU (interleaved rounds: the fastest round, which a busy machine disturbs "
+        "least, with the median and slowest beside it; settings doing the same work "
         "share one time, and their spread is the run's noise floor, under which a "
         "difference is 'within noise'), count its work (kernels evaluated per pixel, "
         "deterministic) and compare its image with the ground "
@@ -272,9 +273,9 @@ def add_accuracy(bsub) -> None:
         "--rounds",
         type=options.number_in("--rounds", MIN_ACCURACY_ROUNDS, 100),
         default=5,
-        help=f"interleaved rounds, {MIN_ACCURACY_ROUNDS}..100; medians with [min–max] and the "
-        "run's noise floor are reported (default 5; fewer rounds give no spread to draw a "
-        "verdict on)",
+        help=f"interleaved rounds, {MIN_ACCURACY_ROUNDS}..100; the fastest round with the "
+        "median and slowest, and the run's noise floor, are reported (default 5; fewer rounds "
+        "give no spread to draw a verdict on)",
     )
     ba.add_argument(
         "--out",
