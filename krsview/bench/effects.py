@@ -16,13 +16,12 @@ we trace shadows at full resolution.
 
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
-from .harness import Variant, bench_inputs, round_times
+from .harness import Variant, bench_inputs, medians, round_times
 from .report import Measured, markdown
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
@@ -69,7 +68,7 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
         rounds,
         f"bench effects {scene.name}",
     )
-    med = {name: statistics.median(t) for name, t in times.items()}
+    med = medians(times)
 
     def each(name: str) -> list[float]:  # its cost over plain's, round by round
         return [a / b - 1.0 for a, b in zip(times[name], times["plain"])]

@@ -78,7 +78,11 @@ def median_times(
     r: Renderer, variants: dict[str, Variant], size: tuple[int, int], rounds: int, label: str
 ) -> dict[str, float]:
     """name → median seconds per frame over ``rounds`` interleaved rounds."""
-    times = round_times(r, variants, size, rounds, label)
+    return medians(round_times(r, variants, size, rounds, label))
+
+
+def medians(times: dict[str, list[float]]) -> dict[str, float]:
+    """name → the median of its per-round times."""
     return {name: statistics.median(t) for name, t in times.items()}
 
 
@@ -89,11 +93,11 @@ def ratio_range(num: list[float], den: list[float]) -> tuple[float, float]:
     return min(per_round), max(per_round)
 
 
-def with_range(value: float, lo: float, hi: float, unit: str = "×") -> str:
+def with_range(value: float, lo: float, hi: float) -> str:
     """``value`` with its round-by-round [lo–hi], said to be within noise where that range
     holds 1 (the rounds disagree on which side of 1 it lies)."""
     noise = " within noise" if lo <= 1 <= hi else ""
-    return f"{value:.2f}{unit} [{lo:.2f}–{hi:.2f}]{noise}"
+    return f"{value:.2f}× [{lo:.2f}–{hi:.2f}]{noise}"
 
 
 def noise_floor(

@@ -15,8 +15,8 @@ import numpy as np
 from ..gpu.renderer import Renderer
 from ..inputs import whole
 from ..scene import Scene
-from .harness import Variant, bench_inputs, ratio_range, round_times, with_range
-from .report import Measured, markdown
+from .harness import Variant, bench_inputs, medians, ratio_range, round_times, with_range
+from .report import Measured, markdown, ms_spread
 
 
 def level_counts(total: int, step: int) -> list[int]:
@@ -43,7 +43,7 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
     timed = {f"{m} levels": Variant(scene, variants[m]) for m in counts}
     timed |= {f"{m} levels, every level": Variant(all_levels, variants[m]) for m in counts}
     times = round_times(r, timed, size, rounds, f"bench levels {scene.name}")
-    med = {name: statistics.median(t) for name, t in times.items()}
+    med = medians(times)
     base = counts[0]
     t_base = med[f"{base} levels"]
     rows = []
@@ -112,7 +112,7 @@ def table(m: Measured) -> str:
             (
                 r["levels"],
                 f"{r['instances']:,}",
-                f"{r['ms']:.2f} [{r['ms_min']:.2f}–{r['ms_max']:.2f}]",
+                ms_spread(r, 2),
                 "1.00×"  # the base row: a ratio to itself
                 if k == 0
                 else with_range(r["time_ratio"], r["time_ratio_min"], r["time_ratio_max"]),

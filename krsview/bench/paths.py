@@ -9,13 +9,20 @@ passes' share of the frame. Variants are interleaved round by round (bench/harne
 
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene
 from ..scene.render import VIEW_PREPASS
-from .harness import Variant, bench_inputs, median_times, ratio_range, round_times, with_range
+from .harness import (
+    Variant,
+    bench_inputs,
+    median_times,
+    medians,
+    ratio_range,
+    round_times,
+    with_range,
+)
 from .report import Measured, markdown
 
 TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
@@ -119,7 +126,7 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
             rounds,
             f"bench paths {scene.name}",
         )
-        med = {name: statistics.median(t) for name, t in times.items()}
+        med = medians(times)
         tiles = {k[1:4]: s for k, s in variants.items() if k[2]}
         coarse = {
             k: median_times(

@@ -23,7 +23,7 @@ from ..scene import KRS, Scene, SceneError
 from ..scene.render import DEFAULT_LOD, VIEW_PREPASS
 from .expansion import TOLERANCE, Mesh, expand, single_krs
 from .harness import Variant, frame_timer, interleaved
-from .report import Measured, markdown
+from .report import Measured, markdown, ms_spread
 
 PEER = "Embree (Open3D)"
 # krsview's rows, each with the effects off (primary rays only, as the peer casts): every
@@ -265,7 +265,7 @@ def table(m: Measured) -> str:
             (
                 r["levels"],
                 r["renderer"],
-                f"{r['ms']:.1f} [{r['ms_min']:.1f}–{r['ms_max']:.1f}]",
+                ms_spread(r),
                 f"{r['ratio']:.2f} [{r['ratio_min']:.2f}–{r['ratio_max']:.2f}]",
                 f"{r['first_frame_s']:.2f} s",
                 f"{r['peak_rss_mb']:,.0f} MiB",

@@ -42,6 +42,11 @@ def markdown(columns: Iterable[str], align: str, rows: Iterable[Iterable[object]
     return "\n".join(lines)
 
 
+def ms_spread(row: dict, digits: int = 1) -> str:
+    """A row's time as "median [min–max]" milliseconds (its ms, ms_min and ms_max)."""
+    return f"{row['ms']:.{digits}f} [{row['ms_min']:.{digits}f}–{row['ms_max']:.{digits}f}]"
+
+
 def write_csv(rows: list[dict], path: str | Path) -> Path:
     """The rows as CSV, fields quoted where they hold a comma (a part named "shadow rays,
     occlusion"); returns the path."""

@@ -10,7 +10,6 @@ shadow ray per pixel); where the scene has the shadow cone, both again without i
 
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 
 from ..compile.geometry import compile_geometry
@@ -19,7 +18,7 @@ from ..gpu.readback import read_plane
 from ..gpu.renderer import Renderer
 from ..gpu.uniforms import variant_defines
 from ..scene import EFFECTS, Scene
-from .harness import Variant, bench_inputs, round_times
+from .harness import Variant, bench_inputs, medians, round_times
 from .report import Measured, markdown
 
 WORK = ("shadow steps/px", "shadow levels/px")  # the frames' rows' work (shadow_work)
@@ -70,7 +69,7 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
     r = Renderer()
     variants = split_variants(scene)
     times = round_times(r, variants, size, rounds, f"bench split {scene.name}")
-    med = {name: statistics.median(t) for name, t in times.items()}
+    med = medians(times)
     parts = [  # (name, the part in a round's times): medians of them add up to the frame
         ("coarse passes", lambda t: t.get("coarse", 0.0)),
         ("tracing", lambda t: t["trace"] - t.get("coarse", 0.0)),

@@ -9,15 +9,14 @@ ratios to sphere tracing. "Hit agreement" compares each hit mask with sphere tra
 from __future__ import annotations
 
 import itertools
-import statistics
 from dataclasses import replace
 
 import numpy as np
 
 from ..gpu.renderer import Renderer
 from ..scene import Scene, SceneError
-from .harness import Variant, bench_inputs, ratio_range, round_times, with_range
-from .report import Measured, markdown
+from .harness import Variant, bench_inputs, medians, ratio_range, round_times, with_range
+from .report import Measured, markdown, ms_spread
 
 BONUS = (1.5, 2.0, 3.0)
 PENALTY = (0.2, 0.3, 0.5)
@@ -61,7 +60,7 @@ def bench_tracers(
         rounds,
         f"bench tracers {scene.name}",
     )
-    med = {name: statistics.median(t) for name, t in times.items()}
+    med = medians(times)
     base = next(iter(runs))
     t0 = med[base]
     it0 = float(np.mean(buffers[base].iterations))
@@ -125,7 +124,7 @@ def table(m: Measured) -> str:
                 f"{r['median_iterations']:.0f}",
                 f"{r['mean_iterations']:.1f}",
                 f"{r['iteration_ratio']:.2f}",
-                f"{r['ms']:.1f} [{r['ms_min']:.1f}–{r['ms_max']:.1f}]",
+                ms_spread(r),
                 with_range(r["time_ratio"], r["time_ratio_min"], r["time_ratio_max"]),
                 f"{r['hit_agreement']:.2%}",
             )

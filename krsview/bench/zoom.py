@@ -7,7 +7,6 @@ fastest."""
 
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 
 import numpy as np
@@ -16,8 +15,8 @@ from ..compile.balls import kernel_ball
 from ..gpu.renderer import Renderer
 from ..inputs import whole
 from ..scene import Scene, SceneError
-from .harness import Variant, bench_inputs, ratio_range, round_times, with_range
-from .report import Measured, markdown
+from .harness import Variant, bench_inputs, medians, ratio_range, round_times, with_range
+from .report import Measured, markdown, ms_spread
 
 END_RADII = 3.0  # the last stop is this many of the finest kernel's ball radii from its centre
 
@@ -73,7 +72,7 @@ def bench_zoom(
     variants |= {f"{n}, every level": Variant(v) for n, v in zip(names, every)}
     variants |= {f"{n}, restart {walk}": Variant(v) for n, v in zip(names, other)}
     times = round_times(r, variants, size, rounds, f"bench zoom {scene.name}")
-    med = {name: statistics.median(t) for name, t in times.items()}
+    med = medians(times)
     rows = []
     for name, v, e, o in zip(names, views, every, other):
         frame = r.render(v, w, h)
@@ -155,7 +154,7 @@ def table(m: Measured) -> str:
             (
                 r["stop"],
                 f"{r['distance']:.4g}",
-                f"{r['ms']:.1f} [{r['ms_min']:.1f}–{r['ms_max']:.1f}]",
+                ms_spread(r),
                 f"{r['ms_every_level']:.1f}",
                 f"{r['iterations']:.1f}",
                 f"{r['levels_per_iteration']:.1f}",
