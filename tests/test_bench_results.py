@@ -221,3 +221,11 @@ def test_a_ratio_carries_its_round_by_round_range_and_is_within_noise_where_it_h
     )
     assert "1.07× [0.90–1.20] within noise" in lines[1]
     assert "1.07× [1.01–1.20] |" in lines[2]  # control: slower in every round
+
+
+def test_the_tracers_base_row_is_its_own_unit_not_a_range_within_noise():
+    """The sphere tracer's row read "1.00× [1.00–1.00] within noise": a ratio to itself."""
+    m = tracers.bench_tracers(krsview.load("sierpinski"), SIZE, rounds=2, sweep=False)
+    lines = data_rows(tracers.table(m))
+    assert "| 1.00× |" in lines[0] and "within noise" not in lines[0]
+    assert "× [" in lines[1]  # control: the binary tracer's ratio carries its range

@@ -125,10 +125,12 @@ def table(m: Measured) -> str:
                 f"{r['mean_iterations']:.1f}",
                 f"{r['iteration_ratio']:.2f}",
                 ms_spread(r),
-                with_range(r["time_ratio"], r["time_ratio_min"], r["time_ratio_max"]),
+                "1.00×"  # the base row: a ratio to itself
+                if k == 0
+                else with_range(r["time_ratio"], r["time_ratio_min"], r["time_ratio_max"]),
                 f"{r['hit_agreement']:.2%}",
             )
-            for r in m.rows
+            for k, r in enumerate(m.rows)
         ),
     )
     binaries = [row for row in m.rows if row["tracer"] == "binary"]
