@@ -755,3 +755,46 @@ def test_a_kernel_changed_back_to_its_kind_comes_back_as_it_was():
         thicker, "toroidal_capsule"
     )
     assert kinds.switch((*LEVELS, 1), cap, "toroidal_capsule") != bent
+
+
+def test_palm_in_a_window_a_kernel_picked_as_a_capsule_and_back_keeps_its_bend(display, tmp_path):
+    """The kernel list of a selected level, clicked in a real window: "capsule" makes the
+    bent toroidal capsule a straight capsule; "toroidal_capsule" picked next gives the bend
+    back (it came back straight [review]). Negative control: the capsule is not the toroid."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.mokrs_panel import KERNEL_KINDS
+    from krsview.editor.window import Editor
+
+    from .test_editor import click, screen_of, settle, window_xy
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        settle(e)
+        by = (*LEVELS, 58, "transform", 2, "by")
+        click(e, screen_of(e, next(h for h in e.handles if h.path == by).position))
+        kernel = (*LEVELS, 58, "kernel")
+        bent = get_at(e.scene, kernel)
+        assert bent.kind == "toroidal_capsule"
+
+        def pick(kind: str) -> None:
+            x0, y0, x1, y1 = e.viewer.interactions.rects[(*kernel, "kind")]
+            click(e, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2))
+            popup = imgui.internal.find_window_by_name("##Combo_00")
+            assert popup is not None and popup.active, "the click opened no list"
+            style = imgui.get_style()
+            line = imgui.get_text_line_height() + style.item_spacing.y
+            y = popup.pos.y + style.window_padding.y + line * KERNEL_KINDS.index(kind) + line / 2
+            click(e, window_xy(e, popup.pos.x + 30, y))
+
+        pick("capsule")
+        capsule = get_at(e.scene, kernel)
+        assert capsule.kind == "capsule" and capsule != bent
+        assert (capsule.a, capsule.b) == (bent.start, bent.end)
+        pick("toroidal_capsule")
+        assert get_at(e.scene, kernel) == bent  # the bend is back
+        assert len(e.doc.history.steps) == 2  # one undo step each
+    finally:
+        e.close()

@@ -158,6 +158,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
         tooltip("the finer levels whose steps equal this level's (linked), for every level")
     kinds = list(KERNEL_KINDS)
     changed, k = imgui.combo("kernel", kinds.index(lv.kernel.kind), kinds)
+    interactions.place((*lev, "kernel", "kind"))
     if changed and kinds[k] != lv.kernel.kind:
         out.append(Edit((*lev, "kernel"), e.kinds_left.switch(lev, lv.kernel, kinds[k])))
     fields(shown.kernel, (*lev, "kernel"), out, interactions)
