@@ -43,7 +43,7 @@ def test_levels_returns_a_row_per_level_count():
         "levels",
         "instances",
         "ms",
-        "ms_min",
+        "ms_median",
         "ms_max",
         "time_ratio",
         "time_ratio_min",
@@ -59,7 +59,7 @@ def test_levels_returns_a_row_per_level_count():
         "lod_speedup_max",
     ]
     assert m.rows[0]["time_ratio"] == 1.0 and m.rows[0]["ratio_per_iteration"] == 1.0
-    assert all(r["ms_min"] <= r["ms"] <= r["ms_max"] for r in m.rows)
+    assert all(r["ms"] == r["ms_median"] == r["ms_max"] for r in m.rows)  # one round
     assert m.column("instances") == [
         scene.geometry().truncated(n).instance_count() for n in (8, 16, 22)
     ]
@@ -229,3 +229,26 @@ def test_the_tracers_base_row_is_its_own_unit_not_a_range_within_noise():
     lines = data_rows(tracers.table(m))
     assert "| 1.00× |" in lines[0] and "within noise" not in lines[0]
     assert "× [" in lines[1]  # control: the binary tracer's ratio carries its range
+
+
+def test_every_bench_times_a_variant_by_its_fastest_round(monkeypatch):
+    """Load from other work only adds time, so a variant's time is its fastest round, the
+    median and slowest beside it; a ratio is fastest to fastest (within the round-by-round
+    range). Here every other round of every variant is slowed by 50 % (a busy neighbour):
+    the times and ratios are the quiet rounds'; the medians, the control, moved."""
+    assert harness.time_columns([0.003, 0.001, 0.002]) == dict(ms=1.0, ms_median=2.0, ms_max=3.0)
+    real = levels.round_times
+
+    def busy(*args):
+        times = real(*args)
+        return {
+            n: [t * (1.5 if k % 2 else 1.0) for k, t in enumerate(ts)] for n, ts in times.items()
+        }
+
+    monkeypatch.setattr(levels, "round_times", busy)
+    m = levels.bench_levels(krsview.load("sierpinski"), SIZE, step=11, rounds=4)
+    for r in m.rows:
+        assert r["ms"] < r["ms_median"] < r["ms_max"]  # control: the slowed rounds are there
+        assert r["time_ratio_min"] <= r["time_ratio"] <= r["time_ratio_max"]
+        assert r["time_ratio"] == pytest.approx(r["ms"] / m.rows[0]["ms"])
+    assert "fastest round [median–slowest]" in levels.table(m)

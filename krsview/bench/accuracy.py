@@ -18,7 +18,6 @@ settings) and error images (holes red, false hits blue)."""
 from __future__ import annotations
 
 import contextlib
-import statistics
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -31,7 +30,7 @@ from ..gpu.passes import splits_shadows
 from ..gpu.renderer import Renderer
 from ..scene import Geometry, Scene, SceneError
 from ..scene.render import PRECISIONS
-from .harness import Variant, noise_floor, round_times
+from .harness import Variant, noise_floor, round_times, time_columns
 from .metrics import compare, error_image
 from .paths import TILES as PREPASS_TILES
 from .report import Measured
@@ -177,7 +176,7 @@ def bench_accuracy(
     groups: dict[str, list[list[float]]] = {}
     for name in order:
         groups.setdefault(rep.get(name, runs[0].name), []).append(times[name])
-    floor = noise_floor(list(groups.values()), min)
+    floor = noise_floor(list(groups.values()))
     pooled = {n: [t for ts in g for t in ts] for n, g in groups.items()}
     t0 = min(pooled[runs[0].name])
     index = {s.name: k for k, s in enumerate(runs)}
@@ -191,13 +190,10 @@ def bench_accuracy(
                 value=s.value,
                 width=w,
                 height=h,
-                ms=min(t) * 1e3,  # the fastest round: what the work takes, least disturbed
+                **time_columns(t),
                 time_ratio=min(t) / t0,
                 mask_error=e.mask_error,
                 **asdict(e),
-                ms_min=min(t) * 1e3,
-                ms_median=statistics.median(t) * 1e3,
-                ms_max=max(t) * 1e3,
                 noise_floor=floor,
                 work=work(images[s.name], walked[s.name], s),
                 same_as=index[rep[s.name]],

@@ -10,7 +10,7 @@ from pathlib import Path
 from ..scene import Scene
 from .accuracy import EPSILON_SCALES, Accuracy, image_name, notable
 from .harness import change, percent
-from .report import accuracy_plots, write_csv
+from .report import accuracy_plots, ms_spread, write_csv
 from .truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS
 
 GOOD_ENOUGH = 0.01  # hit-mask error the summary asks for (1 % of the pixels)
@@ -98,11 +98,7 @@ def _markdown(
     ]
     for k, r in enumerate(rows):
         same = rows[r["same_as"]]
-        ms = (
-            f"{r['ms']:.1f} [{r['ms_median']:.1f}–{r['ms_max']:.1f}]"
-            if r["same_as"] == k
-            else f"= {same['knob']} {same['value']}"
-        )
+        ms = ms_spread(r) if r["same_as"] == k else f"= {same['knob']} {same['value']}"
         dagger = "†" if r["knob"] == "prepass" else ""
         lines.append(
             f"| {r['knob']} | {r['value']} | {ms} | {r['time_ratio']:.2f} | "

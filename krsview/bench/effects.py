@@ -1,6 +1,6 @@
 """`krsview bench effects`: what each effect costs, and what specialising saves [KRS17 §11].
 
-On one scene and view, in one run, frames interleaved round by round (medians):
+On one scene and view, in one run, frames interleaved round by round (fastest rounds):
 - ``plain``: the geometry with no effect, the cheap path every ratio is taken against;
 - each effect alone, specialised (its #define only): its incremental cost;
 - the scene's own effect set, specialised, against the same set in the variant that compiles
@@ -21,7 +21,7 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
-from .harness import Variant, bench_inputs, medians, round_times
+from .harness import Variant, bench_inputs, fastest, round_times
 from .report import Measured, markdown
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
@@ -68,7 +68,7 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
         rounds,
         f"bench effects {scene.name}",
     )
-    med = medians(times)
+    best = fastest(times)
 
     def each(name: str) -> list[float]:  # its cost over plain's, round by round
         return [a / b - 1.0 for a, b in zip(times[name], times["plain"])]
@@ -78,15 +78,15 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
             variant=name,
             effects="+".join(s.effects) or "none",
             all_effects_compiled=uber,
-            ms=med[name] * 1e3,
-            ratio_to_plain=med[name] / med["plain"],
-            incremental=med[name] / med["plain"] - 1.0,
+            ms=best[name] * 1e3,
+            ratio_to_plain=best[name] / best["plain"],
+            incremental=best[name] / best["plain"] - 1.0,
             low=min(each(name)),
             high=max(each(name)),
         )
         for name, (s, uber) in runs.items()
     ]
-    alone = [med[name] for name in runs if name.startswith("component ")]
+    alone = [best[name] for name in runs if name.startswith("component ")]
     if alone:
         rows.append(
             dict(
@@ -94,8 +94,8 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
                 effects="none",
                 all_effects_compiled=False,
                 ms=sum(alone) * 1e3,
-                ratio_to_plain=sum(alone) / med["plain"],
-                incremental=sum(alone) / med["plain"] - 1.0,
+                ratio_to_plain=sum(alone) / best["plain"],
+                incremental=sum(alone) / best["plain"] - 1.0,
                 low="",
                 high="",
             )
@@ -113,7 +113,7 @@ def table(m: Measured) -> str:
     ms = {row["variant"]: row["ms"] for row in m.rows}
     text = (
         f"\nEffect costs — {m.scene.name}, {m.size[0]}×{m.size[1]}, {m.scene.render.tracer} "
-        f"tracing, median of {m.rounds} interleaved rounds (ratios to plain = no effect, "
+        f"tracing, fastest of {m.rounds} interleaved rounds (ratios to plain = no effect, "
         "specialised; a cost whose rounds disagree on its sign is within noise)\n\n"
     )
     text += markdown(

@@ -1,8 +1,11 @@
 """The one timing harness of the benchmarks: every variant is compiled and drawn once
 (warm-up), then the variants are drawn round after round, interleaved, so machine noise hits
-them alike, and each variant's median frame time is kept (DESIGN.md, Measure as ratios), or
-its fastest round where a busy machine slows many rounds (the accuracy bench). The noise
-floor of a run is the spread between those times of variants that do the same work: a time
+them alike (DESIGN.md, Measure as ratios). A variant's time is its fastest round: load from
+other work only ever adds time, so the fastest round is the estimate it disturbs least, and
+on a shared machine, where up to half the rounds run slow, medians move while it holds [Chen
+and Revels 2016, the estimator of Julia's BenchmarkTools]. The median and the slowest round
+stay beside it, and a ratio carries the [min–max] of its round-by-round ratio. The noise
+floor of a run is the spread between the times of variants that do the same work: a time
 difference under it is not a measurement."""
 
 from __future__ import annotations
@@ -74,21 +77,28 @@ def interleaved(
     return times
 
 
-def median_times(
+def fastest_times(
     r: Renderer, variants: dict[str, Variant], size: tuple[int, int], rounds: int, label: str
 ) -> dict[str, float]:
-    """name → median seconds per frame over ``rounds`` interleaved rounds."""
-    return medians(round_times(r, variants, size, rounds, label))
+    """name → its fastest frame, seconds, over ``rounds`` interleaved rounds."""
+    return fastest(round_times(r, variants, size, rounds, label))
 
 
-def medians(times: dict[str, list[float]]) -> dict[str, float]:
-    """name → the median of its per-round times."""
-    return {name: statistics.median(t) for name, t in times.items()}
+def fastest(times: dict[str, list[float]]) -> dict[str, float]:
+    """name → its fastest round: the time its work takes, least disturbed by load."""
+    return {name: min(t) for name, t in times.items()}
+
+
+def time_columns(t: list[float]) -> dict[str, float]:
+    """A variant's time columns from its per-round seconds: ``ms`` (the fastest round),
+    ``ms_median`` and ``ms_max`` (the slowest), milliseconds."""
+    return dict(ms=min(t) * 1e3, ms_median=statistics.median(t) * 1e3, ms_max=max(t) * 1e3)
 
 
 def ratio_range(num: list[float], den: list[float]) -> tuple[float, float]:
     """The [min, max] of the round-by-round ratio ``num[k] / den[k]`` of two variants timed
-    in the same interleaved rounds: the spread a ratio of their medians carries."""
+    in the same interleaved rounds: the spread their ratio carries (the ratio of their fastest
+    rounds always lies inside it)."""
     per_round = [a / b for a, b in zip(num, den, strict=True)]
     return min(per_round), max(per_round)
 
@@ -101,11 +111,12 @@ def with_range(value: float, lo: float, hi: float) -> str:
 
 
 def noise_floor(
-    groups: list[list[list[float]]], estimate: Callable[[list[float]], float] = statistics.median
+    groups: list[list[list[float]]], estimate: Callable[[list[float]], float] = min
 ) -> float:
-    """The largest relative spread (max/min − 1) between the ``estimate`` (median, or the
-    fastest round) of variants that do the same work; each group is a list of per-round
-    times, one per variant. 0 where no group has two variants (nothing measured the noise)."""
+    """The largest relative spread (max/min − 1) between the ``estimate`` (the fastest
+    round, or the median for comparison) of variants that do the same work; each group is a
+    list of per-round times, one per variant. 0 where no group has two variants (nothing
+    measured the noise)."""
     spreads = [
         max(est) / min(est) - 1 for est in ([estimate(t) for t in g] for g in groups if len(g) >= 2)
     ]

@@ -1,13 +1,12 @@
 """`krsview bench levels`: frame time against the number of levels [KRS17 §11, Fig. 12].
 
 The paper's claim: the expansion grows as 2^n while the time per ray grows linearly in n.
-Level counts are interleaved round by round and medians compared, so machine noise hits
-every variant alike.
+Level counts are interleaved round by round and their fastest rounds compared, so machine
+noise hits every variant alike.
 """
 
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 
 import numpy as np
@@ -15,8 +14,16 @@ import numpy as np
 from ..gpu.renderer import Renderer
 from ..inputs import whole
 from ..scene import Scene
-from .harness import Variant, bench_inputs, medians, ratio_range, round_times, with_range
-from .report import Measured, markdown, ms_spread
+from .harness import (
+    Variant,
+    bench_inputs,
+    fastest,
+    ratio_range,
+    round_times,
+    time_columns,
+    with_range,
+)
+from .report import TIME_SPREAD, Measured, markdown, ms_spread
 
 
 def level_counts(total: int, step: int) -> list[int]:
@@ -28,9 +35,9 @@ def level_counts(total: int, step: int) -> list[int]:
 
 def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int = 5) -> Measured:
     """One row per level count (every ``step`` levels, and all): kernel instances, ms per
-    frame (median, min, max), time ratio to the fewest levels and to the row before (each
-    with its round-by-round [min, max]), iterations per pixel, time per iteration ratio, and
-    every level walked (lod 0) beside it."""
+    frame (fastest round, median, slowest), time ratio to the fewest levels and to the row
+    before (each with its round-by-round [min, max]), iterations per pixel, time per
+    iteration ratio, and every level walked (lod 0) beside it."""
     scene, size, rounds = bench_inputs(scene, size, rounds)
     step = whole(step, "step", 1)
     w, h = size
@@ -43,12 +50,12 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
     timed = {f"{m} levels": Variant(scene, variants[m]) for m in counts}
     timed |= {f"{m} levels, every level": Variant(all_levels, variants[m]) for m in counts}
     times = round_times(r, timed, size, rounds, f"bench levels {scene.name}")
-    med = medians(times)
+    best = fastest(times)
     base = counts[0]
-    t_base = med[f"{base} levels"]
+    t_base = best[f"{base} levels"]
     rows = []
     for before, m in zip([base, *counts], counts):
-        name, t = f"{m} levels", med[f"{m} levels"]
+        name, t = f"{m} levels", best[f"{m} levels"]
         every = times[f"{name}, every level"]
         lo, hi = ratio_range(times[name], times[f"{base} levels"])
         prev_lo, prev_hi = ratio_range(times[name], times[f"{before} levels"])
@@ -57,19 +64,17 @@ def bench_levels(scene: Scene, size: tuple[int, int], step: int = 4, rounds: int
             dict(
                 levels=m,
                 instances=variants[m].instance_count(),
-                ms=t * 1e3,
-                ms_min=min(times[name]) * 1e3,
-                ms_max=max(times[name]) * 1e3,
+                **time_columns(times[name]),
                 time_ratio=t / t_base,
                 time_ratio_min=lo,
                 time_ratio_max=hi,
-                to_previous=t / med[f"{before} levels"],  # 1 in the first row
+                to_previous=t / best[f"{before} levels"],  # 1 in the first row
                 to_previous_min=prev_lo,
                 to_previous_max=prev_hi,
                 iterations=iters[m],
                 ratio_per_iteration=(t / iters[m]) / (t_base / iters[base]),
-                ms_every_level=statistics.median(every) * 1e3,
-                lod_speedup=statistics.median(every) / t,
+                ms_every_level=min(every) * 1e3,
+                lod_speedup=min(every) / t,
                 lod_speedup_min=gain_lo,
                 lod_speedup_max=gain_hi,
             )
@@ -90,7 +95,7 @@ def table(m: Measured) -> str:
     rows = m.rows
     text = (
         f"\nFrame time against levels — {m.scene.name}, {m.size[0]}×{m.size[1]}, lod "
-        f"{m.scene.render.lod:g} beside every level, median [min–max] of {m.rounds} "
+        f"{m.scene.render.lod:g} beside every level, ms {TIME_SPREAD} of {m.rounds} "
         f"interleaved rounds; ratios to {rows[0]['levels']} levels and to the row before, "
         "each with the [min–max] of its round-by-round ratio (within noise where that holds "
         "1×)\n\n"

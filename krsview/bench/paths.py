@@ -17,13 +17,14 @@ from ..scene.render import VIEW_PREPASS
 from .harness import (
     Variant,
     bench_inputs,
-    median_times,
-    medians,
+    fastest,
+    fastest_times,
     ratio_range,
     round_times,
+    time_columns,
     with_range,
 )
-from .report import Measured, markdown
+from .report import TIME_SPREAD, Measured, markdown, ms_spread
 
 TILES = (0, 4, 8, 16)  # pre-pass tile sizes compared (0: off)
 ONE_PASS_TILES = (4, 8)  # also timed with a single coarse pass (prepass_levels = 1)
@@ -126,18 +127,18 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
             rounds,
             f"bench paths {scene.name}",
         )
-        med = medians(times)
+        best = fastest(times)
         tiles = {k[1:4]: s for k, s in variants.items() if k[2]}
         coarse = {
-            k: median_times(
+            k: fastest_times(
                 r, {"pre-pass": Variant(s, prepass_only=True)}, (w, h), rounds, "pre-pass alone"
             )["pre-pass"]
             for k, s in tiles.items()
         }
         plain = lever_name(("fragment", "off", 0, 0, 0, ""))
-        base = med[plain]
+        base = best[plain]
         for k, s in variants.items():
-            t = med[lever_name(k)]
+            t = best[lever_name(k)]
             lo, hi = ratio_range(times[plain], times[lever_name(k)])
             rows.append(
                 dict(
@@ -148,7 +149,7 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
                     coarse_passes=k[3],
                     steps=k[4],
                     shadow_rays=k[5],
-                    ms=t * 1e3,
+                    **time_columns(times[lever_name(k)]),
                     speedup=base / t,
                     speedup_min=lo,  # the round-by-round ratio's spread
                     speedup_max=hi,
@@ -162,7 +163,8 @@ def bench_paths(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
 
 def table(m: Measured) -> str:
     caption = (
-        f"\nSpeed levers — {m.scene.name}, median of {m.rounds} interleaved rounds; speed-up "
+        f"\nSpeed levers — {m.scene.name}, ms {TIME_SPREAD} of {m.rounds} interleaved rounds; "
+        "speed-up "
         "against the fragment path without culling or pre-pass at the same size, with the "
         "[min–max] of its round-by-round ratio: where that range holds 1×, the difference is "
         "within noise\n\n"
@@ -192,7 +194,7 @@ def table(m: Measured) -> str:
                 r["coarse_passes"] or "—",
                 r["steps"] or "—",
                 r["shadow_rays"] or "—",
-                f"{r['ms']:.1f}",
+                ms_spread(r),
                 with_range(r["speedup"], r["speedup_min"], r["speedup_max"]),
                 f"{r['iterations']:.1f}",
                 f"{r['levels']:.1f}",

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 import os
 import pickle
-import statistics
 import subprocess
 import sys
 import time
@@ -22,8 +21,8 @@ from ..gpu.renderer import Renderer
 from ..scene import KRS, Scene, SceneError
 from ..scene.render import DEFAULT_LOD, VIEW_PREPASS
 from .expansion import TOLERANCE, Mesh, expand, single_krs
-from .harness import Variant, frame_timer, interleaved
-from .report import Measured, markdown, ms_spread
+from .harness import Variant, frame_timer, interleaved, ratio_range, time_columns
+from .report import TIME_SPREAD, Measured, markdown, ms_spread
 
 PEER = "Embree (Open3D)"
 # krsview's rows, each with the effects off (primary rays only, as the peer casts): every
@@ -156,8 +155,8 @@ def bench_peer(
     tolerance: float = TOLERANCE,
 ) -> Measured:
     """Per level count (the coarsest ``level_counts`` levels of the scene's KRS), a row for
-    the peer and one per krsview variant (VARIANTS): ms per frame, median [min–max] over
-    interleaved rounds, the ratio to the peer (the median of per-round ratios), the first frame
+    the peer and one per krsview variant (VARIANTS): ms per frame over interleaved rounds
+    (:func:`row`), the ratio to the peer (fastest rounds, per-round spread), the first frame
     and peak RSS of a fresh process, the pixels whose hit differs from the peer's, and
     krsview's hits farther from the mesh than its ε(t) and ``tolerance`` (pixels) allow."""
     o3d = load_peer()
@@ -220,20 +219,18 @@ def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene, tolerance: float) 
 
 
 def row(n: int, name: str, times: dict, first: float, peak: float, hit, peer_hit, far: float):
-    """One renderer's columns. Its ratio to the peer is taken per round, between frames
-    drawn side by side, and the median of those reported: load that comes and goes over the
-    run moves both frames of a round, not their ratio."""
+    """One renderer's columns: its time (:func:`harness.time_columns`) and its ratio to the
+    peer's, fastest round to fastest round, with the [min–max] of the ratio per round, between
+    frames drawn side by side."""
     t, peer = times[name], times[PEER]
-    ratios = [a / b for a, b in zip(t, peer)]
+    lo, hi = ratio_range(t, peer)
     return dict(
         levels=n,
         renderer=name,
-        ms=statistics.median(t) * 1e3,
-        ms_min=min(t) * 1e3,
-        ms_max=max(t) * 1e3,
-        ratio=statistics.median(ratios),
-        ratio_min=min(ratios),
-        ratio_max=max(ratios),
+        **time_columns(t),
+        ratio=min(t) / min(peer),
+        ratio_min=lo,
+        ratio_max=hi,
         first_frame_s=first,
         peak_rss_mb=peak,
         hit_differs=float((hit != peer_hit).mean()),
@@ -253,7 +250,7 @@ def table(m: Measured) -> str:
         (
             "levels",
             "renderer",
-            "ms/frame [min–max]",
+            f"ms/frame, {TIME_SPREAD}",
             "× peer [min–max]",
             "first frame",
             "peak RSS",

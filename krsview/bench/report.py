@@ -42,9 +42,13 @@ def markdown(columns: Iterable[str], align: str, rows: Iterable[Iterable[object]
     return "\n".join(lines)
 
 
+TIME_SPREAD = "fastest round [median–slowest]"  # how ms_spread reads, for captions
+
+
 def ms_spread(row: dict, digits: int = 1) -> str:
-    """A row's time as "median [min–max]" milliseconds (its ms, ms_min and ms_max)."""
-    return f"{row['ms']:.{digits}f} [{row['ms_min']:.{digits}f}–{row['ms_max']:.{digits}f}]"
+    """A row's time as "fastest [median–slowest]" milliseconds (its ms, ms_median and
+    ms_max: :func:`harness.time_columns`)."""
+    return f"{row['ms']:.{digits}f} [{row['ms_median']:.{digits}f}–{row['ms_max']:.{digits}f}]"
 
 
 def write_csv(rows: list[dict], path: str | Path) -> Path:

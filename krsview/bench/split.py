@@ -18,7 +18,7 @@ from ..gpu.readback import read_plane
 from ..gpu.renderer import Renderer
 from ..gpu.uniforms import variant_defines
 from ..scene import EFFECTS, Scene
-from .harness import Variant, bench_inputs, medians, round_times
+from .harness import Variant, bench_inputs, fastest, round_times
 from .report import Measured, markdown
 
 WORK = ("shadow steps/px", "shadow levels/px")  # the frames' rows' work (shadow_work)
@@ -69,8 +69,8 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
     r = Renderer()
     variants = split_variants(scene)
     times = round_times(r, variants, size, rounds, f"bench split {scene.name}")
-    med = medians(times)
-    parts = [  # (name, the part in a round's times): medians of them add up to the frame
+    best = fastest(times)
+    parts = [  # (name, the part in a round's times)
         ("coarse passes", lambda t: t.get("coarse", 0.0)),
         ("tracing", lambda t: t["trace"] - t.get("coarse", 0.0)),
         ("nearest kernel and shading", lambda t: t["moving"] - t["trace"]),
@@ -79,15 +79,15 @@ def bench_split(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measure
         ("frame without secondary effects", lambda t: t["moving"]),
     ]
     for key, label in (("per pixel", "a shadow ray per pixel"), ("cone off", "shadow cone off")):
-        if key in med:  # shares of that frame
+        if key in best:  # shares of that frame
             parts += [
                 (f"secondary effects, {label}", lambda t, k=key: t[k] - t["moving"]),
                 (f"frame, {label}", lambda t, k=key: t[k]),
             ]
     rows = []
     for name, part in parts:
-        ms = part(med) * 1e3
-        whole = med.get(_frame_of(name), med["frame"])
+        ms = part(best) * 1e3
+        whole = best.get(_frame_of(name), best["frame"])
         each = [part({k: v[i] for k, v in times.items()}) * 1e3 for i in range(rounds)]
         rows.append(dict(part=name, ms=ms, share=ms / 1e3 / whole, low=min(each), high=max(each)))
     work = {"frame": variants["frame"], "frame, shadow cone off": variants.get("cone off")}
@@ -119,7 +119,7 @@ def table(m: Measured) -> str:
     return (
         f"\nWhere the time goes — {m.scene.name} at {m.size[0]}×{m.size[1]}, pre-pass "
         f"{f'{r.prepass} × {r.prepass_levels}' if r.prepass else 'off'}, culling "
-        f"{r.culling}, lod {r.lod:g}{shared}; median of {m.rounds} interleaved rounds, each "
+        f"{r.culling}, lod {r.lod:g}{shared}; fastest of {m.rounds} interleaved rounds, each "
         "part the difference of two variants (within noise where its rounds disagree on "
         "its sign)\n\n"
     ) + markdown(

@@ -15,8 +15,16 @@ from ..compile.balls import kernel_ball
 from ..gpu.renderer import Renderer
 from ..inputs import whole
 from ..scene import Scene, SceneError
-from .harness import Variant, bench_inputs, medians, ratio_range, round_times, with_range
-from .report import Measured, markdown, ms_spread
+from .harness import (
+    Variant,
+    bench_inputs,
+    fastest,
+    ratio_range,
+    round_times,
+    time_columns,
+    with_range,
+)
+from .report import TIME_SPREAD, Measured, markdown, ms_spread
 
 END_RADII = 3.0  # the last stop is this many of the finest kernel's ball radii from its centre
 
@@ -54,7 +62,7 @@ def stops(scene: Scene, count: int) -> list[Scene]:
 def bench_zoom(
     scene: Scene, size: tuple[int, int], rounds: int = 5, stops_count: int = 12, plot=None
 ) -> Measured:
-    """One row per stop: distance to the kernel, median ms per frame (interleaved rounds),
+    """One row per stop: distance to the kernel, ms per frame (interleaved rounds' fastest),
     iterations per pixel, levels walked per iteration, hit fraction, and beside them every
     level (lod 0) and the other walk (``[render] walk_restart`` switched); ``plot``: a PNG path
     for the plot of time and work along the flight."""
@@ -72,7 +80,7 @@ def bench_zoom(
     variants |= {f"{n}, every level": Variant(v) for n, v in zip(names, every)}
     variants |= {f"{n}, restart {walk}": Variant(v) for n, v in zip(names, other)}
     times = round_times(r, variants, size, rounds, f"bench zoom {scene.name}")
-    med = medians(times)
+    best = fastest(times)
     rows = []
     for name, v, e, o in zip(names, views, every, other):
         frame = r.render(v, w, h)
@@ -83,17 +91,15 @@ def bench_zoom(
             dict(
                 stop=name,
                 distance=float(np.linalg.norm(np.array(v.camera.position) - centre)),
-                ms=med[name] * 1e3,
-                ms_min=min(times[name]) * 1e3,
-                ms_max=max(times[name]) * 1e3,
-                ms_every_level=med[f"{name}, every level"] * 1e3,
+                **time_columns(times[name]),
+                ms_every_level=best[f"{name}, every level"] * 1e3,
                 iterations=iterations,
                 levels_per_iteration=float(walked.sum() / max(frame.iterations.sum(), 1)),
                 levels_every_level=float(
                     r.levels(e, w, h).sum() / max(r.render(e, w, h).iterations.sum(), 1)
                 ),
                 hit=float(frame.hit.mean()),
-                ms_other_walk=med[f"{name}, restart {walk}"] * 1e3,
+                ms_other_walk=best[f"{name}, restart {walk}"] * 1e3,
                 levels_other_walk=float(
                     r.levels(o, w, h).sum() / max(other_frame.iterations.sum(), 1)
                 ),
@@ -104,9 +110,9 @@ def bench_zoom(
         ("ms_every_level", ", every level"),
         ("ms_other_walk", f", restart {walk}"),
     ):  # each stop against the fastest, round by round: the spread of the zoom's ratio
-        fastest = min(names, key=lambda n: med[n + suffix])
+        quickest = min(names, key=lambda n: best[n + suffix])
         for row, name in zip(rows, names):
-            lo, hi = ratio_range(times[name + suffix], times[fastest + suffix])
+            lo, hi = ratio_range(times[name + suffix], times[quickest + suffix])
             row |= {f"{column}_to_fastest_min": lo, f"{column}_to_fastest_max": hi}
     m = Measured(scene, size, rounds, rows)
     if plot is not None:
@@ -115,7 +121,7 @@ def bench_zoom(
 
 
 def spread(m: Measured, column: str = "ms") -> float:
-    """The slowest frame's time over the fastest's along the flight (medians)."""
+    """The slowest frame's time over the fastest's along the flight (fastest rounds)."""
     return max(m.column(column)) / min(m.column(column))
 
 
@@ -132,7 +138,7 @@ def table(m: Measured) -> str:
     path = "persistent lanes" if rs.path == "compute" and rs.steps == 0 else f"{rs.path} path"
     text = (
         f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, pre-pass "
-        f"{rs.prepass or 'off'}, {path}, median [min–max] of {m.rounds} interleaved rounds\n\n"
+        f"{rs.prepass or 'off'}, {path}, ms {TIME_SPREAD} of {m.rounds} interleaved rounds\n\n"
     )
     lod = rs.lod
     walk = "off" if rs.walk_restart == "on" else "on"
@@ -167,7 +173,7 @@ def table(m: Measured) -> str:
         ),
     )
     return (
-        text + f"\n\nslowest frame / fastest (medians, with the [min–max] of the slowest "
+        text + f"\n\nslowest frame / fastest (fastest rounds, with the [min–max] of the slowest "
         f"stop's round-by-round ratio to the fastest's): {spread_text(m)} (lod {lod:g}), "
         f"{spread_text(m, 'ms_every_level')} (every level), "
         f"{spread_text(m, 'ms_other_walk')} (walk restart {walk})"
@@ -184,13 +190,13 @@ def write_plot(m: Measured, path) -> None:
     d = m.column("distance")
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     ms = np.array(m.column("ms"))
-    bars = [ms - m.column("ms_min"), np.array(m.column("ms_max")) - ms]
+    bars = [np.zeros_like(ms), np.array(m.column("ms_max")) - ms]
     lod = f"lod {m.scene.render.lod:g}"
     a.errorbar(d, ms, yerr=bars, fmt="o-", color="C0", capsize=3, label=lod)
     a.plot(d, m.column("ms_every_level"), "o--", color="C3", label="every level (lod 0)")
     walk = "off" if m.scene.render.walk_restart == "on" else "on"
     a.plot(d, m.column("ms_other_walk"), "s:", color="C4", label=f"walk restart {walk}")
-    a.set_ylabel("ms per frame (median, bar: min–max)")
+    a.set_ylabel("ms per frame (fastest round; bar: to the slowest)")
     a.legend()
     a.set_title(f"{m.scene.name}: zoom into the finest kernel, {m.size[0]}×{m.size[1]}")
     b.plot(d, m.column("iterations"), "o-", color="C1", label="iterations per pixel")

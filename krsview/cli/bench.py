@@ -45,7 +45,8 @@ BENCHES = {
     "levels": Bench(
         "frame time against level count (O(n) vs 2^n)",
         "Render the same view with the coarsest 4, 8, … levels, interleaved rounds, and "
-        "every level (lod 0) beside; print the median [min–max] time per frame, its ratio "
+        "every level (lod 0) beside; print the time per frame (fastest round [median–slowest]), "
+        "its ratio "
         "to the smallest level count and to the row before (each with the [min–max] of its "
         "round-by-round ratio, 'within noise' where that holds 1×) beside the kernel "
         "instances. Example: krsview bench levels tree --step 4",
@@ -88,10 +89,10 @@ BENCHES = {
         "sphere vs binary sphere tracing, and a ξ sweep",
         "On one scene and view: sphere tracing, binary tracing at the paper's "
         "ξ_bonus/ξ_penalty = 2.0/0.3, and a sweep over ξ_bonus ∈ {1.5, 2, 3} × ξ_penalty ∈ "
-        "{0.2, 0.3, 0.5}; iterations per pixel, frame time (median [min–max] of interleaved "
-        "rounds) and hit agreement, as ratios to sphere tracing (to binary 2.0/0.3 for a "
-        "MöKRS), time ratios with their round-by-round [min–max]. Example: krsview bench tracers "
-        "palm --epsilon-scale 0.5",
+        "{0.2, 0.3, 0.5}; iterations per pixel, frame time (fastest round [median–slowest] "
+        "of interleaved rounds) and hit agreement, as ratios to sphere tracing (to binary "
+        "2.0/0.3 for a MöKRS), time ratios with their round-by-round [min–max]. Example: "
+        "krsview bench tracers palm --epsilon-scale 0.5",
         scene_options=True,
         own=(
             (
@@ -147,10 +148,10 @@ BENCHES = {
         "(Open3D's RaycastingScene, on every core), cast with krsview's own primary rays. "
         "Per level count: ms per frame of the peer and of krsview (exact, the level of "
         f"detail, the pre-pass {VIEW_PREPASS}, and both: render's default; effects off) in "
-        "interleaved rounds, median [min–max], their ratio (the median of the rounds' "
-        "ratios), the BVH's build, the first frame and peak memory of each "
-        "in a fresh process, and where the hit masks differ. Needs 'krsview[peer]'. "
-        "Example: krsview bench peer tree --levels 16,18 --csv out/peer.csv",
+        "interleaved rounds (fastest round [median–slowest]), their ratio (fastest to "
+        "fastest, with its round-by-round [min–max]), the BVH's build, the first frame and "
+        "peak memory of each in a fresh process, and where the hit masks differ. Needs "
+        "'krsview[peer]'. Example: krsview bench peer tree --levels 16,18 --csv out/peer.csv",
         own=(
             (
                 "--levels",
@@ -195,7 +196,8 @@ def add(sub) -> None:
             "--rounds",
             type=options.number_in("--rounds", 1, 100),
             default=5,
-            help="interleaved rounds; medians are reported (default 5)",
+            help="interleaved rounds; each time is its fastest round, with the median and "
+            "slowest beside it: load only adds time (default 5)",
         )
         sp.add_argument(
             "--csv", metavar="PATH", help="also write the table to this file, ending in .csv"
