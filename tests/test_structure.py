@@ -511,12 +511,13 @@ def test_the_panels_words_go_once_stale_and_a_level_is_selected_by_its_own_handl
     window_editor,
 ):
     """The structure section's message and the panel's error line stay while the scene and
-    the selection are those they were said of, and go with an undo or another selection
-    (they used to stay: 'select a level first' with a level selected, 'insert a fork' after
-    its undo). Selecting the trunk by its outline entry selects its fork (the panel shows
-    the trunk's fields), not the trunk foot, which is the whole route's; so does Delete of
-    the level below it. The trunk foot's growth parameters are text there, not fields that
-    set them without growing the tree again. The control: each word is there until then."""
+    the selection are those they were said of, and go with an undo, another selection or a
+    save (they used to stay: 'select a level first' with a level selected, 'insert a fork'
+    after its undo or a save). Selecting the trunk by its outline entry selects its fork (the
+    panel shows the trunk's fields), not the trunk foot, which is the whole route's; so does
+    Delete of the level below it. The trunk foot's growth parameters are text there, not
+    fields that set them without growing the tree again. The control: each word is there
+    until then."""
     e = window_editor
     n = len(e.scene.route.levels)
     xdo("key", "Insert")
@@ -539,6 +540,11 @@ def test_the_panels_words_go_once_stale_and_a_level_is_selected_by_its_own_handl
     pump(e)
     assert len(e.scene.route.levels) == n - 1 and e.structure.message.startswith("remove")
     assert e.selected.owner == ("route", "levels", n - 2), e.selected.label
+    pump(e, 2)
+    assert e.structure.message.startswith("remove"), "control: gone by itself"
+    xdo("key", "ctrl+s")  # saved: the last edit's word is history, the foot says "saved"
+    pump(e, 2)
+    assert not e.doc.dirty and e.structure.message == "" and "saved" in e.viewer.message
     # the trunk foot shows the route's fields, but not the growth parameters as fields: set
     # there, they would not grow the tree again (the structure section's growth node does)
     e.select(next(h for h in e.handles if h.path == ("route", "base")))

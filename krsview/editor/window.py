@@ -206,7 +206,7 @@ class Editor:
         click, flick = v.input.take_click(), v.input.take_flick()
         v.move(dt)
         self.execute(v.file.watcher.poll())
-        self.words.forget_stale(v, self.structure, self.scene, self.selected)
+        self.words.forget_stale(v, self.structure, self.scene, self.selected, self.doc.saved)
         self._follow()
         status = v.status_line()
         ui = v.hud or bool(status)
