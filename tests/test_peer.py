@@ -241,9 +241,10 @@ def test_without_the_peer_library_the_bench_says_how_to_install(monkeypatch, cap
     monkeypatch.setattr(
         options.importlib.util, "find_spec", lambda m: None if m == "open3d" else real(m)
     )
-    assert main(["bench", "peer", "tree", "--size", "16x9"]) == 3
-    err = capsys.readouterr().err.strip()
-    assert err == "krsview: error: bench peer needs open3d: pip install 'krsview[peer]'"
+    for bench in ("peer", "peer-zoom"):
+        assert main(["bench", bench, "tree", "--size", "16x9"]) == 3
+        err = capsys.readouterr().err.strip()
+        assert err == f"krsview: error: bench {bench} needs open3d: pip install 'krsview[peer]'"
     assert main(["bench", "levels", "sierpinski", "--size", "16x9", "--rounds", "1"]) == 0
 
 
@@ -277,3 +278,39 @@ def test_bench_peer_tiny_run(renderer):
     assert peer.beyond_epsilon(o3d, bvh, frame, view, exact, expansion.TOLERANCE) == 0
     frame.depth[frame.hit] *= 1.5  # negative control
     assert peer.beyond_epsilon(o3d, bvh, frame, view, exact, expansion.TOLERANCE) > 0.01
+
+
+def test_bench_peer_zoom_tiny_run(tmp_path, capsys):
+    """bench zoom's flight with the peer beside krsview: a row per stop, nearer each time;
+    at each stop the peer casts that stop's own rays (its hit fraction is the brute-force
+    one over the same mesh; the control: stop 0's rays read elsewhere), and each renderer's
+    slowest over fastest frame is read off its own column."""
+    from krsview.bench import peer_zoom, zoom
+
+    pytest.importorskip("open3d")
+    scene = krsview.load("tree")
+    size = (32, 18)
+    csv = tmp_path / "pz.csv"
+    args = ["bench", "peer-zoom", "tree", "--levels", "4", "--stops", "3", "--rounds", "2"]
+    assert main([*args, "--size", "32x18", "--csv", str(csv)]) == 0
+    out = capsys.readouterr().out
+    assert "slowest frame / fastest" in out and csv.exists()
+    m = peer_zoom.bench_peer_zoom(scene, size, rounds=2, levels=4, stops_count=3)
+    assert m.column("stop") == ["stop 0", "stop 1", "stop 2"]
+    d = m.column("distance")
+    assert d[0] > d[1] > d[2] and d[0] / d[1] == pytest.approx(d[1] / d[2], rel=1e-6)
+    krs = scene.geometry().truncated(4)
+    cut = scene.with_geometry(krs)
+    mesh = expansion.expand(krs, view_of(scene.camera, *size))
+    views = [view_of(v.camera, *size) for v in zoom.stops(cut, 3)]
+
+    def brute(view) -> float:
+        return float(brute_force_hits(mesh, view.origin, primary_rays(view)).mean())
+
+    for row, view in zip(m.rows, views):
+        assert row["peer_hit"] == pytest.approx(brute(view), abs=2 / (size[0] * size[1]))
+        assert row["ms"] <= row["ms_median"] <= row["ms_max"]
+        assert row["ratio_min"] <= row["ratio"] <= row["ratio_max"]
+    assert abs(brute(views[0]) - m.rows[2]["peer_hit"]) > 0.05  # control
+    assert zoom.spread(m, "peer_ms") == max(m.column("peer_ms")) / min(m.column("peer_ms"))
+    assert "Embree (Open3D) ms" in peer_zoom.table(m)

@@ -6,14 +6,15 @@ returns a ``Measured`` (its ``rows``, and ``table()`` the CLI prints):
 >>> import krsview
 >>> m = krsview.bench.bench_levels("sierpinski", (48, 27), step=8, rounds=1)  # doctest: +SKIP
 
-``bench_levels``, ``bench_tracers``, ``bench_effects``, ``bench_paths``, ``bench_split`` and
-``bench_zoom``, each from the module of its name (imported on first use)."""
+``bench_levels``, ``bench_tracers``, ``bench_effects``, ``bench_paths``, ``bench_split``,
+``bench_zoom``, and against an Embree BVH (with ``krsview[peer]``) ``bench_peer`` and
+``bench_peer_zoom``, each from the module of its name (imported on first use)."""
 
 from __future__ import annotations
 
 import importlib
 
-BENCHES = ("levels", "tracers", "effects", "paths", "split", "zoom")
+BENCHES = ("levels", "tracers", "effects", "paths", "split", "zoom", "peer", "peer_zoom")
 __all__ = [f"bench_{name}" for name in BENCHES]
 
 

@@ -21,7 +21,14 @@ from ..gpu.renderer import Renderer
 from ..scene import KRS, Scene, SceneError
 from ..scene.render import DEFAULT_LOD, VIEW_PREPASS
 from .expansion import TOLERANCE, Mesh, expand, single_krs
-from .harness import Variant, frame_timer, interleaved, ratio_range, time_columns
+from .harness import (
+    Variant,
+    bench_inputs,
+    frame_timer,
+    interleaved,
+    ratio_range,
+    time_columns,
+)
 from .report import TIME_SPREAD, Measured, markdown, ms_spread
 
 PEER = "Embree (Open3D)"
@@ -159,6 +166,7 @@ def bench_peer(
     (:func:`row`), the ratio to the peer (fastest rounds, per-round spread), the first frame
     and peak RSS of a fresh process, the pixels whose hit differs from the peer's, and
     krsview's hits farther from the mesh than its ε(t) and ``tolerance`` (pixels) allow."""
+    scene, size, rounds = bench_inputs(scene, size, rounds)
     o3d = load_peer()
     krs = single_krs(scene)
     check_levels(krs, level_counts, scene.name)

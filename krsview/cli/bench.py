@@ -1,23 +1,23 @@
 """`krsview bench NAME`: one table of benchmarks, each a function of :mod:`krsview.bench`
 returning its rows and a ``table`` making them Markdown; this module only parses, calls and
-prints (and writes ``--csv``). `bench accuracy` writes a report folder per preset."""
+prints (and writes ``--csv``). `bench accuracy` (accuracy.py) writes a report folder per
+preset."""
 
 from __future__ import annotations
 
 import argparse
 import importlib
-import sys
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from .. import app
 from ..bench.expansion import TOLERANCE
-from ..bench.report import MIN_ACCURACY_ROUNDS, markdown, write_csv
-from ..inputs import output_dir, output_file
-from ..scene import MAX_LEVELS, SceneError
-from ..scene.presets import DEFAULT_PRESET, resolve
+from ..bench.report import markdown, write_csv
+from ..inputs import output_file
+from ..scene import MAX_LEVELS
+from ..scene.presets import resolve
 from ..scene.render import VIEW_PREPASS
 from . import options
+from .accuracy import add_accuracy
 from .options import render_option
 
 
@@ -40,6 +40,26 @@ def level_list(text: str) -> tuple[int, ...]:
     parse = options.number_in("--levels", 1, MAX_LEVELS)
     return tuple(parse(item) for item in text.split(","))
 
+
+STOPS = (  # bench zoom's and peer-zoom's cameras
+    "--stops",
+    dict(
+        dest="stops_count",
+        type=options.number_in("--stops", 2, 100),
+        default=12,
+        help="cameras along the flight (default 12)",
+    ),
+)
+PEER_TOLERANCE = (
+    "--tolerance",
+    dict(
+        type=options.number_in("--tolerance", 0.01, 8.0, float),
+        metavar="PIXELS",
+        default=TOLERANCE,
+        help="pixels the peer's mesh may lie from the surface, at the nearest "
+        f"instance of each level (default {TOLERANCE}; finer: more triangles)",
+    ),
+)
 
 BENCHES = {
     "levels": Bench(
@@ -123,15 +143,7 @@ BENCHES = {
         knobs=("prepass", "culling", "lod", "walk_restart", "path", "steps"),
         fast=True,
         own=(
-            (
-                "--stops",
-                dict(
-                    dest="stops_count",
-                    type=options.number_in("--stops", 2, 100),
-                    default=12,
-                    help="cameras along the flight (default 12)",
-                ),
-            ),
+            STOPS,
             (
                 "--plot",
                 dict(
@@ -164,16 +176,34 @@ BENCHES = {
                     "doubles the peer's mesh)",
                 ),
             ),
+            PEER_TOLERANCE,
+        ),
+        needs=("open3d", "peer"),
+    ),
+    "peer-zoom": Bench(
+        "bench zoom's flight with the Embree BVH beside krsview",
+        "The tree cut to --levels levels, expanded and tessellated into an Embree BVH as "
+        "bench peer does, then drawn by both along bench zoom's flight into its finest "
+        "kernel, krsview with `render`'s fast settings and its effects off: per stop the "
+        "frame time of each (fastest round [median–slowest] of interleaved rounds), "
+        "krsview's ratio to the peer, the share of pixels each hits, and each one's slowest "
+        "frame against its fastest: how constant a rate the obvious alternative holds on "
+        "the same flight. Needs 'krsview[peer]'. Example: krsview bench peer-zoom tree "
+        "--levels 16 --rounds 7",
+        knobs=("prepass", "lod"),
+        fast=True,
+        own=(
             (
-                "--tolerance",
+                "--levels",
                 dict(
-                    type=options.number_in("--tolerance", 0.01, 8.0, float),
-                    metavar="PIXELS",
-                    default=TOLERANCE,
-                    help="pixels the peer's mesh may lie from the surface, at the nearest "
-                    f"instance of each level (default {TOLERANCE}; finer: more triangles)",
+                    type=options.number_in("--levels", 1, MAX_LEVELS),
+                    default=16,
+                    help="the coarsest levels kept and expanded (default 16; each level "
+                    "doubles the peer's mesh)",
                 ),
             ),
+            STOPS,
+            PEER_TOLERANCE,
         ),
         needs=("open3d", "peer"),
     ),
@@ -183,7 +213,8 @@ BENCHES = {
 def add(sub) -> None:
     b = sub.add_parser(
         "bench",
-        help="benchmarks (levels, paths, split, tracers, effects, zoom, peer, accuracy, latency)",
+        help="benchmarks (levels, paths, split, tracers, effects, zoom, peer, peer-zoom, accuracy, "
+        "latency)",
         description="Benchmarks that report ratios measured side by side. "
         "Example: krsview bench tracers tree --csv out/tracers.csv",
     )
@@ -224,129 +255,15 @@ def run(args: argparse.Namespace) -> int:
     own = {dest: getattr(args, dest) for dest in args.own}
     if own.get("plot"):  # checked here, where its error is one line (argparse hid it)
         own["plot"] = output_file(own["plot"], "--plot", (".png",))
-    module = importlib.import_module(f"krsview.bench.{args.bench}")
-    measured = getattr(module, f"bench_{args.bench}")(scene, args.size, rounds=args.rounds, **own)
+    name = args.bench.replace("-", "_")  # peer-zoom: krsview.bench.peer_zoom
+    module = importlib.import_module(f"krsview.bench.{name}")
+    measured = getattr(module, f"bench_{name}")(scene, args.size, rounds=args.rounds, **own)
     print(module.table(measured))
     if args.csv:
         print(f"wrote {write_csv(measured.rows, args.csv).resolve()}")
     if own.get("plot"):
         print(f"wrote {own['plot'].resolve()}")
     return 0
-
-
-def add_accuracy(bsub) -> None:
-    ba = bsub.add_parser(
-        "accuracy",
-        help="what accuracy costs: every knob against time and ground truth, as a report "
-        "with plots",
-        description="On one view: sweep ε-scale, the iteration cap, the tracer (sphere, "
-        "over-relaxed with ω, binary with ξ pairs) and the level count; time each setting "
-        "on the GPU (interleaved rounds: the fastest round, which a busy machine disturbs "
-        "least, with the median and slowest beside it; settings doing the same work "
-        "share one time, and their spread is the run's noise floor, under which a "
-        "difference is 'within noise'), count its work (kernels evaluated per pixel, "
-        "deterministic) and compare its image with the ground "
-        "truth (the float64 reference at ε/8, computed once and cached): holes, false "
-        "hits, depth error in ε, normal error, PSNR, SSIM, iterations, capped rays. Writes "
-        "OUT/README.md, OUT/accuracy.csv, plots (error against time and against work per "
-        "knob, the Pareto fronts) and error images. "
-        "Example: krsview bench accuracy tree rock --out out/accuracy",
-    )
-    ba.add_argument(
-        "preset",
-        nargs="*",
-        metavar="PRESET",
-        help="one or more presets (default tree); several write OUT/PRESET each",
-    )
-    ba.add_argument("--size", type=options.size, default=(320, 180), help="default 320x180")
-    ba.add_argument(
-        "--workers",
-        type=options.number_in("--workers", 1, 1024),
-        default=1,
-        help="run the presets as tasks on this many Ray workers (default 1: "
-        "here, one after the other); needs 'krsview[cluster]'",
-    )
-    ba.add_argument(
-        "--address",
-        metavar="ADDRESS",
-        help="run them on an existing Ray cluster (ray://HOST:10001 or 'auto')",
-    )
-    ba.add_argument(
-        "--rounds",
-        type=options.number_in("--rounds", MIN_ACCURACY_ROUNDS, 100),
-        default=5,
-        help=f"interleaved rounds, {MIN_ACCURACY_ROUNDS}..100; the fastest round with the "
-        "median and slowest, and the run's noise floor, are reported (default 5; fewer rounds "
-        "give no spread to draw a verdict on)",
-    )
-    ba.add_argument(
-        "--out",
-        metavar="DIR",
-        help="report folder (default out/accuracy/PRESET; with several presets, DIR/PRESET)",
-    )
-    ba.add_argument(
-        "--cache", metavar="DIR", help="ground-truth cache (default ~/.cache/krsview/truth)"
-    )
-    ba.set_defaults(func=run_accuracy)
-
-
-def report_folder(out: str | None, name: str, several: bool) -> Path:
-    """Where a preset's accuracy report goes: --out, --out/PRESET, or out/accuracy/PRESET."""
-    if out is None:
-        return Path("out") / "accuracy" / resolve(name).stem
-    return Path(out) / resolve(name).stem if several else Path(out)
-
-
-def run_accuracy(args: argparse.Namespace) -> int:
-    from ..bench.accuracy import bench_accuracy
-    from ..bench.accuracy_report import write_report
-    from ..bench.truth import TRUTH_EPSILON_SCALE, TRUTH_ITERATIONS
-
-    names = args.preset or [DEFAULT_PRESET]
-    scenes = {n: options.scene_of(args, n) for n in names}
-    if len(set(names)) != len(names):
-        raise SceneError("PRESET", " ".join(names), "each preset once")
-    outs = {n: report_folder(args.out, n, len(names) > 1) for n in names}
-    for out in outs.values():
-        output_dir(out, "--out")
-    cache = output_dir(args.cache, "--cache") if args.cache else None  # writable, up front
-    if args.workers > 1 or args.address is not None:
-        return run_accuracy_on_ray(args, scenes, outs, cache)
-    for n in names:  # here, one after the other
-        print(
-            f"ground truth: float64 reference, ε-scale {TRUTH_EPSILON_SCALE}, cap "
-            f"{TRUTH_ITERATIONS} (cached) …",
-            flush=True,
-        )
-        print(write_report(bench_accuracy(scenes[n], args.size, args.rounds, cache), outs[n]))
-        print(f"wrote {outs[n].resolve()}/ (README.md, accuracy.csv, plots, error images)")
-    return 0
-
-
-def run_accuracy_on_ray(args: argparse.Namespace, scenes: dict, outs: dict, cache) -> int:
-    """The presets' reports as Ray tasks, each printed as its task ends."""
-    options.require("ray", extra="cluster", what="bench accuracy --workers/--address")
-    from ..share.batch import check_address, run_accuracy_sweep
-
-    check_address(args.address)
-    print(
-        f"krsview: accuracy of {len(scenes)} preset(s) on {args.workers} Ray worker(s) of "
-        f"{args.address or 'a local cluster'}; each report when its task ends",
-        flush=True,
-    )
-
-    def done(name: str, lines: list[str] | None, error: str) -> None:
-        if lines is None:
-            print(f"krsview: error: {name}: {error}", file=sys.stderr)
-            return
-        print(f"{name}: wrote {outs[name].resolve()}/")
-        for line in lines:
-            print(f"  {line}")
-
-    failed = run_accuracy_sweep(
-        scenes, args.size, args.rounds, outs, args.workers, args.address, done, cache
-    )
-    return 1 if failed else 0
 
 
 def add_latency(bsub) -> None:
