@@ -91,6 +91,11 @@ def test_effects_returns_plain_each_effect_and_the_compiled_variants():
     for row in m.rows:
         assert row["incremental"] == pytest.approx(row["ratio_to_plain"] - 1.0)
     assert len(data_rows(effects.table(m))) == len(m.rows)
+    # a compound's components summed: a sum of fastest rounds, with no median or slowest
+    summed = dict(m.rows[0], variant="components alone, summed", ms_median="", ms_max="")
+    last = data_rows(effects.table(replace(m, rows=[*m.rows, dict(summed, low="", high="")])))
+    assert f"| {summed['ms']:.1f} |" in last[-1] and "[" not in last[-1]
+    assert "[" in last[0]  # control: a timed variant's spread
     # negative control: a scene without effects has no specialised-vs-compiled pair
     assert ("scene, specialised" in names) == bool(scene.effects)
 
@@ -237,18 +242,22 @@ def test_every_bench_times_a_variant_by_its_fastest_round(monkeypatch):
     range). Here every other round of every variant is slowed by 50 % (a busy neighbour):
     the times and ratios are the quiet rounds'; the medians, the control, moved."""
     assert harness.time_columns([0.003, 0.001, 0.002]) == dict(ms=1.0, ms_median=2.0, ms_max=3.0)
-    real = levels.round_times
+    quiet = {}  # name → its quiet time (s), made up: 1, 2, … ms, every level 10 % more
 
-    def busy(*args):
-        times = real(*args)
-        return {
-            n: [t * (1.5 if k % 2 else 1.0) for k, t in enumerate(ts)] for n, ts in times.items()
-        }
+    def busy(r, variants, size, rounds, label):
+        for k, name in enumerate(v for v in variants if not v.endswith("every level")):
+            quiet[name] = (k + 1) * 1e-3
+            quiet[f"{name}, every level"] = 1.1 * quiet[name]
+        return {n: [quiet[n] * (1.5 if j % 2 else 1.0) for j in range(rounds)] for n in variants}
 
     monkeypatch.setattr(levels, "round_times", busy)
     m = levels.bench_levels(krsview.load("sierpinski"), SIZE, step=11, rounds=4)
+    base = quiet[f"{m.rows[0]['levels']} levels"]
     for r in m.rows:
-        assert r["ms"] < r["ms_median"] < r["ms_max"]  # control: the slowed rounds are there
+        t = quiet[f"{r['levels']} levels"]
+        assert r["ms"] == pytest.approx(t * 1e3) and r["ms_max"] == pytest.approx(1.5 * t * 1e3)
+        assert r["ms_median"] == pytest.approx(1.25 * t * 1e3)  # control: the medians moved
+        assert r["time_ratio"] == pytest.approx(t / base)
         assert r["time_ratio_min"] <= r["time_ratio"] <= r["time_ratio_max"]
-        assert r["time_ratio"] == pytest.approx(r["ms"] / m.rows[0]["ms"])
+        assert r["lod_speedup"] == pytest.approx(1.1)
     assert "fastest round [median–slowest]" in levels.table(m)

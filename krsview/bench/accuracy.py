@@ -140,8 +140,8 @@ def settings(scene: Scene) -> list[Setting]:
 @dataclass(frozen=True)
 class Accuracy:
     """The accuracy bench's result: one row per setting (the CSV's columns: knob, value,
-    size, time as the fastest round (ms = ms_min), median and slowest over rounds, the run's
-    noise floor, work, the row doing the
+    size, time as the fastest round (ms), the median and slowest over rounds (ms_median,
+    ms_max), the run's noise floor, work, the row doing the
     same work, every error of :class:`krsview.bench.metrics.Errors`) and the error images of
     the notable settings (file name → RGB array)."""
 

@@ -21,8 +21,8 @@ from dataclasses import replace
 from ..gpu.renderer import Renderer
 from ..scene import Compound, EmptyZone, Scene
 from ..scene.effects import allowed_effects
-from .harness import Variant, bench_inputs, fastest, round_times
-from .report import Measured, markdown
+from .harness import Variant, bench_inputs, fastest, round_times, time_columns
+from .report import TIME_SPREAD, Measured, markdown, ms_spread
 
 TWIST_FALLBACK = 10.0  # degrees per unit, when the scene sets no twist of its own
 
@@ -78,7 +78,7 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
             variant=name,
             effects="+".join(s.effects) or "none",
             all_effects_compiled=uber,
-            ms=best[name] * 1e3,
+            **time_columns(times[name]),
             ratio_to_plain=best[name] / best["plain"],
             incremental=best[name] / best["plain"] - 1.0,
             low=min(each(name)),
@@ -94,6 +94,8 @@ def bench_effects(scene: Scene, size: tuple[int, int], rounds: int = 5) -> Measu
                 effects="none",
                 all_effects_compiled=False,
                 ms=sum(alone) * 1e3,
+                ms_median="",  # a sum of fastest rounds, not a frame drawn in rounds
+                ms_max="",
                 ratio_to_plain=sum(alone) / best["plain"],
                 incremental=sum(alone) / best["plain"] - 1.0,
                 low="",
@@ -113,7 +115,7 @@ def table(m: Measured) -> str:
     ms = {row["variant"]: row["ms"] for row in m.rows}
     text = (
         f"\nEffect costs — {m.scene.name}, {m.size[0]}×{m.size[1]}, {m.scene.render.tracer} "
-        f"tracing, fastest of {m.rounds} interleaved rounds (ratios to plain = no effect, "
+        f"tracing, ms {TIME_SPREAD} of {m.rounds} interleaved rounds (ratios to plain = no effect, "
         "specialised; a cost whose rounds disagree on its sign is within noise)\n\n"
     )
     text += markdown(
@@ -123,7 +125,7 @@ def table(m: Measured) -> str:
             (
                 r["variant"],
                 r["effects"],
-                f"{r['ms']:.1f}",
+                f"{r['ms']:.1f}" if r["ms_median"] == "" else ms_spread(r),
                 f"{r['ratio_to_plain']:.2f}",
                 f"{r['incremental']:+.0%}" + _noise(r),
                 "" if r["low"] == "" else f"{r['low']:+.0%} … {r['high']:+.0%}",

@@ -38,7 +38,7 @@ from .peer import (
     peer_timer,
 )
 from .report import TIME_SPREAD, Measured, markdown, ms_spread
-from .zoom import finest_kernel_ball, spread_text, stops
+from .zoom import finest_kernel_ball, spread_text, stops, to_fastest
 
 
 def bench_peer_zoom(
@@ -93,11 +93,8 @@ def bench_peer_zoom(
                 hit=hits[k][1],
             )
         )
-    for column, who in (("peer_ms", PEER), ("ms", "krsview")):  # as bench zoom's spread
-        quickest = min(range(len(views)), key=lambda k: min(times[f"{who} {k}"]))
-        for k, row in enumerate(rows):
-            lo, hi = ratio_range(times[f"{who} {k}"], times[f"{who} {quickest}"])
-            row |= {f"{column}_to_fastest_min": lo, f"{column}_to_fastest_max": hi}
+    for column, who in (("peer_ms", PEER), ("ms", "krsview")):
+        to_fastest(rows, column, [times[f"{who} {k}"] for k in range(len(views))])
     return Measured(scene, size, rounds, rows)
 
 

@@ -65,7 +65,7 @@ def write_csv(rows: list[dict], path: str | Path) -> Path:
 
 
 AXES = (
-    ("ms", "ms per frame (fastest round; bar: its median and slowest)"),
+    ("ms", "ms per frame (fastest round; bar: to the slowest)"),
     ("work", "kernels evaluated per pixel"),
 )
 

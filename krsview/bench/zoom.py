@@ -109,15 +109,22 @@ def bench_zoom(
         ("ms", ""),
         ("ms_every_level", ", every level"),
         ("ms_other_walk", f", restart {walk}"),
-    ):  # each stop against the fastest, round by round: the spread of the zoom's ratio
-        quickest = min(names, key=lambda n: best[n + suffix])
-        for row, name in zip(rows, names):
-            lo, hi = ratio_range(times[name + suffix], times[quickest + suffix])
-            row |= {f"{column}_to_fastest_min": lo, f"{column}_to_fastest_max": hi}
+    ):
+        to_fastest(rows, column, [times[name + suffix] for name in names])
     m = Measured(scene, size, rounds, rows)
     if plot is not None:
         write_plot(m, plot)
     return m
+
+
+def to_fastest(rows: list[dict], column: str, stops: list[list[float]]) -> None:
+    """Each stop's round-by-round ratio to the fastest stop's (``stops``: per-round seconds,
+    one list per row), as the row's ``{column}_to_fastest_min`` and ``_max``: the spread of
+    the zoom's slowest ÷ fastest frame."""
+    quickest = min(stops, key=min)
+    for row, t in zip(rows, stops, strict=True):
+        lo, hi = ratio_range(t, quickest)
+        row |= {f"{column}_to_fastest_min": lo, f"{column}_to_fastest_max": hi}
 
 
 def spread(m: Measured, column: str = "ms") -> float:

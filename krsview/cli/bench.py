@@ -182,7 +182,7 @@ BENCHES = {
     ),
     "peer-zoom": Bench(
         "bench zoom's flight with the Embree BVH beside krsview",
-        "The tree cut to --levels levels, expanded and tessellated into an Embree BVH as "
+        "The scene's KRS cut to --levels levels, expanded and tessellated into an Embree BVH as "
         "bench peer does, then drawn by both along bench zoom's flight into its finest "
         "kernel, krsview with `render`'s fast settings and its effects off: per stop the "
         "frame time of each (fastest round [median–slowest] of interleaved rounds), "
@@ -227,8 +227,8 @@ def add(sub) -> None:
             "--rounds",
             type=options.number_in("--rounds", 1, 100),
             default=5,
-            help="interleaved rounds; each time is its fastest round, with the median and "
-            "slowest beside it: load only adds time (default 5)",
+            help="interleaved rounds; each time is its fastest round (load only adds time), "
+            "the median and slowest printed beside it where the table has room (default 5)",
         )
         sp.add_argument(
             "--csv", metavar="PATH", help="also write the table to this file, ending in .csv"
