@@ -11,6 +11,7 @@ import numpy as np
 from ..algebra import mobius
 from ..scene import MoKRS, SceneError
 from ..scene.model import Empty
+from ..scene.mokrs import check_view
 from .balls import CULL_MARGIN, UNBOUNDED, kernel_ball, union_ball
 from .krs import kernel_records
 
@@ -114,6 +115,14 @@ def compile_mokrs(m: MoKRS, albedo: tuple[float, float, float]) -> CompiledMoKRS
     bounds = bounds_in_and_out(m)
     check_float32(bounds[0])
     return CompiledMoKRS(inverse, reflect, records, types, poles, *bounds)
+
+
+def check_drawable(m: MoKRS, eye: tuple[float, float, float], where: str) -> None:
+    """A SceneError unless the tracer can draw ``m`` from ``eye`` (``where`` names it): the
+    viewpoint off every pole [KRS17 §7], and every bounding ball within float32 (refused,
+    not drawn as a solid colour)."""
+    check_view(m, eye, where)
+    check_float32(bounds_in_and_out(m)[0])
 
 
 def check_float32(bounds: np.ndarray, path: str = "mokrs.levels") -> None:

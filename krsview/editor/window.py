@@ -28,12 +28,11 @@ import numpy as np
 
 from ..compile.camera import View, view_of
 from ..compile.geometry import scene_ball
-from ..compile.mokrs import bounds_in_and_out, check_float32
+from ..compile.mokrs import check_drawable
 from ..document.document import Document
 from ..gpu.overlay import Overlay
 from ..scene import Scene, SceneError
 from ..scene.edits import apply_edit, path_text
-from ..scene.mokrs import check_view
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
 from ..viewer import commands as vc
 from ..viewer.controls import VIEWER_KEYS
@@ -157,8 +156,7 @@ class Editor:
         try:
             scene = apply_edit(self.scene, path, value)
             if scene.mokrs is not None:
-                check_view(scene.mokrs, tuple(v.camera.position), VIEW)
-                check_float32(bounds_in_and_out(scene.mokrs)[0])  # refused, not drawn solid
+                check_drawable(scene.mokrs, tuple(v.camera.position), VIEW)
         except SceneError as e:
             v.error = str(e)
             if field is not None and e.path != path_text(field[0]):  # named where it was typed
