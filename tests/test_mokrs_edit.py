@@ -24,6 +24,23 @@ from krsview.scene.presets import resolve
 PRESETS = ("palm", "shell", "inversion")
 
 
+@pytest.fixture
+def palm_window(display, tmp_path):
+    """The editor on a copy of palm in a real window under Xvfb, settled; closed after."""
+    from krsview.editor.window import Editor
+
+    from .test_editor import settle
+
+    path = tmp_path / "palm.toml"
+    shutil.copy(resolve("palm"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        settle(e)
+        yield e
+    finally:
+        e.close()
+
+
 @pytest.fixture(scope="module", params=PRESETS)
 def scene(request):
     return load_scene(resolve(request.param))
@@ -363,67 +380,60 @@ def test_drags_and_step_list_edits_keep_the_shader_variant():
     assert defines(sphere) != base
 
 
-def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(display, tmp_path):
+def test_palm_in_a_window_a_step_dragged_by_real_pointer_events_saved(palm_window):
     """palm opens with its levels and handles; clicking a translate step's handle selects it
     (over the kernel point it shares), a 40 px drag moves it in the screen plane as one undo
     step without a recompile; a rotation step turns on its ring, monotone and proportional
     to the pointer each way round; Ctrl+S writes it. A refused value stays beside its step; a
     level count the MöKRS cannot truncate to draws every level and says why."""
-    from krsview.editor.window import Editor
     from krsview.scene.model import Empty
     from krsview.viewer.commands import Edit
 
-    from .test_editor import assert_moved_right, click, drag, pump, screen_of, settle, xdo
+    from .test_editor import assert_moved_right, click, drag, pump, screen_of, xdo
 
-    path = tmp_path / "palm.toml"
-    shutil.copy(resolve("palm"), path)
-    e = Editor(path, size=(800, 500))
-    try:
-        settle(e)
-        assert len(e.handles) > 150 and not e.viewer.error
-        compiles = e.viewer.renderer.programs.compiles
-        by = (*LEVELS, 58, "transform", 2, "by")
-        h = next(h for h in e.handles if h.path == by)
-        click(e, screen_of(e, h.position))
-        assert e.selected is not None and e.selected.path == by, e.selected
-        old = np.array(h.position)
-        drag(e, screen_of(e, old), (40, 0))
-        assert_moved_right(e, old, next(k for k in e.handles if k.path == by).position, 40)
-        assert len(e.doc.history.steps) == 1, "the drag was not one undo step"
-        assert e.viewer.renderer.programs.compiles == compiles, "a drag recompiled the shader"
-        turns = turn_the_dial(e, (*LEVELS, 58, "transform", 1, "degrees"))
-        assert len(e.doc.history.steps) == 3, "each way round was not one undo step"
-        assert e.viewer.renderer.programs.compiles == compiles, "a turn recompiled the shader"
-        forth, back = np.diff(turns[0]), np.diff(turns[1])
-        assert (forth > 0).all() and (back < 0).all(), turns  # monotone, each way
-        assert forth.max() < 3 * forth.min() and forth.max() < 10.0, forth  # proportional
-        xdo("key", "ctrl+s")
-        pump(e)
-        saved = load_scene(path)
-        assert get_at(saved, by) == get_at(e.scene, by) != (0.0, 0.34, 0.0)
-        # a refused factor: the scene stays; the step's field, drawn in the panel, keeps the
-        # refused value and its message (naming that field), not the panel's error line
-        factor = (*LEVELS, 58, "transform", 0, "factor")
-        e.execute([Edit(factor, 0.0)])
-        pump(e)
-        assert get_at(e.scene, factor) == 0.93
-        refused = e.viewer.interactions.refused.get(factor)
-        assert refused is not None and refused.value == 0.0 and not e.viewer.error
-        assert refusal_place(refused.message, 58, 3) == "step 0", refused.message
-        # the outermost level without a kernel: one level cannot be drawn, two can
-        e.execute([Edit((*LEVELS, 59, "kernel"), Empty())])
-        e.viewer.drawn.set_levels(1)
-        pump(e)
-        assert e.viewer.drawn.levels == 0 and "cannot be carried" in e.viewer.error
-        assert refusal_place(e.viewer.error, 59, 0) == "selection"  # shown in the panel
-        e.viewer.drawn.set_levels(2)
-        pump(e)
-        assert e.viewer.drawn.levels == 2 and e.viewer.drawn.krs.n == 2
-    finally:
-        e.close()
+    e = palm_window
+    assert len(e.handles) > 150 and not e.viewer.error
+    compiles = e.viewer.renderer.programs.compiles
+    by = (*LEVELS, 58, "transform", 2, "by")
+    h = next(h for h in e.handles if h.path == by)
+    click(e, screen_of(e, h.position))
+    assert e.selected is not None and e.selected.path == by, e.selected
+    old = np.array(h.position)
+    drag(e, screen_of(e, old), (40, 0))
+    assert_moved_right(e, old, next(k for k in e.handles if k.path == by).position, 40)
+    assert len(e.doc.history.steps) == 1, "the drag was not one undo step"
+    assert e.viewer.renderer.programs.compiles == compiles, "a drag recompiled the shader"
+    turns = turn_the_dial(e, (*LEVELS, 58, "transform", 1, "degrees"))
+    assert len(e.doc.history.steps) == 3, "each way round was not one undo step"
+    assert e.viewer.renderer.programs.compiles == compiles, "a turn recompiled the shader"
+    forth, back = np.diff(turns[0]), np.diff(turns[1])
+    assert (forth > 0).all() and (back < 0).all(), turns  # monotone, each way
+    assert forth.max() < 3 * forth.min() and forth.max() < 10.0, forth  # proportional
+    xdo("key", "ctrl+s")
+    pump(e)
+    saved = load_scene(e.path)
+    assert get_at(saved, by) == get_at(e.scene, by) != (0.0, 0.34, 0.0)
+    # a refused factor: the scene stays; the step's field, drawn in the panel, keeps the
+    # refused value and its message (naming that field), not the panel's error line
+    factor = (*LEVELS, 58, "transform", 0, "factor")
+    e.execute([Edit(factor, 0.0)])
+    pump(e)
+    assert get_at(e.scene, factor) == 0.93
+    refused = e.viewer.interactions.refused.get(factor)
+    assert refused is not None and refused.value == 0.0 and not e.viewer.error
+    assert refusal_place(refused.message, 58, 3) == "step 0", refused.message
+    # the outermost level without a kernel: one level cannot be drawn, two can
+    e.execute([Edit((*LEVELS, 59, "kernel"), Empty())])
+    e.viewer.drawn.set_levels(1)
+    pump(e)
+    assert e.viewer.drawn.levels == 0 and "cannot be carried" in e.viewer.error
+    assert refusal_place(e.viewer.error, 59, 0) == "selection"  # shown in the panel
+    e.viewer.drawn.set_levels(2)
+    pump(e)
+    assert e.viewer.drawn.levels == 2 and e.viewer.drawn.krs.n == 2
 
 
-def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
+def test_a_dial_turns_by_its_point_as_by_its_ring(palm_window):
     """A rotation step's dial point (on its guide circle, away from the ring) turns the dial
     when pressed and dragged round the axis, selected or not: the angle follows the pointer,
     in one undo step each time, and lands on hundredths of a degree; a click on the point that
@@ -433,92 +443,85 @@ def test_a_dial_turns_by_its_point_as_by_its_ring(display, tmp_path):
     pressed beside the point, off the point and the ring, turns nothing."""
     from krsview.editor.dial import GRAB_PIXELS, distance_to, plane_basis
     from krsview.editor.mokrs_handles import DIAL_DECIMALS
-    from krsview.editor.window import Editor
 
-    from .test_editor import drag, pump, screen_of, settle, xdo
+    from .test_editor import drag, pump, screen_of, xdo
 
-    path = tmp_path / "palm.toml"
-    shutil.copy(resolve("palm"), path)
-    e = Editor(path, size=(800, 500))
-    try:
-        settle(e)
-        degrees = (*LEVELS, 58, "transform", 1, "degrees")
+    e = palm_window
+    degrees = (*LEVELS, 58, "transform", 1, "degrees")
 
-        def turned(beside=0.0, arc=0.3, steps=6, quick=False):
-            """Press on the dial point (or ``beside`` it, pixels to the right) and drag it
-            ``arc`` radians round the axis: the angle before, after each move, the steps.
-            ``quick``: pressed, moved and let go before the editor's next turn (a flick on a
-            slow frame); the angle after it alone."""
-            h = next(h for h in e.handles if h.path == degrees)
-            before, steps0 = get_at(e.scene, degrees), e.doc.history.index
-            arm = h.position - h.pivot
-            y, z = arm / np.linalg.norm(arm), np.cross(h.axis, arm / np.linalg.norm(arm))
-            angles = []
-            for k in range(steps + 1):
-                t = arc * k / steps
-                q = h.pivot + np.linalg.norm(arm) * (np.cos(t) * y + np.sin(t) * z)
-                x, yy = screen_of(e, q)
-                xdo("mousemove", round(x + beside), round(yy))
-                if quick:
-                    if k == 0:
-                        xdo("mousedown", 1)
-                    continue
-                pump(e, 2 if k == 0 else 1)
+    def turned(beside=0.0, arc=0.3, steps=6, quick=False):
+        """Press on the dial point (or ``beside`` it, pixels to the right) and drag it
+        ``arc`` radians round the axis: the angle before, after each move, the steps.
+        ``quick``: pressed, moved and let go before the editor's next turn (a flick on a
+        slow frame); the angle after it alone."""
+        h = next(h for h in e.handles if h.path == degrees)
+        before, steps0 = get_at(e.scene, degrees), e.doc.history.index
+        arm = h.position - h.pivot
+        y, z = arm / np.linalg.norm(arm), np.cross(h.axis, arm / np.linalg.norm(arm))
+        angles = []
+        for k in range(steps + 1):
+            t = arc * k / steps
+            q = h.pivot + np.linalg.norm(arm) * (np.cos(t) * y + np.sin(t) * z)
+            x, yy = screen_of(e, q)
+            xdo("mousemove", round(x + beside), round(yy))
+            if quick:
                 if k == 0:
                     xdo("mousedown", 1)
-                    pump(e, 2)
-                else:
-                    angles.append(get_at(e.scene, degrees))
-            xdo("mouseup", 1)
-            pump(e, 4 if quick else 2)
-            if quick:
-                angles = [get_at(e.scene, degrees)]
-            return before, angles, e.doc.history.index - steps0
+                continue
+            pump(e, 2 if k == 0 else 1)
+            if k == 0:
+                xdo("mousedown", 1)
+                pump(e, 2)
+            else:
+                angles.append(get_at(e.scene, degrees))
+        xdo("mouseup", 1)
+        pump(e, 4 if quick else 2)
+        if quick:
+            angles = [get_at(e.scene, degrees)]
+        return before, angles, e.doc.history.index - steps0
 
-        def turns(before, angles, steps):
-            moved = np.abs(np.diff([before, *angles]))
-            assert steps == 1 and (moved > 0).sum() >= 4, (before, angles)
-            assert 5.0 < abs(angles[-1] - before) < 40.0, (before, angles)  # 0.3 rad ≈ 17°
-            assert all(a == round(a, DIAL_DECIMALS) for a in angles), angles
-            label = e.doc.history.labels()[0][-1]  # the undo tooltip names the dial, as
-            assert label == f"drag L58 step 1 rotate {before:g} deg", label  # it was pressed
+    def turns(before, angles, steps):
+        moved = np.abs(np.diff([before, *angles]))
+        assert steps == 1 and (moved > 0).sum() >= 4, (before, angles)
+        assert 5.0 < abs(angles[-1] - before) < 40.0, (before, angles)  # 0.3 rad ≈ 17°
+        assert all(a == round(a, DIAL_DECIMALS) for a in angles), angles
+        label = e.doc.history.labels()[0][-1]  # the undo tooltip names the dial, as
+        assert label == f"drag L58 step 1 rotate {before:g} deg", label  # it was pressed
 
-        assert e.selected is None
-        h = next(h for h in e.handles if h.path == degrees)
-        drag(e, screen_of(e, h.position), (3, 0), steps=3)  # a click that slips: selects it
-        assert e.selected is not None and e.selected.path == degrees
-        assert get_at(e.scene, degrees) == -2.5 and not e.doc.history.steps
-        e.select(None)
+    assert e.selected is None
+    h = next(h for h in e.handles if h.path == degrees)
+    drag(e, screen_of(e, h.position), (3, 0), steps=3)  # a click that slips: selects it
+    assert e.selected is not None and e.selected.path == degrees
+    assert get_at(e.scene, degrees) == -2.5 and not e.doc.history.steps
+    e.select(None)
+    pump(e, 2)
+    turns(*turned())  # not selected: the press selects it and turns it
+    assert e.selected is not None and e.selected.path == degrees
+    h = e.selected
+    import glfw
+
+    wx, wy = glfw.get_window_pos(e.viewer.window)
+    x, y = screen_of(e, h.position)
+    ring = e.gizmo.dial._ring(h, e.window_view(), plane_basis(h.axis))
+    assert distance_to(ring, x - wx, y - wy) > 2 * GRAB_PIXELS  # the point is off the ring
+    before, angles, steps = turned(beside=3 * GRAB_PIXELS)
+    assert angles[-1] == before and steps == 0, angles
+    before, steps0 = get_at(e.scene, degrees), len(e.doc.history.steps)
+    drag(e, screen_of(e, e.selected.position), (3, 0), steps=3)  # a click's slip on it
+    assert get_at(e.scene, degrees) == before and len(e.doc.history.steps) == steps0
+    before, slow, _ = turned()  # selected: its point turns it as its ring does
+    turns(before, slow, 1)
+    e.viewer.undo()
+    pump(e, 2)
+    for selected in (True, False):  # a flick turns it as far, selected or not
+        e.select(e.selected if selected else None)
         pump(e, 2)
-        turns(*turned())  # not selected: the press selects it and turns it
-        assert e.selected is not None and e.selected.path == degrees
-        h = e.selected
-        import glfw
-
-        wx, wy = glfw.get_window_pos(e.viewer.window)
-        x, y = screen_of(e, h.position)
-        ring = e.gizmo.dial._ring(h, e.window_view(), plane_basis(h.axis))
-        assert distance_to(ring, x - wx, y - wy) > 2 * GRAB_PIXELS  # the point is off the ring
-        before, angles, steps = turned(beside=3 * GRAB_PIXELS)
-        assert angles[-1] == before and steps == 0, angles
-        before, steps0 = get_at(e.scene, degrees), len(e.doc.history.steps)
-        drag(e, screen_of(e, e.selected.position), (3, 0), steps=3)  # a click's slip on it
-        assert get_at(e.scene, degrees) == before and len(e.doc.history.steps) == steps0
-        before, slow, _ = turned()  # selected: its point turns it as its ring does
-        turns(before, slow, 1)
+        b, fast, steps = turned(quick=True)
+        assert b == before and steps == 1 and e.selected.path == degrees, (b, fast, steps)
+        assert abs(fast[0] - slow[-1]) < 0.05 * abs(slow[-1] - before), (slow, fast)
         e.viewer.undo()
-        pump(e, 2)
-        for selected in (True, False):  # a flick turns it as far, selected or not
-            e.select(e.selected if selected else None)
-            pump(e, 2)
-            b, fast, steps = turned(quick=True)
-            assert b == before and steps == 1 and e.selected.path == degrees, (b, fast, steps)
-            assert abs(fast[0] - slow[-1]) < 0.05 * abs(slow[-1] - before), (slow, fast)
-            e.viewer.undo()
-        b, fast, steps = turned(beside=3 * GRAB_PIXELS, quick=True)  # off the point: nothing
-        assert fast == [before] and steps == 0, fast
-    finally:
-        e.close()
+    b, fast, steps = turned(beside=3 * GRAB_PIXELS, quick=True)  # off the point: nothing
+    assert fast == [before] and steps == 0, fast
 
 
 def turn_the_dial(e, path, steps: int = 6, arc: float = 0.4) -> list[list[float]]:
@@ -757,44 +760,37 @@ def test_a_kernel_changed_back_to_its_kind_comes_back_as_it_was():
     assert kinds.switch((*LEVELS, 1), cap, "toroidal_capsule") != bent
 
 
-def test_palm_in_a_window_a_kernel_picked_as_a_capsule_and_back_keeps_its_bend(display, tmp_path):
+def test_palm_in_a_window_a_kernel_picked_as_a_capsule_and_back_keeps_its_bend(palm_window):
     """The kernel list of a selected level, clicked in a real window: "capsule" makes the
     bent toroidal capsule a straight capsule; "toroidal_capsule" picked next gives the bend
     back (it came back straight [review]). Negative control: the capsule is not the toroid."""
     from imgui_bundle import imgui
 
     from krsview.editor.mokrs_panel import KERNEL_KINDS
-    from krsview.editor.window import Editor
 
-    from .test_editor import click, screen_of, settle, window_xy
+    from .test_editor import click, screen_of, window_xy
 
-    path = tmp_path / "palm.toml"
-    shutil.copy(resolve("palm"), path)
-    e = Editor(path, size=(800, 500))
-    try:
-        settle(e)
-        by = (*LEVELS, 58, "transform", 2, "by")
-        click(e, screen_of(e, next(h for h in e.handles if h.path == by).position))
-        kernel = (*LEVELS, 58, "kernel")
-        bent = get_at(e.scene, kernel)
-        assert bent.kind == "toroidal_capsule"
+    e = palm_window
+    by = (*LEVELS, 58, "transform", 2, "by")
+    click(e, screen_of(e, next(h for h in e.handles if h.path == by).position))
+    kernel = (*LEVELS, 58, "kernel")
+    bent = get_at(e.scene, kernel)
+    assert bent.kind == "toroidal_capsule"
 
-        def pick(kind: str) -> None:
-            x0, y0, x1, y1 = e.viewer.interactions.rects[(*kernel, "kind")]
-            click(e, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2))
-            popup = imgui.internal.find_window_by_name("##Combo_00")
-            assert popup is not None and popup.active, "the click opened no list"
-            style = imgui.get_style()
-            line = imgui.get_text_line_height() + style.item_spacing.y
-            y = popup.pos.y + style.window_padding.y + line * KERNEL_KINDS.index(kind) + line / 2
-            click(e, window_xy(e, popup.pos.x + 30, y))
+    def pick(kind: str) -> None:
+        x0, y0, x1, y1 = e.viewer.interactions.rects[(*kernel, "kind")]
+        click(e, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2))
+        popup = imgui.internal.find_window_by_name("##Combo_00")
+        assert popup is not None and popup.active, "the click opened no list"
+        style = imgui.get_style()
+        line = imgui.get_text_line_height() + style.item_spacing.y
+        y = popup.pos.y + style.window_padding.y + line * KERNEL_KINDS.index(kind) + line / 2
+        click(e, window_xy(e, popup.pos.x + 30, y))
 
-        pick("capsule")
-        capsule = get_at(e.scene, kernel)
-        assert capsule.kind == "capsule" and capsule != bent
-        assert (capsule.a, capsule.b) == (bent.start, bent.end)
-        pick("toroidal_capsule")
-        assert get_at(e.scene, kernel) == bent  # the bend is back
-        assert len(e.doc.history.steps) == 2  # one undo step each
-    finally:
-        e.close()
+    pick("capsule")
+    capsule = get_at(e.scene, kernel)
+    assert capsule.kind == "capsule" and capsule != bent
+    assert (capsule.a, capsule.b) == (bent.start, bent.end)
+    pick("toroidal_capsule")
+    assert get_at(e.scene, kernel) == bent  # the bend is back
+    assert len(e.doc.history.steps) == 2  # one undo step each
