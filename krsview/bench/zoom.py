@@ -203,7 +203,7 @@ def write_plot(m: Measured, path) -> None:
     a.plot(d, m.column("ms_every_level"), "o--", color="C3", label="every level (lod 0)")
     walk = "off" if m.scene.render.walk_restart == "on" else "on"
     a.plot(d, m.column("ms_other_walk"), "s:", color="C4", label=f"walk restart {walk}")
-    a.set_ylabel("ms per frame (fastest round; bar: to the slowest)")
+    a.set_ylabel("ms/frame (fastest; bar: slowest)")
     a.legend()
     a.set_title(f"{m.scene.name}: zoom into the finest kernel, {m.size[0]}×{m.size[1]}")
     b.plot(d, m.column("iterations"), "o-", color="C1", label="iterations per pixel")
