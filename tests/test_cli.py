@@ -377,7 +377,7 @@ def test_check_oracle_prints_certified_counts(capsys):
 
 def test_every_render_option_takes_its_range_and_help_from_the_schema(capsys):
     """Each [render] knob `render` offers accepts its field's bounds and refuses a value just
-    beyond them with the schema's own words; its help is the field's help (DESIGN.md, one
+    beyond them with the schema's own words; its help is the field's help (docs/architecture.md, one
     schema). Negative control: an option's value outside the range exits 2."""
     from dataclasses import fields
 

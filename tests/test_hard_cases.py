@@ -1,6 +1,7 @@
-"""Hard cases are inputs, not accidents (DESIGN.md): the catalogue in krsview.bench.hard_cases,
-each case with its invariants (finite, within the cap and capped rays counted, continuous,
-GPU = reference or a documented precision limit) and the behaviour written beside it."""
+"""Hard cases are inputs, not accidents (docs/architecture.md): the catalogue in
+krsview.bench.hard_cases, each case with its invariants (finite, within the cap and capped rays
+counted, continuous, GPU = reference or a documented precision limit) and the behaviour written
+beside it."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The catalogue of hard cases: named scenes, each with the behaviour expected of it written
-beside it (DESIGN.md: hard cases are inputs, not accidents). The tests and ``krsview check
---stability hard`` run the invariants of :mod:`krsview.bench.stability` over every case;
-docs/stability.md reports the outcomes."""
+beside it (docs/architecture.md: hard cases are inputs, not accidents). The tests and
+``krsview check --stability hard`` run the invariants of :mod:`krsview.bench.stability` over
+every case; docs/stability.md reports the outcomes."""
 
 from __future__ import annotations
 

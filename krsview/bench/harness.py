@@ -1,6 +1,6 @@
-"""The one timing harness of the benchmarks: every variant is compiled and drawn once
-(warm-up), then the variants are drawn round after round, interleaved, so machine noise hits
-them alike (DESIGN.md, Measure as ratios). A variant's time is its fastest round: load from
+"""The one timing harness of the benchmarks: every variant is compiled and drawn once (warm-up),
+then the variants are drawn round after round, interleaved, so machine noise hits them alike
+(docs/architecture.md, Measure as ratios). A variant's time is its fastest round: load from
 other work only ever adds time, so the fastest round is the estimate it disturbs least, and
 on a shared machine, where up to half the rounds run slow, medians move while it holds [Chen
 and Revels 2016, the estimator of Julia's BenchmarkTools]. The median and the slowest round

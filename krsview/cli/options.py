@@ -1,5 +1,5 @@
 """The options the commands share: value parsers, options generated from a schema dataclass's
-field metadata (range, default and help in one place, DESIGN.md), the scene a command's
+field metadata (range, default and help in one place, docs/architecture.md), the scene a command's
 arguments ask for, and the checks of output paths made before any work."""
 
 from __future__ import annotations
@@ -93,7 +93,7 @@ def field_option(
             flag if on else "--no-" + flag[2:],
             dest=name,
             action="store_true" if on else "store_false",
-            help=meta["help"] if on else f"do not {meta['help']} (on by default)",
+            help=meta["help"] if on else f"do not {meta['help']} (without this flag, it does)",
         )
         return
     if typing.get_origin(hint) is tuple:

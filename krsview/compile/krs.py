@@ -3,7 +3,7 @@
 Each kernel becomes a record of ``RECORD_VEC4`` vec4s (layout below, mirrored in
 ``shaders/kernels.glsl``). Compiled once per scene in world coordinates; ``relative_to`` moves
 the origin to the camera each frame, so the GPU works in camera-relative float32 while the CPU
-keeps the camera in float64 (DESIGN.md, Precision).
+keeps the camera in float64 (docs/architecture.md, Precision).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The document: the one seam through which every scene change passes (DESIGN.md).
+"""The document: the one seam through which every scene change passes (docs/architecture.md).
 
 It owns the scene, its file, the undo history and the saved version. A drag, a panel field,
 an effect toggle, a render knob, a bookmark or a reload from disk is an edit applied here:

@@ -1,4 +1,4 @@
-"""Undo and redo over immutable scenes (the three.js editor's History, DESIGN.md).
+"""Undo and redo over immutable scenes (the three.js editor's History, docs/architecture.md).
 
 A step keeps the scene before and after it; scenes are frozen dataclasses that share every
 unchanged part, so a step costs little. Consecutive steps of one interaction (a gizmo drag, a

@@ -1,7 +1,7 @@
 """Shader program builder: ``#include`` resolution with ``#line`` mapping, the constants shared
 with Python (compile/constants.py) and one ``#define`` per enabled feature, a variant cache
 keyed by the define set, and compile errors mapped back to ``file.glsl:line`` (the
-moderngl-window habit, DESIGN.md)."""
+moderngl-window habit, docs/architecture.md)."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ class Source:
 
     Conditionals are resolved here, against the variant's defines: an inactive ``#ifdef``
     block, and any file it includes, never reaches the driver, so a scene without an effect
-    compiles none of that effect's code (DESIGN.md, Specialise, don't branch)."""
+    compiles none of that effect's code (docs/architecture.md, Specialise, don't branch)."""
 
     def __init__(
         self,

@@ -1,6 +1,6 @@
 """Edits as data: a path into the scene's dataclass tree and a new value, applied as a pure
 "replace at path" and validated by the same schema that reads files, so an edit from the
-editor is held to exactly the rules of a scene file (DESIGN.md, One seam for edits).
+editor is held to exactly the rules of a scene file (docs/architecture.md, One seam for edits).
 
 A path is a tuple of field names and list indices, e.g. ``("route", "levels", 3, "fork")``;
 it prints as ``route.levels[3].fork``, the form scene-file errors use.

@@ -2,7 +2,7 @@
 ``effects = [...]`` and the ``[effect_settings]`` that tune it.
 
 Each effect becomes one ``#define KRS_<NAME>`` in the scene's shader variant, so a scene pays
-only for what it lists (DESIGN.md, Specialise, don't branch). Some effects need the KRS
+only for what it lists (docs/architecture.md, Specialise, don't branch). Some effects need the KRS
 distance function or its mirror planes, which a MöKRS does not have [KRS17 §7].
 """
 

@@ -2,7 +2,7 @@
 
 A field is declared with :func:`param`; :func:`from_dict` builds and validates a dataclass
 tree from TOML data and :func:`to_dict` writes it back, so validation, files and (later) GUI
-panels read the same metadata (the Fragmentarium habit, see DESIGN.md).
+panels read the same metadata (the Fragmentarium habit, see docs/architecture.md).
 """
 
 from __future__ import annotations

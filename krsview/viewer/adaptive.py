@@ -30,7 +30,7 @@ class AdaptiveResolution:
     full: tuple[int, int]  # window size in pixels
     target_fps: float = 30.0
     min_scale: float = 0.1
-    scale: float = 0.5  # start near 320×180 for a 640×360 window (DESIGN.md)
+    scale: float = 0.5  # start near 320×180 for a 640×360 window (docs/architecture.md)
     supersample: int = 1  # still images: 1, or 2 for 2×2 supersampling
     history: list[float] = field(default_factory=list)
     rests: list[float] = field(default_factory=list)  # the last REST_TURNS turns' rest

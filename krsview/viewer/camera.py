@@ -1,5 +1,5 @@
 """A float64 fly/orbit camera; the renderer receives camera-relative data from it, so deep
-zooms keep their precision (DESIGN.md, Precision)."""
+zooms keep their precision (docs/architecture.md, Precision)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """What panels and keys return instead of writing state: typed commands. An edit of a scene
 field goes through the document (validated, undoable, saved); the others ask the window for
 one of its own changes. Panels read the window; only the window changes itself, by looking
-a command's class up in its table of handlers (DESIGN.md, One seam for edits)."""
+a command's class up in its table of handlers (docs/architecture.md, One seam for edits)."""
 
 from __future__ import annotations
 

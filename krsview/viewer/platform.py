@@ -21,7 +21,7 @@ import string
 from collections.abc import Callable
 
 import glfw  # noqa: E402  (order matters)
-from imgui_bundle import imgui, implot  # imgui before glfw (DESIGN.md, stack facts)
+from imgui_bundle import imgui, implot  # imgui before glfw (docs/architecture.md, stack facts)
 
 from .controls import LOOK_BUTTON, Input
 from .fonts import load_font
@@ -220,7 +220,7 @@ def open_window(size: tuple[int, int], title: str, visible: bool):
             "use `krsview render` to render headless)"
         )
     size = fitted(size, _screen())
-    for minor in (5, 3):  # 4.6 fails on llvmpipe (DESIGN.md)
+    for minor in (5, 3):  # 4.6 fails on llvmpipe (docs/architecture.md)
         glfw.default_window_hints()
         glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
         glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, minor)

@@ -1,11 +1,12 @@
-"""ImGui widgets generated from the scene schema (the Fragmentarium habit, DESIGN.md): a field's
-type picks the widget, its metadata gives the range, unit and tooltip, so panels never repeat
-a range by hand. A widget returns the new value; the document validates it.
+"""ImGui widgets generated from the scene schema (the Fragmentarium habit,
+docs/architecture.md): a field's type picks the widget, its metadata gives the range, unit and
+tooltip, so panels never repeat a range by hand. A widget returns the new value; the document
+validates it.
 
-Each widget reports its interaction: a slider or drag held down is one interaction, so the
-many values it produces merge into one undo step (DESIGN.md, One seam for edits). A value the
-schema refuses stays in its field, marked red, with the message under it, until a valid value
-replaces it or Esc cancels it (the scene keeps its last valid value meanwhile)."""
+Each widget reports its interaction: a slider or drag held down is one interaction, so the many
+values it produces merge into one undo step (docs/architecture.md, One seam for edits). A value
+the schema refuses stays in its field, marked red, with the message under it, until a valid
+value replaces it or Esc cancels it (the scene keeps its last valid value meanwhile)."""
 
 from __future__ import annotations
 

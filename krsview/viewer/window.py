@@ -15,7 +15,7 @@ from typing import Any
 import glfw  # noqa: E402  (order matters)
 import moderngl
 import numpy as np
-from imgui_bundle import imgui  # noqa: F401  imported before glfw (DESIGN.md, stack facts)
+from imgui_bundle import imgui  # noqa: F401  imported before glfw (docs/architecture.md, stack facts)
 
 from ..document.document import Document
 from ..gpu.context import GL_VERSION
@@ -338,7 +338,7 @@ class Viewer:
         """The window's pixels (H, W, 3), rows top → bottom (for tests and screenshots)."""
         w, h = glfw.get_framebuffer_size(self.window)
         raw = self.ctx.screen.read(viewport=(0, 0, w, h), components=3)
-        _ = self.ctx.error  # screen reads can leave a GL error pending (DESIGN.md)
+        _ = self.ctx.error  # screen reads can leave a GL error pending (docs/architecture.md)
         return np.frombuffer(raw, np.uint8).reshape(h, w, 3)[::-1].copy()
 
 
