@@ -86,7 +86,9 @@ BENCHES = {
         "what culling, the pre-pass and the compute path buy",
         "Exact level culling off/on × the low-resolution pre-pass off and at tiles 4, 8, 16 "
         "(tiles 4 and 8 also with one coarse pass) on the fragment path, and the compute "
-        "path at 4, 8, 16, 32 iterations per round, at --size and twice it, interleaved: "
+        "path at 4, 8, 16, 32 iterations per round (shadow rays as tasks of their own and "
+        "inline, where the scene has shadows) and by persistent lanes (steps 0, at the "
+        "viewer's pre-pass), at --size and twice it, interleaved: "
         "frame time and speed-up against the plain frame, iterations per pixel, the coarse "
         "pass's share. Example: krsview bench paths forest --size 160x90 --csv paths.csv",
         knobs=("tracer",),
