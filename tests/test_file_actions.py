@@ -222,6 +222,25 @@ def test_save_as_replaces_another_file_only_when_asked_twice(tree, tmp_path):
     assert load_scene(other).render.epsilon_scale == 3.0
 
 
+def test_save_as_makes_a_missing_folder_only_when_asked_twice(tree, tmp_path, monkeypatch):
+    """Save-as into a folder that does not exist made it, and every folder above it, without
+    a word: a typo in a folder's name left folders behind [a real-window review]. The first
+    save says the folder is missing and writes nothing; the same name again makes it. The
+    controls: an existing folder saves at once, and so does the user's data folder, where a
+    shipped preset's copy may go."""
+    f, w, _ = part(tree)
+    w.doc.apply(("render", "epsilon_scale"), 2.0)
+    typo = tmp_path / "scnees" / "deep" / "x.toml"
+    assert not f.save_as(str(typo)) and "no folder" in w.error and "save again" in w.error
+    assert not (tmp_path / "scnees").exists()
+    assert f.save_as(str(typo)) and load_scene(typo).render.epsilon_scale == 2.0
+    assert f.save_as(str(tmp_path / "here.toml"))  # control: an existing folder
+    data = tmp_path / "data"
+    monkeypatch.setenv("XDG_DATA_HOME", str(data))
+    assert f.save_as(str(data / "krsview" / "tree.toml")), "the data folder: made at once"
+    assert not f.save_as(str(tmp_path / "other" / "y.toml")), "a new folder asks anew"
+
+
 def test_the_save_as_dialog_says_its_own_refusal_and_opens_again_without_it(tree, tmp_path):
     """A save as refused under a file, then Esc: Ctrl+Shift+S opened the dialog with the old
     refusal still in it [review]. The dialog says its own, until the name changes."""

@@ -11,6 +11,7 @@ import pytest
 
 from krsview.scene import load_scene, save_scene
 from krsview.scene.presets import resolve
+from krsview.scene.render import VIEW_PREPASS
 from krsview.viewer.commands import (
     NextBookmark,
     Redo,
@@ -348,7 +349,10 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
     viewer, tmp_path, monkeypatch
 ):
     """A constructed report: the panel knows which row the view draws, and its button puts
-    the view on the most accurate row that fits the frame budget (scaled by pixels)."""
+    the view on the most accurate row that fits the frame budget (scaled by pixels). The
+    bench draws its rows with the file's pre-pass (none for tree) but its pre-pass rows, so
+    the viewer's own pre-pass makes the view the pre-pass row's, and a row applied draws
+    with the row's pre-pass."""
     from krsview.viewer import hud, measured
     from krsview.viewer.measured import apply_row, best_within, load_measured, matches
 
@@ -358,16 +362,25 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
         "scene,as saved,100,100,50,0.02\nepsilon_scale,0.5,100,100,80,0.01\n"
         "epsilon_scale,4,100,100,20,0.09\nlevels,12,100,100,10,0.2\n"
         "tracer,binary 2/0.3,100,100,90,0.015\nprecision,double,100,100,70,0.019\n"
-        "walk_restart,on,100,100,55,0.02\n"
+        "walk_restart,on,100,100,55,0.02\nprepass,4,100,100,40,0.021\n"
     )
     monkeypatch.setattr(measured, "REPORT_DIRS", (tmp_path,))
     rows = load_measured("tree")
     v = viewer
-    assert [
-        r["value"]
-        for r in rows
-        if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth)
-    ] == ["as saved"]
+
+    def drawn(prepass=None) -> list[str]:
+        """The rows the view draws, as the panel asks (the view's own pre-pass)."""
+        tile = v.prepass if prepass is None else prepass
+        args = v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth, tile
+        return [r["value"] for r in rows if matches(r, *args)]
+
+    assert v.scene.render.prepass is None and v.prepass == VIEW_PREPASS == 4
+    assert drawn() == ["4"]  # the viewer's pre-pass: not the scene as the bench drew it
+    assert drawn(prepass=0) == ["as saved"]  # control: the bench's own pre-pass, none
+    v.execute(apply_row(rows[7], v.doc.saved))
+    assert v.prepass == 4 and drawn() == ["4"]
+    v.execute(apply_row(rows[0], v.doc.saved))
+    assert v.prepass == 0 and drawn() == ["as saved"]  # the row as measured: no pre-pass
     assert best_within(rows, 60.0, 100 * 100)["value"] == "as saved"
     assert best_within(rows, 100.0, 100 * 100)["value"] == "0.5"
     assert best_within(rows, 200.0, 400 * 400)["value"] == "12"  # 16× the pixels
@@ -398,7 +411,8 @@ def test_measured_accuracy_panel_finds_the_setting_and_the_best_within_budget(
         if matches(r, v.scene, v.doc.saved, v.drawn.levels, v.drawn.geometry.depth)
     ] == ["on"]
     v.execute(apply_row(rows[3], v.doc.saved))
-    assert v.drawn.levels == 12 and v.scene.render == v.doc.saved.render
+    assert v.drawn.levels == 12 and v.prepass == 0
+    assert replace(v.scene.render, prepass=None) == v.doc.saved.render
     # the panel itself draws inside an ImGui frame and returns commands, not changes
     v._measured = (v.path.stem, rows)  # as read for this file name
     v.platform.new_frame()
@@ -437,8 +451,6 @@ def test_the_viewer_draws_with_the_prepass_and_its_knob_is_an_undoable_edit(view
     HUD's knob sets the scene's render.prepass through the document (validated by the
     schema's range, one undo step), and the view then draws with it. Off or on, the window
     shows the same tree (pixels change only on outlines, where grazing rays may flip)."""
-    from krsview.scene.render import VIEW_PREPASS
-
     v = viewer
     settle(v)
     assert v.scene.render.prepass is None, "the shipped tree gives no pre-pass of its own"

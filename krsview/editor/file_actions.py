@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol
 
-from ..document.document import ConflictError, Document, copy_target
+from ..document.document import ConflictError, Document, copy_target, user_folder
 from ..scene import Bookmark, SceneError, load_scene
 from ..viewer import commands as vc
 from ..viewer.camera import FlyCamera
@@ -70,6 +70,7 @@ class FileActions:
         self.kept = False  # the person kept their edits: the next save overwrites the file
         self.save_as_text = save_as_default(self.doc)
         self.replacing: Path | None = None  # another file save-as was told exists: again replaces
+        self.creating: Path | None = None  # a folder save-as was told is missing: again makes it
         self.quit = False  # the question was answered: the window closes
 
     @property
@@ -127,12 +128,21 @@ class FileActions:
         return True
 
     def save_as(self, text: str) -> bool:
-        """Save to the file named; another file that exists is replaced only when asked
-        twice (the first time says so: the panel's field, the dialog's button)."""
+        """Save to the file named; another file that exists is replaced, and a folder that
+        does not exist is made (a typo in a folder's name would make folders), only when
+        asked twice: the first time says so (the panel's field, the dialog's button). The
+        user's data folder, where a shipped preset's copy may go, is made without a word."""
         target = _target(text)
         if target.suffix != ".toml" or target.is_dir():
             self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
             return False
+        folder = target.parent.absolute()
+        made = folder.exists() or folder == user_folder().absolute()
+        if not made and self.creating != folder:
+            self.creating = folder
+            self.viewer.error = f"save as: no folder {folder}; save again to make it"
+            return False
+        self.creating = None
         if self.replaces(text) and self.replacing != target.resolve():
             self.replacing = target.resolve()
             self.viewer.error = f"save as: {target} exists; save again to replace it"

@@ -47,17 +47,20 @@ def matches(
 ) -> bool:
     """Whether the view draws with the setting this row measured; ``levels`` is the view's
     level count (0: all ``depth`` levels of the geometry, which the caller already has),
-    ``prepass`` the viewer's pre-pass tile."""
+    ``prepass`` the viewer's pre-pass tile. The bench draws every row but the pre-pass's with
+    the file's own pre-pass, none where the file sets none (bench/accuracy.py), while the
+    viewer draws VIEW_PREPASS there: such a view is the ``prepass`` row's, not the scene's."""
     r, s = scene.render, saved.render
     drawn_levels = levels or depth
     full = drawn_levels == depth
+    knob, value = row["knob"], row["value"]
+    tile = int(value) if knob == "prepass" else (s.prepass or 0)
 
     def same_but(**kw) -> bool:
-        return replace(s, **kw) == r and full
+        return replace(s, prepass=r.prepass, **kw) == r and prepass == tile and full
 
-    knob, value = row["knob"], row["value"]
-    if knob == "scene":
-        return r == s and full
+    if knob in ("scene", "prepass"):
+        return same_but()
     if knob == "epsilon_scale":
         return same_but(epsilon_scale=float(value))
     if knob == "max_iterations":
@@ -68,10 +71,8 @@ def matches(
         return same_but(**_tracer(value))
     if knob in SWITCHES:
         return same_but(**{knob: value})
-    if knob == "prepass":  # the scene's own pre-pass may differ: the view draws ``prepass``
-        return replace(s, prepass=r.prepass) == r and full and prepass == int(value)
     if knob == "levels":
-        return r == s and drawn_levels == int(value)
+        return replace(s, prepass=r.prepass) == r and prepass == tile and drawn_levels == int(value)
     return False
 
 
@@ -92,7 +93,8 @@ def best_within(rows: list[dict], budget_ms: float, pixels: int) -> dict | None:
 
 
 def apply_row(row: dict, saved: Scene) -> list[Command]:
-    """Commands that put the view on a measured setting (the others as saved)."""
+    """Commands that put the view on a measured setting (the others as saved), its pre-pass
+    included: the row's tile, else the file's, none where it sets none (as :func:`matches`)."""
     knob, value = row["knob"], row["value"]
     base = saved.render
     render = {
@@ -103,7 +105,5 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
         **{k: lambda k=k: replace(base, **{k: value}) for k in SWITCHES},
     }.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
-    out: list[Command] = [Edit(("render",), render), SetLevels(levels)]
-    if knob == "prepass":
-        out.append(SetPrepass(int(value)))
-    return out
+    tile = int(value) if knob == "prepass" else (base.prepass or 0)
+    return [Edit(("render",), render), SetLevels(levels), SetPrepass(tile)]
