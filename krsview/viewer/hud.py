@@ -347,7 +347,8 @@ def _measured(v: Viewed, out: list) -> None:
         imgui.text_disabled("the current setting was not measured (change one knob at a time)")
     budget = 1e3 / v.frames.adaptive.target_fps
     best = best_within(rows, budget, w * h)
+    imgui.text_disabled(f"budget: {budget:.0f} ms a frame at {w}×{h} (the moving frames)")
     if best is None:
-        imgui.text_disabled(f"no measured setting fits {budget:.0f} ms at {w}×{h}")
-    elif imgui.button(f"most accurate within {budget:.0f} ms: {best['knob']} {best['value']}"):
+        imgui.text_disabled("no measured setting fits it")
+    elif imgui.button(f"most accurate that fits: {best['knob']} {best['value']}"):
         out += apply_row(best, v.doc.saved)
