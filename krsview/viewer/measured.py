@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..scene import Scene
 from ..scene.presets import PRESET_DIR
+from ..scene.render import Render
 from .commands import Command, Edit, SetLevels, SetPrepass
 
 # A report made here by `krsview bench accuracy` (OUT/PRESET/accuracy.csv) wins over the
@@ -51,15 +52,14 @@ def matches(
     the file's own pre-pass, none where the file sets none (bench/accuracy.py), while the
     viewer draws VIEW_PREPASS there: such a view is the ``prepass`` row's, not the scene's."""
     r, s = scene.render, saved.render
-    drawn_levels = levels or depth
-    full = drawn_levels == depth
     knob, value = row["knob"], row["value"]
-    tile = int(value) if knob == "prepass" else (s.prepass or 0)
+    row_levels = int(value) if knob == "levels" else depth
 
     def same_but(**kw) -> bool:
-        return replace(s, prepass=r.prepass, **kw) == r and prepass == tile and full
+        drawn = replace(s, prepass=r.prepass, **kw) == r and (levels or depth) == row_levels
+        return drawn and prepass == row_prepass(row, s)
 
-    if knob in ("scene", "prepass"):
+    if knob in ("scene", "prepass", "levels"):
         return same_but()
     if knob == "epsilon_scale":
         return same_but(epsilon_scale=float(value))
@@ -71,9 +71,13 @@ def matches(
         return same_but(**_tracer(value))
     if knob in SWITCHES:
         return same_but(**{knob: value})
-    if knob == "levels":
-        return replace(s, prepass=r.prepass) == r and prepass == tile and drawn_levels == int(value)
     return False
+
+
+def row_prepass(row: dict, saved: Render) -> int:
+    """The pre-pass tile the bench drew a row with: a pre-pass row's own, else the file's,
+    none where the file sets none (bench/accuracy.py)."""
+    return int(row["value"]) if row["knob"] == "prepass" else (saved.prepass or 0)
 
 
 def _tracer(value: str) -> dict:
@@ -94,7 +98,7 @@ def best_within(rows: list[dict], budget_ms: float, pixels: int) -> dict | None:
 
 def apply_row(row: dict, saved: Scene) -> list[Command]:
     """Commands that put the view on a measured setting (the others as saved), its pre-pass
-    included: the row's tile, else the file's, none where it sets none (as :func:`matches`)."""
+    (:func:`row_prepass`) included."""
     knob, value = row["knob"], row["value"]
     base = saved.render
     render = {
@@ -105,5 +109,4 @@ def apply_row(row: dict, saved: Scene) -> list[Command]:
         **{k: lambda k=k: replace(base, **{k: value}) for k in SWITCHES},
     }.get(knob, lambda: base)()
     levels = int(value) if knob == "levels" else 0
-    tile = int(value) if knob == "prepass" else (base.prepass or 0)
-    return [Edit(("render",), render), SetLevels(levels), SetPrepass(tile)]
+    return [Edit(("render",), render), SetLevels(levels), SetPrepass(row_prepass(row, base))]
