@@ -283,6 +283,32 @@ def test_a_long_tooltip_wraps_inside_a_small_window(display, tmp_path, monkeypat
         )
 
 
+def test_the_hud_scrolls_under_its_numbers_which_stay_in_sight(display, tmp_path, monkeypatch):
+    """The HUD with its knobs open is taller than a 640×720 window: the wheel over it (real X
+    events) scrolls its knobs, and the lines that say what the image on screen is (moving,
+    refining k/n, still) stay at its top. The whole HUD scrolled, and they went with it (the
+    control: the wheel did scroll something)."""
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.viewer.hud import HUD_BODY, HUD_TITLE
+
+    with hud_open(monkeypatch, tmp_path) as (v, turn):
+        turn(4)
+        wx, wy = glfw.get_window_pos(v.window)
+        xdo("mousemove", wx + 200, wy + 600)
+        turn(2)
+        for _ in range(4):
+            xdo("click", 5)
+            turn(2)
+        hud = imgui.internal.find_window_by_name(HUD_TITLE)
+        parts = [w for w in imgui.get_current_context().windows if w.name.startswith(HUD_TITLE)]
+        assert max(w.scroll.y for w in parts) > 0, "control: the wheel scrolled nothing"
+        assert hud.scroll.y == 0, "the numbers scrolled away"
+        assert any(HUD_BODY in w.name and w.scroll.y > 0 for w in parts)
+        assert hud.pos.y + hud.size.y <= 720, "the HUD runs off the window"
+
+
 def test_escape_closes_an_open_drop_down_list_and_keeps_its_value(display, tmp_path, monkeypatch):
     """A click on the HUD's tracer combo opens its list; Esc closes it, the tracer as it was
     (ImGui's keyboard navigation, which would close it, is off). Negative control: the list
@@ -319,6 +345,39 @@ def test_the_panel_starts_below_the_hud_where_they_would_overlap(side):
     x, y, width, _ = layout.panel((1280, 720), bar, HUD_RIGHT)
     overlaps = x < HUD_RIGHT + MARGIN
     assert overlaps == (side == "left") and y == (MARGIN + bar + MARGIN if overlaps else MARGIN)
+
+
+def test_the_hud_opened_in_the_editor_moves_off_the_panel_docked_left(display, tmp_path):
+    """Docked left, the panel sits under the collapsed HUD's title bar; the HUD opened by a
+    click on its arrow (real X events) moves beside the panel instead of covering it. The
+    control: where it opened, at its own place, it covered the panel."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.commands import PlacePanel
+    from krsview.editor.panels import PANEL_TITLE
+    from krsview.editor.window import Editor
+    from krsview.viewer.hud import HUD_AT, HUD_TITLE
+    from krsview.viewer.status import meets, window_rect
+
+    mine = tmp_path / "mine.toml"
+    shutil.copy(resolve("tree"), mine)
+    e = Editor(mine, size=(1100, 620))
+    try:
+        pump(e)
+        e.execute([PlacePanel("left", 340.0)])
+        pump(e, 3)
+        hud, panel = (imgui.internal.find_window_by_name(n) for n in (HUD_TITLE, PANEL_TITLE))
+        assert hud.collapsed and not meets(window_rect(hud), window_rect(panel))
+        bar = imgui.get_frame_height()
+        click(e, window_xy(e, HUD_AT + bar / 2, HUD_AT + bar / 2))  # the arrow
+        pump(e, 3)
+        hud = imgui.internal.find_window_by_name(HUD_TITLE)
+        assert not hud.collapsed, "the click opened nothing"
+        assert not meets(window_rect(hud), window_rect(panel)), "the HUD covers the panel"
+        opened = (HUD_AT, HUD_AT, HUD_AT + hud.size.x, HUD_AT + hud.size.y)
+        assert meets(opened, window_rect(panel)), "control: opened in place, it covered it"
+    finally:
+        e.close()
 
 
 def test_the_growth_parameters_labels_fit_in_the_panel(tree_editor, monkeypatch):

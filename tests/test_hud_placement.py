@@ -81,3 +81,23 @@ def test_a_window_larger_than_the_screen_opens_at_the_largest_size_that_fits(cap
     assert (w, h) == (1333, 1000)
     assert "4000×3000 does not fit the screen (1600×1000)" in capsys.readouterr().out
     assert fitted((4000, 3000), None) == (4000, 3000)  # no monitor known: as asked
+
+
+def test_the_hud_opened_over_the_edit_panel_moves_beside_it():
+    from krsview.editor.layout import MARGIN as GAP
+    from krsview.editor.layout import hud_clear_of
+
+    hud = (8.0, 8.0, 448.0, 408.0)
+    left = (8.0, 36.0, 348.0, 612.0)  # docked left, below the HUD's title bar
+    x = hud_clear_of(hud, left, "left", 1100.0)
+    assert x == left[2] + GAP and not meets((x, 8.0, x + 440.0, 408.0), left)
+    right = (752.0, 8.0, 1092.0, 612.0)
+    # control: the HUD at its own place beside a panel docked right is left where it is
+    assert hud_clear_of(hud, right, "right", 1100.0) is None
+    dragged = (700.0, 100.0, 1140.0, 500.0)  # dragged onto the right panel: back beside it
+    assert hud_clear_of(dragged, right, "right", 1100.0) == right[0] - GAP - 440.0
+    # a window too narrow for both: as far from the panel as the window lets it go, once
+    narrow = (8.0, 36.0, 328.0, 392.0)
+    x = hud_clear_of(hud, narrow, "left", 640.0)
+    assert x == 640.0 - GAP - 440.0
+    assert hud_clear_of((x, 8.0, x + 440.0, 408.0), narrow, "left", 640.0) is None

@@ -15,10 +15,12 @@ from imgui_bundle import imgui
 from ..compile.camera import View
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
 from ..viewer import commands as vc
-from ..viewer.hud import draw_hud
+from ..viewer.hud import HUD_TITLE, draw_hud
+from ..viewer.status import window_rect
 from .handles import Handle
 from .keys import Timeline
-from .panels import Edited, edit_panel
+from .layout import hud_clear_of
+from .panels import PANEL_TITLE, Edited, edit_panel
 from .picking import hover_label
 from .shapes import editor_shapes
 
@@ -46,6 +48,7 @@ def draw_ui(e: Drawing) -> None:
         shapes = editor_shapes(e.handled_scene(), shown, e.selected, e.clipped)
         fbo, image = v.frames.image
         e.overlay.draw(shapes, fbo, v.ctx.screen, fb, proj @ view_matrix, view.origin, image)
+    _hud_beside_panel(e)
     imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
     e.execute(draw_hud(v, v.interactions))
     e.execute(edit_panel(e, v.interactions))
@@ -54,3 +57,16 @@ def draw_ui(e: Drawing) -> None:
         path = e.selected.path if e.selected is not None else None
         e.execute(e.timeline.draw(e.scene, v.drawn.playback, path, free))
     hover_label(shown, view)
+
+
+def _hud_beside_panel(e: Drawing) -> None:
+    """The HUD opened over the edit panel (docked left, its default place is the panel's)
+    moves beside it, as the windows were last drawn; it stays where the person dragged it
+    elsewhere."""
+    hud, panel = (imgui.internal.find_window_by_name(n) for n in (HUD_TITLE, PANEL_TITLE))
+    if hud is None or panel is None or panel.collapsed:
+        return
+    width = imgui.get_io().display_size.x
+    x = hud_clear_of(window_rect(hud), window_rect(panel), e.layout.side, width)
+    if x is not None:
+        imgui.set_window_pos(HUD_TITLE, imgui.ImVec2(x, hud.pos.y))

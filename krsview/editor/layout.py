@@ -13,6 +13,7 @@ import numpy as np
 
 from ..compile.camera import view_of
 from ..viewer.camera import FlyCamera
+from ..viewer.status import Rect, meets
 
 MARGIN = 8.0  # pixels between the panel and the window's edge
 PANEL_WIDTH = 340.0  # at first
@@ -47,6 +48,19 @@ class Layout:
             return 0.0, float(size[0])
         x, _, width, _ = self.panel(size)
         return (x + width + MARGIN, size[0]) if self.side == "left" else (0.0, x - MARGIN)
+
+
+def hud_clear_of(hud: Rect, panel: Rect, side: str, width: float) -> float | None:
+    """The x the viewer's HUD (window rectangle ``hud``) moves to so that it no longer covers
+    the edit panel (``panel``) docked on ``side`` of a window ``width`` wide: beside the
+    panel, on the view's side, inside the window as far as it fits; None where they do not
+    meet (the HUD stays where the person put it) or where it cannot move further."""
+    if not meets(hud, panel):
+        return None
+    w = hud[2] - hud[0]
+    x = panel[2] + MARGIN if side == "left" else panel[0] - MARGIN - w
+    x = max(min(x, width - MARGIN - w), MARGIN)
+    return None if x == hud[0] else x
 
 
 def frame(

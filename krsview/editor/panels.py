@@ -33,6 +33,7 @@ from .structure_panel import outline_menu, structure_section
 
 GEOMETRY_TABLES = ("krs", "route")  # a component's own geometry: too big for a panel
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.3, 1.0)
+PANEL_TITLE = "edit"
 WARNINGS_OPEN = 0  # warnings are folded under one line that counts them (it never moves)
 
 
@@ -65,7 +66,7 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
     imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
     imgui.set_next_window_bg_alpha(0.8)
-    imgui.begin("edit")  # scrolls when taller than the window; folds by its arrow
+    imgui.begin(PANEL_TITLE)  # scrolls when taller than the window; folds by its arrow
     folded = imgui.is_window_collapsed()
     if folded != e.layout.folded:
         out.append(ec.FoldPanel(folded))

@@ -28,6 +28,7 @@ from .timeline import draw_time
 from .widgets import Interactions, field_widget, red_text, tooltip
 
 HUD_TITLE = "krsview (F1 hides)"
+HUD_BODY = "##hud body"  # the part under the numbers: it scrolls, they stay
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
 HUD_AT = 8  # pixels from the window's top left corner, where the HUD first opens
 HUD_RIGHT = HUD_AT + HUD_WIDTH  # its right edge there
@@ -105,6 +106,15 @@ def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], i
     imgui.begin(HUD_TITLE, None, imgui.WindowFlags_.always_auto_resize)
     slot = imgui.get_cursor_pos()
     imgui.dummy(imgui.ImVec2(0, numbers_height()))
+    imgui.separator()
+    # the rest scrolls under the numbers, which stay in sight (the whole HUD scrolled once,
+    # and the state of the frame on screen went with it)
+    bottom = display.y - HUD_AT - imgui.get_window_pos().y  # the HUD's room, where it is
+    rest = bottom - imgui.get_cursor_pos().y - imgui.get_style().window_padding.y
+    imgui.set_next_window_size_constraints(
+        imgui.ImVec2(0, 0), imgui.ImVec2(width, max(rest, 3 * imgui.get_frame_height()))
+    )
+    imgui.begin_child(HUD_BODY, imgui.ImVec2(0, 0), imgui.ChildFlags_.auto_resize_y)
     _controls(v, out)
     if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
         draw_time(v.drawn.playback, out)
@@ -117,6 +127,7 @@ def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], i
     if v.message:
         imgui.text_wrapped(v.message)
     red_text("\n".join(v.error.splitlines()[1:]))  # the first is the status line (status.py)
+    imgui.end_child()
     imgui.end()
     return out, slot
 

@@ -38,12 +38,12 @@ def status_spot(display: tuple[float, float], measure: Measure, rects: list[Rect
     foot = display[1] - MARGIN
     for x, room in sorted(_gaps(display[0], foot, h, rects), key=lambda g: -g[1]):
         tall = measure(room)[1]
-        if room >= MIN_ROOM and not any(_meets(r, (x, foot - tall, x + room, foot)) for r in rects):
+        if room >= MIN_ROOM and not any(meets(r, (x, foot - tall, x + room, foot)) for r in rects):
             return x, foot, room
     return MARGIN, foot, display[0] - 2 * MARGIN
 
 
-def _meets(a: Rect, b: Rect) -> bool:
+def meets(a: Rect, b: Rect) -> bool:
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
@@ -56,6 +56,11 @@ def _gaps(width: float, foot: float, h: float, rects: list[Rect]) -> Iterator[tu
         x = max(x, x1 + MARGIN)
     if width - MARGIN > x:
         yield x, width - MARGIN - x
+
+
+def window_rect(w) -> Rect:
+    """An ImGui window's rectangle as it was last drawn."""
+    return w.pos.x, w.pos.y, w.pos.x + w.size.x, w.pos.y + w.size.y
 
 
 def _other_windows() -> list[Rect]:
@@ -73,7 +78,7 @@ def _other_windows() -> list[Rect]:
     out = []
     for w in imgui.get_current_context().windows:
         if w.active and not w.hidden and not (w.flags & skip) and not w.name.startswith("Debug##"):
-            out.append((w.pos.x, w.pos.y, w.pos.x + w.size.x, w.pos.y + w.size.y))
+            out.append(window_rect(w))
     return out
 
 
