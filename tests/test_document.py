@@ -14,7 +14,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from krsview.document.document import AUTOSAVE_SECONDS, ConflictError, Document, copy_target
+from krsview.document.document import (
+    AUTOSAVE_SECONDS,
+    ConflictError,
+    Document,
+    copy_target,
+    not_here,
+)
 from krsview.scene import SceneError, load_scene, save_scene
 from krsview.scene.edits import get_at, path_text
 from krsview.scene.presets import PRESET_DIR, resolve
@@ -377,6 +383,10 @@ def test_a_presets_copy_goes_to_the_user_folder_when_the_working_one_is_taken(da
     free = tmp_path / "free"
     free.mkdir()
     assert copy_target(preset, free) == free / "tree.toml"
+    # why, in words, for the copy dialog; nothing to say where it goes here (the control)
+    assert not_here(preset, tmp_path) == f"{tmp_path / 'tree.toml'} exists"
+    assert not_here(preset, PRESET_DIR) == f"{PRESET_DIR} holds krsview's own presets"
+    assert not_here(preset, free) == ""
 
 
 def test_an_autosave_that_cannot_write_says_so_and_recovers(route_file):

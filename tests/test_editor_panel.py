@@ -122,6 +122,43 @@ def test_a_shipped_presets_save_as_field_starts_at_its_copy(display, tmp_path, m
         e.close()
 
 
+def test_a_save_as_path_longer_than_its_field_is_whole_on_hover(tree_editor, monkeypatch):
+    """The save-as field shows a long path's start only, so the file's name is cut off; the
+    pointer over it shows the whole path (real X events). The control: a short path, whole
+    in the field, gets no tooltip."""
+    from imgui_bundle import imgui
+
+    from krsview.editor.commands import SetSaveAsText
+
+    e, field = tree_editor, {}
+    box = imgui.input_text
+
+    def recorded(label, *a):
+        out = box(label, *a)
+        if label == "##saveas":
+            field["rect"] = (imgui.get_item_rect_min(), imgui.get_item_rect_max())
+        return out
+
+    monkeypatch.setattr(imgui, "input_text", recorded)
+
+    def tips() -> list[str]:
+        return [
+            w.name
+            for w in imgui.get_current_context().windows
+            if w.name.startswith("##Tooltip") and w.active
+        ]
+
+    for text, tip in (("short.toml", False), ("/a/" + "long_folder/" * 8 + "mine.toml", True)):
+        e.execute([SetSaveAsText(text)])
+        pump(e)
+        lo, hi = field["rect"]
+        xdo("mousemove", *map(round, window_xy(e, (lo.x + hi.x) / 2, (lo.y + hi.y) / 2)))
+        pump(e, 3)
+        assert bool(tips()) == tip, (text, tips())
+        xdo("mousemove", *map(round, window_xy(e, 20, 390)))  # off the field: the tip goes
+        pump(e, 2)
+
+
 def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
     display, tmp_path, monkeypatch
 ):

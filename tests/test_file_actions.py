@@ -173,6 +173,21 @@ def test_a_shipped_preset_asks_for_its_copy_then_saves_and_follows_it(tmp_path, 
     )
 
 
+def test_a_presets_copy_proposed_in_the_data_folder_says_why(tmp_path, monkeypatch):
+    """./tree.toml taken: the dialog proposes the user's data folder and says why; with the
+    working folder free (the control) it proposes ./tree.toml and says nothing."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    f, _, _ = part(resolve("tree"))
+    f.ask_save_as()
+    assert f.copy_to.text == str(tmp_path / "tree.toml") and f.copy_to.why == ""
+    (tmp_path / "tree.toml").write_text("taken")
+    f.ask_save_as()
+    assert f.copy_to.text == str(tmp_path / "data" / "krsview" / "tree.toml")
+    assert f.copy_to.why == f"{tmp_path / 'tree.toml'} exists"
+    assert f.save() is False and f.copy_to.why, "Ctrl+S's dialog says it too"
+
+
 def test_the_editors_handlers_reach_the_file_part(tree, tmp_path):
     """Commands the editor takes go to its ``file``: save as under the typed name, and a
     bookmark as an edit (the viewer's handler would write the file)."""

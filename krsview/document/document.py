@@ -52,12 +52,25 @@ def copy_target(preset: Path, cwd: Path | None = None) -> Path:
     the working directory if that is free and writable, else in :func:`user_folder`
     (numbered ``NAME-2.toml`` … if taken)."""
     here = (cwd or Path.cwd()) / preset.name
-    if not here.exists() and os.access(here.parent, os.W_OK) and not shipped(here):
+    if not not_here(preset, cwd):
         return here
     folder, k = user_folder(), 1
     while (folder / (preset.name if k == 1 else f"{preset.stem}-{k}.toml")).exists():
         k += 1
     return folder / (preset.name if k == 1 else f"{preset.stem}-{k}.toml")
+
+
+def not_here(preset: Path, cwd: Path | None = None) -> str:
+    """Why a shipped preset's copy does not go to ``NAME.toml`` in the working directory
+    (:func:`copy_target`), in words; "" where it does."""
+    here = (cwd or Path.cwd()) / preset.name
+    if shipped(here):
+        return f"{here.parent} holds krsview's own presets"
+    if here.exists():
+        return f"{here} exists"
+    if not os.access(here.parent, os.W_OK):
+        return f"{here.parent} is not writable"
+    return ""
 
 
 class ConflictError(RuntimeError):

@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol
 
-from ..document.document import ConflictError, Document, copy_target, user_folder
+from ..document.document import ConflictError, Document, copy_target, not_here, user_folder
 from ..scene import Bookmark, SceneError, load_scene
 from ..viewer import commands as vc
 from ..viewer.camera import FlyCamera
@@ -43,6 +43,15 @@ class CopyAsk:
     text: str
     then: tuple[str, Path | None] | None = None
     said: str = ""  # why the last save from this dialog was refused (it stays open)
+    why: str = ""  # why a shipped preset's copy is proposed in the user's data folder
+
+
+def copy_ask(doc: Document, text: str, then: tuple[str, Path | None] | None = None) -> CopyAsk:
+    """The copy dialog's question: for a shipped preset its copy (copy_target), saying why
+    where that is not the working directory; else ``text``, the save-as field's."""
+    if not doc.template:
+        return CopyAsk(text, then)
+    return CopyAsk(str(copy_target(doc.path)), then, why=not_here(doc.path))
 
 
 def save_as_default(doc: Document) -> str:
@@ -109,7 +118,7 @@ class FileActions:
         unsaved-edits question if that is what asked; nothing is saved yet then."""
         v = self.viewer
         if not path and self.doc.template:
-            self.copy_to, self.asking = CopyAsk(str(copy_target(self.doc.path)), self.asking), None
+            self.copy_to, self.asking = copy_ask(self.doc, "", self.asking), None
             return False
         own = not path or Path(path).resolve() == self.doc.path.resolve()
         try:
@@ -161,8 +170,7 @@ class FileActions:
 
     def ask_save_as(self) -> None:
         """Ctrl+Shift+S: the dialog asks where to save (a shipped preset's: its copy)."""
-        start = str(copy_target(self.doc.path)) if self.doc.template else self.save_as_text
-        self.copy_to = CopyAsk(start)
+        self.copy_to = copy_ask(self.doc, self.save_as_text)
 
     def save_copy(self) -> None:
         """Save to the copy named in the dialog; then go on with the question that asked."""

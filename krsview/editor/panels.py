@@ -200,6 +200,9 @@ def _file(e: Edited, out: list) -> None:
     imgui.set_next_item_width(-1)  # the rest of the line, however wide the panel
     enter = imgui.InputTextFlags_.enter_returns_true
     done, text = imgui.input_text("##saveas", e.file.save_as_text, enter)
+    inside = imgui.get_item_rect_size().x - 2 * imgui.get_style().frame_padding.x
+    if imgui.is_item_hovered() and imgui.calc_text_size(text).x > inside:
+        tooltip(text)  # the field shows a long path's start only: the name is at its end
     if text != e.file.save_as_text:
         out.append(ec.SetSaveAsText(text))
     if done:  # Enter saves under the name typed, as the button does

@@ -12,6 +12,7 @@ from . import commands as ec
 from .file_actions import FileActions
 
 DIALOG = "###save"  # the dialog's id, whichever title it shows
+FIELD = 420  # pixels: the name field, and the width its notes wrap at
 
 
 def autosave(f: FileActions, now: float) -> None:
@@ -36,9 +37,13 @@ def copy_dialog(f: FileActions) -> list[Command]:
     if template:
         imgui.text(f"{f.doc.path.name} is a preset shipped with krsview: a template, never")
         imgui.text("overwritten. Save your version as:")
+        if f.copy_to is not None and f.copy_to.why:  # not NAME.toml here: say why
+            imgui.push_text_wrap_pos(imgui.get_cursor_pos_x() + FIELD)
+            imgui.text_disabled(f"(not in the working folder: {f.copy_to.why})")
+            imgui.pop_text_wrap_pos()
     else:
         imgui.text(f"Save {f.doc.path.name} as:")
-    imgui.set_next_item_width(420)
+    imgui.set_next_item_width(FIELD)
     if imgui.is_window_appearing():
         imgui.set_keyboard_focus_here()
     enter = imgui.InputTextFlags_.enter_returns_true
