@@ -18,6 +18,8 @@ from krsview.gpu import program
 from krsview.gpu.display import view_defines
 from krsview.gpu.renderer import Renderer
 
+# one worker builds the sources for all three tests (about 19 s: each variant is compiled)
+pytestmark = pytest.mark.xdist_group("glsl")
 SIZE = (32, 18)
 VERSIONS = (f"#version {program.GL_VERSION} core", "#version 450 core")
 
