@@ -635,6 +635,36 @@ def test_a_step_removed_from_a_linked_level_goes_from_its_linked_levels_and_keep
         e.close()
 
 
+def test_a_step_added_to_a_level_without_steps_is_its_own():
+    """A level without steps (palm has 30, and an inserted level starts so) is linked to no
+    other: a step added to it with step edits linked goes to it alone, as its handle's drag
+    adds one. It went to all 31 empty levels. The control: a leaflet's added step goes to
+    the 30 leaflets."""
+    from types import SimpleNamespace
+
+    from krsview.editor.mokrs_panel import _steps
+    from krsview.scene.mokrs import MobiusStep, linked_levels
+
+    scene = load_scene(resolve("palm"))
+    plain = sum(not lv.transform for lv in scene.mokrs.levels)
+    new, i = changed(list(scene.mokrs.levels), 58, "insert")
+    scene = scene.edit(LEVELS, new)
+    m = scene.mokrs
+    empty = [k for k, lv in enumerate(m.levels) if not lv.transform]
+    assert len(empty) == plain + 1 > 2 and i in empty and linked_levels(m, i) == [i]
+    e = SimpleNamespace(carry=True, scene=scene)
+    step = MobiusStep.registry["translate"]()
+    edit = _steps(e, i, [step])
+    assert edit.path == (*LEVELS, i, "transform") and edit.value == [step]
+    leaflet = max(k for k, lv in enumerate(m.levels) if lv.transform)  # its finer ones link
+    linked = linked_levels(m, leaflet)
+    assert len(linked) > 1 and leaflet in linked
+    edit = _steps(e, leaflet, [*m.levels[leaflet].transform, step])
+    assert edit.path == LEVELS and [k for k in range(len(new)) if edit.value[k] != new[k]] == (
+        linked
+    )
+
+
 def test_level_operations_move_the_selection_with_the_level():
     levels = list("abcde")
     assert changed(levels, 3, "inward") == (list("abdce"), 2)

@@ -223,7 +223,11 @@ class MoKRS:
 def linked_levels(m: MoKRS, i: int) -> list[int]:
     """Level i and every finer level whose steps equal its own (palm's leaflets, shell's
     turns): the levels a linked step edit changes. The coarser ones stay, so level i's frame,
-    and a handle dragged in it, stay where the pointer puts them."""
+    and a handle dragged in it, stay where the pointer puts them. A level without steps is
+    linked to none: it has no step to share, and the first step it gets is its own (palm's
+    30 plain levels, and any level just inserted, took a step added to one all at once)."""
+    if not m.levels[i].transform:
+        return [i]
     return [j for j in range(i + 1) if m.levels[j].transform == m.levels[i].transform]
 
 
