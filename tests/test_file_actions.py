@@ -256,6 +256,23 @@ def test_save_as_makes_a_missing_folder_only_when_asked_twice(tree, tmp_path, mo
     assert not f.save_as(str(tmp_path / "other" / "y.toml")), "a new folder asks anew"
 
 
+def test_a_save_as_refusal_goes_with_the_name_it_was_said_of(tree, tmp_path):
+    """ "save as: no folder …" stood at the window's foot after the person had typed another
+    name [a real-window review]: a refusal of a save-as name goes when the field's text
+    changes. The controls: the same text keeps it, and another error stays."""
+    f, w, _ = part(tree)
+    missing = str(tmp_path / "nowhere" / "x.toml")
+    FILE_HANDLERS[ec.SetSaveAsText](f, ec.SetSaveAsText(missing))
+    assert not f.save_as(missing) and w.error.startswith("save as: no folder")
+    FILE_HANDLERS[ec.SetSaveAsText](f, ec.SetSaveAsText(missing))
+    assert w.error.startswith("save as: no folder"), "the same name: it stays"
+    FILE_HANDLERS[ec.SetSaveAsText](f, ec.SetSaveAsText(missing[:-5]))
+    assert w.error == "" and f.save_as_text == missing[:-5]
+    w.error = "bookmark not saved: the disk is full"
+    FILE_HANDLERS[ec.SetSaveAsText](f, ec.SetSaveAsText(missing))
+    assert w.error == "bookmark not saved: the disk is full", "not the name's: it stays"
+
+
 def test_the_save_as_dialog_says_its_own_refusal_and_opens_again_without_it(tree, tmp_path):
     """A save as refused under a file, then Esc: Ctrl+Shift+S opened the dialog with the old
     refusal still in it [review]. The dialog says its own, until the name changes."""

@@ -450,6 +450,54 @@ def test_insert_delete_and_ctrl_d_keys_edit_the_selected_level(window_editor):
     assert len(e.scene.route.levels) == n
 
 
+TALL = (800, 900)  # the structure section's buttons inside the window, a level selected
+
+
+def test_the_level_buttons_are_greyed_with_no_level_selected(display, scene, tmp_path, monkeypatch):
+    """With nothing selected the structure section's insert / remove / duplicate had nothing
+    to act on, yet looked ready; a click said why far below them, cut off at the panel's
+    foot [a real-window review]. They are greyed, and a click (real X events) does nothing;
+    the control: with a level selected, the same click removes it."""
+    import glfw
+    from imgui_bundle import imgui
+
+    from krsview.editor.window import Editor
+
+    rects = {}
+    button = imgui.button
+
+    def recorded(label, *a):
+        pressed = button(label, *a)
+        rects[label] = (imgui.get_item_rect_min(), imgui.get_item_rect_max())
+        return pressed
+
+    monkeypatch.setattr(imgui, "button", recorded)
+    path = tmp_path / "tree.toml"
+    save_scene(replace(scene, tree=None, route=scene.tree.route()), path)
+    e = Editor(path, size=TALL)
+    pump(e, 2)
+
+    def click_remove() -> None:
+        lo, hi = rects["remove (Del)"]
+        assert hi.y < TALL[1], "the button is out of the window"
+        x, y = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", round(x + (lo.x + hi.x) / 2), round(y + (lo.y + hi.y) / 2))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 3)
+
+    try:
+        n = len(e.scene.route.levels)
+        click_remove()
+        assert len(e.scene.route.levels) == n and e.viewer.error == "", e.viewer.error
+        e.select_level(3)
+        pump(e, 2)
+        click_remove()
+        assert len(e.scene.route.levels) == n - 1, "control: the click removed nothing"
+    finally:
+        e.close()
+
+
 def test_the_grow_again_question_lists_the_edits_it_would_lose(window_editor):
     """After an insert, growing the tree again asks first, in a dialog listing the hand
     edits lost (drawing it closed the editor: it listed the new route instead). Cancel keeps

@@ -195,6 +195,57 @@ def test_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
     assert v.error == "" and v.status_line() == ""
 
 
+def test_an_error_said_after_a_message_takes_the_status_line_at_once(hud_viewer):
+    """ "saved …" held the foot for its seconds while a refusal said after it waited unseen
+    [a real-window review]: the newest takes the line. The controls: a message said after
+    the error takes it in turn, and the same error set again does not take it back."""
+    v = hud_viewer
+    v.say("saved /tmp/x.toml")
+    assert v.status_line() == "saved /tmp/x.toml"
+    v.error = "save as: no folder /tmp/nowhere; save again to make it"
+    assert v.status_line() == v.error and v.status_is_error(v.status_line())
+    v.say("screenshot: x.png")
+    assert v.status_line() == "screenshot: x.png"
+    v.error = v.error  # the same error again (a field refused each frame): no change
+    assert v.status_line() == "screenshot: x.png"
+
+
+def test_the_status_line_is_drawn_over_a_hud_that_leaves_it_no_gap(display, tmp_path, monkeypatch):
+    """A window too narrow beside a HUD that reaches its foot: the status line goes over the
+    HUD, and it is drawn over it, not under it (it was hidden behind the HUD it was placed
+    on). The control: the two meet."""
+    import glfw
+
+    from krsview.viewer.hud import HUD_TITLE
+    from krsview.viewer.status import meets, window_rect
+
+    from .test_editor import open_from_start, xdo
+
+    open_from_start(monkeypatch, "accuracy and view")
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    from krsview.viewer.window import Viewer
+
+    v = Viewer(path, size=(520, 400), hud=True)
+    try:
+        for _ in range(3):
+            v.step(0.05)
+        v.error = "a refusal long enough that no gap beside the HUD holds it on one line"
+        wx, wy = glfw.get_window_pos(v.window)
+        xdo("mousemove", wx + 200, wy + 16)  # a click on the HUD's title bar raises it
+        v.step(0.05)
+        xdo("click", 1)
+        for _ in range(3):
+            glfw.poll_events()
+            v.step(0.05)
+        status, hud = (imgui.internal.find_window_by_name(n) for n in ("##status", HUD_TITLE))
+        assert meets(window_rect(status), window_rect(hud)), "control: they do not meet"
+        order = imgui.internal.find_window_display_index
+        assert order(status) > order(hud), "the status line is drawn under the HUD"
+    finally:
+        v.close()
+
+
 def test_screenshot_goes_beside_a_writable_scene(tmp_path, monkeypatch):
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     scene = tmp_path / "scenes" / "fern.toml"

@@ -20,6 +20,8 @@ from ..viewer.camera import FlyCamera
 from ..viewer.files import ViewerFile
 from . import commands as ec
 
+SAVE_AS = "save as: "  # how a refusal of a save-as name starts (it goes with that name)
+
 
 class Window(Protocol):
     """What the file part reads and calls of the viewer."""
@@ -136,6 +138,13 @@ class FileActions:
         self.save_as_text = str(saved)
         return True
 
+    def set_save_as_text(self, text: str) -> None:
+        """The save-as field's text; a refusal of the name it held goes with that name (it
+        stood at the window's foot after the person had moved on)."""
+        if text != self.save_as_text and self.viewer.error.startswith(SAVE_AS):
+            self.viewer.error = ""
+        self.save_as_text = text
+
     def save_as(self, text: str) -> bool:
         """Save to the file named; another file that exists is replaced, and a folder that
         does not exist is made (a typo in a folder's name would make folders), only when
@@ -143,18 +152,18 @@ class FileActions:
         user's data folder, where a shipped preset's copy may go, is made without a word."""
         target = _target(text)
         if target.suffix != ".toml" or target.is_dir():
-            self.viewer.error = f"save as: {text!r}: a scene file needs a name ending in .toml"
+            self.viewer.error = f"{SAVE_AS}{text!r}: a scene file needs a name ending in .toml"
             return False
         folder = target.parent.absolute()
         made = folder.exists() or folder == user_folder().absolute()
         if not made and self.creating != folder:
             self.creating = folder
-            self.viewer.error = f"save as: no folder {folder}; save again to make it"
+            self.viewer.error = f"{SAVE_AS}no folder {folder}; save again to make it"
             return False
         self.creating = None
         if self.replaces(text) and self.replacing != target.resolve():
             self.replacing = target.resolve()
-            self.viewer.error = f"save as: {target} exists; save again to replace it"
+            self.viewer.error = f"{SAVE_AS}{target} exists; save again to replace it"
             return False
         self.replacing = None
         return self.save(str(target))
@@ -251,7 +260,7 @@ FILE_HANDLERS: dict[type[vc.Command], Callable[[FileActions, Any], None]] = {
     ec.Save: lambda f, c: f.save(),
     ec.SaveAs: lambda f, c: f.save_as(f.save_as_text),
     ec.AskSaveAs: lambda f, c: f.ask_save_as(),
-    ec.SetSaveAsText: lambda f, c: setattr(f, "save_as_text", c.text),
+    ec.SetSaveAsText: lambda f, c: f.set_save_as_text(c.text),
     ec.SetCopyText: lambda f, c: setattr(f, "copy_to", replace(f.copy_to, text=c.text, said="")),
     ec.SaveCopy: lambda f, c: f.save_copy(),
     ec.CancelCopy: lambda f, c: setattr(f, "copy_to", None),

@@ -73,6 +73,9 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
         out.append(ec.SetToolValue("split_at", as_typed(s, t.split_at)))
     if imgui.is_item_hovered():
         tooltip(TIPS["split_at"])
+    unselected = at == ("route",) and e.selected is None  # no level to act on: greyed
+    hovered = False
+    imgui.begin_disabled(unselected)
     for k, (text, command) in enumerate(
         (
             ("insert (Ins)", ec.InsertLevel()),
@@ -84,6 +87,10 @@ def structure_section(e: Structured, interactions: Interactions) -> list[Command
             imgui.same_line()
         if imgui.button(text):
             out.append(command)
+        hovered |= imgui.is_item_hovered(imgui.HoveredFlags_.allow_when_disabled)
+    imgui.end_disabled()
+    if unselected and hovered:  # after: a tooltip begun while disabled is greyed too
+        tooltip("select a level first: click it in the outline or the view")
     imgui.separator_text("whole tree")
     for name, op, lo, hi, button in (
         ("taper", "taper", 0.05, 1.0, "taper"),

@@ -99,6 +99,8 @@ def draw_status(text: str, error: bool = False) -> None:
     imgui.set_next_window_bg_alpha(0.75)
     flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
     imgui.begin("##status", None, flags | imgui.WindowFlags_.no_inputs)
+    # over the others where no gap holds it (a HUD or a panel drawn later hid it)
+    imgui.internal.bring_window_to_display_front(imgui.internal.get_current_window())
     imgui.push_text_wrap_pos(imgui.get_cursor_pos().x + room - 2 * pad.x)
     if error:
         imgui.push_style_color(imgui.Col_.text, RED)

@@ -70,9 +70,9 @@ class Viewer:
         self.view = "shaded"
         self.iteration_scale = VIEW_WHITE  # the iterations view: white at this many
         self.nav = Navigation(self.input, self.scene.camera)
-        self.message, self.error = "", ""
         self.clock = 0.0
         self.status = ("", 0.0)  # text, and the clock it goes at
+        self.message, self.error = "", ""
         fb = glfw.get_framebuffer_size(self.window)
         self.frames = Frames(
             self.ctx, self.renderer, AdaptiveResolution(fb, self.settings.target_fps)
@@ -316,6 +316,17 @@ class Viewer:
         self.say(self.message)
         print(self.message, flush=True)
         return out
+
+    @property
+    def error(self) -> str:
+        """The error shown (the HUD's, the editor panel's; its first line the status line's)."""
+        return self._error
+
+    @error.setter
+    def error(self, text: str) -> None:
+        if text and text != self._error:  # the newest word takes the line:
+            self.status = ("", 0.0)  # an older "saved …" hid a refusal said after it
+        self._error = text
 
     def say(self, text: str) -> None:
         """Show ``text`` in the status line at the window's foot for STATUS_SECONDS."""
