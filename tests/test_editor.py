@@ -346,10 +346,11 @@ def test_overlay_is_composited_by_traced_depth(editor):
     e = editor
     e.execute([Bake()])
     e.select_level(LEVEL)
-    e.viewer.hud = False
     settle(e)
+    draw, e.overlay.draw = e.overlay.draw, lambda *a, **k: None  # the image without it
+    pump(e, 2)
     plain = e.viewer.read_window().astype(int)
-    e.viewer.hud = True
+    e.overlay.draw = draw
 
     def overlay_change(hidden_alpha: float, world) -> float:
         e.overlay.prog["u_hidden_alpha"].value = hidden_alpha

@@ -68,6 +68,22 @@ def test_folding_the_panel_gives_the_view_the_whole_width_and_unfolding_takes_it
         assert abs(target_column(e) - middle) < 2, (folded, target_column(e), middle)
 
 
+def test_f1_gives_the_view_the_whole_width_and_takes_it_back(tree_editor):
+    """F1 (a real key) hides the panel with the HUD: the scene's target moves to the middle
+    of the window, as when the panel folds, and back beside the panel when F1 shows it again
+    (it stayed in the middle of a part no longer covered [a real-window review]). The
+    control: with the panel shown it is well off the window's middle."""
+    e = tree_editor
+    pump(e, 3)
+    x0, x1 = e.layout.free(SIZE)
+    assert abs(target_column(e) - SIZE[0] / 2) > 50, "control: already centred"
+    for hud, middle in ((False, SIZE[0] / 2), (True, (x0 + x1) / 2)):
+        xdo("key", "F1")
+        pump(e, 3)
+        assert e.viewer.hud is hud
+        assert abs(target_column(e) - middle) < 2, (hud, target_column(e), middle)
+
+
 def test_a_levels_grown_depth_is_text_that_clicks_and_typing_do_not_change(tree_editor):
     """The selected level's ``grown`` (bookkeeping for growing again) is a line of text:
     ctrl+click on it and typing a number changes nothing and refuses nothing (a field took

@@ -1,8 +1,8 @@
 """Where the edit panel sits (docked left or right, as wide as the person drags it, at most
 half the window, or folded to its title bar) and the camera that frames the scene in the part
 of the window it leaves: the scene camera's target is turned to the centre of that part, and
-when that part changes (the panel folded, unfolded or docked on the other side) what was in
-its middle stays in the middle of the new part."""
+when that part changes (the panel folded, unfolded, docked on the other side or hidden by
+F1) what was in its middle stays in the middle of the new part."""
 
 from __future__ import annotations
 
@@ -25,6 +25,7 @@ class Layout:
     side: str = "right"  # where the edit panel docks: "left" or "right"
     width: float = PANEL_WIDTH
     folded: bool = False  # only the panel's title bar shows: the view has the whole width
+    hidden: bool = False  # F1 hid the panel with the HUD: the view has the whole width
 
     def panel(
         self, size: tuple[float, float], hud: float = 0.0, hud_right: float = 0.0
@@ -43,8 +44,9 @@ class Layout:
 
     def free(self, size: tuple[float, float]) -> tuple[float, float]:
         """The span (x0, x1) of window columns the panel leaves to the view (all of them
-        while it is folded: its title bar covers a strip of the top only)."""
-        if self.folded:
+        while it is folded: its title bar covers a strip of the top only; none while F1
+        hides it)."""
+        if self.folded or self.hidden:
             return 0.0, float(size[0])
         x, _, width, _ = self.panel(size)
         return (x + width + MARGIN, size[0]) if self.side == "left" else (0.0, x - MARGIN)

@@ -201,6 +201,8 @@ class Editor:
         v = self.viewer
         v.begin_step(dt)
         self.execute(v.input.commands())
+        if self.layout.hidden == v.hud:  # F1 (or a question showing the panel again)
+            self._relayout(replace(self.layout, hidden=not v.hud))
         click, flick = v.input.take_click(), v.input.take_flick()
         v.move(dt)
         self.execute(v.file.watcher.poll())
