@@ -218,14 +218,13 @@ def test_the_status_line_is_drawn_over_a_hud_that_leaves_it_no_gap(display, tmp_
 
     from krsview.viewer.hud import HUD_TITLE
     from krsview.viewer.status import meets, window_rect
+    from krsview.viewer.window import Viewer
 
     from .test_editor import open_from_start, xdo
 
     open_from_start(monkeypatch, "accuracy and view")
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
-    from krsview.viewer.window import Viewer
-
     v = Viewer(path, size=(520, 400), hud=True)
     try:
         for _ in range(3):
