@@ -875,3 +875,31 @@ def test_the_growth_section_says_when_the_forks_differ_from_the_growth(route):
     more = split_level(route, 5)
     assert forks_note(more) == f"the route has {grown + 1} forks now; grow again makes {grown}"
     assert forks_note(merge_level(more, 5)) == ""  # control: back to the grown count
+
+
+def test_baking_a_tree_whose_tracks_move_its_growth_is_refused_and_says_which(display, tmp_path):
+    """tree-growing's tracks move tree.levels, tree.trunk_length …: a route has none of them,
+    and baking it closed the editor with a traceback [a real-window review]. It is refused,
+    the tracks named, the scene as it was; the control: tree-sway (a sway, no growth track)
+    bakes."""
+    import shutil
+
+    from krsview.editor.window import Editor
+
+    for name, refused in (("tree-growing", True), ("tree-sway", False)):
+        path = tmp_path / f"{name}.toml"
+        shutil.copy(resolve(name), path)
+        e = Editor(path, size=WINDOW)
+        try:
+            before = e.scene
+            e.execute([ec.Bake()])
+            pump(e, 2)
+            if refused:
+                assert e.scene == before and not e.doc.dirty
+                assert e.viewer.error.startswith("bake: animation.tracks = ")
+                assert "tree.levels" in e.viewer.error and "tree.trunk_length" in e.viewer.error
+                assert "camera.position" not in e.viewer.error, "a camera track is kept"
+            else:
+                assert e.scene.route is not None and e.viewer.error == ""
+        finally:
+            e.close()

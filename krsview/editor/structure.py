@@ -19,7 +19,7 @@ from typing import Any, NamedTuple, Protocol
 from ..document.document import Document
 from ..messages import counted
 from ..scene import Route, Scene, SceneError
-from ..scene.edits import Path, get_at, path_text, replace_at, validated
+from ..scene.edits import Path, get_at, parse_path, path_text, replace_at, validated
 from ..scene.growth import Growth
 from ..scene.regrow import rebake
 from ..scene.restructure import (
@@ -87,19 +87,45 @@ class Structured(Protocol):
 
 def baked(scene: Scene, component: int | None) -> tuple[Scene, str, str]:
     """The scene with its grown tree (or a compound's ``component``'s) baked into a route,
-    the undo step's label, and what to say."""
+    validated, the undo step's label, and what to say; a SceneError where tracks move the
+    growth parameters, which a route does not have (baking tree-growing closed the editor)."""
     if component is None:
-        return (
-            replace(scene, tree=None, route=scene.tree.route()),
+        out = replace(scene, tree=None, route=scene.tree.route())
+        label, said = (
             "bake the tree into a route",
             "baked: drag forks, control points and mirror normals",
         )
-    c = replace(scene.compound[component], tree=None, route=scene.compound[component].tree.route())
-    return (
-        replace_at(scene, ("compound", component), c),
-        f"bake component {component}'s tree into a route",
-        f"baked component {component}: the structure tools act on its route",
-    )
+    else:
+        c = scene.compound[component]
+        out = replace_at(
+            scene, ("compound", component), replace(c, tree=None, route=c.tree.route())
+        )
+        label, said = (
+            f"bake component {component}'s tree into a route",
+            f"baked component {component}: the structure tools act on its route",
+        )
+    lost = [
+        tr.path
+        for tr in (out.animation.tracks if out.animation else [])
+        if not _holds(out, tr.path)
+    ]
+    if lost:
+        raise SceneError(
+            "animation.tracks",
+            ", ".join(lost),
+            "these tracks move the grown tree's parameters, which a route does not have: "
+            "delete them first (their [[animation.tracks]] in the file)",
+        )
+    return validated(out), label, said
+
+
+def _holds(scene: Scene, path: str) -> bool:
+    """Whether ``scene`` (its animation aside) has the value a track's ``path`` names."""
+    try:
+        get_at(replace(scene, animation=None), parse_path(path))
+    except (AttributeError, IndexError, KeyError, TypeError):
+        return False
+    return True
 
 
 # ----------------------------------------------------------------------------- applying

@@ -267,8 +267,13 @@ class Editor:
     # --------------------------------------------------------------------------- actions
     def bake(self, component: int | None = None) -> None:
         """Grown tree → route (one undo step): every fork becomes a handle; or the tree of a
-        compound's ``component`` (the structure tools then act on its route)."""
-        scene, label, said = baked(self.scene, component)
+        compound's ``component`` (the structure tools then act on its route); refused, said
+        why, where tracks move the grown tree's parameters."""
+        try:
+            scene, label, said = baked(self.scene, component)
+        except SceneError as e:
+            self.viewer.error = f"bake: {e}"
+            return
         self.doc.commit(scene, label)
         self.viewer.sync()
         self.viewer.message = said
