@@ -147,7 +147,8 @@ def test_a_moment_that_cannot_be_posed_shows_why_and_keeps_the_last_pose(display
 
 def test_a_keyed_camera_is_followed_while_playing_and_flown_when_paused(display, tmp_path):
     """tree-growing keys the camera (it steps back as the tree grows): playing puts the view
-    where the track does; paused, W flies from there."""
+    where the track does; paused, W flies from there, and R goes back to the keyed camera
+    of the moment shown (it went to the file's camera, the first moment's close-up)."""
     import shutil
 
     import numpy as np
@@ -173,6 +174,9 @@ def test_a_keyed_camera_is_followed_while_playing_and_flown_when_paused(display,
             v.step(0.1)
         v.input.key("W", False)
         assert np.linalg.norm(v.camera.position - np.array(keyed)) > 0.05, "paused, W did not fly"
+        press(v, "R")  # the keyed camera at this moment, not the file's first one
+        v.step(0.01)
+        assert np.allclose(v.camera.position, keyed, atol=1e-9), "R took the first moment's"
     finally:
         v.close()
 

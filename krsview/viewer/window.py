@@ -210,7 +210,9 @@ class Viewer:
         return False
 
     def reset_view(self) -> None:
-        self.nav.reset(self.scene.camera)
+        """R: the scene's camera at the moment shown (its tracks move it; the file's own
+        camera is the first moment's, a close-up on tree-growing)."""
+        self.nav.reset(self.drawn.posed(self.scene).camera)
         self.frames.dirty = True
         if self.message.endswith(CAMERA_KEPT):  # R took the file's camera: said no more
             self.message = self.message[: -len(CAMERA_KEPT)]
