@@ -101,3 +101,17 @@ def test_the_hud_opened_over_the_edit_panel_moves_beside_it():
     x = hud_clear_of(hud, narrow, "left", 640.0)
     assert x == 640.0 - GAP - 440.0
     assert hud_clear_of((x, 8.0, x + 440.0, 408.0), narrow, "left", 640.0) is None
+
+
+def test_above_a_timeline_beside_a_panel_that_reaches_the_top():
+    """The editor's timeline across the foot up to a panel docked right that spans the whole
+    height: the line goes just above the timeline. It went over the strip's start: the next
+    band tried was above the panel's top, off the window [a real-window review]."""
+    display = (900.0, 560.0)
+    timeline, panel = (8.0, 488.0, 536.0, 552.0), (552.0, 8.0, 892.0, 552.0)
+    spot = status_spot(display, line(237, 30), [timeline, panel])
+    assert spot[:2] == (MARGIN, timeline[1] - MARGIN)
+    drawn = box(spot, line(237, 30))
+    assert not meets(drawn, timeline) and not meets(drawn, panel)
+    # control: at the foot, where no gap holds it, it covers the strip
+    assert meets(box((MARGIN, display[1] - MARGIN, 884.0), line(237, 30)), timeline)

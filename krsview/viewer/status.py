@@ -34,7 +34,7 @@ def status_spot(display: tuple[float, float], measure: Measure, rects: list[Rect
         band = [r for r in rects if r[1] < foot and r[3] > foot - h]
         if not band:
             break
-        foot = min(r[1] for r in band) - MARGIN
+        foot = max(r[1] for r in band) - MARGIN  # above the lowest one only
     foot = display[1] - MARGIN
     for x, room in sorted(_gaps(display[0], foot, h, rects), key=lambda g: -g[1]):
         tall = measure(room)[1]
