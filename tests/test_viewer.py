@@ -106,6 +106,11 @@ def test_orbit_keeps_distance_to_the_picked_point(viewer):
 
 def test_bookmark_is_saved_in_the_preset_and_reset_restores(viewer):
     v = viewer
+    assert not v.scene.bookmarks
+    at = v.camera.to_camera()
+    v.execute([NextBookmark()])  # none yet: said how to add one, the view unmoved
+    assert v.status_line() == "no bookmarks yet: B adds the view as one"
+    assert v.camera.to_camera() == at
     hold(v, "A", 1, 0.2)
     moved = v.camera.to_camera()
     hold(v, "B", 1, 0.01)

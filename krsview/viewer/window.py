@@ -227,8 +227,12 @@ class Viewer:
         self.message, self.frames.dirty = self.nav.go_to(self.scene.bookmarks, index), True
 
     def next_bookmark(self) -> None:
+        """N: the next bookmark; with none, how to add one (N did nothing, without a word)."""
         if self.scene.bookmarks:
             self.go_to_bookmark((self.nav.bookmark_index + 1) % len(self.scene.bookmarks))
+        else:
+            self.message = "no bookmarks yet: B adds the view as one"
+            self.say(self.message)
 
     # --------------------------------------------------------------------------- the loop
     def run(self) -> None:
