@@ -716,6 +716,11 @@ def placed(scene, k: int) -> KRS:
     return scene.compound[k].placed()
 
 
+def picked(k: int) -> SimpleNamespace:
+    """Component k picked as a whole (its entry in the outline), not a handle of its route."""
+    return SimpleNamespace(level=k, path=("compound", k))
+
+
 def test_structure_tools_act_on_the_selected_components_route(compound_editor):
     """Component 1 (a route): insert at the section's level adds a level to it alone (the
     compiled world-space KRS one level deeper, the others as they were), one undo step;
@@ -729,11 +734,11 @@ def test_structure_tools_act_on_the_selected_components_route(compound_editor):
         (0, "component 0 is grown from ratios: bake it"),
         (2, "component 2 is an explicit KRS"),
     ):
-        e.selected = None if selected is None else SimpleNamespace(level=selected)
+        e.selected = None if selected is None else picked(selected)
         e.run(ec.InsertLevel())
         assert why in e.viewer.error and e.structure.refused, (selected, e.viewer.error)
         assert e.scene is start and not e.doc.history.steps
-    e.selected = SimpleNamespace(level=1)
+    e.selected = picked(1)
     e.structure.level = 3
     e.run(ec.InsertLevel())
     assert not e.structure.refused, e.structure.message
@@ -903,3 +908,28 @@ def test_baking_a_tree_whose_tracks_move_its_growth_is_refused_and_says_which(di
                 assert e.scene.route is not None and e.viewer.error == ""
         finally:
             e.close()
+
+
+def test_in_a_compound_the_selection_follows_the_inserted_fork(display, compound_editor):
+    """A fork of component 1's route selected, Insert: the selection moves to the new fork
+    with the section's level, so Delete removes the fork selected. It stayed at the old
+    index while the section's level moved on, and Delete removed another fork [a
+    real-window review]. The control: the fork first selected."""
+    from krsview.editor.window import Editor
+
+    e = Editor(compound_editor.doc.path, size=WINDOW)
+    try:
+        pump(e)
+        fork = ("compound", 1, "route", "levels", 3, "fork")
+        e.select(next(h for h in e.handles if h.path == fork))
+        assert e.structure.level == 3
+        start = e.scene
+        e.execute([ec.InsertLevel()])
+        pump(e)
+        assert e.structure.level == 4 and e.selected.path[:6] == (*fork[:4], 4, "fork")
+        e.execute([ec.RemoveLevel()])
+        pump(e)
+        forks = [[lv.fork for lv in s.compound[1].route.levels] for s in (e.scene, start)]
+        assert forks[0] == forks[1], "Delete removed another fork than the inserted one"
+    finally:
+        e.close()

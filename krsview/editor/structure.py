@@ -82,6 +82,9 @@ class Structured(Protocol):
     def doc(self) -> Document: ...
     @property
     def scene(self) -> Scene: ...
+    @property
+    def handles(self) -> list[Handle]: ...
+    def select(self, h: Handle | None) -> None: ...
     def select_level(self, level: int) -> None: ...
 
 
@@ -213,11 +216,16 @@ def _level(e: Structured, level: int | None, what: str) -> int | None:
 
 def _choose(e: Structured, level: int) -> None:
     """Select ``level`` after an operation: in the outline, or in a compound the section's
-    level of the component's route."""
-    if e.scene.compound:
-        e.structure.level = level
-    else:
+    level of the component's route, and the selection there with it where a handle of that
+    route was selected (it stayed at the old index: Delete then removed another level)."""
+    if not e.scene.compound:
         e.select_level(level)
+        return
+    e.structure.level = level
+    at, _ = target(e)
+    if at is not None and e.selected is not None and e.selected.path[: len(at)] == at:
+        here = (*at, "levels", level)
+        e.select(next((h for h in e.handles if h.path[: len(here)] == here), None))
 
 
 def insert(e: Structured, level: int | None) -> None:
