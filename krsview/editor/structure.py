@@ -19,7 +19,7 @@ from typing import Any, NamedTuple, Protocol
 from ..document.document import Document
 from ..messages import counted
 from ..scene import Route, Scene, SceneError
-from ..scene.edits import Path, get_at, parse_path, path_text, replace_at, validated
+from ..scene.edits import Path, get_at, holds, parse_path, path_text, replace_at, validated
 from ..scene.growth import Growth
 from ..scene.regrow import rebake
 from ..scene.restructure import (
@@ -107,11 +107,9 @@ def baked(scene: Scene, component: int | None) -> tuple[Scene, str, str]:
             f"bake component {component}'s tree into a route",
             f"baked component {component}: the structure tools act on its route",
         )
-    lost = [
-        tr.path
-        for tr in (out.animation.tracks if out.animation else [])
-        if not _holds(out, tr.path)
-    ]
+    rest = replace(out, animation=None)
+    tracks = out.animation.tracks if out.animation else []
+    lost = [tr.path for tr in tracks if not holds(rest, parse_path(tr.path))]
     if lost:
         raise SceneError(
             "animation.tracks",
@@ -120,15 +118,6 @@ def baked(scene: Scene, component: int | None) -> tuple[Scene, str, str]:
             "delete them first (their [[animation.tracks]] in the file)",
         )
     return validated(out), label, said
-
-
-def _holds(scene: Scene, path: str) -> bool:
-    """Whether ``scene`` (its animation aside) has the value a track's ``path`` names."""
-    try:
-        get_at(replace(scene, animation=None), parse_path(path))
-    except (AttributeError, IndexError, KeyError, TypeError):
-        return False
-    return True
 
 
 # ----------------------------------------------------------------------------- applying

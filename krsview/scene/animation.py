@@ -19,7 +19,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..messages import SceneError
-from .edits import get_at, parse_path, replace_at, revalidated
+from .edits import get_at, holds, parse_path, replace_at, revalidated
 from .effects import EFFECTS
 from .route import Route
 from .schema import param, to_dict
@@ -256,10 +256,9 @@ def check_animation(scene: Any) -> None:
                 tr.path,
                 "time itself has no track; allowed: any other value an edit can change",
             )
-        try:
-            here = get_at(rest, path)
-        except (AttributeError, IndexError, KeyError, TypeError):
-            raise SceneError(f"{where}.path", tr.path, "no such value in this scene") from None
+        if not holds(rest, path):
+            raise SceneError(f"{where}.path", tr.path, "no such value in this scene")
+        here = get_at(rest, path)
         if is_dataclass(here) or isinstance(here, list):
             raise SceneError(
                 f"{where}.path",

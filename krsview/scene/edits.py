@@ -31,6 +31,15 @@ def get_at(obj: Any, path: Path) -> Any:
     return obj
 
 
+def holds(obj: Any, path: Path) -> bool:
+    """Whether ``obj`` has a value at ``path`` (each field there, each index in range)."""
+    try:
+        get_at(obj, path)
+    except (AttributeError, IndexError, KeyError, TypeError):
+        return False
+    return True
+
+
 def replace_at(obj: Any, path: Path, value: Any) -> Any:
     """A copy of ``obj`` with the value at ``path`` replaced; everything else is shared."""
     if not path:
