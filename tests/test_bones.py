@@ -84,7 +84,7 @@ def test_a_finer_key_holds_its_value_as_if_the_keyed_fork_were_at_rest(bent):
     rest = np.array(bent.route.levels[20].fork)
     s = keyed(bent, FORK, (0.0, rest), (2.0, rest + MOVE))
     drawn = np.array(s.at(2.0).posed().route.levels[12].fork)
-    k = s.edit("animation", key_now(s, FINER, 2.0))  # K on the finer fork at 2 s
+    k = s.edit("animation", key_now(s, [FINER], 2.0))  # K on the finer fork at 2 s
     assert np.allclose(k.at(2.0).posed().route.levels[12].fork, drawn, atol=1e-12)
     assert np.allclose(k.animation.tracks[1].keys[0].value, drawn - MOVE, atol=1e-12)
     raw = k.edit("animation", with_key(s, FINER, 2.0, tuple(drawn)))  # the drawn value as key

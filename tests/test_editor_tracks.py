@@ -90,6 +90,55 @@ def test_the_mokrs_panel_shows_the_pose_marks_tracks_and_a_typed_value_keys_them
     assert frame_colour(e, CURL, ON_KEY) > 50, "the new key is not marked"
 
 
+def test_k_and_the_strips_key_edits_reach_every_linked_curl_in_a_window(palm):
+    """palm-curl in a window, step edits going to linked levels: K at 1 s keys all 30 curls;
+    a right-click on that key on the strip deletes it from all 30, and a drag of the key at
+    2 s to 3 s moves all 30. Controls: each is one undo step; with step edits on one level
+    only, K keys level 58 alone."""
+    from krsview.viewer.commands import SetTime
+
+    e = palm
+    settle(e)
+    e.select(next(h for h in e.handles if h.path == CURL))
+    curls = [i for i, tr in enumerate(e.scene.animation.tracks) if tr.path.endswith("[1].degrees")]
+
+    def times() -> set[tuple[float, ...]]:
+        return {tuple(k.time for k in e.scene.animation.tracks[i].keys) for i in curls}
+
+    assert len(curls) == 30 and times() == {(0, 2, 4)}
+    e.execute([SetTime(1.0)])
+    pump(e, 3)
+    xdo("key", "k")
+    pump(e, 3)
+    assert times() == {(0, 1, 2, 4)}, "K did not key every linked curl"
+
+    def on_bar(t: float) -> tuple[int, int]:
+        x, y, width = e.timeline.bar
+        return tuple(map(round, window_xy(e, x + width * t / e.scene.animation.duration, y)))
+
+    xdo("mousemove", *on_bar(1.0))
+    pump(e, 3)
+    xdo("click", 3)
+    pump(e, 3)
+    assert times() == {(0, 2, 4)}, "the right-click deleted the key of one curl only"
+    xdo("mousemove", *on_bar(2.0))
+    pump(e, 3)
+    xdo("mousedown", 1)
+    pump(e, 2)
+    for k in range(1, 6):
+        xdo("mousemove", *on_bar(2.0 + 0.2 * k))
+        pump(e, 2)
+    xdo("mouseup", 1)
+    pump(e, 3)
+    moved = times()
+    assert len(moved) == 1 and abs(next(iter(moved))[1] - 3.0) < 0.05, moved
+    assert len(e.doc.history.steps) == 3, "K, the delete and the drag: one step each"
+    e.carry = False
+    xdo("key", "k")
+    pump(e, 3)
+    assert len(times()) == 2, "with step edits on one level, K keyed more than level 58"
+
+
 def test_the_krs_panel_marks_a_keyed_fork(display, tmp_path):
     """A route's keyed fork: its field framed green between keys, yellow on one; its
     neighbour's (no track) neither."""

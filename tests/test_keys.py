@@ -9,7 +9,17 @@ import numpy as np
 import pytest
 
 from krsview import load
-from krsview.editor.keys import KEY_SNAP, key_now, keyed_edit, moved_key, with_key, without_key
+from krsview.editor.keys import (
+    KEY_SNAP,
+    key_now,
+    keyed_edit,
+    keys_together,
+    linked_paths,
+    moved_keys,
+    track_index,
+    with_key,
+    without_keys,
+)
 from krsview.scene.scene import scene_from_toml, scene_to_toml
 
 FORK = ("route", "levels", 20, "fork")
@@ -40,7 +50,7 @@ def test_k_holds_the_value_drawn_then_and_a_drag_of_a_keyed_value_sets_its_key(b
     moved = tuple(x + 0.1 for x in rest)
     s = bent.edit("animation", with_key(bent, FORK, 0.0, rest))
     s = s.edit("animation", with_key(s, FORK, 2.0, moved))
-    middle = key_now(s, FORK, 1.0).tracks[0].keys[1]
+    middle = key_now(s, [FORK], 1.0).tracks[0].keys[1]
     assert middle.time == 1.0
     assert np.allclose(middle.value, (np.array(rest) + moved) / 2, atol=1e-12)  # smooth: the middle
     assert not np.allclose(middle.value, rest), "K took the rest value, not the one drawn"
@@ -54,13 +64,50 @@ def test_a_key_dragged_in_time_stays_between_its_neighbours_and_right_click_dele
     s = bent
     for t in (1.0, 2.0, 3.0):
         s = s.edit("animation", with_key(s, FORK, t, (0.0, t, 0.0)))
-    times = [k.time for k in moved_key(s, 0, 1, 2.5).tracks[0].keys]
+    times = [k.time for k in moved_keys(s, [(0, 1)], 2.5).tracks[0].keys]
     assert times == [1.0, 2.5, 3.0]
-    times = [k.time for k in moved_key(s, 0, 1, 9.0).tracks[0].keys]
+    times = [k.time for k in moved_keys(s, [(0, 1)], 9.0).tracks[0].keys]
     assert times[1] < times[2] == 3.0, "a key passed its neighbour"
-    assert [k.time for k in without_key(s, 0, 0).tracks[0].keys] == [2.0, 3.0]
+    assert [k.time for k in without_keys(s, [(0, 0)]).tracks[0].keys] == [2.0, 3.0]
     one = bent.edit("animation", with_key(bent, FORK, 1.0, (0.0, 1.0, 0.0)))
-    assert without_key(one, 0, 0).tracks == [], "a track without keys stayed"
+    assert without_keys(one, [(0, 0)]).tracks == [], "a track without keys stayed"
+
+
+CURL = ("mokrs", "levels", 58, "transform", 1, "degrees")  # palm-curl: tracked in 30 levels
+
+
+def test_k_and_the_strips_key_edits_act_on_the_linked_levels_as_a_drag_does():
+    """palm-curl's curl, step edits going to linked levels: K keys the curl of all 30 linked
+    levels, and a key dragged in time or deleted on the strip takes the keys at its moment
+    in the other 29 tracks along, so the levels stay alike. Negative control: with step
+    edits on one level only, each acts on level 58's track alone."""
+    s = load("palm-curl")
+    paths = linked_paths(s, CURL, carry=True)
+    tracks = [track_index(s, p) for p in paths]
+    assert len(paths) == 30 and paths[0] == CURL and None not in tracks
+    assert linked_paths(s, CURL, carry=False) == [CURL]
+    assert linked_paths(s, FORK, carry=True) == [FORK]  # not a MöKRS step: alone
+
+    def times(a, i):
+        return [k.time for k in a.tracks[i].keys]
+
+    before = times(s.animation, tracks[0])
+    keyed = key_now(s, paths, 1.0)
+    assert all(times(keyed, i) == sorted([*before, 1.0]) for i in tracks)
+    alone = key_now(s, [CURL], 1.0)
+    assert [1.0 in times(alone, i) for i in tracks].count(True) == 1
+
+    s = s.edit("animation", keyed)
+    j = times(s.animation, tracks[0]).index(1.0)
+    together = keys_together(s, tracks, tracks[0], j)
+    assert len(together) == 30 and together[0] == (tracks[0], j)
+    moved = moved_keys(s, together, 1.5)
+    assert all(1.5 in times(moved, i) and 1.0 not in times(moved, i) for i in tracks)
+    one = moved_keys(s, together[:1], 1.5)
+    assert [1.0 in times(one, i) for i in tracks].count(True) == 29  # the others stayed
+    gone = without_keys(s, together)
+    assert all(times(gone, i) == before for i in tracks)
+    assert len(gone.tracks) == len(s.animation.tracks)
 
 
 def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(display, tmp_path):

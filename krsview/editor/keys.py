@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from imgui_bundle import imgui
 
+from ..messages import counted
 from ..scene import Scene, SceneError
 from ..scene.animation import Animation, Key, Track, bone_offset
 from ..scene.edits import Path, apply_edit, get_at, parse_path, path_text, replace_at
@@ -65,9 +66,26 @@ def held(scene: Scene, path: tuple, value: Any, t: float) -> Any:
     return value if off is None else tuple(float(c) for c in np.subtract(value, off))
 
 
-def key_now(scene: Scene, path: tuple, t: float) -> Animation:
-    """K: a key at ``t`` holding the value at ``path`` as drawn at ``t``."""
-    return with_key(scene, path, t, held(scene, path, get_at(scene.at(t).posed(), path), t))
+def key_now(scene: Scene, paths: list[Path], t: float) -> Animation:
+    """K: a key at ``t`` for each value at ``paths`` (``linked_paths``), holding it as drawn
+    at ``t``."""
+    drawn, keyed = scene.at(t).posed(), scene
+    for path in paths:
+        value = held(scene, path, get_at(drawn, path), t)
+        keyed = replace(keyed, animation=with_key(keyed, path, t, value))
+    return keyed.animation
+
+
+def linked_paths(scene: Scene, path: Path, carry: bool) -> list[Path]:
+    """``path`` and, while step edits go to linked levels (``carry``), the same field of a
+    MöKRS step in the linked levels (``linked_levels``): the values K and the timeline's key
+    edits act on together, as a drag does (palm-curl's 30 curls stay alike)."""
+    step = path[:2] == ("mokrs", "levels") and len(path) == 6 and path[3] == "transform"
+    if not (carry and step):
+        return [path]
+    return [path] + [
+        (*path[:2], k, *path[3:]) for k in linked_levels(scene.mokrs, path[2]) if k != path[2]
+    ]
 
 
 def keyed_edit(scene: Scene, path: tuple, value: Any, t: float) -> tuple[tuple, Any]:
@@ -113,7 +131,7 @@ def linked_edits(scene: Scene, path: Path, value: Any, t: float) -> list[tuple[P
         apply_edit(scene, path, value)
     except SceneError:
         return [(path, value)]
-    paths = [(*path[:2], k, *path[3:]) for k in linked_levels(m, path[2])]
+    paths = linked_paths(scene, path, carry=True)
     tracked = [q for q in paths if track_index(scene, q) is not None]
     if not tracked:
         return [linked_edit(m, path, value)]
@@ -167,43 +185,62 @@ def marked(on_key: bool | None) -> Iterator[None]:
         draw.add_polyline(pts, MARK_BETWEEN, 1.5, imgui.ImDrawFlags_.closed.value)
 
 
-def moved_key(scene: Scene, track: int, key: int, t: float) -> Animation:
-    """The animation with key ``key`` of track ``track`` moved to time ``t``, kept between
-    its neighbours (so the keys keep their order)."""
+def keys_together(scene: Scene, tracks: list[int], track: int, key: int) -> list[tuple[int, int]]:
+    """Key ``key`` of track ``track``, and in each other track of ``tracks`` (the linked
+    levels') its key at the same moment (within KEY_SNAP): the keys the strip moves and
+    deletes as one, as (track, key) pairs."""
     a = scene.animation
-    keys = list(a.tracks[track].keys)
-    lo = keys[key - 1].time + KEY_GAP if key > 0 else 0.0
-    hi = keys[key + 1].time - KEY_GAP if key + 1 < len(keys) else a.duration
-    keys[key] = Key(min(max(t, lo), hi), keys[key].value)
+    t = a.tracks[track].keys[key].time
+    out = [(track, key)]
+    for i in tracks:
+        j = next((j for j, k in enumerate(a.tracks[i].keys) if abs(k.time - t) <= KEY_SNAP), None)
+        if i != track and j is not None:
+            out.append((i, j))
+    return out
+
+
+def moved_keys(scene: Scene, keys: list[tuple[int, int]], t: float) -> Animation:
+    """The animation with each key of ``keys`` ((track, key) pairs) moved to time ``t``,
+    kept between its neighbours (so each track's keys keep their order)."""
+    a = scene.animation
     tracks = list(a.tracks)
-    tracks[track] = replace(tracks[track], keys=keys)
+    for track, key in keys:
+        ks = list(tracks[track].keys)
+        lo = ks[key - 1].time + KEY_GAP if key > 0 else 0.0
+        hi = ks[key + 1].time - KEY_GAP if key + 1 < len(ks) else a.duration
+        ks[key] = Key(min(max(t, lo), hi), ks[key].value)
+        tracks[track] = replace(tracks[track], keys=ks)
     return replace(a, tracks=tracks)
 
 
-def without_key(scene: Scene, track: int, key: int) -> Animation:
-    """The animation without key ``key`` of track ``track`` (a track left with no key goes)."""
-    a = scene.animation
-    tracks = list(a.tracks)
-    keys = [k for j, k in enumerate(tracks[track].keys) if j != key]
-    if keys:
-        tracks[track] = replace(tracks[track], keys=keys)
-    else:
-        del tracks[track]
+def without_keys(scene: Scene, keys: list[tuple[int, int]]) -> Animation:
+    """The animation without the keys ``keys`` ((track, key) pairs); a track left with no key
+    goes."""
+    a, gone = scene.animation, set(keys)
+    tracks = []
+    for i, tr in enumerate(a.tracks):
+        left = [k for j, k in enumerate(tr.keys) if (i, j) not in gone]
+        if left:
+            tracks.append(replace(tr, keys=left))
     return replace(a, tracks=tracks)
 
 
 class Timeline:
-    """The strip's drag state: the key being dragged, and its drag's number (one undo step)."""
+    """The strip's drag state: the keys being dragged (the one on the strip first, then the
+    linked levels' at its moment), and the drag's number (one undo step)."""
 
     def __init__(self) -> None:
-        self.dragging: tuple[int, int] | None = None  # (track, key)
+        self.dragging: list[tuple[int, int]] | None = None  # (track, key) pairs
         self.drags = 0
+        self.bar = (0.0, 0.0, 0.0)  # the time bar as last drawn: left x, middle y, width
 
     def draw(
-        self, scene: Scene, playback: Playback, path: tuple | None, span: tuple[float, float]
+        self, scene: Scene, playback: Playback, paths: list[Path], span: tuple[float, float]
     ) -> list[vc.Command]:
         """Inside the ImGui frame: play/pause, the time bar over the loop with the keys of the
-        selected value (``path``) on it, across the window columns ``span``."""
+        selected value (``paths[0]``; none: ``paths`` empty) on it, across the window columns
+        ``span``. A key dragged or deleted there takes the keys at its moment of the values
+        linked to it (``paths[1:]``: ``linked_paths``) along."""
         out: list[vc.Command] = []
         io = imgui.get_io()
         x0, x1 = span[0] + 8.0, span[1] - 8.0
@@ -215,23 +252,29 @@ class Timeline:
         if imgui.button("pause" if playback.playing else "play"):
             out.append(vc.TogglePlay())
         imgui.same_line()
-        if imgui.button("key (K)") and path is not None:
+        if imgui.button("key (K)") and paths:
             out.append(ec.SetKey())
         imgui.same_line()
-        track = track_index(scene, path) if path is not None else None
-        what = path_text(path) if path is not None else "select a handle to key it"
+        tracks = [i for i in (track_index(scene, p) for p in paths) if i is not None]
+        track = track_index(scene, paths[0]) if paths else None
+        what = path_text(paths[0]) if paths else "select a handle to key it"
+        if len(paths) > 1:
+            what += f" and {counted(len(paths) - 1, 'linked level')}"
         imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {what}")
-        out += self._bar(scene, playback, track)
+        out += self._bar(scene, playback, track, tracks)
         imgui.end()
         return out
 
-    def _bar(self, scene: Scene, playback: Playback, track: int | None) -> list[vc.Command]:
+    def _bar(
+        self, scene: Scene, playback: Playback, track: int | None, tracks: list[int]
+    ) -> list[vc.Command]:
         out: list[vc.Command] = []
         origin = imgui.get_cursor_screen_pos()
         width = max(imgui.get_content_region_avail().x, 1.0)
         imgui.invisible_button("##timebar", imgui.ImVec2(width, 2 * DIAMOND + 4))
         draw = imgui.get_window_draw_list()
         y = origin.y + DIAMOND + 2
+        self.bar = (origin.x, y, width)
 
         def x_of(t: float) -> float:
             return origin.x + width * t / playback.duration
@@ -266,21 +309,19 @@ class Timeline:
         )
         if imgui.is_item_activated():
             if hot is not None:
-                self.dragging, self.drags = (track, hot), self.drags + 1
+                self.dragging = keys_together(scene, tracks, track, hot)
+                self.drags += 1
             else:
                 out.append(vc.SetTime(t_of(mouse.x)))
         elif imgui.is_item_active():
             if self.dragging is not None:
-                tr, j = self.dragging
-                out.append(
-                    vc.Edit(
-                        ("animation",), moved_key(scene, tr, j, t_of(mouse.x)), ("key", self.drags)
-                    )
-                )
+                moved = moved_keys(scene, self.dragging, t_of(mouse.x))
+                out.append(vc.Edit(("animation",), moved, ("key", self.drags)))
             else:
                 out.append(vc.SetTime(t_of(mouse.x)))
         else:
             self.dragging = None
         if hot is not None and imgui.is_item_clicked(imgui.MouseButton_.right):
-            out.append(vc.Edit(("animation",), without_key(scene, track, hot)))
+            gone = without_keys(scene, keys_together(scene, tracks, track, hot))
+            out.append(vc.Edit(("animation",), gone))
         return out

@@ -31,6 +31,7 @@ from ..compile.geometry import scene_ball
 from ..compile.mokrs import check_drawable
 from ..document.document import Document
 from ..gpu.overlay import Overlay
+from ..messages import counted
 from ..scene import Scene, SceneError
 from ..scene.edits import apply_edit, path_text
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
@@ -46,7 +47,7 @@ from .file_actions import FILE_HANDLERS, FileActions
 from .gizmo import Gizmo
 from .grab import Grabbing
 from .handles import Handle, level_handle
-from .keys import Timeline, key_now, keyed_edit
+from .keys import Timeline, key_now, keyed_edit, linked_paths
 from .layout import Layout, frame, shift
 from .mokrs_panel import KindsLeft
 from .picking import pick, visible
@@ -284,8 +285,10 @@ class Editor:
             self.viewer.message = "select a handle to key its value (K)"
             return
         t = self.viewer.drawn.playback.time
-        if self.edit(("animation",), key_now(self.scene, self.selected.path, t)):
-            self.viewer.message = f"key at {t:.2f} s for {self.selected.label}"
+        paths = linked_paths(self.scene, self.selected.path, self.carry)
+        if self.edit(("animation",), key_now(self.scene, paths, t)):
+            linked = f" and {counted(len(paths) - 1, 'linked level')}" if len(paths) > 1 else ""
+            self.viewer.message = f"key at {t:.2f} s for {self.selected.label}{linked}"
 
     def select(self, h: Handle | None) -> None:
         """Select ``h``; a compound component's fork also picks its level for the tools."""
