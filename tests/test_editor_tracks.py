@@ -133,6 +133,12 @@ def test_k_and_the_strips_key_edits_reach_every_linked_curl_in_a_window(palm):
     moved = times()
     assert len(moved) == 1 and abs(next(iter(moved))[1] - 3.0) < 0.05, moved
     assert len(e.doc.history.steps) == 3, "K, the delete and the drag: one step each"
+    curl = "mokrs.levels[58].transform[1].degrees"
+    assert e.doc.history.labels()[0] == [
+        "key at 1.00 s for L58 step 1 rotate -4.75 deg and 29 linked levels",
+        f"delete the key at 1.00 s of {curl} and 29 linked keys",
+        f"move the key at 2.00 s of {curl} and 29 linked keys in time",
+    ]  # what an undo says it undid
     e.carry = False
     xdo("key", "k")
     pump(e, 3)

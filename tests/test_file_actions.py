@@ -53,9 +53,9 @@ def part(path: Path) -> tuple[FileActions, Window, list[str]]:
     """The file part over a stand-in window; the editor's ``opened`` calls are listed."""
     w, told = Window(path), []
 
-    def edit(at: tuple, value) -> bool:
+    def edit(at: tuple, value, label: str | None = None) -> bool:
         try:
-            w.doc.apply(at, value)
+            w.doc.apply(at, value, label=label)
         except SceneError as e:
             w.error = str(e)
             return False
@@ -150,6 +150,7 @@ def test_a_bookmark_is_an_edit_saved_with_the_scene_not_written_at_once(tree):
     assert w.doc.dirty and len(w.doc.scene.bookmarks) == before + 1 and "added" in w.message
     assert w.said == [w.message], "said at the window's foot too: the HUD is folded away"
     assert len(load_scene(tree).bookmarks) == before, "the editor's bookmark skipped the save"
+    assert w.doc.history.labels()[0] == [f"add bookmark 'view {before + 1}'"]  # undo says it
     # the viewer's own bookmark (negative control) is appended to the file on disk at once
     w.file.add_bookmark()
     assert len(load_scene(tree).bookmarks) == before + 1

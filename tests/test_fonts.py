@@ -39,7 +39,7 @@ def ui_characters(paths) -> dict[str, str]:
                 and id(node) not in docs
             ):
                 for c in node.value:
-                    if ord(c) > 126 and c.isprintable():
+                    if ord(c) > 126 and (c.isprintable() or c.isspace()):  # NBSP too
                         out.setdefault(c, path.name)
     return out
 

@@ -511,3 +511,17 @@ def test_an_error_is_shown_once_its_further_lines_in_the_hud(hud_viewer, monkeyp
     wrapped.clear()
     turn(v)
     assert "second line" in wrapped and not any("first line" in s for s in wrapped)
+
+
+def test_undo_and_redo_say_what_they_undid_in_place_of_what_was_said_of_it(hud_viewer):
+    """Ctrl+Z after a bookmark kept saying "bookmark … added" [a real-window review]: an undo
+    or redo takes the message and the status line with the step's name. Control: a step
+    that is not there says nothing and keeps what was said."""
+    v = hud_viewer
+    v.edit(("render", "epsilon_scale"), 2.0)
+    v.message = "said of the edit"
+    assert v.undo() and v.scene.render.epsilon_scale == 1.0
+    assert v.message == "undid set render.epsilon_scale" == v.status_line()
+    assert v.redo() and v.message == "redid set render.epsilon_scale" == v.status_line()
+    v.message = "kept"
+    assert not v.redo() and v.message == "kept"

@@ -168,21 +168,23 @@ class Document:
         """A whole new scene (restoring a recovery, a bake): validated, one undo step."""
         self.commit(validated(scene), label)
 
-    def undo(self) -> bool:
-        """The scene before the last step; :attr:`restored`, the memo taken with it."""
+    def undo(self) -> Step | None:
+        """The scene before the last step, which is returned (None: none);
+        :attr:`restored`, the memo taken with it."""
         step = self.history.undo(self._memo())
         if step is not None:
             self.restored = step.memo_before
             self._set(step.before)
-        return step is not None
+        return step
 
-    def redo(self) -> bool:
-        """The scene after the next step; :attr:`restored`, the memo it was undone with."""
+    def redo(self) -> Step | None:
+        """The scene after the next step, which is returned (None: none); :attr:`restored`,
+        the memo it was undone with."""
         step = self.history.redo()
         if step is not None:
             self.restored = step.memo_after
             self._set(step.after)
-        return step is not None
+        return step
 
     def _memo(self) -> Hashable | None:
         return self.memo() if self.memo is not None else None

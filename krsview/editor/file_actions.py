@@ -67,9 +67,7 @@ class FileActions:
     document (a bookmark is one); ``opened`` is told when another scene was opened (the
     editor drops its selection and frames the scene)."""
 
-    def __init__(
-        self, viewer: Window, edit: Callable[[tuple, Any], bool], opened: Callable[[], None]
-    ):
+    def __init__(self, viewer: Window, edit: Callable[..., bool], opened: Callable[[], None]):
         self.viewer = viewer
         self._edit = edit
         self._opened = opened
@@ -92,7 +90,8 @@ class FileActions:
         """In the editor a bookmark is an edit like any other (saved with the scene)."""
         scene = self.doc.scene
         b = Bookmark(f"view {len(scene.bookmarks) + 1}", self.viewer.camera.to_camera())
-        if self._edit(("bookmarks",), scene.bookmarks + [b]):  # said where one looks too
+        label = f"add bookmark {b.name!r}"
+        if self._edit(("bookmarks",), scene.bookmarks + [b], label=label):  # said too
             self.viewer.message = f"bookmark {b.name!r} added (Ctrl+S saves it)"
             self.viewer.say(self.viewer.message)
 

@@ -316,12 +316,22 @@ class Timeline:
         elif imgui.is_item_active():
             if self.dragging is not None:
                 moved = moved_keys(scene, self.dragging, t_of(mouse.x))
-                out.append(vc.Edit(("animation",), moved, ("key", self.drags)))
+                label = f"move {self._what(scene, self.dragging)} in time"
+                out.append(vc.Edit(("animation",), moved, ("key", self.drags), label=label))
             else:
                 out.append(vc.SetTime(t_of(mouse.x)))
         else:
             self.dragging = None
         if hot is not None and imgui.is_item_clicked(imgui.MouseButton_.right):
-            gone = without_keys(scene, keys_together(scene, tracks, track, hot))
-            out.append(vc.Edit(("animation",), gone))
+            together = keys_together(scene, tracks, track, hot)
+            label = f"delete {self._what(scene, together)}"
+            out.append(vc.Edit(("animation",), without_keys(scene, together), label=label))
         return out
+
+    @staticmethod
+    def _what(scene: Scene, keys: list[tuple[int, int]]) -> str:
+        """The keys ``keys`` named for an undo step: the first one's moment and track."""
+        track, key = keys[0]
+        tr = scene.animation.tracks[track]
+        linked = f" and {counted(len(keys) - 1, 'linked key')}" if len(keys) > 1 else ""
+        return f"the key at {tr.keys[key].time:.2f} s of {tr.path}{linked}"

@@ -286,9 +286,10 @@ class Editor:
             return
         t = self.viewer.drawn.playback.time
         paths = linked_paths(self.scene, self.selected.path, self.carry)
-        if self.edit(("animation",), key_now(self.scene, paths, t)):
-            linked = f" and {counted(len(paths) - 1, 'linked level')}" if len(paths) > 1 else ""
-            self.viewer.message = f"key at {t:.2f} s for {self.selected.label}{linked}"
+        linked = f" and {counted(len(paths) - 1, 'linked level')}" if len(paths) > 1 else ""
+        label = f"key at {t:.2f} s for {self.selected.label}{linked}"
+        if self.edit(("animation",), key_now(self.scene, paths, t), label=label):
+            self.viewer.message = label
 
     def select(self, h: Handle | None) -> None:
         """Select ``h``; a compound component's fork also picks its level for the tools."""
@@ -401,7 +402,7 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),
     ec.SetSnap: lambda e, c: setattr(e.snap, "on", c.on),
     ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),
-    vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction, field=c.field),
+    vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction, c.label, c.field),
     vc.ResetView: lambda e, c: e.reset_view(),
     vc.Undo: lambda e, c: e.undo(),
     vc.Redo: lambda e, c: e.undo(redo=True),

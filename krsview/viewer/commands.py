@@ -33,6 +33,7 @@ class Edit(Command):
     # the field the person changed and its value, where the edit is a larger one (a MöKRS
     # step's change carried to its linked levels): a refusal is shown there
     field: tuple[tuple, Any] | None = None
+    label: str | None = None  # the undo step's name (None: "set" and the path)
 
 
 @dataclass(frozen=True)

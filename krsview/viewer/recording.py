@@ -15,6 +15,10 @@ from ..scene.presets import PRESET_DIR
 from ..scene.scene import write_atomic
 from .camera import FlyCamera
 
+# The command that renders a recorded path, its spaces unbreakable: the HUD wraps the message
+# around it, never inside it.
+RENDER_PATH = "`krsview render --camera-path`".replace(" ", "\u00a0")
+
 
 def path_file(scene_file: Path) -> Path:
     """Where the camera path of a preset is kept: beside it, ``NAME.path.json``; for a
@@ -64,7 +68,7 @@ class Recorder:
             self.source = self.file
             self.message = (
                 f"recorded {len(poses)} poses to {self.file.name} "
-                "(F6 replays; `krsview render --camera-path` renders its frames)"
+                f"(F6 replays; {RENDER_PATH} renders its frames)"
             )
         except OSError as e:
             self.error = f"{self.file}: cannot save the camera path: {e.strerror}"

@@ -18,6 +18,7 @@ import numpy as np
 from imgui_bundle import imgui  # noqa: F401  imported before glfw (docs/architecture.md, stack facts)
 
 from ..document.document import Document
+from ..document.history import Step
 from ..gpu.context import GL_VERSION
 from ..gpu.program import SHADER_DIR, ShaderError
 from ..gpu.renderer import Renderer
@@ -198,16 +199,20 @@ class Viewer:
         self.frames.full_shadows = on
 
     def undo(self) -> bool:
-        if self.doc.undo():
-            self.sync()
-            return True
-        return False
+        """Ctrl+Z: the scene before the last step; what is said says so (what was said of
+        that step, "bookmark added", no longer holds)."""
+        return self._stepped(self.doc.undo(), "undid")
 
     def redo(self) -> bool:
-        if self.doc.redo():
-            self.sync()
-            return True
-        return False
+        return self._stepped(self.doc.redo(), "redid")
+
+    def _stepped(self, step: Step | None, verb: str) -> bool:
+        if step is None:
+            return False
+        self.sync()
+        self.message = f"{verb} {step.label}"
+        self.say(self.message)
+        return True
 
     def reset_view(self) -> None:
         """R: the scene's camera at the moment shown (its tracks move it; the file's own
