@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from krsview.editor import panels
-from krsview.editor.keys import BETWEEN, ON_KEY
+from krsview.editor.keys import BETWEEN, DIAMOND, MARK_BETWEEN, MARK_ON_KEY, ON_KEY
 from krsview.editor.mokrs_panel import LEVELS
 from krsview.scene.edits import get_at
 from krsview.scene.presets import resolve
@@ -52,6 +52,17 @@ def frame_colour(e, path, colour) -> int:
     return int((np.abs(field - rgb) < 14).all(-1).sum())
 
 
+def diamond_pixels(e, path, mark) -> int:
+    """Pixels of the key's diamond (``mark``: ON_KEY filled, BETWEEN hollow) right of the
+    field at ``path`` and its label, as drawn in the window."""
+    x0, y0, x1, y1 = e.viewer.interactions.rects[path]
+    colour = MARK_ON_KEY if mark is ON_KEY else MARK_BETWEEN
+    rgb = np.array([colour & 0xFF, (colour >> 8) & 0xFF, (colour >> 16) & 0xFF])
+    shot = e.viewer.read_window().astype(int)
+    band = shot[round(y0) : round(y1), round(x1) : round(x1) + 2 * round(DIAMOND) + 4]
+    return int((np.abs(band - rgb) < 40).all(-1).sum())
+
+
 def test_the_mokrs_panel_shows_the_pose_marks_tracks_and_a_typed_value_keys_them(palm):
     from krsview.viewer.commands import SetTime
 
@@ -71,6 +82,9 @@ def test_the_mokrs_panel_shows_the_pose_marks_tracks_and_a_typed_value_keys_them
         other = BETWEEN if mark is ON_KEY else ON_KEY
         assert frame_colour(e, CURL, other) == 0
         assert frame_colour(e, FACTOR, mark) == 0, "an untracked field is marked"
+        whole = 32 if mark is ON_KEY else 16  # filled or hollow (whole: 40 and 20 pixels)
+        assert diamond_pixels(e, CURL, mark) >= whole, f"the diamond at {t} s is cut off"
+        assert diamond_pixels(e, FACTOR, mark) == 0
     e.execute([SetTime(1.0)])
     pump(e, 3)
     x0, y0, x1, y1 = scroll_to(e, CURL, 60, 0)

@@ -29,6 +29,7 @@ KEY_SNAP = 1e-3  # seconds: a key set this close to one already there replaces i
 KEY_GAP = 1e-3  # seconds kept between neighbouring keys when one is dragged in time
 STRIP_HEIGHT = 64.0  # pixels: the timeline strip at the window's foot
 DIAMOND = 6.0  # pixels: a key's half size on the strip
+MARK_ROOM = 2 * DIAMOND + 4.0  # pixels kept right of each field's label for its diamond
 KEY, KEY_HOT = 0xFF40C0FF, 0xFF40FFFF  # ImGui's packed ABGR: a key, the key under the pointer
 # A field a track moves, as Blender marks it: yellow with a key at the moment shown, green
 # between keys (its frame, and a diamond beside it: filled on a key, hollow between).

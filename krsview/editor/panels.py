@@ -24,7 +24,7 @@ from . import commands as ec
 from .file_actions import FileActions
 from .gizmo import Snap
 from .handles import Handle, outline
-from .keys import key_marks, marked
+from .keys import MARK_ROOM, key_marks, marked
 from .layout import MIN_WIDTH, Layout
 from .modals import answer_buttons, begin_modal
 from .mokrs_panel import mokrs_section
@@ -279,10 +279,11 @@ def _fields(
 ) -> None:
     """A widget per field of the dataclass ``obj`` at ``at``; nested tables recurse; the
     fields the program keeps (BOOKKEEPING) as a line of text; a field a track moves marked
-    (``marks``: keys.key_marks). The widgets leave room for the longest label: a narrow
-    panel cut labels off (shadow_softness)."""
+    (``marks``: keys.key_marks). The widgets leave room for the longest label (a narrow
+    panel cut labels off: shadow_softness) and a key's diamond after it, tracked or not, so
+    that a first key moves no field (the panel's edge cut the diamond off)."""
     longest = max((imgui.calc_text_size(f.name).x for f in fields(obj)), default=0.0)
-    imgui.push_item_width(-longest - imgui.get_style().item_inner_spacing.x)
+    imgui.push_item_width(-longest - imgui.get_style().item_inner_spacing.x - MARK_ROOM)
     for f in fields(obj):
         _field(obj, f, at, out, interactions, marks, albedo)
     imgui.pop_item_width()
