@@ -135,16 +135,18 @@ def fast_settings(scene: Scene) -> Scene:
     """The scene with the viewer's fast settings where its file sets none: the pre-pass
     tile VIEW_PREPASS (the level of detail and the shadow rays' pixel blocks are scene
     fields, DEFAULT_LOD and DEFAULT_SHADOW_BLOCK unless the file says otherwise), and for
-    a single KRS of LANES_LEVELS levels or more on the fragment path, persistent lanes
-    (``path="compute"``, ``steps=0``: the same image bit for bit). The oracle certifies both
+    a single KRS of LANES_LEVELS levels or more whose file sets no path, persistent lanes
+    (``path="compute"``, ``steps=0``: the same image bit for bit; else the fragment path,
+    as the viewer draws where the file sets none). The oracle certifies both
     geometry settings hole-free; hits may move by up to ε (pre-pass) and 2·lod·ε (level of
     detail)."""
     r, fast = scene.render, {}
     if r.prepass is None:  # 0 is the file's own "off"
         fast["prepass"] = VIEW_PREPASS
-    g = replace(scene, animation=None).geometry()  # the levels, not posed: motion adds none
-    if r.path == "fragment" and isinstance(g, KRS) and g.depth >= LANES_LEVELS:
-        fast.update(path="compute", steps=0)
+    if r.path is None:  # "fragment" is the file's own choice
+        g = replace(scene, animation=None).geometry()  # the levels, not posed: motion adds none
+        deep = isinstance(g, KRS) and g.depth >= LANES_LEVELS
+        fast.update({"path": "compute", "steps": 0} if deep else {"path": "fragment"})
     # constants within the schema's ranges: no edit (its validation of a whole animated
     # scene took 0.24 s a call on palm-curl, every frame of render())
     return replace(scene, render=replace(r, **fast)) if fast else scene

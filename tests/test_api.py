@@ -21,6 +21,7 @@ from PIL import Image
 import krsview
 from krsview.gpu.renderer import Renderer as GpuRenderer
 from krsview.scene.presets import resolve
+from krsview.scene.scene import scene_from_toml, scene_to_toml
 
 SIZE = (40, 24)
 
@@ -248,6 +249,9 @@ def test_fast_settings_trace_a_deep_krs_by_persistent_lanes_the_same_image():
     assert fast_settings(krsview.load("tree-sway")).render.path == "compute"  # a moving KRS
     rounds = tree.edit("render.path", "compute")  # a file's own choice of path stands
     assert fast_settings(rounds).render.steps == 16
+    kept = scene_from_toml(scene_to_toml(tree.edit("render.path", "fragment")))  # so does this
+    assert fast_settings(kept).render.path == "fragment", "a file's fragment path was overruled"
+    assert scene_from_toml(scene_to_toml(tree)).render.path is None  # control: none set
     lanes = krsview.render(tree, SIZE)
     fragment = GpuRenderer().render(configure(fast, path="fragment", steps=16), *SIZE)
     for name in ("color", "depth", "normal", "iterations", "hit"):

@@ -525,3 +525,37 @@ def test_undo_and_redo_say_what_they_undid_in_place_of_what_was_said_of_it(hud_v
     assert v.redo() and v.message == "redid set render.epsilon_scale" == v.status_line()
     v.message = "kept"
     assert not v.redo() and v.message == "kept"
+
+
+def test_the_huds_path_knob_shows_the_path_drawn_where_the_file_sets_none(
+    display, tmp_path, monkeypatch
+):
+    """The file sets no path (None: the fragment path, which the view draws): the HUD's path
+    knob shows "fragment", not a greyed "path: None" it could not change. Control: a file's
+    own "compute" is shown as it is."""
+    import krsview.viewer.hud as hud
+    from krsview.viewer.window import Viewer
+
+    from .test_editor import open_from_start
+
+    open_from_start(monkeypatch, "accuracy and view")
+    shown: dict[str, object] = {}
+    widget = hud.field_widget
+
+    def recording(label, value, meta, refused=None):
+        shown[label] = value
+        return widget(label, value, meta, refused)
+
+    monkeypatch.setattr(hud, "field_widget", recording)
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=SIZE, hud=True)
+    try:
+        assert v.scene.render.path is None
+        v.step(0.05)
+        assert shown["path##render"] == "fragment"
+        v.set_render(path="compute")
+        v.step(0.05)
+        assert shown["path##render"] == "compute"
+    finally:
+        v.close()

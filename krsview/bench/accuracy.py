@@ -119,7 +119,7 @@ def settings(scene: Scene) -> list[Setting]:
                         replace(scene, render=replace(r, shadow_block=block)),
                     )
                 )
-    if r.path == "fragment":  # the compute path's rounds, and its persistent lanes
+    if r.path != "compute":  # the compute path's rounds, and its persistent lanes
         out.append(Setting("path", "compute", replace(scene, render=replace(r, path="compute"))))
         lanes = replace(r, path="compute", steps=0)
         out.append(Setting("path", "lanes", replace(scene, render=lanes)))

@@ -142,7 +142,11 @@ def spread_text(m: Measured, column: str = "ms") -> str:
 
 def table(m: Measured) -> str:
     rs = m.scene.render
-    path = "persistent lanes" if rs.path == "compute" and rs.steps == 0 else f"{rs.path} path"
+    path = (
+        "persistent lanes"
+        if rs.path == "compute" and rs.steps == 0
+        else f"{rs.path or 'fragment'} path"
+    )
     text = (
         f"\nA zoom into the finest kernel — {m.scene.name}, {m.size[0]}×{m.size[1]}, pre-pass "
         f"{rs.prepass or 'off'}, {path}, ms {TIME_SPREAD} of {m.rounds} interleaved rounds\n\n"

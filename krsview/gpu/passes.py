@@ -56,7 +56,7 @@ def splits_shadows(scene: Scene) -> bool:
     in float (the trace pass hands each ray's distance on as a float)."""
     return (
         bool(SHADOW_EFFECTS & set(scene.effects))
-        and (scene.render.path == "fragment" or scene.render.steps == 0)
+        and (scene.render.path != "compute" or scene.render.steps == 0)
         and scene.render.precision == "float"
     )
 

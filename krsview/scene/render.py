@@ -12,7 +12,7 @@ from .schema import COLOR, Vec3, param
 TRACERS = ("sphere", "binary", "relaxed")
 PRECISIONS = ("float", "double")
 SWITCH = ("on", "off")
-PATHS = ("fragment", "compute")
+PATHS = ("fragment", "compute")  # the first is drawn where the file sets none (api.fast_settings)
 PREPASS_RATIO = 4  # pre-pass: a coarse pass's tiles are this many times as wide as the next's
 TARGET_DISTANCE = 1e-9  # below this the view direction is lost to rounding
 # Defaults of the render knobs that the windows and the command line share.
@@ -24,8 +24,8 @@ DEFAULT_LOD = 0.5
 # mean colour, for 14–26 % of a still frame on tree and grove (docs/speed.md); 1: per pixel
 DEFAULT_SHADOW_BLOCK = 2
 # A single KRS this deep traces its primary rays with persistent lanes where the file sets
-# the fragment path (the same image: inside tree's crown 0.82–0.84× the CPU, its whole views
-# within noise; a MöKRS, a compound and shallow trees lose; docs/speed.md)
+# no path (the same image: inside tree's crown 0.82–0.84× the CPU, its whole views within
+# noise; a MöKRS, a compound and shallow trees lose; docs/speed.md)
 LANES_LEVELS = 20
 
 
@@ -159,14 +159,15 @@ class Render:
         "penumbra's radius t/k for soft ones, inside which nothing can darken it (off: every "
         "component from the surface on, as the reference's exact shadows)",
     )
-    path: str = param(
-        "fragment",
+    path: str | None = param(
+        None,
         choices=PATHS,
         help="fragment: one full-screen pass traces and shades each pixel; "
         "compute: rays in a storage buffer traced in rounds of "
         "--steps iterations, finished rays leaving the queue (or by "
         "persistent lanes: --steps 0), then shaded in a deferred pass "
-        "(the same image)",
+        "(the same image); not given: fragment, but `krsview render` and "
+        f"the API trace a single KRS of {LANES_LEVELS} levels or more by persistent lanes",
     )
     steps: int = param(
         16,

@@ -208,7 +208,10 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
         if name == "tracer" and v.scene.mokrs is not None:
             meta = {**meta, "choices": ("binary",)}  # a MöKRS has only unbounding tests
         refused = interactions.refusal(("render", name))  # a refused value stays here
-        changed, value = field_widget(f"{name}##render", getattr(r, name), meta, refused)
+        shown = getattr(r, name)
+        if shown is None:  # not set (the path): the first choice is what the view draws
+            shown = meta["choices"][0]
+        changed, value = field_widget(f"{name}##render", shown, meta, refused)
         key = interactions.key(("render", name))
         if changed:
             out.append(c.Edit(("render", name), value, key))
