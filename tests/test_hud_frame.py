@@ -97,9 +97,13 @@ def fly(v, turns: int) -> list[tuple]:
     return out
 
 
-def test_the_hud_over_a_frame_shows_that_frame_though_built_while_it_is_traced(flying):
+def test_the_hud_over_a_frame_shows_that_frame_though_built_while_it_is_traced(flying, monkeypatch):
     v = flying
-    v.frames.adaptive.target_fps = 60.0  # small moving frames, a new size each turn
+    a, scales = v.frames.adaptive, iter([0.3, 0.4] * 8)
+    # a new size each turn, whatever the machine's load (the frame rate's own changes were
+    # too few on a busy machine for the control below)
+    monkeypatch.setattr(a, "frame_done", lambda *_, **__: setattr(a, "scale", next(scales)))
+    monkeypatch.setattr(a, "predict", lambda *_, **__: None)
     turns = fly(v, 8)
     for after, shown, numbers, _, before, drawn in turns:
         # the numbers describe the image the display pass drew under them, the one on screen
@@ -109,7 +113,7 @@ def test_the_hud_over_a_frame_shows_that_frame_though_built_while_it_is_traced(f
     # negative control: what the HUD's other part saw is the frame before, a size off in
     # some turns: numbers read then would have been one frame late
     stale = [begun.size != shown for _, shown, _, begun, *_ in turns[1:]]
-    assert sum(stale) >= 3, stale
+    assert sum(stale) >= 5, stale
 
 
 def test_the_numbers_fill_the_slot_left_for_them(flying, monkeypatch):
