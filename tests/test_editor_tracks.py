@@ -99,6 +99,8 @@ def test_the_mokrs_panel_shows_the_pose_marks_tracks_and_a_typed_value_keys_them
         e.doc.history.steps[0].before, (*LEVELS, 57, "transform")
     )
     assert len(e.doc.history.steps) == 1, "the typed value was not one undo step"
+    # what Ctrl+Z will say: the field typed into, keyed (not "set animation")
+    assert e.doc.history.labels()[0] == ["key mokrs.levels[58].transform[1].degrees at 1.00 s"]
     xdo("mousemove", *map(round, window_xy(e, 20, 250)))  # off the field: not hovered
     pump(e, 3)
     assert frame_colour(e, CURL, ON_KEY) > 50, "the new key is not marked"
@@ -125,6 +127,8 @@ def test_k_and_the_strips_key_edits_reach_every_linked_curl_in_a_window(palm):
     xdo("key", "k")
     pump(e, 3)
     assert times() == {(0, 1, 2, 4)}, "K did not key every linked curl"
+    said = e.viewer.message  # in the status line too: the HUD starts folded
+    assert said.startswith("key at 1.00 s") and e.viewer.status_line() == said
 
     def on_bar(t: float) -> tuple[int, int]:
         x, y, width = e.timeline.bar
@@ -135,6 +139,7 @@ def test_k_and_the_strips_key_edits_reach_every_linked_curl_in_a_window(palm):
     xdo("click", 3)
     pump(e, 3)
     assert times() == {(0, 2, 4)}, "the right-click deleted the key of one curl only"
+    assert e.viewer.message == "", "what was said of the key deleted stayed"
     xdo("mousemove", *on_bar(2.0))
     pump(e, 3)
     xdo("mousedown", 1)

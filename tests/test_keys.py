@@ -41,6 +41,8 @@ def test_a_key_makes_a_track_and_a_key_at_the_same_moment_replaces_it(bent):
     c = with_key(s, FORK, 0.5, (0.0, 0.9, 0.0))  # before it: sorted in front
     assert [k.time for k in c.tracks[0].keys] == [0.5, 2.0]
     assert with_key(s, FORK, 14.0, (0.0, 1.0, 0.0)).duration == 14.0  # the loop reaches it
+    noisy = with_key(s, FORK, 1.7000000000000006, (0.0, 1.0, 0.0))  # a time after playing
+    assert [k.time for k in noisy.tracks[0].keys] == [1.7, 2.0], "saved with its float noise"
     saved = scene_from_toml(scene_to_toml(bent.edit("animation", c)))
     assert saved.animation.tracks == c.tracks
 
@@ -66,6 +68,7 @@ def test_a_key_dragged_in_time_stays_between_its_neighbours_and_right_click_dele
         s = s.edit("animation", with_key(s, FORK, t, (0.0, t, 0.0)))
     times = [k.time for k in moved_keys(s, [(0, 1)], 2.5).tracks[0].keys]
     assert times == [1.0, 2.5, 3.0]
+    assert moved_keys(s, [(0, 1)], 2.4995515695).tracks[0].keys[1].time == 2.5  # to the ms
     times = [k.time for k in moved_keys(s, [(0, 1)], 9.0).tracks[0].keys]
     assert times[1] < times[2] == 3.0, "a key passed its neighbour"
     assert [k.time for k in without_keys(s, [(0, 0)]).tracks[0].keys] == [2.0, 3.0]

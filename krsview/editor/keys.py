@@ -27,6 +27,9 @@ from . import commands as ec
 
 KEY_SNAP = 1e-3  # seconds: a key set this close to one already there replaces it
 KEY_GAP = 1e-3  # seconds kept between neighbouring keys when one is dragged in time
+KEY_DIGITS = 3  # a key's time is kept to the millisecond (no float noise saved: 1.7, not
+# 1.7000000000000006 after playing)
+STRIP_DIGITS = 2  # the strip's times go by hundredths of a second (a click at "2.00 s")
 STRIP_HEIGHT = 64.0  # pixels: the timeline strip at the window's foot
 DIAMOND = 6.0  # pixels: a key's half size on the strip
 MARK_ROOM = 2 * DIAMOND + 4.0  # pixels kept right of each field's label for its diamond
@@ -48,7 +51,7 @@ def track_index(scene: Scene, path: tuple) -> int | None:
 def with_key(scene: Scene, path: tuple, t: float, value: Any) -> Animation:
     """The scene's animation with the key (t, value) in the track of ``path`` (a new track if
     it has none; a key within KEY_SNAP of t is replaced). The loop grows to reach the key."""
-    a = scene.animation or Animation()
+    a, t = scene.animation or Animation(), round(t, KEY_DIGITS)
     value = tuple(value) if isinstance(value, (list, tuple)) else value
     tracks = list(a.tracks)
     i = track_index(scene, path)
@@ -209,7 +212,7 @@ def moved_keys(scene: Scene, keys: list[tuple[int, int]], t: float) -> Animation
         ks = list(tracks[track].keys)
         lo = ks[key - 1].time + KEY_GAP if key > 0 else 0.0
         hi = ks[key + 1].time - KEY_GAP if key + 1 < len(ks) else a.duration
-        ks[key] = Key(min(max(t, lo), hi), ks[key].value)
+        ks[key] = Key(round(min(max(t, lo), hi), KEY_DIGITS), ks[key].value)
         tracks[track] = replace(tracks[track], keys=ks)
     return replace(a, tracks=tracks)
 
@@ -281,7 +284,9 @@ class Timeline:
             return origin.x + width * t / playback.duration
 
         def t_of(x: float) -> float:
-            return min(max((x - origin.x) / width, 0.0), 1.0) * playback.duration
+            return round(
+                min(max((x - origin.x) / width, 0.0), 1.0) * playback.duration, STRIP_DIGITS
+            )
 
         draw.add_line(imgui.ImVec2(origin.x, y), imgui.ImVec2(origin.x + width, y), 0xFF808080, 2)
         mouse = imgui.get_io().mouse_pos

@@ -149,11 +149,16 @@ class Editor:
         [KRS17 §7]. A value refused for a field the panel shows keeps its message at that
         field (viewer/widgets.py), any other in the panel's error line. A value a track
         moves is keyed at the moment shown instead (keys.py), as a drag or a typed value.
-        ``label`` names the undo step (the undo button's tooltip); by default the path set.
-        ``field``: the (path, value) the person changed where ``path`` is a larger edit (a
-        step carried to its linked levels): a refusal names it first and stays at it."""
-        v = self.viewer
-        path, value = keyed_edit(self.scene, path, value, v.drawn.playback.time)
+        ``label`` names the undo step (the undo button's tooltip, what Ctrl+Z says); by
+        default the field the person changed, set or keyed. ``field``: the (path, value) the
+        person changed where ``path`` is a larger edit (a step carried to its linked
+        levels): a refusal names it first and stays at it. What was said before no longer
+        describes the scene once it changed: it goes."""
+        v, t = self.viewer, self.viewer.drawn.playback.time
+        changed = path_text(field[0] if field is not None else path)
+        path, value = keyed_edit(self.scene, path, value, t)
+        keyed = path == ("animation",) and not changed.startswith("animation")
+        label = label or (f"key {changed} at {t:.2f} s" if keyed else f"set {changed}")
         try:
             scene = apply_edit(self.scene, path, value)
             if scene.mokrs is not None:
@@ -163,8 +168,8 @@ class Editor:
             if field is not None and e.path != path_text(field[0]):  # named where it was typed
                 v.error = str(SceneError(path_text(field[0]), field[1], str(e)))
         else:
-            self.doc.commit(scene, label or f"set {path_text(path)}", interaction)
-            v.error = ""
+            self.doc.commit(scene, label, interaction)
+            v.error = v.message = ""
             v.sync()
         ok = not v.error
         if field is not None:
@@ -290,6 +295,7 @@ class Editor:
         label = f"key at {t:.2f} s for {self.selected.label}{linked}"
         if self.edit(("animation",), key_now(self.scene, paths, t), label=label):
             self.viewer.message = label
+            self.viewer.say(label)  # the HUD, where the message goes, starts folded
 
     def select(self, h: Handle | None) -> None:
         """Select ``h``; a compound component's fork also picks its level for the tools."""
