@@ -154,6 +154,8 @@ def test_a_bookmark_is_an_edit_saved_with_the_scene_not_written_at_once(tree):
     # the viewer's own bookmark (negative control) is appended to the file on disk at once
     w.file.add_bookmark()
     assert len(load_scene(tree).bookmarks) == before + 1
+    assert w.message.startswith("saved bookmark") and w.said[-1] == w.message  # said too
+    assert w.doc.history.labels()[0][-1] == f"add bookmark 'view {before + 1}'"
 
 
 def test_a_shipped_preset_asks_for_its_copy_then_saves_and_follows_it(tmp_path, monkeypatch):

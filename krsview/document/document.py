@@ -262,7 +262,11 @@ class Document:
         from then on. SceneError: the file cannot be read or written."""
         if self.template:
             name = f"view {len(self._scene.bookmarks) + 1}"
-            self.apply(("bookmarks",), self._scene.bookmarks + [Bookmark(name, camera)])
+            self.apply(
+                ("bookmarks",),
+                self._scene.bookmarks + [Bookmark(name, camera)],
+                label=f"add bookmark {name!r}",
+            )
             return name, self.save(copy_target(self.path))
         on_disk = load_scene(self.path)
         name = f"view {len(on_disk.bookmarks) + 1}"
@@ -273,7 +277,7 @@ class Document:
             write_atomic(self.path, text)
         except OSError as e:
             raise SceneError("<file>", str(self.path), f"cannot save: {e.strerror}") from None
-        self.apply(("bookmarks",), written.bookmarks)
+        self.apply(("bookmarks",), written.bookmarks, label=f"add bookmark {name!r}")
         self.mark_saved(written, text)
         return name, self.path
 

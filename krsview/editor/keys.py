@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import replace
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from imgui_bundle import imgui
@@ -23,12 +23,13 @@ from ..scene.edits import Path, apply_edit, get_at, parse_path, path_text, repla
 from ..scene.mokrs import linked_edit, linked_levels
 from ..viewer import commands as vc
 from ..viewer.playback import Playback
+from ..viewer.window import Viewer
 from . import commands as ec
+from .handles import Handle
 
 KEY_SNAP = 1e-3  # seconds: a key set this close to one already there replaces it
 KEY_GAP = 1e-3  # seconds kept between neighbouring keys when one is dragged in time
-KEY_DIGITS = 3  # a key's time is kept to the millisecond (no float noise saved: 1.7, not
-# 1.7000000000000006 after playing)
+KEY_DIGITS = 3  # a key's time is kept to the millisecond: 1.7, not 1.7000000000000006
 STRIP_DIGITS = 2  # the strip's times go by hundredths of a second (a click at "2.00 s")
 STRIP_HEIGHT = 64.0  # pixels: the timeline strip at the window's foot
 DIAMOND = 6.0  # pixels: a key's half size on the strip
@@ -78,6 +79,33 @@ def key_now(scene: Scene, paths: list[Path], t: float) -> Animation:
         value = held(scene, path, get_at(drawn, path), t)
         keyed = replace(keyed, animation=with_key(keyed, path, t, value))
     return keyed.animation
+
+
+class Keyed(Protocol):
+    """What K reads and calls of the editor."""
+
+    selected: Handle | None
+    carry: bool  # step edits go to linked levels
+    viewer: Viewer
+
+    @property
+    def scene(self) -> Scene: ...
+    def edit(self, path: tuple, value: Any, interaction: Any = None, label: Any = None) -> bool: ...
+
+
+def set_key(e: Keyed) -> None:
+    """K: a key for the selected value (``linked_paths``) at the moment shown, holding the
+    value drawn; said in the status line too, since the HUD, where the message goes, starts
+    folded."""
+    if e.selected is None:
+        e.viewer.message = "select a handle to key its value (K)"
+        return
+    t = e.viewer.drawn.playback.time
+    paths = linked_paths(e.scene, e.selected.path, e.carry)
+    label = f"key at {t:.2f} s for {e.selected.label}{and_linked(len(paths) - 1, 'level')}"
+    if e.edit(("animation",), key_now(e.scene, paths, t), label=label):
+        e.viewer.message = label
+        e.viewer.say(label)
 
 
 def linked_paths(scene: Scene, path: Path, carry: bool) -> list[Path]:
@@ -196,11 +224,17 @@ def keys_together(scene: Scene, tracks: list[int], track: int, key: int) -> list
     a = scene.animation
     t = a.tracks[track].keys[key].time
     out = [(track, key)]
-    for i in tracks:
+    for i in (i for i in tracks if i != track):
         j = next((j for j, k in enumerate(a.tracks[i].keys) if abs(k.time - t) <= KEY_SNAP), None)
-        if i != track and j is not None:
+        if j is not None:
             out.append((i, j))
     return out
+
+
+def and_linked(n: int, noun: str) -> str:
+    """What an act on ``n`` linked levels (keys, …) adds to its words: " and 29 linked
+    levels"; nothing for none."""
+    return f" and {counted(n, 'linked ' + noun)}" if n else ""
 
 
 def moved_keys(scene: Scene, keys: list[tuple[int, int]], t: float) -> Animation:
@@ -262,8 +296,7 @@ class Timeline:
         tracks = [i for i in (track_index(scene, p) for p in paths) if i is not None]
         track = track_index(scene, paths[0]) if paths else None
         what = path_text(paths[0]) if paths else "select a handle to key it"
-        if len(paths) > 1:
-            what += f" and {counted(len(paths) - 1, 'linked level')}"
+        what += and_linked(len(paths) - 1, "level")
         imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {what}")
         out += self._bar(scene, playback, track, tracks)
         imgui.end()
@@ -339,5 +372,5 @@ class Timeline:
         """The keys ``keys`` named for an undo step: the first one's moment and track."""
         track, key = keys[0]
         tr = scene.animation.tracks[track]
-        linked = f" and {counted(len(keys) - 1, 'linked key')}" if len(keys) > 1 else ""
+        linked = and_linked(len(keys) - 1, "key")
         return f"the key at {tr.keys[key].time:.2f} s of {tr.path}{linked}"

@@ -31,7 +31,6 @@ from ..compile.geometry import scene_ball
 from ..compile.mokrs import check_drawable
 from ..document.document import Document
 from ..gpu.overlay import Overlay
-from ..messages import counted
 from ..scene import Scene, SceneError
 from ..scene.edits import apply_edit, path_text
 from ..scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings
@@ -47,7 +46,7 @@ from .file_actions import FILE_HANDLERS, FileActions
 from .gizmo import Gizmo
 from .grab import Grabbing
 from .handles import Handle, level_handle
-from .keys import Timeline, key_now, keyed_edit, linked_paths
+from .keys import Timeline, keyed_edit, set_key
 from .layout import Layout, frame, shift
 from .mokrs_panel import KindsLeft
 from .picking import pick, visible
@@ -284,19 +283,6 @@ class Editor:
         self.viewer.sync()
         self.viewer.message = said
 
-    def set_key(self) -> None:
-        """K: a key for the selected value at the moment shown, holding the value drawn."""
-        if self.selected is None:
-            self.viewer.message = "select a handle to key its value (K)"
-            return
-        t = self.viewer.drawn.playback.time
-        paths = linked_paths(self.scene, self.selected.path, self.carry)
-        linked = f" and {counted(len(paths) - 1, 'linked level')}" if len(paths) > 1 else ""
-        label = f"key at {t:.2f} s for {self.selected.label}{linked}"
-        if self.edit(("animation",), key_now(self.scene, paths, t), label=label):
-            self.viewer.message = label
-            self.viewer.say(label)  # the HUD, where the message goes, starts folded
-
     def select(self, h: Handle | None) -> None:
         """Select ``h``; a compound component's fork also picks its level for the tools."""
         self.selected = h
@@ -402,7 +388,7 @@ class Editor:
 # tests/test_commands.py checks them.
 EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.Bake: lambda e, c: e.bake(c.component),
-    ec.SetKey: lambda e, c: e.set_key(),
+    ec.SetKey: lambda e, c: set_key(e),
     ec.Select: lambda e, c: e.select(c.handle),
     ec.SelectLevel: lambda e, c: e.select_level(c.level),
     ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),

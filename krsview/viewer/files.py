@@ -134,6 +134,7 @@ class ViewerFile:
         v.sync()
         self.follow()  # our own save is not an outside edit
         v.message = f"saved bookmark {name!r} in {saved}"
+        v.say(v.message)  # over what the foot said before ("no bookmarks yet …")
 
     def reload_shaders(self) -> None:
         """Compile the current variant from the edited files; on failure keep the old ones."""
