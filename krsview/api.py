@@ -30,13 +30,13 @@ import numpy as np
 from .frame import Frame
 from .inputs import output_file, scene_of, size_of, switch, whole
 from .scene import Render, Scene, SceneError, save_scene
-from .scene.edits import vouched
+from .scene.edits import still_checked, vouched
 from .scene.filetext import saved_text
 from .scene.info import SceneInfo, describe
 from .scene.model import KRS
 from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
-from .scene.render import LANES_LEVELS, VIEW_PREPASS
+from .scene.render import HARDWARE_PREPASS, LANES_LEVELS, VIEW_PREPASS
 from .scene.scene import scene_from_toml, write_atomic
 from .scene.schema import from_dict
 from .scene.settings import MAX_SIDE
@@ -47,6 +47,7 @@ RENDER_KNOBS = tuple(f.name for f in fields(Render))  # render(**knobs): the [re
 _lock = threading.RLock()
 _context = None  # the process's headless GL context, made on first use
 _context_pid = 0  # the process that made it: a child forked after it cannot draw with it
+_hardware: bool | None = None  # whether that context draws on a GPU (on_hardware)
 FORKED = (
     "krsview: this process was forked after krsview had drawn in its parent: an OpenGL "
     "context does not survive a fork (and with Mesa the child cannot make its own); start "
@@ -131,25 +132,42 @@ def configure(
     return scene if levels is None else scene.with_levels(levels)
 
 
-def fast_settings(scene: Scene) -> Scene:
+def fast_settings(scene: Scene, hardware: bool = False) -> Scene:
     """The scene with the viewer's fast settings where its file sets none: the pre-pass
     tile VIEW_PREPASS (the level of detail and the shadow rays' pixel blocks are scene
     fields, DEFAULT_LOD and DEFAULT_SHADOW_BLOCK unless the file says otherwise), and for
     a single KRS of LANES_LEVELS levels or more whose file sets no path, persistent lanes
     (``path="compute"``, ``steps=0``: the same image bit for bit; else the fragment path,
-    as the viewer draws where the file sets none). The oracle certifies both
+    as the viewer draws where the file sets none). On ``hardware`` (a GPU:
+    :func:`on_hardware`) the pre-pass tile is HARDWARE_PREPASS, and every scene whose file
+    sets no path is traced by the compute path's rounds. The oracle certifies both
     geometry settings hole-free; hits may move by up to ε (pre-pass) and 2·lod·ε (level of
     detail)."""
     r, fast = scene.render, {}
     if r.prepass is None:  # 0 is the file's own "off"
-        fast["prepass"] = VIEW_PREPASS
-    if r.path is None:  # "fragment" is the file's own choice
+        fast["prepass"] = HARDWARE_PREPASS if hardware else VIEW_PREPASS
+    if r.path is None and hardware:  # rounds of render.steps iterations
+        fast["path"] = "compute"
+    elif r.path is None:  # "fragment" is the file's own choice
         g = replace(scene, animation=None).geometry()  # the levels, not posed: motion adds none
         deep = isinstance(g, KRS) and g.depth >= LANES_LEVELS
         fast.update({"path": "compute", "steps": 0} if deep else {"path": "fragment"})
     # constants within the schema's ranges: no edit (its validation of a whole animated
     # scene took 0.24 s a call on palm-curl, every frame of render())
-    return replace(scene, render=replace(r, **fast)) if fast else scene
+    return still_checked(scene, replace(scene, render=replace(r, **fast))) if fast else scene
+
+
+def on_hardware() -> bool:
+    """Whether this process draws on a GPU rather than a CPU rasteriser such as Mesa's
+    llvmpipe: there :func:`fast_settings` trace by the compute path's rounds."""
+    global _hardware
+    if _hardware is None:
+        from .gpu.context import hardware
+
+        ctx = _shared_context()
+        with _lock, ctx:
+            _hardware = hardware(ctx.info["GL_RENDERER"])
+    return _hardware
 
 
 def exact_settings(scene: Scene) -> Scene:
@@ -253,11 +271,13 @@ class Renderer:
         left unset by a knob (``prepass=None``: "not given", as in a file) is the setting's
         own (the fast tile, or none with ``exact``)."""
         scene = scene_of(scene)
-        exact = switch(exact, "exact")
-        scene = configure((exact_settings if exact else fast_settings)(scene), **knobs)
+        exact, hardware = switch(exact, "exact"), on_hardware()
+        scene = configure(
+            exact_settings(scene) if exact else fast_settings(scene, hardware), **knobs
+        )
         if scene.render.prepass is None:
-            tile = 0 if exact else VIEW_PREPASS
-            scene = replace(scene, render=replace(scene.render, prepass=tile))
+            tile = 0 if exact else HARDWARE_PREPASS if hardware else VIEW_PREPASS
+            scene = still_checked(scene, replace(scene, render=replace(scene.render, prepass=tile)))
         return scene
 
     def close(self) -> None:
@@ -404,6 +424,7 @@ def certify(
             "the oracle covers scenes without twist or empty zones "
             "(their distortions are not in it)",
         )
-    scene = fast_settings(scene if tracer is None else configure(scene, tracer=tracer))
+    scene = scene if tracer is None else configure(scene, tracer=tracer)
+    scene = fast_settings(scene, on_hardware())
     frame = render(scene, size)
     return count_errors(scene, frame, max_segments=max_segments or MAX_SEGMENTS)

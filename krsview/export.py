@@ -101,10 +101,11 @@ def frames(
     sets none, or with ``exact`` every level and no pre-pass; so they are the frames of
     `krsview render --camera-path` (and ``--exact``), and either resumes the other's folder.
     Returns the frames' files in order."""
-    from .api import Renderer, exact_settings, fast_settings
+    from .api import Renderer, exact_settings, fast_settings, on_hardware
 
-    settle = exact_settings if switch(exact, "exact") else fast_settings
-    scene, size = settle(scene_of(scene)), size_of(size)
+    scene, size = scene_of(scene), size_of(size)
+    exact = switch(exact, "exact")
+    scene = exact_settings(scene) if exact else fast_settings(scene, on_hardware())
     path = camera_path if isinstance(camera_path, CameraPath) else load_camera_path(camera_path)
     fps = real(fps, "fps", 1.0, 240.0)
     wanted = parse_frames(which, path.frame_count(fps), "which")  # before the folder is made

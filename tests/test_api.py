@@ -23,6 +23,8 @@ from krsview.gpu.renderer import Renderer as GpuRenderer
 from krsview.scene.presets import resolve
 from krsview.scene.scene import scene_from_toml, scene_to_toml
 
+from .conftest import same
+
 SIZE = (40, 24)
 
 
@@ -69,7 +71,9 @@ def test_edit_returns_a_new_validated_scene_and_leaves_the_old_one():
 def test_render_is_the_gpu_renderers_image_and_knobs_are_edits():
     scene = krsview.load("rock")
     frame = krsview.render(scene, SIZE)
-    direct = GpuRenderer().render(krsview.api.fast_settings(scene), *SIZE)
+    direct = GpuRenderer().render(
+        krsview.api.fast_settings(scene, krsview.api.on_hardware()), *SIZE
+    )
     for name in ("color", "depth", "normal", "iterations", "hit"):
         assert np.array_equal(getattr(frame, name), getattr(direct, name)), name
     assert frame.size == SIZE and frame.color.shape == (SIZE[1], SIZE[0], 3)
@@ -252,11 +256,50 @@ def test_fast_settings_trace_a_deep_krs_by_persistent_lanes_the_same_image():
     kept = scene_from_toml(scene_to_toml(tree.edit("render.path", "fragment")))  # so does this
     assert fast_settings(kept).render.path == "fragment", "a file's fragment path was overruled"
     assert scene_from_toml(scene_to_toml(tree)).render.path is None  # control: none set
-    lanes = krsview.render(tree, SIZE)
+    lanes = GpuRenderer().render(fast, *SIZE)
     fragment = GpuRenderer().render(configure(fast, path="fragment", steps=16), *SIZE)
-    for name in ("color", "depth", "normal", "iterations", "hit"):
-        assert np.array_equal(getattr(lanes, name), getattr(fragment, name)), name
+    assert same(lanes, fragment)
     # on the command line an option given stands too
     for argv, path in ((["tree"], "compute"), (["tree", "--path", "fragment"], "fragment")):
         args = build_parser().parse_args(["render", *argv])
         assert settled(args, scene_of(args)).render.path == path, argv
+
+
+def test_on_a_gpu_the_fast_settings_trace_by_the_compute_paths_rounds(monkeypatch):
+    """On a GPU (not a CPU rasteriser) `render`, the API and the benches trace every scene
+    whose file sets no path by the compute path's rounds, from the pre-pass tile
+    HARDWARE_PREPASS (2.4–7.3× the fragment path on an H100; docs/speed.md); a file's own
+    path, pre-pass and steps stand. The same scene on llvmpipe keeps lanes or the fragment
+    path (the control), and the rounds draw the fragment path's image (tests/test_compute.py)."""
+    from krsview import api
+    from krsview.cli import build_parser
+    from krsview.cli.options import scene_of
+    from krsview.cli.render import settled
+    from krsview.gpu.context import hardware
+    from krsview.scene.render import HARDWARE_PREPASS, VIEW_PREPASS
+
+    assert not hardware("llvmpipe (LLVM 15.0.6, 256 bits)")
+    assert not hardware("Google SwiftShader") and not hardware("softpipe")
+    assert hardware("NVIDIA H100 80GB HBM3/PCIe/SSE2") and hardware("AMD Radeon RX 7900 XTX")
+    with api._lock, api._shared_context() as ctx:
+        assert api.on_hardware() == hardware(ctx.info["GL_RENDERER"])
+    for name in krsview.presets():
+        scene = krsview.load(name)
+        r, gpu = scene.render, api.fast_settings(scene, hardware=True).render
+        assert gpu.path == (r.path or "compute"), name
+        assert gpu.prepass == (HARDWARE_PREPASS if r.prepass is None else r.prepass), name
+        assert gpu.steps == r.steps, name
+    tree = krsview.load("tree")
+    kept = tree.edit("render.path", "fragment").edit("render.prepass", 2)
+    assert api.fast_settings(kept, hardware=True).render == kept.render  # the file's own
+    monkeypatch.setattr(api, "_hardware", True)
+    assert api.Renderer._settled(tree, False).render.path == "compute"
+    assert api.Renderer._settled(tree, False).render.steps == 16
+    assert api.Renderer._settled(tree, False, prepass=None).render.prepass == HARDWARE_PREPASS
+    assert api.Renderer._settled(tree, True).render.path is None  # exact: as the file says
+    args = build_parser().parse_args(["render", "rock"])
+    assert settled(args, scene_of(args)).render.path == "compute"
+    monkeypatch.setattr(api, "_hardware", False)  # control: a CPU rasteriser
+    assert api.Renderer._settled(tree, False).render.steps == 0  # persistent lanes
+    assert api.Renderer._settled(tree, False, prepass=None).render.prepass == VIEW_PREPASS
+    assert settled(args, scene_of(args)).render.path == "fragment"

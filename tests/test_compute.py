@@ -17,20 +17,15 @@ from krsview.scene import load_scene
 from krsview.scene.presets import preset_names, resolve
 from krsview.scene.render import VIEW_PREPASS
 
-from .conftest import broken_shaders
+from .conftest import broken_shaders, same, same_field
 
 W, H = 64, 36
-FIELDS = ("color", "depth", "normal", "iterations", "hit")
 
 
 def on_path(scene, path, **render):
     """``scene`` on ``path`` with ``render`` knobs, a shadow ray per pixel: the compute path
     traces no other (passes.still_ratio), so the fragment path's image it equals is that."""
     return replace(scene, render=replace(scene.render, path=path, shadow_block=1, **render))
-
-
-def same(a, b) -> bool:
-    return all(np.array_equal(getattr(a, f), getattr(b, f)) for f in FIELDS)
 
 
 @pytest.mark.parametrize(
@@ -161,8 +156,7 @@ def test_a_task_per_component_keeps_every_hit(renderer, tracer, prepass):
     assert "KRS_COMPONENT_TASKS" in variant_defines(tasks, c)
     assert "KRS_COMPONENT_TASKS" not in variant_defines(on_path(scene, "compute"), c)
     fragment, traced = renderer.render(scene, W, H), renderer.render(tasks, W, H)
-    for field in ("color", "depth", "normal", "hit"):
-        assert np.array_equal(getattr(fragment, field), getattr(traced, field)), field
+    assert same(fragment, traced, ("color", "depth", "normal", "hit"))
     assert fragment.hit.any() and (traced.iterations >= fragment.iterations).all()
     assert (traced.iterations > fragment.iterations).any()
 
@@ -176,7 +170,7 @@ def test_component_tasks_count_the_cap_per_task(renderer):
     free = fragment.iterations < 12
     assert (~free).any()
     for field in ("color", "depth", "hit"):
-        assert np.array_equal(getattr(fragment, field)[free], getattr(traced, field)[free])
+        assert same_field(getattr(fragment, field)[free], getattr(traced, field)[free], field)
     assert (traced.hit & ~fragment.hit).any()
 
 

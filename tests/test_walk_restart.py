@@ -194,7 +194,8 @@ def test_the_compute_path_takes_the_same_restarted_steps(renderer, precision):
     """The anchor lives in the Ray between rounds (compile/std430.py): the compute path's
     image equals the fragment path's, bit for bit; negative control: the image without the
     restart is not that image."""
-    from .test_compute import on_path, same
+    from .conftest import same
+    from .test_compute import on_path
 
     scene = on_path(crown(), "fragment", precision=precision)
     fragment = renderer.render(scene, W, H)

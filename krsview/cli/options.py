@@ -206,7 +206,7 @@ def fast_scene_of(args: argparse.Namespace, scene: Scene) -> Scene:
     """``scene`` (``scene_of(args)``) with the viewer's fast settings (api.fast_settings)
     where neither its file nor an option given sets them: an option given stands."""
     given = {k: getattr(scene.render, k) for k in FAST_KNOBS if getattr(args, k, None) is not None}
-    return api.configure(api.fast_settings(scene), **given)
+    return api.configure(api.fast_settings(scene, api.on_hardware()), **given)
 
 
 class MissingExtra(RuntimeError):

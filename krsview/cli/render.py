@@ -16,7 +16,13 @@ from ..inputs import output_dir, output_file
 from ..progress import Progress
 from ..scene import Scene, SceneError
 from ..scene.presets import resolve
-from ..scene.render import DEFAULT_LOD, DEFAULT_SHADOW_BLOCK, LANES_LEVELS, VIEW_PREPASS
+from ..scene.render import (
+    DEFAULT_LOD,
+    DEFAULT_SHADOW_BLOCK,
+    HARDWARE_PREPASS,
+    LANES_LEVELS,
+    VIEW_PREPASS,
+)
 from ..share.frames import DEFAULT_FPS
 from . import options
 from .options import SILENT_SECONDS, render_option
@@ -46,8 +52,10 @@ def add(sub) -> None:
         help="render a scene headless to PNG (and raw buffers)",
         description="Render PRESET headless through EGL and write a PNG; prints the measured "
         "frame time. Draws with the viewer's fast settings (the pre-pass, the level of "
-        f"detail; persistent lanes for a single KRS of {LANES_LEVELS} levels or more) unless "
-        "the scene or an option sets them; --exact draws every level without the pre-pass. "
+        f"detail; persistent lanes for a single KRS of {LANES_LEVELS} levels or more; on a "
+        f"GPU, not a CPU rasteriser, the compute path's rounds from pre-pass tiles of "
+        f"{HARDWARE_PREPASS}) unless the scene or an option sets them; --exact draws every "
+        "level without the pre-pass. "
         "Example: krsview render tree -o tree.png --size 640x360 --prepass 8",
     )
     options.preset(r)

@@ -11,6 +11,15 @@ import moderngl
 GL_VERSION = 430  # compute + std140 + explicit locations; llvmpipe offers 4.5 core
 
 
+# GL_RENDERER of the rasterisers that run on the CPU (Mesa's, Google's): every other is a GPU
+SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "lavapipe", "swiftshader")
+
+
+def hardware(renderer: str) -> bool:
+    """Whether a context whose GL_RENDERER is ``renderer`` draws on a GPU, not the CPU."""
+    return not any(name in renderer.lower() for name in SOFTWARE_RASTERISERS)
+
+
 class ContextError(RuntimeError):
     """No usable OpenGL context; the message says what to install."""
 

@@ -238,10 +238,11 @@ def _sway_route(scene: Any, path: str):
     )
 
 
-def check_animation(scene: Any) -> None:
+def check_animation(scene: Any, under: str = "") -> None:
     """Load-time rules that need the scene: each track's path exists and every key is a
     valid value there (by ``Scene.edit``, so the error names the key and the field's
-    rule), and the sway crosses no branch over a period."""
+    rule), and the sway crosses no branch over a period. ``under``: a top-level table, the
+    only one changed since the scene was checked: only the tracks into it."""
     a = scene.animation
     rest = replace(scene, animation=None)
     for k, tr in enumerate(a.tracks):
@@ -250,6 +251,8 @@ def check_animation(scene: Any) -> None:
             path = parse_path(tr.path)
         except SceneError as e:
             raise SceneError(f"{where}.path", tr.path, e.allowed) from None
+        if under and path[0] != under:
+            continue
         if path[:1] == ("animation",):
             raise SceneError(
                 f"{where}.path",
@@ -273,7 +276,7 @@ def check_animation(scene: Any) -> None:
                 raise SceneError(
                     f"{where}.keys[{j}]", key.to_toml(), f"{e.path}: {e.allowed}"
                 ) from None
-    if a.sway is not None:
+    if a.sway is not None and not under:  # the sway turns the geometry alone
         check_sway(_sway_route(rest, "animation.sway"), a.sway, "animation.sway")
 
 

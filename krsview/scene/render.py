@@ -27,6 +27,11 @@ DEFAULT_SHADOW_BLOCK = 2
 # no path (the same image: inside tree's crown 0.82–0.84× the CPU, its whole views within
 # noise; a MöKRS, a compound and shallow trees lose; docs/speed.md)
 LANES_LEVELS = 20
+# On a hardware GPU the fast settings trace by the compute path's rounds (render.steps, its
+# shadow rays as tasks) from this pre-pass tile where the file sets no path: 2.4–7.3× the
+# fragment path and 2.5× persistent lanes on an H100 at 1920×1080 (tree, grove, palm;
+# docs/speed.md), where a warp waits for its slowest ray; on a CPU rasteriser they lose
+HARDWARE_PREPASS = 8
 
 
 @dataclass(frozen=True)
