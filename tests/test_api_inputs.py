@@ -322,8 +322,8 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
 
 
 def test_a_prepass_knob_of_none_is_the_fast_default_and_a_dropped_renderer_is_given_back():
-    from krsview.api import _shared_context
-    from krsview.scene.render import VIEW_PREPASS
+    from krsview.api import _shared_context, on_hardware
+    from krsview.scene.render import HARDWARE_PREPASS, VIEW_PREPASS
 
     drawn = []
     r = krsview.Renderer(*SIZE)
@@ -331,7 +331,7 @@ def test_a_prepass_knob_of_none_is_the_fast_default_and_a_dropped_renderer_is_gi
     r.render("tree", prepass=None)
     r.render("tree", prepass=0)
     r.render("tree", exact=True, prepass=None)  # exact's own: none
-    assert drawn == [VIEW_PREPASS, 0, 0]
+    assert drawn == [HARDWARE_PREPASS if on_hardware() else VIEW_PREPASS, 0, 0]
     dropped = krsview.Renderer(*SIZE)
     dropped.render("rock")
     del dropped
