@@ -647,7 +647,7 @@ def test_a_step_added_to_a_level_without_steps_is_its_own():
 
     scene = load_scene(resolve("palm"))
     plain = sum(not lv.transform for lv in scene.mokrs.levels)
-    new, i = changed(list(scene.mokrs.levels), 58, "insert")
+    new, i, _ = changed(list(scene.mokrs.levels), 58, "insert")
     scene = scene.edit(LEVELS, new)
     m = scene.mokrs
     empty = [k for k, lv in enumerate(m.levels) if not lv.transform]
@@ -667,13 +667,13 @@ def test_a_step_added_to_a_level_without_steps_is_its_own():
 
 def test_level_operations_move_the_selection_with_the_level():
     levels = list("abcde")
-    assert changed(levels, 3, "inward") == (list("abdce"), 2)
-    assert changed(levels, 3, "outward") == (list("abced"), 4)
-    assert changed(levels, 0, "inward") == (levels, 0)  # nothing inside the innermost
-    assert changed(levels, 4, "outward") == (levels, 4)
-    assert changed(levels, 1, "duplicate") == (list("abbcde"), 1)
-    assert changed(levels, 4, "remove") == (list("abcd"), 3)
-    new, k = changed(levels, 1, "insert")
+    assert changed(levels, 3, "inward")[:2] == (list("abdce"), 2)
+    assert changed(levels, 3, "outward")[:2] == (list("abced"), 4)
+    assert changed(levels, 0, "inward")[:2] == (levels, 0)  # nothing inside the innermost
+    assert changed(levels, 4, "outward")[:2] == (levels, 4)
+    assert changed(levels, 1, "duplicate")[:2] == (list("abbcde"), 1)
+    assert changed(levels, 4, "remove")[:2] == (list("abcd"), 3)
+    new, k, _ = changed(levels, 1, "insert")
     assert k == 2 and len(new) == 6 and new[2].transform == [] and new[:2] == levels[:2]
 
 
@@ -694,7 +694,7 @@ def test_inward_twice_moves_a_level_two_steps_and_the_keys_act_on_levels(display
         start = e.scene.mokrs.levels
         e.select_level(17)
         for _ in range(2):
-            e.execute(level_commands(e.scene.mokrs.levels, e.selected.level, "inward"))
+            e.execute(level_commands(e.selected.level, "inward"))
         assert e.selected.level == 15 and e.scene.mokrs.levels[15] == start[17]
         assert e.scene.mokrs.levels[16:18] == [start[15], start[16]]
         assert len(e.doc.history.steps) == 2
@@ -824,3 +824,61 @@ def test_palm_in_a_window_a_kernel_picked_as_a_capsule_and_back_keeps_its_bend(p
     pick("toroidal_capsule")
     assert get_at(e.scene, kernel) == bent  # the bend is back
     assert len(e.doc.history.steps) == 2  # one undo step each
+
+
+def test_palm_curls_tracks_follow_their_levels_and_a_refusal_keeps_the_selection(tmp_path):
+    """palm-curl's 30 curls are keyed: removing, duplicating or moving a keyed level was
+    refused (its tracks pointed past the list's end) or left a track on another level. Now
+    each track follows its level, a removed level's track goes with it and is said, a copy
+    gets the track copied, and a swap swaps the tracks. A refused operation (a 65th level)
+    changes nothing, the selection included: it used to select the level anyway."""
+    from types import SimpleNamespace
+
+    from krsview.document.document import Document
+    from krsview.editor.mokrs_levels import apply_op
+
+    path = tmp_path / "palm-curl.toml"
+    shutil.copy(resolve("palm-curl"), path)
+    chosen, said = [], []
+    doc = Document(path)
+
+    class Fake:  # what apply_op reads and calls of the editor
+        scene = property(lambda self: doc.scene)
+
+    e = Fake()
+    e.doc, e.select_level = doc, chosen.append
+    e.viewer = SimpleNamespace(
+        camera=doc.scene.camera, sync=lambda: None, error="", message="", say=said.append
+    )
+
+    def keyed() -> dict[int, tuple]:
+        out = {}
+        for t in doc.scene.animation.tracks:
+            level = int(t.path.split("[")[1].split("]")[0])
+            out[level] = tuple(t.keys)
+        return out
+
+    before, n = keyed(), len(doc.scene.mokrs.levels)
+    k = min(before)  # a keyed curl; the level after it has no track
+    assert k + 1 not in before and len(before) == 30
+    apply_op(e, k, "remove")
+    after = keyed()
+    assert e.viewer.error == "" and len(doc.scene.mokrs.levels) == n - 1
+    assert {j - 1 if j > k else j: v for j, v in before.items() if j != k} == after
+    assert "its 1 track went with it" in said[-1] and chosen[-1] == k
+    doc.undo()
+    apply_op(e, k, "duplicate")
+    assert keyed() == {**{j + 1 if j > k else j: v for j, v in before.items()}, k + 1: before[k]}
+    doc.undo()
+    apply_op(e, k, "outward")  # swaps level k and k + 1
+    assert keyed() == {**{j: v for j, v in before.items() if j != k}, k + 1: before[k]}
+    assert chosen[-1] == k + 1
+    doc.undo()
+    assert keyed() == before
+
+    full = doc.scene.edit(LEVELS, [*doc.scene.mokrs.levels, *doc.scene.mokrs.levels[-4:]])
+    doc.commit(full, "grow to 64 levels")  # control: a refusal
+    steps, picks = len(doc.history.steps), len(chosen)
+    apply_op(e, k, "insert")
+    assert "insert level" in e.viewer.error and "refused" in e.viewer.error
+    assert len(chosen) == picks and len(doc.history.steps) == steps and doc.scene == full

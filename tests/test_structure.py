@@ -933,3 +933,79 @@ def test_in_a_compound_the_selection_follows_the_inserted_fork(display, compound
         assert forks[0] == forks[1], "Delete removed another fork than the inserted one"
     finally:
         e.close()
+
+
+def keyed(scene, tracks: dict[str, list]):
+    """``scene`` with ``tracks`` (path → keys [[t, value], …]) and its moment at 1 s."""
+    from krsview import load_dict
+    from krsview.scene.schema import to_dict
+
+    tracks = [{"path": p, "keys": k} for p, k in tracks.items()]
+    return load_dict(to_dict(scene) | {"animation": {"time": 1.0, "tracks": tracks}})
+
+
+def test_the_tracks_follow_their_levels_through_insert_remove_and_duplicate(scene, tmp_path):
+    """A key keeps moving the level it was set on: insert and duplicate move the coarser
+    levels' tracks one up, remove drops the removed fork's track and says so, duplicate
+    copies the level's track to the copy and moves the keyed positions of the levels it
+    carries along the branch with them. Before, the tracks stayed at their indices and
+    drove other forks (tree-sway baked: Delete on a keyed fork). Controls: a track on the
+    camera, and on a finer level an insert does not move, stay as they were."""
+    route = scene.tree.route()
+    fork3, control1 = route.levels[3].fork, route.levels[1].control
+    normal5 = route.levels[5].normal
+    tracks = {
+        "route.levels[3].fork": [[0, list(fork3)], [2, [fork3[0] + 0.2, *fork3[1:]]]],
+        "route.levels[1].control": [
+            [0, list(control1)],
+            [2, [control1[0], control1[1] + 0.1, control1[2]]],
+        ],
+        "route.levels[5].normal": [[0, list(normal5)], [2, [0.3, 0.9, 0.3]]],
+        "camera.position": [[0, list(scene.camera.position)], [2, [0.0, 3.0, 12.0]]],
+    }
+    path = tmp_path / "keyed.toml"
+    save_scene(keyed(replace(scene, tree=None, route=route), tracks), path)
+
+    def posed(e, i, name):
+        return np.array(getattr(e.scene.posed().route.levels[i], name))
+
+    editor = FakeEditor(path)
+    normal_before = posed(editor, 5, "normal")
+    editor.run(ec.InsertLevel(3))
+    paths = [t.path for t in editor.scene.animation.tracks]
+    assert paths == [
+        "route.levels[3].fork",
+        "route.levels[1].control",
+        "route.levels[6].normal",
+        "camera.position",
+    ]
+    assert np.allclose(posed(editor, 6, "normal"), normal_before)  # the same branch turns
+    assert "went with it" not in editor.said[-1]
+    editor.doc.undo()
+
+    editor.run(ec.RemoveLevel(3))
+    paths = [t.path for t in editor.scene.animation.tracks]
+    assert paths == ["route.levels[1].control", "route.levels[4].normal", "camera.position"]
+    assert np.allclose(posed(editor, 4, "normal"), normal_before)
+    assert "its 1 track went with it (route.levels[3].fork)" in editor.said[-1]
+    editor.doc.undo()
+
+    editor.run(ec.DuplicateLevel(3))
+    v = np.subtract(route.levels[3].fork, route.starts()[3])
+    got = {t.path: np.array([k.value for k in t.keys]) for t in editor.scene.animation.tracks}
+    assert sorted(got) == sorted(
+        [
+            "route.levels[4].fork",
+            "route.levels[3].fork",
+            "route.levels[1].control",
+            "route.levels[6].normal",
+            "camera.position",
+        ]
+    )
+    keys = {p: np.array([v for _, v in k]) for p, k in tracks.items()}
+    assert np.allclose(got["route.levels[4].fork"], keys["route.levels[3].fork"])  # the original
+    assert np.allclose(got["route.levels[3].fork"], keys["route.levels[3].fork"] + v)  # its copy
+    assert np.allclose(got["route.levels[1].control"], keys["route.levels[1].control"] + v)
+    assert np.allclose(got["route.levels[6].normal"], keys["route.levels[5].normal"])
+    assert np.allclose(got["camera.position"], keys["camera.position"])
+    assert len(editor.doc.history.steps) == 1  # one undo step each

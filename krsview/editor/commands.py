@@ -116,6 +116,15 @@ class FoldPanel(Command):
     folded: bool
 
 
+@dataclass(frozen=True)
+class LevelOp(Command):
+    """A MöKRS level's operation (editor/mokrs_levels.py OPS): "duplicate", "insert",
+    "remove", "inward" or "outward"."""
+
+    level: int
+    op: str
+
+
 # ------------------------------------------------------------- structure (editor/structure.py)
 @dataclass(frozen=True)
 class InsertLevel(Command):

@@ -119,7 +119,7 @@ def mokrs_section(e: Any, out: list[Command], interactions: Interactions, fields
 def _level_menu(levels: list, i: int, name: str) -> list[Command]:
     """Level i's right-click menu, as a route's outline entry has: the level operations."""
     items = [
-        (f"{op}: {tip}", OP_KEYS.get(op, ""), lambda op=op: level_commands(levels, i, op))
+        (f"{op}: {tip}", OP_KEYS.get(op, ""), lambda op=op: level_commands(i, op))
         for op, tip in OPS.items()
     ]
     return entry_menu(f"mokrs level##{i}", i, name, items)
@@ -140,7 +140,7 @@ def _level(e, levels: list, i: int, out: list, interactions: Interactions, field
         one_line(HINTS.get(e.selected.role, ""))
     for op, tip in OPS.items():
         if imgui.small_button(f"{op}##lv"):
-            out += level_commands(levels, i, op)
+            out += level_commands(i, op)
         if imgui.is_item_hovered():
             tooltip(tip + ("" if op in ("inward", "outward") else f" ({OP_KEYS[op]})"))
         imgui.same_line()

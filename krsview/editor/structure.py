@@ -24,13 +24,17 @@ from ..scene.growth import Growth
 from ..scene.regrow import rebake
 from ..scene.restructure import (
     duplicate_level,
+    duplicate_moves,
     merge_level,
+    merge_moves,
     move_base,
     scale_tree,
     scale_widths,
     split_level,
+    split_moves,
     taper,
 )
+from ..scene.retrack import Moves, dropped_note, retracked
 from ..scene.schema import Vec3, from_dict, to_dict
 from ..viewer.commands import Command
 from ..viewer.window import Viewer
@@ -164,10 +168,12 @@ def commit_route(
     label: str,
     interaction: Any = None,
     at: Path | None = None,
+    moves: Callable[[Route], Moves] | None = None,
 ) -> bool:
     """Replace the route at ``at`` (default: :func:`target`) by ``make(route)``, validated,
-    as one undo step; a SceneError (from the operation or the schema) changes nothing and
-    is said."""
+    as one undo step; ``moves(route)``: where the levels' tracks go (scene/retrack.py), so
+    a key keeps moving the level it was set on. A SceneError (from the operation or the
+    schema) changes nothing and is said; tracks dropped with a removed level are said too."""
     why = ""
     if at is None:
         at, why = target(e)
@@ -175,8 +181,10 @@ def commit_route(
         _say(e, f"{label}: {why}", True)
         return False
     try:
-        route = make(get_at(e.scene, at))
-        scene = validated(replace_at(e.scene, at, route))
+        before = get_at(e.scene, at)
+        scene = replace_at(e.scene, at, make(before))
+        scene, dropped = retracked(scene, (*at, "levels"), moves(before) if moves else {})
+        scene = validated(scene)
     except SceneError as err:
         _say(e, f"{label} refused: {err}", True)
         return False
@@ -185,7 +193,8 @@ def commit_route(
     e.doc.commit(scene, label, interaction)
     e.viewer.sync()
     warned = get_at(scene, at).warnings()
-    _say(e, label + (f" ({counted(len(warned), 'warning')})" if warned else ""), False)
+    said = label + (f" ({counted(len(warned), 'warning')})" if warned else "")
+    _say(e, said + dropped_note(dropped), False)
     return True
 
 
@@ -221,21 +230,31 @@ def insert(e: Structured, level: int | None) -> None:
     i = _level(e, level, "insert a fork")
     s = e.structure.split_at
     if i is not None and commit_route(
-        e, lambda r: split_level(r, i, s), f"insert a fork in L{i} at {s:.2f}"
+        e,
+        lambda r: split_level(r, i, s),
+        f"insert a fork in L{i} at {s:.2f}",
+        moves=lambda r: split_moves(r, i),
     ):
         _choose(e, i + 1)
 
 
 def remove(e: Structured, level: int | None) -> None:
     i = _level(e, level, "remove a fork")
-    if i is not None and commit_route(e, lambda r: merge_level(r, i), f"remove the fork of L{i}"):
+    if i is not None and commit_route(
+        e,
+        lambda r: merge_level(r, i),
+        f"remove the fork of L{i}",
+        moves=lambda r: merge_moves(r, i),
+    ):
         at, _ = target(e)
         _choose(e, min(i, len(get_at(e.scene, at).levels) - 1))
 
 
 def duplicate(e: Structured, level: int | None) -> None:
     i = _level(e, level, "duplicate a level")
-    if i is not None and commit_route(e, lambda r: duplicate_level(r, i), f"duplicate L{i}"):
+    if i is not None and commit_route(
+        e, lambda r: duplicate_level(r, i), f"duplicate L{i}", moves=lambda r: duplicate_moves(r, i)
+    ):
         _choose(e, i)
 
 

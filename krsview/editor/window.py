@@ -48,6 +48,7 @@ from .grab import Grabbing
 from .handles import Handle, level_handle
 from .keys import Timeline, keyed_edit, set_key
 from .layout import Layout, frame, shift
+from .mokrs_levels import VIEW, apply_op
 from .mokrs_panel import KindsLeft
 from .picking import pick, visible
 from .saving import autosave
@@ -56,7 +57,6 @@ from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
 from .words import Words
 
-VIEW = "view.position"  # the viewpoint flown in the editor, in a refused edit's message
 EDITOR_KEYS = {
     **VIEWER_KEYS,
     "ctrl+S": ec.Save(),
@@ -391,6 +391,7 @@ EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.SetKey: lambda e, c: set_key(e),
     ec.Select: lambda e, c: e.select(c.handle),
     ec.SelectLevel: lambda e, c: e.select_level(c.level),
+    ec.LevelOp: lambda e, c: apply_op(e, c.level, c.op),
     ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),
     ec.SetSnap: lambda e, c: setattr(e.snap, "on", c.on),
     ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),

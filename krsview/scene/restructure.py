@@ -16,6 +16,7 @@ import numpy as np
 
 from ..messages import SceneError
 from .model import Mirror, Plane, ToroidalCapsule
+from .retrack import Moves, shifted
 from .route import Route, RouteLevel, centre_at
 from .schema import Vec3
 from .tree import as_vec3
@@ -182,6 +183,26 @@ def duplicate_level(route: Route, i: int) -> Route:
     copy = moved(lv, None)
     finer_levels = [moved(x, x.grown) for x in levels[:i]]
     return replace(route, levels=finer_levels + [copy, original] + levels[i + 1 :])
+
+
+def split_moves(route: Route, i: int) -> Moves:
+    """Where :func:`split_level` at ``i`` puts each level's tracks: the coarser ones one up."""
+    return shifted(i + 1, len(route.levels), 1)
+
+
+def merge_moves(route: Route, i: int) -> Moves:
+    """Where :func:`merge_level` of ``i`` puts each level's tracks: level i's go with its
+    fork, the coarser ones one down."""
+    return {i: [], **shifted(i + 1, len(route.levels), -1)}
+
+
+def duplicate_moves(route: Route, i: int) -> Moves:
+    """Where :func:`duplicate_level` of ``i`` puts each level's tracks: the original's one
+    up, the copy (at i) and the finer levels carried along the branch keep their keys at
+    the same offsets from their moved rest positions, the coarser levels one up."""
+    v = tuple(np.subtract(route.levels[i].fork, route.starts()[i]).tolist())
+    carried = {j: [(j, v)] for j in range(i)}
+    return {**carried, i: [(i + 1, None), (i, v)], **shifted(i + 1, len(route.levels), 1)}
 
 
 # --------------------------------------------------------------------------- whole tree
