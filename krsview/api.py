@@ -33,13 +33,12 @@ from .scene import Render, Scene, SceneError, save_scene
 from .scene.edits import still_checked, vouched
 from .scene.filetext import saved_text
 from .scene.info import SceneInfo, describe
-from .scene.model import KRS
 from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
-from .scene.render import HARDWARE_PREPASS, LANES_LEVELS, VIEW_PREPASS
 from .scene.scene import scene_from_toml, write_atomic
 from .scene.schema import from_dict
 from .scene.settings import MAX_SIDE
+from .scene.speed import exact_settings, fast_settings, fast_tile
 
 DEFAULT_SIZE = (320, 180)
 RENDER_KNOBS = tuple(f.name for f in fields(Render))  # render(**knobs): the [render] fields
@@ -132,31 +131,6 @@ def configure(
     return scene if levels is None else scene.with_levels(levels)
 
 
-def fast_settings(scene: Scene, hardware: bool = False) -> Scene:
-    """The scene with the viewer's fast settings where its file sets none: the pre-pass
-    tile VIEW_PREPASS (the level of detail and the shadow rays' pixel blocks are scene
-    fields, DEFAULT_LOD and DEFAULT_SHADOW_BLOCK unless the file says otherwise), and for
-    a single KRS of LANES_LEVELS levels or more whose file sets no path, persistent lanes
-    (``path="compute"``, ``steps=0``: the same image bit for bit; else the fragment path,
-    as the viewer draws where the file sets none). On ``hardware`` (a GPU:
-    :func:`on_hardware`) the pre-pass tile is HARDWARE_PREPASS, and every scene whose file
-    sets no path is traced by the compute path's rounds. The oracle certifies both
-    geometry settings hole-free; hits may move by up to ε (pre-pass) and 2·lod·ε (level of
-    detail)."""
-    r, fast = scene.render, {}
-    if r.prepass is None:  # 0 is the file's own "off"
-        fast["prepass"] = HARDWARE_PREPASS if hardware else VIEW_PREPASS
-    if r.path is None and hardware:  # rounds of render.steps iterations
-        fast["path"] = "compute"
-    elif r.path is None:  # "fragment" is the file's own choice
-        g = replace(scene, animation=None).geometry()  # the levels, not posed: motion adds none
-        deep = isinstance(g, KRS) and g.depth >= LANES_LEVELS
-        fast.update({"path": "compute", "steps": 0} if deep else {"path": "fragment"})
-    # constants within the schema's ranges: no edit (its validation of a whole animated
-    # scene took 0.24 s a call on palm-curl, every frame of render())
-    return still_checked(scene, replace(scene, render=replace(r, **fast))) if fast else scene
-
-
 def on_hardware() -> bool:
     """Whether this process draws on a GPU rather than a CPU rasteriser such as Mesa's
     llvmpipe: there :func:`fast_settings` trace by the compute path's rounds."""
@@ -168,16 +142,6 @@ def on_hardware() -> bool:
         with _lock, ctx:
             _hardware = hardware(ctx.info["GL_RENDERER"])
     return _hardware
-
-
-def exact_settings(scene: Scene) -> Scene:
-    """The scene drawn with every level, no pre-pass, a shadow ray per pixel that steps
-    every component from the surface (no shadow cone) and no walk restart (a step bounded by
-    the levels above moves a grazing ray's hit by up to a step): the image the float64
-    reference matches pixel for pixel (``exact=True``, ``krsview render --exact``)."""
-    return configure(
-        scene, prepass=0, lod=0.0, shadow_block=1, shadow_cone="off", walk_restart="off"
-    )
 
 
 def _shared_context():
@@ -247,10 +211,11 @@ class Renderer:
         ``exact=True`` every level and no pre-pass (:func:`exact_settings`); ``reference=True``
         traces it with the float64 NumPy reference instead of the GPU; ``progress(done,
         total)`` is called as bands of rows (GPU) or chunks of rays (reference) finish."""
-        scene = self._settled(scene, exact, **knobs)
+        reference = switch(reference, "reference")
+        scene = self._settled(scene, exact, not reference, **knobs)  # the reference: no GL
         if progress is not None and not callable(progress):
             raise SceneError("progress", progress, "expected a function of (done, total)")
-        if switch(reference, "reference"):
+        if reference:
             from .reference import render_reference
 
             return render_reference(scene, self.width, self.height, progress=progress)
@@ -261,22 +226,24 @@ class Renderer:
     ) -> list[float]:
         """Wall time of ``repeats`` frames in seconds (GPU finished), after a warm-up: the
         frames :meth:`render` draws with the same arguments."""
-        scene = self._settled(scene, exact, **knobs)
+        scene = self._settled(scene, exact, True, **knobs)
         repeats = whole(repeats, "repeats", 1)
         return self.gpu.time_frame(scene, self.width, self.height, repeats=repeats)
 
     @staticmethod
-    def _settled(scene: Scene | str | Path, exact: bool, **knobs: Any) -> Scene:
+    def _settled(scene: Scene | str | Path, exact: bool, gpu: bool, **knobs: Any) -> Scene:
         """``scene`` with the fast or exact settings, then ``knobs`` over them; a pre-pass
         left unset by a knob (``prepass=None``: "not given", as in a file) is the setting's
-        own (the fast tile, or none with ``exact``)."""
+        own (the fast tile, or none with ``exact``). ``gpu``: drawn by the GPU renderer, so
+        the fast settings are those of the device it draws on (else no GL is touched)."""
         scene = scene_of(scene)
-        exact, hardware = switch(exact, "exact"), on_hardware()
+        exact = switch(exact, "exact")
+        hardware = gpu and not exact and on_hardware()
         scene = configure(
             exact_settings(scene) if exact else fast_settings(scene, hardware), **knobs
         )
         if scene.render.prepass is None:
-            tile = 0 if exact else HARDWARE_PREPASS if hardware else VIEW_PREPASS
+            tile = 0 if exact else fast_tile(hardware)
             scene = still_checked(scene, replace(scene, render=replace(scene.render, prepass=tile)))
         return scene
 

@@ -293,13 +293,42 @@ def test_on_a_gpu_the_fast_settings_trace_by_the_compute_paths_rounds(monkeypatc
     kept = tree.edit("render.path", "fragment").edit("render.prepass", 2)
     assert api.fast_settings(kept, hardware=True).render == kept.render  # the file's own
     monkeypatch.setattr(api, "_hardware", True)
-    assert api.Renderer._settled(tree, False).render.path == "compute"
-    assert api.Renderer._settled(tree, False).render.steps == 16
-    assert api.Renderer._settled(tree, False, prepass=None).render.prepass == HARDWARE_PREPASS
-    assert api.Renderer._settled(tree, True).render.path is None  # exact: as the file says
+    assert api.Renderer._settled(tree, False, True).render.path == "compute"
+    assert api.Renderer._settled(tree, False, True).render.steps == 16
+    assert api.Renderer._settled(tree, False, True, prepass=None).render.prepass == HARDWARE_PREPASS
+    assert api.Renderer._settled(tree, True, True).render.path is None  # exact: as the file says
+    assert api.Renderer._settled(tree, False, False).render.steps == 0  # the reference's
     args = build_parser().parse_args(["render", "rock"])
     assert settled(args, scene_of(args)).render.path == "compute"
     monkeypatch.setattr(api, "_hardware", False)  # control: a CPU rasteriser
-    assert api.Renderer._settled(tree, False).render.steps == 0  # persistent lanes
-    assert api.Renderer._settled(tree, False, prepass=None).render.prepass == VIEW_PREPASS
+    assert api.Renderer._settled(tree, False, True).render.steps == 0  # persistent lanes
+    assert api.Renderer._settled(tree, False, True, prepass=None).render.prepass == VIEW_PREPASS
     assert settled(args, scene_of(args)).render.path == "fragment"
+
+
+def test_the_reference_touches_no_gl_even_where_the_fast_settings_ask_the_device(tmp_path):
+    """The float64 reference draws without GL: `render(reference=True)` and `krsview render
+    --reference` make no GL context, although the fast settings depend on the device the
+    GPU draws on (it did make one, and so failed where EGL cannot start). Control: a GPU
+    render in the same process makes it."""
+    code = (
+        "import krsview, krsview.api as api\n"
+        "from krsview.cli import main\n"
+        "krsview.render('rock', (8, 6), reference=True)\n"
+        "argv = ['render', 'rock', '--reference', '--size', '8x6', '-o', 'r.png']\n"
+        "assert main(argv) in (0, None)\n"
+        "assert api._context is None, 'a GL context was made'\n"
+        "krsview.render('rock', (8, 6))\n"
+        "assert api._context is not None\n"
+        "print('ok')\n"
+    )
+    env = {**os.environ, "DISPLAY": ""}
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+        cwd=tmp_path,
+    )
+    assert r.returncode == 0 and r.stdout.strip().endswith("ok"), r.stderr[-2000:]

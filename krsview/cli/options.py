@@ -204,9 +204,11 @@ FAST_KNOBS = ("prepass", "path", "steps")  # the [render] fields api.fast_settin
 
 def fast_scene_of(args: argparse.Namespace, scene: Scene) -> Scene:
     """``scene`` (``scene_of(args)``) with the viewer's fast settings (api.fast_settings)
-    where neither its file nor an option given sets them: an option given stands."""
+    where neither its file nor an option given sets them: an option given stands. Those of
+    the device the GPU renderer draws on; --reference draws without GL, so with a CPU's."""
     given = {k: getattr(scene.render, k) for k in FAST_KNOBS if getattr(args, k, None) is not None}
-    return api.configure(api.fast_settings(scene, api.on_hardware()), **given)
+    hardware = not getattr(args, "reference", False) and api.on_hardware()
+    return api.configure(api.fast_settings(scene, hardware), **given)
 
 
 class MissingExtra(RuntimeError):
