@@ -163,6 +163,44 @@ def test_an_enclosure_without_its_error_term_fails_containment():
     assert enclosures_contain_arb(c, *rest, "affine", narrow=True) > 0
 
 
+def float_order(x: np.ndarray) -> np.ndarray:
+    """Each float's place in the order of all floats (as integers: neighbours differ by 1)."""
+    bits = x.view(np.int64)
+    return np.where(bits < 0, -(bits & 0x7FFFFFFFFFFFFFFF), bits)
+
+
+def test_outward_rounding_steps_past_every_float_and_no_further_than_three():
+    """Every operation's bounds step outwards by numbers._up and _down: for floats of every
+    binade, ±0, the subnormals and the largest, each lands 1 to 3 floats beyond x (counted by
+    the floats' bit order, independently of the formula); infinities stay. Negative control:
+    without its least-subnormal term the step leaves 0 and the subnormals where they are."""
+    from krsview.oracle import numbers
+
+    rng = np.random.default_rng(5)
+    powers = 2.0 ** np.arange(-1074, 1024, dtype=np.float64)
+    x = np.concatenate(
+        [
+            rng.standard_normal(20000) * 10.0 ** rng.integers(-322, 306, 20000),
+            powers,
+            -powers,
+            np.nextafter(powers, 0.0),
+            [0.0, -0.0, np.finfo(np.float64).max, -np.finfo(np.float64).max],
+        ]
+    )
+    with np.errstate(over="ignore"):
+        up, down = numbers._up(x), numbers._down(x)
+    big = np.abs(x) == np.finfo(np.float64).max  # the step past them is ±∞
+    n_up, n_down = float_order(up) - float_order(x), float_order(x) - float_order(down)
+    assert ((n_up >= 1) & (n_up <= 3))[np.abs(x) < np.finfo(np.float64).max].all()
+    assert ((n_down >= 1) & (n_down <= 3))[~big].all()
+    assert np.isinf(up[x == np.finfo(np.float64).max]).all()
+    inf = np.array([np.inf, -np.inf])
+    assert np.array_equal(numbers._up(inf), inf) and np.array_equal(numbers._down(inf), inf)
+    tiny = np.abs(x) < 2.0**-1022  # 0 and the subnormals
+    without = x[tiny] + np.abs(x[tiny]) * numbers._ULP
+    assert (without == x[tiny]).any()
+
+
 def test_affine_forms_avoid_the_wrapping_that_widens_intervals():
     """Through 22 folds, interval boxes widen at every non-axis mirror (the wrapping effect);
     affine forms keep the correlation: on short segments of the tree their enclosures are

