@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.balls import kernel_ball
 from ..compile.camera import View
 from ..compile.krs import CompiledKRS, compile_krs
@@ -73,10 +74,10 @@ def kernel_mesh(kind: str, rec: np.ndarray, tol: float) -> tuple[np.ndarray, np.
     elif kind == "capsule":
         a, b = rec[1, :3], rec[2, :3]
         axis = (b - a) / np.linalg.norm(b - a)
-        side = np.cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
+        side = cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
         side /= np.linalg.norm(side)
         core, tangent = np.stack([a, b]), np.stack([axis, axis])
-        n1, n2 = np.stack([side, side]), np.stack([np.cross(axis, side)] * 2)
+        n1, n2 = np.stack([side, side]), np.stack([cross(axis, side)] * 2)
     elif kind == "toroidal_capsule":
         R = 1.0 / float(rec[2] @ rec[2])
         e1, e2, n = arc_world(rec[2], np.eye(3)) / R  # the arc's frame (compile/krs.py)

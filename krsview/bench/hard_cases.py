@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.camera import pixel_ray, view_of
 from ..compile.geometry import compile_geometry
 from ..reference.geometry import component_distances, nearest, scene_distance
@@ -78,9 +79,9 @@ def zoomed(scene: Scene, x: float, y: float, scale: float) -> Scene:
     looking at it at a grazing 14°, so the surface's horizon crosses the image: a deep zoom
     when ``scale`` is 1e-6 of the scene's size."""
     p, n = surface_point(scene, x, y)
-    side = np.cross(n, scene.camera.up)
+    side = cross(n, scene.camera.up)
     if np.linalg.norm(side) < 1e-9:
-        side = np.cross(n, (1.0, 0.0, 0.0))
+        side = cross(n, (1.0, 0.0, 0.0))
     eye = p + scale * (0.25 * n + side / np.linalg.norm(side))
     return replace(look(scene, eye, p), name=f"{scene.name}-zoom-{scale:g}")
 

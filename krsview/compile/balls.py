@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from ..scene import KRS, Capsule, Empty, Kernel, Sphere, ToroidalCapsule, arc_of
+from ..scene.schema import cached
 
 CULL_MARGIN = 1e-6  # relative growth of the culling balls, against rounding
 UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])  # a bound record for "no bounding ball"
@@ -85,10 +86,16 @@ def enclosing_balls(sets: list[np.ndarray]) -> np.ndarray:
     return best
 
 
-def held_balls(krs: KRS) -> list[np.ndarray | None]:
+def held_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
     """n + 1 balls: entry i < n holds A_i (module doc), entry n the whole KRS (K_n ∪ A_{n−1});
-    None from the first plane kernel on (unbounded) and where nothing is held yet. Slots go in
-    batches of EXACT_LEVELS + 1, each needing only the balls of earlier batches."""
+    None from the first plane kernel on (unbounded) and where nothing is held yet. Made once
+    per KRS (frozen): compiling asks for the slots' balls and the whole one."""
+    return cached(krs, "_held_balls", lambda: _held_balls(krs))
+
+
+def _held_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
+    """Slots go in batches of EXACT_LEVELS + 1, each needing only the balls of earlier
+    batches."""
     n = len(krs.mirrors)
     kb = [kernel_ball(k) for k in krs.kernels]
     plane = np.cumsum([b is None and not isinstance(k, Empty) for b, k in zip(kb, krs.kernels)])
@@ -111,8 +118,9 @@ def held_balls(krs: KRS) -> list[np.ndarray | None]:
         sets = {i: expanded(i) for i in batch if not plane[i]}
         sets = {i: s for i, s in sets.items() if len(s)}
         for i, ball in zip(sets, enclosing_balls(list(sets.values())) if sets else ()):
+            ball.flags.writeable = False
             held[i] = ball
-    return held
+    return tuple(held)
 
 
 def krs_ball(krs: KRS) -> np.ndarray | None:

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..scene import Camera
 
 
@@ -44,9 +45,9 @@ def view_of(camera: Camera, width: int, height: int, detail_height: int = 0) -> 
     o = np.array(camera.position, dtype=np.float64)
     f = np.array(camera.target, dtype=np.float64) - o
     f /= np.linalg.norm(f)
-    r = np.cross(f, camera.up)
+    r = cross(f, camera.up)
     r /= np.linalg.norm(r)
-    u = np.cross(r, f)
+    u = cross(r, f)
     tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
     return View(o, f, r, u, tan_half, width, height, detail_height)
 

@@ -13,6 +13,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..scene import KRS, Arc, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
 from .balls import UNBOUNDED, grown, krs_ball, krs_bounds, union_ball
 
@@ -123,7 +124,7 @@ def arc_quaternion(arc: Arc) -> np.ndarray:
     half = arc.phi / 2.0
     e1, e2 = np.array(arc.e1), np.array(arc.e2)
     F = np.stack([np.cos(half) * e1 + np.sin(half) * e2, -np.sin(half) * e1 + np.cos(half) * e2])
-    F = np.stack([F[0], F[1], np.cross(F[0], F[1])], axis=1)  # columns e1, e2, n
+    F = np.stack([F[0], F[1], cross(F[0], F[1])], axis=1)  # columns e1, e2, n
     trace = np.trace(F)
     k = int(np.argmax([trace, *np.diag(F)]))
     if k == 0:

@@ -12,6 +12,7 @@ import math
 import numpy as np
 from imgui_bundle import imgui
 
+from ..algebra.vectors import cross
 from ..compile.camera import View, pixel_ray, project
 from .press import past_click
 
@@ -112,9 +113,9 @@ def on_point(h, v: View, x: float, y: float) -> bool:
 
 def plane_basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors spanning the plane ⊥ ``axis``, right-handed with it."""
-    e = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e = cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
     e /= np.linalg.norm(e)
-    return e, np.cross(axis, e)
+    return e, cross(axis, e)
 
 
 def distance_to(ring: list[tuple[float, float]], x: float, y: float) -> float:

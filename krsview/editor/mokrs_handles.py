@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..algebra import mobius
+from ..algebra.vectors import cross
 from ..scene import MoKRS, Scene
 from ..scene.edits import Path, get_at
 from ..scene.model import Empty
@@ -115,7 +116,7 @@ def _dial_degrees(step: Rotate, q: np.ndarray) -> float:
     a = np.asarray(step.axis, dtype=np.float64)
     v = _dial_vector(a)
     w = q - (q @ a) * a
-    angle = math.degrees(math.atan2(float(np.cross(v, w) @ a), float(v @ w)))
+    angle = math.degrees(math.atan2(float(cross(v, w) @ a), float(v @ w)))
     new = step.degrees + (angle - step.degrees + 180.0) % 360.0 - 180.0
     new = new - 360.0 if new > 360.0 else new + 360.0 if new < -360.0 else new
     return round(new, DIAL_DECIMALS)
@@ -258,7 +259,7 @@ def _one_step(s, sp: Path, i: int, name: str, M, rho: float) -> list[_Local]:
         a = np.array(s.axis)
         v = _dial_vector(a)
         dial = mobius.apply(s.matrix(), rho * v[None])[0]
-        ring = _circle(zero, rho * v, rho * np.cross(a, v))
+        ring = _circle(zero, rho * v, rho * cross(a, v))
         return [
             handle(
                 "degrees", "dial", dial, f"{s.degrees:g} deg", (ring, _segment(zero, dial)), zero, a

@@ -13,6 +13,7 @@ import math
 import numpy as np
 from imgui_bundle import imgui
 
+from ..algebra.vectors import cross
 from ..compile.camera import View, project
 from .gizmo import Snap
 from .handles import Handle
@@ -25,14 +26,12 @@ GRAB_PIXELS = 12.0  # a press this close to the arrow tip starts turning
 def turned(n: np.ndarray, v: View, dx: float, dy: float) -> np.ndarray:
     """Unit normal ``n`` turned by a pointer motion of (dx, dy) window pixels (y down)."""
     d = dx * v.right - dy * v.up
-    omega = RADIANS_PER_PIXEL * np.cross(n, d)
+    omega = RADIANS_PER_PIXEL * cross(n, d)
     angle = float(np.linalg.norm(omega))
     if angle == 0.0:
         return n
     a = omega / angle  # Rodrigues: exact rotation, so the normal stays a unit vector
-    out = (
-        n * math.cos(angle) + np.cross(a, n) * math.sin(angle) + a * (a @ n) * (1 - math.cos(angle))
-    )
+    out = n * math.cos(angle) + cross(a, n) * math.sin(angle) + a * (a @ n) * (1 - math.cos(angle))
     return out / np.linalg.norm(out)
 
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import moderngl
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.camera import View
 from .context import image_uniforms
 from .program import ProgramCache
@@ -28,9 +29,9 @@ class Shapes:
     def disc(
         self, centre: np.ndarray, normal: np.ndarray, radius: float, rgba: tuple, segments: int = 48
     ) -> None:
-        a = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
+        a = cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
         a /= np.linalg.norm(a)
-        b = np.cross(normal, a)
+        b = cross(normal, a)
         ang = np.linspace(0.0, 2.0 * math.pi, segments + 1)
         rim = centre + radius * (np.cos(ang)[:, None] * a + np.sin(ang)[:, None] * b)
         for k in range(segments):

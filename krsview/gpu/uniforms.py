@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.balls import UNBOUNDED
 from ..compile.camera import View
 from ..compile.constants import MOBIUS_RECORD
@@ -198,7 +199,7 @@ def wind_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
     w = np.array([fx.wind_direction[0], 0.0, fx.wind_direction[2]])
     a0 = np.radians(fx.wind_strength) / fx.wind_height
     phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
-    axis = np.cross((0.0, 1.0, 0.0), w / np.linalg.norm(w))
+    axis = cross((0.0, 1.0, 0.0), w / np.linalg.norm(w))
     most = a0 * (1.0 + fx.wind_gust)
     feet, swept = [], []
     if "wind" in scene.effects:

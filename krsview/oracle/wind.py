@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.geometry import Compiled
 from ..reference.wind import Wind
 from ..scene import Scene
@@ -32,13 +33,13 @@ def turn(r: Vec, axis: np.ndarray, sin, half_sin) -> Vec:
     is ``sin`` and half-angle's sine ``half_sin`` (Numbers): Rodrigues' formula less r, with
     1 − cos = 2 sin²(angle/2), as ``reference/wind.py``'s wind_turn."""
     ax = [float(v) for v in axis]
-    cross = (
+    axr = (  # axis × r
         r[2] * ax[1] - r[1] * ax[2],
         r[0] * ax[2] - r[2] * ax[0],
         r[1] * ax[0] - r[0] * ax[1],
     )
     along, chord = dot(axis, r), half_sin.sqr() * 2.0
-    return tuple(cross[k] * sin + (along * ax[k] - r[k]) * chord for k in range(3))
+    return tuple(axr[k] * sin + (along * ax[k] - r[k]) * chord for k in range(3))
 
 
 def unwind(wind: Wind, c: int):
@@ -67,7 +68,7 @@ def hit_stretch(scene: Scene, wind: Wind, p: np.ndarray, s: np.ndarray) -> np.nd
     that may lie within 2s of p (module docstring)."""
     beta = np.zeros(len(p))
     for c, (a, b) in enumerate(zip(np.abs(wind.rates), wind.bases)):
-        rho = np.linalg.norm(np.cross(wind.axis, p - b), axis=-1)
+        rho = np.linalg.norm(cross(wind.axis, p - b), axis=-1)
         near = wind.wind_ball_distance(c, p) <= 2.0 * s
         beta = np.where(near, np.maximum(beta, a * (rho + 2.0 * s)), beta)
     if (beta > 0.5).any():

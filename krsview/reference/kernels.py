@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..algebra.quaternion import conj
+from ..algebra.vectors import cross
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -20,7 +21,7 @@ def arc_local(P: np.ndarray, q: np.ndarray) -> np.ndarray:
     """P̄ q P for offsets q (N, 3) from the arc's centre: q in the arc's frame (x along the
     bisector e1, y along e2, z along n), in units of R = 1/|P|² (compile/krs.py's layout)."""
     w, u = P[0], P[1:]
-    return (w * w - u @ u) * q + 2.0 * (q @ u)[:, None] * u + 2.0 * w * np.cross(q, u)
+    return (w * w - u @ u) * q + 2.0 * (q @ u)[:, None] * u + 2.0 * w * cross(q, u)
 
 
 def arc_world(P: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.constants import (
     BARK_STRETCH,
     GROUND_STRETCH,
@@ -84,7 +85,7 @@ def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
         a = rec[1, :3]
         d = (rec[2, :3] - a) / np.linalg.norm(rec[2, :3] - a)
         e1 = perpendicular(d)
-        e2 = np.cross(d, e1)
+        e2 = cross(d, e1)
         q = xk - a
         return np.stack([q @ d, r * np.arctan2(q @ e2, q @ e1)], axis=1)
     if kind == "toroidal_capsule":  # the arc's frame in units of R: angles from its bisector
@@ -93,7 +94,7 @@ def kernel_uv(kind: str, rec: np.ndarray, xk: np.ndarray) -> np.ndarray:
         return np.stack([along, r * np.arctan2(a[:, 2], np.hypot(a[:, 0], a[:, 1]) - 1.0)], axis=1)
     u = rec[1, :3]  # plane
     e1 = perpendicular(u)
-    return np.stack([xk @ e1, xk @ np.cross(u, e1)], axis=1)
+    return np.stack([xk @ e1, xk @ cross(u, e1)], axis=1)
 
 
 def kernel_texture(

@@ -52,6 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..compile.balls import grown, krs_ball
 from ..compile.mokrs import bounds_in_and_out
 from ..scene import Compound, MoKRS, Scene
@@ -84,7 +85,7 @@ class Wind:
         feet = wind_feet(scene, balls)
         reach = np.array([r for _, r in feet])
         phase = WIND_PHASE / fx.wind_frequency if fx.wind_frequency > 0 else 0.0
-        axis = np.cross(UP, w / np.linalg.norm(w))
+        axis = cross(UP, w / np.linalg.norm(w))
         most = float(np.radians(fx.wind_strength) / fx.wind_height * (1.0 + fx.wind_gust))
         return Wind(
             axis,
@@ -100,8 +101,8 @@ class Wind:
         (int or (N,)) with free radii D: the distance to the axis line, or where smaller
         (ρ + (ŵ·r)⁺)/2 + |a|(ρ + D⁺)²/8 (module docstring, Tighter)."""
         r = p - self.bases[c]
-        rho = np.linalg.norm(np.cross(self.axis, r), axis=-1)
-        along = np.maximum(r @ np.cross(self.axis, UP), 0.0)
+        rho = np.linalg.norm(cross(self.axis, r), axis=-1)
+        along = np.maximum(r @ cross(self.axis, UP), 0.0)
         far = rho + np.maximum(D, 0.0)
         return np.minimum(rho, 0.5 * (rho + along) + 0.125 * np.abs(self.rates[c]) * far**2)
 
@@ -117,8 +118,8 @@ class Wind:
         """‖Dg‖ at the points p (N, 3), exactly: (β + √(4 + 4α + β²))/2 (module docstring)."""
         r = p - self.bases[c]
         a = np.where(r[:, 1] > 0.0, self.rates[c], 0.0)
-        alpha = a * (r @ np.cross(self.axis, UP))
-        beta = np.abs(a) * np.linalg.norm(np.cross(self.axis, r), axis=-1)
+        alpha = a * (r @ cross(self.axis, UP))
+        beta = np.abs(a) * np.linalg.norm(cross(self.axis, r), axis=-1)
         return 0.5 * (beta + np.sqrt(4.0 + 4.0 * alpha + beta**2))
 
     def wind_ball_distance(self, c, p: np.ndarray) -> np.ndarray:
@@ -140,7 +141,7 @@ class Wind:
         a = self.rates[c] * np.ones(len(p))
         above = r[:, 1] > 0.0
         n = g + wind_turn(g, self.axis, a * np.maximum(r[:, 1], 0.0))
-        shear = np.einsum("ij,ij->i", np.cross(self.axis, q - self.bases[c]), g)
+        shear = np.einsum("ij,ij->i", cross(self.axis, q - self.bases[c]), g)
         n[:, 1] -= np.where(above, a * shear, 0.0)
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
@@ -178,7 +179,7 @@ def wind_turn(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     Rodrigues' formula less v, with 1 − cos = 2 sin²(angle/2) against cancellation; exactly 0
     at angle 0, so an idle wind leaves every point as it is."""
     s, h = np.sin(angle)[:, None], np.sin(0.5 * angle)[:, None]
-    return np.cross(axis, v) * s + (np.outer(v @ axis, axis) - v) * (2.0 * h * h)
+    return cross(axis, v) * s + (np.outer(v @ axis, axis) - v) * (2.0 * h * h)
 
 
 def exit_fall(D: np.ndarray, a: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .animation import MAX_TIME
 from .render import Camera
@@ -35,7 +36,7 @@ def horizontal_axes(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     north = ref - (ref @ up) * up
     north /= np.linalg.norm(north)
-    east = np.cross(up, north)
+    east = cross(up, north)
     return east, north
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .compound import Placement
 from .schema import COLOR, Vec3, param
@@ -270,8 +271,8 @@ def swept_ball(foot, reach: float, ball, axis, most: float) -> tuple[float, ...]
     foot, axis, v = np.array(foot), np.array(axis), np.array(ball[:3]) - foot
     half = 0.5 * most * reach
     axial = axis * (axis @ v)
-    turned = axial + (v - axial) * math.cos(half) + np.cross(axis, v) * math.sin(half)
-    chord = 2.0 * np.linalg.norm(np.cross(axis, v)) * math.sin(min(half / 2, math.pi / 2))
+    turned = axial + (v - axial) * math.cos(half) + cross(axis, v) * math.sin(half)
+    chord = 2.0 * np.linalg.norm(cross(axis, v)) * math.sin(min(half / 2, math.pi / 2))
     radius = ball[3] + chord
     if radius >= reach:
         return (*(float(x) for x in foot), float(reach))

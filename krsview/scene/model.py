@@ -12,6 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .schema import COLOR, Tagged, Vec3, cached, param, to_dict
 
@@ -240,18 +241,18 @@ def arc_of(k: ToroidalCapsule) -> Arc | None:
 def _arc(k: ToroidalCapsule) -> Arc | None:
     A, C, B = (np.array(p, dtype=float) for p in (k.start, k.control, k.end))
     a, b = A - C, B - C
-    axb = np.cross(a, b)
+    axb = cross(a, b)
     chord = float(np.linalg.norm(B - A))
     denom = 2.0 * float(axb @ axb)
     if denom <= 0.0:
         return None
-    O = C + np.cross(a @ a * b - b @ b * a, axb) / denom
+    O = C + cross(a @ a * b - b @ b * a, axb) / denom
     R = float(np.linalg.norm(A - O))
     if not np.isfinite(R) or STRAIGHT_RATIO * chord < R:
         return None
-    N = np.cross(C - A, B - C)
+    N = cross(C - A, B - C)
     N /= np.linalg.norm(N)
     e1 = (A - O) / R
-    e2 = np.cross(N, e1)
+    e2 = cross(N, e1)
     phi = math.atan2(float((B - O) @ e2), float((B - O) @ e1)) % (2 * math.pi)
     return Arc(tuple(O), tuple(e1), tuple(e2), R, phi)  # type: ignore[arg-type]

@@ -23,6 +23,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..algebra import mobius
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .model import Empty, Kernel, Plane, Sphere, check_level_count
 from .schema import Tagged, Vec3, cached, param
@@ -293,7 +294,7 @@ def mokrs_of(krs) -> MoKRS:
     def to_x(u):
         """Axis and degrees of the rotation taking unit u to +x."""
         u = np.asarray(u, dtype=np.float64)
-        axis = np.cross(u, [1.0, 0.0, 0.0])
+        axis = cross(u, [1.0, 0.0, 0.0])
         s, c = float(np.linalg.norm(axis)), float(u[0])
         if s < 1e-12:
             return (0.0, 1.0, 0.0), (0.0 if c > 0 else 180.0)

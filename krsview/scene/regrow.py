@@ -17,6 +17,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .growth import Growth, growth_of
 from .route import Route, RouteLevel, level_name
@@ -61,7 +62,7 @@ def frame(route: Route, k: int) -> np.ndarray:
         if np.linalg.norm(a) > 1e-6:
             a = a / np.linalg.norm(a)
             break
-    return np.column_stack([d, a, np.cross(d, a)])
+    return np.column_stack([d, a, cross(d, a)])
 
 
 def level_edit(route: Route, k: int, baked: Route, shape: bool) -> LevelEdit:

@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .model import Mirror, Plane, ToroidalCapsule
 from .retrack import Moves, shifted
@@ -77,11 +78,11 @@ def free_normal(
     points outside, else tilted back from ``t`` by the least angle that does (its mirror
     image of the crown then leaves the branch at twice that angle, as a fork does); among
     equally good directions the nearest to ``hint``."""
-    a = np.cross(t, hint if hint is not None else (0.0, 0.0, 0.0))
+    a = cross(t, hint if hint is not None else (0.0, 0.0, 0.0))
     if np.linalg.norm(a) < 1e-9:
-        a = np.cross(t, [1.0, 0.0, 0.0] if abs(t[0]) < 0.9 else [0.0, 0.0, 1.0])
+        a = cross(t, [1.0, 0.0, 0.0] if abs(t[0]) < 0.9 else [0.0, 0.0, 1.0])
     a /= np.linalg.norm(a)
-    b = np.cross(t, a)  # the hint projected ⟂ t is ±b
+    b = cross(t, a)  # the hint projected ⟂ t is ±b
     phi = np.linspace(0.0, 2.0 * np.pi, NORMAL_CANDIDATES, endpoint=False)
     around = np.cos(phi)[:, None] * b + np.sin(phi)[:, None] * a
     size = max(float(np.ptp(np.concatenate([child, subtree]), axis=0).max()), 1e-9)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..messages import SceneError
 from .route import CLIP_TOLERANCE, Route, arc_points
 from .schema import param
@@ -59,11 +60,11 @@ def turned(route: Route, i: int, theta: float | np.ndarray) -> np.ndarray:
     lv = route.levels[i]
     u = np.array(lv.normal)
     d = np.subtract(lv.fork, route.starts()[i])
-    axis = np.cross(d, u)
+    axis = cross(d, u)
     n = np.linalg.norm(axis)
     axis = axis / n if n > 1e-12 * np.linalg.norm(d) else perpendicular(u)
     th = np.asarray(theta, dtype=float)[..., None]
-    v = u * np.cos(th) + np.cross(axis, u) * np.sin(th)  # axis ⟂ u: a unit vector
+    v = u * np.cos(th) + cross(axis, u) * np.sin(th)  # axis ⟂ u: a unit vector
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 

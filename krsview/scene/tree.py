@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from .growth import Growth, growth_of
 from .model import KRS, Plane
 from .route import Route, RouteLevel
@@ -89,6 +90,6 @@ def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
     """Rodrigues rotation of v around the unit axis."""
     return (
         v * math.cos(angle)
-        + np.cross(axis, v) * math.sin(angle)
+        + cross(axis, v) * math.sin(angle)
         + axis * (axis @ v) * (1 - math.cos(angle))
     )

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..algebra.vectors import cross
 from ..scene import Camera
 from ..scene.camera_path import horizontal_axes, look_direction
 
@@ -42,7 +43,7 @@ class FlyCamera:
         return look_direction(self.yaw, self.pitch, self.world_up)
 
     def right(self) -> np.ndarray:
-        r = np.cross(self.forward(), self.world_up)
+        r = cross(self.forward(), self.world_up)
         return r / np.linalg.norm(r)
 
     def to_camera(self) -> Camera:
