@@ -28,6 +28,8 @@ from krsview.share.web_tracks import PAGE_DATA_CAP, PAGE_RATE
 from .browser import Browser
 from .conftest import headless_render, krsview_cli
 
+# one worker takes the module: one browser, and each moving preset's poses made once
+pytestmark = pytest.mark.xdist_group("web")
 SIZE = (160, 90)
 # Shadertoy's own wrapper, as far as a shader sees it: the version, its uniforms, and a
 # main that calls mainImage (iMouse released, iTime 0).
@@ -63,9 +65,15 @@ def export_page(scene, tmp_path: Path, name: str) -> Path:
 
 
 @functools.cache
+def preset_scene(name: str):
+    """A preset, loaded once for the module: what its page computes is kept on it
+    (web.page_shader), so a moving preset's poses (seconds) are made once."""
+    return load_scene(resolve(name))
+
+
+@functools.cache
 def preset_html(name: str) -> str:
-    """A preset's page, built once for the module (a moving preset's poses take seconds)."""
-    return html_page(load_scene(resolve(name)))
+    return html_page(preset_scene(name))
 
 
 def preset_page(name: str, tmp_path: Path) -> Path:
@@ -203,7 +211,7 @@ def glsl_es_errors(stages: dict[str, str], tmp_path: Path) -> str:
 
 def test_every_preset_and_hard_case_exports_valid_glsl_es(tmp_path):
     assert shutil.which("glslangValidator"), "glslang-tools is missing: `make deps`"
-    scenes = [(n, load_scene(resolve(n))) for n in preset_names()]
+    scenes = [(n, preset_scene(n)) for n in preset_names()]
     scenes += [(f"hard-{c.name}", c.build()) for c in CASES.values()]
     stages, refused = {}, 0
     for name, scene in scenes:
@@ -342,8 +350,8 @@ def test_every_moving_preset_fits_the_cap_and_a_lower_cap_lowers_the_rate(tmp_pa
     """Each moving preset's poses stay under PAGE_DATA_CAP at PAGE_RATE a second. Under a cap
     of two thirds of palm-curl's poses (the negative control: they would not fit), the page
     keeps every other pose, 12 a second, under that cap, and its notes say so."""
-    moving = [n for n in preset_names() if load_scene(resolve(n)).animation is not None]
-    moving = [n for n in moving if load_scene(resolve(n)).animation.moves]
+    moving = [n for n in preset_names() if preset_scene(n).animation is not None]
+    moving = [n for n in moving if preset_scene(n).animation.moves]
     assert {"palm-curl", "tree-sway", "tree-growing"} <= set(moving)
     full = {}
     for name in moving:
