@@ -459,6 +459,56 @@ def test_a_viewers_bookmark_is_appended_to_the_file_as_written(tmp_path):
     assert len(load_scene(palm).bookmarks) == 1
 
 
+def test_a_viewers_bookmark_undone_and_redone_is_taken_out_of_the_file_and_written_again(
+    tmp_path, monkeypatch
+):
+    """B writes the bookmark into the file at once, so its undo takes it out of the file (the
+    file's own text back, byte for byte) and its redo writes it again, over what the file
+    holds then: a bookmark another program added in between stays. Where the file cannot be
+    written, the undo still happens and ``write_error`` says why, the file untouched.
+    Negative control: the undo of an edit never written (a knob) leaves the file alone."""
+    import errno
+    import os
+
+    from krsview.document import document
+    from krsview.scene import Camera
+
+    path = tmp_path / "grove.toml"
+    shutil.copy(resolve("grove"), path)
+    text = path.read_text()
+    doc = Document(path)
+    cam = Camera((1.0, 2.0, 3.0), (0.0, 1.0, 0.0), (0.0, 1.0, 0.0), 45.0)
+    doc.apply(("render", "epsilon_scale"), 2.0)  # a knob's edit, never written
+    doc.add_bookmark(cam)
+    with_mark = path.read_text()
+    doc.undo()
+    assert path.read_text() == text and not doc.scene.bookmarks and not doc.write_error
+    assert doc.dirty and not doc.changed_on_disk()  # the knob is still unsaved; no outside edit
+    doc.undo()  # the knob: the file stays as it is
+    assert path.read_text() == text and not doc.dirty
+    doc.redo()
+    doc.redo()
+    assert path.read_text() == with_mark and not doc.changed_on_disk()
+    # another program adds a bookmark of its own: the undo takes out only ours
+    other = Camera((0.0, 9.0, 9.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 45.0)
+    doc_b = Document(path)
+    doc_b.add_bookmark(other)
+    doc.undo()
+    assert [b.camera for b in load_scene(path).bookmarks] == [other]
+    # a file that cannot be written (a full disk, say): the scene steps back, the file
+    # stays, and it is said
+    doc.redo()
+    before = path.read_text()
+
+    def full(*_):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(document, "write_atomic", full)
+    doc.undo()
+    assert path.read_text() == before and not doc.scene.bookmarks
+    assert doc.write_error == f"{path}: the file is as it was: No space left on device"
+
+
 def test_a_shipped_presets_copy_made_by_a_bookmark_keeps_its_text(tmp_path, monkeypatch):
     """B on a shipped preset writes its copy as the preset's own text with the bookmark
     appended (it used to write every default out: a pre-pass, the fragment path, all the

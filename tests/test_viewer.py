@@ -121,6 +121,17 @@ def test_bookmark_is_saved_in_the_preset_and_reset_restores(viewer):
     assert v.camera.to_camera().position == saved.camera.position
     v.execute([NextBookmark()])
     assert np.allclose(v.camera.position, moved.position)
+    # B wrote the bookmark to the file, so Ctrl+Z takes it out of the file too, and Ctrl+Shift+Z
+    # writes it again; the viewer's own write is no outside edit (no reload said). It used to
+    # leave the file holding the bookmark the view no longer had.
+    with_mark = v.path.read_text()
+    v.execute([Undo()])
+    assert not v.scene.bookmarks and not load_scene(v.path).bookmarks
+    assert v.status_line() == f"undid add bookmark 'view 1' in {v.path.name}"
+    v.step(0.6)
+    assert "reloaded" not in v.message and not v.error
+    v.execute([Redo()])
+    assert v.path.read_text() == with_mark and v.scene.bookmarks == load_scene(v.path).bookmarks
 
 
 def test_hot_reload_applies_edits_and_keeps_the_last_good_scene(viewer):

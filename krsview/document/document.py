@@ -109,6 +109,7 @@ class Document:
         self._autosaved: Scene | None = None
         self._autosave_clock: float | None = None
         self.autosave_error = ""  # why the last autosave could not write ("": it could)
+        self.write_error = ""  # why the last undo or redo of a written step could not write
 
     @property
     def template(self) -> bool:
@@ -157,11 +158,19 @@ class Document:
         scene = apply_edit(self._scene, path, value)
         self.commit(scene, label or f"set {path_text(path)}", interaction)
 
-    def commit(self, scene: Scene, label: str, interaction: Hashable | None = None) -> None:
-        """Make ``scene`` (already valid) the document's scene, as one undo step."""
+    def commit(
+        self,
+        scene: Scene,
+        label: str,
+        interaction: Hashable | None = None,
+        written: bool = False,
+    ) -> None:
+        """Make ``scene`` (already valid) the document's scene, as one undo step (``written``:
+        a step the caller has written to the file; its undo and redo write it too)."""
         if scene == self._scene:
             return
-        self.history.push(Step(label, self._scene, scene, interaction, self._memo()))
+        step = Step(label, self._scene, scene, interaction, self._memo(), written=written)
+        self.history.push(step)
         self._set(scene)
 
     def replace_scene(self, scene: Scene, label: str) -> None:
@@ -170,21 +179,53 @@ class Document:
 
     def undo(self) -> Step | None:
         """The scene before the last step, which is returned (None: none);
-        :attr:`restored`, the memo taken with it."""
+        :attr:`restored`, the memo taken with it. A step written to the file when taken
+        (the viewer's bookmark) is taken out of the file too (:attr:`write_error`)."""
         step = self.history.undo(self._memo())
         if step is not None:
             self.restored = step.memo_before
             self._set(step.before)
+            self._rewrite_bookmark(step, keep=False)
         return step
 
     def redo(self) -> Step | None:
         """The scene after the next step, which is returned (None: none); :attr:`restored`,
-        the memo it was undone with."""
+        the memo it was undone with; a written step is written again."""
         step = self.history.redo()
         if step is not None:
             self.restored = step.memo_after
             self._set(step.after)
+            self._rewrite_bookmark(step, keep=True)
         return step
+
+    def _rewrite_bookmark(self, step: Step, keep: bool) -> None:
+        """A bookmark written to the file when added, undone (``keep`` False) or redone: the
+        file as it is on disk now, less or plus that bookmark, its own text kept. Where it
+        cannot be written, :attr:`write_error` says why and the file stays as it is."""
+        self.write_error = ""
+        if not step.written:
+            return
+        bookmark = step.after.bookmarks[-1]
+        try:
+            on_disk, text = load_scene(self.path), self.path.read_text(encoding="utf-8")
+            marks = list(on_disk.bookmarks)
+            if keep:
+                want = replace(on_disk, bookmarks=[*marks, bookmark])
+                text = with_bookmark(text, bookmark, want)
+            elif bookmark in marks:  # the last one of that name and view
+                k = len(marks) - 1 - marks[::-1].index(bookmark)
+                want = replace(on_disk, bookmarks=marks[:k] + marks[k + 1 :])
+                text = without_bookmark(text, bookmark, on_disk, want)
+            else:  # taken out of the file by another program already
+                return
+            write_atomic(self.path, text)
+        except SceneError as e:
+            self.write_error = f"the file is as it was: {e}"
+            return
+        except OSError as e:
+            self.write_error = f"{self.path}: the file is as it was: {e.strerror}"
+            return
+        self.mark_saved(want, text)
 
     def _memo(self) -> Hashable | None:
         return self.memo() if self.memo is not None else None
@@ -262,11 +303,9 @@ class Document:
         from then on. SceneError: the file cannot be read or written."""
         if self.template:
             name = f"view {len(self._scene.bookmarks) + 1}"
-            self.apply(
-                ("bookmarks",),
-                self._scene.bookmarks + [Bookmark(name, camera)],
-                label=f"add bookmark {name!r}",
-            )
+            marks = self._scene.bookmarks + [Bookmark(name, camera)]
+            scene = apply_edit(self._scene, ("bookmarks",), marks)
+            self.commit(scene, f"add bookmark {name!r}", written=True)
             return name, self.save(copy_target(self.path))
         on_disk = load_scene(self.path)
         name = f"view {len(on_disk.bookmarks) + 1}"
@@ -277,7 +316,8 @@ class Document:
             write_atomic(self.path, text)
         except OSError as e:
             raise SceneError("<file>", str(self.path), f"cannot save: {e.strerror}") from None
-        self.apply(("bookmarks",), written.bookmarks, label=f"add bookmark {name!r}")
+        scene = apply_edit(self._scene, ("bookmarks",), written.bookmarks)
+        self.commit(scene, f"add bookmark {name!r}", written=True)
         self.mark_saved(written, text)
         return name, self.path
 
@@ -343,11 +383,29 @@ class Document:
         self.recovery_path.unlink(missing_ok=True)
 
 
+def bookmark_table(bookmark: Bookmark) -> str:
+    return dumps({"bookmarks": [to_dict(bookmark)]})
+
+
+def without_bookmark(text: str, bookmark: Bookmark, before: Scene, want: Scene) -> str:
+    """A scene file's ``text``, which holds ``before``, with ``bookmark`` taken out: the
+    table :func:`with_bookmark` appended cut off where it is still the file's end (the text
+    as it was, byte for byte), else only that change written into the text (filetext)."""
+    tail = "\n" + bookmark_table(bookmark)
+    if text.endswith(tail):
+        try:
+            if scene_from_toml(text[: -len(tail)]) == want:
+                return text[: -len(tail)]
+        except SceneError:
+            pass
+    return saved_text(text, before, want)
+
+
 def with_bookmark(text: str, bookmark: Bookmark, want: Scene) -> str:
     """A scene file's ``text`` with ``bookmark`` appended as a table of its own: the person's
     comments, layout and numbers stay as they wrote them. Where that does not read back as
     ``want`` (a file that lists its bookmarks inline, say), the whole scene written anew."""
-    table = dumps({"bookmarks": [to_dict(bookmark)]})
+    table = bookmark_table(bookmark)
     # the shipped presets say ``bookmarks = []`` above their tables: that line goes
     bases = [text]
     empty = re.search(r"(?m)^bookmarks[ \t]*=[ \t]*\[[ \t]*\][ \t]*(#.*)?\n", text)

@@ -25,6 +25,8 @@ class Step:
     interaction: Hashable | None = None  # steps of one interaction merge; None never merges
     memo_before: Hashable | None = None  # the caller's state when the step was taken
     memo_after: Hashable | None = None  # ... and when it was undone (what redo brings back)
+    written: bool = False  # written to the file when taken (the viewer's bookmark): so are
+    # its undo and redo (Document.undo)
 
 
 class History:

@@ -207,10 +207,16 @@ class Viewer:
         return self._stepped(self.doc.redo(), "redid")
 
     def _stepped(self, step: Step | None, verb: str) -> bool:
+        """What an undo or redo says; a bookmark's is written to the file too (B wrote it)."""
         if step is None:
             return False
         self.sync()
         self.message = f"{verb} {step.label}"
+        if step.written and not self.doc.write_error:
+            self.file.follow()  # our own write is not an outside edit
+            self.message += f" in {self.doc.path.name}"
+        if self.doc.write_error:
+            self.error = f"{self.message}: {self.doc.write_error}"
         self.say(self.message)
         return True
 
