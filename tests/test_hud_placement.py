@@ -115,3 +115,20 @@ def test_above_a_timeline_beside_a_panel_that_reaches_the_top():
     assert not meets(drawn, timeline) and not meets(drawn, panel)
     # control: at the foot, where no gap holds it, it covers the strip
     assert meets(box((MARGIN, display[1] - MARGIN, 884.0), line(237, 30)), timeline)
+
+
+def test_a_long_line_is_wrapped_above_the_timeline_beside_the_panel():
+    """A refusal too long for one line where the editor's timeline spans the foot and its
+    panel the right: wrapped in the gap above the strip, left of the panel. It was drawn at
+    the foot's left across the strip and the panel [a real-window review]. Control: no
+    band above holds MIN_ROOM (a panel docked over nearly all the width): the foot's left."""
+    display = (800.0, 500.0)
+    timeline, panel = (8.0, 428.0, 452.0, 492.0), (460.0, 8.0, 792.0, 492.0)
+    long = line(900, 20)
+    spot = status_spot(display, long, [timeline, panel])
+    assert spot == (MARGIN, timeline[1] - MARGIN, panel[0] - 2 * MARGIN)
+    drawn = box(spot, long)
+    assert not meets(drawn, timeline) and not meets(drawn, panel) and drawn[1] >= 0
+    assert box(spot, long)[1] == spot[1] - 3 * 20, "three lines"
+    wide = (8.0 + MIN_ROOM, 8.0, 792.0, 492.0)
+    assert status_spot(display, long, [timeline, wide])[:2] == (MARGIN, display[1] - MARGIN)

@@ -23,24 +23,36 @@ def status_spot(display: tuple[float, float], measure: Measure, rects: list[Rect
     """Where the status line goes in a ``display`` (w, h) beside the windows ``rects``: its
     left edge, its foot and the width it may take (x, y, room); ``measure(width)`` is its
     box wrapped at ``width``. One line in the lowest band with room for it, leftmost; else
-    wrapped in the widest gap at the foot that holds MIN_ROOM; else at the foot's left,
-    over the other windows."""
+    wrapped in the widest gap that holds MIN_ROOM, in the lowest band with one (above the
+    editor's timeline, beside its panel); else at the foot's left, over the other windows."""
     w, h = measure(math.inf)
-    foot = display[1] - MARGIN
-    while foot - h >= 0:
+    feet = list(_feet(display, h, rects))
+    for foot in feet:
         for x, room in _gaps(display[0], foot, h, rects):
             if room >= w:
                 return x, foot, room
+    for foot in feet:
+        for x, room in sorted(_gaps(display[0], foot, h, rects), key=lambda g: -g[1]):
+            top = foot - measure(room)[1]
+            if (
+                room >= MIN_ROOM
+                and top >= 0
+                and not any(meets(r, (x, top, x + room, foot)) for r in rects)
+            ):
+                return x, foot, room
+    return MARGIN, display[1] - MARGIN, display[0] - 2 * MARGIN
+
+
+def _feet(display: tuple[float, float], h: float, rects: list[Rect]) -> Iterator[float]:
+    """The bands a line of height ``h`` may sit on, from the window's foot up: each next one
+    just above the lowest window that reaches into the band below it."""
+    foot = display[1] - MARGIN
+    while foot - h >= 0:
+        yield foot
         band = [r for r in rects if r[1] < foot and r[3] > foot - h]
         if not band:
-            break
+            return
         foot = max(r[1] for r in band) - MARGIN  # above the lowest one only
-    foot = display[1] - MARGIN
-    for x, room in sorted(_gaps(display[0], foot, h, rects), key=lambda g: -g[1]):
-        tall = measure(room)[1]
-        if room >= MIN_ROOM and not any(meets(r, (x, foot - tall, x + room, foot)) for r in rects):
-            return x, foot, room
-    return MARGIN, foot, display[0] - 2 * MARGIN
 
 
 def meets(a: Rect, b: Rect) -> bool:
