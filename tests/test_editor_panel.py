@@ -580,3 +580,41 @@ def test_own_color_gives_a_level_the_albedo_it_is_drawn_in_and_takes_it_back(tre
     assert e.scene.route.levels[LEVEL].color == tuple(e.scene.material.albedo)
     assert np.array_equal(image(), albedo)  # ticked: nothing changes until it is set
     assert len(e.doc.history.steps) == 3  # the bake and one undo step per click
+
+
+def test_the_opened_hud_ends_above_the_editors_timeline(display, tmp_path, monkeypatch):
+    """In an 800×500 editor on a moving scene the timeline strip spans the foot of the view;
+    the HUD opened by a click on its arrow (real X events), its accuracy section unfolded,
+    ends above the strip and scrolls the rest, so the strip's play button and time bar stay
+    in sight. It reached down over them. Control: with no room kept at the foot, the same
+    HUD covers the strip."""
+    from imgui_bundle import imgui
+
+    from krsview.editor import drawing
+    from krsview.editor.window import Editor
+    from krsview.viewer.hud import HUD_AT, HUD_TITLE
+    from krsview.viewer.status import meets, window_rect
+
+    open_from_start(monkeypatch, "accuracy and view")
+    mine = tmp_path / "curl.toml"
+    shutil.copy(resolve("tree-growing"), mine)
+    e = Editor(mine, size=(800, 500))
+
+    def rects():
+        hud, strip = (imgui.internal.find_window_by_name(n) for n in (HUD_TITLE, "##timeline"))
+        assert not hud.collapsed, "the click opened nothing"
+        return window_rect(hud), window_rect(strip)
+
+    try:
+        pump(e)
+        bar = imgui.get_frame_height()
+        click(e, window_xy(e, HUD_AT + bar / 2, HUD_AT + bar / 2))  # the arrow
+        pump(e, 4)
+        hud, strip = rects()
+        assert not meets(hud, strip) and hud[3] <= strip[1] - HUD_AT
+        monkeypatch.setattr(drawing, "STRIP_ROOM", 0.0)
+        pump(e, 4)
+        hud, strip = rects()
+        assert meets(hud, strip), "control: the HUD is short enough anyway"
+    finally:
+        e.close()

@@ -16,6 +16,7 @@ from krsview.editor.keys import (
     keys_together,
     linked_paths,
     moved_keys,
+    strip_words,
     track_index,
     with_key,
     without_keys,
@@ -88,6 +89,10 @@ def test_k_and_the_strips_key_edits_act_on_the_linked_levels_as_a_drag_does():
     paths = linked_paths(s, CURL, carry=True)
     tracks = [track_index(s, p) for p in paths]
     assert len(paths) == 30 and paths[0] == CURL and None not in tracks
+    # what the strip says it keys (with nothing selected it said "… and -1 linked levels")
+    assert strip_words(paths) == "mokrs.levels[58].transform[1].degrees and 29 linked levels"
+    assert strip_words([CURL]) == "mokrs.levels[58].transform[1].degrees"
+    assert strip_words([]) == "select a handle to key it"
     assert linked_paths(s, CURL, carry=False) == [CURL]
     assert linked_paths(s, FORK, carry=True) == [FORK]  # not a MöKRS step: alone
 

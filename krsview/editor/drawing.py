@@ -18,7 +18,7 @@ from ..viewer import commands as vc
 from ..viewer.hud import HUD_TITLE, draw_hud
 from ..viewer.status import window_rect
 from .handles import Handle
-from .keys import Timeline, linked_paths
+from .keys import STRIP_ROOM, Timeline, linked_paths
 from .layout import hud_clear_of
 from .panels import PANEL_TITLE, Edited, edit_panel
 from .picking import hover_label
@@ -50,7 +50,7 @@ def draw_ui(e: Drawing) -> None:
         e.overlay.draw(shapes, fbo, v.ctx.screen, fb, proj @ view_matrix, view.origin, image)
     _hud_beside_panel(e)
     imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
-    e.execute(draw_hud(v, v.interactions))
+    e.execute(draw_hud(v, v.interactions, STRIP_ROOM if e.scene.animated else 0.0))
     e.execute(edit_panel(e, v.interactions))
     if e.scene.animated:  # a still scene keeps the whole view (K starts a track)
         free = e.layout.free(glfw.get_window_size(v.window))

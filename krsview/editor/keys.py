@@ -32,6 +32,7 @@ KEY_GAP = 1e-3  # seconds kept between neighbouring keys when one is dragged in 
 KEY_DIGITS = 3  # a key's time is kept to the millisecond: 1.7, not 1.7000000000000006
 STRIP_DIGITS = 2  # the strip's times go by hundredths of a second (a click at "2.00 s")
 STRIP_HEIGHT = 64.0  # pixels: the timeline strip at the window's foot
+STRIP_ROOM = STRIP_HEIGHT + 8.0  # pixels of the foot it keeps, the gap under it with it
 DIAMOND = 6.0  # pixels: a key's half size on the strip
 MARK_ROOM = 2 * DIAMOND + 4.0  # pixels kept right of each field's label for its diamond
 KEY, KEY_HOT = 0xFF40C0FF, 0xFF40FFFF  # ImGui's packed ABGR: a key, the key under the pointer
@@ -231,6 +232,14 @@ def keys_together(scene: Scene, tracks: list[int], track: int, key: int) -> list
     return out
 
 
+def strip_words(paths: list[Path]) -> str:
+    """What the timeline strip says it keys: the selected value and the levels linked to it
+    (``paths``: ``linked_paths``), or how to choose one."""
+    if not paths:
+        return "select a handle to key it"
+    return path_text(paths[0]) + and_linked(len(paths) - 1, "level")
+
+
 def and_linked(n: int, noun: str) -> str:
     """What an act on ``n`` linked levels (keys, …) adds to its words: " and 29 linked
     levels"; nothing for none."""
@@ -282,7 +291,7 @@ class Timeline:
         out: list[vc.Command] = []
         io = imgui.get_io()
         x0, x1 = span[0] + 8.0, span[1] - 8.0
-        imgui.set_next_window_pos(imgui.ImVec2(x0, io.display_size.y - STRIP_HEIGHT - 8.0))
+        imgui.set_next_window_pos(imgui.ImVec2(x0, io.display_size.y - STRIP_ROOM))
         imgui.set_next_window_size(imgui.ImVec2(max(x1 - x0, 200.0), STRIP_HEIGHT))
         imgui.set_next_window_bg_alpha(0.75)
         flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.no_move
@@ -295,9 +304,7 @@ class Timeline:
         imgui.same_line()
         tracks = [i for i in (track_index(scene, p) for p in paths) if i is not None]
         track = track_index(scene, paths[0]) if paths else None
-        what = path_text(paths[0]) if paths else "select a handle to key it"
-        what += and_linked(len(paths) - 1, "level")
-        imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {what}")
+        imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {strip_words(paths)}")
         out += self._bar(scene, playback, track, tracks)
         imgui.end()
         return out

@@ -82,22 +82,26 @@ class Viewed(Protocol):
     def nearest_distance(self) -> float: ...
 
 
-def draw_hud(v: Viewed, interactions: Interactions) -> list[c.Command]:
+def draw_hud(v: Viewed, interactions: Interactions, foot: float = 0.0) -> list[c.Command]:
     """The whole HUD at once (:func:`begin_hud`, then :func:`finish_hud`); its commands."""
-    out, slot = begin_hud(v, interactions)
+    out, slot = begin_hud(v, interactions, foot)
     finish_hud(v, slot)
     return out
 
 
-def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], imgui.ImVec2]:
+def begin_hud(
+    v: Viewed, interactions: Interactions, foot: float = 0.0
+) -> tuple[list[c.Command], imgui.ImVec2]:
     """The HUD but the numbers of the image on screen, which :func:`finish_hud` draws into
     the slot left for them (returned, with the commands): this part reads nothing of the
-    frame traced this turn, so the viewer builds it while that frame is traced."""
+    frame traced this turn, so the viewer builds it while that frame is traced. It ends
+    ``foot`` pixels above the window's foot (the editor's timeline keeps them), scrolling
+    what does not fit."""
     out: list[c.Command] = []
     interactions.inline.clear()  # the fields drawn this frame show their own errors
     imgui.set_next_window_pos(imgui.ImVec2(HUD_AT, HUD_AT), imgui.Cond_.first_use_ever)
     display = imgui.get_io().display_size
-    tallest, widest = display.y - 2 * HUD_AT, display.x - 2 * HUD_AT
+    tallest, widest = display.y - 2 * HUD_AT - foot, display.x - 2 * HUD_AT
     width = max(min(HUD_WIDTH, widest), 160)  # a small window: as wide as it (it scrolls)
     imgui.set_next_window_size_constraints(
         imgui.ImVec2(width, 0), imgui.ImVec2(width, max(tallest, 100))
@@ -109,7 +113,7 @@ def begin_hud(v: Viewed, interactions: Interactions) -> tuple[list[c.Command], i
     imgui.separator()
     # the rest scrolls under the numbers, which stay in sight (the whole HUD scrolled once,
     # and the state of the frame on screen went with it)
-    bottom = display.y - HUD_AT - imgui.get_window_pos().y  # the HUD's room, where it is
+    bottom = display.y - HUD_AT - foot - imgui.get_window_pos().y  # its room, where it is
     rest = bottom - imgui.get_cursor_pos().y - imgui.get_style().window_padding.y
     imgui.set_next_window_size_constraints(
         imgui.ImVec2(0, 0), imgui.ImVec2(width, max(rest, 3 * imgui.get_frame_height()))
