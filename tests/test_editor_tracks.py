@@ -219,3 +219,48 @@ def test_a_linked_dial_drag_on_palm_curl_keys_every_curl_at_the_moment():
     assert 4.0 < abs(keyed[0].keys[1].value - drawn) < 6.0, (keyed[0].keys[1].value, drawn)
     alone = drag_edits(s, h, p, carry=False, t=1.0)
     assert [path for path, _ in alone] == [CURL]  # keyed by Editor.edit: this level only
+
+
+def test_a_grown_trees_growth_fields_show_the_moment_and_a_typed_value_keys_it(
+    display, tmp_path, monkeypatch
+):
+    """tree-growing's tracks move its growth parameters, which no handle holds: the panel's
+    growth section shows them as grown at the moment shown, the tracked ones marked, and a
+    value typed into a tracked one keys it at that moment (one undo step, the rest value
+    kept). They could be edited only in a text editor. Negative control: an untracked field
+    (radius_ratio) typed sets the value itself, no track made."""
+    from krsview.editor.window import Editor
+    from krsview.scene import load_scene
+    from krsview.viewer.commands import SetTime
+
+    shown: dict[str, object] = {}
+    widget = panels.field_widget
+
+    def recording(label, value, meta, refused=None):
+        shown[label.split("##", 1)[1]] = value
+        return widget(label, value, meta, refused)
+
+    monkeypatch.setattr(panels, "field_widget", recording)
+    path = tmp_path / "growing.toml"
+    shutil.copy(resolve("tree-growing"), path)
+    e = Editor(path, size=(800, 500))
+    ratio, radius = ("tree", "length_ratio"), ("tree", "radius_ratio")
+    try:
+        e.execute([SetTime(3.0)])
+        pump(e, 4)
+        posed = e.scene.at(3.0).posed().tree
+        assert shown["tree.length_ratio"] == posed.length_ratio != e.scene.tree.length_ratio
+        assert shown["tree.levels"] == posed.levels == 12
+        assert frame_colour(e, ratio, BETWEEN) > 50 and frame_colour(e, radius, BETWEEN) == 0
+        x0, y0, x1, y1 = e.viewer.interactions.rects[ratio]
+        type_at(e, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2), "0.7")
+        track = next(tr for tr in e.scene.animation.tracks if tr.path == "tree.length_ratio")
+        assert [(k.time, k.value) for k in track.keys] == [(0.0, 0.62), (3.0, 0.7), (7.5, 0.76)]
+        assert e.scene.tree.length_ratio == load_scene(path).tree.length_ratio  # rest kept
+        assert e.doc.history.labels()[0] == ["key tree.length_ratio at 3.00 s"]
+        x0, y0, x1, y1 = e.viewer.interactions.rects[radius]
+        type_at(e, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2), "0.7")
+        assert e.scene.tree.radius_ratio == 0.7
+        assert not any(tr.path == "tree.radius_ratio" for tr in e.scene.animation.tracks)
+    finally:
+        e.close()

@@ -232,11 +232,12 @@ def keys_together(scene: Scene, tracks: list[int], track: int, key: int) -> list
     return out
 
 
-def strip_words(paths: list[Path]) -> str:
+def strip_words(paths: list[Path], grown: bool = False) -> str:
     """What the timeline strip says it keys: the selected value and the levels linked to it
-    (``paths``: ``linked_paths``), or how to choose one."""
+    (``paths``: ``linked_paths``), or how to choose one (``grown``: a grown tree, which has
+    no handles; its panel's growth fields key what they are typed into)."""
     if not paths:
-        return "select a handle to key it"
+        return "type a value under growth to key it" if grown else "select a handle to key it"
     return path_text(paths[0]) + and_linked(len(paths) - 1, "level")
 
 
@@ -304,7 +305,8 @@ class Timeline:
         imgui.same_line()
         tracks = [i for i in (track_index(scene, p) for p in paths) if i is not None]
         track = track_index(scene, paths[0]) if paths else None
-        imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {strip_words(paths)}")
+        what = strip_words(paths, scene.tree is not None)
+        imgui.text(f"{playback.time:6.2f} s / {playback.duration:g} s · {what}")
         out += self._bar(scene, playback, track, tracks)
         imgui.end()
         return out

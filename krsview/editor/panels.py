@@ -84,6 +84,9 @@ def edit_panel(e: Edited, interactions: Interactions) -> list[Command]:
         )
         if imgui.button("bake into a route"):
             out.append(ec.Bake())
+        if imgui.collapsing_header("growth", imgui.TreeNodeFlags_.default_open):
+            # as grown at the moment shown; a value a track moves is keyed there (tree-growing)
+            fields_of(shown.tree, ("tree",), out, interactions)
     elif scene.mokrs is not None:
         mokrs_section(e, out, interactions, fields_of)
     else:
