@@ -22,11 +22,8 @@ CURL = (*LEVELS, 58, "transform", 1, "degrees")  # palm-curl's track: -2.5° at 
 FACTOR = (*LEVELS, 58, "transform", 0, "factor")  # no track
 
 
-@pytest.fixture
-def palm(display, tmp_path, monkeypatch):
-    """palm-curl in an editor, with the values its panel's fields show recorded by path."""
-    from krsview.editor.window import Editor
-
+def recorded_fields(monkeypatch) -> dict[str, object]:
+    """The values the panels' fields show, recorded by path ("tree.levels") as drawn."""
     shown: dict[str, object] = {}
     widget = panels.field_widget
 
@@ -35,6 +32,15 @@ def palm(display, tmp_path, monkeypatch):
         return widget(label, value, meta, refused)
 
     monkeypatch.setattr(panels, "field_widget", recording)
+    return shown
+
+
+@pytest.fixture
+def palm(display, tmp_path, monkeypatch):
+    """palm-curl in an editor, with the values its panel's fields show recorded by path."""
+    from krsview.editor.window import Editor
+
+    shown = recorded_fields(monkeypatch)
     path = tmp_path / "palm-curl.toml"
     shutil.copy(resolve("palm-curl"), path)
     e = Editor(path, size=(800, 500))
@@ -233,14 +239,7 @@ def test_a_grown_trees_growth_fields_show_the_moment_and_a_typed_value_keys_it(
     from krsview.scene import load_scene
     from krsview.viewer.commands import SetTime
 
-    shown: dict[str, object] = {}
-    widget = panels.field_widget
-
-    def recording(label, value, meta, refused=None):
-        shown[label.split("##", 1)[1]] = value
-        return widget(label, value, meta, refused)
-
-    monkeypatch.setattr(panels, "field_widget", recording)
+    shown = recorded_fields(monkeypatch)
     path = tmp_path / "growing.toml"
     shutil.copy(resolve("tree-growing"), path)
     e = Editor(path, size=(800, 500))
