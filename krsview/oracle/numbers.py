@@ -39,12 +39,12 @@ def _step(x):
 
 
 def _down(x):
-    """A float below x (−∞ and NaN stay)."""
+    """A float below x (the infinities and NaN stay)."""
     return x - _step(x)
 
 
 def _up(x):
-    """A float above x (+∞ and NaN stay)."""
+    """A float above x (the infinities and NaN stay)."""
     return x + _step(x)
 
 
