@@ -13,7 +13,6 @@ to the user's data folder.
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -25,9 +24,8 @@ from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
 from ..scene.filetext import saved_text
 from ..scene.presets import PRESET_DIR
-from ..scene.scene import scene_from_toml, write_atomic
-from ..scene.schema import to_dict
-from ..scene.toml_writer import dumps
+from ..scene.scene import write_atomic
+from .bookmarks import with_bookmark, without_bookmark
 from .history import History, Step
 
 AUTOSAVE_SECONDS = 3.0  # a crash loses at most this much work
@@ -381,42 +379,3 @@ class Document:
 
     def discard_recovery(self) -> None:
         self.recovery_path.unlink(missing_ok=True)
-
-
-def bookmark_table(bookmark: Bookmark) -> str:
-    return dumps({"bookmarks": [to_dict(bookmark)]})
-
-
-def without_bookmark(text: str, bookmark: Bookmark, before: Scene, want: Scene) -> str:
-    """A scene file's ``text``, which holds ``before``, with ``bookmark`` taken out: the
-    table :func:`with_bookmark` appended cut off where it is still the file's end (the text
-    as it was, byte for byte), else only that change written into the text (filetext)."""
-    tail = "\n" + bookmark_table(bookmark)
-    if text.endswith(tail):
-        try:
-            if scene_from_toml(text[: -len(tail)]) == want:
-                return text[: -len(tail)]
-        except SceneError:
-            pass
-    return saved_text(text, before, want)
-
-
-def with_bookmark(text: str, bookmark: Bookmark, want: Scene) -> str:
-    """A scene file's ``text`` with ``bookmark`` appended as a table of its own: the person's
-    comments, layout and numbers stay as they wrote them. Where that does not read back as
-    ``want`` (a file that lists its bookmarks inline, say), the whole scene written anew."""
-    table = bookmark_table(bookmark)
-    # the shipped presets say ``bookmarks = []`` above their tables: that line goes
-    bases = [text]
-    empty = re.search(r"(?m)^bookmarks[ \t]*=[ \t]*\[[ \t]*\][ \t]*(#.*)?\n", text)
-    first = re.search(r"(?m)^\[", text)
-    if empty and (first is None or empty.start() < first.start()):
-        bases.append(text[: empty.start()] + text[empty.end() :])
-    for base in bases:
-        added = base + ("" if base.endswith("\n") else "\n") + "\n" + table
-        try:
-            if scene_from_toml(added) == want:
-                return added
-        except SceneError:
-            pass
-    return scene_to_toml(want)
