@@ -27,7 +27,8 @@ FULL = os.environ.get("KRSVIEW_FUZZ") == "full"
 SCENE_FILES = 2000 if FULL else 150
 VALID_SCENES = 300 if FULL else 25
 COMMAND_LINES = 250 if FULL else 40
-pytestmark = pytest.mark.fuzz
+# one worker runs the whole module in order, so the report at its end sees every count
+pytestmark = [pytest.mark.fuzz, pytest.mark.xdist_group("fuzz")]
 COUNTS: dict[str, int] = {}
 
 
