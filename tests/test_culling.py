@@ -198,7 +198,7 @@ def test_levels_walked_on_the_gpu_match_the_walks_and_drop_with_culling(renderer
 def test_with_the_level_of_detail_culling_still_changes_no_value(name):
     """Culling with the level of detail (ρ per point, as lod 0.5 and 2 at a tree's distance
     give): the same values as the walk without culling, bit for bit. The balls drawn below a
-    cut reach up to 2ρ beyond the balls above them, and culling waits for that."""
+    cut reach up to 2Kρ beyond the balls above them, and culling waits for that."""
     scene = load_scene(resolve(name))
     c = compile_krs(scene.geometry(), (1.0, 1.0, 1.0))
     x = points(scene)
@@ -209,13 +209,13 @@ def test_with_the_level_of_detail_culling_still_changes_no_value(name):
 
 def test_culling_that_ignores_the_reach_of_the_balls_below_changes_the_image(renderer, tmp_path):
     """Negative control on the GPU: culling on and off draw `tree` at lod 0.5 bit for bit
-    (tests/test_prepass.py, every preset); a shader whose culling test leaves out the 2ρ that
-    a ball drawn below may reach beyond C_i draws some pixels differently."""
+    (tests/test_prepass.py, every preset); a shader whose culling test leaves out the 2Kρ
+    that a ball drawn below may reach beyond C_i draws some pixels differently."""
     from krsview.gpu.renderer import Renderer
 
     from .conftest import broken_shaders
 
-    cut = "length(x - b.xyz) - b.w - reach >= d"
+    cut = "length(x - b.xyz) - b.w - lod.reach >= d"
     naive = Renderer(
         shader_dir=broken_shaders(tmp_path, "krs.glsl", cut, "length(x - b.xyz) - b.w >= d")
     )
@@ -235,13 +235,14 @@ def test_the_cut_ball_drawn_after_the_walk_equals_the_cut_in_place(renderer, tmp
 
     from .conftest import broken_shaders
 
-    deferred = "if (b.w >= 0.0 && b.w < rho) { cut = i; return false; }"
+    test = "if (b.w >= 0.0 && top - i >= lod.depth)"
+    deferred = test + " { cut = i; return false; }"
     in_place = (  # and it tells the shading that the ball won where it did (g_cut)
-        "if (b.w >= 0.0 && b.w < rho) { real k = length(x - b.xyz) - b.w; "
-        "g_cut = k < d ? i : -1; d = min(d, k); return false; }"
+        test + " { real k = length(x - b.xyz) - b.w; g_cut = k < d ? i : -1; d = min(d, k); "
+        "return false; }"
     )
     inline = Renderer(shader_dir=broken_shaders(tmp_path / "a", "krs.glsl", deferred, in_place))
-    above = "if (b.w >= 0.0 && b.w < rho) { cut = i + 1; return false; }"
+    above = test + " { cut = i + 1; return false; }"
     wrong = Renderer(shader_dir=broken_shaders(tmp_path / "b", "krs.glsl", deferred, above))
     scene = load_scene(resolve("tree"))
     scene = replace(scene, render=replace(scene.render, culling=culling, lod=2.0))

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import shutil
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -168,6 +169,6 @@ def test_the_wedge_taken_at_the_whole_angle_is_found(probe, phi):
     assert misfit(c.records[0], k, x, probe(c, x)) < 1e-5  # the intact record passes
     wrong = c.records.copy()
     wrong[0, 3, 0] = math.tan(phi / 2)
-    broken = type(c)(c.mirrors, c.bounds, wrong, c.types, c.ball)
+    broken = replace(c, records=wrong)
     assert misfit(wrong[0], k, x, kernel_distance("toroidal_capsule", wrong[0], x)) > 1e-3
     assert misfit(wrong[0], k, x, probe(broken, x)) > 1e-3

@@ -289,12 +289,12 @@ def test_rays_saved_whole_keep_their_anchors(renderer, monkeypatch):
             "            lane_begin(p, listed, r, dir, index);",
             "            Ray last = r;\n            lane_begin(p, listed, r, dir, index);\n"
             "            r.wx = last.wx; r.wdir = last.wdir; r.wt = last.wt; r.wm = last.wm;\n"
-            "            r.wd = last.wd; r.wr = last.wr; r.wj = last.wj;",
+            "            r.wd = last.wd; r.wj = last.wj;",
         ),
         (  # an anchor kept however far the ray moved past its fold margin
             "krs.glsl",
-            "s < min(am, adist) && rho <= ar",
-            "s < adist && rho <= ar",
+            "s < min(am, adist) && top - aj <= lod.depth",
+            "s < adist && top - aj <= lod.depth",
         ),
     ],
     ids=["stale anchor", "past the margin"],

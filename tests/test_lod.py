@@ -15,13 +15,16 @@ from hypothesis import strategies as st
 
 from krsview.api import load_dict
 from krsview.bench.metrics import COLOR_TOL, DEPTH_REL, NORMAL_DEG, agreement
+from krsview.compile.balls import top_balls
 from krsview.compile.krs import compile_krs
+from krsview.compile.lod import cut_depth
 from krsview.gpu.uniforms import variant_defines
 from krsview.oracle.certify import count_errors
 from krsview.reference import krs
 from krsview.scene import load_scene
 from krsview.scene.presets import resolve
 from krsview.scene.render import DEFAULT_LOD
+from krsview.scene.speed import fast_settings
 
 from .conftest import per_pixel
 from .test_culling import points
@@ -46,13 +49,14 @@ def radii(c, x: np.ndarray, seed: int = 1) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", ["tree", "bent-tree", "grass", "rock"])
-def test_lod_stays_below_the_full_walk_and_within_two_rho(name):
+def test_lod_stays_below_the_full_walk_and_within_its_reach(name):
     scene, c = compiled(name)
     x = points(scene, 4000)
     rho = radii(c, x)
     full, lod = krs.distance(c, x, cull=False), krs.distance(c, x, rho=rho)
+    reach = c.lod_cut[2] * rho  # 2Kρ: a cut ball's diameter at most (compile/lod.py)
     assert np.all(lod <= full), "the level of detail lost geometry: a ray could pass it"
-    assert np.all(full - lod <= 2.0 * rho + 1e-12), (full - lod - 2.0 * rho).max()
+    assert np.all(full - lod <= reach + 1e-12), (full - lod - reach).max()
     assert np.array_equal(krs.distance(c, x, rho=0.0), full)  # off: the walk itself
     assert (lod < full).mean() > 0.05  # and it did cut somewhere
 
@@ -66,7 +70,7 @@ def test_negative_controls_a_shrunk_ball_or_a_cut_at_any_size_break_the_bounds()
     shrunk[:, 3] *= 0.5  # a ball that no longer holds its levels: geometry lost
     assert np.any(krs.distance(replace(c, bounds=shrunk), x, rho=rho) > full)
     huge = np.full(len(x), 1e9)  # every ball stands in, however large: far from the tree
-    assert np.any(full - krs.distance(c, x, rho=huge) > 2.0 * rho)
+    assert np.any(full - krs.distance(c, x, rho=huge) > c.lod_cut[2] * rho)
 
 
 @settings(max_examples=25, deadline=None)
@@ -182,17 +186,58 @@ def test_the_oracle_finds_no_hole_and_the_hits_within_the_lod_reach(renderer, tm
 
 
 def test_levels_below_the_pixel_are_not_walked(renderer):
-    """The deterministic half of the speed claim, at the tree's view: the five finest levels
-    (18 → 23), and seven more grown below them (→ 30), add less than half as many levels
-    walked with LOD as without. (Not none: a deeper tree's balls are larger, since each
-    holds more, so the cut comes about a level later.)"""
-    scene = load_scene(resolve("tree"))
-    deep = scene.edit(("tree", "levels"), 29)
+    """The deterministic half of the speed claim, at the tree's view with the fast settings
+    (pre-pass): the five finest levels (18 → 23) add less than half as many levels walked
+    with LOD as without, and seven more grown below them (→ 30) under 2 % of what they add
+    without: the cut asks how large a slot looks, not how deep the tree below it goes
+    (compile/lod.py). Cut where the subtree's own ball fell below ρ, as before, the seven
+    levels added 4.5 %: a deeper subtree's ball is larger, so its cut came a level later."""
+    deep = fast_settings(load_scene(resolve("tree")).edit(("tree", "levels"), 29))
     walked = {}
     for lod in (0.0, 1.0):
         for m in (18, 23, 30):
             s = with_lod(deep, lod)
             walked[lod, m] = renderer.levels(s, W, H, s.geometry().truncated(m)).sum()
-    for a, b in ((18, 23), (23, 30)):
-        assert walked[1.0, b] - walked[1.0, a] < 0.5 * (walked[0.0, b] - walked[0.0, a])
+    added = {(a, b): walked[1.0, b] - walked[1.0, a] for a, b in ((18, 23), (23, 30))}
+    assert added[18, 23] < 0.5 * (walked[0.0, 23] - walked[0.0, 18]), walked
+    assert added[23, 30] < 0.02 * (walked[0.0, 30] - walked[0.0, 23]), walked
     assert walked[0.0, 30] > 1.2 * walked[0.0, 23]  # without LOD the finer levels cost
+
+
+def envelope(c, k: np.ndarray) -> np.ndarray:
+    """The cut radii's envelope A·q^k at depths k (compile/lod.py)."""
+    return np.exp(c.lod_cut[0] + k / c.lod_cut[1])
+
+
+def test_the_cut_is_the_first_depth_whose_envelope_is_below_rho():
+    """cut_depth's closed form against a search over the depths, and the envelope lies on or
+    above every slot's cut radius (the ball of its top levels alone) and under K times it
+    every slot's own ball. ρ = 0 never cuts."""
+    _, c = compiled("tree")
+    rho = np.exp(np.linspace(np.log(1e-4), np.log(20.0), 4001))
+    k = np.arange(c.n + 40)
+    searched = np.array([int(np.argmax(envelope(c, k) < r)) for r in rho])
+    got = cut_depth(c.lod_cut, rho)
+    assert np.mean(got == searched) > 0.999 and np.abs(got - searched).max() <= 1
+    tops = top_balls(load_scene(resolve("tree")).geometry())
+    depth = c.n - 1 - np.arange(c.n)
+    assert all(envelope(c, depth[i]) >= 0.999 * tops[i][3] for i in range(c.n))
+    assert np.all(c.bounds[:, 3] <= c.lod_cut[2] / 2 * envelope(c, depth))
+    assert cut_depth(c.lod_cut, 0.0) > c.n
+
+
+def test_a_deeper_tree_cuts_where_the_shallower_one_does():
+    """Grown from 23 to 30 levels, the tree's slots cut at the same depths for every ρ that
+    cuts the 23-level one (or differ at a boundary, one ρ in a thousand); its subtrees'
+    balls, each holding seven more levels, would have cut deeper (negative control: the
+    first depth whose subtree ball is below ρ)."""
+    deep = load_scene(resolve("tree")).edit(("tree", "levels"), 29).geometry()
+    c23, c30 = (compile_krs(deep.truncated(m), ALBEDO) for m in (23, 30))
+    rho = np.exp(np.linspace(np.log(c23.bounds[0, 3]), np.log(c23.bounds[-1, 3]), 1000))
+    assert np.mean(cut_depth(c23.lod_cut, rho) == cut_depth(c30.lod_cut, rho)) > 0.99
+
+    def by_subtree_ball(c):
+        radii = c.bounds[::-1, 3]  # by depth below the top
+        return np.array([int(np.argmax(radii < r)) for r in rho])
+
+    assert np.mean(by_subtree_ball(c23) == by_subtree_ball(c30)) < 0.9

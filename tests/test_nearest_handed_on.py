@@ -70,19 +70,21 @@ def test_the_handed_on_kernel_is_the_whole_walks(renderer, whole_walk, name):
 
 
 @pytest.mark.parametrize(
-    "wrong, why",
+    "wrong, why, share",
     [
-        (handed("(slots & 0xffff)", "(slots >> 16) - 1"), "the kernel one level coarser"),
-        (handed("(slots & 0xffff) - 1", "-1"), "a ball that won ignored"),
+        (handed("(slots & 0xffff)", "(slots >> 16) - 1"), "the kernel one level coarser", 0.2),
+        (handed("(slots & 0xffff) - 1", "-1"), "a ball that won ignored", 0.02),
     ],
 )
-def test_negative_control_a_wrong_hand_on_shows(renderer, tmp_path, wrong, why):
+def test_negative_control_a_wrong_hand_on_shows(renderer, tmp_path, wrong, why, share):
     """Both of what the trace hands on are used on `tree` at this size: the shading told a
     level one coarser, or not told that the level-of-detail ball won (so the kernels below
-    it go untested), draws other normals on many pixels (481 and 612 of 1,150 hits when written)."""
+    it go untested), draws other normals on many pixels (481 and 612 of 1,150 hits when
+    written; since the cut falls by the slots' top levels, compile/lod.py, a ball that won
+    and hid a nearer kernel below it is rarer: 57 of 1,126)."""
     broken = Renderer(shader_dir=broken_shaders(tmp_path, "trace.glsl", HANDED_ON, wrong))
     _, normal = image(broken, CASES["tree"])
     _, want = image(renderer, CASES["tree"])
     hit = np.abs(want).sum(-1) > 0
     differ = (np.abs(normal - want).max(-1) > 1e-3) & hit
-    assert differ.sum() > 0.2 * hit.sum(), f"{why}: {differ.sum()} of {hit.sum()} hits differ"
+    assert differ.sum() > share * hit.sum(), f"{why}: {differ.sum()} of {hit.sum()} hits differ"

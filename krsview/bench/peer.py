@@ -17,7 +17,9 @@ import time
 import numpy as np
 
 from ..compile.camera import View, primary_rays, view_of
+from ..compile.geometry import compile_geometry
 from ..gpu.renderer import Renderer
+from ..oracle.certify import lod_reach
 from ..scene import KRS, Scene, SceneError
 from ..scene.render import DEFAULT_LOD, VIEW_PREPASS
 from .expansion import TOLERANCE, Mesh, expand, single_krs
@@ -213,15 +215,17 @@ def measure_level(
 
 
 def beyond_epsilon(o3d, bvh, frame, view: View, scene: Scene, tolerance: float) -> float:
-    """Fraction of pixels where krsview hits farther from the mesh than (1 + 2·lod)·ε(t) +
+    """Fraction of pixels where krsview hits farther from the mesh than (1 + 2K·lod)·ε(t) +
     ``tolerance`` pixels at its depth t: a hit the mesh does not explain (the mesh lies within
     ``tolerance`` pixels of the surface, the tracer stops within ε(t) of it [KRS17 §4], and
-    the level of detail moves a hit by at most 2·lod·ε)."""
+    the level of detail moves a hit by at most its cut ball's diameter, 2K·lod·ε:
+    compile/lod.py)."""
     t = frame.depth[frame.hit]
     d = primary_rays(view).reshape(*frame.hit.shape, 3)[frame.hit]
     points = (view.origin + t[:, None] * d).astype(np.float32)
     gap = bvh.compute_distance(o3d.core.Tensor(points)).numpy()
-    eps = scene.render.epsilon_scale * (1.0 + 2.0 * scene.render.lod)
+    reach = lod_reach(compile_geometry(scene.geometry(), scene.material.albedo))
+    eps = scene.render.epsilon_scale * (1.0 + reach * scene.render.lod)
     allowed = (eps + tolerance) * view.footprint * t
     return float((gap > allowed).sum() / frame.hit.size)
 
@@ -289,7 +293,7 @@ def table(m: Measured) -> str:
     ]
     notes += [
         "hits beyond ε: pixels where krsview hits farther from the mesh than its ε(t) "
-        "(1 + 2·lod of them with the level of detail) and the "
+        "(1 + 2K·lod of them with the level of detail, K about 1.5) and the "
         f"mesh's {m.rows[0]['tolerance_px']} px allow (the tracer stops within ε(t) of the "
         "surface, so it draws sub-pixel twigs about a pixel wide, where the mesh's rays pass "
         "by: krsview only)",

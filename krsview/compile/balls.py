@@ -97,30 +97,56 @@ def _held_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
     """Slots go in batches of EXACT_LEVELS + 1, each needing only the balls of earlier
     batches."""
     n = len(krs.mirrors)
-    kb = [kernel_ball(k) for k in krs.kernels]
-    plane = np.cumsum([b is None and not isinstance(k, Empty) for b, k in zip(kb, krs.kernels)])
-    u = np.array([m.normal for m in krs.mirrors]).reshape(-1, 3)
-    w = np.array([m.offset for m in krs.mirrors])
+    e = _Expansion(krs)
     held: list[np.ndarray | None] = [None] * (n + 1)
-
-    def expanded(i: int) -> np.ndarray:
-        first = max(0, i - EXACT_LEVELS)
-        below = held[first - 1] if first > 0 else None
-        balls = np.zeros((0, 4)) if below is None else below[None]
-        for j in range(first, min(i, n - 1) + 1):
-            if kb[j] is not None:
-                balls = np.vstack([kb[j][None], balls])
-            balls = np.vstack([balls, reflected(balls, u[j], w[j])])
-        return balls if i < n or kb[n] is None else np.vstack([kb[n][None], balls])
-
     for first in range(0, n + 1, EXACT_LEVELS + 1):
         batch = range(first, min(n + 1, first + EXACT_LEVELS + 1))
-        sets = {i: expanded(i) for i in batch if not plane[i]}
+        sets = {i: e.balls(i, held) for i in batch if not e.plane[i]}
         sets = {i: s for i, s in sets.items() if len(s)}
         for i, ball in zip(sets, enclosing_balls(list(sets.values())) if sets else ()):
             ball.flags.writeable = False
             held[i] = ball
     return tuple(held)
+
+
+def top_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
+    """n entries: per mirror slot i, a ball around its top EXACT_LEVELS + 1 levels alone
+    (i down to i − EXACT_LEVELS, expanded as :func:`held_balls` expands them, without the
+    ball of everything below): what the slot looks like at a glance, whatever the depth of
+    the tree below it (compile/lod.py). None where those levels hold no bounded kernel."""
+    e = _Expansion(krs)
+    sets = {i: e.balls(i) for i in range(len(krs.mirrors)) if not e.plane[i]}
+    sets = {i: s for i, s in sets.items() if len(s)}
+    out: list[np.ndarray | None] = [None] * len(krs.mirrors)
+    for i, ball in zip(sets, enclosing_balls(list(sets.values())) if sets else ()):
+        out[i] = ball
+    return tuple(out)
+
+
+class _Expansion:
+    """A KRS's kernel balls and mirrors, expanded a few levels down per slot."""
+
+    def __init__(self, krs: KRS):
+        self.n = len(krs.mirrors)
+        self.kb = [kernel_ball(k) for k in krs.kernels]
+        self.plane = np.cumsum(
+            [b is None and not isinstance(k, Empty) for b, k in zip(self.kb, krs.kernels)]
+        )
+        self.u = np.array([m.normal for m in krs.mirrors]).reshape(-1, 3)
+        self.w = np.array([m.offset for m in krs.mirrors])
+
+    def balls(self, i: int, held: list | None = None) -> np.ndarray:
+        """(m, 4): slot i's kernel balls EXACT_LEVELS levels down, around the held ball of
+        the slot below those (``held``; None: without it); i = n adds the top kernel's."""
+        first = max(0, i - EXACT_LEVELS)
+        below = held[first - 1] if held is not None and first > 0 else None
+        balls = np.zeros((0, 4)) if below is None else below[None]
+        for j in range(first, min(i, self.n - 1) + 1):
+            if self.kb[j] is not None:
+                balls = np.vstack([self.kb[j][None], balls])
+            balls = np.vstack([balls, reflected(balls, self.u[j], self.w[j])])
+        kb = self.kb[self.n] if i == self.n else None
+        return balls if kb is None else np.vstack([kb[None], balls])
 
 
 def krs_ball(krs: KRS) -> np.ndarray | None:
@@ -148,10 +174,11 @@ def krs_bounds(krs: KRS) -> np.ndarray:
     """(n, 4): per mirror slot i, the ball C_i of A_i, everything Alg. 1 still tests before
     folding at level i (radius −1: unbounded, from a plane kernel on), grown by CULL_MARGIN
     against rounding. A point x with d ≤ dist(x, C_i) cannot lower d any more: the walk stops
-    there with the same value [issue 17, exact level culling]; with the level of detail at ρ,
-    once d ≤ dist(x, C_i) − 2ρ, since a ball drawn for the levels below (radius < ρ, holding
-    its part of A_i) reaches at most 2ρ beyond A_i ⊂ C_i (krs.glsl). Slots below only empty
-    kernels get no ball (the walk's d is still ∞ there).
+    there with the same value [issue 17, exact level culling]; with the level of detail,
+    once d ≤ dist(x, C_i) − 2R, since a ball C_j of radius R drawn for the levels below
+    (holding its part of A_i) reaches at most its diameter beyond A_i ⊂ C_i (krs.glsl,
+    compile/lod.py). Slots below only empty kernels get no ball (the walk's d is still ∞
+    there).
 
     Every centre lies on its slot's mirror plane, so that a walk that reads the ball at every
     level anyway (the level of detail) folds about it, u·(x − c), and need not read the

@@ -16,6 +16,7 @@ import numpy as np
 from ..algebra.vectors import cross
 from ..scene import KRS, Arc, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
 from .balls import UNBOUNDED, grown, krs_ball, krs_bounds, union_ball
+from .lod import lod_cut
 
 # Kernel type codes, equal to the KERNEL_* defines in kernels.glsl.
 KERNEL_CODES = {"empty": 0, "sphere": 1, "capsule": 2, "toroidal_capsule": 3, "plane": 4}
@@ -45,6 +46,7 @@ class CompiledKRS:
     records: np.ndarray  # (n+1, RECORD_VEC4, 4) float64
     types: tuple[str, ...]  # kernel type per level (after arc → capsule degeneration)
     ball: np.ndarray  # (4,): grown(krs_ball), everything drawn (r < 0: unbounded)
+    lod_cut: np.ndarray  # (4,): where the level of detail cuts the walk (compile/lod.py)
 
     @property
     def n(self) -> int:
@@ -71,7 +73,7 @@ class CompiledKRS:
         bounds = self.bounds.copy()
         bounds[:, :3] -= o  # every centre, with or without a ball: it stays on its plane
         ball = self.ball - np.array([*o, 0.0]) if self.ball[3] >= 0 else self.ball
-        return CompiledKRS(mirrors, bounds, records, self.types, ball)
+        return CompiledKRS(mirrors, bounds, records, self.types, ball, self.lod_cut)
 
 
 def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
@@ -80,7 +82,8 @@ def compile_krs(krs: KRS, albedo: tuple[float, float, float]) -> CompiledKRS:
         -1, 4
     )
     records, types = kernel_records(krs.kernels, albedo)
-    return CompiledKRS(mirrors, krs_bounds(krs), records, types, grown(krs_ball(krs)))
+    bounds = krs_bounds(krs)
+    return CompiledKRS(mirrors, bounds, records, types, grown(krs_ball(krs)), lod_cut(krs, bounds))
 
 
 def kernel_records(

@@ -89,7 +89,6 @@ RAY = Struct(
         Field("real", "wt"),
         Field("real", "wm"),
         Field("real", "wd"),
-        Field("real", "wr"),
         Field("int", "wj"),
     ),
 )

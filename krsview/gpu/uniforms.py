@@ -11,6 +11,7 @@ from ..compile.camera import View
 from ..compile.constants import MOBIUS_RECORD
 from ..compile.geometry import Compiled, walk_restarts
 from ..compile.krs import KERNEL_CODES, RECORD_VEC4, CompiledCompound
+from ..compile.lod import NO_CUT
 from ..compile.mokrs import CompiledMoKRS
 from ..scene import EFFECTS, MAX_COMPONENTS, MAX_LEVELS, Scene
 from ..scene.compound import COMPOUND_SLOTS
@@ -168,6 +169,18 @@ def component_balls(c: Compiled) -> list[tuple[float, ...]]:
     )
 
 
+def component_lod_cuts(c: Compiled) -> list[tuple[float, ...]]:
+    """Each component's level-of-detail cut (CompiledKRS.lod_cut), one per slot as in
+    component_balls; NO_CUT for a MöKRS (its levels cut by their own bounds) and unused
+    slots."""
+    if isinstance(c, CompiledMoKRS):
+        return [tuple(NO_CUT)]
+    rows = [tuple(float(v) for v in part.lod_cut) for part, _ in component_slots(c)]
+    if isinstance(c, CompiledCompound):
+        rows += [tuple(NO_CUT)] * (MAX_COMPONENTS - len(rows))
+    return rows
+
+
 def component_half_spaces(c: Compiled) -> list[tuple[float, ...]]:
     """Each component's half-space u·x ≤ w (CompiledKRS.half_space), one per slot as in
     component_balls; NO_HALF_SPACE (u = 0) where it has none. Shadow rays' cones read them
@@ -250,6 +263,7 @@ def view_uniforms(scene: Scene, view: View, c: Compiled) -> dict[str, object]:
         "u_tan_half": view.tan_half,
         "u_eps_per_t": view.detail_footprint * scene.render.epsilon_scale,
         "u_lod": scene.render.lod,
+        "u_lod_cut": per_component(c, component_lod_cuts(c)),
         "u_max_iterations": scene.render.max_iterations,
         "u_max_distance": scene.render.max_distance,
         "u_xi_bonus": scene.render.xi_bonus,

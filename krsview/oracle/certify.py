@@ -34,10 +34,11 @@ import numpy as np
 
 from ..compile.camera import primary_rays, view_of
 from ..compile.geometry import compile_geometry
+from ..compile.mokrs import CompiledMoKRS
 from ..frame import Frame
 from ..reference.wind import Wind
 from ..scene import Scene
-from .distance import Bounds, bounds, in_box, on_segments
+from .distance import Bounds, bounds, in_box, on_segments, placed
 from .wind import hit_stretch, wind_moved
 
 DELTA_PIXELS = 0.25  # a crossing is certified within a quarter pixel footprint
@@ -158,12 +159,19 @@ def free_boxes(c, centers: np.ndarray, half: np.ndarray) -> np.ndarray:
 HIT_REACH = {"sphere": 1.0, "relaxed": 1.0, "binary": 2.0}
 
 
-def hit_reach(scene: Scene, eps_per_t: float) -> float:
+def hit_reach(scene: Scene, c, eps_per_t: float) -> float:
     """How near a hit is to a surface, in ε(t): HIT_REACH, and with the level of detail
-    (render.lod) the diameter of a ball standing for the levels below it, 2·lod·ε at most
-    (reference/krs.py, distance; a binary probe takes lod·ε at its far side, 2ε further)."""
+    (render.lod) the diameter of a ball standing for the levels below it, 2K·lod·ε at most
+    for the compiled geometry ``c`` (2·lod·ε for a MöKRS's; reference/krs.py, distance; a
+    binary probe takes lod·ε at its far side, 2ε further)."""
     r = scene.render
-    return HIT_REACH[r.tracer] + 2.0 * r.lod * (1.0 + 2.0 * eps_per_t)
+    return HIT_REACH[r.tracer] + lod_reach(c) * r.lod * (1.0 + 2.0 * eps_per_t)
+
+
+def lod_reach(c) -> float:
+    """The most a ball cut at the level of detail ρ reaches beyond what it holds, per ρ: the
+    largest of the KRS components' 2K (compile/lod.py), 2 for a MöKRS's level bounds."""
+    return max(2.0 if isinstance(p, CompiledMoKRS) else float(p.lod_cut[2]) for p, _ in placed(c))
 
 
 @dataclass
@@ -213,7 +221,7 @@ def count_errors(
             else np.where(DECIDED[cert.surface + 1] > DECIDED[surface + 1], cert.surface, surface)
         )
     centres = view.origin + t[hit, None] * dirs[hit]
-    reach = hit_reach(scene, view.footprint * scene.render.epsilon_scale) * eps[hit]
+    reach = hit_reach(scene, c, view.footprint * scene.render.epsilon_scale) * eps[hit]
     if wind is not None:
         reach = reach * hit_stretch(scene, wind, centres, reach)
     false_hits = int(free_boxes(c, centres, reach).sum())

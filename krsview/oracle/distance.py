@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.krs import CompiledCompound, CompiledKRS
+from ..compile.lod import cut_depth, cut_reach
 from ..compile.mokrs import CompiledMoKRS
 from ..reference.kernels import arc_half_angle, arc_local
 from .numbers import Affine, Interval, Number
@@ -128,28 +129,31 @@ def mobius_apply(H, x: Vec) -> Vec:
 
 
 def steps(c: CompiledKRS | CompiledMoKRS):
-    """The walk as (ball, size, move, kind, record) per kernel, outermost first: ``move``
+    """The walk as (ball, cuts, move, kind, record) per kernel, outermost first: ``move``
     takes the point into the kernel's frame; ``ball`` (centre, radius, in the frame before
-    ``move``; None: no bound) holds everything this and the later steps test; ``size`` is
-    its radius in world lengths (∞ where the frame's scale varies).
+    ``move``; None: no bound) holds everything this and the later steps test; ``cuts(lod)``
+    says per element whether the level of detail ``lod`` (world lengths) ends the walk at
+    that ball.
 
     KRS [KRS17 Alg. 1]: the top kernel, then per level i a fold and k_i; the ball is the
-    culling ball C_i (``compile/balls.krs_bounds``). MöKRS [KRS17 Alg. 3]: per level
+    culling ball C_i (``compile/balls.krs_bounds``), cut at depth k*(lod) below the top
+    (``compile/lod.cut_depth``). MöKRS [KRS17 Alg. 3]: per level
     x ← H_i(x), folded to x ≤ 0 where it reflects, then k_i; the ball is the level's bound
     mapped out by G_i = H_i⁻¹ (``reference/mokrs.bounds_in_and_out``), so it is tested before
-    H_i, where a pole of H_i is not."""
+    H_i, where a pole of H_i is not; it is cut where its radius in world lengths is at most
+    lod (never where the frame's scale varies)."""
     if isinstance(c, CompiledMoKRS):
         for i in range(c.n - 1, -1, -1):
             ball = c.outer[i] if c.outer[i, 3] >= 0 else None
             move = lambda x, H=c.inverse[i], r=c.reflect[i]: inwards(H, r, x)  # noqa: E731
-            yield ball, c.outer_size[i], move, c.types[i], c.records[i]
+            yield ball, lambda lod, s=c.outer_size[i]: s <= lod, move, c.types[i], c.records[i]
         return
-    yield None, np.inf, lambda x: x, c.types[c.n], c.records[c.n]
+    yield None, None, lambda x: x, c.types[c.n], c.records[c.n]
     for i in range(c.n - 1, -1, -1):
         ball = c.bounds[i] if c.bounds[i, 3] >= 0 else None
         yield (
             ball,
-            np.inf if ball is None else ball[3],
+            lambda lod, k=c.n - 1 - i: k >= cut_depth(c.lod_cut, lod),
             lambda x, m=c.mirrors[i]: fold(m, x),
             c.types[i],
             c.records[i],
@@ -203,22 +207,33 @@ def bounds(
     """Bounds of the value over the batch ``x`` walked with the levels' balls: where a
     point's ball lies clear (its enclosure > 0) the levels below cannot reach 0 and its
     walk ends (culling, which for a MöKRS also steps around the poles); with ``lod`` (a
-    length per element) a walk also ends at the first ball of radius ≤ lod, whose distance
-    then stands for the levels below — detail smaller than the level of detail asked for.
+    length per element) a walk also ends at the ball where it cuts (:func:`steps`), whose
+    distance then stands for the levels below — detail smaller than the level of detail
+    asked for.
     A :class:`Moved` component is walked from its map's enclosure of x, in its rest space,
     where its balls are: a ball clear of that enclosure is clear of every mapped point."""
     n = x[0].size
     out = Bounds(np.full(n, np.inf), np.full(n, np.inf), np.full(n, np.inf))
     for part, g in placed(c):
         rows, y = np.arange(n), x if g is None else g(x)
-        for ball, size, move, kind, rec in steps(part):
+        for ball, cuts, move, kind, rec in steps(part):
             if ball is not None:
                 blo = (norm(minus(y, ball[:3])) - float(ball[3])).range()[0]
                 # a KRS's balls are not nested (compile/balls.py): with a level of detail, a
-                # ball cut below reaches up to 2·lod beyond this one; a MöKRS's are nested
-                reach = 0.0 if lod is None or isinstance(part, CompiledMoKRS) else 2 * lod[rows]
+                # ball cut below reaches up to its diameter beyond this one; a MöKRS's are
+                # nested
+                reach = (
+                    0.0
+                    if lod is None or isinstance(part, CompiledMoKRS)
+                    else cut_reach(
+                        part.lod_cut,
+                        part.bounds[:, 3],
+                        cut_depth(part.lod_cut, lod[rows]),
+                        lod[rows],
+                    )
+                )
                 clear = blo > reach  # NaN: not clear
-                cut = ~clear & (size <= lod[rows]) if lod is not None else np.zeros_like(clear)
+                cut = ~clear & cuts(lod[rows]) if lod is not None else np.zeros_like(clear)
                 out.lo[rows[clear]] = np.minimum(out.lo[rows[clear]], blo[clear])
                 out.cut[rows[cut]] = np.minimum(out.cut[rows[cut]], blo[cut])
                 if (clear | cut).any():

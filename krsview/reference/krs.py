@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.krs import CompiledKRS
+from ..compile.lod import cut_depth, cut_reach
 from .kernels import kernel_distance, world_normal
 
 
@@ -31,26 +32,29 @@ def distance(
     at level i once d ≤ dist(x, C_i), the ball of all it would still test (compile/krs.py,
     krs_bounds): the value is the same, the shader saves the levels below.
 
-    Level of detail ``rho`` (a length per point, 0: none): at the first ball C_i of radius
-    below rho the walk takes d = min(d, dist(x, C_i)) and stops. That is Alg. 1 of the *LOD
-    geometry*: the levels above i, and in place of levels i..0 the 2^(n−i−1) copies of the
-    solid ball C_i. It holds the KRS (C_i holds all below it),
-    so the value stays a lower bound of the full walk's and no ray passes the KRS; and every
-    point of C_i is within its diameter, 2·rho, of the geometry it holds. Culling and the
-    level of detail are independent switches, as in the shader; since such a ball reaches up
-    to 2·rho beyond the balls above it (they hold the KRS, not each other: compile/balls.py),
-    culling with the level of detail stops only once d ≤ dist(x, C_i) − 2·rho."""
+    Level of detail ``rho`` (a length per point, 0: none): at the first ball C_i at least
+    k*(rho) levels below the top (compile/lod.py, cut_depth) the walk takes
+    d = min(d, dist(x, C_i)) and stops. That is Alg. 1 of the *LOD geometry*: the levels
+    above i, and in place of levels i..0 the 2^(n−i−1) copies of the solid ball C_i. It holds
+    the KRS (C_i holds all below it), so the value stays a lower bound of the full walk's and
+    no ray passes the KRS; and every point of C_i is within its diameter (``reach``, less
+    than 2K·rho: compile/lod.py) of the geometry it holds. Culling and the level of detail
+    are independent switches, as in the shader; since such a ball reaches up to that beyond
+    the balls above it (they hold the KRS, not each other: compile/balls.py), culling with
+    the level of detail stops only once d ≤ dist(x, C_i) − reach."""
     x = xw
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
     live = np.ones(len(x), dtype=bool)
     rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (len(x),))
+    depth = cut_depth(c.lod_cut, rho)
+    reach = cut_reach(c.lod_cut, c.bounds[:, 3], depth, rho)
     for i in range(c.n - 1, -1, -1):
         b = c.bounds[i]
         if b[3] >= 0 and (cull or rho.any()):
             db = np.linalg.norm(x - b[:3], axis=1) - b[3]
-            cut = live & (b[3] < rho)
+            cut = live & (c.n - 1 - i >= depth)
             d = np.where(cut, np.minimum(d, db), d)
-            live &= ~cut & ((db - 2.0 * rho < d) | (not cull))
+            live &= ~cut & ((db - reach < d) | (not cull))
         x, _ = fold(c.mirrors[i, :3], c.bounds[i, :3], x)
         if c.types[i] != "empty":
             d = np.where(live, np.minimum(d, kernel_distance(c.types[i], c.records[i], x)), d)
@@ -61,8 +65,8 @@ def distance(
 class Anchor:
     """Per ray, Alg. 1's state before level slot ``j`` (−1: none) at ray distance ``t``: the
     point folded by the mirrors above (``x``), the ray's direction folded alike (``u``), the
-    least |e| of those folds (``m``), the least distance of the levels above (``d``) and the
-    least radius of the balls tested above (``r``). Twin of trace.glsl's Ray fields w*."""
+    least |e| of those folds (``m``) and the least distance of the levels above (``d``).
+    Twin of trace.glsl's Ray fields w*."""
 
     j: np.ndarray
     x: np.ndarray
@@ -70,12 +74,11 @@ class Anchor:
     t: np.ndarray
     m: np.ndarray
     d: np.ndarray
-    r: np.ndarray
 
     @staticmethod
     def none(n: int) -> Anchor:
         z = np.zeros(n)
-        return Anchor(np.full(n, -1), np.zeros((n, 3)), np.zeros((n, 3)), z, z, z, z)
+        return Anchor(np.full(n, -1), np.zeros((n, 3)), np.zeros((n, 3)), z, z, z)
 
     def take(self, rows: np.ndarray) -> Anchor:
         return Anchor(*(getattr(self, f)[rows] for f in FIELDS))
@@ -90,7 +93,7 @@ class Anchor:
         return Anchor(**out)
 
 
-FIELDS = ("j", "x", "u", "t", "m", "d", "r")
+FIELDS = ("j", "x", "u", "t", "m", "d")
 
 
 def restart(
@@ -106,24 +109,25 @@ def restart(
     """Alg. 1 at the points p = origin + t·dirs, each walk restarted below its ray's anchor
     ``a`` where the folds above cannot have changed (krs.glsl, krs_restart): a point
     s = t − a.t < a.m further folds to a.x + s·a.u (every fold an isometry on its side of its
-    mirror), a.d − s bounds the levels above (1-Lipschitz), and with rho ≤ a.r no ball above
-    cuts. The value is Alg. 1's where the levels below end under that bound; where the bound
-    limits it is only a lower bound (``bounded``) and the anchor is dropped. The anchor moves
-    to the deepest level with min(margin, distance above) ≥ ``keep``. ``margin=False`` ignores
-    the fold margin (a negative control). Returns (distance, bounded, new anchors, levels
-    walked per point)."""
+    mirror), a.d − s bounds the levels above (1-Lipschitz), and where rho cuts no higher
+    than a.j no ball above cuts. The value is Alg. 1's where the levels below end under that
+    bound; where the bound limits it is only a lower bound (``bounded``) and the anchor is
+    dropped. The anchor moves to the deepest level with min(margin, distance above) ≥
+    ``keep``. ``margin=False`` ignores the fold margin (a negative control). Returns
+    (distance, bounded, new anchors, levels walked per point)."""
     N, n = len(p), c.n
     rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (N,))
     s = t - a.t
     fits = s < np.minimum(a.m, a.d) if margin else s < a.d
-    again = (a.j >= 0) & fits & (rho <= a.r)
+    depth = cut_depth(c.lod_cut, rho)
+    reach = cut_reach(c.lod_cut, c.bounds[:, 3], depth, rho)
+    again = (a.j >= 0) & fits & (n - 1 - a.j <= depth)
     start = np.where(again, a.j, n - 1)
     x = np.where(again[:, None], a.x + s[:, None] * a.u, p)
     u = np.where(again[:, None], a.u, dirs)
     bound = a.d - s
     d = np.where(again, bound, kernel_distance(c.types[n], c.records[n], p))
     m = np.where(again, a.m - s, np.inf)
-    r = np.where(again, a.r, np.inf)
     out, levels = a, np.zeros(N, dtype=np.int64)
     live = np.ones(N, dtype=bool)
     for i in range(n - 1, -1, -1):
@@ -131,15 +135,14 @@ def restart(
         sv = np.flatnonzero(act & (np.minimum(m, d) >= keep))
         if sv.size:
             j = np.full(sv.size, i)
-            out = out.put(sv, Anchor(j, x[sv], u[sv], t[sv], m[sv], d[sv], r[sv]))
+            out = out.put(sv, Anchor(j, x[sv], u[sv], t[sv], m[sv], d[sv]))
         levels += act
         b = c.bounds[i]
         if b[3] >= 0:
             db = np.linalg.norm(x - b[:3], axis=1) - b[3]
-            r = np.where(act, np.minimum(r, b[3]), r)
-            cut = act & (b[3] < rho)
+            cut = act & (n - 1 - i >= depth)
             d = np.where(cut, np.minimum(d, db), d)
-            live &= ~(act & (cut | (db - 2.0 * rho >= d)))  # 2ρ: what is cut below reaches
+            live &= ~(act & (cut | (db - reach >= d)))  # what is cut below reaches
             act = live & (i <= start)
         mu = c.mirrors[i, :3]
         xf, e = fold(mu, c.bounds[i, :3], x)

@@ -133,10 +133,10 @@ class Render:
         lo=0.0,
         hi=8.0,
         unit="ε",
-        help="level of detail: Alg. 1 stops at the first level whose bounding ball "
-        "is smaller than lod × ε at its distance from the eye, and draws that ball for "
-        "the levels below (0: off, every level; hit points move by at most "
-        "2·lod·ε, never a hole)",
+        help="level of detail: Alg. 1 stops at the first level whose top five levels look "
+        "smaller than lod × ε at its distance from the eye, and draws the ball of "
+        "everything below it there (0: off, every level; hit points move by at most that "
+        "ball's diameter, 2K·lod·ε with K about 1.5 on a tree, never a hole)",
     )
     walk_restart: str = param(
         "off",

@@ -24,8 +24,8 @@ def fast_settings(scene: Scene, hardware: bool = False) -> Scene:
     as the viewer draws where the file sets none). On ``hardware`` (a GPU:
     ``krsview.api.on_hardware()``) the pre-pass tile is HARDWARE_PREPASS, and every scene
     whose file sets no path is traced by the compute path's rounds. The oracle certifies both
-    geometry settings hole-free; hits may move by up to ε (pre-pass) and 2·lod·ε (level of
-    detail)."""
+    geometry settings hole-free; hits may move by up to ε (pre-pass) and a cut ball's
+    diameter, 2K·lod·ε (level of detail, compile/lod.py)."""
     r, fast = scene.render, {}
     if r.prepass is None:  # 0 is the file's own "off"
         fast["prepass"] = fast_tile(hardware)

@@ -3,7 +3,6 @@
 // Without twist, wind and empty zones this is Alg. 1 itself [KRS17 Alg. 1]; in a compound,
 // each component is a KRS of its own [KRS17 §5.1].
 #include "krs.glsl"
-#include "lod.glsl"
 #if defined(KRS_TWIST) || defined(KRS_WIND)
 // The δ with δ(1 + k(ρ + δ)) = D, in its cancellation-free form: a step that stays in the free
 // ball of radius D through a map whose Jacobian is at most 1 + k·(distance to its axis);
@@ -85,7 +84,7 @@ ivec2 component(int c) {
 
 real undistorted_distance(int c, vec3r q, real rho) {
     ivec2 k = component(c);
-    return krs_distance(k.x, k.y, q, rho);
+    return krs_distance(k.x, k.y, q, krs_lod(c, k.x, k.y, rho));
 }
 
 #ifdef KRS_WIND

@@ -1,6 +1,7 @@
 // KRS distance [KRS17 Alg. 1] and nearest kernel with world normal [KRS14 §6.1];
 // twin of reference/krs.py. Folding clips each level to its mirror's negative side.
 #include "kernels.glsl"
+#include "lod.glsl"
 
 // Reflect p if it lies behind mirror i, the plane u·p = w; returns that signed distance e.
 // With the level of detail the walk reads slot i's ball (c, r) at every level, and
@@ -22,40 +23,38 @@ real fold(int i, vec3r c, inout vec3r p) {
 // Exact level culling [issue 17]: once d ≤ dist(x, C_i), the ball of everything levels i..0
 // would still test (compile/balls.py, krs_bounds; r < 0: none), the walk stops with the
 // same value. Most rays far from the finer levels pay for a few levels instead of n.
-// Level of detail [issue 27, KRS14 LOD]: at the first ball C_i whose radius is below rho,
-// the ball stands for levels i..0 (d = min(d, dist(x, C_i)), a lower bound of what they
-// would give) and the walk stops: detail smaller than rho costs nothing (distance.glsl,
-// lod_radius; reference/krs.py says which geometry that draws). Such a ball holds its part
-// of the levels below and is less than 2·rho across, so it reaches at most 2·rho beyond the
-// ball of any slot above (compile/balls.py: the balls are not nested): culling then stops
-// once d ≤ dist(x, C_i) − 2·rho, still with the value the whole walk would give.
+// Level of detail [issue 27, KRS14 LOD]: at the first ball C_i at least lod.depth levels
+// below the top (where ρ cuts, compile/lod.py), the ball stands for levels i..0
+// (d = min(d, dist(x, C_i)), a lower bound of what they would give) and the walk stops:
+// detail smaller than ρ costs nothing (lod.glsl; reference/krs.py says which geometry that
+// draws). Such a ball holds its part of the levels below and is less than 2Kρ across, so it
+// reaches at most lod.reach = 2Kρ beyond the ball of any slot above (compile/balls.py: the
+// balls are not nested): culling then stops once d ≤ dist(x, C_i) − lod.reach, still with
+// the value the whole walk would give.
 #ifdef KRS_COUNT_LEVELS
 int g_levels = 0;   // levels walked so far by this invocation (bench paths' measure)
 #endif
 
-// Level slot i of Alg. 1 on the point x with the distance d found above it: culling, the level
-// of detail, the fold (its e returned) and the kernel; false where the walk ends here. A
+// Level slot i (top: the KRS's top slot) of Alg. 1 on the point x with the distance d found
+// above it: culling, the level of detail, the fold (its e returned) and the kernel; false
+// where the walk ends here. A
 // level-of-detail cut only notes its slot in `cut` and leaves x as it is: krs_lod_cut adds
 // the ball's distance once, after the walk. On llvmpipe each read of the uniform block is a
 // gather per component that costs far more than the arithmetic around it, and a branch's
 // reads run whether any pixel takes it or not (docs/speed.md): the ball (c, r) is read once,
 // and its centre c serves culling, the level of detail and the fold alike.
-bool krs_level(int i, inout vec3r x, inout real d, real rho, out real e, inout int cut) {
+bool krs_level(int i, int top, inout vec3r x, inout real d, KrsLod lod, out real e,
+               inout int cut) {
 #ifdef KRS_COUNT_LEVELS
     ++g_levels;
 #endif
     e = 0.0;
     vec4r b = u_bounds[i];
 #ifdef KRS_CULLING
-#ifdef KRS_LOD
-    real reach = 2.0 * rho;  // how far a ball drawn below may reach beyond C_i (above)
-#else
-    real reach = 0.0;
-#endif
-    if (b.w >= 0.0 && length(x - b.xyz) - b.w - reach >= d) return false;
+    if (b.w >= 0.0 && length(x - b.xyz) - b.w - lod.reach >= d) return false;
 #endif
 #ifdef KRS_LOD
-    if (b.w >= 0.0 && b.w < rho) { cut = i; return false; }
+    if (b.w >= 0.0 && top - i >= lod.depth) { cut = i; return false; }
 #endif
     e = fold(i, b.xyz, x);
     real k = kernel_distance_of(i, x, KRS_LEVEL_KERNELS);
@@ -78,14 +77,15 @@ real krs_lod_cut(int cut, vec3r x, real d) {
     return d;
 }
 
-real krs_distance(int first, int n, vec3r xw, real rho) {
+real krs_distance(int first, int n, vec3r xw, KrsLod lod) {
     vec3r x = xw;
     real d = kernel_distance_of(first + n, x, KRS_TOP_KERNELS);
     g_slot = first + n;
     g_cut = -1;
     real e;
     int cut = -1;
-    for (int i = first + n - 1; i >= first; --i) if (!krs_level(i, x, d, rho, e, cut)) break;
+    int top = first + n - 1;
+    for (int i = top; i >= first; --i) if (!krs_level(i, top, x, d, lod, e, cut)) break;
     return krs_lod_cut(cut, x, d);
 }
 
@@ -93,40 +93,37 @@ real krs_distance(int first, int n, vec3r xw, real rho) {
 // The walk restarted below the levels whose folds cannot change [issue 27]. An anchor is the
 // walk's state before level slot j (aj; −1: none) at the ray distance where it was taken: x
 // folded by the mirrors above (ax), the ray's direction folded alike (ad), the least |e| of
-// those folds (am), the least distance of the levels above (adist) and the least radius of
-// the balls tested above (ar, for the level of detail). Each fold is an isometry on each side
-// of its mirror, so a point s < am further along the ray folds to ax + s·ad, adist − s bounds
-// the levels above (1-Lipschitz), and with rho ≤ ar no ball above cuts. The walk from j down
+// those folds (am) and the least distance of the levels above (adist). Each fold is an
+// isometry on each side of its mirror, so a point s < am further along the ray folds to
+// ax + s·ad, adist − s bounds the levels above (1-Lipschitz), and where the level of detail
+// cuts no higher than j no ball above cuts. The walk from j down
 // is then Alg. 1's own value where it ends below adist − s; where that bound is what limits,
 // it is only a lower bound (`bounded`): the anchor is dropped, and the next step walks from
 // the top. (Walking on from the top in the same step cost more on llvmpipe, which runs a
 // group of 8 pixels as long as its slowest: docs/speed.md.) The anchor moves to the deepest
 // level whose min(margin, distance above) ≥ keep (κ times the last step), so the next steps
 // fit under it; `saved`: an anchor was taken at this point.
-real krs_restart(int first, int n, vec3r p, vec3r dir, real s, real rho, real keep,
+real krs_restart(int first, int n, vec3r p, vec3r dir, real s, KrsLod lod, real keep,
                  inout int aj, inout vec3r ax, inout vec3r ad, inout real am,
-                 inout real adist, inout real ar, out bool saved, out bool bounded) {
-    bool again = aj >= 0 && s < min(am, adist) && rho <= ar;
-    int i = again ? aj : first + n - 1;
+                 inout real adist, out bool saved, out bool bounded) {
+    int top = first + n - 1;
+    bool again = aj >= 0 && s < min(am, adist) && top - aj <= lod.depth;
+    int i = again ? aj : top;
     vec3r x = again ? ax + s * ad : p, u = again ? ad : dir;
     real bound = adist - s;
     real d = again ? bound : kernel_distance_of(first + n, p, KRS_TOP_KERNELS);
-    real m = again ? am - s : FAR_AWAY, r = again ? ar : FAR_AWAY;
+    real m = again ? am - s : FAR_AWAY;
     g_slot = again ? -1 : first + n;  // above the anchor: not known
     g_cut = -1;
     saved = false;
     int cut = -1;
     for (; i >= first;) {
         if (min(m, d) >= keep) {
-            aj = i; ax = x; ad = u; am = m; adist = d; ar = r;
+            aj = i; ax = x; ad = u; am = m; adist = d;
             saved = true;
         }
-#ifdef KRS_LOD
-        real b = u_bounds[i].w;
-        r = b >= 0.0 ? min(r, b) : r;
-#endif
         real e;
-        bool on = krs_level(i, x, d, rho, e, cut);
+        bool on = krs_level(i, top, x, d, lod, e, cut);
         vec3r mu = u_mirrors[i].xyz;
         u -= 2.0 * (e > 0.0 ? dot(u, mu) : 0.0) * mu;
         m = min(m, abs(e));

@@ -45,7 +45,7 @@ struct Ray {
     vec3r wx;                   // walk restart: the anchor's folded point,
     int slots;                  // (a hit's packed_slots(), in wx's padding)
     vec3r wdir;                 // the ray's direction folded alike,
-    real wt, wm, wd, wr;        // its ray distance, fold margin, distance above, least ball
+    real wt, wm, wd;            // its ray distance, fold margin and distance above,
     int wj;                     // and its level slot (−1: none; krs.glsl, krs_restart)
 };
 
@@ -61,7 +61,7 @@ Ray ray_begin(real start[COMPONENT_SLOTS]) {
     r.state = RAY_LIVE;
     r.slots = 0;  // none known
     r.wx = r.wdir = vec3r(0.0);
-    r.wt = r.wm = r.wd = r.wr = 0.0;
+    r.wt = r.wm = r.wd = 0.0;
     r.wj = -1;
     return r;
 }
@@ -184,8 +184,8 @@ void ray_step(inout Ray r, vec3r origin, vec3r dir) {
 real restart_distance(inout Ray r, vec3r p, vec3r dir, real t, real last, out bool bounded) {
     ivec2 k = component(0);
     bool saved;
-    real d = krs_restart(k.x, k.y, p, dir, t - r.wt, lod_radius(length(p)), RESTART_KEEP * last,
-                         r.wj, r.wx, r.wdir, r.wm, r.wd, r.wr, saved, bounded);
+    real d = krs_restart(k.x, k.y, p, dir, t - r.wt, krs_lod(0, k.x, k.y, lod_radius(length(p))),
+                         RESTART_KEEP * last, r.wj, r.wx, r.wdir, r.wm, r.wd, saved, bounded);
     if (saved) r.wt = t;
     return d;
 }
