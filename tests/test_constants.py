@@ -187,7 +187,7 @@ TWIN_NAMES: dict[str, str | None] = {
     "undistorted_distance": "reference/geometry.py:component_distances",
     "component_distance_at": "component_distance",  # ρ given: component_distance's lod, reach
     "lod_radius": "reference/geometry.py:Lod",  # Lod.radius
-    "krs_lod": "compile/lod.py:cut_depth",  # ρ → the cut's depth, and culling's reach
+    "krs_lod": "compile/lod.py:krs_lod",  # ρ → the cut's depth and culling's reach
     "component": None,  # a compound's slot range from the uniforms
     "nearest_component": "nearest",  # geometry.nearest picks the component
     "scene_nearest": "nearest",

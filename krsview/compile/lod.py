@@ -13,8 +13,9 @@ searched, cost llvmpipe what it saved: docs/speed.md).
 
 The walk cuts at the first slot with a ball at or below depth k*. Its ball holds everything
 below, so the LOD geometry still holds the KRS (no ray passes it), and R_i ≤ K·r̂_i < K·ρ with
-K = max_i R_i / r̂_i: a ball drawn below a slot reaches at most 2Kρ beyond that slot's ball,
-which is culling's reach, and every point of it lies within 2Kρ of what it stands for."""
+K = max_i R_i / r̂_i: a ball drawn below a slot reaches at most its diameter, under 2Kρ,
+beyond that slot's ball, which is culling's reach (read once a step, :func:`krs_lod`), and
+every point of it lies within that diameter of what it stands for."""
 
 from __future__ import annotations
 
@@ -64,14 +65,15 @@ def cut_depth(cut: np.ndarray, rho: np.ndarray | float) -> np.ndarray:
     return np.clip(np.floor(np.minimum(x, np.float32(DEEPEST))) + 1, 0, DEEPEST).astype(np.int64)
 
 
-def cut_reach(
-    cut: np.ndarray, radii: np.ndarray, depth: np.ndarray, rho: np.ndarray | float
-) -> np.ndarray:
-    """How far a ball cut at ``depth`` (:func:`cut_depth`) reaches beyond the ball of any slot
-    above it: the diameter of the slot's ball at that depth (``radii``: the slots' culling
-    radii, bottom to top, < 0: none), 2Kρ where that slot has none and the cut falls to a
-    ball below it, 0 where the depth is past the last level (twin of lod.glsl's krs_lod)."""
-    n = len(radii)
-    slot = n - 1 - np.minimum(depth, n)
-    r = radii[np.maximum(slot, 0)] if n else np.zeros_like(slot, dtype=np.float64)
-    return np.where(slot < 0, 0.0, np.where(r >= 0, 2.0 * r, cut[2] * np.asarray(rho)))
+def krs_lod(c, rho: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+    """A walk's level of detail at ρ in the compiled KRS ``c`` (its ``lod_cut`` and
+    ``bounds``): the cut depth (:func:`cut_depth`), and how far a ball cut there reaches
+    beyond the ball of any slot above it, culling's reach: the diameter of the slot's ball at
+    that depth, 2Kρ where that slot has none and the cut falls to a ball below it, 0 where
+    the depth is past the last level. Twin of lod.glsl's krs_lod."""
+    rho = np.asarray(rho, dtype=np.float64)
+    depth = cut_depth(c.lod_cut, rho)
+    radii = c.bounds[:, 3]
+    slot = c.n - 1 - np.minimum(depth, c.n)
+    r = radii[np.maximum(slot, 0)] if c.n else np.zeros(np.shape(slot))
+    return depth, np.where(slot < 0, 0.0, np.where(r >= 0, 2.0 * r, c.lod_cut[2] * rho))

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.krs import CompiledCompound, CompiledKRS
-from ..compile.lod import cut_depth, cut_reach
+from ..compile.lod import cut_depth, krs_lod
 from ..compile.mokrs import CompiledMoKRS
 from ..reference.kernels import arc_half_angle, arc_local
 from .numbers import Affine, Interval, Number
@@ -225,12 +225,7 @@ def bounds(
                 reach = (
                     0.0
                     if lod is None or isinstance(part, CompiledMoKRS)
-                    else cut_reach(
-                        part.lod_cut,
-                        part.bounds[:, 3],
-                        cut_depth(part.lod_cut, lod[rows]),
-                        lod[rows],
-                    )
+                    else krs_lod(part, lod[rows])[1]
                 )
                 clear = blo > reach  # NaN: not clear
                 cut = ~clear & cuts(lod[rows]) if lod is not None else np.zeros_like(clear)

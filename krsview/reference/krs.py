@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.krs import CompiledKRS
-from ..compile.lod import cut_depth, cut_reach
+from ..compile.lod import krs_lod
 from .kernels import kernel_distance, world_normal
 
 
@@ -33,7 +33,7 @@ def distance(
     krs_bounds): the value is the same, the shader saves the levels below.
 
     Level of detail ``rho`` (a length per point, 0: none): at the first ball C_i at least
-    k*(rho) levels below the top (compile/lod.py, cut_depth) the walk takes
+    k*(rho) levels below the top (compile/lod.py, krs_lod) the walk takes
     d = min(d, dist(x, C_i)) and stops. That is Alg. 1 of the *LOD geometry*: the levels
     above i, and in place of levels i..0 the 2^(n−i−1) copies of the solid ball C_i. It holds
     the KRS (C_i holds all below it), so the value stays a lower bound of the full walk's and
@@ -46,8 +46,7 @@ def distance(
     d = kernel_distance(c.types[c.n], c.records[c.n], x)
     live = np.ones(len(x), dtype=bool)
     rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (len(x),))
-    depth = cut_depth(c.lod_cut, rho)
-    reach = cut_reach(c.lod_cut, c.bounds[:, 3], depth, rho)
+    depth, reach = krs_lod(c, rho)
     for i in range(c.n - 1, -1, -1):
         b = c.bounds[i]
         if b[3] >= 0 and (cull or rho.any()):
@@ -119,8 +118,7 @@ def restart(
     rho = np.broadcast_to(np.asarray(rho, dtype=np.float64), (N,))
     s = t - a.t
     fits = s < np.minimum(a.m, a.d) if margin else s < a.d
-    depth = cut_depth(c.lod_cut, rho)
-    reach = cut_reach(c.lod_cut, c.bounds[:, 3], depth, rho)
+    depth, reach = krs_lod(c, rho)
     again = (a.j >= 0) & fits & (n - 1 - a.j <= depth)
     start = np.where(again, a.j, n - 1)
     x = np.where(again[:, None], a.x + s[:, None] * a.u, p)

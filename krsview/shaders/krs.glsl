@@ -27,8 +27,8 @@ real fold(int i, vec3r c, inout vec3r p) {
 // below the top (where ρ cuts, compile/lod.py), the ball stands for levels i..0
 // (d = min(d, dist(x, C_i)), a lower bound of what they would give) and the walk stops:
 // detail smaller than ρ costs nothing (lod.glsl; reference/krs.py says which geometry that
-// draws). Such a ball holds its part of the levels below and is less than 2Kρ across, so it
-// reaches at most lod.reach = 2Kρ beyond the ball of any slot above (compile/balls.py: the
+// draws). Such a ball holds its part of the levels below, so it reaches at most its
+// diameter, lod.reach (under 2Kρ), beyond the ball of any slot above (compile/balls.py: the
 // balls are not nested): culling then stops once d ≤ dist(x, C_i) − lod.reach, still with
 // the value the whole walk would give.
 #ifdef KRS_COUNT_LEVELS
@@ -37,12 +37,12 @@ int g_levels = 0;   // levels walked so far by this invocation (bench paths' mea
 
 // Level slot i (top: the KRS's top slot) of Alg. 1 on the point x with the distance d found
 // above it: culling, the level of detail, the fold (its e returned) and the kernel; false
-// where the walk ends here. A
-// level-of-detail cut only notes its slot in `cut` and leaves x as it is: krs_lod_cut adds
-// the ball's distance once, after the walk. On llvmpipe each read of the uniform block is a
-// gather per component that costs far more than the arithmetic around it, and a branch's
-// reads run whether any pixel takes it or not (docs/speed.md): the ball (c, r) is read once,
-// and its centre c serves culling, the level of detail and the fold alike.
+// where the walk ends here. A level-of-detail cut only notes its slot in `cut` and leaves x
+// as it is: krs_lod_cut adds the ball's distance once, after the walk. On llvmpipe each read
+// of the uniform block is a gather per component that costs far more than the arithmetic
+// around it, and a branch's reads run whether any pixel takes it or not (docs/speed.md): the
+// ball (c, r) is read once, and its centre c serves culling, the level of detail and the
+// fold alike.
 bool krs_level(int i, int top, inout vec3r x, inout real d, KrsLod lod, out real e,
                inout int cut) {
 #ifdef KRS_COUNT_LEVELS

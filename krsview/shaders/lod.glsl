@@ -44,7 +44,7 @@ uniform vec4 u_lod_cut;
 // Component c's cut at ρ (its slots first..first + n − 1): the first depth k whose envelope
 // A·q^k is below ρ, k = ⌊ln(ρ/A) / ln q⌋ + 1 ≥ 0, in float; the reach is twice the radius
 // of that slot's ball, one read a step, or 2Kρ where the cut falls below it (twin:
-// compile/lod.py, cut_depth and cut_reach).
+// compile/lod.py, krs_lod).
 KrsLod krs_lod(int c, int first, int n, real rho) {
 #ifdef KRS_LOD
     vec4 f = LOD_CUT(c);
