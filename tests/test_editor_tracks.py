@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from krsview.editor import panels
-from krsview.editor.keys import BETWEEN, DIAMOND, MARK_BETWEEN, MARK_ON_KEY, ON_KEY
+from krsview.editor.keys import BETWEEN, DIAMOND, KEY, MARK_BETWEEN, MARK_ON_KEY, ON_KEY
 from krsview.editor.mokrs_panel import LEVELS
 from krsview.scene.edits import get_at
 from krsview.scene.presets import resolve
@@ -263,5 +263,91 @@ def test_a_grown_trees_growth_fields_show_the_moment_and_a_typed_value_keys_it(
         type_at(e, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2), "0.7")
         assert e.scene.tree.radius_ratio == 0.7
         assert not any(tr.path == "tree.radius_ratio" for tr in e.scene.animation.tracks)
+    finally:
+        e.close()
+
+
+def strip_keys(e, times) -> list[int]:
+    """Pixels of a key's diamond on the timeline strip's bar at each of ``times``, as drawn
+    in the window (the pointer off the window first: a key under it is drawn hot)."""
+    xdo("mousemove", *(round(v) for v in window_xy(e, 900, 600)))
+    pump(e, 3)
+    x, y, width = e.timeline.bar
+    rgb = np.array([KEY & 0xFF, (KEY >> 8) & 0xFF, (KEY >> 16) & 0xFF])
+    shot = e.viewer.read_window().astype(int)
+    band = (np.abs(shot[round(y - DIAMOND) : round(y + DIAMOND) + 1] - rgb) < 40).all(-1)
+    columns = [round(x + width * t / e.scene.animation.duration) for t in times]
+    return [int(band[:, c - round(DIAMOND) : c + round(DIAMOND) + 1].sum()) for c in columns]
+
+
+def test_a_growth_field_clicked_puts_its_keys_on_the_strip_where_k_keys_and_drags_move_them(
+    display, tmp_path
+):
+    """tree-growing has no handles, so its growth tracks' keys never reached the timeline
+    strip (it said to type a value): a click into a growth field puts the field on the strip,
+    which draws its keys; K keys it at the moment shown; a key dragged along the strip moves
+    and a right-click deletes it, each one undo step. Controls: before the click the strip
+    draws no key and K keys nothing (it says what to do); the click itself changes nothing;
+    the diamonds are found at the keys' moments and not between them."""
+    from krsview.editor.window import Editor
+    from krsview.viewer.commands import SetTime
+
+    path = tmp_path / "growing.toml"
+    shutil.copy(resolve("tree-growing"), path)
+    e = Editor(path, size=(800, 500))
+    ratio = ("tree", "length_ratio")
+
+    def keys() -> list[float]:
+        track = next(tr for tr in e.scene.animation.tracks if tr.path == "tree.length_ratio")
+        return [k.time for k in track.keys]
+
+    def on_bar(t: float) -> tuple[int, int]:
+        x, y, width = e.timeline.bar
+        return tuple(map(round, window_xy(e, x + width * t / e.scene.animation.duration, y)))
+
+    try:
+        e.execute([SetTime(3.0)])
+        pump(e, 4)
+        before = e.scene
+        assert keys() == [0.0, 7.5] and strip_keys(e, (0.0, 7.5)) == [0, 0]
+        xdo("key", "k")
+        pump(e, 3)
+        assert e.scene == before and e.viewer.message == "click a growth field to key it (K)"
+        x0, y0, x1, y1 = e.viewer.interactions.rects[ratio]
+        xdo("mousemove", *map(round, window_xy(e, (x0 + x1) / 2, (y0 + y1) / 2)))
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 3)
+        assert e.scene == before, "a click into the field changed the scene"
+        assert e.timeline.field == ratio
+        at_keys, between = strip_keys(e, (0.0, 7.5)), strip_keys(e, (1.5, 4.5))
+        assert min(at_keys) > 20 and between == [0, 0], (at_keys, between)
+        xdo("key", "k")
+        pump(e, 3)
+        drawn = e.scene.at(3.0).posed().tree.length_ratio
+        assert keys() == [0.0, 3.0, 7.5]
+        track = next(tr for tr in e.scene.animation.tracks if tr.path == "tree.length_ratio")
+        assert track.keys[1].value == pytest.approx(drawn)
+        assert e.viewer.message == "key at 3.00 s for tree.length_ratio"
+        xdo("mousemove", *on_bar(3.0))
+        pump(e, 3)
+        xdo("mousedown", 1)
+        pump(e, 2)
+        for k in range(1, 6):
+            xdo("mousemove", *on_bar(3.0 + 0.2 * k))
+            pump(e, 2)
+        xdo("mouseup", 1)
+        pump(e, 3)
+        assert keys() == [0.0, 4.0, 7.5], keys()
+        xdo("mousemove", *on_bar(4.0))
+        pump(e, 3)
+        xdo("click", 3)
+        pump(e, 3)
+        assert keys() == [0.0, 7.5]
+        assert e.doc.history.labels()[0] == [
+            "key at 3.00 s for tree.length_ratio",
+            "move the key at 3.00 s of tree.length_ratio in time",
+            "delete the key at 4.00 s of tree.length_ratio",
+        ]
     finally:
         e.close()

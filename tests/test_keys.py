@@ -93,7 +93,7 @@ def test_k_and_the_strips_key_edits_act_on_the_linked_levels_as_a_drag_does():
     assert strip_words(paths) == "mokrs.levels[58].transform[1].degrees and 29 linked levels"
     assert strip_words([CURL]) == "mokrs.levels[58].transform[1].degrees"
     assert strip_words([]) == "select a handle to key it"
-    assert strip_words([], grown=True) == "type a value under growth to key it"
+    assert strip_words([], grown=True) == "click a growth field to key it"
     assert linked_paths(s, CURL, carry=False) == [CURL]
     assert linked_paths(s, FORK, carry=True) == [FORK]  # not a MöKRS step: alone
 

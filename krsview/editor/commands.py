@@ -210,3 +210,11 @@ class CancelCopy(Command):
 @dataclass(frozen=True)
 class SetKey(Command):
     """K: a key for the selected value at the moment shown (an edit of the tracks)."""
+
+
+@dataclass(frozen=True)
+class ShowKeys(Command):
+    """A click into a panel field that a track moves (or into a grown tree's growth field,
+    which has no handle): the timeline strip shows its keys, and K keys it."""
+
+    path: tuple

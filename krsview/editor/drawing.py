@@ -18,7 +18,7 @@ from ..viewer import commands as vc
 from ..viewer.hud import HUD_TITLE, draw_hud
 from ..viewer.status import window_rect
 from .handles import Handle
-from .keys import STRIP_ROOM, Timeline, linked_paths
+from .keys import STRIP_ROOM, Timeline
 from .layout import hud_clear_of
 from .panels import PANEL_TITLE, Edited, edit_panel
 from .picking import hover_label
@@ -54,7 +54,7 @@ def draw_ui(e: Drawing) -> None:
     e.execute(edit_panel(e, v.interactions))
     if e.scene.animated:  # a still scene keeps the whole view (K starts a track)
         free = e.layout.free(glfw.get_window_size(v.window))
-        paths = [] if e.selected is None else linked_paths(e.scene, e.selected.path, e.carry)
+        paths = e.timeline.paths(e.scene, e.selected, e.carry)
         e.execute(e.timeline.draw(e.scene, v.drawn.playback, paths, free))
     hover_label(shown, view)
 

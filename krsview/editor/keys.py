@@ -19,7 +19,7 @@ from imgui_bundle import imgui
 from ..messages import counted
 from ..scene import Scene, SceneError
 from ..scene.animation import Animation, Key, Track, bone_offset
-from ..scene.edits import Path, apply_edit, get_at, parse_path, path_text, replace_at
+from ..scene.edits import Path, apply_edit, get_at, holds, parse_path, path_text, replace_at
 from ..scene.mokrs import linked_edit, linked_levels
 from ..viewer import commands as vc
 from ..viewer.playback import Playback
@@ -88,6 +88,7 @@ class Keyed(Protocol):
     selected: Handle | None
     carry: bool  # step edits go to linked levels
     viewer: Viewer
+    timeline: Timeline
 
     @property
     def scene(self) -> Scene: ...
@@ -98,12 +99,13 @@ def set_key(e: Keyed) -> None:
     """K: a key for the selected value (``linked_paths``) at the moment shown, holding the
     value drawn; said in the status line too, since the HUD, where the message goes, starts
     folded."""
-    if e.selected is None:
-        e.viewer.message = "select a handle to key its value (K)"
+    paths = e.timeline.paths(e.scene, e.selected, e.carry)
+    if not paths:
+        e.viewer.message = strip_words([], e.scene.tree is not None) + " (K)"
         return
     t = e.viewer.drawn.playback.time
-    paths = linked_paths(e.scene, e.selected.path, e.carry)
-    label = f"key at {t:.2f} s for {e.selected.label}{and_linked(len(paths) - 1, 'level')}"
+    what = e.selected.label if e.timeline.field is None else path_text(paths[0])
+    label = f"key at {t:.2f} s for {what}{and_linked(len(paths) - 1, 'level')}"
     if e.edit(("animation",), key_now(e.scene, paths, t), label=label):
         e.viewer.message = label
         e.viewer.say(label)
@@ -235,9 +237,9 @@ def keys_together(scene: Scene, tracks: list[int], track: int, key: int) -> list
 def strip_words(paths: list[Path], grown: bool = False) -> str:
     """What the timeline strip says it keys: the selected value and the levels linked to it
     (``paths``: ``linked_paths``), or how to choose one (``grown``: a grown tree, which has
-    no handles; its panel's growth fields key what they are typed into)."""
+    no handles; a click into one of its panel's growth fields puts it on the strip)."""
     if not paths:
-        return "type a value under growth to key it" if grown else "select a handle to key it"
+        return "click a growth field to key it" if grown else "select a handle to key it"
     return path_text(paths[0]) + and_linked(len(paths) - 1, "level")
 
 
@@ -274,13 +276,24 @@ def without_keys(scene: Scene, keys: list[tuple[int, int]]) -> Animation:
 
 
 class Timeline:
-    """The strip's drag state: the keys being dragged (the one on the strip first, then the
-    linked levels' at its moment), and the drag's number (one undo step)."""
+    """The strip's state: the panel field it shows (else the selected handle's value), the
+    keys being dragged (the one on the strip first, then the linked levels' at its moment),
+    and the drag's number (one undo step)."""
 
     def __init__(self) -> None:
+        self.field: Path | None = None  # a panel field clicked (ShowKeys); a selection clears it
         self.dragging: list[tuple[int, int]] | None = None  # (track, key) pairs
         self.drags = 0
         self.bar = (0.0, 0.0, 0.0)  # the time bar as last drawn: left x, middle y, width
+
+    def paths(self, scene: Scene, selected: Handle | None, carry: bool) -> list[Path]:
+        """The values the strip shows and K keys (``linked_paths``): the panel field clicked
+        last while the scene still has it (an undo or a removed level may take it), else
+        the selected handle's value; none: empty."""
+        if self.field is not None and not holds(scene, self.field):
+            self.field = None
+        path = self.field or (selected.path if selected is not None else None)
+        return [] if path is None else linked_paths(scene, path, carry)
 
     def draw(
         self, scene: Scene, playback: Playback, paths: list[Path], span: tuple[float, float]

@@ -183,6 +183,18 @@ def _steps(e, i: int, steps: list) -> Edit:
     return Edit((*LEVELS, i, "transform"), steps)
 
 
+def _linked(scene, c: Command, t: float) -> list[Command]:
+    """A step field's command with step edits going to linked levels: an edit, as the same
+    edit of each linked level (keyed where a track moves it); any other command as it is
+    (ShowKeys: the strip takes the linked levels itself)."""
+    if not isinstance(c, Edit):
+        return [c]
+    return [
+        Edit(path, value, c.interaction, field=(c.path, c.value))
+        for path, value in linked_edits(scene, c.path, c.value, t)
+    ]
+
+
 def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interactions, fields):
     """One step: a header that selects its handle, reorder and remove buttons, its fields,
     and a refusal of one of them (or of a drag of its handle: a pole) beneath."""
@@ -204,10 +216,6 @@ def _step(e, lv, i: int, j: int, s, mine: bool, error: str, out: list, interacti
     fields(s, sp, out, interactions)
     if e.carry:  # linked: the same change in the finer levels with the same steps (keyed
         t = e.viewer.drawn.playback.time  # where a track moves it)
-        out[first:] = [
-            Edit(path, value, c.interaction, field=(c.path, c.value))
-            for c in out[first:]
-            for path, value in linked_edits(e.scene, c.path, c.value, t)
-        ]
+        out[first:] = [linked for c in out[first:] for linked in _linked(e.scene, c, t)]
     imgui.unindent()
     red_text(error)

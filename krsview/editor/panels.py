@@ -315,10 +315,13 @@ def _field(
         _fields(value, path, out, interactions, marks, albedo)
     else:
         refused = interactions.refusal(path)
-        with marked((marks or {}).get(path)):
+        tracked = (marks or {}).get(path)
+        with marked(tracked):
             changed, new = field_widget(
                 f"{f.name}##{'.'.join(map(str, path))}", value, dict(f.metadata), refused
             )
+        if imgui.is_item_activated() and (tracked is not None or path[0] == "tree"):
+            out.append(ec.ShowKeys(path))  # its keys on the strip (a grown tree: no handles)
         key = interactions.key(path)
         if changed:
             out.append(Edit(path, new, key))

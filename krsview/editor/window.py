@@ -286,6 +286,7 @@ class Editor:
     def select(self, h: Handle | None) -> None:
         """Select ``h``; a compound component's fork also picks its level for the tools."""
         self.selected = h
+        self.timeline.field = None  # the strip shows the selection's keys
         self.scroll_outline = True
         if h is not None and self.scene.compound and "levels" in h.path:
             self.structure.level = h.path[h.path.index("levels") + 1]
@@ -389,6 +390,7 @@ class Editor:
 EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
     ec.Bake: lambda e, c: e.bake(c.component),
     ec.SetKey: lambda e, c: set_key(e),
+    ec.ShowKeys: lambda e, c: setattr(e.timeline, "field", c.path),
     ec.Select: lambda e, c: e.select(c.handle),
     ec.SelectLevel: lambda e, c: e.select_level(c.level),
     ec.LevelOp: lambda e, c: apply_op(e, c.level, c.op),
