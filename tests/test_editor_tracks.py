@@ -62,6 +62,25 @@ def frame_colour(e, path, colour) -> int:
     return int((np.abs(field - rgb) < 14).all(-1).sum())
 
 
+def on_bar(e, t: float) -> tuple[int, int]:
+    """The screen point of moment ``t`` on the timeline strip's bar, as last drawn."""
+    x, y, width = e.timeline.bar
+    return tuple(map(round, window_xy(e, x + width * t / e.scene.animation.duration, y)))
+
+
+def drag_on_bar(e, t0: float, t1: float) -> None:
+    """Press on the strip's bar at ``t0`` and drag to ``t1`` in five steps, as a hand does."""
+    xdo("mousemove", *on_bar(e, t0))
+    pump(e, 3)
+    xdo("mousedown", 1)
+    pump(e, 2)
+    for k in range(1, 6):
+        xdo("mousemove", *on_bar(e, t0 + (t1 - t0) * k / 5))
+        pump(e, 2)
+    xdo("mouseup", 1)
+    pump(e, 3)
+
+
 def diamond_pixels(e, path, mark) -> int:
     """Pixels of the key's diamond (``mark``: ON_KEY filled, BETWEEN hollow) right of the
     field at ``path`` and its label, as drawn in the window."""
@@ -138,25 +157,13 @@ def test_k_and_the_strips_key_edits_reach_every_linked_curl_in_a_window(palm):
     said = e.viewer.message  # in the status line too: the HUD starts folded
     assert said.startswith("key at 1.00 s") and e.viewer.status_line() == said
 
-    def on_bar(t: float) -> tuple[int, int]:
-        x, y, width = e.timeline.bar
-        return tuple(map(round, window_xy(e, x + width * t / e.scene.animation.duration, y)))
-
-    xdo("mousemove", *on_bar(1.0))
+    xdo("mousemove", *on_bar(e, 1.0))
     pump(e, 3)
     xdo("click", 3)
     pump(e, 3)
     assert times() == {(0, 2, 4)}, "the right-click deleted the key of one curl only"
     assert e.viewer.message == "", "what was said of the key deleted stayed"
-    xdo("mousemove", *on_bar(2.0))
-    pump(e, 3)
-    xdo("mousedown", 1)
-    pump(e, 2)
-    for k in range(1, 6):
-        xdo("mousemove", *on_bar(2.0 + 0.2 * k))
-        pump(e, 2)
-    xdo("mouseup", 1)
-    pump(e, 3)
+    drag_on_bar(e, 2.0, 3.0)
     moved = times()
     assert len(moved) == 1 and abs(next(iter(moved))[1] - 3.0) < 0.05, moved
     assert len(e.doc.history.steps) == 3, "K, the delete and the drag: one step each"
@@ -301,10 +308,6 @@ def test_a_growth_field_clicked_puts_its_keys_on_the_strip_where_k_keys_and_drag
         track = next(tr for tr in e.scene.animation.tracks if tr.path == "tree.length_ratio")
         return [k.time for k in track.keys]
 
-    def on_bar(t: float) -> tuple[int, int]:
-        x, y, width = e.timeline.bar
-        return tuple(map(round, window_xy(e, x + width * t / e.scene.animation.duration, y)))
-
     try:
         e.execute([SetTime(3.0)])
         pump(e, 4)
@@ -329,17 +332,9 @@ def test_a_growth_field_clicked_puts_its_keys_on_the_strip_where_k_keys_and_drag
         track = next(tr for tr in e.scene.animation.tracks if tr.path == "tree.length_ratio")
         assert track.keys[1].value == pytest.approx(drawn)
         assert e.viewer.message == "key at 3.00 s for tree.length_ratio"
-        xdo("mousemove", *on_bar(3.0))
-        pump(e, 3)
-        xdo("mousedown", 1)
-        pump(e, 2)
-        for k in range(1, 6):
-            xdo("mousemove", *on_bar(3.0 + 0.2 * k))
-            pump(e, 2)
-        xdo("mouseup", 1)
-        pump(e, 3)
+        drag_on_bar(e, 3.0, 4.0)
         assert keys() == [0.0, 4.0, 7.5], keys()
-        xdo("mousemove", *on_bar(4.0))
+        xdo("mousemove", *on_bar(e, 4.0))
         pump(e, 3)
         xdo("click", 3)
         pump(e, 3)
