@@ -49,12 +49,17 @@ def palm(display, tmp_path, monkeypatch):
     e.close()
 
 
+def pointer_away(e) -> None:
+    """The pointer off the 800×500 window: nothing in it is drawn hovered."""
+    xdo("mousemove", *(round(v) for v in window_xy(e, 900, 600)))
+    pump(e, 3)
+
+
 def frame_colour(e, path, colour) -> int:
     """Pixels of the field at ``path`` (its left half: the frame) in ``colour`` (an ImVec4).
     The pointer goes off the window first: one left over a field (by this test or an earlier
     one in the same X server) draws that field in ImGui's hovered colour, not its frame."""
-    xdo("mousemove", *(round(v) for v in window_xy(e, 900, 600)))
-    pump(e, 3)
+    pointer_away(e)
     x0, y0, x1, y1 = e.viewer.interactions.rects[path]
     shot = e.viewer.read_window().astype(int)
     field = shot[round(y0) + 2 : round(y1) - 2, round(x0) + 2 : round((x0 + x1) / 2)]
@@ -277,8 +282,7 @@ def test_a_grown_trees_growth_fields_show_the_moment_and_a_typed_value_keys_it(
 def strip_keys(e, times) -> list[int]:
     """Pixels of a key's diamond on the timeline strip's bar at each of ``times``, as drawn
     in the window (the pointer off the window first: a key under it is drawn hot)."""
-    xdo("mousemove", *(round(v) for v in window_xy(e, 900, 600)))
-    pump(e, 3)
+    pointer_away(e)
     x, y, width = e.timeline.bar
     rgb = np.array([KEY & 0xFF, (KEY >> 8) & 0xFF, (KEY >> 16) & 0xFF])
     shot = e.viewer.read_window().astype(int)
