@@ -10,7 +10,8 @@ from dataclasses import dataclass, fields
 import pytest
 
 from krsview.editor import commands as editor_commands
-from krsview.editor.window import EDITOR_HANDLERS, EDITOR_KEYS
+from krsview.editor.handlers import EDITOR_HANDLERS
+from krsview.editor.window import EDITOR_KEYS
 from krsview.scene import SceneError
 from krsview.scene.schema import check_value, describe_range
 from krsview.scene.settings import EDITOR_SETTINGS, ViewerSettings, make_settings, settings_meta

@@ -17,8 +17,8 @@ import pytest
 from krsview.document.document import Document
 from krsview.editor import commands as ec
 from krsview.editor.file_actions import FILE_HANDLERS, FileActions
+from krsview.editor.handlers import EDITOR_HANDLERS
 from krsview.editor.saving import autosave
-from krsview.editor.window import EDITOR_HANDLERS
 from krsview.gpu.program import SHADER_DIR
 from krsview.scene import SceneError, load_scene, save_scene
 from krsview.scene.presets import resolve

@@ -6,11 +6,11 @@ autosaved beside the scene.
 
 The editor composes a :class:`Viewer`: it turns the event loop itself, calling the viewer's
 parts (keys, camera, file watching, tracing, HUD) and adding its overlay (shapes.py), panels,
-gizmo, trackball and picking (picking.py). Commands of its own go to EDITOR_HANDLERS, and those
-the editor decides differently (bookmark, open, a file changed on disk, a field's edit, reset
-view); the rest to the viewer's. Its other jobs live beside it: the file, a part it holds
-(``self.file``, file_actions.py), what the view shows at the moment shown (shown.py) and a
-drag's edits (dragging.py).
+gizmo, trackball and picking (picking.py). Commands of its own go to EDITOR_HANDLERS
+(handlers.py), and those the editor decides differently (bookmark, open, a file changed on disk,
+a field's edit, reset view); the rest to the viewer's. Its other jobs live beside it: the file,
+a part it holds (``self.file``, file_actions.py), what the view shows at the moment shown
+(shown.py) and a drag's edits (dragging.py).
 
 A drag changes only uniforms (kernel records and mirrors): the shader variant stays, so a
 drag never recompiles; while dragging the adaptive resolution keeps the view fluid."""
@@ -18,7 +18,6 @@ drag never recompiles; while dragging the adaptive resolution keeps the view flu
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -42,18 +41,19 @@ from ..viewer.window import Viewer
 from . import commands as ec
 from .dragging import manipulate
 from .drawing import draw_ui
-from .file_actions import FILE_HANDLERS, FileActions
+from .file_actions import FileActions
 from .gizmo import Gizmo
 from .grab import Grabbing
+from .handlers import EDITOR_HANDLERS
 from .handles import Handle, level_handle
-from .keys import Timeline, keyed_edit, set_key
+from .keys import Timeline, keyed_edit
 from .layout import Layout, frame, shift
-from .mokrs_levels import VIEW, apply_op
+from .mokrs_levels import VIEW
 from .mokrs_panel import KindsLeft
 from .picking import pick, visible
 from .saving import autosave
 from .shown import Shown
-from .structure import STRUCTURE_HANDLERS, STRUCTURE_KEYS, StructureTools, baked
+from .structure import STRUCTURE_KEYS, StructureTools, baked
 from .trackball import Trackball
 from .words import Words
 
@@ -382,27 +382,3 @@ class Editor:
         the camera's. (Whether a press lands on one, only the frame after it can tell: the
         pointer may have moved since this frame.)"""
         return self.gizmo.dragging() or self.trackball.active or self.grabbing.now is not None
-
-
-# The editor's commands, and the viewer's that the editor decides itself (a bookmark is an
-# edit, opening or reloading asks about unsaved edits: the file part's, FILE_HANDLERS);
-# tests/test_commands.py checks them.
-EDITOR_HANDLERS: dict[type[vc.Command], Callable[[Editor, Any], None]] = {
-    ec.Bake: lambda e, c: e.bake(c.component),
-    ec.SetKey: lambda e, c: set_key(e),
-    ec.ShowKeys: lambda e, c: setattr(e.timeline, "field", c.path),
-    ec.Select: lambda e, c: e.select(c.handle),
-    ec.SelectLevel: lambda e, c: e.select_level(c.level),
-    ec.LevelOp: lambda e, c: apply_op(e, c.level, c.op),
-    ec.OutlineScrolled: lambda e, c: setattr(e, "scroll_outline", False),
-    ec.SetSnap: lambda e, c: setattr(e.snap, "on", c.on),
-    ec.SetCarry: lambda e, c: setattr(e, "carry", c.on),
-    vc.Edit: lambda e, c: e.edit(c.path, c.value, c.interaction, c.label, c.field),
-    vc.ResetView: lambda e, c: e.reset_view(),
-    vc.Undo: lambda e, c: e.undo(),
-    vc.Redo: lambda e, c: e.undo(redo=True),
-    ec.PlacePanel: lambda e, c: e.place_panel(c.side, c.width),
-    ec.FoldPanel: lambda e, c: e.fold_panel(c.folded),
-    **STRUCTURE_HANDLERS,
-    **{kind: (lambda e, c, h=h: h(e.file, c)) for kind, h in FILE_HANDLERS.items()},
-}
