@@ -48,6 +48,30 @@ def preset_paths() -> list[Path]:
     return sorted(PRESET_DIR.glob("*.toml"))
 
 
+# A sweep runs one check over every preset or hard case. `make test` (CI) runs each sweep's
+# slice: a scene of every kind the check treats differently (a grown tree, a compound, a
+# plane kernel, no balls, a MöKRS, the hard cases named); `KRSVIEW_SWEEP=full` runs them all.
+FULL_SWEEP = os.environ.get("KRSVIEW_SWEEP") == "full"
+
+
+def sweep(cases: list, slice_: set[str], name=str) -> list:
+    """``cases`` as parameters, those whose ``name`` is outside ``slice_`` marked ``sweep``
+    (deselected unless KRSVIEW_SWEEP=full). Every name in the slice must be a case."""
+    names = {name(c) for c in cases}
+    assert slice_ <= names, f"the slice names no case: {sorted(slice_ - names)}"
+    return [c if name(c) in slice_ else pytest.param(c, marks=pytest.mark.sweep) for c in cases]
+
+
+def pytest_collection_modifyitems(config, items):
+    """Without KRSVIEW_SWEEP=full, the sweeps' cases outside their slice are deselected."""
+    if FULL_SWEEP:
+        return
+    dropped = [item for item in items if item.get_closest_marker("sweep")]
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+        items[:] = [item for item in items if not item.get_closest_marker("sweep")]
+
+
 # The compute path's deferred shading and the fragment path's shading are separate stages:
 # on a CPU rasteriser (llvmpipe, CI) they give the same colours bit for bit, but a GPU's
 # compiler contracts their multiply-adds apart. On an H100 the colours differed by up to

@@ -1,4 +1,5 @@
-"""Every preset: the GLSL tracer agrees with the float64 NumPy reference pixel by pixel."""
+"""Every preset: the GLSL tracer agrees with the float64 NumPy reference pixel by pixel
+(`make test` runs a slice, a preset of each kind; KRSVIEW_SWEEP=full every preset)."""
 
 from __future__ import annotations
 
@@ -11,12 +12,25 @@ from krsview.compile.camera import view_of
 from krsview.reference import render_reference
 from krsview.scene import load_scene
 
-from .conftest import assert_finite, check_against_reference, fold_ties, per_pixel, preset_paths
+from .conftest import (
+    assert_finite,
+    check_against_reference,
+    fold_ties,
+    per_pixel,
+    preset_paths,
+    sweep,
+)
 
 W, H = 160, 120
 
 
-@pytest.mark.parametrize("path", preset_paths(), ids=lambda p: p.stem)
+# CI's slice: a scene of each kind (module doc); KRSVIEW_SWEEP=full adds the rest
+SLICE = {"tree", "grove", "grass", "rock", "sierpinski", "palm", "shell", "palm-curl", "tree-wind"}
+
+
+@pytest.mark.parametrize(
+    "path", sweep(preset_paths(), SLICE, name=lambda p: p.stem), ids=lambda p: p.stem
+)
 def test_preset_matches_reference(renderer, path):
     """The fragment tracer against the reference, and the same with the low-resolution
     pre-pass [issue 17 §2]. Without it both take the same steps, so every tolerance holds.

@@ -18,7 +18,7 @@ from krsview.oracle.certify import count_errors
 from krsview.scene import load_scene
 from krsview.scene.presets import preset_names, resolve
 
-from .conftest import broken_shaders, krsview_cli
+from .conftest import broken_shaders, krsview_cli, sweep
 
 W, H = 48, 27
 GRID = (32, 18)  # the grid's images: the oracle's cost grows with the rays, the skips are per ray
@@ -30,7 +30,9 @@ def with_prepass(scene, tile):
 
 # every still preset: wind is not in the oracle (tests/test_wind.py holds its pre-pass), and
 # a moving preset poses the geometry of its still original at each moment (the oracle
-# certifies a swaying frame in tests/test_oracle.py), so it would only lengthen the run
+# certifies a swaying frame in tests/test_oracle.py), so it would only lengthen the run.
+# `make test` runs a slice (a grown tree, a compound, a plane kernel, no balls, a MöKRS and
+# the hard cases); KRSVIEW_SWEEP=full every still preset
 SCENES = [n for n in preset_names() if not load_scene(resolve(n)).animated]
 HARD = [
     "camera-on-mirror",
@@ -45,7 +47,9 @@ def scene_of(name):
     return replace(CASES[name].build(), name=name) if name in CASES else load_scene(resolve(name))
 
 
-@pytest.mark.parametrize("name", SCENES + HARD)
+@pytest.mark.parametrize(
+    "name", sweep(SCENES + HARD, {"tree", "grove", "grass", "shell", "sierpinski", *HARD})
+)
 def test_the_prepass_skips_no_surface(renderer, name):
     """Certified by the oracle: no ray of the pre-pass image passes a surface, none stops
     in empty space beyond ε. Against the image without the pre-pass, away from outlines
