@@ -210,17 +210,15 @@ def test_an_error_said_after_a_message_takes_the_status_line_at_once(hud_viewer)
     assert v.status_line() == "screenshot: x.png"
 
 
-def test_the_status_line_is_drawn_over_a_hud_that_leaves_it_no_gap(display, tmp_path, monkeypatch):
-    """A window too narrow beside a HUD that reaches its foot: the status line goes over the
-    HUD, and it is drawn over it, not under it (it was hidden behind the HUD it was placed
-    on). The control: the two meet."""
-    import glfw
-
-    from krsview.viewer.hud import HUD_TITLE
+def test_a_hud_reaching_the_foot_ends_above_the_status_line(display, tmp_path, monkeypatch):
+    """A HUD tall enough to reach the window's foot ends above the status line while there
+    is one (its knobs scroll in less height): the line, wrapped where it is too long for one,
+    covers none of the HUD and the HUD none of it. The control: with nothing to say, the same
+    HUD reaches into the band the line takes."""
     from krsview.viewer.status import meets, window_rect
     from krsview.viewer.window import Viewer
 
-    from .test_editor import open_from_start, xdo
+    from .test_editor import open_from_start
 
     open_from_start(monkeypatch, "accuracy and view")
     path = tmp_path / "tree.toml"
@@ -229,20 +227,60 @@ def test_the_status_line_is_drawn_over_a_hud_that_leaves_it_no_gap(display, tmp_
     try:
         for _ in range(3):
             v.step(0.05)
+        alone = window_rect(imgui.internal.find_window_by_name(HUD_TITLE))
         v.error = "a refusal long enough that no gap beside the HUD holds it on one line"
-        wx, wy = glfw.get_window_pos(v.window)
-        xdo("mousemove", wx + 200, wy + 16)  # a click on the HUD's title bar raises it
-        v.step(0.05)
-        xdo("click", 1)
         for _ in range(3):
-            glfw.poll_events()
             v.step(0.05)
-        status, hud = (imgui.internal.find_window_by_name(n) for n in ("##status", HUD_TITLE))
-        assert meets(window_rect(status), window_rect(hud)), "control: they do not meet"
-        order = imgui.internal.find_window_display_index
-        assert order(status) > order(hud), "the status line is drawn under the HUD"
+        status, hud = (
+            window_rect(imgui.internal.find_window_by_name(n)) for n in ("##status", HUD_TITLE)
+        )
+        assert not meets(status, hud), (status, hud)
+        assert status[3] > 400 - 16 and hud[3] < status[1]  # the line at the foot, under it
+        assert alone[3] > status[1], "control: the HUD alone does not reach the line's band"
     finally:
         v.close()
+
+
+def test_in_the_editor_a_refusal_lies_between_the_hud_the_panel_and_the_timeline(display, tmp_path):
+    """tree-growing at 800×500 with the HUD unfolded: a bake refused says why in a status
+    line wrapped above the timeline, beside the panel, and the HUD ends above it; none of
+    the four windows meets another (the line was drawn across the timeline and the panel).
+    The control: before the refusal the HUD reaches into the band the line takes."""
+    import glfw
+
+    from krsview.editor.panels import PANEL_TITLE
+    from krsview.editor.window import Editor
+    from krsview.viewer.status import meets, window_rect
+
+    from .test_editor import pump, xdo
+
+    path = tmp_path / "tree-growing.toml"
+    shutil.copy(resolve("tree-growing"), path)
+    e = Editor(path, size=(800, 500))
+    try:
+        pump(e, 3)
+        wx, wy = glfw.get_window_pos(e.viewer.window)
+        xdo("mousemove", wx + 20, wy + 18)  # the HUD's arrow: it opens folded in the editor
+        pump(e, 2)
+        xdo("click", 1)
+        pump(e, 2)
+        xdo("mousemove", wx + 300, wy + 5)
+        pump(e, 3)
+        rect = lambda name: window_rect(imgui.internal.find_window_by_name(name))  # noqa: E731
+        alone = rect(HUD_TITLE)
+        assert alone[3] - alone[1] > 250, "the HUD did not unfold"
+        e.bake()
+        assert e.viewer.error.startswith("bake: "), e.viewer.error
+        pump(e, 3)
+        windows = {n: rect(n) for n in ("##status", HUD_TITLE, PANEL_TITLE, "##timeline")}
+        for a in windows:
+            for b in windows:
+                assert a == b or not meets(windows[a], windows[b]), (a, b, windows)
+        status, timeline = windows["##status"], windows["##timeline"]
+        assert status[3] <= timeline[1] and status[1] >= windows[HUD_TITLE][3]
+        assert alone[3] > status[1], "control: the HUD alone does not reach the line's band"
+    finally:
+        e.close()
 
 
 def test_screenshot_goes_beside_a_writable_scene(tmp_path, monkeypatch):

@@ -16,7 +16,7 @@ from ..compile.camera import View
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
 from ..viewer import commands as vc
 from ..viewer.hud import HUD_TITLE, draw_hud
-from ..viewer.status import window_rect
+from ..viewer.status import status_room, window_rect
 from .handles import Handle
 from .keys import STRIP_ROOM, Timeline
 from .layout import hud_clear_of
@@ -38,7 +38,9 @@ class Drawing(Edited):
     def shown(self) -> list[Handle]: ...
 
 
-def draw_ui(e: Drawing) -> None:
+def draw_ui(e: Drawing, status: str) -> None:
+    """The editor's windows over the image; the HUD ends above the timeline and above the
+    ``status`` line wrapped into the view's columns (status.py)."""
     v = e.viewer
     view = e.window_view()
     shown = e.shown()
@@ -50,7 +52,10 @@ def draw_ui(e: Drawing) -> None:
         e.overlay.draw(shapes, fbo, v.ctx.screen, fb, proj @ view_matrix, view.origin, image)
     _hud_beside_panel(e)
     imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
-    e.execute(draw_hud(v, v.interactions, STRIP_ROOM if e.scene.animated else 0.0))
+    size = glfw.get_window_size(v.window)
+    foot = status_room(status, e.layout.free(size), size[0])
+    foot += STRIP_ROOM if e.scene.animated else 0.0
+    e.execute(draw_hud(v, v.interactions, foot))
     e.execute(edit_panel(e, v.interactions))
     if e.scene.animated:  # a still scene keeps the whole view (K starts a track)
         free = e.layout.free(glfw.get_window_size(v.window))

@@ -240,7 +240,7 @@ class Editor:
         self._follow()
         if ui:
             if v.hud:
-                draw_ui(self)
+                draw_ui(self, status)
             draw_status(status, v.status_is_error(status))
             v.platform.render()
         v.input.claimed = v.hud and self._dragging()

@@ -7,10 +7,12 @@ from __future__ import annotations
 
 from typing import Protocol
 
+from imgui_bundle import imgui
+
 from . import commands as c
 from .hud import Viewed, begin_hud, finish_hud
 from .platform import Platform
-from .status import draw_status
+from .status import draw_status, status_room
 from .widgets import Interactions
 
 
@@ -46,7 +48,9 @@ class HudFrame:
         self.begun = True
         self.v.platform.new_frame()
         if self.v.hud:
-            self.commands, self.slot = begin_hud(self.v, self.v.interactions)
+            width = imgui.get_io().display_size.x  # the HUD ends above the status line
+            foot = status_room(self.status, (0.0, width), width)
+            self.commands, self.slot = begin_hud(self.v, self.v.interactions, foot)
 
     def finish(self) -> list[c.Command]:
         """The numbers of the image on screen into the HUD; its commands, to apply before

@@ -1,8 +1,10 @@
 """The status line: a line at the window's foot (a screenshot's path; an error in red), HUD
 shown or not, placed where no other window covers it: at the foot's left, else to the right
-of the windows that reach the foot (the HUD, the editor's panel), else above them (the
-editor's timeline spans the foot); where it fits whole on one line nowhere, it is wrapped
-into the widest gap at the foot."""
+of the windows that reach the foot (the editor's panel), else above them (the editor's
+timeline spans the foot); where it fits whole on one line nowhere, it is wrapped into the
+widest gap at the foot. The HUD ends above it (:func:`status_room`): a HUD reaching the foot
+scrolls its knobs in less height while there is something to say, and neither covers the
+other."""
 
 from __future__ import annotations
 
@@ -94,10 +96,8 @@ def _other_windows() -> list[Rect]:
     return out
 
 
-def draw_status(text: str, error: bool = False) -> None:
-    """The status line ``text`` (red for an ``error``), where no other window covers it."""
-    if not text:
-        return
+def _measure(text: str) -> Measure:
+    """The status line's box, ``text`` wrapped at a width (inf: one line)."""
     pad = imgui.get_style().window_padding
 
     def measure(width: float) -> tuple[float, float]:
@@ -105,8 +105,27 @@ def draw_status(text: str, error: bool = False) -> None:
         size = imgui.calc_text_size(text, False, wrap)
         return size.x + 2 * pad.x, size.y + 2 * pad.y
 
+    return measure
+
+
+def status_room(text: str, span: tuple[float, float], width: float) -> float:
+    """Pixels above the foot the HUD leaves the status line ``text`` (0 with none): its box
+    wrapped into the columns ``span`` (x0, x1) of a window ``width`` wide that the view keeps
+    (all of them, or those the editor's panel leaves), inside the margins, with the margin
+    above it: the gap status_spot then finds free."""
+    if not text:
+        return 0.0
+    room = min(span[1], width - MARGIN) - max(span[0], MARGIN)
+    return _measure(text)(room)[1] + MARGIN
+
+
+def draw_status(text: str, error: bool = False) -> None:
+    """The status line ``text`` (red for an ``error``), where no other window covers it."""
+    if not text:
+        return
+    pad = imgui.get_style().window_padding
     display = imgui.get_io().display_size
-    x, y, room = status_spot((display.x, display.y), measure, _other_windows())
+    x, y, room = status_spot((display.x, display.y), _measure(text), _other_windows())
     imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always, imgui.ImVec2(0, 1))
     imgui.set_next_window_bg_alpha(0.75)
     flags = imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
