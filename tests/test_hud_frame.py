@@ -49,9 +49,9 @@ def flying(display, tmp_path, monkeypatch):
         seen["numbers"].append(viewer.frames.frame_state())
         return numbers(viewer)
 
-    def begun(viewer, interactions):
+    def begun(viewer, interactions, foot=0.0):
         seen["begun"].append((viewer.frames.frame_state(), draws[0]))
-        out, slot = begin(viewer, interactions)
+        out, slot = begin(viewer, interactions, foot)
         spacing = imgui.get_style().item_spacing.y
         seen["slot"].append([slot.y + hud.numbers_height() + spacing])  # where the slot ends
         return out, slot
@@ -126,8 +126,8 @@ def test_the_numbers_fill_the_slot_left_for_them(flying, monkeypatch):
     # negative control: a plot taller than the slot was made for ends past it
     begin = hudframe.begin_hud  # the fixture's recorder
 
-    def taller_after(viewer, interactions):
-        out = begin(viewer, interactions)
+    def taller_after(viewer, interactions, foot=0.0):
+        out = begin(viewer, interactions, foot)
         monkeypatch.setattr(hud, "PLOT_HEIGHT", hud.PLOT_HEIGHT + 10)
         return out
 

@@ -122,6 +122,8 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
 
 
 def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
+    from krsview.viewer.status import meets, window_rect
+
     v = hud_viewer
     turn(v)  # the HUD takes its height in its first frames (its knobs' part, then itself)
     v.input.key("F12", True)
@@ -134,12 +136,17 @@ def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
     assert v.status_line() == f"screenshot: {out}" and str(out) in capsys.readouterr().out
     _, drawn, _ = turn(v)
     assert f"screenshot: {out}" in drawn, "the status line is not drawn"
-    status, hud = (imgui.internal.find_window_by_name(n) for n in ("##status", HUD_TITLE))
-    assert hud.pos.y + hud.size.y > status.pos.y, "control: the HUD reaches the foot"
-    assert status.pos.x >= hud.pos.x + hud.size.x, "the status line covers the HUD"
+    # the path is too long for one line beside the HUD: the HUD ends above it, at the foot
+    status, hud = (
+        window_rect(imgui.internal.find_window_by_name(n)) for n in ("##status", HUD_TITLE)
+    )
+    assert not meets(status, hud), "the status line covers the HUD"
+    assert status[3] > SIZE[1] - 16 and status[2] > hud[2], (status, hud)
     v.clock += 10  # the status line goes after a few seconds; the HUD's message stays
     _, drawn, _ = turn(v)
     assert v.status_line() == "" and drawn.count(f"screenshot: {out}") == 0
+    turn(v)  # the control: with nothing to say, the HUD reaches into the line's band again
+    assert window_rect(imgui.internal.find_window_by_name(HUD_TITLE))[3] > status[1]
     v.hud = False
     v.execute(v.input.commands())
     v.input.key("F12", True)
@@ -211,10 +218,10 @@ def test_an_error_said_after_a_message_takes_the_status_line_at_once(hud_viewer)
 
 
 def test_a_hud_reaching_the_foot_ends_above_the_status_line(display, tmp_path, monkeypatch):
-    """A HUD tall enough to reach the window's foot ends above the status line while there
-    is one (its knobs scroll in less height): the line, wrapped where it is too long for one,
-    covers none of the HUD and the HUD none of it. The control: with nothing to say, the same
-    HUD reaches into the band the line takes."""
+    """A HUD tall enough to reach the window's foot ends above a status line too long for
+    one line beside it (its knobs scroll in less height): neither covers the other. The
+    control: with nothing to say, the same HUD reaches into the band the line takes. A short
+    line goes beside the HUD, which keeps its height."""
     from krsview.viewer.status import meets, window_rect
     from krsview.viewer.window import Viewer
 
@@ -237,6 +244,13 @@ def test_a_hud_reaching_the_foot_ends_above_the_status_line(display, tmp_path, m
         assert not meets(status, hud), (status, hud)
         assert status[3] > 400 - 16 and hud[3] < status[1]  # the line at the foot, under it
         assert alone[3] > status[1], "control: the HUD alone does not reach the line's band"
+        v.error = "no"  # fits on one line beside the HUD (56 px): the HUD keeps its height
+        for _ in range(3):
+            v.step(0.05)
+        status, hud = (
+            window_rect(imgui.internal.find_window_by_name(n)) for n in ("##status", HUD_TITLE)
+        )
+        assert not meets(status, hud) and status[0] >= hud[2] and hud[3] > status[1]
     finally:
         v.close()
 

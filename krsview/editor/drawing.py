@@ -16,7 +16,7 @@ from ..compile.camera import View
 from ..gpu.overlay import FAR, NEAR, Overlay, camera_matrices
 from ..viewer import commands as vc
 from ..viewer.hud import HUD_TITLE, draw_hud
-from ..viewer.status import status_room, window_rect
+from ..viewer.status import drawn_rect, status_room, window_rect
 from .handles import Handle
 from .keys import STRIP_ROOM, Timeline
 from .layout import hud_clear_of
@@ -53,7 +53,7 @@ def draw_ui(e: Drawing, status: str) -> None:
     _hud_beside_panel(e)
     imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
     size = glfw.get_window_size(v.window)
-    foot = status_room(status, e.layout.free(size), size[0])
+    foot = status_room(status, e.layout.free(size), size[0], drawn_rect(HUD_TITLE))
     foot += STRIP_ROOM if e.scene.animated else 0.0
     e.execute(draw_hud(v, v.interactions, foot))
     e.execute(edit_panel(e, v.interactions))

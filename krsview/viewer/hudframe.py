@@ -10,9 +10,9 @@ from typing import Protocol
 from imgui_bundle import imgui
 
 from . import commands as c
-from .hud import Viewed, begin_hud, finish_hud
+from .hud import HUD_TITLE, Viewed, begin_hud, finish_hud
 from .platform import Platform
-from .status import draw_status, status_room
+from .status import draw_status, drawn_rect, status_room
 from .widgets import Interactions
 
 
@@ -49,7 +49,7 @@ class HudFrame:
         self.v.platform.new_frame()
         if self.v.hud:
             width = imgui.get_io().display_size.x  # the HUD ends above the status line
-            foot = status_room(self.status, (0.0, width), width)
+            foot = status_room(self.status, (0.0, width), width, drawn_rect(HUD_TITLE))
             self.commands, self.slot = begin_hud(self.v, self.v.interactions, foot)
 
     def finish(self) -> list[c.Command]:

@@ -2,9 +2,9 @@
 shown or not, placed where no other window covers it: at the foot's left, else to the right
 of the windows that reach the foot (the editor's panel), else above them (the editor's
 timeline spans the foot); where it fits whole on one line nowhere, it is wrapped into the
-widest gap at the foot. The HUD ends above it (:func:`status_room`): a HUD reaching the foot
-scrolls its knobs in less height while there is something to say, and neither covers the
-other."""
+widest gap at the foot. Where it does not fit on one line beside the HUD, the HUD ends above
+it (:func:`status_room`): a HUD reaching the foot scrolls its knobs in less height while
+there is something to say, and neither covers the other."""
 
 from __future__ import annotations
 
@@ -77,6 +77,12 @@ def window_rect(w) -> Rect:
     return w.pos.x, w.pos.y, w.pos.x + w.size.x, w.pos.y + w.size.y
 
 
+def drawn_rect(name: str) -> Rect | None:
+    """The rectangle of the window ``name`` as it was last drawn; None before it was."""
+    w = imgui.internal.find_window_by_name(name)
+    return None if w is None else window_rect(w)
+
+
 def _other_windows() -> list[Rect]:
     """The rectangles of the top-level windows drawn this frame that show something: not
     tooltips and popups (they move or close of themselves), not an overlay that takes no
@@ -108,15 +114,21 @@ def _measure(text: str) -> Measure:
     return measure
 
 
-def status_room(text: str, span: tuple[float, float], width: float) -> float:
-    """Pixels above the foot the HUD leaves the status line ``text`` (0 with none): its box
-    wrapped into the columns ``span`` (x0, x1) of a window ``width`` wide that the view keeps
-    (all of them, or those the editor's panel leaves), inside the margins, with the margin
-    above it: the gap status_spot then finds free."""
+def status_room(
+    text: str, span: tuple[float, float], width: float, hud: Rect | None = None
+) -> float:
+    """Pixels above the foot the HUD leaves the status line ``text``: 0 with none, or where
+    it fits on one line beside the ``hud`` (as last drawn); else its box wrapped into the
+    columns ``span`` (x0, x1) of a window ``width`` wide that the view keeps (all of them, or
+    those the editor's panel leaves), inside the margins, with the margin above it: the gap
+    status_spot then finds free."""
     if not text:
         return 0.0
-    room = min(span[1], width - MARGIN) - max(span[0], MARGIN)
-    return _measure(text)(room)[1] + MARGIN
+    measure = _measure(text)
+    lo, hi = max(span[0], MARGIN), min(span[1], width - MARGIN)
+    if hud is not None and max(hud[0] - MARGIN - lo, hi - hud[2] - MARGIN) >= measure(math.inf)[0]:
+        return 0.0
+    return measure(hi - lo)[1] + MARGIN
 
 
 def draw_status(text: str, error: bool = False) -> None:
