@@ -122,7 +122,7 @@ def test_the_hud_shows_the_image_on_screen_moving_then_each_step_then_still(hud_
 
 
 def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
-    from krsview.viewer.status import meets, window_rect
+    from krsview.viewer.status import drawn_rect, meets
 
     v = hud_viewer
     turn(v)  # the HUD takes its height in its first frames (its knobs' part, then itself)
@@ -137,16 +137,14 @@ def test_f12_writes_beside_the_scene_and_says_where(hud_viewer, capsys):
     _, drawn, _ = turn(v)
     assert f"screenshot: {out}" in drawn, "the status line is not drawn"
     # the path is too long for one line beside the HUD: the HUD ends above it, at the foot
-    status, hud = (
-        window_rect(imgui.internal.find_window_by_name(n)) for n in ("##status", HUD_TITLE)
-    )
+    status, hud = (drawn_rect(n) for n in ("##status", HUD_TITLE))
     assert not meets(status, hud), "the status line covers the HUD"
     assert status[3] > SIZE[1] - 16 and status[2] > hud[2], (status, hud)
     v.clock += 10  # the status line goes after a few seconds; the HUD's message stays
     _, drawn, _ = turn(v)
     assert v.status_line() == "" and drawn.count(f"screenshot: {out}") == 0
     turn(v)  # the control: with nothing to say, the HUD reaches into the line's band again
-    assert window_rect(imgui.internal.find_window_by_name(HUD_TITLE))[3] > status[1]
+    assert drawn_rect(HUD_TITLE)[3] > status[1]
     v.hud = False
     v.execute(v.input.commands())
     v.input.key("F12", True)
@@ -222,7 +220,7 @@ def test_a_hud_reaching_the_foot_ends_above_the_status_line(display, tmp_path, m
     one line beside it (its knobs scroll in less height): neither covers the other. The
     control: with nothing to say, the same HUD reaches into the band the line takes. A short
     line goes beside the HUD, which keeps its height."""
-    from krsview.viewer.status import meets, window_rect
+    from krsview.viewer.status import drawn_rect, meets
     from krsview.viewer.window import Viewer
 
     from .test_editor import open_from_start
@@ -234,22 +232,18 @@ def test_a_hud_reaching_the_foot_ends_above_the_status_line(display, tmp_path, m
     try:
         for _ in range(3):
             v.step(0.05)
-        alone = window_rect(imgui.internal.find_window_by_name(HUD_TITLE))
+        alone = drawn_rect(HUD_TITLE)
         v.error = "a refusal long enough that no gap beside the HUD holds it on one line"
         for _ in range(3):
             v.step(0.05)
-        status, hud = (
-            window_rect(imgui.internal.find_window_by_name(n)) for n in ("##status", HUD_TITLE)
-        )
+        status, hud = (drawn_rect(n) for n in ("##status", HUD_TITLE))
         assert not meets(status, hud), (status, hud)
         assert status[3] > 400 - 16 and hud[3] < status[1]  # the line at the foot, under it
         assert alone[3] > status[1], "control: the HUD alone does not reach the line's band"
         v.error = "no"  # fits on one line beside the HUD (56 px): the HUD keeps its height
         for _ in range(3):
             v.step(0.05)
-        status, hud = (
-            window_rect(imgui.internal.find_window_by_name(n)) for n in ("##status", HUD_TITLE)
-        )
+        status, hud = (drawn_rect(n) for n in ("##status", HUD_TITLE))
         assert not meets(status, hud) and status[0] >= hud[2] and hud[3] > status[1]
     finally:
         v.close()
@@ -264,7 +258,7 @@ def test_in_the_editor_a_refusal_lies_between_the_hud_the_panel_and_the_timeline
 
     from krsview.editor.panels import PANEL_TITLE
     from krsview.editor.window import Editor
-    from krsview.viewer.status import meets, window_rect
+    from krsview.viewer.status import drawn_rect, meets
 
     from .test_editor import pump, xdo
 
@@ -280,13 +274,12 @@ def test_in_the_editor_a_refusal_lies_between_the_hud_the_panel_and_the_timeline
         pump(e, 2)
         xdo("mousemove", wx + 300, wy + 5)
         pump(e, 3)
-        rect = lambda name: window_rect(imgui.internal.find_window_by_name(name))  # noqa: E731
-        alone = rect(HUD_TITLE)
+        alone = drawn_rect(HUD_TITLE)
         assert alone[3] - alone[1] > 250, "the HUD did not unfold"
         e.bake()
         assert e.viewer.error.startswith("bake: "), e.viewer.error
         pump(e, 3)
-        windows = {n: rect(n) for n in ("##status", HUD_TITLE, PANEL_TITLE, "##timeline")}
+        windows = {n: drawn_rect(n) for n in ("##status", HUD_TITLE, PANEL_TITLE, "##timeline")}
         for a in windows:
             for b in windows:
                 assert a == b or not meets(windows[a], windows[b]), (a, b, windows)

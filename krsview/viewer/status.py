@@ -1,6 +1,6 @@
 """The status line: a line at the window's foot (a screenshot's path; an error in red), HUD
 shown or not, placed where no other window covers it: at the foot's left, else to the right
-of the windows that reach the foot (the editor's panel), else above them (the editor's
+of the windows that reach the foot (the HUD, the editor's panel), else above them (the editor's
 timeline spans the foot); where it fits whole on one line nowhere, it is wrapped into the
 widest gap at the foot. Where it does not fit on one line beside the HUD, the HUD ends above
 it (:func:`status_room`): a HUD reaching the foot scrolls its knobs in less height while
