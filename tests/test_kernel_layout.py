@@ -15,7 +15,7 @@ import pytest
 from krsview.compile.krs import compile_krs
 from krsview.gpu.uniforms import krs_block
 from krsview.reference.kernels import arc_half_angle, arc_local, kernel_distance
-from krsview.scene import KRS, Level, ToroidalCapsule, arc_of
+from krsview.scene import KRS, Capsule, Empty, Level, Mirror, Sphere, ToroidalCapsule, arc_of
 from krsview.scene.model import MAX_LEVELS, STRAIGHT_RATIO
 
 ALBEDO = (0.5, 0.5, 0.5)
@@ -82,6 +82,35 @@ def test_arc_record_is_the_arc_through_the_kernels_points(phi):
     assert np.allclose(a[[0, 2]], [[c, -s, 0.0], [c, s, 0.0]], atol=1e-12)
     assert abs(np.hypot(*a[1, :2]) - 1.0) < 1e-12 and abs(a[1, 2]) < 1e-12 and a[1, 0] > c
     assert 1.0 / float(rec[2] @ rec[2]) == pytest.approx(arc_of(k).R, rel=1e-14)
+
+
+def arc_misplaced(rec: np.ndarray, k: ToroidalCapsule) -> float:
+    """How far the record puts the kernel's start and end from (c, ∓s, 0), and its control
+    off the unit circle, in units of R (0 for the arc through the kernel's points)."""
+    c, s = arc_half_angle(rec)
+    a = arc_local(rec[2], np.array([k.start, k.control, k.end]) - rec[1, :3])
+    ends = np.abs(a[[0, 2]] - [[c, -s, 0.0], [c, s, 0.0]]).max()
+    return float(max(ends, abs(np.hypot(*a[1, :2]) - 1.0), abs(a[1, 2])))
+
+
+def test_a_krs_of_every_kind_compiles_each_arc_into_its_own_level():
+    """Compiling finds a KRS's arcs all at once (scene.arcs_of, compile/krs.py); each
+    level's record still holds its own kernel: every arc angle between spheres, capsules,
+    empties and a straight arc (drawn as a capsule), each arc's points where the layout puts
+    them. Negative control: the arcs' records in each other's levels misplace them."""
+    rng = np.random.default_rng(7)
+    arcs = [arc_kernel(rng, phi) for phi in ANGLES]
+    straight = ToroidalCapsule((0.0, 0.0, 0.0), (0.5, 1e-9, 0.0), (1.0, 0.0, 0.0), 0.1)
+    others = [Sphere((0.0, 1.0, 0.0), 0.2), Capsule(radius=0.05), Empty(), straight]
+    kernels = [k for pair in zip(arcs, others * 3) for k in pair]
+    mirror = Mirror((0.0, 0.0, 1.0), 3.0)
+    c = compile_krs(KRS([Level(k, mirror if i else None) for i, k in enumerate(kernels)]), ALBEDO)
+    at = [i for i, k in enumerate(kernels) if k in arcs]
+    assert [c.types[i] for i in at] == ["toroidal_capsule"] * len(arcs)
+    assert {c.types[i] for i, k in enumerate(kernels) if k is straight} == {"capsule"}
+    assert max(arc_misplaced(c.records[i], kernels[i]) for i in at) < 1e-12
+    swapped = [arc_misplaced(c.records[i], kernels[j]) for i, j in zip(at, at[1:] + at[:1])]
+    assert min(swapped) > 1e-3
 
 
 def test_the_rational_half_angle_is_accurate_in_float32_where_a_square_root_is_not():

@@ -18,3 +18,8 @@ def cross(a, b) -> np.ndarray:
         ],
         axis=-1,
     )
+
+
+def dot(a, b) -> np.ndarray:
+    """a · b over the last axis."""
+    return np.einsum("...k,...k->...", a, b)

@@ -19,6 +19,7 @@ from ..scene.schema import cached
 
 CULL_MARGIN = 1e-6  # relative growth of the culling balls, against rounding
 UNBOUNDED = np.array([0.0, 0.0, 0.0, -1.0])  # a bound record for "no bounding ball"
+NO_BALL = np.array([0.0, 0.0, 0.0, -np.inf])  # a row of an expansion that holds nothing
 EXACT_LEVELS = 4  # levels expanded below each ball: 2^(EXACT_LEVELS + 2) kernel balls
 CENTRE_STEPS = 16  # Bădoiu–Clarkson steps choosing a ball's centre
 
@@ -58,32 +59,38 @@ def union_ball(p: np.ndarray | None, q: np.ndarray | None) -> np.ndarray | None:
     return np.array([*(p[:3] + (r - p[3]) / d * (q[:3] - p[:3])), r])
 
 
-def reflected(balls: np.ndarray, u: np.ndarray, w: float) -> np.ndarray:
-    """(m, 4) balls reflected in the plane u·x = w."""
-    out = balls.copy()
-    out[:, :3] -= 2.0 * (balls[:, :3] @ u - w)[:, None] * u
+def reflected(balls: np.ndarray, u: np.ndarray, w: np.ndarray | float) -> np.ndarray:
+    """(..., m, 4) balls reflected in the planes u·x = w (u (..., 3), w (...)): one plane per
+    leading index."""
+    out, w = balls.copy(), np.asarray(w)
+    out[..., :3] -= (
+        2.0
+        * (np.einsum("...mk,...k->...m", balls[..., :3], u) - w[..., None])[..., None]
+        * u[..., None, :]
+    )
     return out
 
 
-def enclosing_balls(sets: list[np.ndarray]) -> np.ndarray:
-    """(len(sets), 4): per (m, 4) array of balls, a small ball holding them all. The centre:
-    CENTRE_STEPS Bădoiu–Clarkson steps from the box's centre, all sets at once (a set is padded
-    by repeating its last ball); the radius is exact for the best centre met."""
-    m = max(len(s) for s in sets)
-    balls = np.stack([np.vstack([s, np.repeat(s[-1:], m - len(s), axis=0)]) for s in sets])
-    lo = (balls[..., :3] - balls[..., 3:]).min(axis=1)
-    hi = (balls[..., :3] + balls[..., 3:]).max(axis=1)
+def enclosing_balls(balls: np.ndarray) -> np.ndarray:
+    """(s, 4): per set of (s, m, 4) ``balls``, a small ball holding all of its balls; a row
+    of radius −∞ is no ball (every set holds at least one). The centre: CENTRE_STEPS
+    Bădoiu–Clarkson steps from the box's centre, all sets at once; the radius is exact for
+    the best centre met."""
+    centres, radii = np.ascontiguousarray(balls[..., :3]), balls[..., 3]
+    lo = (centres - radii[..., None]).min(axis=1)
+    hi = (centres + radii[..., None]).max(axis=1)
     c = (lo + hi) / 2
-    best = np.full((len(sets), 4), np.inf)
-    rows = np.arange(len(sets))
+    best_c, best_r = c, np.full(len(balls), np.inf)
+    rows = np.arange(len(balls))
     for k in range(CENTRE_STEPS):
-        v = balls[..., :3] - c[:, None]
-        reach = np.sqrt(np.einsum("smk,smk->sm", v, v)) + balls[..., 3]
+        v = centres - c[:, None]
+        reach = np.sqrt(np.einsum("smk,smk->sm", v, v)) + radii
         far = reach.argmax(axis=1)
-        better = reach[rows, far] < best[:, 3]
-        best[better] = np.column_stack([c, reach[rows, far]])[better]
-        c = c + (balls[rows, far, :3] - c) / (k + 2)
-    return best
+        r = reach[rows, far]
+        better = r < best_r
+        best_c, best_r = np.where(better[:, None], c, best_c), np.where(better, r, best_r)
+        c = c + (centres[rows, far] - c) / (k + 2)
+    return np.column_stack([best_c, best_r])
 
 
 def held_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
@@ -100,10 +107,9 @@ def _held_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
     e = _Expansion(krs)
     held: list[np.ndarray | None] = [None] * (n + 1)
     for first in range(0, n + 1, EXACT_LEVELS + 1):
-        batch = range(first, min(n + 1, first + EXACT_LEVELS + 1))
-        sets = {i: e.balls(i, held) for i in batch if not e.plane[i]}
-        sets = {i: s for i, s in sets.items() if len(s)}
-        for i, ball in zip(sets, enclosing_balls(list(sets.values())) if sets else ()):
+        slots = np.arange(first, min(n + 1, first + EXACT_LEVELS + 1))
+        below = [held[i - EXACT_LEVELS - 1] if i > EXACT_LEVELS else None for i in slots]
+        for i, ball in e.enclosed(slots, below):
             ball.flags.writeable = False
             held[i] = ball
     return tuple(held)
@@ -114,39 +120,55 @@ def top_balls(krs: KRS) -> tuple[np.ndarray | None, ...]:
     (i down to i − EXACT_LEVELS, expanded as :func:`held_balls` expands them, without the
     ball of everything below): what the slot looks like at a glance, whatever the depth of
     the tree below it (compile/lod.py). None where those levels hold no bounded kernel."""
-    e = _Expansion(krs)
-    sets = {i: e.balls(i) for i in range(len(krs.mirrors)) if not e.plane[i]}
-    sets = {i: s for i, s in sets.items() if len(s)}
-    out: list[np.ndarray | None] = [None] * len(krs.mirrors)
-    for i, ball in zip(sets, enclosing_balls(list(sets.values())) if sets else ()):
+    n = len(krs.mirrors)
+    out: list[np.ndarray | None] = [None] * n
+    for i, ball in _Expansion(krs).enclosed(np.arange(n), [None] * n):
         out[i] = ball
     return tuple(out)
 
 
 class _Expansion:
-    """A KRS's kernel balls and mirrors, expanded a few levels down per slot."""
+    """A KRS's kernel balls and mirrors, expanded EXACT_LEVELS + 1 levels down per slot, many
+    slots at once: slot i expands levels i − EXACT_LEVELS .. i, each adding its kernel's ball
+    and then the mirror images of everything so far. A level that is not there (below level
+    0), a kernel without a ball and the images at level n (which has no mirror) are rows of
+    radius −∞, so every slot's rows line up."""
 
     def __init__(self, krs: KRS):
-        self.n = len(krs.mirrors)
-        self.kb = [kernel_ball(k) for k in krs.kernels]
+        n, pad = len(krs.mirrors), EXACT_LEVELS  # level j is row j + pad
+        kb = [kernel_ball(k) for k in krs.kernels]
         self.plane = np.cumsum(
-            [b is None and not isinstance(k, Empty) for b, k in zip(self.kb, krs.kernels)]
+            [b is None and not isinstance(k, Empty) for b, k in zip(kb, krs.kernels)]
         )
-        self.u = np.array([m.normal for m in krs.mirrors]).reshape(-1, 3)
-        self.w = np.array([m.offset for m in krs.mirrors])
+        self.kb = np.array([NO_BALL] * pad + [NO_BALL if b is None else b for b in kb])
+        self.u = np.zeros((pad + n + 1, 3))
+        self.w = np.zeros(pad + n + 1)
+        for j, m in enumerate(krs.mirrors):
+            self.u[pad + j], self.w[pad + j] = m.normal, m.offset
+        level = np.arange(pad + n + 1) - pad
+        self.mirrored = (level >= 0) & (level < n)
 
-    def balls(self, i: int, held: list | None = None) -> np.ndarray:
-        """(m, 4): slot i's kernel balls EXACT_LEVELS levels down, around the held ball of
-        the slot below those (``held``; None: without it); i = n adds the top kernel's."""
-        first = max(0, i - EXACT_LEVELS)
-        below = held[first - 1] if held is not None and first > 0 else None
-        balls = np.zeros((0, 4)) if below is None else below[None]
-        for j in range(first, min(i, self.n - 1) + 1):
-            if self.kb[j] is not None:
-                balls = np.vstack([self.kb[j][None], balls])
-            balls = np.vstack([balls, reflected(balls, self.u[j], self.w[j])])
-        kb = self.kb[self.n] if i == self.n else None
-        return balls if kb is None else np.vstack([kb[None], balls])
+    def balls(self, slots: np.ndarray, below: np.ndarray) -> np.ndarray:
+        """(len(slots), m, 4): each slot's kernel balls EXACT_LEVELS levels down, around
+        ``below`` (per slot, the held ball of the slot below those; NO_BALL: without it);
+        slot n adds the top kernel's."""
+        balls = below[:, None].copy()
+        for step in range(EXACT_LEVELS + 1):
+            row = slots + step  # level slots − EXACT_LEVELS + step
+            balls = np.concatenate([self.kb[row][:, None], balls], axis=1)
+            images = reflected(balls, self.u[row], self.w[row])
+            images[~self.mirrored[row], :, 3] = -np.inf
+            balls = np.concatenate([balls, images], axis=1)
+        return balls
+
+    def enclosed(self, slots: np.ndarray, below: list) -> list[tuple[int, np.ndarray]]:
+        """(slot, ball) for each of ``slots`` above every plane kernel whose expansion
+        (:meth:`balls`) holds a ball: the least ball found around it."""
+        bounded = self.plane[slots] == 0
+        below = np.array([NO_BALL if b is None else b for b in below]).reshape(-1, 4)
+        slots, balls = slots[bounded], self.balls(slots[bounded], below[bounded])
+        some = (balls[..., 3] > -np.inf).any(axis=1)
+        return list(zip(slots[some].tolist(), enclosing_balls(balls[some])))
 
 
 def krs_ball(krs: KRS) -> np.ndarray | None:

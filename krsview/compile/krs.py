@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from ..algebra.vectors import cross
-from ..scene import KRS, Arc, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arc_of
+from ..scene import KRS, Arc, Capsule, Empty, Plane, Sphere, ToroidalCapsule, arcs_of
 from .balls import UNBOUNDED, grown, krs_ball, krs_bounds, union_ball
 from .lod import lod_cut
 
@@ -92,6 +92,9 @@ def kernel_records(
     """One record per kernel (layout above) and each kernel's drawn type."""
     records = np.zeros((len(kernels), RECORD_VEC4, 4))
     types = []
+    at = [i for i, k in enumerate(kernels) if isinstance(k, ToroidalCapsule)]
+    arcs = {i: arc for i, arc in zip(at, arcs_of([kernels[i] for i in at])) if arc is not None}
+    quaternions = dict(zip(arcs, arc_quaternions(list(arcs.values())))) if arcs else {}
     for i, k in enumerate(kernels):
         kind = k.kind
         r = records[i]
@@ -102,14 +105,14 @@ def kernel_records(
             r[1] = [*k.a, k.radius]
             r[2, :3] = k.b
         elif isinstance(k, ToroidalCapsule):
-            arc = arc_of(k)
+            arc = arcs.get(i)
             if arc is None:
                 kind = "capsule"
                 r[1] = [*k.start, k.radius]
                 r[2, :3] = k.end
             else:
                 r[1] = [*arc.center, k.radius]
-                r[2] = arc_quaternion(arc)
+                r[2] = quaternions[i]
                 r[3, 0] = np.tan(arc.phi / 4.0)
         elif isinstance(k, Plane):
             r[1] = [*k.normal, k.offset]
@@ -120,27 +123,30 @@ def kernel_records(
     return records, tuple(types)
 
 
-def arc_quaternion(arc: Arc) -> np.ndarray:
-    """P of the arc's record (layout above): the unit quaternion of the rotation whose columns
-    are the bisector e1, e2 and n, divided by √R (Shepperd's choice of the largest term, so
-    no square root of a small difference)."""
-    half = arc.phi / 2.0
-    e1, e2 = np.array(arc.e1), np.array(arc.e2)
-    F = np.stack([np.cos(half) * e1 + np.sin(half) * e2, -np.sin(half) * e1 + np.cos(half) * e2])
-    F = np.stack([F[0], F[1], cross(F[0], F[1])], axis=1)  # columns e1, e2, n
-    trace = np.trace(F)
-    k = int(np.argmax([trace, *np.diag(F)]))
-    if k == 0:
-        q = [1.0 + trace, F[2, 1] - F[1, 2], F[0, 2] - F[2, 0], F[1, 0] - F[0, 1]]
-    else:
-        a, b, c = k - 1, k % 3, (k + 1) % 3
-        q = np.zeros(4)
-        q[0] = F[c, b] - F[b, c]
-        q[1 + a] = 1.0 + 2.0 * F[a, a] - trace
-        q[1 + b] = F[b, a] + F[a, b]
-        q[1 + c] = F[c, a] + F[a, c]
-    q = np.asarray(q, dtype=np.float64)
-    return q / (np.linalg.norm(q) * np.sqrt(arc.R))
+def arc_quaternions(arcs: list[Arc]) -> np.ndarray:
+    """(len(arcs), 4): P of each arc's record (layout above), the unit quaternion of the
+    rotation whose columns are the bisector e1, e2 and n, divided by √R; of the four ways to
+    read it from the matrix F, Shepperd's takes the one with the largest term (of 1 + trace and
+    1 + 2 F_aa − trace), so no square root of a small difference."""
+    half = np.array([arc.phi for arc in arcs])[:, None] / 2.0
+    e1, e2 = np.array([arc.e1 for arc in arcs]), np.array([arc.e2 for arc in arcs])
+    b1 = np.cos(half) * e1 + np.sin(half) * e2
+    b2 = -np.sin(half) * e1 + np.cos(half) * e2
+    F = np.stack([b1, b2, cross(b1, b2)], axis=-1)  # columns e1, e2, n
+    (f00, f01, f02), (f10, f11, f12), (f20, f21, f22) = F.transpose(1, 2, 0)
+    trace = f00 + f11 + f22
+    ways = np.stack(
+        [
+            [1.0 + trace, f21 - f12, f02 - f20, f10 - f01],
+            [f21 - f12, 1.0 + 2.0 * f00 - trace, f10 + f01, f20 + f02],
+            [f02 - f20, f01 + f10, 1.0 + 2.0 * f11 - trace, f21 + f12],
+            [f10 - f01, f02 + f20, f12 + f21, 1.0 + 2.0 * f22 - trace],
+        ]
+    )  # (way, component, arc)
+    way = np.argmax(np.stack([trace, f00, f11, f22]), axis=0)
+    q = ways[way, :, np.arange(len(arcs))]
+    R = np.array([arc.R for arc in arcs])
+    return q / (np.linalg.norm(q, axis=-1) * np.sqrt(R))[:, None]
 
 
 @dataclass(frozen=True)

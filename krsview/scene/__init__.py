@@ -16,6 +16,7 @@ from .model import (
     Sphere,
     ToroidalCapsule,
     arc_of,
+    arcs_of,
 )
 from .mokrs import Invert, MobiusLevel, MobiusStep, MoKRS, Rotate, Scale, Translate
 from .render import TRACERS, Camera, Light, Material, Render
@@ -61,6 +62,7 @@ __all__ = [
     "RouteLevel",
     "Tree",
     "arc_of",
+    "arcs_of",
     "load_scene",
     "save_scene",
     "scene_from_toml",

@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..algebra.vectors import cross
+from ..algebra.vectors import cross, dot
 from ..messages import SceneError
 from .schema import COLOR, Tagged, Vec3, cached, param, to_dict
 
@@ -232,27 +232,42 @@ class Arc:
     phi: float
 
 
+PASSES = ("start", "control", "end")  # the three points an arc passes through
+
+
 def arc_of(k: ToroidalCapsule) -> Arc | None:
     """The arc through start, control, end; None when nearly straight (draw as a capsule).
     Made once per kernel (kernels are frozen)."""
-    return cached(k, "_arc", lambda: _arc(k))
+    return arcs_of([k])[0]
 
 
-def _arc(k: ToroidalCapsule) -> Arc | None:
-    A, C, B = (np.array(p, dtype=float) for p in (k.start, k.control, k.end))
+def arcs_of(kernels: list[ToroidalCapsule]) -> list[Arc | None]:
+    """:func:`arc_of` of each kernel, those not made before made together (a posed tree's
+    arcs all at once: one NumPy step per operation, not one per kernel)."""
+    new = [k for k in kernels if "_arc" not in k.__dict__]
+    for k, arc in zip(new, _arcs(new) if new else ()):
+        cached(k, "_arc", lambda arc=arc: arc)
+    return [k.__dict__["_arc"] for k in kernels]
+
+
+def _arcs(kernels: list[ToroidalCapsule]) -> list[Arc | None]:
+    A, C, B = (np.array([getattr(k, p) for k in kernels], dtype=float) for p in PASSES)
     a, b = A - C, B - C
     axb = cross(a, b)
-    chord = float(np.linalg.norm(B - A))
-    denom = 2.0 * float(axb @ axb)
-    if denom <= 0.0:
-        return None
-    O = C + cross(a @ a * b - b @ b * a, axb) / denom
-    R = float(np.linalg.norm(A - O))
-    if not np.isfinite(R) or STRAIGHT_RATIO * chord < R:
-        return None
-    N = cross(C - A, B - C)
-    N /= np.linalg.norm(N)
-    e1 = (A - O) / R
-    e2 = cross(N, e1)
-    phi = math.atan2(float((B - O) @ e2), float((B - O) @ e1)) % (2 * math.pi)
-    return Arc(tuple(O), tuple(e1), tuple(e2), R, phi)  # type: ignore[arg-type]
+    chord = np.linalg.norm(B - A, axis=-1)
+    denom = 2.0 * dot(axb, axb)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        O = C + cross(dot(a, a)[:, None] * b - dot(b, b)[:, None] * a, axb) / denom[:, None]
+        R = np.linalg.norm(A - O, axis=-1)
+        N = cross(C - A, B - C)
+        N /= np.linalg.norm(N, axis=-1)[:, None]
+        e1 = (A - O) / R[:, None]
+        e2 = cross(N, e1)
+        phi = np.arctan2(dot(B - O, e2), dot(B - O, e1)) % (2 * math.pi)
+    drawn = (denom > 0.0) & np.isfinite(R) & (STRAIGHT_RATIO * chord >= R)
+    return [
+        Arc(tuple(O[i]), tuple(e1[i]), tuple(e2[i]), float(R[i]), float(phi[i]))  # type: ignore[arg-type]
+        if drawn[i]
+        else None
+        for i in range(len(kernels))
+    ]
