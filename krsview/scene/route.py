@@ -30,9 +30,10 @@ from .model import (
     Mirror,
     ToroidalCapsule,
     arc_of,
+    arcs_of,
     check_mirror_per_level,
 )
-from .schema import COLOR, Vec3, param
+from .schema import COLOR, Vec3, cached, param
 
 FORK_SEPARATION = 1e-9  # forks closer than this × the route's size are "on top of each other"
 CLIP_TOLERANCE = 0.5  # × a child's radius: a shallower crossing stays inside the fork joint
@@ -149,8 +150,23 @@ class Route:
         return Mirror(lv.normal, float(u @ np.array(lv.fork)))  # type: ignore[arg-type]
 
     def kernel(self, i: int) -> ToroidalCapsule:
-        lv = self.levels[i]
-        return ToroidalCapsule(self.starts()[i], lv.control, lv.fork, lv.radius, lv.color)
+        return self.kernels()[i]
+
+    def kernels(self) -> tuple[ToroidalCapsule, ...]:
+        """Each level's branch, from its start through its control point to its fork; made
+        once per route (frozen), their arcs together (the route's checks, its clipping and
+        its KRS ask for them level by level)."""
+
+        def make():
+            starts = self.starts()
+            out = tuple(
+                ToroidalCapsule(start, lv.control, lv.fork, lv.radius, lv.color)
+                for start, lv in zip(starts, self.levels)
+            )
+            arcs_of(list(out))
+            return out
+
+        return cached(self, "_kernels", make)
 
     def krs(self) -> KRS:
         """Level i: kernel K_i (the branch ending at P_i) and, for i ≥ 1, mirror R_{i−1}."""
