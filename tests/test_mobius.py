@@ -237,3 +237,35 @@ def test_the_real_matrix_is_the_four_left_multiplication_blocks():
         assert np.array_equal(M.real_matrix(H), np.block(blocks))
         swapped = np.block([blocks[0][::-1], blocks[1]])
         assert not np.array_equal(M.real_matrix(H), swapped)
+
+
+def test_a_stack_of_matrices_has_each_ones_real_matrix_and_condition():
+    """real_matrix and conditions over a stack (a pose's levels at once) are those of each
+    matrix alone; a singular one in the stack is ∞ there and nowhere else."""
+    rng = np.random.default_rng(11)
+    H = np.stack([random_transform(rng) for _ in range(6)] + [M.matrix(*[M.ONE] * 4)])
+    assert np.array_equal(M.real_matrix(H), np.stack([M.real_matrix(h) for h in H]))
+    got = M.conditions(H)
+    alone = [M.condition(h) for h in H]
+    assert np.array_equal(got[:-1], alone[:-1]) and np.isfinite(got[:-1]).all()
+    assert got[-1] > 1e15 and alone[-1] > 1e15
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds, st.sampled_from([(), (1,), (2,), (16,), (17,), (300,)]))
+def test_the_hamilton_product_is_the_left_matrix_times_q_for_one_or_many(seed, shape):
+    """Q.mul, by p's left matrix for a few quaternions and by component for many, against
+    quaternion.left_matrix (written out from the Hamilton table) one pair at a time; each
+    factor alone or broadcast. Negative control: the product the other way round, qp."""
+    rng = np.random.default_rng(seed)
+    p, q = rng.normal(size=(*shape, 4)), rng.normal(size=(*shape, 4))
+    one = rng.normal(size=4)
+    for a, b in ((p, q), (one, q), (p, one)):
+        got = Q.mul(a, b)
+        A, B = np.broadcast_to(a, got.shape), np.broadcast_to(b, got.shape)
+        want = np.array([Q.left_matrix(x) @ y for x, y in zip(A.reshape(-1, 4), B.reshape(-1, 4))])
+        assert np.allclose(got.reshape(-1, 4), want, rtol=0, atol=1e-12)
+        flipped = np.array(
+            [Q.left_matrix(y) @ x for x, y in zip(A.reshape(-1, 4), B.reshape(-1, 4))]
+        )
+        assert not np.allclose(got.reshape(-1, 4), flipped, rtol=0, atol=1e-6)

@@ -67,24 +67,25 @@ def compose(*Hs: np.ndarray) -> np.ndarray:
     return out
 
 
-# The 4 × 4 real matrix of q ↦ h q (quaternion.left_matrix) as a sign pattern over a
-# permutation of h's components: L[i, j] = SIGN[i, j] · h[PERM[i, j]].
-_PERM = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
-_SIGN = np.array([[1.0, -1, -1, -1], [1, 1, -1, 1], [1, 1, 1, -1], [1, -1, 1, 1]])
-
-
 def real_matrix(H: np.ndarray) -> np.ndarray:
-    """H as the real 8×8 matrix of the left-linear map (q1, q2) ↦ (a q1 + b q2, c q1 + d q2):
-    the four blocks quaternion.left_matrix(H[r, k]), built at once (a drag or a playing frame
-    asks it of every level)."""
-    return (_SIGN * H[:, :, _PERM]).transpose(0, 2, 1, 3).reshape(8, 8)
+    """H (..., 2, 2, 4) as the real 8×8 matrix of the left-linear map (q1, q2) ↦ (a q1 + b q2,
+    c q1 + d q2): the four blocks quaternion.left_matrix(H[r, k]), built at once (a drag or a
+    playing frame asks it of every level)."""
+    blocks = Q.left_matrices(np.asarray(H))  # (..., r, k, 4, 4)
+    return np.swapaxes(blocks, -3, -2).reshape(*np.shape(H)[:-3], 8, 8)
+
+
+def conditions(H: np.ndarray) -> np.ndarray:
+    """Condition numbers of matrices H (..., 2, 2, 4), ∞ where singular: how much rounding
+    each inverse amplifies."""
+    with np.errstate(all="ignore"):
+        c = np.linalg.cond(real_matrix(H))
+    return np.where(np.isfinite(c), c, np.inf)
 
 
 def condition(H: np.ndarray) -> float:
-    """Condition number of H (∞ when singular): how much rounding its inverse amplifies."""
-    with np.errstate(all="ignore"):
-        c = np.linalg.cond(real_matrix(H))
-    return float(c) if np.isfinite(c) else float("inf")
+    """Condition number of one H (:func:`conditions`)."""
+    return float(conditions(H))
 
 
 def inverse(H: np.ndarray) -> np.ndarray:

