@@ -14,7 +14,7 @@ import numpy as np
 
 from ..algebra.vectors import cross, dot
 from ..messages import SceneError
-from .schema import COLOR, Tagged, Vec3, cached, param, to_dict
+from .schema import COLOR, Tagged, Vec3, cached_each, param, to_dict
 
 MAX_LEVELS = 64  # kernels K_0..K_63, mirrors R_0..R_62; sized for the shader's uniform block
 
@@ -244,10 +244,7 @@ def arc_of(k: ToroidalCapsule) -> Arc | None:
 def arcs_of(kernels: list[ToroidalCapsule]) -> list[Arc | None]:
     """:func:`arc_of` of each kernel, those not made before made together (a posed tree's
     arcs all at once: one NumPy step per operation, not one per kernel)."""
-    new = [k for k in kernels if "_arc" not in k.__dict__]
-    for k, arc in zip(new, _arcs(new) if new else ()):
-        cached(k, "_arc", lambda arc=arc: arc)
-    return [k.__dict__["_arc"] for k in kernels]
+    return cached_each(kernels, "_arc", _arcs)
 
 
 def _arcs(kernels: list[ToroidalCapsule]) -> list[Arc | None]:

@@ -26,7 +26,7 @@ from ..algebra import mobius
 from ..algebra.vectors import cross
 from ..messages import SceneError
 from .model import Empty, Kernel, Plane, Sphere, check_level_count
-from .schema import Tagged, Vec3, cached, param
+from .schema import Tagged, Vec3, cached, cached_each, param
 
 SINGULAR_CONDITION = 1e12  # a composed transformation this ill-conditioned is rejected
 
@@ -149,13 +149,12 @@ class MoKRS:
     def validate(self, path: str) -> None:
         p = f"{path}.levels"
         check_level_count(self.levels, p, "a MöKRS needs at least one level")
-        new = [lv for lv in self.levels if "_condition" not in lv.__dict__]
-        if new:  # kept per level (frozen), those of a new pose found at once
-            found = mobius.conditions(np.array([lv.matrix() for lv in new]))
-            for lv, cond in zip(new, found.tolist()):
-                cached(lv, "_condition", lambda cond=cond: cond)
-        for i, lv in enumerate(self.levels):
-            cond = lv.__dict__["_condition"]
+        found = cached_each(  # kept per level (frozen); a new pose's found at once
+            self.levels,
+            "_condition",
+            lambda new: mobius.conditions(np.array([lv.matrix() for lv in new])).tolist(),
+        )
+        for i, cond in enumerate(found):
             if not cond <= SINGULAR_CONDITION:
                 raise SceneError(
                     f"{p}[{i}].transform",

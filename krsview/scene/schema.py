@@ -34,6 +34,16 @@ def cached(obj: Any, name: str, make: Any) -> Any:
     return obj.__dict__[name]
 
 
+def cached_each(objs: list, name: str, make: Any) -> list:
+    """:func:`cached` for each of ``objs``: those without a kept value get theirs from one
+    call ``make(those)`` (a list in their order), so a new pose's arcs or condition numbers
+    are found in one NumPy pass, not one per object."""
+    new = [obj for obj in objs if name not in obj.__dict__]
+    for obj, value in zip(new, make(new) if new else ()):
+        cached(obj, name, lambda value=value: value)
+    return [obj.__dict__[name] for obj in objs]
+
+
 def param(
     default: Any = MISSING,
     *,
