@@ -3,7 +3,7 @@ finite pixels inside the cap; random broken files and arguments always end in th
 one-line error, never a traceback or a hang.
 
 CI runs a bounded, seeded slice; `KRSVIEW_FUZZ=full pytest -m fuzz` runs the full campaign
-(2000 scene files, 250 command lines) and prints the counts."""
+(2000 scene files, 250 command lines); each test prints what it covered."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from krsview.cli import main
@@ -27,9 +27,7 @@ FULL = os.environ.get("KRSVIEW_FUZZ") == "full"
 SCENE_FILES = 2000 if FULL else 150
 VALID_SCENES = 300 if FULL else 25
 COMMAND_LINES = 250 if FULL else 40
-# one worker runs the whole module in order, so the report at its end sees every count
-pytestmark = [pytest.mark.fuzz, pytest.mark.xdist_group("fuzz")]
-COUNTS: dict[str, int] = {}
+pytestmark = pytest.mark.fuzz
 
 
 def fuzz_settings(n: int):
@@ -40,6 +38,14 @@ def fuzz_settings(n: int):
         database=None,
         suppress_health_check=list(HealthCheck),
     )
+
+
+def report(capsys, what: str, counts: dict) -> None:
+    """Prints what one test's campaign covered, also when the test passes. Each test reports
+    its own counts: a report test at the module's end relied on running after the others in
+    the same process, which a parallel run does not promise."""
+    with capsys.disabled():
+        print(f"\nfuzz, {what}:", ", ".join(f"{k}: {v}" for k, v in counts.items()))
 
 
 # ----------------------------------------------------------------------- valid scenes
@@ -96,16 +102,28 @@ def valid_scene(draw) -> dict:
     }
 
 
-def test_random_valid_scenes_render_finite_within_the_cap(renderer):
+def one_sphere(z: float) -> dict:
+    """A scene of one sphere on the view axis: in front of the camera (z > 0) or behind it."""
+    return {
+        "camera": {"position": [0.0, 0.0, 0.0], "target": [0.0, 0.0, 1.0], "up": [0.0, 1.0, 0.0]},
+        "krs": {"levels": [{"kernel": {"type": "sphere", "center": [0.0, 0.0, z], "radius": 1.0}}]},
+    }
+
+
+def test_random_valid_scenes_render_finite_within_the_cap(renderer, capsys):
     rendered = []
+    refused = 0
 
     @fuzz_settings(VALID_SCENES)
     @given(valid_scene())
+    @example(one_sphere(4.0))  # fills the view, and a scene showing nothing: the random ones
+    @example(one_sphere(-4.0))  # may all land on one side, so both are always among them
     def run(doc):
         try:
             scene = scene_from_toml(dumps(doc))
         except SceneError:  # e.g. the camera's up along the view: refused, not drawn
-            COUNTS["valid scenes refused"] = COUNTS.get("valid scenes refused", 0) + 1
+            nonlocal refused
+            refused += 1
             return
         b = renderer.render(scene, 12, 8)
         for name in ("color", "depth", "normal"):
@@ -114,7 +132,7 @@ def test_random_valid_scenes_render_finite_within_the_cap(renderer):
         rendered.append(b.hit.mean())
 
     run()
-    COUNTS["valid scenes rendered"] = len(rendered)
+    report(capsys, "valid scenes", {"rendered": len(rendered), "refused": refused})
     assert len(rendered) >= 0.8 * VALID_SCENES  # not vacuous: most were drawn
     assert 0 < np.mean([h > 0 for h in rendered]) < 1  # and some show geometry, some not
 
@@ -184,7 +202,7 @@ def broken_file(draw) -> bytes:
     return (out if out is not None else repr(doc)).encode()
 
 
-def test_random_broken_scene_files_give_one_clear_line(tmp_path):
+def test_random_broken_scene_files_give_one_clear_line(tmp_path, capsys):
     outcomes = {"refused": 0, "accepted": 0}
 
     @fuzz_settings(SCENE_FILES)
@@ -201,7 +219,7 @@ def test_random_broken_scene_files_give_one_clear_line(tmp_path):
             outcomes["refused"] += 1
 
     run()
-    COUNTS.update({f"scene files {k}": v for k, v in outcomes.items()})
+    report(capsys, "scene files", outcomes)
     assert outcomes["refused"] >= 0.5 * SCENE_FILES
 
 
@@ -239,7 +257,7 @@ def command_line(draw, out: str) -> list[str]:
     return [a for a in argv if a != ""]
 
 
-def test_random_command_lines_end_in_an_exit_code_not_a_traceback(tmp_path):
+def test_random_command_lines_end_in_an_exit_code_not_a_traceback(tmp_path, capsys):
     codes: dict[int, int] = {}
 
     @fuzz_settings(COMMAND_LINES)
@@ -262,12 +280,5 @@ def test_random_command_lines_end_in_an_exit_code_not_a_traceback(tmp_path):
         codes[code] = codes.get(code, 0) + 1
 
     run()
-    COUNTS.update({f"command lines exit {k}": v for k, v in sorted(codes.items())})
+    report(capsys, "command lines", {f"exit {k}": v for k, v in sorted(codes.items())})
     assert codes.get(0, 0) > 0 and sum(v for k, v in codes.items() if k) > 0
-
-
-def test_zz_report_counts(capsys):
-    """Prints what the campaign covered (run last in this module)."""
-    with capsys.disabled():
-        print("\nfuzz counts:", ", ".join(f"{k}: {v}" for k, v in COUNTS.items()))
-    assert COUNTS
