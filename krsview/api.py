@@ -36,7 +36,7 @@ from .scene.info import SceneInfo, describe
 from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
 from .scene.scene import scene_from_toml, write_atomic
-from .scene.schema import from_dict
+from .scene.schema import COORDINATE_LIMIT, from_dict
 from .scene.settings import MAX_SIDE
 from .scene.speed import exact_settings, fast_settings, fast_tile
 
@@ -300,10 +300,11 @@ def render(
 
 
 def distance(scene: Scene | str | Path, points: Any) -> np.ndarray:
-    """Alg. 1's distance from each of ``points`` (an array (..., 3), world units) to the
-    surface the scene draws at its time, in float64 by the NumPy reference [KRS17 Alg. 1]: a
-    lower bound of the true distance (equal to it where no mirror clips a kernel), negative
-    inside a kernel; the shape of ``points`` less its last axis. A MöKRS has no distance
+    """Alg. 1's distance from each of ``points`` (an array (..., 3), world units within the
+    scene's coordinate limit, ±1e9) to the surface the scene draws at its time, in float64
+    by the NumPy reference [KRS17 Alg. 1]: a lower bound of the true distance (equal to it
+    where no mirror clips a kernel), negative inside a kernel; the shape of ``points`` less
+    its last axis. A MöKRS has no distance
     function [KRS17 §6] and is refused. (A ray's hit from the eye: :func:`render`'s
     ``depth``.)
 
@@ -323,9 +324,14 @@ def distance(scene: Scene | str | Path, points: Any) -> np.ndarray:
         p = np.asarray(points, dtype=float)
     except (ValueError, TypeError):
         p = np.full((), np.nan)
-    if p.ndim == 0 or p.shape[-1] != 3 or not np.isfinite(p).all():
+    if p.ndim == 0 or p.shape[-1] != 3 or not (np.abs(p) <= COORDINATE_LIMIT).all():
         shown = f"<an array of shape {p.shape}>" if p.ndim else p
-        raise SceneError("points", shown, "expected finite points, an array of shape (..., 3)")
+        raise SceneError(
+            "points",
+            shown,
+            f"expected points of coordinates within ±{COORDINATE_LIMIT:g} (the scene's own "
+            "limit), an array of shape (..., 3)",
+        )
     c = compile_geometry(scene.geometry(), scene.material.albedo)
     d = scene_distance(c, p.reshape(-1, 3), Distortion.of(scene))
     return d.reshape(p.shape[:-1])

@@ -43,42 +43,31 @@ class Frame:
         return Image.fromarray(self.rgb8(), "RGB")
 
     def save(self, path: str | Path) -> Path:
-        """Write the colour (``.png``, or any format Pillow knows by the suffix) or every
-        array (``.npz``), whole or not at all (a temporary file beside it, renamed); returns
-        the path. A suffix neither knows, a folder, or a place under a file is refused in
-        one line (SceneError, a ValueError) before anything is written; a write that fails
-        (a disk full) is an OSError naming ``path``, and leaves nothing behind."""
-        from PIL import Image
-
+        """Write the colour (``.png``, or any format Pillow writes by the suffix) or every
+        array (``.npz``), whole or not at all (the file's bytes are made in memory first, then
+        written to a temporary file beside it and renamed); returns the path. A suffix
+        neither writes (Pillow reads some formats it cannot write, or not in colour), a
+        folder, a name the system refuses, or a place under a file is refused in one line
+        (SceneError, a ValueError) before anything is written; a write that fails (a disk
+        full) is an OSError naming ``path``, and leaves nothing behind."""
         if not isinstance(path, (str, Path)) or str(path) == "":
             raise SceneError("path", path, "expected a file's path")
+        if "\0" in str(path):
+            raise SceneError("path", repr(str(path)), "a file name cannot hold a NUL character")
         path = Path(path)
-        suffix = path.suffix.lower()
-        if suffix != ".npz" and suffix not in Image.registered_extensions():
-            raise SceneError(
-                "path",
-                str(path),
-                "the file must end in .png, .npz or another image format's suffix (.jpg, "
-                ".tif, .webp, …)",
-            )
-        if path.is_dir():
+        data = self._encoded(path)
+        try:
+            is_dir = path.is_dir()
+        except OSError as e:  # a name too long, say
+            raise SceneError("path", str(path), f"refused by the system: {e.strerror}") from None
+        if is_dir:
             raise SceneError("path", str(path), "is a folder; give a file name")
         if why := under_a_file(path.parent):
             raise SceneError("path", str(path), why)
-        tmp = path.with_name(f".{path.name}.tmp{suffix}")
+        tmp = path.with_name(f".{path.name}.tmp")
         try:
             path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do
-            if suffix == ".npz":
-                np.savez_compressed(
-                    tmp,
-                    color=self.color,
-                    depth=self.depth,
-                    normal=self.normal,
-                    iterations=self.iterations,
-                    hit=self.hit,
-                )
-            else:
-                self.image().save(tmp)
+            tmp.write_bytes(data)
             os.replace(tmp, path)
         except OSError as e:  # a disk full, a place not writable: said of the file asked for
             raise OSError(e.errno, e.strerror, str(path)) from None
@@ -86,6 +75,34 @@ class Frame:
             with contextlib.suppress(OSError):  # under a file, say: nothing was made
                 tmp.unlink(missing_ok=True)
         return path
+
+    def _encoded(self, path: Path) -> bytes:
+        """The bytes :meth:`save` writes for ``path``'s suffix, or a SceneError."""
+        from PIL import Image
+
+        suffix = path.suffix.lower()
+        out = io.BytesIO()
+        if suffix == ".npz":
+            np.savez_compressed(out, **{n: getattr(self, n) for n in self.__dataclass_fields__})
+            return out.getvalue()
+        kind = Image.registered_extensions().get(suffix)
+        allowed = "allowed: .png, .npz or another format Pillow writes in colour (.jpg, .tif, …)"
+        if kind not in Image.SAVE:
+            raise SceneError(
+                "path",
+                str(path),
+                f"Pillow writes no {suffix or 'file without a suffix'}; {allowed}",
+            )
+        try:
+            self.image().save(out, format=kind)
+        except (OSError, ValueError, KeyError) as e:  # e.g. a format of one bit per pixel
+            said = str(e).strip() or type(e).__name__
+            raise SceneError(
+                "path",
+                str(path),
+                f"Pillow cannot write a colour image as {suffix} ({said}); {allowed}",
+            ) from None
+        return out.getvalue()
 
     @classmethod
     def load(cls, path: str | Path) -> Frame:

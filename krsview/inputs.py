@@ -19,6 +19,7 @@ from .scene import Scene, SceneError
 from .scene.edits import checked
 from .scene.presets import resolve
 from .scene.scene import load_scene
+from .scene.schema import COORDINATE_LIMIT
 from .scene.settings import MAX_SIDE
 
 
@@ -64,13 +65,17 @@ def real(value: Any, what: str, lo: float, hi: float) -> float:
 
 
 def region(box: Any, what: str) -> tuple[float, ...]:
-    """(XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX): six finite numbers, each max above its min."""
-    allowed = "expected six finite numbers (XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX)"
+    """(XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX): six numbers within the scene's coordinate limit,
+    each max above its min."""
+    allowed = (
+        f"expected six numbers within ±{COORDINATE_LIMIT:g} (XMIN, YMIN, ZMIN, XMAX, YMAX, ZMAX)"
+    )
     if isinstance(box, (str, bytes)) or not isinstance(box, Iterable):
         raise SceneError(what, box, allowed)
     values = tuple(box)
     if len(values) != 6 or not all(
-        isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) for v in values
+        isinstance(v, numbers.Real) and not isinstance(v, bool) and abs(v) <= COORDINATE_LIMIT
+        for v in values
     ):
         raise SceneError(what, values, allowed)
     if not all(values[k + 3] > values[k] for k in range(3)):

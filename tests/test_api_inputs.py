@@ -161,7 +161,7 @@ def test_numpy_values_are_numbers():
         (lambda: krsview.Renderer(16, 9).render("nope"), "'nope': not a file and not a preset"),
         (lambda: krsview.Renderer(16, 9).time("rock", 0), "repeats = 0: allowed"),
         (lambda: krsview.distance("palm", [0, 0, 0]), "a MöKRS has no distance function"),
-        (lambda: krsview.distance("rock", [0, 0]), "expected finite points"),
+        (lambda: krsview.distance("rock", [0, 0]), "expected points of coordinates within ±1e+09"),
         (
             lambda: krsview.load("tree").edit("route.levels[3].fork", (0, 1, 0)),
             "this scene has no [route] table",
@@ -211,9 +211,22 @@ def test_files_are_checked_before_any_work(tmp_path):
         assert said in one_line(e)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file", "frames"], "nothing written"
     frame = krsview.render("rock", SIZE)
-    with pytest.raises(krsview.SceneError, match=r"must end in \.png, \.npz"):  # [review]
-        frame.save(tmp_path / "x.foo")
+    # a suffix Pillow does not know, one it reads but cannot write (FITS), one it writes
+    # only in one bit per pixel (XBM): each refused before a byte is written (the last two
+    # were raw KeyError and OSError half-way through the save)
+    for suffix, said in (
+        (".foo", "writes no .foo"),
+        (".fits", "writes no .fits"),
+        (".xbm", "mode RGB"),
+    ):
+        with pytest.raises(krsview.SceneError) as e:
+            frame.save(tmp_path / f"x{suffix}")
+        assert said in one_line(e) and "allowed: .png, .npz" in one_line(e), suffix
+    with pytest.raises(krsview.SceneError, match="cannot hold a NUL"):
+        frame.save(str(tmp_path / "x\0.png"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file", "frames"], "nothing written"
     png = frame.save(tmp_path / "x.png")  # control
+    assert frame.save(tmp_path / "x.tif").exists()  # control: another format, in colour
     # a folder, a place under a file, a place that cannot be written: one line, as the
     # API's other writers say (these were raw OSErrors), and no file left half written
     (tmp_path / "d.png").mkdir()
@@ -303,9 +316,20 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
         (lambda: krsview.load("rock").edit("krs.levels[0.kernel", 1), "expected names and"),
         (lambda: krsview.load("rock").edit(None, 1), "path = None: expected a path"),
         (lambda: krsview.render("rock", SIZE, progress=3), "progress = 3: expected a function"),
-        (lambda: krsview.distance("rock", ["a", "b", "c"]), "expected finite points"),
-        (lambda: krsview.distance("rock", [[1, 2, 3], [1, 2]]), "expected finite points"),
-        (lambda: krsview.distance("rock", [1j, 0, 0]), "expected finite points"),
+        (
+            lambda: krsview.distance("rock", ["a", "b", "c"]),
+            "expected points of coordinates within ±1e+09",
+        ),
+        (
+            lambda: krsview.distance("rock", [[1, 2, 3], [1, 2]]),
+            "expected points of coordinates within ±1e+09",
+        ),
+        (
+            lambda: krsview.distance("rock", [1j, 0, 0]),
+            "expected points of coordinates within ±1e+09",
+        ),
+        # far beyond the scene's own limit the distance overflowed to NaN or ∞ [review]
+        (lambda: krsview.distance("tree-wind", [1e155, 1, 0]), "within ±1e+09"),
         (lambda: krsview.load(""), "name_or_path = '': expected"),
     ]
     for call, said in refusals:

@@ -322,3 +322,30 @@ def test_a_ground_planes_texture_has_no_streaks():
         for k in (0, 2)
     ]
     assert max(old) / min(old) > 4.0, old
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the control's overflow in NumPy too
+def test_the_finest_texture_and_the_slowest_gust_allowed_draw_as_the_reference(renderer):
+    """The floors of texture_scale and wind_frequency (scene/effects.py's SHORTEST and
+    SLOWEST_GUST; wind_height shares the first) draw what the float64 reference draws, and a
+    value below each is refused in one line. Negative control: past the schema, at 1e-39
+    the GPU's float32 1/x overflows, the texture turns black and the sway's phase infinite,
+    and the frames leave the reference (the images the floors were set against)."""
+    from krsview.scene import SceneError
+    from krsview.scene.effects import SHORTEST, SLOWEST_GUST
+
+    rock, wind = load_scene(resolve("rock")), load_scene(resolve("tree-wind"))
+    cases = {"texture_scale": (rock, 0.0), "wind_frequency": (wind, 2.5)}
+    for field, (scene, t) in cases.items():
+        floor = SHORTEST if field == "texture_scale" else SLOWEST_GUST
+        with pytest.raises(SceneError, match=rf"effect_settings\.{field} = 1e-39: allowed"):
+            scene.edit(f"effect_settings.{field}", 1e-39)
+        for value, agrees in ((floor, True), (1e-39, False)):
+            settings = replace(scene.effect_settings, **{field: value})  # past the schema
+            s = per_pixel(
+                replace(scene, effect_settings=settings, render=replace(scene.render, lod=0.0))
+            )
+            s = s.at(t)
+            gpu, ref = renderer.render(s, 48, 27), render_reference(s, 48, 27)
+            apart = (np.abs(gpu.color - ref.color).max(-1) > 8 / 255).mean()
+            assert (apart < 0.02) == agrees, (field, value, apart)

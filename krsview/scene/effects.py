@@ -83,6 +83,11 @@ EFFECTS: dict[str, Effect] = {e.name: replace(e, bit=1 << k) for k, e in enumera
 EXCLUSIVE = [("shadows", "soft_shadows"), ("twist", "wind")]  # pairs a scene may not list together
 MAX_EMPTY_ZONES = 8
 MIN_HORIZONTAL = 1e-3  # the least horizontal part of wind_direction (sine of its tilt)
+# The shortest texture cell and wind height, and the slowest gust (Hz): the GPU divides by
+# them in float32, so far below these 1/x overflows (from about 3e-39) and the image is
+# wrong (a black texture, a sway of infinite phase) where the float64 reference is right.
+SHORTEST = 1e-6
+SLOWEST_GUST = 1e-6
 # Gusts: n(t) = Σ w_k sin(2π r_k f t), |n| ≤ 1, at frequencies r_k f in irrational ratios so
 # the sway never repeats; component c sways at t + c·WIND_PHASE/f (a golden-ratio fraction of
 # the slowest period), so no two neighbours' sines keep in step (offsets .62, .38, .39 turns).
@@ -126,7 +131,7 @@ class EffectSettings:
     )
     ao_strength: float = param(1.0, lo=0.0, hi=4.0, help="ambient_occlusion: darkening scale")
     texture_scale: float = param(
-        0.5, lo=0.0, lo_open=True, hi=1e6, help="textures: size of one noise cell, scene units"
+        0.5, lo=SHORTEST, hi=1e6, help="textures: size of one noise cell, scene units"
     )
     texture_strength: float = param(
         0.5, lo=0.0, hi=1.0, help="textures: 0 = plain albedo, 1 = full contrast"
@@ -155,8 +160,7 @@ class EffectSettings:
     )
     wind_height: float = param(
         5.0,
-        lo=0.0,
-        lo_open=True,
+        lo=SHORTEST,
         hi=1e6,
         unit="scene units",
         help="wind: the height above the foot that leans by wind_strength",
@@ -169,7 +173,8 @@ class EffectSettings:
         lo=0.0,
         hi=10.0,
         unit="Hz",
-        help="wind: of the slowest of the gusts' three sways (0: a steady lean)",
+        help=f"wind: of the slowest of the gusts' three sways (0: a steady lean; else at "
+        f"least {SLOWEST_GUST:g})",
     )
     wind_base: Vec3 = param(
         (0.0, 0.0, 0.0),
@@ -199,6 +204,12 @@ class EffectSettings:
                 f"{path}.empty_zones",
                 f"<{len(self.empty_zones)} zones>",
                 f"allowed: at most {MAX_EMPTY_ZONES}",
+            )
+        if 0.0 < self.wind_frequency < SLOWEST_GUST:
+            raise SceneError(
+                f"{path}.wind_frequency",
+                self.wind_frequency,
+                f"allowed: 0 (a steady lean) or value ≥ {SLOWEST_GUST:g} Hz",
             )
         if math.hypot(self.wind_direction[0], self.wind_direction[2]) < MIN_HORIZONTAL:
             raise SceneError(
