@@ -304,9 +304,8 @@ def distance(scene: Scene | str | Path, points: Any) -> np.ndarray:
     scene's coordinate limit, ±1e9) to the surface the scene draws at its time, in float64
     by the NumPy reference [KRS17 Alg. 1]: a lower bound of the true distance (equal to it
     where no mirror clips a kernel), negative inside a kernel; the shape of ``points`` less
-    its last axis. A MöKRS has no distance
-    function [KRS17 §6] and is refused. (A ray's hit from the eye: :func:`render`'s
-    ``depth``.)
+    its last axis. A MöKRS has no distance function [KRS17 §6] and is refused. (A ray's hit
+    from the eye: :func:`render`'s ``depth``.)
 
     >>> float(distance("rock", [0.0, 100.0, 0.0])) > 90
     True
