@@ -331,11 +331,20 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
         # far beyond the scene's own limit the distance overflowed to NaN or ∞ [review]
         (lambda: krsview.distance("tree-wind", [1e155, 1, 0]), "within ±1e+09"),
         (lambda: krsview.load(""), "name_or_path = '': expected"),
+        # a lone surrogate validated, then failed the save with a UnicodeEncodeError; a
+        # newline or an escape in a name split or coloured the lines it is printed in
+        (lambda: krsview.load("rock").edit("description", "\ud800"), "or lone surrogates"),
+        (lambda: krsview.load("rock").edit("name", "a\nb"), "one line of text, without"),
+        (lambda: krsview.load("rock").edit("name", "\x1b[31mred"), "without control"),
     ]
     for call, said in refusals:
         with pytest.raises(krsview.SceneError) as e:
             call()
         assert said in one_line(e)
+    named = krsview.load("rock").edit("description", "tabs\tand é ✓ 木")  # control: kept
+    assert (
+        krsview.load(krsview.save(named, tmp_path / "named.toml")).description == named.description
+    )
     sway = krsview.load("tree-sway")
     assert sway.at(np.float32(0.6)).time == 0.6  # the decimal it shows
     error = pickle.loads(pickle.dumps(krsview.SceneError("a", 1, "b", "f.toml")))

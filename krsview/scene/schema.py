@@ -11,6 +11,7 @@ import functools
 import math
 import types
 import typing
+import unicodedata
 from dataclasses import MISSING, field, fields, is_dataclass
 from typing import Any, ClassVar
 
@@ -183,6 +184,13 @@ def check_value(hint: Any, x: Any, path: str, meta: dict) -> Any:
             raise SceneError(path, x, "expected a string" + one_of)
         if meta.get("choices") and x not in meta["choices"]:
             raise SceneError(path, x, "allowed: " + ", ".join(map(repr, meta["choices"])))
+        if any(unicodedata.category(c) in ("Cc", "Cs") and c != "\t" for c in x):
+            raise SceneError(  # a newline or an escape split or coloured the lines it is in
+                path,
+                x,
+                "allowed: one line of text, without control characters (newlines, escapes) "
+                "or lone surrogates (no UTF-8 file can hold one)",
+            )
         return x
     if origin is tuple:  # Vec3
         return _check_vec3(x, path, meta)
