@@ -116,9 +116,20 @@ def test_chunks_and_an_interrupted_run_give_the_same_files(path_file, tmp_path, 
         frame_file(chunks, k).name for k in (0, 1, 3, 4)
     ]  # whole files
     assert job.missing(range(5)) == [2]
+    # a frame cut short or overwritten since (by a full disk, by hand) is not "already
+    # there": it was counted so, and the video step then refused a frame of 0×0 [review]
+    f3 = frame_file(chunks, 3)
+    f3.write_bytes(f3.read_bytes()[:-20])
+    frame_file(chunks, 4).write_bytes(b"not a png")
+    assert job.missing(range(5)) == [2, 3, 4]  # control above: the whole ones stay
     render_frames(job, job.missing(range(5)), renderer)
     for k in range(5):
         assert np.array_equal(read(frame_file(whole, k)), read(frame_file(chunks, k))), k
+    junk = tmp_path / "junk"  # a folder of an older run (no frames.json) holding no PNG
+    junk.mkdir()
+    frame_file(junk, 0).write_bytes(b"not a png")
+    with pytest.raises(SceneError, match="holds frame_00000.png, not a PNG image of 64×36"):
+        FrameJob(scene, path, FPS, SIZE, junk).claim()
 
 
 def test_a_resumed_run_skips_the_frames_already_written(path_file, tmp_path):

@@ -120,8 +120,8 @@ class Track:
                 raise SceneError(
                     f"{path}.keys[{j}]",
                     b.to_toml(),
-                    f"every key of a track holds the same kind of value: keys[0] holds "
-                    f"{_kind(first.value)}",
+                    f"every key of a track holds the same kind of value: this one holds "
+                    f"{_kind(b.value)}, keys[0] = {first.to_toml()!r} holds {_kind(first.value)}",
                 )
 
     def value_at(self, t: float, steps: bool, unit: bool) -> Any:

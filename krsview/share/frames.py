@@ -56,8 +56,9 @@ class FrameJob:
         return replace(self.scene, camera=camera).at(self.scene.time + k / self.fps)
 
     def missing(self, frames: range) -> list[int]:
-        """Frames of ``frames`` with no file yet (what a resumed run still renders)."""
-        return [k for k in frames if not frame_file(self.folder, k).exists()]
+        """Frames of ``frames`` without a whole frame file yet (what a resumed run still
+        renders): none, or one cut short or damaged since (krsview writes whole ones)."""
+        return [k for k in frames if not whole_frame(frame_file(self.folder, k), self.size)]
 
     def made_by(self) -> dict:
         """What makes this run's frames (the folder's MANIFEST): the scene, the camera
@@ -95,11 +96,12 @@ class FrameJob:
             for f in self._frames_there():
                 if frame_size(f) != self.size:
                     w, h = frame_size(f)
+                    held = f"{f.name} of {w}×{h}, not" if w else f"{f.name}, not a PNG image of"
                     raise SceneError(
                         what,
                         str(self.folder),
-                        f"holds {f.name} of {w}×{h}, not {self.size[0]}×{self.size[1]}; give "
-                        "another folder, or empty this one",
+                        f"holds {held} {self.size[0]}×{self.size[1]}; give another folder, or "
+                        "empty this one",
                     )
         write_atomic(file, json.dumps(mine, indent=1) + "\n")
 
@@ -108,6 +110,23 @@ class FrameJob:
         can be far larger than what the folder holds)."""
         there = (frame_file(self.folder, k) for k in range(min(self.count, frames_in(self.folder))))
         return [f for f in there if f.exists()]
+
+
+PNG_START = b"\x89PNG\r\n\x1a\n"  # a PNG's signature, and its last chunk (IEND, empty)
+PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"
+
+
+def whole_frame(f: Path, size: tuple[int, int]) -> bool:
+    """Whether ``f`` is a whole PNG of ``size``: its signature, its closing chunk and its
+    header's size, read without decoding (a resumed run of thousands of frames checks each)."""
+    try:
+        with f.open("rb") as file:
+            start = file.read(len(PNG_START))
+            file.seek(-len(PNG_END), os.SEEK_END)
+            end = file.read()
+    except OSError:  # none, or shorter than the closing chunk
+        return False
+    return start == PNG_START and end == PNG_END and frame_size(f) == tuple(size)
 
 
 def frame_size(f: Path) -> tuple[int, int]:
