@@ -52,6 +52,8 @@ def test_reference_render_matches_size(tmp_path):
         # a window needs room for its image and HUD; the control: 64x48 opens (test_playback)
         (["view", "tree", "--size", "10x10"], "--size '10x10': each side must be 48..8192"),
         (["edit", "tree", "--size", "47x200"], "--size '47x200': each side must be 48..8192"),
+        # the latency bench opens the editor's window: its range, said as every --size is
+        (["bench", "latency", "tree", "--size", "8x4"], "--size '8x4': each side must be 48..8192"),
         (
             ["render", "tree", "--epsilon-scale", "nan"],
             "--epsilon-scale = nan: NaN and infinity are "

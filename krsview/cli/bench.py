@@ -16,6 +16,7 @@ from ..inputs import output_file
 from ..scene import MAX_LEVELS
 from ..scene.presets import resolve
 from ..scene.render import VIEW_PREPASS
+from ..scene.settings import ViewerSettings
 from . import options
 from .accuracy import add_accuracy
 from .options import render_option
@@ -283,7 +284,7 @@ def add_latency(bsub) -> None:
         "Example: krsview bench latency grove --size 1280x720",
     )
     options.preset(bl)
-    bl.add_argument("--size", type=options.size, default=(1280, 720), help="default 1280x720")
+    options.field_option(bl, ViewerSettings, "size", default=(1280, 720))  # the window's range
     bl.add_argument(
         "--steps",
         type=options.number_in("--steps", 2, 10000),
