@@ -1,8 +1,11 @@
 """The viewer's clock (issue 29): playing advances the moment shown by wall time × speed round
 the loop; paused, nothing moves."""
 
+import shutil
+
 import pytest
 
+from krsview.scene.presets import resolve
 from krsview.viewer.playback import SPEED_RANGE, Playback
 
 
@@ -210,5 +213,50 @@ def test_playing_past_the_last_key_redraws_nothing_and_the_image_refines(display
             asked += v.frames.dirty
             v.step(0.0)
         assert asked == 5
+    finally:
+        v.close()
+
+
+def test_nan_typed_for_the_time_or_the_speed_is_ignored():
+    """A NaN froze the clock at a time of NaN (the HUD's slider let it through); ∞ is the
+    end of the range, as any value past it."""
+    p = Playback(time=2.0, duration=10.0, speed=1.5)
+    p.seek(float("nan"))
+    p.set_speed(float("nan"))
+    assert (p.time, p.speed) == (2.0, 1.5)
+    p.seek(float("inf"))
+    p.set_speed(float("inf"))
+    assert (p.time, p.speed) == (10.0, SPEED_RANGE[1])  # control: a number past the end
+
+
+def test_a_speed_typed_into_the_hud_is_that_speed_and_stays_in_range(display, tmp_path):
+    """Ctrl+click the HUD's speed slider and type, with real X events: 2 plays ×2 (the typed
+    value was the slider's exponent, ×4), 1e9 is taken to the top of the range (2**1e9
+    overflowed and closed the window, losing an editor's unsaved edits), nan leaves the
+    speed as it was. Control: the speed before typing is 1."""
+    import glfw
+
+    from krsview.viewer.window import Viewer
+
+    from .test_editor import pump, type_at
+
+    path = tmp_path / "tree-sway.toml"
+    shutil.copy(resolve("tree-sway"), path)
+    v = Viewer(path, size=(640, 480), hud=True)
+    try:
+        pump(v, 3)
+        assert v.drawn.playback.speed == 1.0
+        wx, wy = glfw.get_window_pos(v.window)
+
+        def typed(text: str) -> float:
+            x0, y0, x1, y1 = v.interactions.rects[("playback", "speed")]
+            type_at(v, (wx + (x0 + x1) / 2, wy + (y0 + y1) / 2), text)
+            return v.drawn.playback.speed
+
+        assert typed("2") == pytest.approx(2.0)
+        assert typed("1e9") == SPEED_RANGE[1]
+        assert typed("0.5") == pytest.approx(0.5)
+        assert typed("nan") == pytest.approx(0.5)
+        assert not glfw.window_should_close(v.window)
     finally:
         v.close()

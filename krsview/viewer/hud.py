@@ -121,7 +121,7 @@ def begin_hud(
     imgui.begin_child(HUD_BODY, imgui.ImVec2(0, 0), imgui.ChildFlags_.auto_resize_y)
     _controls(v, out)
     if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
-        draw_time(v.drawn.playback, out)
+        draw_time(v.drawn.playback, out, interactions)
     if imgui.collapsing_header("accuracy and view"):
         _accuracy(v, out, interactions)
     if imgui.collapsing_header("measured accuracy"):

@@ -5,6 +5,7 @@ scene posed at that moment. No GL."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 from ..scene import Scene, SceneError
@@ -29,11 +30,15 @@ class Playback:
         return True
 
     def seek(self, t: float) -> None:
-        """Show moment ``t`` (clamped into the loop)."""
-        self.time = min(max(float(t), 0.0), self.duration)
+        """Show moment ``t`` (clamped into the loop; a value typed as NaN is ignored)."""
+        if not math.isnan(t):
+            self.time = min(max(float(t), 0.0), self.duration)
 
     def set_speed(self, speed: float) -> None:
-        self.speed = min(max(float(speed), SPEED_RANGE[0]), SPEED_RANGE[1])
+        """Play at ``speed`` × real time (clamped into SPEED_RANGE; NaN is ignored: it froze
+        the clock at a time of NaN)."""
+        if not math.isnan(speed):
+            self.speed = min(max(float(speed), SPEED_RANGE[0]), SPEED_RANGE[1])
 
 
 class Posing:

@@ -4,28 +4,34 @@ commands."""
 
 from __future__ import annotations
 
-import math
-
 from imgui_bundle import imgui
 
 from . import commands as c
 from .playback import SPEED_RANGE, Playback
+from .widgets import Interactions
 
 
-def draw_time(playback: Playback, out: list[c.Command]) -> None:
+def draw_time(playback: Playback, out: list[c.Command], interactions: Interactions) -> None:
     """Play/pause (Space), time and speed: the section a moving scene shows first."""
     if imgui.button("pause (Space)" if playback.playing else "play (Space)"):
         out.append(c.TogglePlay())
     imgui.same_line()
     imgui.set_next_item_width(-60)
     changed, t = imgui.slider_float(
-        "time##playback", playback.time, 0.0, playback.duration, "%.2f s"
+        "time##playback", playback.time, 0.0, playback.duration, "%.2f s", CLAMPED
     )
+    interactions.place(("playback", "time"))
     if changed:
         out.append(c.SetTime(t))
-    lo, hi = (math.log2(s) for s in SPEED_RANGE)
-    changed, k = imgui.slider_float(
-        "speed##playback", math.log2(playback.speed), lo, hi, f"×{playback.speed:.2f}"
+    # the speed itself on a logarithmic scale: a value typed (Ctrl+click) is the speed; it
+    # was the slider's exponent, so 2 played ×4 and 1024 overflowed 2**k and closed the window
+    changed, speed = imgui.slider_float(
+        "speed##playback", playback.speed, *SPEED_RANGE, "×%.2f", CLAMPED | LOGARITHMIC
     )
+    interactions.place(("playback", "speed"))
     if changed:
-        out.append(c.SetSpeed(2.0**k))
+        out.append(c.SetSpeed(speed))
+
+
+CLAMPED = imgui.SliderFlags_.always_clamp  # a value typed past the ends is taken to the end
+LOGARITHMIC = imgui.SliderFlags_.logarithmic
