@@ -200,6 +200,24 @@ def test_an_error_is_the_status_line_in_red(hud_viewer, monkeypatch):
     assert v.error == "" and v.status_line() == ""
 
 
+def test_a_message_said_at_the_foot_is_not_also_in_the_hud(hud_viewer, monkeypatch):
+    """A bookmark saved (B) was said twice, in the HUD and in the status line [a real-window
+    review]: while the foot says it, the HUD does not; once the foot's line is gone the HUD
+    keeps it (the control)."""
+    v, wrapped = hud_viewer, []
+    text_wrapped = imgui.text_wrapped
+    monkeypatch.setattr(imgui, "text_wrapped", lambda s: (wrapped.append(s), text_wrapped(s))[1])
+    turn(v)
+    v.file.add_bookmark()
+    turn(v)
+    assert v.message.startswith("saved bookmark") and v.status_line() == v.message
+    assert v.message not in wrapped and v.message in v.written
+    v.clock += 10
+    wrapped.clear()
+    turn(v)
+    assert v.status_line() == "" and v.message in wrapped
+
+
 def test_an_error_said_after_a_message_takes_the_status_line_at_once(hud_viewer):
     """ "saved …" held the foot for its seconds while a refusal said after it waited unseen
     [a real-window review]: the newest takes the line. The controls: a message said after

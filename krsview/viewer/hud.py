@@ -80,6 +80,7 @@ class Viewed(Protocol):
     @property
     def measured(self) -> list[dict] | None: ...
     def nearest_distance(self) -> float: ...
+    def status_line(self) -> str: ...
 
 
 def draw_hud(v: Viewed, interactions: Interactions, foot: float = 0.0) -> list[c.Command]:
@@ -128,7 +129,7 @@ def begin_hud(
         _measured(v, out)
     if imgui.collapsing_header("scene, camera, output"):
         _scene(v, out)
-    if v.message:
+    if v.message and v.message != v.status_line():  # said at the foot now: not twice
         imgui.text_wrapped(v.message)
     red_text("\n".join(v.error.splitlines()[1:]))  # the first is the status line (status.py)
     imgui.end_child()
