@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .messages import SceneError, under_a_file
+from .messages import SceneError, name_too_long, under_a_file
 
 
 @dataclass(eq=False)  # arrays: == would be ambiguous; compare the arrays themselves
@@ -55,12 +55,10 @@ class Frame:
         if "\0" in str(path):
             raise SceneError("path", repr(str(path)), "a file name cannot hold a NUL character")
         path = Path(path)
+        if why := name_too_long(path):
+            raise SceneError("path", str(path), why)
         data = self._encoded(path)
-        try:
-            is_dir = path.is_dir()
-        except OSError as e:  # a name too long, say
-            raise SceneError("path", str(path), f"refused by the system: {e.strerror}") from None
-        if is_dir:
+        if path.is_dir():
             raise SceneError("path", str(path), "is a folder; give a file name")
         if why := under_a_file(path.parent):
             raise SceneError("path", str(path), why)

@@ -10,11 +10,12 @@ from __future__ import annotations
 import contextlib
 import math
 import numbers
+import os
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from .messages import under_a_file
+from .messages import name_too_long, under_a_file
 from .scene import Scene, SceneError
 from .scene.edits import checked
 from .scene.presets import resolve
@@ -104,9 +105,13 @@ def output_file(path: Any, what: str, suffixes: Iterable[str]) -> Path:
     if p.suffix.lower() not in allowed:
         names = ", ".join(allowed[:-1]) + " or " * (len(allowed) > 1) + allowed[-1]
         raise SceneError(what, str(path), "the file must end in " + names)
+    if why := name_too_long(p):
+        raise SceneError(what, str(path), why)
     if p.is_dir():
         raise SceneError(what, str(path), "is a folder; give a file name ending in " + allowed[0])
-    _probe(p.parent, f".{p.name}.write-test", what, str(path))
+    # the probe's own short name: one after the file's (".NAME.write-test") refused a file
+    # name within 12 characters of the system's limit as too long
+    _probe(p.parent, f".krsview-{os.getpid()}.write-test", what, str(path))
     return p
 
 

@@ -4,6 +4,7 @@ frame and everything above raise it."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -49,6 +50,26 @@ def under_a_file(folder: Path) -> str:
     exists, is a file ("'x' is a file, not a folder"); "" where it is not."""
     above = next((p for p in (folder, *folder.parents) if p.exists()), None)
     return f"{str(above)!r} is a file, not a folder" if above and not above.is_dir() else ""
+
+
+TEMP_ROOM = 16  # bytes a temporary file's name adds to the name of the file it becomes
+
+
+def name_too_long(path: Path) -> str:
+    """Why ``path``'s file name cannot be written, its temporary file beside it first: longer
+    than the system allows ("a file name of 300 bytes; …"); "" where it fits."""
+    above = next((p for p in path.parents if p.exists()), Path("/"))
+    try:
+        limit = os.pathconf(above, "PC_NAME_MAX")
+    except (OSError, ValueError):  # no such limit said: the common one
+        limit = 255
+    size = len(os.fsencode(path.name))
+    if size + TEMP_ROOM <= limit:
+        return ""
+    return (
+        f"a file name of {size} bytes; allowed: at most {limit - TEMP_ROOM} (the system's "
+        f"{limit}, less room for the temporary file written first)"
+    )
 
 
 # The "paths" of mistakes in a file as a whole (unreadable, too large, not UTF-8 or not TOML),

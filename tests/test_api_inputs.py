@@ -222,11 +222,14 @@ def test_files_are_checked_before_any_work(tmp_path):
         with pytest.raises(krsview.SceneError) as e:
             frame.save(tmp_path / f"x{suffix}")
         assert said in one_line(e) and "allowed: .png, .npz" in one_line(e), suffix
+    with pytest.raises(krsview.SceneError, match="a file name of 304 bytes; allowed: at most"):
+        frame.save(tmp_path / ("a" * 300 + ".png"))  # its temporary file's name, too
     with pytest.raises(krsview.SceneError, match="cannot hold a NUL"):
         frame.save(str(tmp_path / "x\0.png"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file", "frames"], "nothing written"
     png = frame.save(tmp_path / "x.png")  # control
     assert frame.save(tmp_path / "x.tif").exists()  # control: another format, in colour
+    assert frame.save(tmp_path / ("b" * 230 + ".png")).exists()  # control: a long name fits
     # a folder, a place under a file, a place that cannot be written: one line, as the
     # API's other writers say (these were raw OSErrors), and no file left half written
     (tmp_path / "d.png").mkdir()
