@@ -48,8 +48,13 @@ def _is_real(x: Any) -> bool:
 def under_a_file(folder: Path) -> str:
     """Why nothing can be written in ``folder`` when it, or the nearest of its parents that
     exists, is a file ("'x' is a file, not a folder"); "" where it is not."""
-    above = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    above = nearest_existing(folder)
     return f"{str(above)!r} is a file, not a folder" if above and not above.is_dir() else ""
+
+
+def nearest_existing(folder: Path) -> Path | None:
+    """``folder``, or the nearest of its parents that exists; None where none does."""
+    return next((p for p in (folder, *folder.parents) if p.exists()), None)
 
 
 TEMP_ROOM = 16  # bytes a temporary file's name adds to the name of the file it becomes
@@ -58,7 +63,7 @@ TEMP_ROOM = 16  # bytes a temporary file's name adds to the name of the file it 
 def name_too_long(path: Path) -> str:
     """Why ``path``'s file name cannot be written, its temporary file beside it first: longer
     than the system allows ("a file name of 300 bytes; …"); "" where it fits."""
-    above = next((p for p in path.parents if p.exists()), Path("/"))
+    above = nearest_existing(path.parent) or Path("/")
     try:
         limit = os.pathconf(above, "PC_NAME_MAX")
     except (OSError, ValueError):  # no such limit said: the common one

@@ -335,9 +335,8 @@ def test_the_finest_texture_and_the_slowest_gust_allowed_draw_as_the_reference(r
     from krsview.scene.effects import SHORTEST, SLOWEST_GUST
 
     rock, wind = load_scene(resolve("rock")), load_scene(resolve("tree-wind"))
-    cases = {"texture_scale": (rock, 0.0), "wind_frequency": (wind, 2.5)}
-    for field, (scene, t) in cases.items():
-        floor = SHORTEST if field == "texture_scale" else SLOWEST_GUST
+    cases = {"texture_scale": (rock, 0.0, SHORTEST), "wind_frequency": (wind, 2.5, SLOWEST_GUST)}
+    for field, (scene, t, floor) in cases.items():
         with pytest.raises(SceneError, match=rf"effect_settings\.{field} = 1e-39: allowed"):
             scene.edit(f"effect_settings.{field}", 1e-39)
         for value, agrees in ((floor, True), (1e-39, False)):

@@ -25,7 +25,7 @@ from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .timeline import draw_time
-from .widgets import Interactions, field_widget, red_text, tooltip
+from .widgets import LOG_CLAMPED, Interactions, field_widget, red_text, tooltip
 
 HUD_TITLE = "krsview (F1 hides)"
 HUD_BODY = "##hud body"  # the part under the numbers: it scrolls, they stay
@@ -248,8 +248,9 @@ def _iteration_legend(v: Viewed, out: list) -> None:
     its legend: the ramp with 0, N/2 and N under it, as `krsview render --view iterations`
     draws below its image."""
     cap = v.scene.render.max_iterations
-    flags = imgui.SliderFlags_.logarithmic | imgui.SliderFlags_.always_clamp
-    changed, n = imgui.slider_int("white at (iterations)", v.iteration_scale, 1, cap, flags=flags)
+    changed, n = imgui.slider_int(
+        "white at (iterations)", v.iteration_scale, 1, cap, flags=LOG_CLAMPED
+    )
     if changed:
         out.append(c.SetIterationScale(n))
     draw, x0 = imgui.get_window_draw_list(), imgui.get_cursor_screen_pos()

@@ -8,7 +8,7 @@ from imgui_bundle import imgui
 
 from . import commands as c
 from .playback import SPEED_RANGE, Playback
-from .widgets import Interactions
+from .widgets import CLAMPED, LOG_CLAMPED, Interactions
 
 
 def draw_time(playback: Playback, out: list[c.Command], interactions: Interactions) -> None:
@@ -20,18 +20,13 @@ def draw_time(playback: Playback, out: list[c.Command], interactions: Interactio
     changed, t = imgui.slider_float(
         "time##playback", playback.time, 0.0, playback.duration, "%.2f s", CLAMPED
     )
-    interactions.place(("playback", "time"))
     if changed:
         out.append(c.SetTime(t))
     # the speed itself on a logarithmic scale: a value typed (Ctrl+click) is the speed; it
     # was the slider's exponent, so 2 played ×4 and 1024 overflowed 2**k and closed the window
     changed, speed = imgui.slider_float(
-        "speed##playback", playback.speed, *SPEED_RANGE, "×%.2f", CLAMPED | LOGARITHMIC
+        "speed##playback", playback.speed, *SPEED_RANGE, "×%.2f", LOG_CLAMPED
     )
     interactions.place(("playback", "speed"))
     if changed:
         out.append(c.SetSpeed(speed))
-
-
-CLAMPED = imgui.SliderFlags_.always_clamp  # a value typed past the ends is taken to the end
-LOGARITHMIC = imgui.SliderFlags_.logarithmic

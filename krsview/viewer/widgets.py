@@ -18,6 +18,8 @@ from imgui_bundle import imgui
 
 from ..scene.schema import describe_range
 
+CLAMPED = imgui.SliderFlags_.always_clamp  # a value typed past a slider's ends is taken there
+LOG_CLAMPED = imgui.SliderFlags_.logarithmic | CLAMPED
 LOG_RATIO = 100.0  # a range spanning more than this factor gets a logarithmic slider
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 RED_FRAME = imgui.ImVec4(0.55, 0.08, 0.06, 1.0)
