@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from .files import write_atomic
 from .frame import Frame
 from .inputs import output_file, scene_of, size_of, switch, whole
 from .scene import Render, Scene, SceneError, save_scene
@@ -35,7 +36,7 @@ from .scene.filetext import saved_text
 from .scene.info import SceneInfo, describe
 from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
-from .scene.scene import scene_from_toml, write_atomic
+from .scene.scene import scene_from_toml
 from .scene.schema import COORDINATE_LIMIT, from_dict
 from .scene.settings import MAX_SIDE
 from .scene.speed import exact_settings, fast_settings, fast_tile

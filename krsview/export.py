@@ -12,14 +12,13 @@ True
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
 from pathlib import Path
 
+from .files import write_atomic
 from .inputs import output_dir, output_file, real, region, scene_of, size_of, switch, whole
 from .scene import Scene, SceneError
 from .scene.camera_path import CameraPath, load_camera_path
-from .scene.scene import write_atomic
 from .share.frames import (
     DEFAULT_FPS,
     FrameJob,
@@ -75,12 +74,7 @@ def mesh(
     lod = real(lod, "lod", 0.0, 4.0)
     box = None if box is None else region(box, "box")
     m, stats = build_mesh(scene, resolution, box, lod, progress)
-    tmp = out.with_name(f".{out.name}.tmp{out.suffix}")
-    try:
-        m.export(tmp)
-        os.replace(tmp, out)
-    finally:
-        tmp.unlink(missing_ok=True)
+    write_atomic(out, m.export(file_type=out.suffix[1:].lower()))
     return stats
 
 

@@ -3,14 +3,13 @@
 
 from __future__ import annotations
 
-import contextlib
 import io
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .files import write_atomic
 from .messages import SceneError, name_too_long, under_a_file
 
 
@@ -45,7 +44,8 @@ class Frame:
     def save(self, path: str | Path) -> Path:
         """Write the colour (``.png``, or any format Pillow writes by the suffix) or every
         array (``.npz``), whole or not at all (the file's bytes are made in memory first, then
-        written to a temporary file beside it and renamed); returns the path. A suffix
+        written to a temporary file beside it and renamed; a link stays a link, and the file
+        it points to is written); returns the path. A suffix
         neither writes (Pillow reads some formats it cannot write, or not in colour), a
         folder, a name the system refuses, or a place under a file is refused in one line
         (SceneError, a ValueError) before anything is written; a write that fails (a disk
@@ -62,16 +62,11 @@ class Frame:
             raise SceneError("path", str(path), "is a folder; give a file name")
         if why := under_a_file(path.parent):
             raise SceneError("path", str(path), why)
-        tmp = path.with_name(f".{path.name}.tmp")
         try:
             path.parent.mkdir(parents=True, exist_ok=True)  # as krsview.save and export do
-            tmp.write_bytes(data)
-            os.replace(tmp, path)
+            write_atomic(path, data)
         except OSError as e:  # a disk full, a place not writable: said of the file asked for
             raise OSError(e.errno, e.strerror, str(path)) from None
-        finally:
-            with contextlib.suppress(OSError):  # under a file, say: nothing was made
-                tmp.unlink(missing_ok=True)
         return path
 
     def _encoded(self, path: Path) -> bytes:

@@ -230,6 +230,12 @@ def test_files_are_checked_before_any_work(tmp_path):
     png = frame.save(tmp_path / "x.png")  # control
     assert frame.save(tmp_path / "x.tif").exists()  # control: another format, in colour
     assert frame.save(tmp_path / ("b" * 230 + ".png")).exists()  # control: a long name fits
+    # a link stays a link, and the file it names gets the image (the save replaced the link)
+    (tmp_path / "frames" / "linked.png").write_bytes(b"old")
+    (tmp_path / "link.png").symlink_to(tmp_path / "frames" / "linked.png")
+    frame.save(tmp_path / "link.png")
+    assert (tmp_path / "link.png").is_symlink()
+    assert (tmp_path / "frames" / "linked.png").read_bytes() == png.read_bytes()
     # a folder, a place under a file, a place that cannot be written: one line, as the
     # API's other writers say (these were raw OSErrors), and no file left half written
     (tmp_path / "d.png").mkdir()
@@ -257,6 +263,16 @@ def test_save_writes_what_load_reads(tmp_path):
     edited = krsview.load("bent-tree").edit("route.levels[2].fork", (0.1, 2.0, 0.3))
     assert krsview.load(krsview.save(edited, tmp_path / "b.toml")) == edited
     assert krsview.load(out) != edited  # control
+
+
+def test_none_is_what_a_file_leaving_the_field_out_gets():
+    """``edit(path, None)`` gives the field its default, as a file without it reads."""
+    s = krsview.load("tree-sway")
+    assert s.name != "untitled" and s.animation is not None  # control: what changes
+    assert s.edit("name", None).name == "untitled" == krsview.Scene().name
+    assert s.edit("animation", None).animation is None
+    with pytest.raises(krsview.SceneError, match="exactly one geometry"):
+        s.edit("tree", None)  # a table the scene needs: refused, not emptied
 
 
 def test_distance_is_the_kernels_at_points():

@@ -149,7 +149,7 @@ def test_batch_on_the_command_line(tmp_path, path_file):
     assert (tmp_path / "f" / "frames.json").read_text() == (rendered / "frames.json").read_text()
     # control: --exact draws other frames, so its run refuses the folder of the fast ones
     r = krsview_cli(*args, "--exact")
-    assert r.returncode == 2 and "holds frames of another run (its scene differs)" in r.stderr
+    assert r.returncode == 2 and "frames drawn with other render settings (lod: 0.5" in r.stderr
 
 
 def test_a_local_cluster_takes_a_worker_per_cpu_and_no_more_than_its_chunks(tmp_path, path_file):

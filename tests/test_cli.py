@@ -11,6 +11,7 @@ import pytest
 from PIL import Image
 
 import krsview
+from krsview import files
 from krsview.cli import main
 
 from .conftest import krsview_cli
@@ -161,7 +162,7 @@ def test_ctrl_c_a_full_disk_and_a_closed_pipe_end_in_one_line(tmp_path, monkeypa
     def full(*args, **kw):
         raise OSError(28, "No space left on device", str(tmp_path / "b.png"))
 
-    monkeypatch.setattr(Path, "write_bytes", full)  # the encoded image meets a full disk
+    monkeypatch.setattr(files.os, "fsync", full)  # the encoded image meets a full disk
     capsys.readouterr()
     assert (
         main(["render", "rock", "--size", "16x9", "--repeats", "1", "-o", str(tmp_path / "b.png")])

@@ -156,7 +156,12 @@ def test_a_folder_of_another_runs_frames_is_refused(path_file, tmp_path):
     r = krsview_cli(*other)
     assert r.returncode == 2 and "holds frames of another run (its size differs)" in r.stderr
     r = krsview_cli("render", "rock", *base, "--size", f"{SIZE[0]}x{SIZE[1]}")
-    assert r.returncode == 2 and "(its scene differs)" in r.stderr
+    assert r.returncode == 2 and "(its scene and render differ)" in r.stderr
+    # this run, resumed with --exact: said as such, naming the settings apart ("its scene
+    # differs" read as if the folder held another scene)
+    r = krsview_cli(*other[:-1], f"{SIZE[0]}x{SIZE[1]}", "--exact")
+    assert r.returncode == 2 and "this run's frames drawn with other render settings" in r.stderr
+    assert "lod: 0.5 there, 0.0 here;" in r.stderr and "--exact or not" in r.stderr
     (out / "frames.json").unlink()  # frames an older krsview wrote
     r = krsview_cli(*other)
     assert r.returncode == 2 and "holds frame_00000.png of 64×36, not 48×28" in r.stderr
@@ -238,6 +243,16 @@ def test_bad_camera_path_options_are_one_line_errors(path_file, tmp_path, args, 
             "poses[0].roll = 1: unknown key; a pose has t, position, yaw, pitch",
         ),
         ('{"poses": [{"t": 0, "position": [0, 2e9, 0], "yaw": 0, "pitch": 0}]}', "±1e+09"),
+        # JSON keeps the last of a key given twice; which one the author meant is a guess
+        (
+            '{"poses": [{"t": 0, "position": [0, 0, 0], "yaw": 0, "yaw": 1, "pitch": 0}]}',
+            "key 'yaw' given twice in one object",
+        ),
+        ('[{"t": 0, "position": [0, 0, 0], "yaw": 0, "pitch": 0}]', "a JSON array: an object"),
+        ('{"poses": [1]}', "poses[0] = 1: an object with t, position, yaw, pitch"),
+        # float() alone took true as 1 and "1.5" as 1.5
+        ('{"poses": [{"t": true, "position": [0, 0, 0], "yaw": 0, "pitch": 0}]}', "True is not"),
+        ('{"poses": [{"t": 0, "position": [0, 0, "1.5"], "yaw": 0, "pitch": 0}]}', "'1.5' is not"),
     ],
 )
 def test_a_damaged_path_file_names_the_file_and_the_pose(tmp_path, text, message):
@@ -338,5 +353,5 @@ def test_the_apis_frames_are_the_command_lines(path_file, tmp_path, exact):
     krsview.export.frames("tree", path_file, api, SIZE, FPS, "0-1", exact=exact)
     for k in (0, 1):
         assert np.array_equal(read(frame_file(api, k)), cli[k]), k
-    with pytest.raises(SceneError, match="holds frames of another run"):  # control
+    with pytest.raises(SceneError, match="frames drawn with other render settings"):  # control
         krsview.export.frames("tree", path_file, out, SIZE, FPS, exact=not exact)

@@ -134,9 +134,11 @@ def run(*args: str) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize("suffix", [".glb", ".ply", ".stl", ".obj"])
 def test_each_format_loads_back_with_the_same_triangles(tmp_path, suffix):
-    out = tmp_path / f"tree{suffix}"
-    r = run("tree", "-o", str(out), "--resolution", "32")  # bark and leaves
+    out, link = tmp_path / f"tree{suffix}", tmp_path / f"link{suffix}"
+    link.symlink_to(out)  # the save replaced a link by a file; now it writes what it names
+    r = run("tree", "-o", str(link), "--resolution", "32")  # bark and leaves
     assert r.returncode == 0, r.stderr
+    assert link.is_symlink() and out.is_file()
     triangles = int(r.stdout.split(" triangles")[0].split()[-1].replace(",", ""))
     mesh = trimesh.load(out, force="mesh")
     assert len(mesh.faces) == triangles and mesh.is_watertight

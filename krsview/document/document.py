@@ -18,13 +18,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from ..files import write_atomic
 from ..messages import under_a_file
 from ..scene import Bookmark, Camera, Scene, SceneError, load_scene, scene_to_toml
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
 from ..scene.filetext import saved_text
 from ..scene.presets import PRESET_DIR
-from ..scene.scene import write_atomic
 from .bookmarks import with_bookmark, without_bookmark
 from .history import History, Step
 

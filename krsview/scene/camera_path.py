@@ -84,11 +84,41 @@ class CameraPath:
         return Camera(pose.position, tuple(float(c) for c in target), base.up, base.fov_y)
 
 
+class _DuplicateKey(ValueError):
+    def __init__(self, key: str):
+        super().__init__(key)
+        self.key = key
+
+
+def _refuse_duplicates(pairs: list[tuple[str, object]]) -> dict:
+    """A JSON object whose key appears twice (JSON keeps the last silently; TOML refuses)."""
+    out: dict = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
+
+
+def _number(v: object) -> float:
+    """A JSON number; ``float`` alone would take true as 1 and "1.5" as 1.5."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise TypeError(f"{v!r} is not a number")
+    return float(v)
+
+
 def load_camera_path(path: str | Path) -> CameraPath:
     """Read a path file; a damaged one is a SceneError naming the file, the pose and field."""
     f = Path(path)
     try:
-        data = json.loads(f.read_text(encoding="utf-8"))
+        data = json.loads(f.read_text(encoding="utf-8"), object_pairs_hook=_refuse_duplicates)
+    except _DuplicateKey as e:
+        raise SceneError(
+            "<file>",
+            f"key {e.key!r} given twice in one object",
+            "each key at most once (which one counts would be a guess)",
+            str(f),
+        ) from None
     except OSError as e:
         raise SceneError("<file>", str(f), f"cannot read: {e.strerror}", str(f)) from None
     except json.JSONDecodeError as e:
@@ -105,12 +135,17 @@ def load_camera_path(path: str | Path) -> CameraPath:
             "not UTF-8 text",
             str(f),
         ) from None
-    poses = data.get("poses") if isinstance(data, dict) else None
+    if not isinstance(data, dict):
+        kind = {list: "a JSON array", str: "a JSON string"}.get(type(data), "a single value")
+        raise SceneError("<file>", kind, f"an object; expected {FORMAT}", str(f))
+    poses = data.get("poses")
     if not isinstance(poses, list) or not poses:
         raise SceneError("poses", poses, f"a non-empty list; expected {FORMAT}", str(f))
     out = []
     for i, p in enumerate(poses):
-        unknown = sorted(set(p) - set(POSE_KEYS)) if isinstance(p, dict) else []
+        if not isinstance(p, dict):
+            raise SceneError(f"poses[{i}]", p, f"an object with {', '.join(POSE_KEYS)}", str(f))
+        unknown = sorted(set(p) - set(POSE_KEYS))
         if unknown:
             raise SceneError(
                 f"poses[{i}].{unknown[0]}",
@@ -120,16 +155,17 @@ def load_camera_path(path: str | Path) -> CameraPath:
             )
         try:
             pose = Pose(
-                float(p["t"]),
-                tuple(float(c) for c in p["position"]),
-                float(p["yaw"]),
-                float(p["pitch"]),
+                _number(p["t"]),
+                tuple(_number(c) for c in p["position"]),
+                _number(p["yaw"]),
+                _number(p["pitch"]),
             )
         except (KeyError, TypeError, ValueError) as e:
+            why = f"{e} is missing" if isinstance(e, KeyError) else str(e)
             raise SceneError(
                 f"poses[{i}]",
                 p,
-                f"needs t, position [x, y, z], yaw and pitch as numbers ({e!r})",
+                f"needs t, position [x, y, z], yaw and pitch as numbers ({why})",
                 str(f),
             ) from None
         values = (pose.t, *pose.position, pose.yaw, pose.pitch)

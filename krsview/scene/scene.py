@@ -3,15 +3,13 @@ and the effect set; loaded from and saved to TOML."""
 
 from __future__ import annotations
 
-import contextlib
 import numbers
 import os
-import stat
-import tempfile
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..files import write_atomic
 from ..messages import SceneError
 from .animation import (
     DEFAULT_DURATION,
@@ -223,9 +221,11 @@ class Scene:
         reads files (a SceneError names the field and what is allowed; this scene is left as
         it is). ``path``: ``"render.tracer"``, ``"route.levels[3].fork"`` or a tuple. A table
         given whole (``edit("camera", {...})``) replaces it: the fields it leaves out take
-        their defaults, so set one field by its own path (``"camera.position"``). Scenes
-        share their unchanged parts: change one by ``edit``, not in place (a list changed in
-        place changes every scene holding it).
+        their defaults, so set one field by its own path (``"camera.position"``). ``None``
+        is what a file that leaves the field out gets: its default (``edit("name", None)``
+        names the scene "untitled"), and an optional table goes (``edit("animation",
+        None)``: the scene stands still). Scenes share their unchanged parts: change one by
+        ``edit``, not in place (a list changed in place changes every scene holding it).
 
         >>> from krsview import load
         >>> load("tree").edit("render.epsilon_scale", 0.5).render.epsilon_scale
@@ -328,43 +328,3 @@ def scene_to_toml(scene: Scene) -> str:
 def save_scene(scene: Scene, path: str | os.PathLike) -> None:
     """Atomic save, so an edit is never lost half-written."""
     write_atomic(path, scene_to_toml(scene))
-
-
-def write_atomic(path: str | os.PathLike, data: str | bytes) -> None:
-    """Write a temporary file beside the target, then rename it over the target: text as
-    UTF-8, bytes as they are. The file keeps its mode (and owner, where permitted; a new one
-    gets what the umask gives, not mkstemp's 600), a link stays a link, and the folder is
-    synced so that the rename survives a crash."""
-    p = Path(os.path.realpath(path))
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    try:
-        _take_mode(fd, p)
-        with os.fdopen(fd, "wb") as f:
-            f.write(data.encode("utf-8") if isinstance(data, str) else data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, p)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    folder = os.open(p.parent, os.O_RDONLY | os.O_DIRECTORY)
-    try:
-        os.fsync(folder)
-    finally:
-        os.close(folder)
-
-
-def _take_mode(fd: int, target: Path) -> None:
-    """Give the temporary file ``fd`` the target's mode and owner (a new file: 666 − umask)."""
-    try:
-        st = target.stat()
-    except FileNotFoundError:
-        umask = os.umask(0o022)
-        os.umask(umask)
-        os.fchmod(fd, 0o666 & ~umask)
-        return
-    os.fchmod(fd, stat.S_IMODE(st.st_mode))
-    if (st.st_uid, st.st_gid) != (os.getuid(), os.getgid()):
-        # only root may give a file away; the contents are saved all the same
-        with contextlib.suppress(PermissionError):
-            os.fchown(fd, st.st_uid, st.st_gid)

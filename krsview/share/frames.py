@@ -16,12 +16,24 @@ from pathlib import Path
 
 from PIL import Image
 
-from ..scene import Scene, SceneError
+from ..files import write_atomic
+from ..scene import Render, Scene, SceneError
 from ..scene.camera_path import CameraPath, camera_path_json
-from ..scene.scene import scene_to_toml, write_atomic
+from ..scene.scene import scene_to_toml
+from ..scene.schema import to_dict
 
 DEFAULT_FPS = 30.0
 MANIFEST = "frames.json"  # in the frames' folder: what made them (FrameJob.claim)
+
+
+def settings_apart(theirs: object, mine: dict) -> str:
+    """The render settings two runs differ in, as "lod: 0.5 there, 0.0 here; prepass: …",
+    the first three of them."""
+    theirs = theirs if isinstance(theirs, dict) else {}
+    keys = [k for k in {**theirs, **mine} if theirs.get(k) != mine.get(k)]
+    said = [f"{k}: {theirs.get(k, 'unset')} there, {mine.get(k, 'unset')} here" for k in keys]
+    more = f"; and {len(said) - 3} more" if len(said) > 3 else ""
+    return "; ".join(said[:3]) + more
 
 
 def frame_file(folder: Path, k: int) -> Path:
@@ -64,8 +76,10 @@ class FrameJob:
         """What makes this run's frames (the folder's MANIFEST): the scene, the camera
         path (digests of their files' text), the frame rate and the size."""
         poses = camera_path_json(list(self.path.poses))
+        drawn = scene_to_toml(replace(self.scene, render=Render()))
         return {
-            "scene": hashlib.sha256(scene_to_toml(self.scene).encode()).hexdigest()[:16],
+            "scene": hashlib.sha256(drawn.encode()).hexdigest()[:16],
+            "render": to_dict(self.scene.render),  # itself: a run says which setting differs
             "camera_path": hashlib.sha256(poses.encode()).hexdigest()[:16],
             "fps": self.fps,
             "size": list(self.size),
@@ -84,11 +98,21 @@ class FrameJob:
             except (OSError, ValueError):
                 theirs = {}
             differ = [k for k in mine if not isinstance(theirs, dict) or theirs.get(k) != mine[k]]
-            if differ and self._frames_there():
+            if differ == ["render"] and self._frames_there():
                 raise SceneError(
                     what,
                     str(self.folder),
-                    f"holds frames of another run (its {' and '.join(differ)} "
+                    "holds this run's frames drawn with other render settings "
+                    f"({settings_apart(theirs['render'], mine['render'])}); resume it with the "
+                    "options it was started with (--exact or not), give another folder, or "
+                    "empty this one",
+                )
+            if differ and self._frames_there():
+                names = [n.replace("_", " ") for n in differ]
+                raise SceneError(
+                    what,
+                    str(self.folder),
+                    f"holds frames of another run (its {' and '.join(names)} "
                     f"{'differ' if len(differ) > 1 else 'differs'}); give "
                     "another folder, or empty this one",
                 )
@@ -221,6 +245,7 @@ def write_video(
             raise SceneError(
                 "folder", str(folder), f"frame_{k:05d}.png is {a}×{b}, frame 0 of the video {w}×{h}"
             )
+    video = Path(os.path.realpath(video))  # a link stays a link: the file it names is written
     tmp = video.with_name(f".{video.name}.tmp{video.suffix}")
     writer = imageio_ffmpeg.write_frames(
         str(tmp),

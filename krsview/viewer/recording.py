@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 
 from ..document.document import copy_target, shipped
+from ..files import write_atomic
 from ..scene import SceneError
 from ..scene.camera_path import CameraPath, Pose, camera_path_json, load_camera_path
 from ..scene.presets import PRESET_DIR
-from ..scene.scene import write_atomic
 from .camera import FlyCamera
 
 # The command that renders a recorded path, its spaces unbreakable: the HUD wraps the message

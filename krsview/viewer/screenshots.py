@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from ..files import write_atomic
 from ..scene.presets import PRESET_DIR
-from ..scene.scene import write_atomic
 
 
 def pictures_folder() -> Path:
