@@ -260,3 +260,45 @@ def test_a_speed_typed_into_the_hud_is_that_speed_and_stays_in_range(display, tm
         assert not glfw.window_should_close(v.window)
     finally:
         v.close()
+
+
+def test_numbers_typed_into_the_huds_whole_number_fields_are_taken_or_refused(display, tmp_path):
+    """Real X events into the HUD's 'accuracy and view' section. The levels slider: -1 closed
+    the window (an IndexError cutting the tree); now it is taken at the slider's end, 1. The
+    iteration cap (a whole-number field): 2.5 was read as 2 and 1e30 as 1, without a word;
+    now both stay red in the field with the schema's reason, and the cap is unchanged.
+    Control: a whole number typed is taken."""
+    import glfw
+
+    from krsview.viewer.window import Viewer
+
+    from .test_editor import pump, type_at, xdo
+
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    v = Viewer(path, size=(640, 720), hud=True)
+    try:
+        pump(v, 3)
+        wx, wy = glfw.get_window_pos(v.window)
+
+        def centre(key):
+            x0, y0, x1, y1 = v.interactions.rects[key]
+            return wx + (x0 + x1) / 2, wy + (y0 + y1) / 2
+
+        xdo("mousemove", *map(round, centre(("hud", "accuracy and view"))))
+        pump(v, 2)
+        xdo("click", 1)
+        pump(v, 3)
+        type_at(v, centre(("view", "levels")), "--", "-1")
+        assert not glfw.window_should_close(v.window) and v.drawn.levels == 1
+        cap = v.scene.render.max_iterations
+        for text, said in (("2.5", "expected a whole number"), ("1e30", "allowed: 1 ≤ value")):
+            type_at(v, centre(("render", "max_iterations")), text)
+            assert v.scene.render.max_iterations == cap, text
+            refused = v.interactions.refused[("render", "max_iterations")]
+            assert said in refused.message, refused.message
+        type_at(v, centre(("render", "max_iterations")), "300")  # control
+        assert v.scene.render.max_iterations == 300, v.interactions.refused
+        assert ("render", "max_iterations") not in v.interactions.refused
+    finally:
+        v.close()

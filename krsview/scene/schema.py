@@ -122,14 +122,14 @@ def _check_number(x: Any, path: str, meta: dict, kind: type) -> float | int:
     x = _plain(x)
     if isinstance(x, bool) or not isinstance(x, (int, float)):
         raise SceneError(path, x, f"expected a number ({kind.__name__})")
-    if kind is int and not isinstance(x, int):
-        raise SceneError(path, x, "expected a whole number")
     if not math.isfinite(x):
         raise SceneError(path, x, "NaN and infinity are not allowed; " + describe_range(meta, kind))
     lo, hi = _bounds(meta, kind)
     below = lo is not None and (x <= lo if meta.get("lo_open") else x < lo)
-    if below or (hi is not None and x > hi):
+    if below or (hi is not None and x > hi):  # first: 1e30 for a count is out of range
         raise SceneError(path, x, describe_range(meta, kind))
+    if kind is int and not isinstance(x, int):
+        raise SceneError(path, x, "expected a whole number")
     return kind(x)
 
 

@@ -108,8 +108,9 @@ class Drawn:
         self._time_moved()
 
     def set_levels(self, levels: int) -> None:
-        """Draw only the coarsest ``levels`` levels (0 or all: the whole scene)."""
-        self.levels = 0 if levels >= self.geometry.depth else levels
+        """Draw only the coarsest ``levels`` levels (0 or all: the whole scene; below 1, the
+        coarsest: a negative count typed into the HUD closed the window)."""
+        self.levels = 0 if levels == 0 or levels >= self.geometry.depth else max(1, levels)
         self._cut()
 
     def _draw(self, geometry: Geometry) -> None:

@@ -25,7 +25,7 @@ from .frames import Frames
 from .measured import apply_row, best_within, matches
 from .navigation import Navigation
 from .timeline import draw_time
-from .widgets import LOG_CLAMPED, Interactions, field_widget, red_text, tooltip
+from .widgets import CLAMPED, LOG_CLAMPED, Interactions, field_widget, red_text, tooltip
 
 HUD_TITLE = "krsview (F1 hides)"
 HUD_BODY = "##hud body"  # the part under the numbers: it scrolls, they stay
@@ -123,7 +123,9 @@ def begin_hud(
     _controls(v, out)
     if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
         draw_time(v.drawn.playback, out, interactions)
-    if imgui.collapsing_header("accuracy and view"):
+    opened = imgui.collapsing_header("accuracy and view")
+    interactions.place(("hud", "accuracy and view"))
+    if opened:
         _accuracy(v, out, interactions)
     if imgui.collapsing_header("measured accuracy"):
         _measured(v, out)
@@ -226,7 +228,8 @@ def _accuracy(v: Viewed, out: list, interactions: Interactions) -> None:
     if changed:
         out.append(c.SetPrepass(tile, key))
     total = v.drawn.geometry.depth
-    changed, levels = imgui.slider_int("levels", v.drawn.levels or total, 1, total)
+    changed, levels = imgui.slider_int("levels", v.drawn.levels or total, 1, total, flags=CLAMPED)
+    interactions.place(("view", "levels"))
     if changed:
         out.append(c.SetLevels(levels))
     changed, k = imgui.combo("view", VIEW_MODES.index(v.view), list(VIEW_MODES))

@@ -18,6 +18,7 @@ from imgui_bundle import imgui
 
 from ..scene.schema import describe_range
 
+WHOLE_LIMIT = 2**24  # the whole numbers an int field (a float32 widget) holds exactly
 CLAMPED = imgui.SliderFlags_.always_clamp  # a value typed past a slider's ends is taken there
 LOG_CLAMPED = imgui.SliderFlags_.logarithmic | CLAMPED
 LOG_RATIO = 100.0  # a range spanning more than this factor gets a logarithmic slider
@@ -170,12 +171,14 @@ def field_widget(
         return changed, new
     # no tooltip: it would cover the refusal's message under the field (Interactions.key)
     imgui.push_style_color(imgui.Col_.frame_bg, RED_FRAME)
-    changed, new = _widget(label, refused.value, meta)
+    changed, new = _widget(label, refused.value, meta, type(value))  # the field's own kind
     imgui.pop_style_color()
     return changed, new
 
 
-def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
+def _widget(label: str, value: Any, meta: dict, kind: type | None = None) -> tuple[bool, Any]:
+    """The widget of a value of ``kind`` (by default the value's own: a refused 2.5 shown in
+    a whole-number field is still typed into a whole-number field)."""
     lo, hi = meta.get("lo"), meta.get("hi")
     if isinstance(value, bool):
         changed, value = imgui.checkbox(label, value)
@@ -183,8 +186,14 @@ def _widget(label: str, value: Any, meta: dict) -> tuple[bool, Any]:
         choices = list(meta["choices"])
         changed, k = imgui.combo(label, choices.index(value), choices)
         value = choices[k]
-    elif isinstance(value, int):
-        changed, value = imgui.drag_int(label, value, 0.2, int(lo or 0), int(hi or 0))
+    elif (kind or type(value)) is int:
+        # a float field showing whole numbers: ImGui's int field read a typed 1e30 as 1 and
+        # 2.5 as 2 without a word; typed, they come back as typed and the schema refuses
+        # them (float32 holds every whole number up to 2^24 exactly)
+        changed, new = imgui.drag_float(
+            label, float(value), 0.2, float(lo or 0), float(hi or 0), "%.0f"
+        )
+        value = int(new) if float(new).is_integer() and abs(new) <= WHOLE_LIMIT else float(new)
     elif (
         isinstance(value, float)
         and lo is not None
