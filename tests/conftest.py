@@ -160,6 +160,13 @@ def fold_ties(scene, ref: Frame, ulps: float = 4.0) -> np.ndarray:
     return ties.reshape(h, w) & ref.hit
 
 
+@pytest.fixture
+def unfolded_hud(monkeypatch):
+    """The viewer's HUD opens unfolded in any window (one narrower than two HUD widths opens
+    it folded, hud.FOLDED_BELOW): for tests that read or type into it in a small window."""
+    monkeypatch.setattr("krsview.viewer.hud.FOLDED_BELOW", 0.0)
+
+
 @pytest.fixture(scope="session")
 def display():
     """An X display: the session's own, or an Xvfb started for the window tests."""

@@ -16,7 +16,7 @@ SIZE = (640, 360)  # the HUD is 440 px wide
 
 
 @pytest.fixture
-def flying(display, tmp_path, monkeypatch):
+def flying(display, tmp_path, monkeypatch, unfolded_hud):
     """A viewer with its HUD on, recording per turn: the image handed to the display pass,
     the image on screen as the HUD's numbers and its other part read it, and the passes
     issued by then."""

@@ -229,6 +229,7 @@ def test_nan_typed_for_the_time_or_the_speed_is_ignored():
     assert (p.time, p.speed) == (10.0, SPEED_RANGE[1])  # control: a number past the end
 
 
+@pytest.mark.usefixtures("unfolded_hud")
 def test_a_speed_typed_into_the_hud_is_that_speed_and_stays_in_range(display, tmp_path):
     """Ctrl+click the HUD's speed slider and type, with real X events: 2 plays ×2 (the typed
     value was the slider's exponent, ×4), 1e9 is taken to the top of the range (2**1e9
@@ -262,7 +263,10 @@ def test_a_speed_typed_into_the_hud_is_that_speed_and_stays_in_range(display, tm
         v.close()
 
 
-def test_numbers_typed_into_the_huds_whole_number_fields_are_taken_or_refused(display, tmp_path):
+@pytest.mark.usefixtures("unfolded_hud")
+def test_numbers_typed_into_the_huds_whole_number_fields_are_taken_or_refused(
+    display, tmp_path, monkeypatch
+):
     """Real X events into the HUD's 'accuracy and view' section. The levels slider: -1 closed
     the window (an IndexError cutting the tree); now it is taken at the slider's end, 1. The
     iteration cap (a whole-number field): 2.5 was read as 2 and 1e30 as 1, without a word;
@@ -272,8 +276,9 @@ def test_numbers_typed_into_the_huds_whole_number_fields_are_taken_or_refused(di
 
     from krsview.viewer.window import Viewer
 
-    from .test_editor import pump, type_at, xdo
+    from .test_editor import open_from_start, pump, type_at
 
+    open_from_start(monkeypatch, "accuracy and view")
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(640, 720), hud=True)
@@ -285,10 +290,6 @@ def test_numbers_typed_into_the_huds_whole_number_fields_are_taken_or_refused(di
             x0, y0, x1, y1 = v.interactions.rects[key]
             return wx + (x0 + x1) / 2, wy + (y0 + y1) / 2
 
-        xdo("mousemove", *map(round, centre(("hud", "accuracy and view"))))
-        pump(v, 2)
-        xdo("click", 1)
-        pump(v, 3)
         type_at(v, centre(("view", "levels")), "--", "-1")
         assert not glfw.window_should_close(v.window) and v.drawn.levels == 1
         cap = v.scene.render.max_iterations

@@ -169,10 +169,12 @@ def test_zero_radius_and_fork_on_fork_are_clear_errors():
     with pytest.raises(
         SceneError,
         match=r"route\.levels\[0\]\.fork .*must differ from "
-        r"levels\[1\]\.fork",
+        r"route\.levels\[1\]\.fork",  # the whole path, as the field's own
     ):
         apply_edit(scene, ("route", "levels", 0, "fork"), [0.0, 1.0, 0.0])
-    with pytest.raises(SceneError, match=r"route\.levels\[1\]\.fork .*must differ from base"):
+    with pytest.raises(
+        SceneError, match=r"route\.levels\[1\]\.fork .*must differ from route\.base"
+    ):
         apply_edit(scene, ("route", "levels", 1, "fork"), [0.0, 0.0, 0.0])
 
 

@@ -24,7 +24,7 @@ RGB = np.arange(4 * 6 * 3, dtype=np.uint8).reshape(4, 6, 3)
 
 
 @pytest.fixture
-def hud_viewer(display, tmp_path, monkeypatch):
+def hud_viewer(display, tmp_path, monkeypatch, unfolded_hud):
     """A viewer with its HUD on; every line the HUD writes is kept in ``v.written``."""
     from krsview.viewer.window import Viewer
 
@@ -233,6 +233,7 @@ def test_an_error_said_after_a_message_takes_the_status_line_at_once(hud_viewer)
     assert v.status_line() == "screenshot: x.png"
 
 
+@pytest.mark.usefixtures("unfolded_hud")
 def test_a_hud_reaching_the_foot_ends_above_the_status_line(display, tmp_path, monkeypatch):
     """A HUD tall enough to reach the window's foot ends above a status line too long for
     one line beside it (its knobs scroll in less height): neither covers the other. The
@@ -590,6 +591,7 @@ def test_undo_and_redo_say_what_they_undid_in_place_of_what_was_said_of_it(hud_v
     assert not v.redo() and v.message == "kept"
 
 
+@pytest.mark.usefixtures("unfolded_hud")
 def test_the_huds_path_knob_shows_the_path_drawn_where_the_file_sets_none(
     display, tmp_path, monkeypatch
 ):
@@ -622,3 +624,26 @@ def test_the_huds_path_knob_shows_the_path_drawn_where_the_file_sets_none(
         assert shown["path##render"] == "compute"
     finally:
         v.close()
+
+
+def test_a_narrow_window_opens_with_the_hud_folded(display, tmp_path):
+    """At 640×400 the unfolded HUD (440 px wide) covered the trunk and most of the crown of
+    the preset's view; a window narrower than two HUD widths opens it folded to its title
+    bar (a click unfolds it). Control: a window 960 wide opens it unfolded, as before."""
+    from krsview.viewer.status import drawn_rect
+    from krsview.viewer.window import Viewer
+
+    path = tmp_path / "tree.toml"
+    shutil.copy(resolve("tree"), path)
+    heights = {}
+    for size in ((640, 400), (960, 400)):
+        v = Viewer(path, size=size, hud=True)
+        try:
+            for _ in range(3):
+                v.step(0.05)
+            x0, y0, x1, y1 = drawn_rect(HUD_TITLE)
+            heights[size[0]] = (y1 - y0) / imgui.get_frame_height()  # in lines
+        finally:
+            v.close()
+    assert heights[640] < 1.5, heights  # its title bar
+    assert heights[960] > 8, heights

@@ -161,7 +161,7 @@ def route_handles(route: Route, at: Path) -> list[Handle]:
                     "normal",
                     fork + length * np.array(lv.normal),
                     i,
-                    f"mirror normal R{i - 1}",
+                    f"mirror normal R{i - 1} at P{i}",  # levels[i].normal, as errors say
                     lev,
                     pivot=fork,
                 )

@@ -104,7 +104,7 @@ class Route:
         size = max(float(np.ptp(forks, axis=0).max()), 1.0)
         for i, (start, lv) in enumerate(zip(self.starts(), self.levels)):
             if np.linalg.norm(np.subtract(lv.fork, start)) <= FORK_SEPARATION * size:
-                below = "base" if i == len(self.levels) - 1 else f"levels[{i + 1}].fork"
+                below = f"{path}.base" if i == len(self.levels) - 1 else f"{p}[{i + 1}].fork"
                 raise SceneError(
                     f"{p}[{i}].fork",
                     list(lv.fork),

@@ -31,6 +31,7 @@ HUD_TITLE = "krsview (F1 hides)"
 HUD_BODY = "##hud body"  # the part under the numbers: it scrolls, they stay
 HUD_WIDTH = 440  # pixels; it is as tall as its content, up to the window's height
 HUD_AT = 8  # pixels from the window's top left corner, where the HUD first opens
+FOLDED_BELOW = 2.0  # a window narrower than this many HUD widths opens with the HUD folded
 HUD_RIGHT = HUD_AT + HUD_WIDTH  # its right edge there
 PLOT_HEIGHT = 130  # the frame-time plot, tall enough for readable axis labels
 PLOTTED = 120  # moving frames in the plot
@@ -102,6 +103,8 @@ def begin_hud(
     interactions.inline.clear()  # the fields drawn this frame show their own errors
     imgui.set_next_window_pos(imgui.ImVec2(HUD_AT, HUD_AT), imgui.Cond_.first_use_ever)
     display = imgui.get_io().display_size
+    if display.x < FOLDED_BELOW * HUD_WIDTH:  # unfolded, it would hide most of the view
+        imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
     tallest, widest = display.y - 2 * HUD_AT - foot, display.x - 2 * HUD_AT
     width = max(min(HUD_WIDTH, widest), 160)  # a small window: as wide as it (it scrolls)
     imgui.set_next_window_size_constraints(
@@ -123,9 +126,7 @@ def begin_hud(
     _controls(v, out)
     if v.scene.animated and imgui.collapsing_header("time", imgui.TreeNodeFlags_.default_open):
         draw_time(v.drawn.playback, out, interactions)
-    opened = imgui.collapsing_header("accuracy and view")
-    interactions.place(("hud", "accuracy and view"))
-    if opened:
+    if imgui.collapsing_header("accuracy and view"):
         _accuracy(v, out, interactions)
     if imgui.collapsing_header("measured accuracy"):
         _measured(v, out)
