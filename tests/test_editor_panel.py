@@ -187,6 +187,7 @@ def test_a_value_the_viewers_hud_refuses_stays_in_its_field_with_its_message(
     from krsview.viewer.window import Viewer
 
     open_from_start(monkeypatch, "accuracy and view")
+    monkeypatch.setattr("krsview.viewer.hud.FOLDED_BELOW", 0.0)  # unfolded at 640 wide
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(640, 720))
@@ -253,6 +254,7 @@ def hud_open(monkeypatch, tmp_path, section="accuracy and view"):
     from krsview.viewer.window import Viewer
 
     open_from_start(monkeypatch, section)
+    monkeypatch.setattr("krsview.viewer.hud.FOLDED_BELOW", 0.0)  # unfolded at 640 wide
     path = tmp_path / "tree.toml"
     shutil.copy(resolve("tree"), path)
     v = Viewer(path, size=(640, 720))

@@ -169,3 +169,24 @@ def test_in_a_window_k_and_a_drag_key_a_fork_that_then_plays_and_is_saved(displa
         assert len(e.doc.history.steps) == 3, "K, the drag and the typing: one step each"
     finally:
         e.close()
+
+
+def test_a_keyed_value_out_of_range_is_refused_at_its_field(display, tmp_path):
+    """tree-growing keys tree.levels. Typing 0 there keys it at the moment shown; the key is
+    refused, and the refusal was said of `animation.tracks[0].keys[0]`, at the panel's foot,
+    while the field snapped back. Now it is said of the field typed in, and kept there (red,
+    with the field's range). Control: a value in range is keyed, and nothing stays red."""
+    from .test_editor import editor_on_a_copy
+
+    for e in editor_on_a_copy(tmp_path, "tree-growing", (640, 400)):
+        v, field = e.viewer, ("tree", "levels")
+        for _ in range(3):  # the panel drawn, its growth section open: the field shown
+            e.step(0.02)
+        before = e.scene.animation
+        assert not e.edit(field, 0)
+        assert e.scene.animation == before
+        refused = v.interactions.refused[field]
+        assert refused.value == 0
+        assert refused.message.startswith("tree.levels = 0: allowed: 1 ≤ value ≤ 63")
+        assert e.edit(field, 12)  # control
+        assert e.scene.animation != before and field not in v.interactions.refused

@@ -155,6 +155,7 @@ class Editor:
         describes the scene once it changed: it goes."""
         v, t = self.viewer, self.viewer.drawn.playback.time
         changed = path_text(field[0] if field is not None else path)
+        typed = field if field is not None else (path, value)
         path, value = keyed_edit(self.scene, path, value, t)
         keyed = path == ("animation",) and not changed.startswith("animation")
         label = label or (f"key {changed} at {t:.2f} s" if keyed else f"set {changed}")
@@ -163,7 +164,7 @@ class Editor:
             if scene.mokrs is not None:
                 check_drawable(scene.mokrs, tuple(v.camera.position), VIEW)
         except SceneError as e:
-            v.error = str(e)
+            v.error = str(e) if not keyed else self._key_refusal(e, *typed)
             if field is not None and e.path != path_text(field[0]):  # named where it was typed
                 v.error = str(SceneError(path_text(field[0]), field[1], str(e)))
         else:
@@ -171,11 +172,22 @@ class Editor:
             v.error = v.message = ""
             v.sync()
         ok = not v.error
-        if field is not None:
-            path, value = field
+        if field is not None or keyed:
+            path, value = typed  # a refusal stays at the field typed in, keyed or not
         if v.interactions.settle(path, value, v.error):
             v.error = ""
         return ok
+
+    def _key_refusal(self, e: SceneError, path: tuple, value: Any) -> str:
+        """A key refused: said of the field typed in where the value itself is out of its
+        range ("tree.levels = 0: allowed: 1 ≤ value ≤ 63"), not of the track's key
+        (``animation.tracks[0].keys[0]``); else the key's own reason."""
+        try:
+            apply_edit(self.scene, path, value)  # the value as the field's rest value
+        except SceneError as own:
+            if own.path == path_text(path):
+                return str(own)
+        return str(e)
 
     def _update_title(self) -> None:
         title = f"krsview edit — {self.doc.title}"
