@@ -14,17 +14,18 @@ PACKAGE = Path(__file__).resolve().parent.parent / "krsview"
 # viewer/editor → gpu → compile → scene → algebra; reference, oracle → compile;
 # bench/share → gpu, reference; the public API (krsview/__init__.py) sits under the CLI, and
 # checks its arguments by inputs → scene, as the benchmarks' functions check theirs.
-BASE = {"algebra", "frame", "progress", "heatmap", "version", "messages"}
+BASE = {"algebra", "frame", "progress", "heatmap", "version", "messages", "files"}
 ALLOWED = {
     "algebra": set(),
     "version": set(),
     "messages": set(),
-    "frame": {"messages"},
+    "files": set(),
+    "frame": {"files", "messages"},
     "progress": set(),
     "heatmap": set(),
-    "scene": {"algebra", "messages"},
+    "scene": {"algebra", "files", "messages"},
     "compile": {"scene", "algebra"},
-    "document": {"scene", "messages"},
+    "document": {"scene", "files", "messages"},
     "reference": {"compile", "scene"} | BASE,
     "gpu": {"compile", "scene"} | BASE,
     "oracle": {"reference", "compile", "scene"} | BASE,

@@ -184,7 +184,8 @@ def test_the_clipped_part_is_the_branch_on_the_mirrors_positive_side(route_scene
     for text in said:
         for name, field in re.findall(r"(R\d+) \((levels\[\d+\]\.normal)\)", text):
             k = int(field[7 : field.index("]")])
-            assert labels[f"mirror normal {name}"] == ("route", "levels", k, "normal"), text
+            label = f"mirror normal {name} at P{k}"
+            assert labels[label] == ("route", "levels", k, "normal"), text
         for name in re.findall(r"fork (P\d+)", text):
             assert labels[f"fork {name}"][-1] == "fork" and labels[f"fork {name}"][2] == int(
                 name[1:]
