@@ -45,11 +45,11 @@ class Frame:
         """Write the colour (``.png``, or any format Pillow writes by the suffix) or every
         array (``.npz``), whole or not at all (the file's bytes are made in memory first, then
         written to a temporary file beside it and renamed; a link stays a link, and the file
-        it points to is written); returns the path. A suffix
-        neither writes (Pillow reads some formats it cannot write, or not in colour), a
-        folder, a name the system refuses, or a place under a file is refused in one line
-        (SceneError, a ValueError) before anything is written; a write that fails (a disk
-        full) is an OSError naming ``path``, and leaves nothing behind."""
+        it points to is written); returns the path. A suffix neither writes (Pillow reads
+        some formats it cannot write, or not in colour), a folder, a name the system refuses,
+        or a place under a file is refused in one line (SceneError, a ValueError) before
+        anything is written; a write that fails (a disk full) is an OSError naming ``path``,
+        and leaves nothing behind."""
         if not isinstance(path, (str, Path)) or str(path) == "":
             raise SceneError("path", path, "expected a file's path")
         if "\0" in str(path):

@@ -103,7 +103,7 @@ class FrameJob:
                     what,
                     str(self.folder),
                     "holds this run's frames drawn with other render settings "
-                    f"({settings_apart(theirs['render'], mine['render'])}); resume it with the "
+                    f"({settings_apart(theirs.get('render'), mine['render'])}); resume it with the "
                     "options it was started with (--exact or not), give another folder, or "
                     "empty this one",
                 )

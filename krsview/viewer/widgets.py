@@ -176,6 +176,11 @@ def field_widget(
     return changed, new
 
 
+def _whole(x: float) -> bool:
+    """A whole number an int field holds exactly (WHOLE_LIMIT)."""
+    return float(x).is_integer() and abs(x) <= WHOLE_LIMIT
+
+
 def _widget(label: str, value: Any, meta: dict, kind: type | None = None) -> tuple[bool, Any]:
     """The widget of a value of ``kind`` (by default the value's own: a refused 2.5 shown in
     a whole-number field is still typed into a whole-number field)."""
@@ -190,10 +195,11 @@ def _widget(label: str, value: Any, meta: dict, kind: type | None = None) -> tup
         # a float field showing whole numbers: ImGui's int field read a typed 1e30 as 1 and
         # 2.5 as 2 without a word; typed, they come back as typed and the schema refuses
         # them (float32 holds every whole number up to 2^24 exactly)
+        shown = "%.0f" if _whole(value) else "%g"  # a refused 2.5 shows as typed, not as 2
         changed, new = imgui.drag_float(
-            label, float(value), 0.2, float(lo or 0), float(hi or 0), "%.0f"
+            label, float(value), 0.2, float(lo or 0), float(hi or 0), shown
         )
-        value = int(new) if float(new).is_integer() and abs(new) <= WHOLE_LIMIT else float(new)
+        value = int(new) if _whole(new) else float(new)
     elif (
         isinstance(value, float)
         and lo is not None
