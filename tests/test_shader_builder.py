@@ -49,6 +49,21 @@ def test_include_cycle_and_missing_file_are_named(shader_copy):
         Source("c.glsl", {}, shader_copy)
 
 
+def test_a_file_edited_is_read_anew_even_at_the_same_size(shader_copy):
+    """Each file is parsed once per version (its mtime and size): a shader reload must not be
+    served the text parsed before the edit."""
+    import os
+
+    f = shader_copy / "one.glsl"
+    f.write_text("float one() { return 111.5; }\n")
+    assert "111.5" in Source("one.glsl", {}, shader_copy).text
+    f.write_text("float one() { return 222.5; }\n")  # the same length
+    st = f.stat()
+    os.utime(f, ns=(st.st_atime_ns, st.st_mtime_ns + 1))
+    again = Source("one.glsl", {}, shader_copy).text
+    assert "222.5" in again and "111.5" not in again
+
+
 def test_source_map_points_every_line_back():
     src = Source("render.frag", DEFINES)
     lines = src.text.splitlines()

@@ -5,6 +5,7 @@ moderngl-window habit, docs/architecture.md)."""
 
 from __future__ import annotations
 
+import functools
 import re
 from importlib import resources
 from pathlib import Path
@@ -32,6 +33,20 @@ _DIRECTIVE = re.compile(
     r"^\s*#\s*(ifdef|ifndef|if|elif|else|endif|define|undef)\b\s*(.*?)\s*(//.*)?$"
 )
 _DEFINED = re.compile(r"defined\s*\(?\s*(\w+)\s*\)?")
+_CONDITIONALS = ("ifdef", "ifndef", "if", "elif", "else", "endif")
+
+
+@functools.lru_cache(maxsize=512)
+def _parsed(path: Path, stamp: tuple[int, int]) -> tuple[tuple[str, str, str | None, str], ...]:
+    """Each line of a shader file as (directive or "", its argument, the file it includes or
+    None, the line), read and matched once per version of the file (``stamp``: its mtime and
+    size, so a shader reload reads an edited file anew): a variant's source is assembled from
+    these without a regular expression per line."""
+    out = []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        d, m = _DIRECTIVE.match(line), _INCLUDE.match(line)
+        out.append((d.group(1) if d else "", d.group(2) if d else "", m and m.group(1), line))
+    return tuple(out)
 
 
 class Source:
@@ -71,33 +86,33 @@ class Source:
         self.included.add(name)
         path = self.shader_dir / name
         try:
-            text = path.read_text(encoding="utf-8")
+            stat = path.stat()
+            parsed = _parsed(path, (stat.st_mtime_ns, stat.st_size))
         except OSError:
             where = f" (included from {stack[-1]})" if stack else ""
             raise ShaderError(f"shader file not found: {name}{where}") from None
         out: list[str] = []
         # One entry per open conditional: [is this branch emitted, was any branch taken].
-        active = [[True, True]]
-        for k, line in enumerate(text.splitlines(), 1):
-            d = _DIRECTIVE.match(line)
-            if d and d.group(1) in ("ifdef", "ifndef", "if", "elif", "else", "endif"):
-                self._conditional(d.group(1), d.group(2), active, name, k)
+        active, emitting = [[True, True]], True
+        for k, (kind, arg, include, line) in enumerate(parsed, 1):
+            if kind in _CONDITIONALS:
+                self._conditional(kind, arg, active, name, k)
+                emitting = all(on for on, _ in active)
                 continue
-            if not all(on for on, _ in active):
+            if not emitting:
                 continue
-            if d and d.group(1) == "define":
-                defined = d.group(2).split("(")[0].split()[0]
+            if kind == "define":
+                defined = arg.split("(")[0].split()[0]
                 if defined in SHARED:
                     raise ShaderError(
                         f"{name}:{k}: #define {defined}: shared with Python, so defined once "
                         "in compile/constants.py and given to every program"
                     )
                 self.defined.add(defined)
-            elif d and d.group(1) == "undef":
-                self.defined.discard(d.group(2))
-            m = _INCLUDE.match(line)
-            if m:
-                out += self._expand(m.group(1), stack + [name])
+            elif kind == "undef":
+                self.defined.discard(arg)
+            if include is not None:
+                out += self._expand(include, stack + [name])
             else:
                 out.append(line)
                 self.origin.append((name, k))
