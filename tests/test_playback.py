@@ -6,7 +6,7 @@ import shutil
 import pytest
 
 from krsview.scene.presets import resolve
-from krsview.viewer.playback import SPEED_RANGE, Playback
+from krsview.viewer.playback import SPEED_RANGE, Playback, Posing
 
 
 def test_playing_advances_by_wall_time_times_speed_round_the_loop():
@@ -32,6 +32,26 @@ def test_speed_stays_in_the_sliders_range():
     assert p.speed == SPEED_RANGE[0]
     p.set_speed(1.5)
     assert p.speed == 1.5
+
+
+def test_a_moment_asked_twice_is_posed_once(monkeypatch):
+    """A turn asks the pose for the geometry and again for the image: the second is the
+    first pose (palm-curl posed every moment twice, 9 ms each); a new moment or a new scene
+    (an edit) poses anew."""
+    import krsview
+    from krsview.scene import scene as scene_module
+
+    scene, posed = krsview.load("palm-curl"), []
+    real = scene_module.pose
+    monkeypatch.setattr(scene_module, "pose", lambda s: posed.append(s.time) or real(s))
+    p = Posing()
+    first = p.pose(scene, 1.5)
+    assert p.pose(scene, 1.5) is first and posed == [1.5]
+    assert p.pose(scene, 1.75) is not first and posed == [1.5, 1.75]  # controls
+    edited = scene.edit("name", "edited")
+    assert p.pose(edited, 1.75).name == "edited" and posed == [1.5, 1.75, 1.75]
+    expected = krsview.load("palm-curl").at(1.5).posed()
+    assert p.pose(scene, 1.5) == expected
 
 
 def press(v, key: str) -> None:

@@ -50,14 +50,22 @@ class Posing:
         self.error = ""
         self._last: Scene | None = None
         self._drawn: Scene | None = None  # the last pose, time aside
+        self._asked: tuple[Scene, float, Scene] | None = None  # the last (scene, t) and its pose
 
     def pose(self, scene: Scene, t: float) -> Scene:
+        """``scene`` posed at ``t``; asked again for the same scene and moment (a turn asks
+        twice: for the geometry and for the image), the pose made then, not posed anew."""
+        asked = self._asked
+        if asked is not None and asked[0] is scene and asked[1] == t:
+            return asked[2]
         try:
             pose = scene.at(t).posed()
         except SceneError as e:
             self.error = str(e)
-            return self._last if self._last is not None else scene.at(0.0).posed()
-        self.error, self._last = "", pose
+            pose = self._last if self._last is not None else scene.at(0.0).posed()
+        else:
+            self.error, self._last = "", pose
+        self._asked = (scene, t, pose)
         return pose
 
     def changed(self, pose: Scene) -> bool:
