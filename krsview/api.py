@@ -32,7 +32,7 @@ from .frame import Frame
 from .inputs import output_file, scene_of, size_of, switch, whole
 from .scene import Render, Scene, SceneError, save_scene
 from .scene.edits import still_checked, vouched
-from .scene.filetext import saved_text
+from .scene.filetext import read_file_text, saved_text
 from .scene.info import SceneInfo, describe
 from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
@@ -80,7 +80,7 @@ def save(scene: Scene, path: str | Path) -> Path:
     scene = scene_of(scene)
     out = output_file(path, "path", (".toml",))
     try:  # over a scene file: only what changed is written into its text, comments kept
-        text = out.read_text(encoding="utf-8")
+        text = read_file_text(out)
         write_atomic(out, saved_text(text, scene_from_toml(text, str(out)), scene))
     except (OSError, UnicodeDecodeError, SceneError):
         save_scene(scene, out)

@@ -658,3 +658,43 @@ def test_the_title_says_which_file_after_a_save_as_into_another_folder(
     assert doc.title.startswith(f"elsewhere/{route_file.name} — ")
     monkeypatch.chdir(other.parent)  # control: from its own folder, the name alone
     assert doc.title.startswith(f"{route_file.name} — ")
+
+
+@pytest.mark.parametrize("mark, ends", [("\ufeff", "\n"), ("", "\r\n"), ("\ufeff", "\r\n")])
+def test_a_file_with_a_byte_order_mark_or_crlf_keeps_them_and_its_comments(tmp_path, mark, ends):
+    """Windows' Notepad starts a file with a byte-order mark; many Windows editors end lines
+    with CRLF. A save over such a file wrote the whole scene anew (a mark: every comment
+    gone, every default spelled out) or turned every line end to LF (CRLF). The document's
+    save, its bookmark and the API's save each keep the mark, the line ends and the
+    comments; the control is the file's own text compared byte for byte."""
+    import krsview
+
+    plain = resolve("grove").read_text()
+    assert plain.count("#") > 3
+    for act in ("document", "bookmark", "api"):
+        path = tmp_path / f"{act}.toml"
+        path.write_bytes((mark + plain.replace("\n", ends)).encode())
+        if act == "document":
+            doc = Document(path)
+            doc.apply(("render", "epsilon_scale"), 2.0)
+            doc.save()
+        elif act == "bookmark":
+            cam = load_scene(path).camera
+            Document(path).add_bookmark(replace(cam, fov_y=50.0))
+        else:
+            krsview.save(krsview.load(path).edit("render.epsilon_scale", 2.0), path)
+        raw = path.read_bytes().decode()
+        body = raw.removeprefix(mark)
+        assert raw.startswith(mark) and body.startswith(plain.splitlines()[0]), act
+        assert body.count("\n") == body.count(ends), f"{act}: mixed line ends"
+        assert body.replace(ends, "\n").count("#") == plain.count("#"), act
+        lines = body.replace(ends, "\n").splitlines()
+        if act == "bookmark":  # appended: the file's text stays as it was above it
+            assert body.replace(ends, "\n").startswith(plain.replace("\nbookmarks = []\n", "\n"))
+        else:  # one line added to [render], not the scene written anew
+            assert len(lines) <= len(plain.splitlines()) + 1, act
+        again = load_scene(path)
+        if act == "bookmark":
+            assert again.bookmarks[-1].camera.fov_y == 50.0
+        else:
+            assert again.render.epsilon_scale == 2.0

@@ -23,7 +23,7 @@ from ..messages import under_a_file
 from ..scene import Bookmark, Camera, Scene, SceneError, load_scene, scene_to_toml
 from ..scene.edits import Path as EditPath
 from ..scene.edits import apply_edit, path_text, validated
-from ..scene.filetext import saved_text
+from ..scene.filetext import read_file_text, saved_text
 from ..scene.presets import PRESET_DIR
 from .bookmarks import with_bookmark, without_bookmark
 from .history import History, Step
@@ -96,7 +96,7 @@ class Document:
         self.path = Path(path)
         self._scene = load_scene(self.path)  # a bad file is a SceneError, nothing opened
         self.saved = self._scene  # the version on disk
-        self.saved_text = self.path.read_text(encoding="utf-8")  # as written, comments too
+        self.saved_text = read_file_text(self.path)  # as written, comments too
         self.stamp = Stamp.of(self.path)
         self.history = History()
         # the caller's own state kept with each step (the editor: its selection), and what
@@ -205,7 +205,7 @@ class Document:
             return
         bookmark = step.after.bookmarks[-1]
         try:
-            on_disk, text = load_scene(self.path), self.path.read_text(encoding="utf-8")
+            on_disk, text = load_scene(self.path), read_file_text(self.path)
             marks = list(on_disk.bookmarks)
             if keep:
                 want = replace(on_disk, bookmarks=[*marks, bookmark])
@@ -235,7 +235,7 @@ class Document:
         if stamp == self.stamp:
             return False
         try:
-            return self.path.read_text(encoding="utf-8") != self.saved_text
+            return read_file_text(self.path) != self.saved_text
         except (OSError, UnicodeDecodeError):
             return True
 
@@ -244,7 +244,7 @@ class Document:
         SceneError for a bad file, keeping the current scene."""
         scene = load_scene(self.path)
         self.commit(scene, f"reload {self.path.name}")
-        self.mark_saved(scene, self.path.read_text(encoding="utf-8"))  # as written
+        self.mark_saved(scene, read_file_text(self.path))  # as written
 
     def save(self, path: str | os.PathLike | None = None, overwrite: bool = False) -> Path:
         """Write the scene atomically (to ``path``: save as). Refuses, with ConflictError, to
@@ -310,7 +310,7 @@ class Document:
         bookmark = Bookmark(name, camera)
         written = replace(on_disk, bookmarks=on_disk.bookmarks + [bookmark])
         try:
-            text = with_bookmark(self.path.read_text(encoding="utf-8"), bookmark, written)
+            text = with_bookmark(read_file_text(self.path), bookmark, written)
             write_atomic(self.path, text)
         except OSError as e:
             raise SceneError("<file>", str(self.path), f"cannot save: {e.strerror}") from None

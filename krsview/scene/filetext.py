@@ -13,6 +13,9 @@ written anew."""
 from __future__ import annotations
 
 import difflib
+import os
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import tomlkit
@@ -22,11 +25,45 @@ from ..messages import SceneError
 from .scene import Scene, scene_from_toml, scene_to_toml
 from .schema import to_dict
 
+BOM = "\ufeff"  # a byte-order mark: Windows' Notepad starts UTF-8 files with one
+
+
+def read_file_text(path: str | os.PathLike) -> str:
+    """A scene file's text as written: a byte-order mark and CRLF line ends kept (Python's
+    text mode turns CRLF into LF), so that a save writes them back (:class:`Style`)."""
+    return Path(path).read_bytes().decode("utf-8")
+
+
+@dataclass(frozen=True)
+class Style:
+    """What a file's text holds besides its TOML: a byte-order mark, CRLF line ends."""
+
+    mark: str = ""
+    crlf: bool = False
+
+    @staticmethod
+    def split(text: str) -> tuple[str, Style]:
+        """``text`` as LF text without a mark, and its style."""
+        mark, body = (BOM, text[1:]) if text.startswith(BOM) else ("", text)
+        crlf = "\r\n" in body
+        return (body.replace("\r\n", "\n") if crlf else body), Style(mark, crlf)
+
+    def apply(self, body: str) -> str:
+        """LF text ``body`` given this style."""
+        return self.mark + (body.replace("\n", "\r\n") if self.crlf else body)
+
 
 def saved_text(text: str, before: Scene, after: Scene) -> str:
-    """The text of a file that held ``before`` as ``text``, changed to hold ``after``."""
+    """The text of a file that held ``before`` as ``text``, changed to hold ``after``, in
+    the file's own style (a save over a file with a byte-order mark wrote the whole scene
+    anew, its comments gone; one with CRLF line ends came back LF throughout)."""
     if after == before:
         return text
+    body, style = Style.split(text)
+    return style.apply(_saved(body, before, after))
+
+
+def _saved(text: str, before: Scene, after: Scene) -> str:
     try:
         document = tomlkit.parse(text)
         _patch(document, to_dict(before), to_dict(after))

@@ -278,8 +278,9 @@ MAX_FILE_BYTES = 4 * 1024 * 1024
 
 
 def scene_from_toml(text: str, file: str = "<string>") -> Scene:
+    """The scene a file's ``text`` holds (a leading byte-order mark is no text)."""
     try:
-        data = tomllib.loads(text)
+        data = tomllib.loads(text.removeprefix("\ufeff"))
     except tomllib.TOMLDecodeError as e:
         what, _, where = str(e).rpartition(" (at ")  # tomllib: "... (at line 2, column 8)"
         where = where.rstrip(")") if what else "the file"
