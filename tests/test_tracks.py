@@ -9,11 +9,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from krsview import load
 from krsview.bench.metrics import gpu_reference_agreement, tolerance_failures
 from krsview.reference import render_reference
 from krsview.scene import SceneError
+from krsview.scene.animation import Key, Track
 from krsview.scene.edits import replace_at, revalidated, validated
 from krsview.scene.scene import scene_from_toml, scene_to_toml
 
@@ -39,11 +42,67 @@ def test_linear_and_smooth_pass_through_the_keys_and_interpolate_between():
         assert radius(lin, t) == pytest.approx(v) and radius(smooth, t) == pytest.approx(v)
     assert radius(lin, 0.0) == radius(lin, 1.0) and radius(lin, 9.0) == pytest.approx(0.2)
     assert radius(lin, 1.5) == pytest.approx(0.2) and radius(lin, 3.0) == pytest.approx(0.25)
-    # smooth: the cubic Hermite with Catmull–Rom tangents, by hand on the middle segment
-    m1, m2, s = (0.2 - 0.1) / 3.0 * 2.0, 0.0, 0.5  # tangents × segment length (2 s)
-    hand = (2 * s**3 - 3 * s**2 + 1) * 0.3 + (s**3 - 2 * s**2 + s) * m1
-    hand += (-2 * s**3 + 3 * s**2) * 0.2 + (s**3 - s**2) * m2
+    # smooth: the cubic Hermite, by hand on the middle segment; the key at 2 s is a peak, so
+    # its slope is 0 (Catmull–Rom's would be (0.2 − 0.1) / 3), the last key's 0 (the end)
+    s = 0.5
+    hand = (2 * s**3 - 3 * s**2 + 1) * 0.3 + (-2 * s**3 + 3 * s**2) * 0.2
     assert radius(smooth, 3.0) == pytest.approx(hand)
+    # on a rise, Catmull–Rom's slope where it is within 3× each segment's slope
+    rise = [[0.0, 0.1], [1.0, 0.2], [3.0, 0.5]]
+    smooth = tracked("tree", [{"path": "tree.trunk_radius", "keys": rise}])
+    m = (0.5 - 0.1) / 3.0 * 2.0  # × the segment's 2 s; 3× the slopes: 0.3 and 0.45 per s
+    hand = (2 * s**3 - 3 * s**2 + 1) * 0.2 + (s**3 - 2 * s**2 + s) * m
+    hand += (-2 * s**3 + 3 * s**2) * 0.5
+    assert radius(smooth, 2.0) == pytest.approx(hand)
+
+
+def catmull_rom(keys: list, t: float) -> float:
+    """The unlimited curve, by hand: cubic Hermite with Catmull–Rom slopes, 0 at the ends."""
+    times, v = [k[0] for k in keys], [k[1] for k in keys]
+    j = max(i for i in range(len(times) - 1) if times[i] <= t)
+    h, s = times[j + 1] - times[j], (t - times[j]) / (times[j + 1] - times[j])
+
+    def m(i):
+        inner = 0 < i < len(times) - 1
+        return (v[i + 1] - v[i - 1]) / (times[i + 1] - times[i - 1]) * h if inner else 0.0
+
+    return (
+        (2 * s**3 - 3 * s**2 + 1) * v[j]
+        + (s**3 - 2 * s**2 + s) * m(j)
+        + (-2 * s**3 + 3 * s**2) * v[j + 1]
+        + (s**3 - s**2) * m(j + 1)
+    )
+
+
+def test_smooth_never_leaves_the_range_of_the_keys_around_it():
+    """Keys 40, 0, 88 of a branch angle (allowed 0..89): Catmull–Rom dips below 0 before
+    the middle key (the control, by hand), so a moment `krsview check` never posed could
+    not be drawn. The limited curve stays within [0, 40] there, and every moment poses."""
+    from krsview import check
+
+    keys = [[0.0, 40.0], [3.75, 0.0], [7.5, 88.0]]
+    ts = np.linspace(0.0, 3.75, 301)
+    assert min(catmull_rom(keys, t) for t in ts) < -1e-3  # the control: it overshoots
+    s = tracked("tree", [{"path": "tree.branch_angle", "keys": keys}])
+    angles = [s.at(t).posed().tree.branch_angle for t in ts]
+    assert min(angles) >= 0.0 and max(angles) <= 40.0
+    assert not check(s).warnings
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.floats(0.0, 1.0), min_size=2, max_size=6),
+    st.lists(st.floats(0.05, 3.0), min_size=5, max_size=5),
+)
+def test_smooth_stays_between_each_pair_of_keys(values, gaps):
+    """Random keys at random spacings: the value between two keys lies between theirs."""
+    times = np.concatenate([[0.0], np.cumsum(gaps[: len(values) - 1])])
+    track = Track("tree.trunk_radius", [Key(float(t), v) for t, v in zip(times, values)])
+    for j in range(len(values) - 1):
+        lo, hi = sorted(values[j : j + 2])
+        for t in np.linspace(times[j], times[j + 1], 17):
+            got = track.value_at(float(t), False, False)
+            assert lo - 1e-12 <= got <= hi + 1e-12, (t, got, lo, hi)
 
 
 def slope(scene, t: float, side: float, h: float = 1e-5) -> float:

@@ -18,7 +18,9 @@ def moments(scene: Any) -> list[float]:
     """The times at which `krsview check` poses a scene with tracks: the loop's ends, every
     key and the middle of every pair of keys (where two keys symmetric about a forbidden
     value, a direction and its opposite, meet it exactly). Numbers between two valid keys
-    stay valid (a field's range is an interval); the sway is checked over a period at load."""
+    stay valid: a field's range is an interval, and a track's value between two keys stays
+    between theirs (linear, or smooth with its limited tangents, ``Track._tangent``), also
+    per component; the sway is checked over a period at load."""
     a = scene.animation
     if a is None or not a.tracks:
         return []
