@@ -332,8 +332,24 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
         # the advice is one that works (it said "e.g. ['none']", itself refused)
         (lambda: krsview.render("rock", SIZE, effects="none"), "list of effect names; none is []"),
         (lambda: krsview.load("rock").with_effects(None), "effects = None: expected a list"),
-        (lambda: krsview.load("rock").edit("krs.levels[0.kernel", 1), "expected names and"),
+        (lambda: krsview.load("rock").edit("krs.levels[0.kernel", 1), "expected field names and"),
         (lambda: krsview.load("rock").edit(None, 1), "path = None: expected a path"),
+        # a tuple path: -1 does not count from the end, True is no index (IndexError, or
+        # silently level 1, before), and an empty path names nothing
+        (
+            lambda: krsview.load("bent-tree").edit(("route", "levels", -24, "fork"), (0, 2, 0)),
+            "path = ('route', 'levels', -24, 'fork'): expected field names and list indices ≥ 0",
+        ),
+        (
+            lambda: krsview.load("bent-tree").edit(("route", "levels", True, "fork"), (0, 2, 0)),
+            "path = ('route', 'levels', True, 'fork'): expected field names",
+        ),
+        (lambda: krsview.load("rock").edit((), 1), "path = (): expected field names"),
+        (lambda: krsview.load("rock").edit("", 1), "path = '': expected field names"),
+        (
+            lambda: krsview.load("bent-tree").edit("route.levels[-1].fork", (0, 2, 0)),
+            "path = 'route.levels[-1].fork': expected field names and list indices ≥ 0",
+        ),
         (lambda: krsview.render("rock", SIZE, progress=3), "progress = 3: expected a function"),
         (
             lambda: krsview.distance("rock", ["a", "b", "c"]),
@@ -360,6 +376,9 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
         with pytest.raises(krsview.SceneError) as e:
             call()
         assert said in one_line(e)
+    bent, fork = krsview.load("bent-tree"), (0.1, 2.0, 0.0)  # a NumPy index is an index
+    by_numpy = bent.edit(("route", "levels", np.int64(3), "fork"), fork)
+    assert by_numpy == bent.edit("route.levels[3].fork", fork) != bent
     named = krsview.load("rock").edit("description", "tabs\tand é ✓ 木")  # control: kept
     assert (
         krsview.load(krsview.save(named, tmp_path / "named.toml")).description == named.description

@@ -344,6 +344,20 @@ def test_a_byte_order_mark_is_read_as_no_text(tmp_path):
         load_scene(f)
 
 
+@pytest.mark.parametrize("depth", [496, 2000])
+def test_arrays_nested_hundreds_deep_are_one_line_not_a_recursion_error(tmp_path, depth):
+    """A 4 kB file of nested brackets overflowed Python's stack, in the TOML reader (2000)
+    or in reading the values (496): `check` printed "maximum recursion depth exceeded"
+    without the file, as an environment error (exit 3)."""
+    f = tmp_path / "deep.toml"
+    f.write_text('name = "x"\n[krs]\nlevels = ' + "[" * depth + "]" * depth + "\n")
+    with pytest.raises(SceneError, match="deep.toml: arrays or tables nested hundreds deep"):
+        load_scene(f)
+    f.write_text('name = "x"\n[krs]\nlevels = ' + "[" * 40 + "]" * 40 + "\n")  # control
+    with pytest.raises(SceneError, match=r"krs\.levels\[0\] = .*expected a table"):
+        load_scene(f)
+
+
 def test_a_long_vector_in_a_message_is_cut_after_whole_numbers():
     """camera.target = [-44.901…, -44.9012806053457…: the noise of the first numbers took the
     line [review]."""

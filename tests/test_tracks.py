@@ -216,7 +216,7 @@ def test_duration_defaults_to_the_last_key_and_a_file_keeps_it_following():
         (
             {"path": "tree..bend", "keys": [[0, 1.0]]},
             r"animation\.tracks\[1\]\.path = 'tree\.\.bend'",
-            "expected names and",
+            "expected field names and list indices",
         ),
         (
             {"path": "animation.time", "keys": [[0, 1.0]]},

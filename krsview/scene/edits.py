@@ -8,6 +8,7 @@ it prints as ``route.levels[3].fork``, the form scene-file errors use.
 
 from __future__ import annotations
 
+import numbers
 import re
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
@@ -98,19 +99,39 @@ def still_checked(before: Any, after: Any) -> Any:
     return after
 
 
+PATH_FORM = (
+    "expected field names and list indices ≥ 0, e.g. 'route.levels[3].fork' or "
+    "('route', 'levels', 3, 'fork')"
+)
+
+
 def parse_path(text: str | Path) -> Path:
-    """``"route.levels[3].fork"`` → ``("route", "levels", 3, "fork")`` (a tuple passes)."""
+    """``"route.levels[3].fork"`` → ``("route", "levels", 3, "fork")``; a tuple is checked
+    (names, and indices ≥ 0: a NumPy integer is taken as one, True is not, and -1 does not
+    count from the end) and passes."""
     if isinstance(text, tuple):
-        return text
+        out = tuple(_part(text, part) for part in text)
+        if not out:
+            raise SceneError("path", text, PATH_FORM)
+        return out
     if not isinstance(text, str):
         raise SceneError("path", text, "expected a path such as 'render.tracer', or a tuple")
     out: list[str | int] = []
     for part in text.split("."):
         if not re.fullmatch(r"[A-Za-z_]\w*(\[\d+\])*", part):
-            raise SceneError(text, "<path>", "expected names and [indices], e.g. render.tracer")
+            raise SceneError("path", text, PATH_FORM)
         name, *indices = part.replace("]", "").split("[")
         out += [name, *(int(i) for i in indices)]
     return tuple(out)
+
+
+def _part(path: tuple, part: Any) -> str | int:
+    """One part of a tuple path: a field name, or a list index ≥ 0."""
+    if isinstance(part, str) and part.isidentifier():
+        return part
+    if isinstance(part, numbers.Integral) and not isinstance(part, bool) and part >= 0:
+        return int(part)
+    raise SceneError("path", path, PATH_FORM)
 
 
 def revalidated(scene: Any, paths: list[Path]) -> Any:
@@ -170,7 +191,7 @@ def _not_there(scene: Any, path: Path) -> str:
         if isinstance(key, int):
             if not isinstance(obj, (list, tuple)):
                 return f"{here} is not a list"
-            if key >= len(obj):
+            if not 0 <= key < len(obj):
                 return f"{here} has {len(obj)} items" + (f" (0..{len(obj) - 1})" if obj else "")
             obj = obj[key]
         elif obj is None:

@@ -277,6 +277,12 @@ def _frozen(data: object) -> object:
 MAX_FILE_BYTES = 4 * 1024 * 1024
 
 
+DEEP, TOO_DEEP = (
+    "arrays or tables nested hundreds deep",
+    "not read (a scene nests a few: a kernel in a level in a table)",
+)
+
+
 def scene_from_toml(text: str, file: str = "<string>") -> Scene:
     """The scene a file's ``text`` holds (a leading byte-order mark is no text)."""
     try:
@@ -285,10 +291,14 @@ def scene_from_toml(text: str, file: str = "<string>") -> Scene:
         what, _, where = str(e).rpartition(" (at ")  # tomllib: "... (at line 2, column 8)"
         where = where.rstrip(")") if what else "the file"
         raise SceneError("<syntax>", where, f"not valid TOML ({what or e})", file) from None
+    except RecursionError:  # tomllib reads nested arrays and tables recursively
+        raise SceneError("<syntax>", DEEP, TOO_DEEP, file) from None
     try:
         return from_dict(Scene, data)
     except SceneError as e:
         raise e.in_file(file) from None
+    except RecursionError:
+        raise SceneError("<syntax>", DEEP, TOO_DEEP, file) from None
 
 
 def load_scene(path: str | os.PathLike) -> Scene:
