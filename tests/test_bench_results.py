@@ -127,6 +127,9 @@ def test_paths_returns_every_lever_at_two_sizes():
     plain = [r for r in m.rows if (r["path"], r["culling"], r["prepass"]) == ("fragment", "off", 0)]
     assert [r["speedup"] for r in plain] == [1.0, 1.0]
     assert all((r["coarse_share"] > 0) == (r["prepass"] > 0) for r in m.rows)
+    # a share above the whole frame is noise of sub-millisecond frames (it read 1007 %)
+    assert paths.share(0.254) == "25%" and paths.share(1.0) == "100%"
+    assert paths.share(10.07) == "— (noise)"
 
 
 def test_accuracy_returns_a_row_per_setting_and_error_images(tmp_path):

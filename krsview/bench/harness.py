@@ -77,13 +77,6 @@ def interleaved(
     return times
 
 
-def fastest_times(
-    r: Renderer, variants: dict[str, Variant], size: tuple[int, int], rounds: int, label: str
-) -> dict[str, float]:
-    """name → its fastest frame, seconds, over ``rounds`` interleaved rounds."""
-    return fastest(round_times(r, variants, size, rounds, label))
-
-
 def fastest(times: dict[str, list[float]]) -> dict[str, float]:
     """name → its fastest round: the time its work takes, least disturbed by load."""
     return {name: min(t) for name, t in times.items()}
