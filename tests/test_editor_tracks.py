@@ -350,3 +350,34 @@ def test_a_growth_field_clicked_puts_its_keys_on_the_strip_where_k_keys_and_drag
         ]
     finally:
         e.close()
+
+
+def test_an_infinity_typed_into_a_keyed_step_is_refused_as_the_fields_own(palm):
+    """palm-curl's curl is keyed in 30 linked levels. An infinity or NaN typed into it was
+    refused as `…degrees = inf: animation.tracks[29].keys[1][1] = inf: a key's value is a
+    number, …`, blaming a key the person never saw for not being a number. It is refused
+    with the field's own rule, at the field, as the same value typed into a field without a
+    track (the control: FACTOR's). A value in range is keyed (the second control)."""
+    from krsview.editor.keys import linked_edits
+    from krsview.scene.edits import path_text
+
+    e, v = palm, palm.viewer
+    settle(e)
+    e.select(next(h for h in e.handles if h.path == CURL))
+    pump(e, 3)
+    scroll_to(e, CURL, 60, 0)  # the fields drawn: a refusal stays at them
+    pump(e, 3)
+    for bad in (float("inf"), float("nan")):
+        before = e.scene
+        for path, value in linked_edits(e.scene, CURL, bad, 1.0):
+            assert not e.edit(path, value, field=(CURL, bad))
+        assert e.scene == before
+        said = v.interactions.refused[CURL].message
+        assert said.startswith(f"{path_text(CURL)} = {bad}: NaN and infinity"), said
+        assert "tracks" not in said
+    e.edit(FACTOR, float("inf"), field=(FACTOR, float("inf")))
+    plain = v.interactions.refused[FACTOR].message
+    assert "NaN and infinity are not allowed" in plain and "tracks" not in plain
+    for path, value in linked_edits(e.scene, CURL, -3.0, 1.0):
+        assert e.edit(path, value, field=(CURL, -3.0))
+    assert CURL not in v.interactions.refused

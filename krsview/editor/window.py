@@ -164,9 +164,10 @@ class Editor:
             if scene.mokrs is not None:
                 check_drawable(scene.mokrs, tuple(v.camera.position), VIEW)
         except SceneError as e:
-            v.error = str(e) if not keyed else self._key_refusal(e, *typed)
-            if field is not None and e.path != path_text(field[0]):  # named where it was typed
-                v.error = str(SceneError(path_text(field[0]), field[1], str(e)))
+            refusal = self._key_refusal(e, *typed) if keyed else e
+            if field is not None and refusal.path != path_text(field[0]):  # where it was typed
+                refusal = SceneError(path_text(field[0]), field[1], str(refusal))
+            v.error = str(refusal)
         else:
             self.doc.commit(scene, label, interaction)
             v.error = v.message = ""
@@ -178,16 +179,17 @@ class Editor:
             v.error = ""
         return ok
 
-    def _key_refusal(self, e: SceneError, path: tuple, value: Any) -> str:
-        """A key refused: said of the field typed in where the value itself is out of its
-        range ("tree.levels = 0: allowed: 1 ≤ value ≤ 63"), not of the track's key
-        (``animation.tracks[0].keys[0]``); else the key's own reason."""
+    def _key_refusal(self, e: SceneError, path: tuple, value: Any) -> SceneError:
+        """A key refused: said of the field typed in where the value itself breaks its
+        rule ("tree.levels = 0: allowed: 1 ≤ value ≤ 63", "… = inf: NaN and infinity are
+        not allowed"), not of the track's key (``animation.tracks[0].keys[0]``, which
+        called an infinity no number); else the key's own reason."""
         try:
             apply_edit(self.scene, path, value)  # the value as the field's rest value
         except SceneError as own:
             if own.path == path_text(path):
-                return str(own)
-        return str(e)
+                return own
+        return e
 
     def _update_title(self) -> None:
         title = f"krsview edit — {self.doc.title}"
