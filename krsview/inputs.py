@@ -32,7 +32,7 @@ def scene_of(x: Any, what: str = "scene") -> Scene:
     if isinstance(x, Scene):
         return checked(x)
     if isinstance(x, (str, Path)) and str(x) != "":
-        return load_scene(resolve(str(x)))
+        return load_scene(resolve(str(x), what))
     hint = "; a dict: krsview.load_dict(d)" if isinstance(x, dict) else ""  # "" too
     raise SceneError(what, x, "expected a Scene, a preset's name or a .toml path" + hint)
 

@@ -46,6 +46,8 @@ def test_bad_input_is_one_line_naming_source_field_and_what_is_allowed():
     assert text.startswith("<dict>: krs.levels[0].kernel.radius = -1") and "\n" not in text
     with pytest.raises(krsview.SceneError, match="'no-such-preset': not a file and not a preset"):
         krsview.load("no-such-preset")
+    with pytest.raises(krsview.SceneError, match=r"^name_or_path = 'trea': .* mean `tree`"):
+        krsview.load("trea")  # the argument's name, not the command line's PRESET
     scene = krsview.load("tree")
     with pytest.raises(krsview.SceneError, match=r"render.tracer = 'fast': allowed: 'sphere'"):
         scene.edit("render.tracer", "fast")

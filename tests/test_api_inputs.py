@@ -471,7 +471,7 @@ def test_a_process_forked_after_drawing_is_told_to_spawn(tmp_path):
         (lambda b: b.bench_levels("sierpinski", (0, 0), rounds=1), "size = (0, 0): expected"),
         (lambda b: b.bench_levels("sierpinski", (16, 9), step=0), "step = 0: allowed"),
         (lambda b: b.bench_split("sierpinski", (16, 9), rounds=0), "rounds = 0: allowed"),
-        (lambda b: b.bench_paths("no-such", (16, 9)), "PRESET = 'no-such': not a file"),
+        (lambda b: b.bench_paths("no-such", (16, 9)), "scene = 'no-such': not a file"),
         (lambda b: b.bench_zoom("tree", (16, 9), stops_count=1), "stops_count = 1: allowed"),
         (lambda b: b.bench_peer("tree", (16, 0)), "size = (16, 0): expected"),
         (lambda b: b.bench_peer_zoom("tree", (16, 9), stops_count=1), "stops_count = 1: allowed"),

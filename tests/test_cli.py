@@ -69,6 +69,9 @@ def test_reference_render_matches_size(tmp_path):
             "--max-iterations = -3: allowed: 1 ≤ value ≤ 10000",
         ),
         (["render", "tree", "--tracer", "bent"], "--tracer = 'bent': allowed: 'sphere', 'binary'"),
+        (["check", "sierpinsky"], "not a file and not a preset; did you mean `sierpinski`?"),
+        (["check", "Tree"], "did you mean `tree` or"),
+        (["check", ""], "PRESET = '': expected a preset's name or a scene file (.toml)"),
         (
             ["render", "no-such-preset"],
             "not a file and not a preset; presets: bent-tree, forest, grass, grove",
