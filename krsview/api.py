@@ -318,14 +318,14 @@ def distance(scene: Scene | str | Path, points: Any) -> np.ndarray:
     scene = scene_of(scene).posed()
     if scene.mokrs is not None:
         raise SceneError("scene", scene.name, "a MöKRS has no distance function [KRS17 §6]")
-    try:  # a complex number, text, a ragged list: refused below
+    try:  # a complex number, text, a ragged list: refused below, as what was given
         if np.iscomplexobj(points):
             raise TypeError
         p = np.asarray(points, dtype=float)
     except (ValueError, TypeError):
-        p = np.full((), np.nan)
-    if p.ndim == 0 or p.shape[-1] != 3 or not (np.abs(p) <= COORDINATE_LIMIT).all():
-        shown = f"<an array of shape {p.shape}>" if p.ndim else p
+        p = None
+    if p is None or p.ndim == 0 or p.shape[-1] != 3 or not (np.abs(p) <= COORDINATE_LIMIT).all():
+        shown = f"<an array of shape {p.shape}>" if p is not None and p.ndim else points
         raise SceneError(
             "points",
             shown,

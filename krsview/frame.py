@@ -57,9 +57,9 @@ class Frame:
         path = Path(path)
         if why := name_too_long(path):
             raise SceneError("path", str(path), why)
-        data = self._encoded(path)
-        if path.is_dir():
+        if path.is_dir():  # first: a folder has no suffix to ask about
             raise SceneError("path", str(path), "is a folder; give a file name")
+        data = self._encoded(path)
         if why := under_a_file(path.parent):
             raise SceneError("path", str(path), why)
         try:

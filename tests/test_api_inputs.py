@@ -239,8 +239,10 @@ def test_files_are_checked_before_any_work(tmp_path):
     # a folder, a place under a file, a place that cannot be written: one line, as the
     # API's other writers say (these were raw OSErrors), and no file left half written
     (tmp_path / "d.png").mkdir()
+    (tmp_path / "saves").mkdir()
     for bad, said in (
         (tmp_path / "d.png", "is a folder; give a file name"),
+        (tmp_path / "saves", "is a folder; give a file name"),  # said 'no suffix' before
         (tmp_path / "a-file" / "x.png", "a-file' is a file, not a folder"),
     ):
         with pytest.raises(krsview.SceneError) as e:
@@ -351,6 +353,7 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
             "path = 'route.levels[-1].fork': expected field names and list indices ≥ 0",
         ),
         (lambda: krsview.render("rock", SIZE, progress=3), "progress = 3: expected a function"),
+        (lambda: krsview.distance("rock", "abc"), "points = 'abc': expected"),  # not nan
         (
             lambda: krsview.distance("rock", ["a", "b", "c"]),
             "expected points of coordinates within ±1e+09",

@@ -1,7 +1,8 @@
 """Benchmarks: variants compared side by side in one run, reported as ratios. From Python
 each is a function of a scene (a :class:`krsview.Scene`, a preset's name or a file), a
 (width, height) and rounds, checked before any work as the API checks its arguments; each
-returns a ``Measured`` (its ``rows``, and ``table()`` the CLI prints):
+returns a ``Measured``: its ``rows`` (a dict per row) and ``column(name)``; the module's
+``table(m)`` is the table the CLI prints:
 
 >>> import krsview
 >>> m = krsview.bench.bench_levels("sierpinski", (48, 27), step=8, rounds=1)  # doctest: +SKIP

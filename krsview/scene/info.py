@@ -40,9 +40,8 @@ class SceneInfo:
         if self.description:
             lines.append(f"  {self.description}")
         if self.geometry == "MöKRS":
-            lines.append(
-                f"  geometry        MöKRS: {self.mirrors} levels, {self.reflecting} reflecting"
-            )
+            levels = counted(self.mirrors, "level")
+            lines.append(f"  geometry        MöKRS: {levels}, {self.reflecting} reflecting")
         elif self.geometry == "compound":
             parts = ", ".join(self.parts)
             lines.append(f"  geometry        compound of {len(self.parts)}: {parts}")
@@ -82,7 +81,7 @@ def describe(scene: Scene, posed: int = 0) -> SceneInfo:
     else:
         kind = "tree (grown)" if scene.tree else "tree (route)" if scene.route else "explicit KRS"
     parts = tuple(
-        f"{'tree' if c.tree else 'route' if c.route else 'KRS'} of {p.depth} levels"
+        f"{'tree' if c.tree else 'route' if c.route else 'KRS'} of {counted(p.depth, 'level')}"
         for c, p in zip(scene.compound, getattr(g, "parts", ()))
     )
     r = scene.render
@@ -117,7 +116,8 @@ def motion(scene: Scene, posed: int = 0) -> str:
         parts.append(f"{len(a.tracks)} keyframe track{'s' * (len(a.tracks) != 1)}")
     if a is not None and a.sway is not None:
         w = a.sway
-        parts.append(f"sway of {w.levels} levels, {w.amplitude:g}° at {w.frequency:g} Hz")
+        levels = counted(w.levels, "level")
+        parts.append(f"sway of {levels}, {w.amplitude:g}° at {w.frequency:g} Hz")
     if not parts:
         return ""
     checked = f", posed at {counted(posed, 'moment')}" if posed else ""
