@@ -125,6 +125,13 @@ def configure(
         if name not in RENDER_KNOBS:
             raise SceneError(name, value, "not a render knob; allowed: " + ", ".join(RENDER_KNOBS))
         scene = scene.edit(("render", name), value)
+    tracer = scene.render.tracer  # a knob the tracer would ignore is refused, as the CLI does
+    if "relaxation" in knobs and tracer != "relaxed":
+        raise SceneError(
+            "relaxation", knobs["relaxation"], f"applies to tracer='relaxed' (this traces {tracer})"
+        )
+    if knobs.get("walk_restart") == "on" and tracer != "sphere":
+        raise SceneError("walk_restart", "on", f"applies to tracer='sphere' (this traces {tracer})")
     if time is not None:
         scene = scene.at(time)
     if effects is not None:

@@ -336,6 +336,10 @@ def test_a_second_round_of_misuse_is_refused_in_one_line(tmp_path):
         (lambda: krsview.load("rock").with_effects(None), "effects = None: expected a list"),
         (lambda: krsview.load("rock").edit("krs.levels[0.kernel", 1), "expected field names and"),
         (lambda: krsview.load("rock").edit(None, 1), "path = None: expected a path"),
+        (  # a knob the tracer ignores, refused as the command line refuses it
+            lambda: krsview.render("rock", SIZE, relaxation=1.5),
+            "relaxation = 1.5: applies to tracer='relaxed' (this traces sphere)",
+        ),
         # a tuple path: -1 does not count from the end, True is no index (IndexError, or
         # silently level 1, before), and an empty path names nothing
         (

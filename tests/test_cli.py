@@ -70,6 +70,10 @@ def test_reference_render_matches_size(tmp_path):
         ),
         (["render", "tree", "--tracer", "bent"], "--tracer = 'bent': allowed: 'sphere', 'binary'"),
         (["check", "sierpinsky"], "not a file and not a preset; did you mean `sierpinski`?"),
+        # options this run would ignore (they were taken and did nothing)
+        (["render", "rock", "--steps", "5"], "--steps = 5: applies to --path compute"),
+        (["render", "rock", "--reference", "--prepass", "4"], "no effect with --reference"),
+        (["render", "rock", "--reference", "--shadow-block", "2"], "no effect with --reference"),
         (["check", "Tree"], "did you mean `tree` or"),
         (["check", ""], "PRESET = '': expected a preset's name or a scene file (.toml)"),
         (

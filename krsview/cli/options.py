@@ -185,6 +185,17 @@ def scene_of(args: argparse.Namespace, name: str | None = None) -> Scene:
     knobs = {k: v for k in api.RENDER_KNOBS if (v := getattr(args, k, None)) is not None}
     if "tracer" in knobs:
         scene.check_tracer(knobs["tracer"], "--tracer")
+    tracer = knobs.get("tracer", scene.render.tracer)  # what configure refuses, said of flags
+    if "relaxation" in knobs and tracer != "relaxed":
+        raise SceneError(
+            "--relaxation",
+            knobs["relaxation"],
+            f"applies to --tracer relaxed (this run traces {tracer})",
+        )
+    if knobs.get("walk_restart") == "on" and tracer != "sphere":
+        raise SceneError(
+            "--walk-restart", "on", f"applies to --tracer sphere (this run traces {tracer})"
+        )
     scene = api.configure(scene, **knobs)
     effects = getattr(args, "effects", None)
     if effects is not None:

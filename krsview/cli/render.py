@@ -191,7 +191,18 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-GPU_ONLY = ("repeats", "path", "steps", "shadow_tasks", "component_tasks", "precision")
+GPU_ONLY = (  # the GPU's settings, which the float64 reference never reads
+    "repeats",
+    "path",
+    "steps",
+    "shadow_tasks",
+    "component_tasks",
+    "precision",
+    "culling",
+    "prepass",
+    "prepass_levels",
+    "shadow_block",
+)
 
 
 def refuse_unused(args: argparse.Namespace, scene: Scene) -> None:
@@ -217,11 +228,10 @@ def refuse_unused(args: argparse.Namespace, scene: Scene) -> None:
     for name in GPU_ONLY if args.reference else ():
         if getattr(args, name) is not None:
             refuse(name, "has no effect with --reference (a setting of the GPU's)")
-    tracer = scene.render.tracer
-    if args.relaxation is not None and tracer != "relaxed":
-        refuse("relaxation", f"applies to --tracer relaxed (this run traces {tracer})")
-    if args.walk_restart == "on" and tracer != "sphere":
-        refuse("walk_restart", f"applies to --tracer sphere (this run traces {tracer})")
+    if scene.render.path != "compute" and not args.reference:
+        for name in ("steps", "shadow_tasks", "component_tasks"):
+            if getattr(args, name) is not None:
+                refuse(name, "applies to --path compute (this run traces by the fragment path)")
 
 
 def settled(args: argparse.Namespace, scene: Scene) -> Scene:
