@@ -77,7 +77,8 @@ def add_mesh(xsub) -> None:
         type=options.number_in("--resolution", 16, 2048),
         default=256,
         metavar="N",
-        help="voxels along the side of the cube sampled, rounded up to 16·2^k (default 256)",
+        help="voxels along the side of the cube sampled, 16..2048, rounded up to 16·2^k "
+        "(default 256)",
     )
     xm.add_argument(
         "--lod",
@@ -86,7 +87,7 @@ def add_mesh(xsub) -> None:
         metavar="VOXELS",
         help="mesh the level set this many voxels out, the "
         "renderer's level of detail: leaves thinner than a voxel thicken instead of "
-        "vanishing (default 0.5; 0: the surface itself)",
+        "vanishing, 0..4 (default 0.5; 0: the surface itself)",
     )
     xm.add_argument(
         "--box",
