@@ -409,3 +409,6 @@ def test_the_page_shows_its_notes_to_the_exporter_not_in_its_caption():
     assert notes and all(n not in caption for n in notes) and "drag to orbit" in caption
     head = page[: page.index("-->")]
     assert all(f"Note: {n}" in head for n in notes)
+    toy = export_notes(scene, shadertoy=True)  # a shader's notes speak of the shader
+    assert toy and all("the page" not in n for n in toy) and "the shader draws" in toy[-1]
+    assert any("the page draws every level" in n for n in notes)  # control

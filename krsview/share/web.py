@@ -62,21 +62,21 @@ def export_notes(scene: Scene, shadertoy: bool = False) -> list[str]:
     """What the page (or, ``shadertoy``, the Shadertoy file) leaves out, one line each; a
     scene that cannot be exported at all is a SceneError naming the field."""
     refuse(scene)
-    r = scene.render
+    r, it = scene.render, "the shader" if shadertoy else "the page"
     notes = []
     if r.path == "compute":
         notes.append(
-            'render.path = "compute": the page traces in one fragment pass '
+            f'render.path = "compute": {it} traces in one fragment pass '
             "(WebGL2 has no compute shaders; the same image)"
         )
     if r.prepass:
         notes.append(
-            f"render.prepass = {r.prepass}: the page traces without the pre-pass "
+            f"render.prepass = {r.prepass}: {it} traces without the pre-pass "
             "(the same surfaces, a slower frame)"
         )
     if r.lod:
         notes.append(
-            f"render.lod = {r.lod:g}: the page draws every level (its orbiting eye moves "
+            f"render.lod = {r.lod:g}: {it} draws every level (its orbiting eye moves "
             "away from the origin the level of detail is measured from)"
         )
     a = scene.animation
