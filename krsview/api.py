@@ -36,6 +36,7 @@ from .scene.filetext import read_file_text, saved_text
 from .scene.info import SceneInfo, describe
 from .scene.motion import check_motion
 from .scene.presets import preset_names, resolve
+from .scene.render import ignored_by_tracer
 from .scene.scene import scene_from_toml
 from .scene.schema import COORDINATE_LIMIT, from_dict
 from .scene.settings import MAX_SIDE
@@ -125,13 +126,10 @@ def configure(
         if name not in RENDER_KNOBS:
             raise SceneError(name, value, "not a render knob; allowed: " + ", ".join(RENDER_KNOBS))
         scene = scene.edit(("render", name), value)
-    tracer = scene.render.tracer  # a knob the tracer would ignore is refused, as the CLI does
-    if "relaxation" in knobs and tracer != "relaxed":
-        raise SceneError(
-            "relaxation", knobs["relaxation"], f"applies to tracer='relaxed' (this traces {tracer})"
-        )
-    if knobs.get("walk_restart") == "on" and tracer != "sphere":
-        raise SceneError("walk_restart", "on", f"applies to tracer='sphere' (this traces {tracer})")
+    if ignored := ignored_by_tracer(knobs, scene.render.tracer):  # refused, as the CLI does
+        name, needs = ignored
+        said = f"applies to tracer={needs!r} (this traces {scene.render.tracer})"
+        raise SceneError(name, knobs[name], said)
     if time is not None:
         scene = scene.at(time)
     if effects is not None:

@@ -16,6 +16,7 @@ from .. import api
 from ..inputs import region
 from ..scene import EFFECTS, MAX_LEVELS, Render, Scene, SceneError
 from ..scene.presets import DEFAULT_PRESET
+from ..scene.render import ignored_by_tracer
 from ..scene.schema import check_value, describe_range
 from ..scene.settings import MAX_SIDE
 
@@ -186,16 +187,10 @@ def scene_of(args: argparse.Namespace, name: str | None = None) -> Scene:
     if "tracer" in knobs:
         scene.check_tracer(knobs["tracer"], "--tracer")
     tracer = knobs.get("tracer", scene.render.tracer)  # what configure refuses, said of flags
-    if "relaxation" in knobs and tracer != "relaxed":
-        raise SceneError(
-            "--relaxation",
-            knobs["relaxation"],
-            f"applies to --tracer relaxed (this run traces {tracer})",
-        )
-    if knobs.get("walk_restart") == "on" and tracer != "sphere":
-        raise SceneError(
-            "--walk-restart", "on", f"applies to --tracer sphere (this run traces {tracer})"
-        )
+    if ignored := ignored_by_tracer(knobs, tracer):
+        name, needs = ignored
+        said = f"applies to --tracer {needs} (this run traces {tracer})"
+        raise SceneError("--" + name.replace("_", "-"), knobs[name], said)
     scene = api.configure(scene, **knobs)
     effects = getattr(args, "effects", None)
     if effects is not None:

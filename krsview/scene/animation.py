@@ -159,7 +159,7 @@ class Track:
         trough, and at most 3× the slope of either segment beside it, which keeps each
         segment's cubic monotone [de Boor and Swartz; Fritsch and Carlson 1980]; zero at
         the first and last key (easing in and out). Unlimited, keys 40, 0, 88 of an angle
-        allowed 0..89 dipped to −0.008 between the last two, a pose that no check foresaw."""
+        allowed 0..89 dipped to −0.008 between the first two, a pose no check foresaw."""
         if i == 0 or i == len(times) - 1:
             return np.zeros_like(v[i])
         before = (v[i] - v[i - 1]) / (times[i] - times[i - 1])

@@ -22,10 +22,8 @@ import tomlkit
 from tomlkit.exceptions import TOMLKitError
 
 from ..messages import SceneError
-from .scene import Scene, scene_from_toml, scene_to_toml
+from .scene import BOM, Scene, scene_from_toml, scene_to_toml
 from .schema import to_dict
-
-BOM = "\ufeff"  # a byte-order mark: Windows' Notepad starts UTF-8 files with one
 
 
 def read_file_text(path: str | os.PathLike) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from ..messages import SceneError
 from .schema import COLOR, Vec3, param
@@ -218,3 +219,13 @@ class Render:
         "starts where the coarser cone around it stopped (1: "
         "one coarse pass)",
     )
+
+
+def ignored_by_tracer(knobs: dict[str, Any], tracer: str) -> tuple[str, str] | None:
+    """The knob of ``knobs`` that ``tracer`` would ignore, and the tracer it needs: the
+    over-relaxation belongs to the relaxed tracer, the walk restart to the sphere tracer."""
+    if "relaxation" in knobs and tracer != "relaxed":
+        return "relaxation", "relaxed"
+    if knobs.get("walk_restart") == "on" and tracer != "sphere":
+        return "walk_restart", "sphere"
+    return None

@@ -283,10 +283,13 @@ DEEP, TOO_DEEP = (
 )
 
 
+BOM = "\ufeff"  # a byte-order mark: Windows' Notepad starts UTF-8 files with one
+
+
 def scene_from_toml(text: str, file: str = "<string>") -> Scene:
     """The scene a file's ``text`` holds (a leading byte-order mark is no text)."""
     try:
-        data = tomllib.loads(text.removeprefix("\ufeff"))
+        data = tomllib.loads(text.removeprefix(BOM))
     except tomllib.TOMLDecodeError as e:
         what, _, where = str(e).rpartition(" (at ")  # tomllib: "... (at line 2, column 8)"
         where = where.rstrip(")") if what else "the file"
